@@ -1,0 +1,60 @@
+#include "cli_support.hpp"
+
+#include <tbb/global_control.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <random>
+
+#include "core/memory.hpp"
+
+namespace angiosynth::cli {
+
+void addCommonOptions(CLI::App& cmd, CommonOptions& o) {
+  cmd.add_option("--threads", o.threads, "worker threads (0 = all cores); outputs do not depend on it")
+      ->check(CLI::Range(0, 1024));
+  cmd.add_option("--memory-limit", o.memory_limit_gib, "refuse maps needing more than this many GiB (default: 75% of RAM)")
+      ->check(CLI::Range(0.0, 1e6));
+  cmd.add_option("--vascusynth-unit", o.vascusynth_unit,
+                 "length unit of VOXEL_WIDTH in VascuSynth parameter files; flows and pressures follow the "
+                 "coherent (length, g, s) system, i.e. CGS for cm")
+      ->check(CLI::IsMember({"um", "mm", "cm", "m"}));
+  cmd.add_flag("--quiet", o.quiet, "no progress output");
+}
+
+std::shared_ptr<void> limitThreads(int threads) {
+  if (threads <= 0) return nullptr;
+  return std::make_shared<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+}
+
+std::uint64_t memoryLimit(const CommonOptions& o) {
+  return o.memory_limit_gib > 0 ? static_cast<std::uint64_t>(o.memory_limit_gib * double(1ULL << 30))
+                                : defaultMemoryLimitBytes();
+}
+
+std::uint64_t freshSeed() {
+  std::random_device rd;
+  const std::uint64_t s = (std::uint64_t(rd()) << 32) ^ rd() ^
+                          static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
+  return s & ((1ULL << 53) - 1);  // exact in JSON readers that use doubles
+}
+
+ProgressFn progressPrinter(const CommonOptions& o, const std::string& label) {
+  if (o.quiet || !isatty(STDERR_FILENO)) return {};
+  const auto start = std::chrono::steady_clock::now();
+  return [label, start](std::int64_t done, std::int64_t total) {
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "\r%s: %lld / %lld terminals (%.1f s)%s", label.c_str(), static_cast<long long>(done),
+                 static_cast<long long>(total), s, done >= total ? "\n" : "");
+    std::fflush(stderr);
+  };
+}
+
+std::string commandLine(int argc, char** argv) {
+  std::string s;
+  for (int i = 0; i < argc; ++i) s += (i ? " " : "") + std::string(argv[i]);
+  return s;
+}
+
+}  // namespace angiosynth::cli

@@ -1,0 +1,32 @@
+#pragma once
+// What the subcommands share: threads, seeds, progress on a terminal, the memory limit.
+#include <CLI/CLI.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "grow/vascusynth_grower.hpp"
+
+namespace angiosynth::cli {
+
+struct CommonOptions {
+  int threads = 0;                 // 0: all cores
+  double memory_limit_gib = 0;     // 0: 75 % of physical memory
+  bool quiet = false;
+  std::string vascusynth_unit = "cm";
+};
+
+void addCommonOptions(CLI::App& cmd, CommonOptions& o);
+// Applies --threads for the lifetime of the returned object.
+std::shared_ptr<void> limitThreads(int threads);
+std::uint64_t memoryLimit(const CommonOptions& o);
+// A seed when none was given: fresh entropy, recorded in sample.json so the run can be repeated.
+std::uint64_t freshSeed();
+// Progress line on stderr when it is a terminal (and not --quiet); empty function otherwise.
+ProgressFn progressPrinter(const CommonOptions& o, const std::string& label);
+std::string commandLine(int argc, char** argv);
+
+
+}  // namespace angiosynth::cli

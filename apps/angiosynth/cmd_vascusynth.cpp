@@ -1,0 +1,63 @@
+// `angiosynth vascusynth PARAM_LIST NAME_LIST VOXEL_WIDTH [NOISE_FILE...]`: VascuSynth's own
+// arguments and directory layout, so existing batch scripts keep working.
+#include <iostream>
+
+#include "commands.hpp"
+#include "core/error.hpp"
+#include "io/staged_directory.hpp"
+#include "io/text_lines.hpp"
+#include "pipeline/generate_sample.hpp"
+
+namespace angiosynth::cli {
+
+CLI::App* addVascuSynth(CLI::App& app, VascuSynthArgs& a) {
+  auto* c = app.add_subcommand("vascusynth", "run like VascuSynth: one tree per line of PARAM_LIST into the directory "
+                                             "named on the same line of NAME_LIST");
+  c->add_option("PARAM_LIST", a.param_list, "file listing one parameter file per line")->required();
+  c->add_option("NAME_LIST", a.name_list, "file listing one output directory per line")->required();
+  c->add_option("VOXEL_WIDTH", a.output_voxel_width, "output image voxel width, in VOXEL_WIDTH's unit")
+      ->required()
+      ->check(CLI::PositiveNumber);
+  c->add_option("NOISE_FILE", a.noise_files, "VascuSynth noise files (checked to exist; noisy images arrive with the degradation stage)");
+  addCommonOptions(*c, a.common);
+  return c;
+}
+
+int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line) {
+  const auto threads = limitThreads(a.common.threads);
+  const auto params = readTextLines(a.param_list, "parameter list");
+  const auto names = readTextLines(a.name_list, "name list");
+  if (params.size() != names.size())
+    throw InputError(a.name_list, names.empty() ? 0 : names.back().number,
+                     std::to_string(names.size()) + " names for " + std::to_string(params.size()) +
+                         " parameter files in " + a.param_list + "; give one name per parameter file");
+  if (params.empty()) throw InputError(a.param_list, 0, "lists no parameter file");
+  for (const auto& n : a.noise_files)
+    if (!std::filesystem::exists(n)) throw InputError(n, 0, "no such noise file");
+  ReadOptions ro;
+  ro.vascusynth_length_unit = a.common.vascusynth_unit;
+  // Read every parameter file before writing anything, so a typo in the last one costs nothing.
+  std::vector<Scenario> scenarios;
+  for (const auto& l : params) scenarios.push_back(readParameters(resolveInputPath(l.text, a.param_list, l.number), ro));
+  if (!a.noise_files.empty() && !a.common.quiet)
+    std::cerr << "note: noise files were checked but noisy images are not produced by this version\n";
+  for (std::size_t i = 0; i < scenarios.size(); ++i) {
+    const Scenario& sc = scenarios[i];
+    StagedDirectory dir(names[i].text, /*replace=*/true);  // VascuSynth overwrites its outputs too
+    SampleRequest req;
+    req.scenario = &sc;
+    req.seed = sc.seed ? *sc.seed : freshSeed();
+    req.vascusynth_layout = true;
+    req.graph_id = names[i].text + "/tree_structure.xml";
+    req.command_line = command_line;
+    req.memory_limit = memoryLimit(a.common);
+    req.progress = progressPrinter(a.common, names[i].text);
+    req.extra["output_voxel_width"] = {{"value", a.output_voxel_width * sc.input_units.mm_per_length}, {"unit", "mm"}};
+    generateSample(req, dir.path());
+    dir.commit();
+    if (!a.common.quiet) std::cerr << "wrote " << names[i].text << "/tree_structure.xml (seed " << req.seed << ")\n";
+  }
+  return 0;
+}
+
+}  // namespace angiosynth::cli

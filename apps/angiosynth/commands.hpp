@@ -1,0 +1,33 @@
+#pragma once
+#include <CLI/CLI.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cli_support.hpp"
+
+namespace angiosynth::cli {
+
+struct GenerateArgs {
+  std::string params;
+  std::string out;
+  std::optional<std::uint64_t> seed;
+  std::string gxl_dialect;
+  bool force = false;
+  CommonOptions common;
+};
+CLI::App* addGenerate(CLI::App& app, GenerateArgs& a);
+int runGenerate(const GenerateArgs& a, const std::string& command_line);
+
+struct VascuSynthArgs {
+  std::string param_list, name_list;
+  double output_voxel_width = 0;
+  std::vector<std::string> noise_files;
+  CommonOptions common;
+};
+CLI::App* addVascuSynth(CLI::App& app, VascuSynthArgs& a);
+int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line);
+
+}  // namespace angiosynth::cli

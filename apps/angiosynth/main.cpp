@@ -1,0 +1,37 @@
+// angiosynth: the command line. Thin: parse, call src/, report.
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+
+#include "angiosynth/version.hpp"
+#include "cli_support.hpp"
+#include "commands.hpp"
+#include "core/error.hpp"
+
+int main(int argc, char** argv) {
+  using namespace angiosynth;
+  CLI::App app{"angiosynth: synthetic vascular trees and angiography volumes with exact ground truth"};
+  app.set_version_flag("--version", std::string("angiosynth ") + kVersion);
+  app.require_subcommand(1);
+  cli::GenerateArgs gen;
+  cli::VascuSynthArgs vs;
+  auto* g = cli::addGenerate(app, gen);
+  auto* v = cli::addVascuSynth(app, vs);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  const std::string cmdline = cli::commandLine(argc, argv);
+  try {
+    if (g->parsed()) return cli::runGenerate(gen, cmdline);
+    if (v->parsed()) return cli::runVascuSynth(vs, cmdline);
+  } catch (const InputError& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "angiosynth: internal error: " << e.what() << "\n";
+    return 3;
+  }
+  return 1;
+}

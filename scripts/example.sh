@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# Quick start 1: install what is missing, build, grow the shipped VascuSynth-like example.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/build.sh
+build/angiosynth generate examples/vascusynth_like.toml --out out/vascusynth_like --force
+echo "wrote out/vascusynth_like/ (sample.json, tree.gxl, tree.dot)"

@@ -1,0 +1,121 @@
+#include "core/vascular_tree.hpp"
+
+#include <stdexcept>
+
+namespace angiosynth {
+
+const char* nodeTypeName(NodeType t) {
+  switch (t) {
+    case NodeType::Root: return "root";
+    case NodeType::Bifurcation: return "bifurcation";
+    case NodeType::Terminal: return "terminal";
+  }
+  return "";
+}
+
+void VascularTree::reserve(std::size_t n) {
+  position.reserve(n); parent.reserve(n); child0.reserve(n); child1.reserve(n);
+  terminals.reserve(n); length.reserve(n); reduced_resistance.reserve(n); beta.reserve(n);
+  cost_ratio.reserve(n); radius.reserve(n); flow.reserve(n); pressure.reserve(n); depth.reserve(n);
+}
+
+void VascularTree::truncate(std::size_t n) {
+  position.resize(n); parent.resize(n); child0.resize(n); child1.resize(n);
+  terminals.resize(n); length.resize(n); reduced_resistance.resize(n); beta.resize(n);
+  cost_ratio.resize(n); radius.resize(n); flow.resize(n); pressure.resize(n); depth.resize(n);
+}
+
+std::int32_t VascularTree::addNode(const Vec3& p, std::int32_t parent_node) {
+  const auto id = nodeCount();
+  position.push_back(p);
+  parent.push_back(parent_node);
+  child0.push_back(-1);
+  child1.push_back(-1);
+  terminals.push_back(1);
+  length.push_back(parent_node >= 0 ? distance(position[parent_node], p) : 0.0);
+  reduced_resistance.push_back(0);
+  beta.push_back(1);
+  cost_ratio.push_back(0);
+  radius.push_back(0);
+  flow.push_back(0);
+  pressure.push_back(0);
+  depth.push_back(parent_node >= 0 ? depth[parent_node] + 1 : 0);
+  if (parent_node >= 0) {
+    if (child0[parent_node] < 0) child0[parent_node] = id;
+    else if (child1[parent_node] < 0) child1[parent_node] = id;
+    else throw std::logic_error("node already has two children");
+  }
+  return id;
+}
+
+void VascularTree::replaceChild(std::int32_t node, std::int32_t old_child, std::int32_t new_child) {
+  if (child0[node] == old_child) child0[node] = new_child;
+  else if (child1[node] == old_child) child1[node] = new_child;
+  else throw std::logic_error("replaceChild: not a child");
+}
+
+std::vector<std::int32_t> VascularTree::topDownOrder() const {
+  std::vector<std::int32_t> order;
+  if (position.empty()) return order;
+  order.reserve(position.size());
+  order.push_back(0);
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const auto i = order[k];
+    if (child0[i] >= 0) order.push_back(child0[i]);
+    if (child1[i] >= 0) order.push_back(child1[i]);
+  }
+  return order;
+}
+
+void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments) {
+  std::vector<char> removed(position.size(), 0);
+  std::vector<std::int32_t> merged_into(position.size(), -1);  // bifurcation -> surviving child
+  for (auto s : segments) {
+    if (s <= 0 || removed[s]) continue;
+    const auto p = parent[s];
+    const auto sib = sibling(s);
+    std::vector<std::int32_t> stack{s};
+    while (!stack.empty()) {
+      const auto i = stack.back();
+      stack.pop_back();
+      removed[i] = 1;
+      if (child0[i] >= 0) stack.push_back(child0[i]);
+      if (child1[i] >= 0) stack.push_back(child1[i]);
+    }
+    replaceChild(p, s, -1);
+    if (child0[p] < 0) std::swap(child0[p], child1[p]);
+    if (p != 0 && sib >= 0) {
+      // Bifurcation p now has one child: splice it out, sib hangs from p's parent.
+      const auto pp = parent[p];
+      replaceChild(pp, p, sib);
+      parent[sib] = pp;
+      removed[p] = 1;
+    }
+  }
+  // Compact, keeping relative order; rebuild lengths and depths.
+  std::vector<std::int32_t> remap(position.size(), -1);
+  std::int32_t n = 0;
+  for (std::size_t i = 0; i < position.size(); ++i)
+    if (!removed[i]) remap[i] = n++;
+  VascularTree out;
+  out.reserve(n);
+  for (std::size_t i = 0; i < position.size(); ++i) {
+    if (removed[i]) continue;
+    out.position.push_back(position[i]);
+    out.parent.push_back(parent[i] >= 0 ? remap[parent[i]] : -1);
+    out.child0.push_back(child0[i] >= 0 ? remap[child0[i]] : -1);
+    out.child1.push_back(child1[i] >= 0 ? remap[child1[i]] : -1);
+  }
+  const auto m = out.position.size();
+  out.terminals.assign(m, 1); out.length.assign(m, 0); out.reduced_resistance.assign(m, 0);
+  out.beta.assign(m, 1); out.cost_ratio.assign(m, 0); out.radius.assign(m, 0);
+  out.flow.assign(m, 0); out.pressure.assign(m, 0); out.depth.assign(m, 0);
+  for (auto i : out.topDownOrder()) {
+    if (i == 0) continue;
+    out.length[i] = distance(out.position[out.parent[i]], out.position[i]);
+    out.depth[i] = out.depth[out.parent[i]] + 1;
+  }
+  *this = std::move(out);
+}
+
+}  // namespace angiosynth

@@ -1,0 +1,58 @@
+#pragma once
+// The vascular tree as struct-of-arrays. Node 0 is the root (perforation point); every other
+// node i is the distal end of exactly one segment, which also has id i and runs from node
+// parent[i] to node i. The root node has one child segment; bifurcations have two.
+#include <cstdint>
+#include <vector>
+
+#include "core/vec3.hpp"
+
+namespace angiosynth {
+
+enum class NodeType { Root, Bifurcation, Terminal };
+
+struct VascularTree {
+  std::vector<Vec3> position;               // mm
+  std::vector<std::int32_t> parent;         // proximal node of segment i (-1 for the root)
+  std::vector<std::int32_t> child0, child1; // segments leaving node i (-1: none)
+  std::vector<std::int32_t> terminals;      // terminals downstream of segment i
+  std::vector<double> length;               // mm
+  std::vector<double> reduced_resistance;   // R*·π/(8η) of the subtree of segment i, in mm^-3·mm^4 = mm
+  std::vector<double> beta;                 // r_i / r_parent(i); 1 for the root segment
+  std::vector<double> cost_ratio;           // Σ_subtree l^μ (r/r_i)^λ
+  std::vector<double> radius;               // mm
+  std::vector<double> flow;                 // mm^3/s
+  std::vector<double> pressure;             // Pa, at node i (distal end of segment i)
+  std::vector<std::int32_t> depth;          // segments from the root to node i
+
+  std::int32_t nodeCount() const { return static_cast<std::int32_t>(position.size()); }
+  std::int32_t segmentCount() const { return nodeCount() > 0 ? nodeCount() - 1 : 0; }
+  std::int32_t terminalCount() const { return nodeCount() > 1 ? terminals[rootSegment()] : 0; }
+  // The segment leaving the root node.
+  std::int32_t rootSegment() const { return child0.empty() ? -1 : child0[0]; }
+  bool isTerminal(std::int32_t i) const { return i > 0 && child0[i] < 0; }
+  NodeType type(std::int32_t i) const {
+    return i == 0 ? NodeType::Root : (child0[i] < 0 ? NodeType::Terminal : NodeType::Bifurcation);
+  }
+  // The other segment leaving the proximal node of segment i (-1 if none).
+  std::int32_t sibling(std::int32_t i) const {
+    const std::int32_t p = parent[i];
+    return child0[p] == i ? child1[p] : child0[p];
+  }
+
+  // Appends a node with its incoming segment from `parent_node` (-1 for the root); returns its id.
+  std::int32_t addNode(const Vec3& p, std::int32_t parent_node);
+  void replaceChild(std::int32_t node, std::int32_t old_child, std::int32_t new_child);
+  void reserve(std::size_t nodes);
+  // Drops nodes >= n (their links must already be undone).
+  void truncate(std::size_t n);
+  // Nodes ordered so that every parent precedes its children (breadth-first from the root).
+  std::vector<std::int32_t> topDownOrder() const;
+  // Removes the given segments together with their subtrees and merges each orphaned
+  // bifurcation into one straight segment; node ids are compacted, order is preserved.
+  void removeSubtrees(const std::vector<std::int32_t>& segments);
+};
+
+const char* nodeTypeName(NodeType t);
+
+}  // namespace angiosynth

@@ -1,0 +1,22 @@
+#pragma once
+// Lowers the demand around a newly perfused terminal (seed 002 §3.10, eq. 13) with VascuSynth's
+// supply law: a voxel at distance d (map voxels) from the terminal is multiplied by
+// 1 if d ≥ c_{K-1} (cut-off), else max(0, 1 − 1/Σ_i c_i dⁱ); d = 0 gives 0.
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "core/vec3.hpp"
+#include "domain/demand_map.hpp"
+#include "domain/demand_sampler.hpp"
+
+namespace angiosynth {
+
+double supplyFactor(const std::vector<double>& coefficients, double d);
+
+// Applies the law around terminal t (mm) using the supply coefficients of t's voxel; touches
+// only voxels within the cut-off.
+void perfuse(const DemandMap& map, DemandSampler& sampler, const Vec3& terminal_mm,
+             std::vector<std::pair<std::int64_t, double>>& scratch);
+
+}  // namespace angiosynth

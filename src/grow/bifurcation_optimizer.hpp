@@ -1,0 +1,71 @@
+#pragma once
+// Places the bifurcation that connects a new terminal t to segment s so that the cost of the
+// whole tree, Σ l^μ r^λ (seed 002 eq. 8), is minimal. The cost of a trial point is exact and
+// costs O(depth): only the new bifurcation and the ancestors of s change their reduced
+// resistance, radius ratios and subtree cost; everything else is reused from the tree.
+//
+// The optimiser is a generalised Weiszfeld iteration: at a stationary point Σ_j w_j (b − x_j)/l_j
+// = 0 with w_j = ∂C/∂l_j > 0 for the three segments meeting at b (parent end, old distal end,
+// terminal), so b ← Σ (w_j/l_j) x_j / Σ (w_j/l_j). Every iterate is a convex combination of the
+// three ends, so it stays inside the (box-shaped) domain; an iterate is kept only if the exact
+// cost decreased. It reaches far lower cost than VascuSynth's 20-step axis hill-climb.
+#include <cstdint>
+#include <vector>
+
+#include "core/vascular_tree.hpp"
+#include "physics/hemodynamics.hpp"
+
+namespace angiosynth {
+
+class DemandMap;
+
+// New values of one segment on the path from the bifurcation to the root after a connection.
+struct PathLevel {
+  std::int32_t segment;     // the existing ancestor (level 0: -1, the new bifurcation segment)
+  std::int32_t child;       // the child on the path (level 0: s)
+  std::int32_t other;       // the other child (level 0: -1, the new terminal)
+  double beta_child, beta_other;
+  double reduced_resistance, cost_ratio;
+  std::int32_t terminals;
+};
+
+struct Connection {
+  std::int32_t segment = -1;  // s, the segment that is split
+  Vec3 bifurcation;
+  Vec3 terminal;
+  double cost = 0;            // whole-tree cost after the connection, mm^(μ+λ)
+  double root_radius = 0;     // mm
+  std::vector<PathLevel> path;  // filled by `record`
+  bool valid = false;
+};
+
+class BifurcationOptimizer {
+ public:
+  BifurcationOptimizer(const VascularTree& tree, const PhysicsParameters& p, const DemandMap& map,
+                       double min_segment_length_mm)
+      : tree_(tree), params_(p), kernel_(p), map_(map), min_length_(min_segment_length_mm) {}
+
+  // Best valid bifurcation on segment s for terminal t; valid = false when every trial point
+  // makes a segment cross a zero-demand voxel or shorter than the minimum length.
+  Connection optimise(std::int32_t s, const Vec3& t, int max_iterations = 12) const;
+  // Exact whole-tree cost with the three new lengths (parent part, distal part, terminal).
+  double cost(std::int32_t s, double l_up, double l_down, double l_term, std::vector<PathLevel>* record = nullptr) const;
+  // Cost of the connection at point b (no constraint checks).
+  double costAt(std::int32_t s, const Vec3& b, const Vec3& t) const;
+  struct Subtree { double reduced_resistance, cost_ratio; };
+  // Values of segment s if it started at distance l_down from its distal node.
+  Subtree shortened(std::int32_t s, double l_down) const;
+  // Fills c.path and c.root_radius for a chosen connection.
+  void record(Connection& c) const;
+  // True if the three segments meeting at b are long enough and cross no zero-demand voxel.
+  bool admissible(std::int32_t s, const Vec3& b, const Vec3& t) const;
+
+ private:
+  const VascularTree& tree_;
+  const PhysicsParameters& params_;
+  PowerKernel kernel_;
+  const DemandMap& map_;
+  double min_length_;
+};
+
+}  // namespace angiosynth

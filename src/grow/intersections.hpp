@@ -1,0 +1,25 @@
+#pragma once
+// Vessels are capsules (cylinders with spherical caps). Two segments "intersect" when their
+// capsules overlap and they are more than two segments apart: pairs that share a node, or that
+// have one segment between them, necessarily touch at a joint and are exempt.
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "core/vascular_tree.hpp"
+
+namespace angiosynth {
+
+// True if segments x and y share a node or one segment lies between them.
+bool withinTwoSegments(const VascularTree& tree, std::int32_t x, std::int32_t y);
+
+inline bool capsulesOverlap(const Vec3& a0, const Vec3& a1, double ra, const Vec3& b0, const Vec3& b1, double rb) {
+  return segmentSegmentDistance(a0, a1, b0, b1) < ra + rb;
+}
+
+// Every intersecting pair of the tree with its current radii, (smaller id, larger id), sorted.
+// O(N) expected with a uniform grid over [lo, hi].
+std::vector<std::pair<std::int32_t, std::int32_t>> intersectingPairs(const VascularTree& tree, const Vec3& lo,
+                                                                     const Vec3& hi);
+
+}  // namespace angiosynth

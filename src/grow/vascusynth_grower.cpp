@@ -1,0 +1,312 @@
+#include "grow/vascusynth_grower.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+#include "core/rng.hpp"
+#include "domain/demand_sampler.hpp"
+#include "domain/supply.hpp"
+#include "grow/bifurcation_optimizer.hpp"
+#include "grow/intersections.hpp"
+#include "grow/segment_index.hpp"
+
+namespace angiosynth {
+namespace {
+
+// How many ancestors above a new bifurcation are re-checked for collisions when they thicken;
+// higher ones change by a negligible factor per terminal and are covered by the final check.
+constexpr int kAncestorsChecked = 6;
+
+class Grower {
+ public:
+  Grower(const DemandMap& map, const GrowthOptions& o, GrowthReport& report)
+      : map_(map), opt_(o), report_(report), params_(o.physics), sampler_(map.demand),
+        index_(Vec3(0, 0, 0), map.extentMm()), rng_(o.seed, o.sample, Stage::Growth) {
+    params_.total_terminals = o.terminals;
+    min_length_ = o.min_segment_length_mm > 0 ? o.min_segment_length_mm : map.voxel_mm / 20;
+    tree_.reserve(2 * o.terminals + 1);
+    tree_.addNode(o.root_mm, -1);
+    root_history_.assign(o.terminals + 2, 0.0);
+  }
+
+  VascularTree run(const ProgressFn& progress) {
+    growUntil(opt_.terminals, progress);
+    solveTree(tree_, params_);
+    if (opt_.avoid_intersections) repair(progress);
+    solveTree(tree_, params_);
+    report_.intersecting_pairs =
+        static_cast<std::int64_t>(intersectingPairs(tree_, Vec3(0, 0, 0), map_.extentMm()).size());
+    report_.root_radius_mm = tree_.radius[tree_.rootSegment()];
+    return std::move(tree_);
+  }
+
+ private:
+  Vec3 drawCandidate() {
+    for (;;) {
+      const auto v = sampler_.sample(rng_.uniform());
+      const Vec3 jitter(rng_.uniform(), rng_.uniform(), rng_.uniform());
+      if (v < 0) continue;
+      const std::int64_t nx = map_.dims[0], ny = map_.dims[1];
+      const Vec3 corner(double(v % nx), double((v / nx) % ny), double(v / (nx * ny)));
+      return map_.toMm(corner + jitter);
+    }
+  }
+
+  void growUntil(std::int64_t target, const ProgressFn& progress) {
+    std::int64_t consecutive = 0;
+    std::vector<std::pair<double, std::int32_t>> near;
+    std::vector<Connection> trials;
+    std::int64_t next_report = 0;
+    while (tree_.terminalCount() < target) {
+      if (progress && tree_.terminalCount() >= next_report) {
+        progress(tree_.terminalCount(), target);
+        next_report = tree_.terminalCount() + std::max<std::int64_t>(1, target / 200);
+      }
+      if (consecutive >= opt_.max_consecutive_rejections || !(sampler_.total() > 0))
+        throw GrowthError("could place only " + std::to_string(tree_.terminalCount()) + " of " +
+                          std::to_string(target) + " terminals: " + std::to_string(consecutive) +
+                          " candidates in a row were rejected (demand left: " + std::to_string(sampler_.total()) +
+                          "); lower the number of terminals or MIN_DISTANCE, or enlarge the demand map");
+      ++consecutive;
+      ++report_.candidates;
+      const Vec3 cand = drawCandidate();
+      if (tree_.segmentCount() == 0) {
+        if (distance(tree_.position[0], cand) < min_length_ || !map_.segmentClear(tree_.position[0], cand)) {
+          ++report_.rejected_unreachable;
+          continue;
+        }
+        const auto t = tree_.addNode(cand, 0);
+        tree_.reduced_resistance[t] = tree_.length[t];
+        tree_.cost_ratio[t] = PowerKernel(params_).lengthCost(tree_.length[t]);
+        rel_.assign(2, 1.0);
+        root_history_[1] = rootRadius(params_, params_.terminalFlow(), tree_.reduced_resistance[t]);
+        index_.refresh(tree_, true);
+        perfuse(map_, sampler_, cand, scratch_);
+        consecutive = 0;
+        continue;
+      }
+      if (opt_.min_distance_mm > 0 && index_.anyWithin(tree_, cand, opt_.min_distance_mm)) {
+        ++report_.rejected_too_close;
+        continue;
+      }
+      index_.nearest(tree_, cand, opt_.closest_neighbours, near);
+      trials.assign(near.size(), Connection{});
+      const BifurcationOptimizer opt(tree_, params_, map_, min_length_);
+      tbb::parallel_for(std::size_t(0), near.size(), [&](std::size_t i) { trials[i] = opt.optimise(near[i].second, cand); });
+      std::vector<std::size_t> order;
+      for (std::size_t i = 0; i < trials.size(); ++i)
+        if (trials[i].valid) order.push_back(i);
+      if (order.empty()) {
+        ++report_.rejected_unreachable;
+        continue;
+      }
+      std::sort(order.begin(), order.end(), [&](auto a, auto b) {
+        return std::tie(trials[a].cost, trials[a].segment) < std::tie(trials[b].cost, trials[b].segment);
+      });
+      bool accepted = false;
+      for (auto i : order) {
+        Connection& c = trials[i];
+        opt.record(c);
+        const Undo undo = commit(c);
+        if (!opt_.avoid_intersections || !collides(c)) {
+          accepted = true;
+          break;
+        }
+        rollback(undo);
+      }
+      if (!accepted) {
+        ++report_.rejected_intersection;
+        continue;
+      }
+      const auto n = tree_.nodeCount();
+      index_.insert(tree_, n - 2);
+      index_.insert(tree_, n - 1);
+      index_.insert(tree_, tree_.child0[n - 2]);  // the split segment, now starting at b
+      index_.refresh(tree_);
+      perfuse(map_, sampler_, cand, scratch_);
+      consecutive = 0;
+    }
+    if (progress) progress(tree_.terminalCount(), target);
+  }
+
+  struct Saved {
+    std::int32_t id, terminals;
+    double reduced_resistance, cost_ratio, beta, rel;
+  };
+  struct Undo {
+    std::int32_t s, proximal;
+    double length_s;
+    std::vector<Saved> saved;
+  };
+
+  void save(Undo& u, std::int32_t id) {
+    u.saved.push_back({id, tree_.terminals[id], tree_.reduced_resistance[id], tree_.cost_ratio[id], tree_.beta[id], rel_[id]});
+  }
+
+  // Applies a recorded connection: new bifurcation b (splitting s) and terminal t.
+  Undo commit(const Connection& c) {
+    auto& t = tree_;
+    const auto s = c.segment, P = t.parent[s];
+    Undo u{s, P, t.length[s], {}};
+    save(u, s);
+    for (std::size_t k = 1; k < c.path.size(); ++k) {
+      save(u, c.path[k].segment);
+      save(u, c.path[k].other);
+    }
+    const auto b = t.addNode(c.bifurcation, -1);
+    t.parent[b] = P;
+    t.replaceChild(P, s, b);
+    t.parent[s] = b;
+    t.child0[b] = s;
+    t.length[b] = distance(t.position[P], c.bifurcation);
+    t.length[s] = distance(c.bifurcation, t.position[s]);
+    const auto term = t.addNode(c.terminal, b);
+    const PowerKernel k(params_);
+    const BifurcationOptimizer opt(tree_, params_, map_, min_length_);
+    const auto sv = opt.shortened(s, t.length[s]);
+    t.reduced_resistance[s] = sv.reduced_resistance;
+    t.cost_ratio[s] = sv.cost_ratio;
+    t.reduced_resistance[term] = t.length[term];
+    t.cost_ratio[term] = k.lengthCost(t.length[term]);
+    rel_.resize(t.nodeCount());
+    // Write the path bottom-up, then relative radii top-down.
+    for (std::size_t lv = 0; lv < c.path.size(); ++lv) {
+      const auto& L = c.path[lv];
+      const auto seg = lv == 0 ? b : L.segment;
+      const auto child = lv == 0 ? s : (lv == 1 ? b : L.child);
+      const auto other = lv == 0 ? term : L.other;
+      t.terminals[seg] = L.terminals;
+      t.reduced_resistance[seg] = L.reduced_resistance;
+      t.cost_ratio[seg] = L.cost_ratio;
+      t.beta[child] = L.beta_child;
+      t.beta[other] = L.beta_other;
+    }
+    const auto top = c.path.size() == 1 ? b : c.path.back().segment;
+    t.beta[top] = 1;
+    rel_[top] = 1;
+    for (std::size_t lv = c.path.size(); lv-- > 0;) {
+      const auto& L = c.path[lv];
+      const auto seg = lv == 0 ? b : L.segment;
+      const auto child = lv == 0 ? s : (lv == 1 ? b : L.child);
+      const auto other = lv == 0 ? term : L.other;
+      rel_[child] = rel_[seg] * L.beta_child;
+      rel_[other] = rel_[seg] * L.beta_other;
+    }
+    root_history_[t.terminalCount()] = c.root_radius;
+    return u;
+  }
+
+  void rollback(const Undo& u) {
+    auto& t = tree_;
+    const auto b = t.nodeCount() - 2;
+    t.replaceChild(u.proximal, b, u.s);
+    t.parent[u.s] = u.proximal;
+    t.length[u.s] = u.length_s;
+    t.truncate(b);
+    rel_.resize(b);
+    for (auto it = u.saved.rbegin(); it != u.saved.rend(); ++it) {
+      t.terminals[it->id] = it->terminals;
+      t.reduced_resistance[it->id] = it->reduced_resistance;
+      t.cost_ratio[it->id] = it->cost_ratio;
+      t.beta[it->id] = it->beta;
+      rel_[it->id] = it->rel;
+    }
+  }
+
+  // Radius scale from now to the final tree, from the root radius's growth r ∝ n^a so far.
+  double finalScale() const {
+    const std::int64_t n = tree_.terminalCount(), N = opt_.terminals;
+    if (n >= N) return 1.0;
+    double a = 1.0 / params_.murray_exponent;
+    if (n >= 16 && root_history_[n / 2] > 0)
+      a = std::clamp(std::log(root_history_[n] / root_history_[n / 2]) / std::log(double(n) / double(n / 2)), 0.1, 0.6);
+    return std::pow(double(N) / double(n), a);
+  }
+
+  // True if the new segments (or the ancestors just above them) overlap another vessel, with
+  // every radius scaled to its predicted final size.
+  bool collides(const Connection& c) {
+    const auto& t = tree_;
+    const double scale = c.root_radius * finalScale();
+    const double r_max = scale;
+    const auto b = t.nodeCount() - 2;
+    std::vector<std::int32_t> check{b, c.segment, b + 1};
+    for (std::size_t lv = 1; lv < c.path.size() && lv <= kAncestorsChecked; ++lv) check.push_back(c.path[lv].segment);
+    for (auto x : check) {
+      const Vec3& a0 = t.position[t.parent[x]];
+      const Vec3& a1 = t.position[x];
+      const double rx = rel_[x] * scale;
+      bool hit = false;
+      index_.forEachNearSegment(a0, a1, rx + r_max, [&](std::int32_t y) {
+        if (hit || y == x || withinTwoSegments(t, x, y)) return;
+        if (capsulesOverlap(a0, a1, rx, t.position[t.parent[y]], t.position[y], rel_[y] * scale)) hit = true;
+      });
+      if (hit) return true;
+    }
+    return false;
+  }
+
+  // Removes the branches that still collide in the exact final tree and regrows as many
+  // terminals, until no pair is left.
+  void repair(const ProgressFn& progress) {
+    for (int round = 0; round < opt_.max_repair_rounds; ++round) {
+      const auto pairs = intersectingPairs(tree_, Vec3(0, 0, 0), map_.extentMm());
+      if (pairs.empty()) return;
+      ++report_.repair_rounds;
+      std::vector<std::int32_t> remove;
+      for (const auto& [x, y] : pairs) {
+        const bool x_smaller = std::tie(tree_.terminals[x], y) < std::tie(tree_.terminals[y], x);
+        remove.push_back(x_smaller ? x : y);
+      }
+      std::sort(remove.begin(), remove.end());
+      remove.erase(std::unique(remove.begin(), remove.end()), remove.end());
+      const auto before = tree_.terminalCount();
+      tree_.removeSubtrees(remove);
+      // A spliced-out bifurcation leaves a straight segment that may cross an obstacle.
+      for (bool again = true; again && tree_.segmentCount() > 0;) {
+        std::vector<std::int32_t> blocked;
+        for (std::int32_t s = 1; s < tree_.nodeCount(); ++s)
+          if (!map_.segmentClear(tree_.position[tree_.parent[s]], tree_.position[s])) blocked.push_back(s);
+        again = !blocked.empty();
+        if (again) tree_.removeSubtrees(blocked);
+      }
+      report_.repaired_terminals += before - tree_.terminalCount();
+      solveTree(tree_, params_);
+      rel_.assign(tree_.nodeCount(), 1.0);
+      if (tree_.segmentCount() > 0) {
+        const double r_root = tree_.radius[tree_.rootSegment()];
+        for (std::int32_t s = 1; s < tree_.nodeCount(); ++s) rel_[s] = tree_.radius[s] / r_root;
+        root_history_[tree_.terminalCount()] = r_root;
+      }
+      index_.refresh(tree_, true);
+      growUntil(opt_.terminals, progress);
+      solveTree(tree_, params_);
+    }
+  }
+
+  const DemandMap& map_;
+  const GrowthOptions& opt_;
+  GrowthReport& report_;
+  PhysicsParameters params_;
+  DemandSampler sampler_;
+  SegmentIndex index_;
+  Rng rng_;
+  VascularTree tree_;
+  std::vector<double> rel_{1.0};        // radius / root radius, refreshed along every new path
+  std::vector<double> root_history_;    // root radius when the tree had n terminals
+  std::vector<std::pair<std::int64_t, double>> scratch_;
+  double min_length_ = 0;
+};
+
+}  // namespace
+
+VascularTree growVascuSynth(const DemandMap& map, const GrowthOptions& options, GrowthReport& report,
+                            const ProgressFn& progress) {
+  Grower g(map, options, report);
+  return g.run(progress);
+}
+
+}  // namespace angiosynth

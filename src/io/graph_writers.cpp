@@ -1,0 +1,85 @@
+#include "io/graph_writers.hpp"
+
+#include <cstdio>
+
+#include "core/format.hpp"
+
+namespace angiosynth {
+namespace {
+
+std::string sig6(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+std::string floatAttr(const char* name, double v) {
+  return std::string("      <attr name=\"") + name + "\"><float>" + exactNumber(v) + "</float></attr>\n";
+}
+
+std::string tupAttr(const char* name, const Vec3& p) {
+  return std::string("      <attr name=\"") + name + "\"><tup><float>" + exactNumber(p.x) + "</float><float>" +
+         exactNumber(p.y) + "</float><float>" + exactNumber(p.z) + "</float></tup></attr>\n";
+}
+
+}  // namespace
+
+void writeGxl(std::ostream& out, const VascularTree& t, const GraphFrame& f, const std::string& graph_id) {
+  out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+         "<!DOCTYPE gxl SYSTEM \"http://www.gupro.de/GXL/gxl-1.0.dtd\">\n"
+         "<gxl xmlns:xlink=\"http://www.w3.org/1999/xlink\">\n"
+      << "  <graph id=\"" << graph_id << "\" edgeids=\"true\" edgemode=\"directed\" hypergraph=\"false\">\n";
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    out << "    <node id=\"n" << i << "\">\n"
+        << "      <attr name=\"type\"><string>" << nodeTypeName(t.type(i)) << "</string></attr>\n"
+        << tupAttr("position", t.position[i]) << tupAttr("position_voxel", t.position[i] / f.voxel_mm) << "    </node>\n";
+  }
+  for (auto i : t.topDownOrder()) {
+    if (i == 0) continue;
+    out << "    <edge id=\"e" << i << "\" from=\"n" << t.parent[i] << "\" to=\"n" << i << "\">\n"
+        << floatAttr("radius", t.radius[i]) << floatAttr("length", t.length[i]) << floatAttr("flow", t.flow[i])
+        << floatAttr("pressure_proximal", t.pressure[t.parent[i]]) << floatAttr("pressure_distal", t.pressure[i])
+        << "    </edge>\n";
+  }
+  out << "  </graph>\n</gxl>\n";
+}
+
+void writeVascuSynthGxl(std::ostream& out, const VascularTree& t, const GraphFrame& f, const std::string& graph_id) {
+  static const char* kTypes[] = {" root node ", " bifurication ", " terminal node "};
+  const double len = f.vs_units.mm_per_length;
+  out << "<gxl><graph id=\"" << graph_id << "\" edgeids=\" true\" edgemode=\" directed\" hypergraph=\" false\">\n";
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    const Vec3 v = t.position[i] / f.voxel_mm;
+    out << "  <node id=\"n" << i << "\">\n"
+        << "    <attr name=\" nodeType\"><string>" << kTypes[static_cast<int>(t.type(i))] << "</string></attr>\n"
+        << "    <attr name=\" position\"><tup><float>" << sig6(v.x) << "</float><float>" << sig6(v.y) << "</float><float>"
+        << sig6(v.z) << "</float></tup></attr>\n"
+        << "  </node>\n";
+  }
+  for (auto i : t.topDownOrder()) {
+    if (i == 0) continue;
+    out << "  <edge id=\"e" << i << "\" to=\"n" << i << "\" from=\"n" << t.parent[i] << "\">\n"
+        << "    <attr name=\" flow\"><float>" << sig6(t.flow[i] / f.vs_units.mm3s_per_flow()) << "</float></attr>\n"
+        << "    <attr name=\" radius\"><float>" << sig6(t.radius[i] / len) << "</float></attr>\n"
+        << "  </edge>\n";
+  }
+  out << "</graph></gxl>\n";
+}
+
+void writeDot(std::ostream& out, const VascularTree& t, const GraphFrame& f) {
+  out << "digraph tree {\n  // positions in mm; radius and length in mm, flow in mm^3/s, pressure in Pa\n";
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    const Vec3& p = t.position[i];
+    out << "  n" << i << " [type=" << nodeTypeName(t.type(i)) << ", position=\"" << exactNumber(p.x) << ","
+        << exactNumber(p.y) << "," << exactNumber(p.z) << "\"];\n";
+  }
+  for (auto i : t.topDownOrder()) {
+    if (i == 0) continue;
+    out << "  n" << t.parent[i] << " -> n" << i << " [radius=" << exactNumber(t.radius[i])
+        << ", length=" << exactNumber(t.length[i]) << ", flow=" << exactNumber(t.flow[i])
+        << ", pressure=" << exactNumber(t.pressure[i]) << "];\n";
+  }
+  out << "}\n";
+}
+
+}  // namespace angiosynth

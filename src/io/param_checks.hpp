@@ -1,0 +1,44 @@
+#pragma once
+// Range checks shared by both parameter formats; each names the file line and the allowed range.
+#include <cmath>
+#include <string>
+
+#include "core/error.hpp"
+
+namespace angiosynth {
+
+struct Where {
+  std::string file;
+  int line;
+};
+
+inline std::string show(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+// lo < v (open) or lo <= v (closed), likewise for hi.
+inline void checkRange(double v, double lo, bool lo_open, double hi, bool hi_open, const Where& w,
+                       const std::string& what) {
+  const bool ok = (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+  if (!ok)
+    throw InputError(w.file, w.line,
+                     what + " = " + show(v) + " is out of range; allowed: " + (lo_open ? "(" : "[") + show(lo) + ", " +
+                         (std::isinf(hi) ? "inf" : show(hi)) + (hi_open ? ")" : "]"));
+}
+
+// The growth and physics limits, in one place for both formats.
+struct Limits {
+  static constexpr double kMaxTerminals = 5e6;
+  static constexpr double kMaxNeighbours = 100;
+  static constexpr double kMinMurray = 1, kMaxMurray = 10;     // γ in (1, 10]
+  static constexpr double kMaxCostExponent = 10;                // λ, μ in [0, 10]
+};
+
+}  // namespace angiosynth
+
+#include "core/vec3.hpp"
+namespace angiosynth {
+inline std::string show3(const Vec3& v) { return show(v.x) + " " + show(v.y) + " " + show(v.z); }
+}  // namespace angiosynth

@@ -1,0 +1,51 @@
+#pragma once
+// A validated parameter set in internal units (mm, mm^3/s, Pa, Pa*s), with where every value
+// came from, so that later errors (e.g. a root in zero demand) can still point at a file line.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/units.hpp"
+#include "grow/vascusynth_grower.hpp"
+
+namespace angiosynth {
+
+struct Scenario {
+  std::string parameter_file;
+  std::string format;  // "vascusynth" or "toml"
+  std::filesystem::path demand_map;
+  std::filesystem::path supply_map;            // empty: supply_coefficients everywhere
+  std::vector<double> supply_coefficients{0.65, 0.34, 0.01, 7};
+  int supply_line = 0;
+  double voxel_mm = 0;
+  Vec3 root_voxel;                             // map-voxel coordinates
+  int root_line = 0;
+  GrowthOptions growth;                        // root_mm is set once the map is known
+  std::optional<std::uint64_t> seed;
+  std::string gxl_dialect = "gxl";             // "gxl" (GXL 1.0) or "vascusynth"
+  CoherentUnits input_units;                   // only for VascuSynth files
+  nlohmann::ordered_json parameters;           // resolved values with units, for sample.json
+  std::string units_note;
+};
+
+struct ReadOptions {
+  std::string vascusynth_length_unit = "cm";   // unit of VOXEL_WIDTH in VascuSynth files
+};
+
+// Reads a VascuSynth parameter file (2008 or 2011 keys).
+Scenario readVascuSynthParameters(const std::filesystem::path& file, const ReadOptions& opt = {});
+// Reads a native TOML parameter file.
+Scenario readTomlParameters(const std::filesystem::path& file);
+// Chooses by extension: .toml is native, anything else VascuSynth.
+Scenario readParameters(const std::filesystem::path& file, const ReadOptions& opt = {});
+
+// Resolves a path named in a parameter file: relative to that file's directory if it exists
+// there, else relative to the working directory (VascuSynth's convention).
+std::filesystem::path resolveInputPath(const std::filesystem::path& named, const std::filesystem::path& param_file,
+                                       int line);
+
+}  // namespace angiosynth

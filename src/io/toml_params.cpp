@@ -1,0 +1,203 @@
+// The native parameter format: TOML with units written out ("0.4 mm", "100 mmHg",
+// "3.6 mPa*s", "8330 mm3/s"). Every key is checked; unknown keys are errors.
+#include <toml++/toml.h>
+
+#include <set>
+
+#include "core/error.hpp"
+#include "io/param_checks.hpp"
+#include "io/scenario.hpp"
+
+namespace angiosynth {
+namespace {
+
+class TomlReader {
+ public:
+  TomlReader(const toml::table& root, std::string file) : root_(root), file_(std::move(file)) {}
+
+  int lineOf(const toml::node* n) const { return n ? static_cast<int>(n->source().begin.line) : 0; }
+
+  const toml::table& table(const std::string& name, const std::set<std::string>& allowed) {
+    const toml::node* n = root_.get(name);
+    if (!n) {
+      static const toml::table empty;
+      return empty;
+    }
+    if (!n->is_table()) throw InputError(file_, lineOf(n), "[" + name + "] must be a table");
+    const auto& t = *n->as_table();
+    checkKeys(t, allowed, "[" + name + "]");
+    return t;
+  }
+
+  void checkKeys(const toml::table& t, const std::set<std::string>& allowed, const std::string& where) {
+    for (const auto& [k, v] : t) {
+      if (allowed.count(std::string(k.str()))) continue;
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      throw InputError(file_, lineOf(&v), "unknown key '" + std::string(k.str()) + "' in " + where + "; allowed: " + list);
+    }
+  }
+
+  const toml::node* need(const toml::table& t, const std::string& section, const std::string& key) {
+    const toml::node* n = t.get(key);
+    if (!n) throw InputError(file_, lineOf(&t), "missing key '" + key + "' in [" + section + "]");
+    return n;
+  }
+
+  double quantity(const toml::table& t, const std::string& section, const std::string& key, Dimension dim,
+                  double voxel_mm = 0) {
+    const toml::node* n = need(t, section, key);
+    const auto s = n->value<std::string>();
+    if (!s) throw InputError(file_, lineOf(n), key + " must be a string \"<number> <unit>\"; units: " + allowedUnits(dim));
+    try {
+      return parseQuantity(*s, dim, voxel_mm);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(file_, lineOf(n), key + ": " + e.what());
+    }
+  }
+
+  double number(const toml::table& t, const std::string& section, const std::string& key) {
+    const toml::node* n = need(t, section, key);
+    const auto v = n->value<double>();
+    if (!v || n->is_string()) throw InputError(file_, lineOf(n), key + " must be a number");
+    return *v;
+  }
+
+  std::int64_t integer(const toml::table& t, const std::string& section, const std::string& key) {
+    const toml::node* n = need(t, section, key);
+    if (!n->is_integer()) throw InputError(file_, lineOf(n), key + " must be a whole number");
+    return *n->value<std::int64_t>();
+  }
+
+  std::string string(const toml::table& t, const std::string& section, const std::string& key) {
+    const toml::node* n = need(t, section, key);
+    const auto v = n->value<std::string>();
+    if (!v) throw InputError(file_, lineOf(n), key + " must be a string");
+    return *v;
+  }
+
+  std::vector<double> numbers(const toml::node* n, const std::string& key, std::size_t count) {
+    const auto* arr = n->as_array();
+    if (!arr || (count && arr->size() != count) || arr->empty())
+      throw InputError(file_, lineOf(n), key + " must be an array of " + (count ? std::to_string(count) + " " : "") + "numbers");
+    std::vector<double> out;
+    for (const auto& e : *arr) {
+      const auto v = e.value<double>();
+      if (!v || e.is_string()) throw InputError(file_, lineOf(n), key + " must hold numbers only");
+      out.push_back(*v);
+    }
+    return out;
+  }
+
+  Where at(const toml::table& t, const std::string& key) const { return {file_, lineOf(t.get(key))}; }
+  const std::string& file() const { return file_; }
+
+ private:
+  const toml::table& root_;
+  std::string file_;
+};
+
+}  // namespace
+
+Scenario readTomlParameters(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  if (!std::filesystem::exists(path)) throw InputError(file, 0, "no such parameter file");
+  toml::table root;
+  try {
+    root = toml::parse_file(file);
+  } catch (const toml::parse_error& e) {
+    throw InputError(file, static_cast<int>(e.source().begin.line), std::string("not valid TOML: ") + std::string(e.description()));
+  }
+  TomlReader r(root, file);
+  r.checkKeys(root, {"seed", "domain", "tree", "physics", "output"}, "the top level");
+  Scenario sc;
+  sc.parameter_file = file;
+  sc.format = "toml";
+  if (const auto* s = root.get("seed")) {
+    if (!s->is_integer() || *s->value<std::int64_t>() < 0)
+      throw InputError(file, r.lineOf(s), "seed must be a whole number >= 0");
+    sc.seed = static_cast<std::uint64_t>(*s->value<std::int64_t>());
+  }
+
+  const auto& dom = r.table("domain", {"demand_map", "supply_map", "supply_coefficients", "voxel_size"});
+  sc.voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
+  checkRange(sc.voxel_mm, 0, true, INFINITY, true, r.at(dom, "voxel_size"), "voxel_size (mm)");
+  sc.demand_map = resolveInputPath(r.string(dom, "domain", "demand_map"), path, r.lineOf(dom.get("demand_map")));
+  if (dom.get("supply_map") && dom.get("supply_coefficients"))
+    throw InputError(file, r.lineOf(dom.get("supply_coefficients")), "give supply_map or supply_coefficients, not both");
+  if (dom.get("supply_map")) {
+    sc.supply_map = resolveInputPath(r.string(dom, "domain", "supply_map"), path, r.lineOf(dom.get("supply_map")));
+    sc.supply_line = r.lineOf(dom.get("supply_map"));
+  } else if (const auto* c = dom.get("supply_coefficients")) {
+    sc.supply_coefficients = r.numbers(c, "supply_coefficients", 0);
+    if (sc.supply_coefficients.back() < 0)
+      throw InputError(file, r.lineOf(c), "supply_coefficients: the last value is the cut-off radius (map voxels) and must be >= 0");
+  }
+
+  auto& g = sc.growth;
+  const auto& tree = r.table("tree", {"method", "terminals", "root_voxel", "root", "min_distance", "closest_neighbours",
+                                       "min_segment_length", "avoid_intersections"});
+  if (tree.get("method")) {
+    const auto m = r.string(tree, "tree", "method");
+    if (m != "vascusynth")
+      throw InputError(file, r.lineOf(tree.get("method")), "method '" + m + "' is not available; allowed: vascusynth");
+  }
+  g.terminals = r.integer(tree, "tree", "terminals");
+  checkRange(double(g.terminals), 1, false, Limits::kMaxTerminals, false, r.at(tree, "terminals"), "terminals");
+  if (tree.get("root_voxel") && tree.get("root"))
+    throw InputError(file, r.lineOf(tree.get("root")), "give root (mm) or root_voxel (map voxels), not both");
+  if (const auto* n = tree.get("root_voxel")) {
+    const auto v = r.numbers(n, "root_voxel", 3);
+    sc.root_voxel = Vec3(v[0], v[1], v[2]);
+    sc.root_line = r.lineOf(n);
+  } else if (const auto* n2 = tree.get("root")) {
+    const auto v = r.numbers(n2, "root (mm)", 3);
+    sc.root_voxel = Vec3(v[0], v[1], v[2]) / sc.voxel_mm;
+    sc.root_line = r.lineOf(n2);
+  } else {
+    throw InputError(file, r.lineOf(&tree), "missing key 'root' (mm) or 'root_voxel' (map voxels) in [tree]");
+  }
+  g.min_distance_mm = tree.get("min_distance") ? r.quantity(tree, "tree", "min_distance", Dimension::Length, sc.voxel_mm) : sc.voxel_mm;
+  checkRange(g.min_distance_mm, 0, false, INFINITY, true, r.at(tree, "min_distance"), "min_distance (mm)");
+  g.closest_neighbours = tree.get("closest_neighbours") ? static_cast<int>(r.integer(tree, "tree", "closest_neighbours")) : 5;
+  checkRange(g.closest_neighbours, 1, false, Limits::kMaxNeighbours, false, r.at(tree, "closest_neighbours"), "closest_neighbours");
+  if (tree.get("min_segment_length")) {
+    g.min_segment_length_mm = r.quantity(tree, "tree", "min_segment_length", Dimension::Length, sc.voxel_mm);
+    checkRange(g.min_segment_length_mm, 0, true, INFINITY, true, r.at(tree, "min_segment_length"), "min_segment_length (mm)");
+  }
+  if (const auto* n = tree.get("avoid_intersections")) {
+    if (!n->is_boolean()) throw InputError(file, r.lineOf(n), "avoid_intersections must be true or false");
+    g.avoid_intersections = *n->value<bool>();
+  }
+
+  const auto& ph = r.table("physics", {"murray_exponent", "cost_radius_exponent", "cost_length_exponent", "viscosity",
+                                        "perfusion_pressure", "terminal_pressure", "perfusion_flow"});
+  auto& p = g.physics;
+  p.murray_exponent = ph.get("murray_exponent") ? r.number(ph, "physics", "murray_exponent") : 3.0;
+  checkRange(p.murray_exponent, Limits::kMinMurray, true, Limits::kMaxMurray, false, r.at(ph, "murray_exponent"), "murray_exponent");
+  p.cost_radius_exponent = ph.get("cost_radius_exponent") ? r.number(ph, "physics", "cost_radius_exponent") : 2.0;
+  checkRange(p.cost_radius_exponent, 0, false, Limits::kMaxCostExponent, false, r.at(ph, "cost_radius_exponent"), "cost_radius_exponent");
+  p.cost_length_exponent = ph.get("cost_length_exponent") ? r.number(ph, "physics", "cost_length_exponent") : 1.0;
+  checkRange(p.cost_length_exponent, 0, false, Limits::kMaxCostExponent, false, r.at(ph, "cost_length_exponent"), "cost_length_exponent");
+  p.viscosity = r.quantity(ph, "physics", "viscosity", Dimension::Viscosity);
+  checkRange(p.viscosity, 0, true, INFINITY, true, r.at(ph, "viscosity"), "viscosity (Pa*s)");
+  p.perfusion_pressure = r.quantity(ph, "physics", "perfusion_pressure", Dimension::Pressure);
+  p.terminal_pressure = r.quantity(ph, "physics", "terminal_pressure", Dimension::Pressure);
+  checkRange(p.terminal_pressure, 0, false, INFINITY, true, r.at(ph, "terminal_pressure"), "terminal_pressure (Pa)");
+  if (!(p.perfusion_pressure > p.terminal_pressure))
+    throw InputError(file, r.lineOf(ph.get("perfusion_pressure")), "perfusion_pressure must exceed terminal_pressure");
+  p.perfusion_flow = r.quantity(ph, "physics", "perfusion_flow", Dimension::Flow);
+  checkRange(p.perfusion_flow, 0, true, INFINITY, true, r.at(ph, "perfusion_flow"), "perfusion_flow (mm^3/s)");
+  p.total_terminals = g.terminals;
+
+  const auto& out = r.table("output", {"gxl_dialect"});
+  if (out.get("gxl_dialect")) {
+    sc.gxl_dialect = r.string(out, "output", "gxl_dialect");
+    if (sc.gxl_dialect != "gxl" && sc.gxl_dialect != "vascusynth")
+      throw InputError(file, r.lineOf(out.get("gxl_dialect")), "gxl_dialect '" + sc.gxl_dialect + "'; allowed: gxl, vascusynth");
+  }
+  sc.units_note = "all values carry their units in the parameter file; internal units are mm, mm^3/s, Pa, Pa*s";
+  return sc;
+}
+
+}  // namespace angiosynth

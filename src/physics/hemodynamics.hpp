@@ -1,0 +1,69 @@
+#pragma once
+// Poiseuille flow in a tree with equal terminal flows, Murray's law with exponent γ, and radii
+// fixed by the root pressure drop (seed 002 §2, §3.7–3.8; Karch 1999). Reduced resistances are
+// stored without the constant 8η/π, i.e. in mm: R̃_i = l_i + [β_a⁴/R̃_a + β_b⁴/R̃_b]⁻¹.
+#include <cmath>
+#include <cstdint>
+
+#include "core/vascular_tree.hpp"
+
+namespace angiosynth {
+
+struct PhysicsParameters {
+  double murray_exponent = 3;     // γ
+  double cost_radius_exponent = 2;  // λ
+  double cost_length_exponent = 1;  // μ
+  double viscosity = 3.6e-3;      // Pa*s
+  double perfusion_pressure = 13300;  // Pa
+  double terminal_pressure = 8300;    // Pa
+  double perfusion_flow = 8330;       // mm^3/s, split equally among the final terminals
+  std::int64_t total_terminals = 1;   // N: every terminal carries perfusion_flow / N
+  double terminalFlow() const { return perfusion_flow / static_cast<double>(total_terminals); }
+};
+
+// Powers with fast paths for the usual exponents (γ = 3, λ = 2, μ = 1); used in inner loops.
+class PowerKernel {
+ public:
+  explicit PowerKernel(const PhysicsParameters& p)
+      : gamma_(p.murray_exponent), lambda_(p.cost_radius_exponent), mu_(p.cost_length_exponent),
+        gamma3_(gamma_ == 3.0), lambda2_(lambda_ == 2.0), mu1_(mu_ == 1.0) {}
+
+  struct Split { double beta_a, beta_b; };
+  // Radius ratios of two children a, b to their parent: r_a/r_b = (n_a R̃_a / n_b R̃_b)^¼ (eq. 12)
+  // and β = (1 + (r_other/r_self)^γ)^(-1/γ) (eq. 11).
+  Split split(double n_a, double R_a, double n_b, double R_b) const {
+    const double y = (n_b * R_b) / (n_a * R_a);  // (r_b/r_a)^4
+    const double q = std::sqrt(std::sqrt(y));     // r_b/r_a
+    const double u = gamma3_ ? q * q * q : std::pow(q, gamma_);
+    const double beta_a = gamma3_ ? 1.0 / std::cbrt(1.0 + u) : std::pow(1.0 + u, -1.0 / gamma_);
+    return {beta_a, beta_a * q};
+  }
+  double radiusCost(double beta) const { return lambda2_ ? beta * beta : std::pow(beta, lambda_); }
+  double lengthCost(double l) const { return mu1_ ? l : std::pow(l, mu_); }
+  double murray(double r) const { return gamma3_ ? r * r * r : std::pow(r, gamma_); }
+
+ private:
+  double gamma_, lambda_, mu_;
+  bool gamma3_, lambda2_, mu1_;
+};
+
+inline double pow4(double x) { return (x * x) * (x * x); }
+
+// R̃ of a node whose children a, b have ratios `s`: l + [β_a⁴/R̃_a + β_b⁴/R̃_b]⁻¹.
+inline double combinedResistance(double l, const PowerKernel::Split& s, double R_a, double R_b) {
+  return l + 1.0 / (pow4(s.beta_a) / R_a + pow4(s.beta_b) / R_b);
+}
+
+// Root radius from r⁴ = Q_root·(8η/π)·R̃_root / (P_perf − P_term) (eq. 10).
+double rootRadius(const PhysicsParameters& p, double root_flow, double root_reduced_resistance);
+
+// Recomputes terminal counts, lengths, reduced resistances, β, cost ratios (bottom-up) and then
+// radii, flows and pressures (top-down) of the whole tree from its geometry alone: O(N).
+void solveTree(VascularTree& tree, const PhysicsParameters& p);
+
+// Σ l^μ r^λ over all segments, in mm^(μ+λ).
+double treeCost(const VascularTree& tree, const PhysicsParameters& p);
+// Σ π r² l, in mm^3.
+double treeVolume(const VascularTree& tree);
+
+}  // namespace angiosynth

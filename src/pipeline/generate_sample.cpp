@@ -1,0 +1,164 @@
+#include "pipeline/generate_sample.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+
+#include "angiosynth/version.hpp"
+#include "core/error.hpp"
+#include "core/format.hpp"
+#include "io/graph_writers.hpp"
+#include "io/map_files.hpp"
+#include "physics/hemodynamics.hpp"
+
+namespace angiosynth {
+namespace {
+
+using Json = nlohmann::ordered_json;
+using Clock = std::chrono::steady_clock;
+
+double seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
+
+Json q(double v, const char* unit) { return Json{{"value", v}, {"unit", unit}}; }
+
+void writeText(const std::filesystem::path& file, const std::string& text) {
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+  if (!out) throw InputError(file.string(), 0, "cannot write this file (disk full or no permission?)");
+}
+
+template <class F>
+void writeWith(const std::filesystem::path& file, F&& f) {
+  std::ofstream out(file, std::ios::binary);
+  f(out);
+  out.flush();
+  if (!out) throw InputError(file.string(), 0, "cannot write this file (disk full or no permission?)");
+}
+
+}  // namespace
+
+Json describeParameters(const Scenario& sc) {
+  const auto& g = sc.growth;
+  const auto& p = g.physics;
+  Json j;
+  j["method"] = "vascusynth";
+  j["demand_map"] = sc.demand_map.string();
+  if (sc.supply_map.empty()) j["supply_coefficients"] = sc.supply_coefficients;
+  else j["supply_map"] = sc.supply_map.string();
+  j["voxel_size"] = q(sc.voxel_mm, "mm");
+  j["root"] = Json{{"value", {sc.root_voxel.x * sc.voxel_mm, sc.root_voxel.y * sc.voxel_mm, sc.root_voxel.z * sc.voxel_mm}},
+                   {"unit", "mm"}};
+  j["root_voxel"] = {sc.root_voxel.x, sc.root_voxel.y, sc.root_voxel.z};
+  j["terminals"] = g.terminals;
+  j["min_distance"] = q(g.min_distance_mm, "mm");
+  j["closest_neighbours"] = g.closest_neighbours;
+  j["min_segment_length"] = q(g.min_segment_length_mm > 0 ? g.min_segment_length_mm : sc.voxel_mm / 20, "mm");
+  j["avoid_intersections"] = g.avoid_intersections;
+  j["murray_exponent"] = p.murray_exponent;
+  j["cost_radius_exponent"] = p.cost_radius_exponent;
+  j["cost_length_exponent"] = p.cost_length_exponent;
+  j["viscosity"] = q(p.viscosity, "Pa*s");
+  j["perfusion_pressure"] = q(p.perfusion_pressure, "Pa");
+  j["terminal_pressure"] = q(p.terminal_pressure, "Pa");
+  j["perfusion_flow"] = q(p.perfusion_flow, "mm^3/s");
+  j["terminal_flow"] = q(p.perfusion_flow / double(g.terminals), "mm^3/s");
+  return j;
+}
+
+Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) {
+  const Scenario& sc = *req.scenario;
+  Json timing;
+  auto t0 = Clock::now();
+  const DemandMap map = loadDomain(sc, req.memory_limit);
+  timing["read_maps"] = seconds(t0);
+
+  GrowthOptions opt = sc.growth;
+  opt.root_mm = map.toMm(sc.root_voxel);
+  opt.seed = req.seed;
+  GrowthReport report;
+  t0 = Clock::now();
+  VascularTree tree;
+  try {
+    tree = growVascuSynth(map, opt, report, req.progress);
+  } catch (const GrowthError& e) {
+    throw InputError(sc.parameter_file, 0, e.what());
+  }
+  timing["grow"] = seconds(t0);
+
+  t0 = Clock::now();
+  GraphFrame frame{map.voxel_mm, sc.input_units};
+  Json files;
+  if (req.vascusynth_layout) {
+    writeWith(dir / "tree_structure.xml", [&](std::ostream& o) { writeVascuSynthGxl(o, tree, frame, req.graph_id); });
+    files["gxl"] = "tree_structure.xml";
+  } else {
+    writeWith(dir / "tree.gxl", [&](std::ostream& o) {
+      if (req.gxl_dialect == "vascusynth") writeVascuSynthGxl(o, tree, frame, req.graph_id);
+      else writeGxl(o, tree, frame, req.graph_id);
+    });
+    files["gxl"] = "tree.gxl";
+    writeWith(dir / "tree.dot", [&](std::ostream& o) { writeDot(o, tree, frame); });
+    files["dot"] = "tree.dot";
+  }
+  timing["write"] = seconds(t0);
+
+  // Statistics of the final tree.
+  const auto& p = opt.physics;
+  std::int64_t depth_max = 0;
+  double depth_sum = 0, r_min = INFINITY, r_max = 0;
+  for (std::int32_t i = 1; i < tree.nodeCount(); ++i) {
+    r_min = std::min(r_min, tree.radius[i]);
+    r_max = std::max(r_max, tree.radius[i]);
+    if (!tree.isTerminal(i)) continue;
+    depth_max = std::max<std::int64_t>(depth_max, tree.depth[i]);
+    depth_sum += tree.depth[i];
+  }
+  PhysicsParameters pp = p;
+  pp.total_terminals = opt.terminals;
+  const double cost = treeCost(tree, pp);
+  const double len_unit = sc.input_units.mm_per_length;
+  Json stats;
+  stats["terminals"] = tree.terminalCount();
+  stats["nodes"] = tree.nodeCount();
+  stats["segments"] = tree.segmentCount();
+  stats["total_volume"] = q(treeVolume(tree), "mm^3");
+  stats["cost"] = Json{{"value", cost},
+                       {"unit", "mm^" + exactNumber(p.cost_length_exponent + p.cost_radius_exponent)},
+                       {"definition", "sum over segments of length^mu * radius^lambda"}};
+  stats["cost_" + sc.input_units.length] =
+      Json{{"value", cost / std::pow(len_unit, p.cost_length_exponent + p.cost_radius_exponent)},
+           {"unit", sc.input_units.length + "^" + exactNumber(p.cost_length_exponent + p.cost_radius_exponent)}};
+  stats["depth_max"] = depth_max;
+  stats["depth_mean"] = tree.terminalCount() ? depth_sum / double(tree.terminalCount()) : 0.0;
+  stats["root_radius"] = q(report.root_radius_mm, "mm");
+  stats["min_radius"] = q(r_min, "mm");
+  stats["max_radius"] = q(r_max, "mm");
+  stats["intersecting_pairs"] = report.intersecting_pairs;
+  stats["intersecting_pairs_definition"] = "segment capsules that overlap and are more than two segments apart";
+  stats["candidates_drawn"] = report.candidates;
+  stats["rejected_too_close"] = report.rejected_too_close;
+  stats["rejected_unreachable"] = report.rejected_unreachable;
+  stats["rejected_intersection"] = report.rejected_intersection;
+  stats["repair_rounds"] = report.repair_rounds;
+  stats["repaired_terminals"] = report.repaired_terminals;
+
+  Json j;
+  j["tool"] = Json{{"name", "angiosynth"}, {"version", kVersion}};
+  j["command_line"] = req.command_line;
+  j["seed"] = req.seed;
+  j["parameter_file"] = sc.parameter_file;
+  j["parameter_format"] = sc.format;
+  j["units"] = Json{{"length", "mm"}, {"flow", "mm^3/s"}, {"pressure", "Pa"}, {"viscosity", "Pa*s"},
+                    {"input", sc.units_note},
+                    {"frame", "positions in mm from the corner of map voxel (0,0,0), axes along the map's x, y, z; "
+                              "position_voxel in map voxels"}};
+  j["parameters"] = describeParameters(sc);
+  for (const auto& [k, v] : req.extra.items()) j["parameters"][k] = v;
+  j["statistics"] = stats;
+  j["files"] = files;
+  j["timing_seconds"] = timing;
+  writeText(dir / "sample.json", j.dump(2) + "\n");
+  return j;
+}
+
+}  // namespace angiosynth

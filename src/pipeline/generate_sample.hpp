@@ -1,0 +1,32 @@
+#pragma once
+// One sample through the pipeline: scenario → domain → growth → graph files and sample.json.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "grow/vascusynth_grower.hpp"
+#include "io/scenario.hpp"
+
+namespace angiosynth {
+
+struct SampleRequest {
+  const Scenario* scenario = nullptr;
+  std::uint64_t seed = 1;
+  std::string gxl_dialect = "gxl";        // "gxl" or "vascusynth"
+  bool vascusynth_layout = false;         // NAME/tree_structure.xml as VascuSynth writes it
+  std::string graph_id = "tree";
+  std::string command_line;
+  std::uint64_t memory_limit = 0;
+  nlohmann::ordered_json extra;           // more resolved parameters for sample.json
+  ProgressFn progress;
+};
+
+// Writes the sample's files into `dir` and returns the content of its sample.json.
+nlohmann::ordered_json generateSample(const SampleRequest& request, const std::filesystem::path& dir);
+
+// The resolved parameters of a scenario with their units, as recorded in sample.json.
+nlohmann::ordered_json describeParameters(const Scenario& sc);
+
+}  // namespace angiosynth
