@@ -67,14 +67,10 @@ std::vector<std::int32_t> VascularTree::topDownOrder() const {
   return order;
 }
 
-void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments) {
+void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments, const std::vector<std::int32_t>& prune) {
   std::vector<char> removed(position.size(), 0);
-  std::vector<std::int32_t> merged_into(position.size(), -1);  // bifurcation -> surviving child
-  for (auto s : segments) {
-    if (s <= 0 || removed[s]) continue;
-    const auto p = parent[s];
-    const auto sib = sibling(s);
-    std::vector<std::int32_t> stack{s};
+  const auto drop = [&](std::int32_t root) {
+    std::vector<std::int32_t> stack{root};
     while (!stack.empty()) {
       const auto i = stack.back();
       stack.pop_back();
@@ -82,6 +78,18 @@ void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments) {
       if (child0[i] >= 0) stack.push_back(child0[i]);
       if (child1[i] >= 0) stack.push_back(child1[i]);
     }
+  };
+  for (auto node : prune) {
+    if (removed[node] || child0[node] < 0) continue;
+    drop(child0[node]);
+    if (child1[node] >= 0) drop(child1[node]);
+    child0[node] = child1[node] = -1;
+  }
+  for (auto s : segments) {
+    if (s <= 0 || removed[s]) continue;
+    const auto p = parent[s];
+    const auto sib = sibling(s);
+    drop(s);
     replaceChild(p, s, -1);
     if (child0[p] < 0) std::swap(child0[p], child1[p]);
     if (p != 0 && sib >= 0) {
@@ -110,11 +118,14 @@ void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments) {
   out.terminals.assign(m, 1); out.length.assign(m, 0); out.reduced_resistance.assign(m, 0);
   out.beta.assign(m, 1); out.cost_ratio.assign(m, 0); out.radius.assign(m, 0);
   out.flow.assign(m, 0); out.pressure.assign(m, 0); out.depth.assign(m, 0);
-  for (auto i : out.topDownOrder()) {
+  const auto order = out.topDownOrder();
+  for (auto i : order) {
     if (i == 0) continue;
     out.length[i] = distance(out.position[out.parent[i]], out.position[i]);
     out.depth[i] = out.depth[out.parent[i]] + 1;
   }
+  for (auto it = order.rbegin(); it != order.rend(); ++it)
+    if (*it > 0 && out.child0[*it] >= 0) out.terminals[*it] = out.terminals[out.child0[*it]] + out.terminals[out.child1[*it]];
   *this = std::move(out);
 }
 

@@ -50,7 +50,9 @@ struct VascularTree {
   std::vector<std::int32_t> topDownOrder() const;
   // Removes the given segments together with their subtrees and merges each orphaned
   // bifurcation into one straight segment; node ids are compacted, order is preserved.
-  void removeSubtrees(const std::vector<std::int32_t>& segments);
+  // Nodes in `prune` lose both child subtrees and become terminals (no splice). Pruning comes
+  // first; segments inside pruned subtrees are skipped.
+  void removeSubtrees(const std::vector<std::int32_t>& segments, const std::vector<std::int32_t>& prune = {});
 };
 
 const char* nodeTypeName(NodeType t);

@@ -54,56 +54,116 @@ bool BifurcationOptimizer::admissible(std::int32_t s, const Vec3& b, const Vec3&
   return map_.segmentClear(p, b) && map_.segmentClear(b, o) && map_.segmentClear(b, term);
 }
 
+BifurcationOptimizer::Level0 BifurcationOptimizer::level0(std::int32_t s, double l_up, double l_down,
+                                                          double l_term) const {
+  const auto& k = kernel_;
+  const auto [R_s, V_s] = shortened(s, l_down);
+  const double R_t = l_term, V_t = k.lengthCost(l_term);
+  const auto sp = k.split(tree_.terminals[s], R_s, 1.0, R_t);
+  return {combinedResistance(l_up, sp, R_s, R_t),
+          k.lengthCost(l_up) + k.radiusCost(sp.beta_a) * V_s + k.radiusCost(sp.beta_b) * V_t};
+}
+
+BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, const double (&l)[3]) const {
+  const auto& t = tree_;
+  const auto& k = kernel_;
+  const double gamma = params_.murray_exponent, lambda = params_.cost_radius_exponent;
+  const Level0 base = level0(s, l[0], l[1], l[2]);
+  double R = base.R, V = base.V;
+  double n = t.terminals[s] + 1;
+  // Tangents: a = ∂R/∂R0, bR = ∂V/∂R0, cV = ∂V/∂V0 (R does not depend on V0).
+  double a = 1, bR = 0, cV = 1;
+  std::int32_t below = s;
+  for (std::int32_t node = t.parent[s]; node != 0; below = node, node = t.parent[node]) {
+    const auto o = t.child0[node] == below ? t.child1[node] : t.child0[node];
+    const double R_o = t.reduced_resistance[o], V_o = t.cost_ratio[o];
+    const auto sp = k.split(n, R, t.terminals[o], R_o);
+    const double q = sp.beta_b / sp.beta_a;  // r_o / r_c
+    const double u = k.murray(q);
+    const double D = pow4(sp.beta_a) / R + pow4(sp.beta_b) / R_o;
+    const double bc = k.radiusCost(sp.beta_a), bo = k.radiusCost(sp.beta_b);
+    // Closed forms: ∂β_c/∂R = β_c·u/(4R(1+u)), ∂β_o/∂R = −β_o/(4R(1+u)), ∂R'/∂R = 1/(R·D·(1+u)).
+    const double inv = 1.0 / (4.0 * R * (1.0 + u));
+    const double dV_dR = lambda * inv * (bc * V * u - bo * V_o);
+    const double dR_dR = 1.0 / (R * D * (1.0 + u));
+    bR = dV_dR * a + bc * bR;
+    cV = bc * cV;
+    a = dR_dR * a;
+    R = t.length[node] + 1.0 / D;
+    V = k.lengthCost(t.length[node]) + bc * V + bo * V_o;
+    n = t.terminals[node] + 1;
+  }
+  (void)gamma;
+  const double r_root = rootRadius(params_, n * params_.terminalFlow(), R);
+  const double rl = k.radiusCost(r_root);
+  Evaluation e;
+  e.cost = rl * V;
+  const double gR = lambda / 4.0 * e.cost / R * a + rl * bR;  // ∂C/∂R0
+  const double gV = rl * cV;                                   // ∂C/∂V0
+  // Level 0 depends on the three lengths in O(1): differentiate it numerically.
+  for (int j = 0; j < 3; ++j) {
+    double lp[3] = {l[0], l[1], l[2]};
+    const double h = 1e-6 * l[j] + 1e-12;
+    lp[j] += h;
+    const Level0 p = level0(s, lp[0], lp[1], lp[2]);
+    e.d_length[j] = gR * (p.R - base.R) / h + gV * (p.V - base.V) / h;
+  }
+  return e;
+}
+
 Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int max_iterations) const {
   const std::array<Vec3, 3> ends{tree_.position[tree_.parent[s]], tree_.position[s], term};
   Connection best;
   best.segment = s;
   best.terminal = term;
-  // Start at VascuSynth's midpoint, moved a third of the way to the terminal.
-  Vec3 b = (ends[0] + ends[1]) * 0.5;
-  b = b + (term - b) * (1.0 / 3.0);
-  const auto try_point = [&](const Vec3& x) {
-    if (!admissible(s, x, term)) return false;
-    const double c = costAt(s, x, term);
-    if (best.valid && c >= best.cost) return false;
-    best.valid = true;
-    best.cost = c;
-    best.bifurcation = x;
-    return true;
+  const auto lengths = [&](const Vec3& x, double (&l)[3]) {
+    for (int j = 0; j < 3; ++j) l[j] = std::max(distance(x, ends[j]), min_length_);
   };
-  if (!try_point(b)) {
-    // The midpoint of s itself only needs the terminal segment to be clear.
-    if (!try_point((ends[0] + ends[1]) * 0.5)) return best;
-    b = best.bifurcation;
+  // Start at VascuSynth's midpoint, moved a third of the way to the terminal; fall back to the
+  // midpoint itself, whose only new segment is the one to the terminal.
+  const Vec3 mid = (ends[0] + ends[1]) * 0.5;
+  Vec3 b = mid + (term - mid) * (1.0 / 3.0);
+  if (!admissible(s, b, term)) {
+    b = mid;
+    if (!admissible(s, b, term)) return best;
   }
+  double l[3];
+  lengths(b, l);
+  Evaluation e = evaluate(s, l);
+  best.valid = true;
+  best.cost = e.cost;
+  best.bifurcation = b;
   const double tol = 1e-6 * (distance(ends[0], ends[1]) + distance(ends[1], ends[2]) + 1e-12);
   for (int it = 0; it < max_iterations; ++it) {
-    std::array<double, 3> l;
-    for (int j = 0; j < 3; ++j) l[j] = std::max(distance(b, ends[j]), min_length_);
-    const double c0 = cost(s, l[0], l[1], l[2]);
+    // Weiszfeld step with the exact local sensitivities w_j = ∂C/∂l_j.
     Vec3 num;
     double den = 0;
     for (int j = 0; j < 3; ++j) {
-      std::array<double, 3> lp = l;
-      const double h = 1e-7 * l[j] + 1e-12;
-      lp[j] += h;
-      const double w = std::max((cost(s, lp[0], lp[1], lp[2]) - c0) / h, 0.0);
-      num += ends[j] * (w / l[j]);
-      den += w / l[j];
+      const double w = std::max(e.d_length[j], 0.0) / l[j];
+      num += ends[j] * w;
+      den += w;
     }
     if (!(den > 0)) break;
     Vec3 next = num / den;
-    // Halve the step until the exact cost decreases and the point is admissible.
     bool moved = false;
-    for (int half = 0; half < 4 && !moved; ++half) {
-      moved = try_point(next);
-      next = (next + best.bifurcation) * 0.5;
+    for (int half = 0; half < 4 && !moved; ++half, next = (next + b) * 0.5) {
+      if (!admissible(s, next, term)) continue;
+      double ln[3];
+      lengths(next, ln);
+      const Evaluation en = evaluate(s, ln);
+      if (en.cost < e.cost) {
+        moved = true;
+        const double step = distance(b, next);
+        b = next;
+        e = en;
+        std::copy(ln, ln + 3, l);
+        if (step < tol) it = max_iterations;
+      }
     }
     if (!moved) break;
-    const double step = distance(b, best.bifurcation);
-    b = best.bifurcation;
-    if (step < tol) break;
   }
+  best.cost = e.cost;
+  best.bifurcation = b;
   return best;
 }
 

@@ -50,6 +50,13 @@ class BifurcationOptimizer {
   Connection optimise(std::int32_t s, const Vec3& t, int max_iterations = 12) const;
   // Exact whole-tree cost with the three new lengths (parent part, distal part, terminal).
   double cost(std::int32_t s, double l_up, double l_down, double l_term, std::vector<PathLevel>* record = nullptr) const;
+  // Exact cost and its derivatives with respect to the three new lengths, from one walk to the
+  // root that carries forward-mode derivatives of (R̃, V) of the new bifurcation segment.
+  struct Evaluation {
+    double cost;
+    double d_length[3];  // ∂C/∂l for parent part, distal part, terminal
+  };
+  Evaluation evaluate(std::int32_t s, const double (&l)[3]) const;
   // Cost of the connection at point b (no constraint checks).
   double costAt(std::int32_t s, const Vec3& b, const Vec3& t) const;
   struct Subtree { double reduced_resistance, cost_ratio; };
@@ -61,6 +68,9 @@ class BifurcationOptimizer {
   bool admissible(std::int32_t s, const Vec3& b, const Vec3& t) const;
 
  private:
+  struct Level0 { double R, V; };
+  Level0 level0(std::int32_t s, double l_up, double l_down, double l_term) const;
+
   const VascularTree& tree_;
   const PhysicsParameters& params_;
   PowerKernel kernel_;
