@@ -1,5 +1,6 @@
 #include "grow/bifurcation_optimizer.hpp"
 
+#include <algorithm>
 #include <array>
 
 #include "domain/demand_map.hpp"
@@ -122,14 +123,22 @@ Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int 
   // Start at VascuSynth's midpoint, moved a third of the way to the terminal; fall back to the
   // midpoint itself, whose only new segment is the one to the terminal.
   const Vec3 mid = (ends[0] + ends[1]) * 0.5;
-  Vec3 b = mid + (term - mid) * (1.0 / 3.0);
-  if (!admissible(s, b, term)) {
-    b = mid;
-    if (!admissible(s, b, term)) return best;
-  }
+  Vec3 b;
   double l[3];
-  lengths(b, l);
-  Evaluation e = evaluate(s, l);
+  Evaluation e{};
+  bool have = false;
+  for (const Vec3& start : {mid + (term - mid) * (1.0 / 3.0), mid}) {
+    if (!admissible(s, start, term)) continue;
+    double ls[3];
+    lengths(start, ls);
+    const Evaluation es = evaluate(s, ls);
+    if (have && es.cost >= e.cost) continue;
+    have = true;
+    b = start;
+    e = es;
+    std::copy(ls, ls + 3, l);
+  }
+  if (!have) return best;
   best.valid = true;
   best.cost = e.cost;
   best.bifurcation = b;
@@ -146,7 +155,7 @@ Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int 
     if (!(den > 0)) break;
     Vec3 next = num / den;
     bool moved = false;
-    for (int half = 0; half < 4 && !moved; ++half, next = (next + b) * 0.5) {
+    for (int half = 0; half < 10 && !moved; ++half, next = (next + b) * 0.5) {
       if (!admissible(s, next, term)) continue;
       double ln[3];
       lengths(next, ln);
@@ -165,6 +174,42 @@ Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int 
   best.cost = e.cost;
   best.bifurcation = b;
   return best;
+}
+
+void BifurcationOptimizer::polish(Connection& c) const {
+  // Compass-search polish: escapes where the fixed-point step stalls (an obstacle boundary, a
+  // minimum length) with axis moves of shrinking size, at most kPolishEvaluations trials.
+  constexpr int kPolishEvaluations = 48;
+  const Vec3& term = c.terminal;
+  const std::int32_t s = c.segment;
+  const std::array<Vec3, 3> ends{tree_.position[tree_.parent[s]], tree_.position[s], term};
+  Vec3 b = c.bifurcation;
+  double l[3];
+  for (int j = 0; j < 3; ++j) l[j] = std::max(distance(b, ends[j]), min_length_);
+  double best_cost = c.cost;
+  double step = 0.25 * std::min({l[0], l[1], l[2]});
+  const double tol = 1e-6 * (distance(ends[0], ends[1]) + distance(ends[1], ends[2]) + 1e-12);
+  const double min_step = 1e-3 * min_length_ + tol;
+  for (int evals = 0; evals < kPolishEvaluations && step > min_step;) {
+    bool improved = false;
+    for (int d = 0; d < 6 && evals < kPolishEvaluations; ++d) {
+      Vec3 next = b;
+      (d / 2 == 0 ? next.x : (d / 2 == 1 ? next.y : next.z)) += (d % 2 ? -step : step);
+      if (!admissible(s, next, term)) continue;
+      ++evals;
+      double ln[3];
+      for (int j = 0; j < 3; ++j) ln[j] = std::max(distance(next, ends[j]), min_length_);
+      const double cn = cost(s, ln[0], ln[1], ln[2]);
+      if (cn < best_cost) {
+        b = next;
+        best_cost = cn;
+        improved = true;
+      }
+    }
+    if (!improved) step *= 0.5;
+  }
+  c.bifurcation = b;
+  c.cost = best_cost;
 }
 
 void BifurcationOptimizer::record(Connection& c) const {

@@ -47,7 +47,7 @@ class BifurcationOptimizer {
 
   // Best valid bifurcation on segment s for terminal t; valid = false when every trial point
   // makes a segment cross a zero-demand voxel or shorter than the minimum length.
-  Connection optimise(std::int32_t s, const Vec3& t, int max_iterations = 12) const;
+  Connection optimise(std::int32_t s, const Vec3& t, int max_iterations = 20) const;
   // Exact whole-tree cost with the three new lengths (parent part, distal part, terminal).
   double cost(std::int32_t s, double l_up, double l_down, double l_term, std::vector<PathLevel>* record = nullptr) const;
   // Exact cost and its derivatives with respect to the three new lengths, from one walk to the
@@ -62,6 +62,9 @@ class BifurcationOptimizer {
   struct Subtree { double reduced_resistance, cost_ratio; };
   // Values of segment s if it started at distance l_down from its distal node.
   Subtree shortened(std::int32_t s, double l_down) const;
+  // Compass-search polish of an optimised connection: escapes where the fixed-point step stalls
+  // (an obstacle boundary, a minimum length). Applied to the connection growth accepts.
+  void polish(Connection& c) const;
   // Fills c.path and c.root_radius for a chosen connection.
   void record(Connection& c) const;
   // True if the three segments meeting at b are long enough and cross no zero-demand voxel.

@@ -25,7 +25,7 @@ constexpr int kAncestorsChecked = 6;
 // (measured: scaling each vessel by its flow share instead leaves ten times more collisions).
 constexpr double kMaxPredictedScale = 4.0;
 // The final repair never removes more than this share of the terminals for one collision.
-constexpr double kMaxRepairShare = 0.02;
+constexpr double kMaxRepairShare = 0.05;
 
 class Grower {
  public:
@@ -118,6 +118,7 @@ class Grower {
       bool accepted = false;
       for (auto i : order) {
         Connection& c = trials[i];
+        opt.polish(c);
         opt.record(c);
         const Undo undo = commit(c);
         if (!opt_.avoid_intersections || !collides(c)) {

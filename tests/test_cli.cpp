@@ -1,0 +1,159 @@
+// End-to-end tests of the angiosynth command line.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+#include <tinyxml2.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+using Json = nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  int code;
+  std::string err;
+};
+
+Run run(const std::string& args, const fs::path& cwd) {
+  const fs::path err = cwd / "stderr.txt";
+  const std::string cmd = "cd '" + cwd.string() + "' && '" + ANGIOSYNTH_EXE + "' " + args + " 2>'" + err.string() + "' >/dev/null";
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(err);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("angiosynth_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+  const fs::path src_ = ANGIOSYNTH_SOURCE_DIR;
+};
+
+TEST_F(Cli, GenerateWritesValidRoundTrippingGxlAndSidecar) {
+  const auto r = run("generate '" + (src_ / "examples/vascusynth_like.toml").string() + "' --out out --quiet", dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Json j = Json::parse(slurp(dir_ / "out/sample.json"));
+  EXPECT_EQ(j["seed"], 1);
+  EXPECT_EQ(j["statistics"]["terminals"], 1000);
+  EXPECT_EQ(j["statistics"]["intersecting_pairs"], 0);
+  EXPECT_EQ(j["files"]["gxl"], "tree.gxl");
+  EXPECT_EQ(j["files"]["dot"], "tree.dot");
+  EXPECT_EQ(j["parameters"]["viscosity"]["unit"], "Pa*s");
+  EXPECT_LT(j["statistics"]["cost_cm"]["value"].get<double>(), 0.1719);
+  ASSERT_TRUE(fs::exists(dir_ / "out/tree.dot"));
+
+  tinyxml2::XMLDocument doc;
+  ASSERT_EQ(doc.LoadFile((dir_ / "out/tree.gxl").c_str()), tinyxml2::XML_SUCCESS);
+  const auto* graph = doc.FirstChildElement("gxl")->FirstChildElement("graph");
+  ASSERT_NE(graph, nullptr);
+  EXPECT_STREQ(graph->Attribute("edgemode"), "directed");
+  int nodes = 0, edges = 0, roots = 0, terminals = 0;
+  double volume = 0;
+  for (const auto* n = graph->FirstChildElement("node"); n; n = n->NextSiblingElement("node")) {
+    ++nodes;
+    const std::string type = n->FirstChildElement("attr")->FirstChildElement("string")->GetText();
+    roots += type == "root";
+    terminals += type == "terminal";
+  }
+  for (const auto* e = graph->FirstChildElement("edge"); e; e = e->NextSiblingElement("edge")) {
+    ++edges;
+    double radius = 0, length = 0;
+    for (const auto* a = e->FirstChildElement("attr"); a; a = a->NextSiblingElement("attr")) {
+      const std::string name = a->Attribute("name");
+      const double v = std::stod(a->FirstChildElement("float")->GetText());
+      if (name == "radius") radius = v;
+      if (name == "length") length = v;
+    }
+    volume += M_PI * radius * radius * length;
+  }
+  EXPECT_EQ(nodes, 2000);
+  EXPECT_EQ(edges, 1999);
+  EXPECT_EQ(roots, 1);
+  EXPECT_EQ(terminals, 1000);
+  // Numbers round-trip: the volume from the GXL equals the recorded one to the last bits.
+  EXPECT_NEAR(volume, j["statistics"]["total_volume"]["value"].get<double>(), 1e-12 * volume);
+}
+
+TEST_F(Cli, SameSeedSameBytesWhateverTheThreads) {
+  const std::string params = "'" + (src_ / "examples/vascusynth/param_rods_1000.txt").string() + "'";
+  ASSERT_EQ(run("generate " + params + " --out one --threads 1 --quiet", dir_).code, 0);
+  ASSERT_EQ(run("generate " + params + " --out two --threads 2 --quiet", dir_).code, 0);
+  EXPECT_EQ(slurp(dir_ / "one/tree.gxl"), slurp(dir_ / "two/tree.gxl"));
+  EXPECT_EQ(slurp(dir_ / "one/tree.dot"), slurp(dir_ / "two/tree.dot"));
+  Json a = Json::parse(slurp(dir_ / "one/sample.json")), b = Json::parse(slurp(dir_ / "two/sample.json"));
+  for (auto* j : {&a, &b}) j->erase("timing_seconds"), j->erase("command_line");
+  EXPECT_EQ(a.dump(), b.dump());
+  ASSERT_EQ(run("generate " + params + " --out three --seed 2 --quiet", dir_).code, 0);
+  EXPECT_NE(slurp(dir_ / "one/tree.gxl"), slurp(dir_ / "three/tree.gxl"));
+}
+
+TEST_F(Cli, BadInputExitsNonZeroWithFileLineAndLeavesNoOutput) {
+  std::string text = slurp(src_ / "examples/vascusynth/param_rods_1000.txt");
+  text.replace(text.find("GAMMA: 3"), 8, "GAMMA: three");
+  std::ofstream(dir_ / "bad.txt") << text;
+  const auto r = run("generate bad.txt --out out", dir_);
+  EXPECT_NE(r.code, 0);
+  EXPECT_EQ(r.err.rfind("bad.txt:9: GAMMA: 'three' is not a number", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+  // A growth that cannot finish (too many terminals for the space) leaves nothing either.
+  text = slurp(src_ / "examples/vascusynth/param_rods_1000.txt");
+  text.replace(text.find("MIN_DISTANCE: 1"), 15, "MIN_DISTANCE: 40");
+  for (auto pos = text.find("../../demand_maps"); pos != std::string::npos; pos = text.find("../../demand_maps"))
+    text.replace(pos, 17, (src_ / "demand_maps").string());
+  std::ofstream(dir_ / "crowded.txt") << text;
+  const auto c = run("generate crowded.txt --out out2 --quiet", dir_);
+  EXPECT_NE(c.code, 0);
+  EXPECT_NE(c.err.find("could place only"), std::string::npos) << c.err;
+  for (const auto& e : fs::directory_iterator(dir_)) EXPECT_EQ(e.path().filename().string().find("out"), std::string::npos);
+}
+
+TEST_F(Cli, VascuSynthSubcommandWritesItsLayoutAndDialect) {
+  const fs::path ex = src_ / "examples/vascusynth";
+  for (const char* f : {"param_rods_1000.txt", "param_2008_crlf_200.txt", "paramList.txt", "imageNames.txt"})
+    fs::copy_file(ex / f, dir_ / f);
+  fs::create_directories(dir_ / "../../demand_maps");
+  // The parameter files name maps relative to themselves; point them at the source tree.
+  for (const char* f : {"param_rods_1000.txt", "param_2008_crlf_200.txt"}) {
+    std::string t = slurp(dir_ / f);
+    for (auto pos = t.find("../../demand_maps"); pos != std::string::npos; pos = t.find("../../demand_maps"))
+      t.replace(pos, 17, (src_ / "demand_maps").string());
+    std::ofstream(dir_ / f, std::ios::binary) << t;
+  }
+  const auto r = run("vascusynth paramList.txt imageNames.txt 0.04 --quiet", dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string xml = slurp(dir_ / "image2/tree_structure.xml");
+  EXPECT_EQ(xml.rfind("<gxl><graph id=\"image2/tree_structure.xml\" edgeids=\" true\"", 0), 0u);
+  EXPECT_NE(xml.find("<attr name=\" nodeType\"><string> root node </string></attr>"), std::string::npos);
+  EXPECT_NE(xml.find(" bifurication "), std::string::npos);
+  EXPECT_NE(xml.find("<attr name=\" flow\"><float>8.33</float></attr>"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir_ / "image1/tree_structure.xml"));
+  EXPECT_TRUE(fs::exists(dir_ / "image1/sample.json"));
+}
+
+TEST_F(Cli, HelpAndVersion) {
+  EXPECT_EQ(run("--version", dir_).code, 0);
+  EXPECT_EQ(run("generate --help", dir_).code, 0);
+  EXPECT_EQ(run("vascusynth --help", dir_).code, 0);
+  EXPECT_NE(run("generate", dir_).code, 0);
+}
+
+}  // namespace

@@ -1,0 +1,161 @@
+// Parameter and map files: VascuSynth's spellings accepted, bad input reported as file:line.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <functional>
+
+#include "core/error.hpp"
+#include "test_support.hpp"
+
+using namespace angiosynth;
+namespace fs = std::filesystem;
+
+namespace {
+
+class Files : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("angiosynth_inputs_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+                                        "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    write("demand.txt", "20 20 20\n0 0 0 20 20 20\n1\n5 5 5 10 10 10\n0\n");
+    write("supply.txt", "20 20 20 4\n0 0 0 20 20 20\n0.65 0.34 0.01 7\n");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path write(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name, std::ios::binary) << text;
+    return dir_ / name;
+  }
+  static std::string params(const std::string& eol = "\n", const std::string& sep = ": ") {
+    std::string s;
+    for (const char* kv : {"SUPPLY_MAP|supply.txt", "OXYGENATION_MAP|demand.txt", "RANDOM_SEED|3", "PERF_POINT|0 10 10",
+                           "PERF_PRESSURE|133000", "TERM_PRESSURE|83000", "PERF_FLOW|8.33", "RHO|0.036", "GAMMA|3",
+                           "LAMBDA|2", "MU|1", "MIN_DISTANCE|1", "NUM_NODES|20", "VOXEL_WIDTH|0.04", "CLOSEST_NEIGHBOURS|5"}) {
+      const std::string t = kv;
+      s += t.substr(0, t.find('|')) + sep + t.substr(t.find('|') + 1) + eol;
+    }
+    return s;
+  }
+  // Expects an InputError whose message starts with "<file>:<line>: " and contains `what`.
+  void expectError(const fs::path& file, int line, const std::string& what, const std::function<void()>& f) {
+    try {
+      f();
+      FAIL() << "no error for " << what;
+    } catch (const InputError& e) {
+      const std::string prefix = file.string() + (line > 0 ? ":" + std::to_string(line) : "") + ": ";
+      EXPECT_EQ(std::string(e.what()).rfind(prefix, 0), 0u) << e.what();
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  }
+  fs::path dir_;
+};
+
+TEST_F(Files, VascuSynthSpellingsAreAllAccepted) {
+  const auto a = readVascuSynthParameters(write("a.txt", params()));
+  std::string b_text = params("\r\n", ":");
+  b_text.insert(0, "\r\n");
+  b_text.replace(b_text.find("RHO"), 3, "ROW");
+  b_text.replace(b_text.find("MU:"), 2, "MEW");
+  b_text.insert(b_text.find("GAMMA"), "\r\n\r\n");
+  const auto b = readVascuSynthParameters(write("b.txt", b_text));
+  EXPECT_EQ(a.growth.physics.viscosity, b.growth.physics.viscosity);
+  EXPECT_EQ(a.growth.physics.cost_length_exponent, b.growth.physics.cost_length_exponent);
+  EXPECT_EQ(a.growth.terminals, 20);
+  // CGS: 133000 dyn/cm^2 = 13300 Pa, 8.33 cm^3/s = 8330 mm^3/s, 0.036 P = 0.0036 Pa*s, 0.04 cm = 0.4 mm.
+  EXPECT_DOUBLE_EQ(a.growth.physics.perfusion_pressure, 13300);
+  EXPECT_DOUBLE_EQ(a.growth.physics.perfusion_flow, 8330);
+  EXPECT_DOUBLE_EQ(a.growth.physics.viscosity, 0.0036);
+  EXPECT_DOUBLE_EQ(a.voxel_mm, 0.4);
+  EXPECT_EQ(*a.seed, 3u);
+}
+
+TEST_F(Files, VascuSynthErrorsNameFileAndLine) {
+  std::string s = params();
+  auto f = write("unknown.txt", s + "COLOUR: red\n");
+  expectError(f, 16, "unknown key 'COLOUR'", [&] { readVascuSynthParameters(f); });
+  f = write("repeat.txt", s + "ROW: 0.04\n");
+  expectError(f, 16, "RHO is given twice (first on line 8)", [&] { readVascuSynthParameters(f); });
+  std::string missing = s;
+  missing.erase(missing.find("GAMMA"), missing.find('\n', missing.find("GAMMA")) - missing.find("GAMMA") + 1);
+  f = write("missing.txt", missing);
+  expectError(f, 0, "missing keys: GAMMA", [&] { readVascuSynthParameters(f); });
+  std::string bad = s;
+  bad.replace(bad.find("NUM_NODES: 20"), 13, "NUM_NODES: 2x");
+  f = write("nan.txt", bad);
+  expectError(f, 13, "'2x' is not a whole number", [&] { readVascuSynthParameters(f); });
+  bad = s;
+  bad.replace(bad.find("PERF_FLOW: 8.33"), 15, "PERF_FLOW: -1");
+  f = write("range.txt", bad);
+  expectError(f, 7, "PERF_FLOW = -1 is out of range", [&] { readVascuSynthParameters(f); });
+  bad = s;
+  bad.replace(bad.find("OXYGENATION_MAP: demand.txt"), 27, "OXYGENATION_MAP: nowhere.txt");
+  f = write("nofile.txt", bad);
+  expectError(f, 2, "no such file 'nowhere.txt'", [&] { readVascuSynthParameters(f); });
+}
+
+TEST_F(Files, MapErrorsNameFileAndLine) {
+  const auto ok = readVascuSynthParameters(write("p.txt", params()));
+  auto sc = ok;
+  sc.demand_map = write("box.txt", "20 20 20\n0 0 0 20 20 21\n1\n");
+  expectError(sc.demand_map, 2, "lies outside the map", [&] { loadDomain(sc, 1ULL << 30); });
+  sc.demand_map = write("value.txt", "20 20 20\n0 0 0 20 20 20\nhigh\n");
+  expectError(sc.demand_map, 3, "'high' is not a number", [&] { loadDomain(sc, 1ULL << 30); });
+  sc.demand_map = write("huge.txt", "100000 100000 100000\n0 0 0 1 1 1\n1\n");
+  expectError(sc.demand_map, 1, "raise --memory-limit", [&] { loadDomain(sc, 1ULL << 30); });
+  sc = ok;
+  sc.root_voxel = Vec3(30, 1, 1);
+  expectError(dir_ / "p.txt", 4, "outside the 20 x 20 x 20 demand map", [&] { loadDomain(sc, 1ULL << 30); });
+  sc.root_voxel = Vec3(7, 7, 7);
+  expectError(dir_ / "p.txt", 4, "zero-demand voxel", [&] { loadDomain(sc, 1ULL << 30); });
+  sc = ok;
+  sc.supply_map = write("supply_bad.txt", "20 20 20 4\n0 0 0 20 20 20\n0.65 0.34 7\n");
+  expectError(sc.supply_map, 3, "expected K = 4 coefficients", [&] { loadDomain(sc, 1ULL << 30); });
+  // The valid map: 5^3 zero-demand voxels, supply everywhere.
+  sc = ok;
+  const auto m = loadDomain(sc, 1ULL << 30);
+  int zeros = 0;
+  for (float d : m.demand) zeros += d == 0;
+  EXPECT_EQ(zeros, 125);
+}
+
+TEST_F(Files, TomlMatchesVascuSynthAndRejectsBadUnits) {
+  const std::string toml = R"(seed = 3
+[domain]
+demand_map = "demand.txt"
+supply_map = "supply.txt"
+voxel_size = "0.4 mm"
+[tree]
+terminals = 20
+root_voxel = [0, 10, 10]
+min_distance = "1 voxel"
+closest_neighbours = 5
+[physics]
+viscosity = "3.6 mPa*s"
+perfusion_pressure = "13300 Pa"
+terminal_pressure = "8300 Pa"
+perfusion_flow = "8330 mm3/s"
+)";
+  const auto t = readTomlParameters(write("p.toml", toml));
+  const auto v = readVascuSynthParameters(write("p.txt", params()));
+  EXPECT_DOUBLE_EQ(t.growth.physics.viscosity, v.growth.physics.viscosity);
+  EXPECT_DOUBLE_EQ(t.growth.physics.perfusion_pressure, v.growth.physics.perfusion_pressure);
+  EXPECT_DOUBLE_EQ(t.growth.physics.perfusion_flow, v.growth.physics.perfusion_flow);
+  EXPECT_DOUBLE_EQ(t.growth.min_distance_mm, v.growth.min_distance_mm);
+  std::string bad = toml;
+  bad.replace(bad.find("\"13300 Pa\""), 10, "\"13300 bar\"");
+  auto f = write("unit.toml", bad);
+  expectError(f, 13, "unknown unit 'bar'", [&] { readTomlParameters(f); });
+  f = write("key.toml", toml + "colour = 1\n");
+  expectError(f, 16, "unknown key 'colour'", [&] { readTomlParameters(f); });
+  bad = toml;
+  bad.replace(bad.find("terminals = 20"), 14, "terminals = 0");
+  f = write("n.toml", bad);
+  expectError(f, 7, "terminals = 0 is out of range", [&] { readTomlParameters(f); });
+  bad = toml;
+  bad.replace(bad.find("\"3.6 mPa*s\""), 11, "3.6");
+  f = write("nounit.toml", bad);
+  expectError(f, 12, "viscosity must be a string", [&] { readTomlParameters(f); });
+}
+
+}  // namespace
