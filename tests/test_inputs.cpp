@@ -37,16 +37,24 @@ class Files : public ::testing::Test {
     }
     return s;
   }
-  // Expects an InputError whose message starts with "<file>:<line>: " and contains `what`.
-  void expectError(const fs::path& file, int line, const std::string& what, const std::function<void()>& f) {
+  // Success if f throws an InputError starting with "<file>:<line>: " and containing `what`.
+  static ::testing::AssertionResult errorAt(const fs::path& file, int line, const std::string& what,
+                                            const std::function<void()>& f) {
     try {
       f();
-      FAIL() << "no error for " << what;
     } catch (const InputError& e) {
+      const std::string msg = e.what();
       const std::string prefix = file.string() + (line > 0 ? ":" + std::to_string(line) : "") + ": ";
-      EXPECT_EQ(std::string(e.what()).rfind(prefix, 0), 0u) << e.what();
-      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+      if (msg.rfind(prefix, 0) == 0 && msg.find(what) != std::string::npos) return ::testing::AssertionSuccess();
+      return ::testing::AssertionFailure() << "expected '" << prefix << "…" << what << "…', got '" << msg << "'";
     }
+    return ::testing::AssertionFailure() << "no error for " << what;
+  }
+  // `text` with its first `from` replaced by `to`.
+  static std::string edited(std::string text, const std::string& from, const std::string& to) {
+    const auto pos = text.find(from);
+    EXPECT_NE(pos, std::string::npos) << from;
+    return pos == std::string::npos ? text : text.replace(pos, from.size(), to);
   }
   fs::path dir_;
 };
@@ -73,44 +81,38 @@ TEST_F(Files, VascuSynthSpellingsAreAllAccepted) {
 TEST_F(Files, VascuSynthErrorsNameFileAndLine) {
   std::string s = params();
   auto f = write("unknown.txt", s + "COLOUR: red\n");
-  expectError(f, 16, "unknown key 'COLOUR'", [&] { readVascuSynthParameters(f); });
+  EXPECT_TRUE(errorAt(f, 16, "unknown key 'COLOUR'", [&] { readVascuSynthParameters(f); }));
   f = write("repeat.txt", s + "ROW: 0.04\n");
-  expectError(f, 16, "RHO is given twice (first on line 8)", [&] { readVascuSynthParameters(f); });
+  EXPECT_TRUE(errorAt(f, 16, "RHO is given twice (first on line 8)", [&] { readVascuSynthParameters(f); }));
   std::string missing = s;
   missing.erase(missing.find("GAMMA"), missing.find('\n', missing.find("GAMMA")) - missing.find("GAMMA") + 1);
   f = write("missing.txt", missing);
-  expectError(f, 0, "missing keys: GAMMA", [&] { readVascuSynthParameters(f); });
-  std::string bad = s;
-  bad.replace(bad.find("NUM_NODES: 20"), 13, "NUM_NODES: 2x");
-  f = write("nan.txt", bad);
-  expectError(f, 13, "'2x' is not a whole number", [&] { readVascuSynthParameters(f); });
-  bad = s;
-  bad.replace(bad.find("PERF_FLOW: 8.33"), 15, "PERF_FLOW: -1");
-  f = write("range.txt", bad);
-  expectError(f, 7, "PERF_FLOW = -1 is out of range", [&] { readVascuSynthParameters(f); });
-  bad = s;
-  bad.replace(bad.find("OXYGENATION_MAP: demand.txt"), 27, "OXYGENATION_MAP: nowhere.txt");
-  f = write("nofile.txt", bad);
-  expectError(f, 2, "no such file 'nowhere.txt'", [&] { readVascuSynthParameters(f); });
+  EXPECT_TRUE(errorAt(f, 0, "missing keys: GAMMA", [&] { readVascuSynthParameters(f); }));
+  f = write("nan.txt", edited(s, "NUM_NODES: 20", "NUM_NODES: 2x"));
+  EXPECT_TRUE(errorAt(f, 13, "'2x' is not a whole number", [&] { readVascuSynthParameters(f); }));
+  f = write("range.txt", edited(s, "PERF_FLOW: 8.33", "PERF_FLOW: -1"));
+  EXPECT_TRUE(errorAt(f, 7, "PERF_FLOW = -1 is out of range", [&] { readVascuSynthParameters(f); }));
+  f = write("nofile.txt", edited(s, "OXYGENATION_MAP: demand.txt", "OXYGENATION_MAP: nowhere.txt"));
+  EXPECT_TRUE(errorAt(f, 2, "no such file 'nowhere.txt'", [&] { readVascuSynthParameters(f); }));
 }
 
 TEST_F(Files, MapErrorsNameFileAndLine) {
   const auto ok = readVascuSynthParameters(write("p.txt", params()));
   auto sc = ok;
   sc.demand_map = write("box.txt", "20 20 20\n0 0 0 20 20 21\n1\n");
-  expectError(sc.demand_map, 2, "lies outside the map", [&] { loadDomain(sc, 1ULL << 30); });
+  EXPECT_TRUE(errorAt(sc.demand_map, 2, "lies outside the map", [&] { loadDomain(sc, 1ULL << 30); }));
   sc.demand_map = write("value.txt", "20 20 20\n0 0 0 20 20 20\nhigh\n");
-  expectError(sc.demand_map, 3, "'high' is not a number", [&] { loadDomain(sc, 1ULL << 30); });
+  EXPECT_TRUE(errorAt(sc.demand_map, 3, "'high' is not a number", [&] { loadDomain(sc, 1ULL << 30); }));
   sc.demand_map = write("huge.txt", "100000 100000 100000\n0 0 0 1 1 1\n1\n");
-  expectError(sc.demand_map, 1, "raise --memory-limit", [&] { loadDomain(sc, 1ULL << 30); });
+  EXPECT_TRUE(errorAt(sc.demand_map, 1, "raise --memory-limit", [&] { loadDomain(sc, 1ULL << 30); }));
   sc = ok;
   sc.root_voxel = Vec3(30, 1, 1);
-  expectError(dir_ / "p.txt", 4, "outside the 20 x 20 x 20 demand map", [&] { loadDomain(sc, 1ULL << 30); });
+  EXPECT_TRUE(errorAt(dir_ / "p.txt", 4, "outside the 20 x 20 x 20 demand map", [&] { loadDomain(sc, 1ULL << 30); }));
   sc.root_voxel = Vec3(7, 7, 7);
-  expectError(dir_ / "p.txt", 4, "zero-demand voxel", [&] { loadDomain(sc, 1ULL << 30); });
+  EXPECT_TRUE(errorAt(dir_ / "p.txt", 4, "zero-demand voxel", [&] { loadDomain(sc, 1ULL << 30); }));
   sc = ok;
   sc.supply_map = write("supply_bad.txt", "20 20 20 4\n0 0 0 20 20 20\n0.65 0.34 7\n");
-  expectError(sc.supply_map, 3, "expected K = 4 coefficients", [&] { loadDomain(sc, 1ULL << 30); });
+  EXPECT_TRUE(errorAt(sc.supply_map, 3, "expected K = 4 coefficients", [&] { loadDomain(sc, 1ULL << 30); }));
   // The valid map: 5^3 zero-demand voxels, supply everywhere.
   sc = ok;
   const auto m = loadDomain(sc, 1ULL << 30);
@@ -142,20 +144,14 @@ perfusion_flow = "8330 mm3/s"
   EXPECT_DOUBLE_EQ(t.growth.physics.perfusion_pressure, v.growth.physics.perfusion_pressure);
   EXPECT_DOUBLE_EQ(t.growth.physics.perfusion_flow, v.growth.physics.perfusion_flow);
   EXPECT_DOUBLE_EQ(t.growth.min_distance_mm, v.growth.min_distance_mm);
-  std::string bad = toml;
-  bad.replace(bad.find("\"13300 Pa\""), 10, "\"13300 bar\"");
-  auto f = write("unit.toml", bad);
-  expectError(f, 13, "unknown unit 'bar'", [&] { readTomlParameters(f); });
+  auto f = write("unit.toml", edited(toml, "\"13300 Pa\"", "\"13300 bar\""));
+  EXPECT_TRUE(errorAt(f, 13, "unknown unit 'bar'", [&] { readTomlParameters(f); }));
   f = write("key.toml", toml + "colour = 1\n");
-  expectError(f, 16, "unknown key 'colour'", [&] { readTomlParameters(f); });
-  bad = toml;
-  bad.replace(bad.find("terminals = 20"), 14, "terminals = 0");
-  f = write("n.toml", bad);
-  expectError(f, 7, "terminals = 0 is out of range", [&] { readTomlParameters(f); });
-  bad = toml;
-  bad.replace(bad.find("\"3.6 mPa*s\""), 11, "3.6");
-  f = write("nounit.toml", bad);
-  expectError(f, 12, "viscosity must be a string", [&] { readTomlParameters(f); });
+  EXPECT_TRUE(errorAt(f, 16, "unknown key 'colour'", [&] { readTomlParameters(f); }));
+  f = write("n.toml", edited(toml, "terminals = 20", "terminals = 0"));
+  EXPECT_TRUE(errorAt(f, 7, "terminals = 0 is out of range", [&] { readTomlParameters(f); }));
+  f = write("nounit.toml", edited(toml, "\"3.6 mPa*s\"", "3.6"));
+  EXPECT_TRUE(errorAt(f, 12, "viscosity must be a string", [&] { readTomlParameters(f); }));
 }
 
 }  // namespace

@@ -68,7 +68,7 @@ BifurcationOptimizer::Level0 BifurcationOptimizer::level0(std::int32_t s, double
 BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, const double (&l)[3]) const {
   const auto& t = tree_;
   const auto& k = kernel_;
-  const double gamma = params_.murray_exponent, lambda = params_.cost_radius_exponent;
+  const double lambda = params_.cost_radius_exponent;
   const Level0 base = level0(s, l[0], l[1], l[2]);
   double R = base.R, V = base.V;
   double n = t.terminals[s] + 1;
@@ -94,7 +94,6 @@ BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, 
     V = k.lengthCost(t.length[node]) + bc * V + bo * V_o;
     n = t.terminals[node] + 1;
   }
-  (void)gamma;
   const double r_root = rootRadius(params_, n * params_.terminalFlow(), R);
   const double rl = k.radiusCost(r_root);
   Evaluation e;

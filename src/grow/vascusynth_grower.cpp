@@ -33,7 +33,7 @@ class Grower {
       : map_(map), opt_(o), report_(report), params_(o.physics), sampler_(map.demand),
         index_(Vec3(0, 0, 0), map.extentMm()), rng_(o.seed, o.sample, Stage::Growth) {
     params_.total_terminals = o.terminals;
-    min_length_ = o.min_segment_length_mm > 0 ? o.min_segment_length_mm : map.voxel_mm / 20;
+    min_length_ = o.minSegmentLength(map.voxel_mm);
     tree_.reserve(2 * o.terminals + 1);
     tree_.addNode(o.root_mm, -1);
     root_history_.assign(o.terminals + 2, 0.0);
@@ -42,8 +42,7 @@ class Grower {
   VascularTree run(const ProgressFn& progress) {
     growUntil(opt_.terminals, progress);
     solveTree(tree_, params_);
-    if (opt_.avoid_intersections) repair(progress);
-    solveTree(tree_, params_);
+    if (opt_.avoid_intersections) repair(progress);  // leaves the tree solved
     report_.intersecting_pairs =
         static_cast<std::int64_t>(intersectingPairs(tree_, Vec3(0, 0, 0), map_.extentMm()).size());
     report_.root_radius_mm = tree_.radius[tree_.rootSegment()];

@@ -23,7 +23,7 @@ struct GrowthOptions {
   Vec3 root_mm;                        // perforation point
   double min_distance_mm = 0;          // candidates closer than this to any segment are rejected
   int closest_neighbours = 5;          // segments tried per candidate
-  double min_segment_length_mm = 0;    // no segment shorter than this (default: voxel/20)
+  double min_segment_length_mm = 0;    // no segment shorter than this (0: voxel/20)
   PhysicsParameters physics;           // total_terminals is set from `terminals`
   std::uint64_t seed = 1;
   std::uint64_t sample = 0;            // sample index within a dataset
@@ -31,6 +31,8 @@ struct GrowthOptions {
   int max_repair_rounds = 30;
   // Give up after this many consecutive rejected candidates.
   std::int64_t max_consecutive_rejections = 200000;
+
+  double minSegmentLength(double voxel_mm) const { return min_segment_length_mm > 0 ? min_segment_length_mm : voxel_mm / 20; }
 };
 
 struct GrowthReport {

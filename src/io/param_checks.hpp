@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/vec3.hpp"
 
 namespace angiosynth {
 
@@ -17,6 +18,8 @@ inline std::string show(double v) {
   std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
 }
+
+inline std::string show3(const Vec3& v) { return show(v.x) + " " + show(v.y) + " " + show(v.z); }
 
 // lo < v (open) or lo <= v (closed), likewise for hi.
 inline void checkRange(double v, double lo, bool lo_open, double hi, bool hi_open, const Where& w,
@@ -36,9 +39,4 @@ struct Limits {
   static constexpr double kMaxCostExponent = 10;                // λ, μ in [0, 10]
 };
 
-}  // namespace angiosynth
-
-#include "core/vec3.hpp"
-namespace angiosynth {
-inline std::string show3(const Vec3& v) { return show(v.x) + " " + show(v.y) + " " + show(v.z); }
 }  // namespace angiosynth

@@ -52,7 +52,7 @@ Json describeParameters(const Scenario& sc) {
   j["terminals"] = g.terminals;
   j["min_distance"] = q(g.min_distance_mm, "mm");
   j["closest_neighbours"] = g.closest_neighbours;
-  j["min_segment_length"] = q(g.min_segment_length_mm > 0 ? g.min_segment_length_mm : sc.voxel_mm / 20, "mm");
+  j["min_segment_length"] = q(g.minSegmentLength(sc.voxel_mm), "mm");
   j["avoid_intersections"] = g.avoid_intersections;
   j["murray_exponent"] = p.murray_exponent;
   j["cost_radius_exponent"] = p.cost_radius_exponent;
