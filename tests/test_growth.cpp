@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iomanip>
 
 #include <tbb/global_control.h>
 
@@ -115,7 +116,7 @@ TEST(Growth, OptimiserBeatsVascuSynthAxisHillClimb) {
     }
     ASSERT_TRUE(ours.valid);
     ++compared;
-    EXPECT_LE(ours.cost, c * (1 + 1e-12));
+    EXPECT_LE(ours.cost, c * (1 + 1e-12)) << std::setprecision(17) << "rel " << (ours.cost - c) / c << " ours " << ours.bifurcation.x << "," << ours.bifurcation.y << "," << ours.bifurcation.z << " hill " << b.x << "," << b.y << "," << b.z << " seg " << s << " p " << t.position[t.parent[s]].x << "," << t.position[t.parent[s]].y << "," << t.position[t.parent[s]].z << " o " << t.position[s].x << "," << t.position[s].y << "," << t.position[s].z << " t " << cand.x << "," << cand.y << "," << cand.z;
     if (ours.cost < c * (1 - 1e-9)) ++better;
   }
   EXPECT_GT(compared, 50);

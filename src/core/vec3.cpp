@@ -5,11 +5,17 @@
 namespace angiosynth {
 
 double segmentSegmentDistance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1) {
+  double s, t;
+  return segmentSegmentDistance(p0, p1, q0, q1, s, t);
+}
+
+double segmentSegmentDistance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double& s, double& t) {
   // Closest points of two segments, clamping the unconstrained solution (Ericson, RTCD 5.1.9).
   const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
   const double a = dot(d1, d1), e = dot(d2, d2), f = dot(d2, r);
   constexpr double eps = 1e-300;
-  double s = 0, t = 0;
+  s = 0;
+  t = 0;
   if (a <= eps && e <= eps) return norm(r);
   if (a <= eps) {
     t = std::clamp(f / e, 0.0, 1.0);

@@ -33,5 +33,7 @@ inline double pointSegmentDistance(const Vec3& p, const Vec3& a, const Vec3& b) 
 // Shortest distance between the segments [p0, p1] and [q0, q1] (robust for parallel and
 // degenerate segments).
 double segmentSegmentDistance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1);
+// The same, also giving the closest points' parameters: p0 + s(p1 − p0) and q0 + t(q1 − q0).
+double segmentSegmentDistance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double& s, double& t);
 
 }  // namespace angiosynth

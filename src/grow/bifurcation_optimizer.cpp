@@ -55,6 +55,19 @@ bool BifurcationOptimizer::admissible(std::int32_t s, const Vec3& b, const Vec3&
   return map_.segmentClear(p, b) && map_.segmentClear(b, o) && map_.segmentClear(b, term);
 }
 
+Vec3 BifurcationOptimizer::keepLengths(Vec3 b, const std::array<Vec3, 3>& ends) const {
+  // Push b out to the minimum length from each end it comes too close to, so that the search
+  // slides along the constraint (the optimum often wants b to merge into a node) instead of
+  // stopping at it.
+  const double r = min_length_ * (1 + 1e-9);
+  for (const Vec3& x : ends) {
+    const Vec3 d = b - x;
+    const double len = norm(d);
+    if (len < r && len > 0) b = x + d * (r / len);
+  }
+  return b;
+}
+
 BifurcationOptimizer::Level0 BifurcationOptimizer::level0(std::int32_t s, double l_up, double l_down,
                                                           double l_term) const {
   const auto& k = kernel_;
@@ -142,33 +155,69 @@ Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int 
   best.cost = e.cost;
   best.bifurcation = b;
   const double tol = 1e-6 * (distance(ends[0], ends[1]) + distance(ends[1], ends[2]) + 1e-12);
-  for (int it = 0; it < max_iterations; ++it) {
-    // Weiszfeld step with the exact local sensitivities w_j = ∂C/∂l_j.
-    Vec3 num;
+  // Gradient ∇C = Σ_j w_j (b − x_j)/l_j with w_j = ∂C/∂l_j, and the Weiszfeld metric 1/Σ(w_j/l_j).
+  const auto gradient = [&](const Evaluation& ev, const Vec3& x, const double (&lx)[3], double* metric) {
+    Vec3 g;
     double den = 0;
     for (int j = 0; j < 3; ++j) {
-      const double w = std::max(e.d_length[j], 0.0) / l[j];
-      num += ends[j] * w;
-      den += w;
+      const double w = ev.d_length[j] / lx[j];
+      g += (x - ends[j]) * w;
+      den += std::max(w, 0.0);
     }
-    if (!(den > 0)) break;
-    Vec3 next = num / den;
+    if (metric) *metric = den > 0 ? 1.0 / den : 0.0;
+    return g;
+  };
+  double h0 = 0;
+  Vec3 g = gradient(e, b, l, &h0);
+  if (!(h0 > 0)) {
+    best.cost = e.cost;
+    best.bifurcation = b;
+    return best;
+  }
+  // BFGS from the Weiszfeld metric (whose plain step b − h0·∇C is the Weiszfeld point), with
+  // backtracking that also steps back from points that cross an obstacle.
+  double H[3][3] = {{h0, 0, 0}, {0, h0, 0}, {0, 0, h0}};
+  for (int it = 0; it < max_iterations; ++it) {
+    const Vec3 dir(-(H[0][0] * g.x + H[0][1] * g.y + H[0][2] * g.z), -(H[1][0] * g.x + H[1][1] * g.y + H[1][2] * g.z),
+                   -(H[2][0] * g.x + H[2][1] * g.y + H[2][2] * g.z));
+    const double slope = dot(g, dir);
+    if (!(slope < 0)) break;
     bool moved = false;
-    for (int half = 0; half < 10 && !moved; ++half, next = (next + b) * 0.5) {
+    Vec3 next;
+    double ln[3];
+    Evaluation en{};
+    for (double t = 1.0; t > 1e-3 && !moved; t *= 0.5) {
+      next = keepLengths(b + dir * t, ends);
       if (!admissible(s, next, term)) continue;
-      double ln[3];
       lengths(next, ln);
-      const Evaluation en = evaluate(s, ln);
-      if (en.cost < e.cost) {
-        moved = true;
-        const double step = distance(b, next);
-        b = next;
-        e = en;
-        std::copy(ln, ln + 3, l);
-        if (step < tol) it = max_iterations;
-      }
+      en = evaluate(s, ln);
+      moved = en.cost < e.cost + 1e-4 * t * slope || (t < 0.2 && en.cost < e.cost);
     }
     if (!moved) break;
+    const Vec3 gn = gradient(en, next, ln, nullptr);
+    const Vec3 sv = next - b, yv = gn - g;
+    b = next;
+    e = en;
+    g = gn;
+    std::copy(ln, ln + 3, l);
+    if (norm(sv) < tol) {
+      best.converged = true;
+      break;
+    }
+    const double sy = dot(sv, yv);
+    if (sy > 1e-300) {
+      // H ← (I − ρ s yᵀ) H (I − ρ y sᵀ) + ρ s sᵀ
+      const double rho = 1.0 / sy;
+      const double s_[3] = {sv.x, sv.y, sv.z}, y_[3] = {yv.x, yv.y, yv.z};
+      double Hy[3], yHy = 0;
+      for (int i = 0; i < 3; ++i) {
+        Hy[i] = H[i][0] * y_[0] + H[i][1] * y_[1] + H[i][2] * y_[2];
+        yHy += y_[i] * Hy[i];
+      }
+      for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 3; ++k)
+          H[i][k] += rho * ((1 + rho * yHy) * s_[i] * s_[k] - Hy[i] * s_[k] - s_[i] * Hy[k]);
+    }
   }
   best.cost = e.cost;
   best.bifurcation = b;
@@ -176,8 +225,8 @@ Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int 
 }
 
 void BifurcationOptimizer::polish(Connection& c) const {
-  // Compass-search polish: escapes where the fixed-point step stalls (an obstacle boundary, a
-  // minimum length) with axis moves of shrinking size, at most kPolishEvaluations trials.
+  if (c.converged) return;  // a stationary point of the smooth cost: nothing to escape
+  // Axis moves of shrinking size, at most kPolishEvaluations trials.
   constexpr int kPolishEvaluations = 48;
   const Vec3& term = c.terminal;
   const std::int32_t s = c.segment;
@@ -194,6 +243,7 @@ void BifurcationOptimizer::polish(Connection& c) const {
     for (int d = 0; d < 6 && evals < kPolishEvaluations; ++d) {
       Vec3 next = b;
       (d / 2 == 0 ? next.x : (d / 2 == 1 ? next.y : next.z)) += (d % 2 ? -step : step);
+      next = keepLengths(next, ends);
       if (!admissible(s, next, term)) continue;
       ++evals;
       double ln[3];

@@ -272,22 +272,25 @@ class Grower {
     std::int32_t lost, segment, prune;
     bool operator<(const Removal& o) const { return std::tie(lost, segment, prune) < std::tie(o.lost, o.segment, o.prune); }
   };
-  // Pulls terminal segment s back towards its bifurcation until its capsule clears every
-  // non-exempt vessel (with 1 % margin on radii); false if even the shortest length collides.
+  // True if segment s, with ends a–e, clears every vessel more than two segments away from it
+  // (radii with 1 % margin, as the physics re-solve after a repair shifts them slightly).
+  bool capsuleClear(std::int32_t s, const Vec3& a, const Vec3& e, SegmentIndex& index) const {
+    const double rs = 1.01 * tree_.radius[s];
+    bool hit = false;
+    index.forEachNearSegment(a, e, rs + 1.01 * r_max_, [&](std::int32_t y) {
+      if (hit || y == s || withinTwoSegments(tree_, s, y)) return;
+      hit = capsulesOverlap(a, e, rs, tree_.position[tree_.parent[y]], tree_.position[y], 1.01 * tree_.radius[y]);
+    });
+    return !hit;
+  }
+
+  // Pulls terminal segment s back towards its bifurcation until it clears every vessel; false if
+  // even the shortest length collides. Any part of a clear segment is clear of obstacles.
   bool retract(std::int32_t s, SegmentIndex& index) {
     if (!tree_.isTerminal(s)) return false;
     const Vec3 a = tree_.position[tree_.parent[s]], end = tree_.position[s];
     const double len = distance(a, end);
-    const auto clear_at = [&](double f) {
-      const Vec3 e = a + (end - a) * f;
-      const double rs = 1.01 * tree_.radius[s];
-      bool hit = false;
-      index.forEachNearSegment(a, e, rs + 1.01 * r_max_, [&](std::int32_t y) {
-        if (hit || y == s || withinTwoSegments(tree_, s, y)) return;
-        hit = capsulesOverlap(a, e, rs, tree_.position[tree_.parent[y]], tree_.position[y], 1.01 * tree_.radius[y]);
-      });
-      return !hit;
-    };
+    const auto clear_at = [&](double f) { return capsuleClear(s, a, a + (end - a) * f, index); };
     const double f_min = std::min(1.0, 2 * min_length_ / len);
     if (!clear_at(f_min)) return false;
     double lo = f_min, hi = 1.0;
@@ -297,7 +300,62 @@ class Grower {
     }
     tree_.position[s] = a + (end - a) * lo;
     tree_.length[s] = distance(a, tree_.position[s]);
+    index.insert(tree_, s);
     return true;
+  }
+
+  // Moves node v by d if every segment meeting at v stays long enough, clear of obstacles and
+  // clear of other vessels; restores it otherwise.
+  bool tryMove(std::int32_t v, const Vec3& d, SegmentIndex& index) {
+    const Vec3 old = tree_.position[v];
+    tree_.position[v] = old + d;
+    std::int32_t segs[3] = {v, tree_.child0[v], tree_.child1[v]};
+    bool ok = true;
+    for (auto sg : segs) {
+      if (sg < 0 || !ok) continue;
+      const Vec3& a = tree_.position[tree_.parent[sg]];
+      const Vec3& e = tree_.position[sg];
+      ok = distance(a, e) >= min_length_ && map_.segmentClear(a, e) && capsuleClear(sg, a, e, index);
+    }
+    if (!ok) {
+      tree_.position[v] = old;
+      return false;
+    }
+    for (auto sg : segs)
+      if (sg >= 0) {
+        tree_.length[sg] = distance(tree_.position[tree_.parent[sg]], tree_.position[sg]);
+        index.insert(tree_, sg);
+      }
+    return true;
+  }
+
+  // Separates a colliding pair by moving one end node of either vessel away from the other by
+  // the overlap (scaled by how much the closest point follows that node); the thinner vessel's
+  // nodes are tried first. This keeps trunk collisions from costing whole branches.
+  bool separate(std::int32_t x, std::int32_t y, SegmentIndex& index) {
+    if (tree_.radius[x] > tree_.radius[y]) std::swap(x, y);
+    double sx, sy;
+    const Vec3 x0 = tree_.position[tree_.parent[x]], x1 = tree_.position[x];
+    const Vec3 y0 = tree_.position[tree_.parent[y]], y1 = tree_.position[y];
+    const double d = segmentSegmentDistance(x0, x1, y0, y1, sx, sy);
+    const Vec3 cx = x0 + (x1 - x0) * sx, cy = y0 + (y1 - y0) * sy;
+    Vec3 n = cx - cy;
+    if (norm(n) < 1e-12 * (tree_.radius[x] + tree_.radius[y])) {
+      // Axes cross: push perpendicular to both.
+      const Vec3 u = x1 - x0, w = y1 - y0;
+      n = Vec3(u.y * w.z - u.z * w.y, u.z * w.x - u.x * w.z, u.x * w.y - u.y * w.x);
+      if (norm(n) == 0) return false;
+    }
+    n = n / norm(n);
+    const double overlap = 1.03 * (tree_.radius[x] + tree_.radius[y]) - d;
+    struct Move { std::int32_t node; double weight; double sign; };
+    const Move moves[4] = {{x, sx, 1}, {tree_.parent[x], 1 - sx, 1}, {y, sy, -1}, {tree_.parent[y], 1 - sy, -1}};
+    for (const auto& m : moves) {
+      if (m.node <= 0 || m.weight < 0.25) continue;
+      for (double k : {1.0, 1.5, 2.5})
+        if (tryMove(m.node, n * (m.sign * k * overlap / m.weight), index)) return true;
+    }
+    return false;
   }
 
   Removal removalOf(std::int32_t s) const {
@@ -324,12 +382,17 @@ class Grower {
       SegmentIndex index(Vec3(0, 0, 0), map_.extentMm());
       index.refresh(tree_, true);
       r_max_ = tree_.radius[tree_.rootSegment()];
-      std::int64_t retracted = 0;
+      std::int64_t retracted = 0, moved = 0;
       for (const auto& [x, y] : pairs) {
-        // Retract the thinner side if it is a terminal, else the other; else remove a branch.
+        // Cheapest first: retract a terminal (the thinner side first), move a node, and only
+        // then remove a small branch.
         const bool x_thin = tree_.radius[x] <= tree_.radius[y];
         if (retract(x_thin ? x : y, index) || retract(x_thin ? y : x, index)) {
           ++retracted;
+          continue;
+        }
+        if (separate(x, y, index)) {
+          ++moved;
           continue;
         }
         const Removal r = std::min(removalOf(x), removalOf(y));
@@ -341,7 +404,13 @@ class Grower {
         std::sort(v->begin(), v->end());
         v->erase(std::unique(v->begin(), v->end()), v->end());
       }
-      if (remove.empty() && prune.empty() && retracted == 0) return;  // nothing cheap left to do
+      report_.retracted_terminals += retracted;
+      report_.moved_nodes += moved;
+      if (remove.empty() && prune.empty()) {
+        if (retracted + moved == 0) return;  // nothing cheap left to do
+        solveTree(tree_, params_);           // lengths changed: radii follow
+        continue;
+      }
       const auto before = tree_.terminalCount();
       tree_.removeSubtrees(remove, prune);
       // A spliced-out bifurcation leaves a straight segment that may cross an obstacle.
@@ -354,7 +423,6 @@ class Grower {
       }
       report_.repaired_terminals += before - tree_.terminalCount();
       recomputeDemand();
-      report_.retracted_terminals += retracted;
       solveTree(tree_, params_);
       rel_.assign(tree_.nodeCount(), 1.0);
       if (tree_.segmentCount() > 0) {

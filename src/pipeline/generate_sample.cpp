@@ -141,6 +141,7 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   stats["rejected_intersection"] = report.rejected_intersection;
   stats["repair_rounds"] = report.repair_rounds;
   stats["retracted_terminals"] = report.retracted_terminals;
+  stats["moved_nodes"] = report.moved_nodes;
   stats["repaired_terminals"] = report.repaired_terminals;
 
   Json j;
