@@ -1,6 +1,7 @@
 // Growth time and peak memory of the VascuSynth grower at 1k, 10k and 100k terminals.
-// 1k and 10k grow in VascuSynth's 100^3 example map (twelve zero-demand rods), 100k in a
-// uniform 200^3 map; parameters as in examples/vascusynth_like (CGS values converted).
+// 1k and 10k grow in VascuSynth's 100^3 example map (twelve zero-demand rods); 1k, 10k and 100k
+// in a uniform 200^3 map, the series that shows how time per terminal scales with N.
+// Parameters as in examples/vascusynth_like (CGS values converted).
 // Run bench/run_growth.sh for a table with one process per size (peak RSS is per process).
 #include <benchmark/benchmark.h>
 
@@ -36,9 +37,10 @@ DemandMap makeMap(int n, bool rods) {
   return m;
 }
 
+// range(0): terminals; range(1): 0 = VascuSynth's 100^3 rods map, 1 = uniform 200^3.
 void BM_GrowVascuSynth(benchmark::State& state) {
   const auto n = state.range(0);
-  const DemandMap map = n >= 100000 ? makeMap(200, false) : makeMap(100, true);
+  const DemandMap map = state.range(1) ? makeMap(200, false) : makeMap(100, true);
   GrowthOptions o;
   o.terminals = n;
   o.root_mm = Vec3(0, 50, 50) * (map.dims[0] / 100) * map.voxel_mm;
@@ -56,6 +58,7 @@ void BM_GrowVascuSynth(benchmark::State& state) {
     benchmark::DoNotOptimize(tree.nodeCount());
   }
   state.counters["terminals"] = double(n);
+  state.counters["map"] = double(state.range(1));
   state.counters["us_per_terminal"] =
       benchmark::Counter(double(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.counters["peak_rss_MiB"] = double(peakRssBytes()) / double(1 << 20);
@@ -65,5 +68,13 @@ void BM_GrowVascuSynth(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_GrowVascuSynth)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_GrowVascuSynth)
+    ->ArgNames({"terminals", "uniform200"})
+    ->Args({1000, 0})
+    ->Args({10000, 0})
+    ->Args({1000, 1})
+    ->Args({10000, 1})
+    ->Args({100000, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 BENCHMARK_MAIN();
