@@ -1,0 +1,180 @@
+#include "raster/capsule_rasterizer.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace angiosynth {
+namespace {
+
+// A capsule in continuous voxel-index coordinates scaled to mm (so distances are in mm).
+struct Capsule {
+  Vec3 a, d;        // start and axis (mm)
+  double inv_len2;  // 1/|d|²
+  double r, r2;
+  std::uint32_t id;
+  // Signed distance to the surface, moved inwards by half_var·κ.
+  double signedDistance(const Vec3& p, double half_var) const {
+    const Vec3 ap = p - a;
+    const double u = inv_len2 > 0 ? dot(ap, d) * inv_len2 : 0.0;
+    const double t = u < 0 ? 0 : (u > 1 ? 1 : u);
+    const Vec3 q = ap - d * t;
+    const double kappa = (t == u && inv_len2 > 0) ? 1.0 / r : 2.0 / r;
+    return std::sqrt(dot(q, q)) - r + half_var * kappa;
+  }
+  double dist2(const Vec3& p) const {
+    const Vec3 ap = p - a;
+    double t = inv_len2 > 0 ? dot(ap, d) * inv_len2 : 0.0;
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    const Vec3 q = ap - d * t;
+    return dot(q, q);
+  }
+};
+
+Capsule capsuleOf(const VascularTree& t, std::int32_t s) {
+  const Vec3 a = t.position[t.parent[s]], b = t.position[s];
+  const Vec3 d = b - a;
+  const double l2 = dot(d, d);
+  return {a, d, l2 > 0 ? 1.0 / l2 : 0.0, t.radius[s], t.radius[s] * t.radius[s], static_cast<std::uint32_t>(s)};
+}
+
+}  // namespace
+
+BrickBins binSegments(const VascularTree& tree, const VolumeGrid& g) {
+  BrickBins bins;
+  for (int ax = 0; ax < 3; ++ax) bins.bricks[ax] = (g.dims[ax] + kBrick - 1) / kBrick;
+  const Vec3 sp = g.spacing_mm;
+  const double brick_half_diag = 0.5 * kBrick * std::sqrt(dot(sp, sp));
+  std::vector<std::pair<std::int64_t, std::int32_t>> pairs;
+  for (std::int32_t s = 1; s < tree.nodeCount(); ++s) {
+    const Vec3 a = tree.position[tree.parent[s]], b = tree.position[s];
+    const double r = tree.radius[s];
+    // Voxel x (cube [x−½, x+½] in index units) can touch the capsule's box if
+    // x ∈ [⌈min − r/s − ½⌉, ⌊max + r/s + ½⌋]; bricks hold voxels 8b … 8b+7.
+    int lo[3], hi[3];
+    bool outside = false;
+    for (int ax = 0; ax < 3; ++ax) {
+      const double ia = (a[ax] - g.origin_mm[ax]) / sp[ax], ib = (b[ax] - g.origin_mm[ax]) / sp[ax];
+      const double rr = r / sp[ax] + 0.5;
+      const double x_lo = std::max(0.0, std::ceil(std::min(ia, ib) - rr));
+      const double x_hi = std::min(double(g.dims[ax] - 1), std::floor(std::max(ia, ib) + rr));
+      if (x_hi < x_lo) outside = true;
+      lo[ax] = static_cast<int>(x_lo) / kBrick;
+      hi[ax] = static_cast<int>(std::max(x_lo, x_hi)) / kBrick;
+    }
+    if (outside) continue;
+    const bool big = (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1) > 8;
+    for (int k = lo[2]; k <= hi[2]; ++k)
+      for (int j = lo[1]; j <= hi[1]; ++j)
+        for (int i = lo[0]; i <= hi[0]; ++i) {
+          if (big) {
+            // Brick centre = centre of its voxels (i·8 + 3.5).
+            const Vec3 c = g.centre(0, 0, 0) + Vec3((i * kBrick + 3.5) * sp.x, (j * kBrick + 3.5) * sp.y, (k * kBrick + 3.5) * sp.z);
+            if (pointSegmentDistance(c, a, b) > r + brick_half_diag) continue;
+          }
+          pairs.emplace_back(i + std::int64_t(bins.bricks[0]) * (j + std::int64_t(bins.bricks[1]) * k), s);
+        }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  for (const auto& [brick, s] : pairs) {
+    if (bins.brick_ids.empty() || bins.brick_ids.back() != brick) {
+      bins.brick_ids.push_back(brick);
+      bins.segments.emplace_back();
+    }
+    bins.segments.back().push_back(s);
+  }
+  return bins;
+}
+
+void rasterizeBricks(const VascularTree& tree, const VolumeGrid& g, const BrickBins& bins, const RasterOptions& opt,
+                     const BrickVisitor& visit) {
+  const int S = std::max(1, opt.supersampling);
+  const Vec3 sp = g.spacing_mm;
+  // A voxel lies wholly inside (outside) a capsule if its centre is deeper (farther) than the
+  // voxel's half diagonal from the capsule surface.
+  const double half_diag = 0.5 * std::sqrt(dot(sp, sp));
+  std::vector<Vec3> offsets;
+  for (int c = 0; c < S; ++c)
+    for (int b = 0; b < S; ++b)
+      for (int a = 0; a < S; ++a)
+        offsets.emplace_back(((a + 0.5) / S - 0.5) * sp.x, ((b + 0.5) / S - 0.5) * sp.y, ((c + 0.5) / S - 0.5) * sp.z);
+  const double inv_samples = 1.0 / double(offsets.size());
+  const double sub_width = std::cbrt(sp.x * sp.y * sp.z) / S;  // subvoxel edge
+  const double inv_sub_width = 1.0 / sub_width;
+  const double half_var = sub_width * sub_width / 24.0;      // σ²/2 with σ² = w²/12
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bins.brick_ids.size(), 16), [&](const tbb::blocked_range<std::size_t>& range) {
+    std::vector<Capsule> caps, near;
+    float fraction[kBrick * kBrick * kBrick];
+    std::uint32_t instance[kBrick * kBrick * kBrick];
+    for (std::size_t bi = range.begin(); bi != range.end(); ++bi) {
+      const std::int64_t brick = bins.brick_ids[bi];
+      const std::int64_t bx = brick % bins.bricks[0], by = (brick / bins.bricks[0]) % bins.bricks[1],
+                         bz = brick / (std::int64_t(bins.bricks[0]) * bins.bricks[1]);
+      caps.clear();
+      for (auto s : bins.segments[bi]) caps.push_back(capsuleOf(tree, s));
+      for (int k = 0; k < kBrick; ++k)
+        for (int j = 0; j < kBrick; ++j)
+          for (int i = 0; i < kBrick; ++i) {
+            const int v = i + kBrick * (j + kBrick * k);
+            fraction[v] = 0;
+            instance[v] = 0;
+            const std::int64_t x = bx * kBrick + i, y = by * kBrick + j, z = bz * kBrick + k;
+            if (!g.contains(x, y, z)) continue;
+            const Vec3 c = g.centre(x, y, z);
+            near.clear();
+            double best = 1e300;
+            bool full = false;
+            for (const auto& cap : caps) {
+              const double depth = std::sqrt(cap.dist2(c)) - cap.r;  // < 0 inside
+              if (depth >= half_diag) continue;
+              if (depth < best) best = depth, instance[v] = cap.id;
+              if (depth <= -half_diag) full = true;
+              near.push_back(cap);
+            }
+            if (full) {
+              fraction[v] = 1;
+              continue;
+            }
+            if (near.empty()) continue;
+            // Each subvoxel counts by its signed distance to the vessel surface through a linear
+            // ramp of its width w (the same second moment, w²/12, as the exact cube coverage in
+            // any orientation), with the surface moved in by σ²κ/2 (κ = 1/r on the cylinder,
+            // 2/r on the caps): the level shift that smoothing causes on a curved surface.
+            // Second-order accurate; 0/1 samples alias on thin vessels (1.5 % at r = 0.5 voxel).
+            double inside = 0;
+            for (const Vec3& o : offsets) {
+              const Vec3 p = c + o;
+              double sd = 1e300;
+              for (const auto& cap : near) sd = std::min(sd, cap.signedDistance(p, half_var));
+              inside += std::clamp(0.5 - sd * inv_sub_width, 0.0, 1.0);
+            }
+            fraction[v] = static_cast<float>(std::min(1.0, inside * inv_samples));
+            if (inside == 0) instance[v] = 0;
+          }
+      visit(brick, fraction, instance);
+    }
+  });
+}
+
+void rasterizeDense(const VascularTree& tree, const VolumeGrid& g, const RasterOptions& opt, Volume<float>& fraction,
+                    Volume<std::uint32_t>& instances) {
+  fraction = Volume<float>(g, 0.0f);
+  instances = Volume<std::uint32_t>(g, 0u);
+  const BrickBins bins = binSegments(tree, g);
+  std::array<std::int32_t, 3> nb = bins.bricks;
+  rasterizeBricks(tree, g, bins, opt, [&](std::int64_t brick, const float* f, const std::uint32_t* id) {
+    const std::int64_t bx = brick % nb[0], by = (brick / nb[0]) % nb[1], bz = brick / (std::int64_t(nb[0]) * nb[1]);
+    for (int k = 0; k < kBrick; ++k)
+      for (int j = 0; j < kBrick; ++j)
+        for (int i = 0; i < kBrick; ++i) {
+          const std::int64_t x = bx * kBrick + i, y = by * kBrick + j, z = bz * kBrick + k;
+          if (!g.contains(x, y, z)) continue;
+          const int v = i + kBrick * (j + kBrick * k);
+          fraction.at(x, y, z) = f[v];
+          instances.at(x, y, z) = id[v];
+        }
+  });
+}
+
+}  // namespace angiosynth

@@ -1,0 +1,73 @@
+#include "raster/ground_truth.hpp"
+
+#include <cmath>
+#include <cstdlib>
+
+namespace angiosynth {
+
+std::uint64_t denseRasterBytes(const VolumeGrid& g) {
+  const std::uint64_t per_voxel = sizeof(float) /*fraction*/ + 1 /*mask*/ + 1 /*centerline*/ + sizeof(float) /*radius*/ +
+                                  sizeof(std::uint32_t) /*instances*/ + sizeof(float) /*image*/;
+  return static_cast<std::uint64_t>(g.voxelCount()) * per_voxel;
+}
+
+void centerlineVoxels(const VolumeGrid& g, const Vec3& a_mm, const Vec3& b_mm,
+                      std::vector<std::array<std::int64_t, 3>>& out) {
+  out.clear();
+  const Vec3 a = g.index(a_mm), b = g.index(b_mm);
+  std::int64_t p[3], q[3], d[3], s[3];
+  for (int ax = 0; ax < 3; ++ax) {
+    p[ax] = static_cast<std::int64_t>(std::floor(a[ax] + 0.5));  // voxel i covers [i − ½, i + ½)
+    q[ax] = static_cast<std::int64_t>(std::floor(b[ax] + 0.5));
+    d[ax] = std::llabs(q[ax] - p[ax]);
+    s[ax] = q[ax] >= p[ax] ? 1 : -1;
+  }
+  // 3D Bresenham along the dominant axis: each step moves to one of the 26 neighbours.
+  const int m = d[0] >= d[1] ? (d[0] >= d[2] ? 0 : 2) : (d[1] >= d[2] ? 1 : 2);
+  const int u = (m + 1) % 3, v = (m + 2) % 3;
+  std::int64_t eu = 2 * d[u] - d[m], ev = 2 * d[v] - d[m];
+  for (std::int64_t n = 0; n <= d[m]; ++n) {
+    if (g.contains(p[0], p[1], p[2])) out.push_back({p[0], p[1], p[2]});
+    if (eu > 0) p[u] += s[u], eu -= 2 * d[m];
+    if (ev > 0) p[v] += s[v], ev -= 2 * d[m];
+    eu += 2 * d[u];
+    ev += 2 * d[v];
+    p[m] += s[m];
+  }
+}
+
+GroundTruthVolumes rasterizeGroundTruth(const VascularTree& t, const VolumeGrid& g, const RasterOptions& opt) {
+  GroundTruthVolumes gt;
+  rasterizeDense(t, g, opt, gt.fraction, gt.instances);
+  gt.mask = Volume<std::uint8_t>(g, 0);
+  gt.centerline = Volume<std::uint8_t>(g, 0);
+  gt.radius = Volume<float>(g, 0.0f);
+  for (std::size_t v = 0; v < gt.fraction.data.size(); ++v) {
+    gt.mask.data[v] = gt.fraction.data[v] >= 0.5f;
+    if (!gt.mask.data[v]) gt.instances.data[v] = 0;
+  }
+  // Thin vessels stay connected: every voxel a centreline crosses belongs to the mask. Segments
+  // in id order, so at shared voxels the result does not depend on anything but the tree.
+  std::vector<std::array<std::int64_t, 3>> curve;
+  for (std::int32_t s = 1; s < t.nodeCount(); ++s) {
+    const Vec3& a = t.position[t.parent[s]];
+    const Vec3& b = t.position[s];
+    forEachCrossedVoxel(g, a, b, [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+      const auto v = g.flat(i, j, k);
+      if (!gt.mask.data[v]) {
+        gt.mask.data[v] = 1;
+        gt.instances.data[v] = static_cast<std::uint32_t>(s);
+      }
+    });
+    centerlineVoxels(g, a, b, curve);
+    for (const auto& c : curve) {
+      const auto v = g.flat(c[0], c[1], c[2]);
+      gt.centerline.data[v] = 1;
+      if (t.radius[s] > gt.radius.data[v]) gt.radius.data[v] = static_cast<float>(t.radius[s]);
+      if (!gt.mask.data[v]) gt.mask.data[v] = 1, gt.instances.data[v] = static_cast<std::uint32_t>(s);
+    }
+  }
+  return gt;
+}
+
+}  // namespace angiosynth

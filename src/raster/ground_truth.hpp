@@ -1,0 +1,65 @@
+#pragma once
+// The tree's ground truth on an image grid: partial-volume fraction, mask, centreline, radius
+// and instance labels, all derived from the tree (the single source of truth).
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/vascular_tree.hpp"
+#include "raster/capsule_rasterizer.hpp"
+#include "raster/volume.hpp"
+
+namespace angiosynth {
+
+struct GroundTruthVolumes {
+  Volume<float> fraction;            // fraction of each voxel inside the vessels, [0, 1]
+  Volume<std::uint8_t> mask;         // fraction >= 0.5, plus every voxel a centreline crosses
+  Volume<std::uint8_t> centerline;   // 26-connected voxel curve of every segment
+  Volume<float> radius;              // mm, on centreline voxels (the thicker vessel at joints)
+  Volume<std::uint32_t> instances;   // segment id (= distal node id) on mask voxels, else 0
+};
+
+// Bytes of all dense channels plus a float image, for the size guard.
+std::uint64_t denseRasterBytes(const VolumeGrid& grid);
+
+GroundTruthVolumes rasterizeGroundTruth(const VascularTree& tree, const VolumeGrid& grid, const RasterOptions& opt);
+
+// The 26-connected voxel curve (3D Bresenham) between the voxels containing a and b (mm),
+// clipped to the grid.
+void centerlineVoxels(const VolumeGrid& grid, const Vec3& a_mm, const Vec3& b_mm,
+                      std::vector<std::array<std::int64_t, 3>>& out);
+// Calls f(i, j, k) for every voxel the segment a–b (mm) passes through.
+template <class F>
+void forEachCrossedVoxel(const VolumeGrid& grid, const Vec3& a_mm, const Vec3& b_mm, F&& f);
+
+}  // namespace angiosynth
+
+#include "core/voxel_traversal.hpp"
+
+namespace angiosynth {
+
+template <class F>
+void forEachCrossedVoxel(const VolumeGrid& g, const Vec3& a_mm, const Vec3& b_mm, F&& f) {
+  // Shift by ½ so that voxel i covers [i, i+1); clip the segment to the grid box first.
+  Vec3 a = g.index(a_mm) + Vec3(0.5, 0.5, 0.5), b = g.index(b_mm) + Vec3(0.5, 0.5, 0.5);
+  double t0 = 0, t1 = 1;
+  const Vec3 d = b - a;
+  for (int ax = 0; ax < 3; ++ax) {
+    const double lo = 0, hi = g.dims[ax];
+    if (d[ax] == 0) {
+      if (a[ax] < lo || a[ax] > hi) return;
+      continue;
+    }
+    double ta = (lo - a[ax]) / d[ax], tb = (hi - a[ax]) / d[ax];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  if (t0 > t1) return;
+  traverseVoxels(a + d * t0, a + d * t1, g.dims, [&](std::int32_t i, std::int32_t j, std::int32_t k) {
+    f(i, j, k);
+    return true;
+  });
+}
+
+}  // namespace angiosynth
