@@ -171,6 +171,7 @@ void rasterizeDense(const VascularTree& tree, const VolumeGrid& g, const RasterO
           const std::int64_t x = bx * kBrick + i, y = by * kBrick + j, z = bz * kBrick + k;
           if (!g.contains(x, y, z)) continue;
           const int v = i + kBrick * (j + kBrick * k);
+          if (f[v] == 0) continue;  // untouched pages stay unallocated
           fraction.at(x, y, z) = f[v];
           instances.at(x, y, z) = id[v];
         }

@@ -38,14 +38,31 @@ void centerlineVoxels(const VolumeGrid& g, const Vec3& a_mm, const Vec3& b_mm,
 
 GroundTruthVolumes rasterizeGroundTruth(const VascularTree& t, const VolumeGrid& g, const RasterOptions& opt) {
   GroundTruthVolumes gt;
-  rasterizeDense(t, g, opt, gt.fraction, gt.instances);
-  gt.mask = Volume<std::uint8_t>(g, 0);
-  gt.centerline = Volume<std::uint8_t>(g, 0);
-  gt.radius = Volume<float>(g, 0.0f);
-  for (std::size_t v = 0; v < gt.fraction.data.size(); ++v) {
-    gt.mask.data[v] = gt.fraction.data[v] >= 0.5f;
-    if (!gt.mask.data[v]) gt.instances.data[v] = 0;
-  }
+  gt.fraction = Volume<float>(g);
+  gt.instances = Volume<std::uint32_t>(g);
+  gt.mask = Volume<std::uint8_t>(g);
+  gt.centerline = Volume<std::uint8_t>(g);
+  gt.radius = Volume<float>(g);
+  // Bricks are disjoint, so the visitor writes from several threads without conflict; only
+  // non-zero voxels are written.
+  const BrickBins bins = binSegments(t, g);
+  const auto nb = bins.bricks;
+  rasterizeBricks(t, g, bins, opt, [&](std::int64_t brick, const float* f, const std::uint32_t* id) {
+    const std::int64_t bx = brick % nb[0], by = (brick / nb[0]) % nb[1], bz = brick / (std::int64_t(nb[0]) * nb[1]);
+    for (int k = 0; k < kBrick; ++k)
+      for (int j = 0; j < kBrick; ++j)
+        for (int i = 0; i < kBrick; ++i) {
+          const int v = i + kBrick * (j + kBrick * k);
+          const std::int64_t x = bx * kBrick + i, y = by * kBrick + j, z = bz * kBrick + k;
+          if (f[v] == 0 || !g.contains(x, y, z)) continue;
+          const auto w = g.flat(x, y, z);
+          gt.fraction.data[w] = f[v];
+          if (f[v] >= 0.5f) {
+            gt.mask.data[w] = 1;
+            gt.instances.data[w] = id[v];
+          }
+        }
+  });
   // Thin vessels stay connected: every voxel a centreline crosses belongs to the mask. Segments
   // in id order, so at shared voxels the result does not depend on anything but the tree.
   std::vector<std::array<std::int64_t, 3>> curve;

@@ -1,7 +1,10 @@
 #pragma once
 // A voxel grid in the tree's mm frame and dense volumes on it. Voxel (i,j,k) is centred at
 // origin + (i·sx, j·sy, k·sz): `origin_mm` is the centre of voxel (0,0,0).
+#include <algorithm>
 #include <array>
+#include <cstdlib>
+#include <new>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -30,12 +33,40 @@ struct VolumeGrid {
   bool operator==(const VolumeGrid&) const = default;
 };
 
+// Allocates zeroed memory with calloc and skips value-initialisation, so a mostly empty volume
+// costs no time and no resident memory until its voxels are written (the kernel hands out zero
+// pages lazily); zero-filling a 512³ float volume otherwise takes most of a second.
+template <class T>
+struct ZeroAllocator {
+  using value_type = T;
+  ZeroAllocator() = default;
+  template <class U>
+  ZeroAllocator(const ZeroAllocator<U>&) {}
+  T* allocate(std::size_t n) {
+    if (void* p = std::calloc(n, sizeof(T))) return static_cast<T*>(p);
+    throw std::bad_alloc();
+  }
+  void deallocate(T* p, std::size_t) { std::free(p); }
+  template <class U>
+  void construct(U* p) {}  // the memory is already zero
+  template <class U, class... A>
+  void construct(U* p, A&&... a) { ::new (static_cast<void*>(p)) U(std::forward<A>(a)...); }
+  template <class U>
+  bool operator==(const ZeroAllocator<U>&) const { return true; }
+};
+
+template <class T>
+using VoxelBuffer = std::vector<T, ZeroAllocator<T>>;
+
 template <class T>
 struct Volume {
   VolumeGrid grid;
-  std::vector<T> data;
+  VoxelBuffer<T> data;
   Volume() = default;
-  explicit Volume(const VolumeGrid& g, T fill = T{}) : grid(g), data(static_cast<std::size_t>(g.voxelCount()), fill) {}
+  // Zero-filled unless `fill` says otherwise.
+  explicit Volume(const VolumeGrid& g, T fill = T{}) : grid(g), data(static_cast<std::size_t>(g.voxelCount())) {
+    if (fill != T{}) std::fill(data.begin(), data.end(), fill);
+  }
   T& at(std::int64_t i, std::int64_t j, std::int64_t k) { return data[grid.flat(i, j, k)]; }
   const T& at(std::int64_t i, std::int64_t j, std::int64_t k) const { return data[grid.flat(i, j, k)]; }
 };
