@@ -21,4 +21,18 @@ void writeGxl(std::ostream& out, const VascularTree& tree, const GraphFrame& fra
 void writeVascuSynthGxl(std::ostream& out, const VascularTree& tree, const GraphFrame& frame, const std::string& graph_id);
 void writeDot(std::ostream& out, const VascularTree& tree, const GraphFrame& frame);
 
+// Radius at a node: that of its incoming segment (the root takes the root segment's).
+double nodeRadius(const VascularTree& tree, std::int32_t node);
+
+// VesselGraph-style tables. nodes.csv: id,pos_x,pos_y,pos_z (mm),type,pressure (Pa);
+// edges.csv: id,node1id,node2id (proximal, distal),length,radius (mm),flow (mm^3/s),volume (mm^3).
+void writeNodesCsv(std::ostream& out, const VascularTree& tree);
+void writeEdgesCsv(std::ostream& out, const VascularTree& tree);
+// VTK XML PolyData: one line cell per segment; point data Radius (mm), cell data Radius, Flow.
+void writeVtp(std::ostream& out, const VascularTree& tree);
+// SWC: one row per node, parents before children, type 1 for the root and 0 otherwise.
+void writeSwc(std::ostream& out, const VascularTree& tree);
+// GraphML (directed), readable by NetworkX: node x, y, z, type, radius; edge length, radius, flow.
+void writeGraphml(std::ostream& out, const VascularTree& tree);
+
 }  // namespace angiosynth

@@ -1,0 +1,91 @@
+// Tabular and XML graph exports: VesselGraph CSV, VTK PolyData, SWC, GraphML.
+#include <numbers>
+
+#include "core/format.hpp"
+#include "io/graph_writers.hpp"
+
+namespace angiosynth {
+
+double nodeRadius(const VascularTree& t, std::int32_t i) {
+  if (i > 0) return t.radius[i];
+  return t.rootSegment() > 0 ? t.radius[t.rootSegment()] : 0.0;
+}
+
+void writeNodesCsv(std::ostream& out, const VascularTree& t) {
+  out << "id,pos_x,pos_y,pos_z,type,pressure\n";
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    const Vec3& p = t.position[i];
+    out << i << ',' << exactNumber(p.x) << ',' << exactNumber(p.y) << ',' << exactNumber(p.z) << ','
+        << nodeTypeName(t.type(i)) << ',' << exactNumber(t.pressure[i]) << '\n';
+  }
+}
+
+void writeEdgesCsv(std::ostream& out, const VascularTree& t) {
+  out << "id,node1id,node2id,length,radius,flow,volume\n";
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i)
+    out << i << ',' << t.parent[i] << ',' << i << ',' << exactNumber(t.length[i]) << ',' << exactNumber(t.radius[i]) << ','
+        << exactNumber(t.flow[i]) << ',' << exactNumber(std::numbers::pi * t.radius[i] * t.radius[i] * t.length[i]) << '\n';
+}
+
+void writeVtp(std::ostream& out, const VascularTree& t) {
+  const auto n = t.nodeCount();
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\">\n<PolyData>\n"
+      << "<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"0\" NumberOfLines=\"" << t.segmentCount()
+      << "\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
+      << "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (std::int32_t i = 0; i < n; ++i)
+    out << exactNumber(t.position[i].x) << ' ' << exactNumber(t.position[i].y) << ' ' << exactNumber(t.position[i].z) << '\n';
+  out << "</DataArray>\n</Points>\n<PointData Scalars=\"Radius\">\n<DataArray type=\"Float64\" Name=\"Radius\" format=\"ascii\">\n";
+  for (std::int32_t i = 0; i < n; ++i) out << exactNumber(nodeRadius(t, i)) << '\n';
+  out << "</DataArray>\n</PointData>\n<CellData Scalars=\"Radius\">\n<DataArray type=\"Float64\" Name=\"Radius\" format=\"ascii\">\n";
+  for (std::int32_t i = 1; i < n; ++i) out << exactNumber(t.radius[i]) << '\n';
+  out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"Flow\" format=\"ascii\">\n";
+  for (std::int32_t i = 1; i < n; ++i) out << exactNumber(t.flow[i]) << '\n';
+  out << "</DataArray>\n</CellData>\n<Lines>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+  for (std::int32_t i = 1; i < n; ++i) out << t.parent[i] << ' ' << i << '\n';
+  out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+  for (std::int32_t i = 1; i < n; ++i) out << 2 * i << '\n';
+  out << "</DataArray>\n</Lines>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+}
+
+void writeSwc(std::ostream& out, const VascularTree& t) {
+  out << "# angiosynth vascular tree; x y z R in mm; type 1 = root, 0 = vessel node\n";
+  // SWC ids start at 1 and a parent must precede its children.
+  const auto order = t.topDownOrder();
+  std::vector<std::int64_t> id(t.nodeCount(), -1);
+  for (std::size_t k = 0; k < order.size(); ++k) id[order[k]] = std::int64_t(k) + 1;
+  for (auto i : order) {
+    const Vec3& p = t.position[i];
+    out << id[i] << ' ' << (i == 0 ? 1 : 0) << ' ' << exactNumber(p.x) << ' ' << exactNumber(p.y) << ' ' << exactNumber(p.z)
+        << ' ' << exactNumber(nodeRadius(t, i)) << ' ' << (i == 0 ? -1 : id[t.parent[i]]) << '\n';
+  }
+}
+
+void writeGraphml(std::ostream& out, const VascularTree& t) {
+  out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+         "<graphml xmlns=\"http://graphml.graphdrawing.org/xmlns\" "
+         "xmlns:xsi=\"http://www.w3.org/2001/XMLSchema-instance\" "
+         "xsi:schemaLocation=\"http://graphml.graphdrawing.org/xmlns http://graphml.graphdrawing.org/xmlns/1.0/graphml.xsd\">\n"
+         "  <key id=\"x\" for=\"node\" attr.name=\"x\" attr.type=\"double\"/>\n"
+         "  <key id=\"y\" for=\"node\" attr.name=\"y\" attr.type=\"double\"/>\n"
+         "  <key id=\"z\" for=\"node\" attr.name=\"z\" attr.type=\"double\"/>\n"
+         "  <key id=\"type\" for=\"node\" attr.name=\"type\" attr.type=\"string\"/>\n"
+         "  <key id=\"node_radius\" for=\"node\" attr.name=\"radius\" attr.type=\"double\"/>\n"
+         "  <key id=\"length\" for=\"edge\" attr.name=\"length\" attr.type=\"double\"/>\n"
+         "  <key id=\"radius\" for=\"edge\" attr.name=\"radius\" attr.type=\"double\"/>\n"
+         "  <key id=\"flow\" for=\"edge\" attr.name=\"flow\" attr.type=\"double\"/>\n"
+         "  <graph id=\"tree\" edgedefault=\"directed\">\n";
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    const Vec3& p = t.position[i];
+    out << "    <node id=\"n" << i << "\"><data key=\"x\">" << exactNumber(p.x) << "</data><data key=\"y\">" << exactNumber(p.y)
+        << "</data><data key=\"z\">" << exactNumber(p.z) << "</data><data key=\"type\">" << nodeTypeName(t.type(i))
+        << "</data><data key=\"node_radius\">" << exactNumber(nodeRadius(t, i)) << "</data></node>\n";
+  }
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i)
+    out << "    <edge id=\"e" << i << "\" source=\"n" << t.parent[i] << "\" target=\"n" << i << "\"><data key=\"length\">"
+        << exactNumber(t.length[i]) << "</data><data key=\"radius\">" << exactNumber(t.radius[i]) << "</data><data key=\"flow\">"
+        << exactNumber(t.flow[i]) << "</data></edge>\n";
+  out << "  </graph>\n</graphml>\n";
+}
+
+}  // namespace angiosynth

@@ -1,0 +1,69 @@
+#pragma once
+// Volume writers. Conventions shared by every format:
+// - angiosynth's mm frame is taken as the RAS+ world frame of NIfTI (+x right, +y anterior,
+//   +z superior); voxel (i,j,k) is centred at origin + (i·sx, j·sy, k·sz) with x fastest.
+// - NRRD is written in LPS (its usual space), so x and y axes and origin are negated there:
+//   the same physical geometry in every viewer.
+// Every writer throws InputError(path, 0, …) when the file cannot be written.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "raster/volume.hpp"
+
+namespace angiosynth {
+
+enum class VoxelType { UInt8, Int16, UInt16, UInt32, Float32 };
+
+// A typed, read-only view of a volume's voxels.
+struct VolumeView {
+  const VolumeGrid* grid = nullptr;
+  const void* data = nullptr;
+  VoxelType type = VoxelType::Float32;
+  bool label = false;            // label map: NIfTI intent LABEL, nearest-neighbour semantics
+  std::string description;       // ≤ 79 characters, stored in the header
+};
+
+template <class T>
+constexpr VoxelType voxelTypeOf();
+template <> constexpr VoxelType voxelTypeOf<std::uint8_t>() { return VoxelType::UInt8; }
+template <> constexpr VoxelType voxelTypeOf<std::int16_t>() { return VoxelType::Int16; }
+template <> constexpr VoxelType voxelTypeOf<std::uint16_t>() { return VoxelType::UInt16; }
+template <> constexpr VoxelType voxelTypeOf<std::uint32_t>() { return VoxelType::UInt32; }
+template <> constexpr VoxelType voxelTypeOf<float>() { return VoxelType::Float32; }
+
+template <class T>
+VolumeView viewOf(const Volume<T>& v, bool label, std::string description) {
+  return {&v.grid, v.data.data(), voxelTypeOf<T>(), label, std::move(description)};
+}
+
+std::size_t voxelBytes(VoxelType t);
+
+// NIfTI-1, gzip-compressed (.nii.gz): sform = qform, code 1 (scanner), mm units.
+void writeNifti(const std::filesystem::path& file, const VolumeView& v);
+// NRRD with gzip encoding, space left-posterior-superior.
+void writeNrrd(const std::filesystem::path& file, const VolumeView& v);
+
+}  // namespace angiosynth
+
+namespace angiosynth {
+
+// Multi-page TIFF (one page per z slice, zip-compressed, lossless) through OpenImageIO.
+void writeTiff(const std::filesystem::path& file, const VolumeView& v);
+
+// A 2D 8-bit image (row-major, width fastest).
+struct Image8 {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> pixels;
+};
+// Maximum-intensity projection along axis 0, 1 or 2, mapping [lo, hi] to [0, 255]. The image
+// shows the two remaining axes in increasing order (the lower one horizontal), index 0 at the
+// top left.
+Image8 maximumProjection(const Volume<float>& v, int axis, double lo, double hi);
+// Slice z of a volume, mapping [lo, hi] to [0, 255].
+Image8 sliceZ(const Volume<float>& v, std::int32_t z, double lo, double hi);
+// Lossless 8-bit PNG through OpenImageIO.
+void writePng(const std::filesystem::path& file, const Image8& image);
+
+}  // namespace angiosynth
