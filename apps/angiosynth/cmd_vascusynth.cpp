@@ -52,6 +52,7 @@ int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line) {
     req.command_line = command_line;
     req.memory_limit = memoryLimit(a.common);
     req.progress = progressPrinter(a.common, names[i].text);
+    req.output_voxel_mm = a.output_voxel_width * sc.input_units.mm_per_length;
     req.extra["output_voxel_width"] = {{"value", a.output_voxel_width * sc.input_units.mm_per_length}, {"unit", "mm"}};
     generateSample(req, dir.path());
     dir.commit();

@@ -15,6 +15,8 @@ struct GenerateArgs {
   std::string out;
   std::optional<std::uint64_t> seed;
   std::string gxl_dialect;
+  std::vector<std::string> formats;
+  bool no_image = false;
   bool force = false;
   CommonOptions common;
 };

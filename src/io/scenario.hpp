@@ -14,6 +14,18 @@
 
 namespace angiosynth {
 
+// How the tree becomes volumes (issue: rasterizer). Defaults suit 8-bit images of the map.
+struct ImageParameters {
+  bool enabled = true;
+  double voxel_mm = 0;                 // 0: the demand map's voxel size
+  Vec3 field_of_view_mm;               // 0: the demand map's extent
+  int supersampling = 4;               // S: S³ samples per partially covered voxel
+  double background = 0, vessel = 255; // image = background + (vessel − background) × fraction
+  std::string dtype = "uint8";         // uint8, uint16, int16, float32
+  std::vector<std::string> formats{"nifti", "png"};                        // nifti, nrrd, tiff, png
+  std::vector<std::string> graph_formats{"csv", "vtp", "swc", "graphml"};  // besides GXL and DOT
+};
+
 struct Scenario {
   std::string parameter_file;
   std::string format;  // "vascusynth" or "toml"
@@ -26,6 +38,8 @@ struct Scenario {
   int root_line = 0;
   GrowthOptions growth;                        // root_mm is set once the map is known
   std::optional<std::uint64_t> seed;
+  ImageParameters image;
+  int image_line = 0;                          // line of [image], for errors about its size
   std::string gxl_dialect = "gxl";             // "gxl" (GXL 1.0) or "vascusynth"
   CoherentUnits input_units;                   // only for VascuSynth files
   nlohmann::ordered_json parameters;           // resolved values with units, for sample.json

@@ -2,6 +2,7 @@
 // "3.6 mPa*s", "8330 mm3/s"). Every key is checked; unknown keys are errors.
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <set>
 
 #include "core/error.hpp"
@@ -109,7 +110,7 @@ Scenario readTomlParameters(const std::filesystem::path& path) {
     throw InputError(file, static_cast<int>(e.source().begin.line), std::string("not valid TOML: ") + std::string(e.description()));
   }
   TomlReader r(root, file);
-  r.checkKeys(root, {"seed", "domain", "tree", "physics", "output"}, "the top level");
+  r.checkKeys(root, {"seed", "domain", "tree", "physics", "image", "output"}, "the top level");
   Scenario sc;
   sc.parameter_file = file;
   sc.format = "toml";
@@ -189,6 +190,63 @@ Scenario readTomlParameters(const std::filesystem::path& path) {
   p.perfusion_flow = r.quantity(ph, "physics", "perfusion_flow", Dimension::Flow);
   checkRange(p.perfusion_flow, 0, true, INFINITY, true, r.at(ph, "perfusion_flow"), "perfusion_flow (mm^3/s)");
   p.total_terminals = g.terminals;
+
+  const auto& im = r.table("image", {"enabled", "voxel_size", "field_of_view", "supersampling", "background", "vessel",
+                                     "dtype", "formats", "graph_formats"});
+  auto& ip = sc.image;
+  sc.image_line = r.lineOf(root.get("image"));
+  if (const auto* n = im.get("enabled")) {
+    if (!n->is_boolean()) throw InputError(file, r.lineOf(n), "enabled must be true or false");
+    ip.enabled = *n->value<bool>();
+  }
+  if (im.get("voxel_size")) {
+    ip.voxel_mm = r.quantity(im, "image", "voxel_size", Dimension::Length, sc.voxel_mm);
+    checkRange(ip.voxel_mm, 0, true, INFINITY, true, r.at(im, "voxel_size"), "image voxel_size (mm)");
+  }
+  if (const auto* n = im.get("field_of_view")) {
+    const auto* arr = n->as_array();
+    if (!arr || arr->size() != 3) throw InputError(file, r.lineOf(n), "field_of_view must be 3 lengths, e.g. [\"40 mm\", \"40 mm\", \"40 mm\"]");
+    double f[3];
+    for (int ax = 0; ax < 3; ++ax) {
+      const auto v = (*arr)[ax].value<std::string>();
+      if (!v) throw InputError(file, r.lineOf(n), "field_of_view must hold strings \"<number> <unit>\"");
+      try {
+        f[ax] = parseQuantity(*v, Dimension::Length, sc.voxel_mm);
+      } catch (const std::invalid_argument& e) {
+        throw InputError(file, r.lineOf(n), std::string("field_of_view: ") + e.what());
+      }
+      checkRange(f[ax], 0, true, INFINITY, true, r.at(im, "field_of_view"), "field_of_view (mm)");
+    }
+    ip.field_of_view_mm = Vec3(f[0], f[1], f[2]);
+  }
+  if (im.get("supersampling")) {
+    ip.supersampling = static_cast<int>(r.integer(im, "image", "supersampling"));
+    checkRange(ip.supersampling, 1, false, 16, false, r.at(im, "supersampling"), "supersampling");
+  }
+  if (im.get("background")) ip.background = r.number(im, "image", "background");
+  if (im.get("vessel")) ip.vessel = r.number(im, "image", "vessel");
+  if (im.get("dtype")) {
+    ip.dtype = r.string(im, "image", "dtype");
+    if (ip.dtype != "uint8" && ip.dtype != "uint16" && ip.dtype != "int16" && ip.dtype != "float32")
+      throw InputError(file, r.lineOf(im.get("dtype")), "dtype '" + ip.dtype + "'; allowed: uint8, uint16, int16, float32");
+  }
+  const auto strings = [&](const char* key, const std::vector<std::string>& allowed) {
+    const toml::node* n = im.get(key);
+    std::vector<std::string> out;
+    const auto* arr = n->as_array();
+    if (!arr) throw InputError(file, r.lineOf(n), std::string(key) + " must be an array of strings");
+    for (const auto& e : *arr) {
+      const auto v = e.value<std::string>();
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      if (!v || std::find(allowed.begin(), allowed.end(), *v) == allowed.end())
+        throw InputError(file, r.lineOf(n), std::string(key) + ": '" + (v ? *v : "?") + "' is not a format; allowed: " + list);
+      out.push_back(*v);
+    }
+    return out;
+  };
+  if (im.get("formats")) ip.formats = strings("formats", {"nifti", "nrrd", "tiff", "png"});
+  if (im.get("graph_formats")) ip.graph_formats = strings("graph_formats", {"csv", "vtp", "swc", "graphml"});
 
   const auto& out = r.table("output", {"gxl_dialect"});
   if (out.get("gxl_dialect")) {

@@ -9,6 +9,7 @@
 #include "core/format.hpp"
 #include "io/graph_writers.hpp"
 #include "io/map_files.hpp"
+#include "pipeline/volume_outputs.hpp"
 #include "physics/hemodynamics.hpp"
 
 namespace angiosynth {
@@ -62,6 +63,17 @@ Json describeParameters(const Scenario& sc) {
   j["terminal_pressure"] = q(p.terminal_pressure, "Pa");
   j["perfusion_flow"] = q(p.perfusion_flow, "mm^3/s");
   j["terminal_flow"] = q(p.perfusion_flow / double(g.terminals), "mm^3/s");
+  const auto& im = sc.image;
+  j["image"] = Json{{"enabled", im.enabled},
+                    {"voxel_size", q(im.voxel_mm > 0 ? im.voxel_mm : sc.voxel_mm, "mm")},
+                    {"field_of_view", im.field_of_view_mm.x > 0 ? Json{{"value", {im.field_of_view_mm.x, im.field_of_view_mm.y, im.field_of_view_mm.z}}, {"unit", "mm"}}
+                                                               : Json("the demand map's extent")},
+                    {"supersampling", im.supersampling},
+                    {"background", im.background},
+                    {"vessel", im.vessel},
+                    {"dtype", im.dtype},
+                    {"formats", im.formats},
+                    {"graph_formats", im.graph_formats}};
   return j;
 }
 
@@ -100,7 +112,24 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
     writeWith(dir / "tree.dot", [&](std::ostream& o) { writeDot(o, tree, frame); });
     files["dot"] = "tree.dot";
   }
-  timing["write"] = seconds(t0);
+  timing["write_graphs"] = seconds(t0);
+
+  Json stats;
+  ImageParameters ip = sc.image;
+  if (!req.formats.empty()) ip.formats = req.formats;
+  if (req.vascusynth_layout) ip.formats = {"nifti"};  // beside the PNG slices of original_image
+  if (ip.enabled && !req.no_image) {
+    t0 = Clock::now();
+    VolumeRequest vr;
+    vr.grid = req.vascusynth_layout ? vascusynthGrid(map, req.output_voxel_mm) : imageGrid(map, ip);
+    vr.image = ip;
+    vr.memory_limit = req.memory_limit;
+    vr.parameter_file = sc.parameter_file;
+    vr.image_line = sc.image_line;
+    vr.slices = req.vascusynth_layout;
+    writeVolumes(tree, vr, dir, files, stats);
+    timing["rasterize_and_write_volumes"] = seconds(t0);
+  }
 
   // Statistics of the final tree.
   const auto& p = opt.physics;
@@ -117,7 +146,6 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   pp.total_terminals = opt.terminals;
   const double cost = treeCost(tree, pp);
   const double len_unit = sc.input_units.mm_per_length;
-  Json stats;
   stats["terminals"] = tree.terminalCount();
   stats["nodes"] = tree.nodeCount();
   stats["segments"] = tree.segmentCount();

@@ -21,6 +21,9 @@ struct SampleRequest {
   std::uint64_t memory_limit = 0;
   nlohmann::ordered_json extra;           // more resolved parameters for sample.json
   ProgressFn progress;
+  double output_voxel_mm = 0;             // VascuSynth layout: the image voxel width
+  std::vector<std::string> formats;       // volume formats overriding the parameters' (empty: keep)
+  bool no_image = false;                  // graphs only
 };
 
 // Writes the sample's files into `dir` and returns the content of its sample.json.

@@ -1,0 +1,37 @@
+#pragma once
+// The volume stage of a sample: grid, size guard, rasterisation, and every volume, key-point and
+// graph file, recorded by role for sample.json.
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "domain/demand_map.hpp"
+#include "io/scenario.hpp"
+#include "raster/volume.hpp"
+
+namespace angiosynth {
+
+// The image grid over the demand map: voxel size and field of view from the parameters, by
+// default the map's own; voxel centres at (i + ½)·voxel from the map's corner.
+VolumeGrid imageGrid(const DemandMap& map, const ImageParameters& p);
+// VascuSynth's output grid: floor(map size × VOXEL_WIDTH / OUTPUT_VOXEL_WIDTH) + 1 samples per
+// axis at i·OUTPUT_VOXEL_WIDTH (map-voxel corners), so a 100³ map at 0.04/0.04 gives 101³.
+VolumeGrid vascusynthGrid(const DemandMap& map, double output_voxel_mm);
+
+struct VolumeRequest {
+  VolumeGrid grid;
+  ImageParameters image;
+  std::uint64_t memory_limit = 0;
+  std::string parameter_file;     // for size errors
+  int image_line = 0;
+  bool slices = false;            // also one lossless PNG per z slice (VascuSynth's layout)
+  std::string slice_dir = "original_image";
+};
+
+// Writes the volumes and graph files into dir; adds {role: path} to `files` and figures to
+// `stats`. Throws InputError before allocating when the volumes would exceed the memory limit.
+void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std::filesystem::path& dir,
+                  nlohmann::ordered_json& files, nlohmann::ordered_json& stats);
+
+}  // namespace angiosynth

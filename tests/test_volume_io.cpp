@@ -1,0 +1,115 @@
+// Volume and graph files as other tools read them: NIfTI through nibabel, GraphML through
+// NetworkX, PNG/TIFF through OpenImageIO, NRRD by its header.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "io/graph_writers.hpp"
+#include "io/volume_writers.hpp"
+#include "test_support.hpp"
+
+using namespace angiosynth;
+namespace fs = std::filesystem;
+
+namespace {
+
+// Debian's interpreter: nibabel and NetworkX come from Debian packages (python3 on PATH may be
+// another installation).
+std::string python(const std::string& script) {
+  const fs::path file = fs::temp_directory_path() / "angiosynth_check.py";
+  std::ofstream(file) << script;
+  std::string out;
+  if (FILE* p = popen(("/usr/bin/python3 '" + file.string() + "' 2>&1").c_str(), "r")) {
+    char buf[4096];
+    while (fgets(buf, sizeof buf, p)) out += buf;
+    pclose(p);
+  }
+  return out;
+}
+
+class VolumeFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("angiosynth_vol_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    grid_.dims = {7, 5, 3};
+    grid_.spacing_mm = Vec3(0.5, 0.25, 2.0);
+    grid_.origin_mm = Vec3(-3.0, 1.5, 10.0);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+  VolumeGrid grid_;
+};
+
+TEST_F(VolumeFiles, NiftiReadByNibabelHasTheIntendedAffineAndExactLabels) {
+  Volume<std::uint32_t> labels(grid_);
+  for (std::size_t v = 0; v < labels.data.size(); ++v) labels.data[v] = static_cast<std::uint32_t>(v * 40503u + 7u);
+  labels.at(6, 4, 2) = 4000000000u;
+  Volume<float> image(grid_);
+  for (std::size_t v = 0; v < image.data.size(); ++v) image.data[v] = 0.125f * float(v);
+  writeNifti(dir_ / "labels.nii.gz", viewOf(labels, true, "labels"));
+  writeNifti(dir_ / "image.nii.gz", viewOf(image, false, "image"));
+  const std::string out = python(R"(
+import nibabel as nib, numpy as np
+d = ')" + dir_.string() + R"('
+lab = nib.load(d + '/labels.nii.gz'); img = nib.load(d + '/image.nii.gz')
+want = np.array([[0.5,0,0,-3.0],[0,0.25,0,1.5],[0,0,2.0,10.0],[0,0,0,1]])
+print('affine', np.allclose(lab.affine, want, atol=1e-6), np.allclose(img.affine, want, atol=1e-6))
+h = lab.header
+print('codes', int(h['sform_code']), int(h['qform_code']), np.allclose(h.get_sform(), h.get_qform(), atol=1e-6))
+print('units', h.get_xyzt_units()[0], 'intent', h.get_intent()[0])
+a = np.asanyarray(lab.dataobj)
+print('dtype', a.dtype, a.shape, int(a[6,4,2]), int(a[1,0,0]), int(a[0,1,0]), int(a[0,0,1]))
+b = np.asanyarray(img.dataobj)
+print('image', b.dtype, float(b[1,0,0]), float(b[0,1,0]), float(b[0,0,1]))
+# ITK reads the same file in LPS: the centre of voxel (6,4,2) is RAS (0,2.5,14) -> LPS (-0,-2.5,14)
+print('world', list(np.round(lab.affine @ [6,4,2,1], 6)[:3]))
+)");
+  EXPECT_NE(out.find("affine True True"), std::string::npos) << out;
+  EXPECT_NE(out.find("codes 1 1 True"), std::string::npos) << out;
+  EXPECT_NE(out.find("units mm intent label"), std::string::npos) << out;
+  // x fastest: flat index v = i + 7 (j + 5 k).
+  EXPECT_NE(out.find("dtype uint32 (7, 5, 3) 4000000000 40510 283528 1417612"), std::string::npos) << out;
+  EXPECT_NE(out.find("image float32 0.125 0.875 4.375"), std::string::npos) << out;
+  EXPECT_NE(out.find("world [0.0, 2.5, 14.0]"), std::string::npos) << out;
+}
+
+TEST_F(VolumeFiles, NrrdHeaderDescribesTheSameGeometryInLps) {
+  Volume<std::uint8_t> m(grid_);
+  writeNrrd(dir_ / "m.nrrd", viewOf(m, true, "mask"));
+  std::ifstream in(dir_ / "m.nrrd", std::ios::binary);
+  std::string header, line;
+  while (std::getline(in, line) && !line.empty()) header += line + "\n";
+  EXPECT_NE(header.find("space: left-posterior-superior"), std::string::npos) << header;
+  EXPECT_NE(header.find("space directions: (-0.5,0,0) (0,-0.25,0) (0,0,2)"), std::string::npos) << header;
+  EXPECT_NE(header.find("space origin: (3,-1.5,10)"), std::string::npos) << header;
+  EXPECT_NE(header.find("sizes: 7 5 3"), std::string::npos) << header;
+}
+
+TEST(GraphFiles, GraphmlLoadsInNetworkxAndMatchesTheTree) {
+  auto ex = test::vascusynthExample(50, 3);
+  const VascularTree t = test::grow(ex);
+  const fs::path file = fs::temp_directory_path() / "angiosynth_tree.graphml";
+  std::ofstream(file) << [&] {
+    std::ostringstream s;
+    writeGraphml(s, t);
+    return s.str();
+  }();
+  const std::string out = python(R"(
+import networkx as nx
+g = nx.read_graphml(')" + file.string() + R"(')
+print('graph', g.number_of_nodes(), g.number_of_edges(), nx.is_tree(g.to_undirected()))
+print('root', g.nodes['n0']['type'], repr(g.edges['n0', list(g.successors('n0'))[0]]['radius']))
+)");
+  std::ostringstream want;
+  want << "graph " << t.nodeCount() << " " << t.segmentCount() << " True";
+  EXPECT_NE(out.find(want.str()), std::string::npos) << out;
+  EXPECT_NE(out.find("root root " + std::to_string(t.radius[t.rootSegment()]).substr(0, 6)), std::string::npos) << out;
+  fs::remove(file);
+}
+
+}  // namespace
