@@ -60,6 +60,12 @@ TEST_F(Cli, GenerateWritesValidRoundTrippingGxlAndSidecar) {
   EXPECT_EQ(j["parameters"]["viscosity"]["unit"], "Pa*s");
   EXPECT_LT(j["statistics"]["cost_cm"]["value"].get<double>(), 0.1719);
   ASSERT_TRUE(fs::exists(dir_ / "out/tree.dot"));
+  for (const char* role : {"image", "mask", "centerline", "radius", "instances", "keypoints", "mip_x", "mip_y", "mip_z",
+                           "nodes_csv", "edges_csv", "vtp", "swc", "graphml"}) {
+    ASSERT_TRUE(j["files"].contains(role)) << role;
+    EXPECT_TRUE(fs::exists(dir_ / "out" / j["files"][role].get<std::string>())) << role;
+  }
+  EXPECT_EQ(j["statistics"]["image_size"], Json::parse("[100,100,100]"));
 
   tinyxml2::XMLDocument doc;
   ASSERT_EQ(doc.LoadFile((dir_ / "out/tree.gxl").c_str()), tinyxml2::XML_SUCCESS);
@@ -99,6 +105,9 @@ TEST_F(Cli, SameSeedSameBytesWhateverTheThreads) {
   ASSERT_EQ(run("generate " + params + " --out two --threads 2 --quiet", dir_).code, 0);
   EXPECT_EQ(slurp(dir_ / "one/tree.gxl"), slurp(dir_ / "two/tree.gxl"));
   EXPECT_EQ(slurp(dir_ / "one/tree.dot"), slurp(dir_ / "two/tree.dot"));
+  for (const char* f : {"image.nii.gz", "mask.nii.gz", "centerline.nii.gz", "radius.nii.gz", "instances.nii.gz", "mip_z.png",
+                        "keypoints.csv", "tree.graphml", "centerlines.vtp"})
+    EXPECT_EQ(slurp(dir_ / "one" / f), slurp(dir_ / "two" / f)) << f;
   Json a = Json::parse(slurp(dir_ / "one/sample.json")), b = Json::parse(slurp(dir_ / "two/sample.json"));
   for (auto* j : {&a, &b}) j->erase("timing_seconds"), j->erase("command_line");
   EXPECT_EQ(a.dump(), b.dump());
@@ -146,7 +155,30 @@ TEST_F(Cli, VascuSynthSubcommandWritesItsLayoutAndDialect) {
   EXPECT_NE(xml.find(" bifurication "), std::string::npos);
   EXPECT_NE(xml.find("<attr name=\" flow\"><float>8.33</float></attr>"), std::string::npos);
   EXPECT_TRUE(fs::exists(dir_ / "image1/tree_structure.xml"));
+  // The lossless image VascuSynth users expect: 101³ for a 100³ map at 0.04/0.04, as NIfTI and
+  // one PNG per slice (never JPEG).
+  EXPECT_TRUE(fs::exists(dir_ / "image1/original_image/image.nii.gz"));
+  EXPECT_TRUE(fs::exists(dir_ / "image1/original_image/image000.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "image1/original_image/image100.png"));
+  EXPECT_FALSE(fs::exists(dir_ / "image1/original_image/image101.png"));
+  const Json j = Json::parse(slurp(dir_ / "image1/sample.json"));
+  EXPECT_EQ(j["statistics"]["image_size"], Json::parse("[101,101,101]"));
   EXPECT_TRUE(fs::exists(dir_ / "image1/sample.json"));
+}
+
+TEST_F(Cli, OversizedImagesAreRefusedBeforeAllocating) {
+  std::ofstream(dir_ / "big.toml") << slurp(src_ / "examples/vascusynth_like.toml") << "\n";
+  std::string t = slurp(dir_ / "big.toml");
+  const std::string rel = "\"../demand_maps/";
+  t.replace(t.find(rel), rel.size(), "\"" + (src_ / "demand_maps").string() + "/");
+  t.replace(t.find("[output]"), 8, "[image]\nvoxel_size = \"0.01 mm\"\n\n[output]");
+  std::ofstream(dir_ / "big.toml") << t;
+  const auto r = run("generate big.toml --out out --memory-limit 1 --quiet", dir_);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("an image of 4000x4000x4000 voxels needs"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("raise [image] voxel_size"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.rfind("big.toml:", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
 
 TEST_F(Cli, HelpAndVersion) {

@@ -84,6 +84,22 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   const DemandMap map = loadDomain(sc, req.memory_limit);
   timing["read_maps"] = seconds(t0);
 
+  // The volume request is settled, and its size checked, before the (possibly long) growth.
+  ImageParameters ip = sc.image;
+  if (!req.formats.empty()) ip.formats = req.formats;
+  if (req.vascusynth_layout) ip.formats = {"nifti"};  // beside the PNG slices of original_image
+  const bool volumes = ip.enabled && !req.no_image;
+  VolumeRequest vr;
+  if (volumes) {
+    vr.grid = req.vascusynth_layout ? vascusynthGrid(map, req.output_voxel_mm) : imageGrid(map, ip);
+    vr.image = ip;
+    vr.memory_limit = req.memory_limit;
+    vr.parameter_file = sc.parameter_file;
+    vr.image_line = sc.image_line;
+    vr.slices = req.vascusynth_layout;
+    checkVolumeMemory(vr);
+  }
+
   GrowthOptions opt = sc.growth;
   opt.root_mm = map.toMm(sc.root_voxel);
   opt.seed = req.seed;
@@ -115,18 +131,8 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   timing["write_graphs"] = seconds(t0);
 
   Json stats;
-  ImageParameters ip = sc.image;
-  if (!req.formats.empty()) ip.formats = req.formats;
-  if (req.vascusynth_layout) ip.formats = {"nifti"};  // beside the PNG slices of original_image
-  if (ip.enabled && !req.no_image) {
+  if (volumes) {
     t0 = Clock::now();
-    VolumeRequest vr;
-    vr.grid = req.vascusynth_layout ? vascusynthGrid(map, req.output_voxel_mm) : imageGrid(map, ip);
-    vr.image = ip;
-    vr.memory_limit = req.memory_limit;
-    vr.parameter_file = sc.parameter_file;
-    vr.image_line = sc.image_line;
-    vr.slices = req.vascusynth_layout;
     writeVolumes(tree, vr, dir, files, stats);
     timing["rasterize_and_write_volumes"] = seconds(t0);
   }

@@ -71,17 +71,23 @@ VolumeGrid vascusynthGrid(const DemandMap& map, double output_voxel_mm) {
   return g;
 }
 
-void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std::filesystem::path& dir, Json& files,
-                  Json& stats) {
+void checkVolumeMemory(const VolumeRequest& req) {
   const VolumeGrid& g = req.grid;
-  const ImageParameters& ip = req.image;
   const std::string size = std::to_string(g.dims[0]) + "x" + std::to_string(g.dims[1]) + "x" + std::to_string(g.dims[2]);
+  // Every channel, the typed image, and slack for one more float volume during conversion.
   const std::uint64_t need = denseRasterBytes(g) + static_cast<std::uint64_t>(g.voxelCount()) * 4;
   if (need > req.memory_limit)
     throw InputError(req.parameter_file, req.image_line,
                      "an image of " + size + " voxels needs " + formatBytes(need) + " of memory, more than the limit of " +
                          formatBytes(req.memory_limit) +
                          "; raise [image] voxel_size, shrink [image] field_of_view, or raise --memory-limit");
+}
+
+void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std::filesystem::path& dir, Json& files,
+                  Json& stats) {
+  const VolumeGrid& g = req.grid;
+  const ImageParameters& ip = req.image;
+  checkVolumeMemory(req);
   const GroundTruthVolumes gt = rasterizeGroundTruth(tree, g, RasterOptions{ip.supersampling});
 
   // Volumes in every requested format; the first format owns the plain role names.

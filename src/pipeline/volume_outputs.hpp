@@ -29,6 +29,9 @@ struct VolumeRequest {
   std::string slice_dir = "original_image";
 };
 
+// Throws InputError when the request's volumes would exceed its memory limit.
+void checkVolumeMemory(const VolumeRequest& req);
+
 // Writes the volumes and graph files into dir; adds {role: path} to `files` and figures to
 // `stats`. Throws InputError before allocating when the volumes would exceed the memory limit.
 void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std::filesystem::path& dir,
