@@ -15,9 +15,9 @@ CLI::App* addGenerate(CLI::App& app, GenerateArgs& a) {
   c->add_option("--seed", a.seed, "random seed (default: the file's seed, else fresh and recorded in sample.json)");
   c->add_option("--gxl-dialect", a.gxl_dialect, "gxl: valid GXL 1.0 (default); vascusynth: VascuSynth 2011's dialect")
       ->check(CLI::IsMember({"gxl", "vascusynth"}));
-  c->add_option("--format", a.formats, "volume formats, overriding [image] formats: nifti, nrrd, tiff, png (MIPs)")
+  c->add_option("--format", a.formats, "volume formats, overriding [image] formats: nifti, nrrd, tiff, png (MIPs), vdb (sparse)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"nifti", "nrrd", "tiff", "png"}));
+      ->check(CLI::IsMember({"nifti", "nrrd", "tiff", "png", "vdb"}));
   c->add_flag("--no-image", a.no_image, "grow and write graphs only, no volumes");
   c->add_flag("--force", a.force, "replace the output directory if it exists");
   addCommonOptions(*c, a.common);

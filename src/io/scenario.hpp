@@ -22,7 +22,7 @@ struct ImageParameters {
   int supersampling = 4;               // S: S³ samples per partially covered voxel
   double background = 0, vessel = 255; // image = background + (vessel − background) × fraction
   std::string dtype = "uint8";         // uint8, uint16, int16, float32
-  std::vector<std::string> formats{"nifti", "png"};                        // nifti, nrrd, tiff, png
+  std::vector<std::string> formats{"nifti", "png"};                        // nifti, nrrd, tiff, png, vdb
   std::vector<std::string> graph_formats{"csv", "vtp", "swc", "graphml"};  // besides GXL and DOT
 };
 

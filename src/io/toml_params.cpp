@@ -245,7 +245,7 @@ Scenario readTomlParameters(const std::filesystem::path& path) {
     }
     return out;
   };
-  if (im.get("formats")) ip.formats = strings("formats", {"nifti", "nrrd", "tiff", "png"});
+  if (im.get("formats")) ip.formats = strings("formats", {"nifti", "nrrd", "tiff", "png", "vdb"});
   if (im.get("graph_formats")) ip.graph_formats = strings("graph_formats", {"csv", "vtp", "swc", "graphml"});
 
   const auto& out = r.table("output", {"gxl_dialect"});

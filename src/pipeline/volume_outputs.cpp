@@ -8,6 +8,7 @@
 #include "core/format.hpp"
 #include "core/memory.hpp"
 #include "io/graph_writers.hpp"
+#include "io/vdb_writer.hpp"
 #include "io/volume_writers.hpp"
 #include "raster/ground_truth.hpp"
 
@@ -47,6 +48,30 @@ void writeKeypoints(std::ostream& out, const VascularTree& t, const VolumeGrid& 
   }
 }
 
+// Key points and the graph formats besides GXL and DOT.
+void writeGraphFiles(const VascularTree& tree, const VolumeGrid& g, const ImageParameters& ip,
+                     const std::filesystem::path& dir, Json& files) {
+  writeText(dir / "keypoints.csv", [&](std::ostream& o) { writeKeypoints(o, tree, g); });
+  files["keypoints"] = "keypoints.csv";
+  for (const auto& fmt : ip.graph_formats) {
+    if (fmt == "csv") {
+      writeText(dir / "nodes.csv", [&](std::ostream& o) { writeNodesCsv(o, tree); });
+      writeText(dir / "edges.csv", [&](std::ostream& o) { writeEdgesCsv(o, tree); });
+      files["nodes_csv"] = "nodes.csv";
+      files["edges_csv"] = "edges.csv";
+    } else if (fmt == "vtp") {
+      writeText(dir / "centerlines.vtp", [&](std::ostream& o) { writeVtp(o, tree); });
+      files["vtp"] = "centerlines.vtp";
+    } else if (fmt == "swc") {
+      writeText(dir / "tree.swc", [&](std::ostream& o) { writeSwc(o, tree); });
+      files["swc"] = "tree.swc";
+    } else if (fmt == "graphml") {
+      writeText(dir / "tree.graphml", [&](std::ostream& o) { writeGraphml(o, tree); });
+      files["graphml"] = "tree.graphml";
+    }
+  }
+}
+
 }  // namespace
 
 VolumeGrid imageGrid(const DemandMap& map, const ImageParameters& p) {
@@ -71,7 +96,12 @@ VolumeGrid vascusynthGrid(const DemandMap& map, double output_voxel_mm) {
   return g;
 }
 
+bool needsDense(const VolumeRequest& req) {
+  return req.slices || std::any_of(req.image.formats.begin(), req.image.formats.end(), [](const std::string& f) { return f != "vdb"; });
+}
+
 void checkVolumeMemory(const VolumeRequest& req) {
+  if (!needsDense(req)) return;  // the sparse path is checked once the tree is known
   const VolumeGrid& g = req.grid;
   const std::string size = std::to_string(g.dims[0]) + "x" + std::to_string(g.dims[1]) + "x" + std::to_string(g.dims[2]);
   // Every channel, the typed image, and slack for one more float volume during conversion.
@@ -88,6 +118,25 @@ void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std:
   const VolumeGrid& g = req.grid;
   const ImageParameters& ip = req.image;
   checkVolumeMemory(req);
+  if (std::find(ip.formats.begin(), ip.formats.end(), "vdb") != ip.formats.end()) {
+    const BrickBins bins = binSegments(tree, g);
+    const auto need = sparseRasterBytes(bins);
+    if (need > req.memory_limit)
+      throw InputError(req.parameter_file, req.image_line,
+                       "the sparse volume needs about " + formatBytes(need) + ", more than the limit of " +
+                           formatBytes(req.memory_limit) + "; raise [image] voxel_size or --memory-limit");
+    const VdbReport r = writeVdb(dir / "volume.vdb", tree, g, bins, RasterOptions{ip.supersampling});
+    files["vdb"] = "volume.vdb";
+    stats["vdb_leaves"] = r.leaves;
+    stats["vdb_active_voxels"] = r.active_voxels;
+  }
+  stats["image_size"] = {g.dims[0], g.dims[1], g.dims[2]};
+  stats["image_voxel_size"] = Json{{"value", {g.spacing_mm.x, g.spacing_mm.y, g.spacing_mm.z}}, {"unit", "mm"}};
+  stats["image_origin"] = Json{{"value", {g.origin_mm.x, g.origin_mm.y, g.origin_mm.z}},
+                               {"unit", "mm"},
+                               {"definition", "centre of voxel (0,0,0); world frame RAS+ (NIfTI, VDB), LPS in NRRD"}};
+  writeGraphFiles(tree, g, ip, dir, files);
+  if (!needsDense(req)) return;
   const GroundTruthVolumes gt = rasterizeGroundTruth(tree, g, RasterOptions{ip.supersampling});
 
   // Volumes in every requested format; the first format owns the plain role names.
@@ -111,6 +160,7 @@ void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std:
                               {"instances", viewOf(gt.instances, true, "angiosynth segment id")}};
   bool first_volume_format = true;
   for (const auto& fmt : ip.formats) {
+    if (fmt == "vdb") continue;
     if (fmt == "png") {
       // Maximum-intensity projections of the partial-volume image along each axis.
       const char* axes[] = {"mip_x", "mip_y", "mip_z"};
@@ -142,32 +192,8 @@ void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std:
     }
     files["original_image_slices"] = req.slice_dir + "/image%03d.png";
   }
-  writeText(dir / "keypoints.csv", [&](std::ostream& o) { writeKeypoints(o, tree, g); });
-  files["keypoints"] = "keypoints.csv";
-  for (const auto& fmt : ip.graph_formats) {
-    if (fmt == "csv") {
-      writeText(dir / "nodes.csv", [&](std::ostream& o) { writeNodesCsv(o, tree); });
-      writeText(dir / "edges.csv", [&](std::ostream& o) { writeEdgesCsv(o, tree); });
-      files["nodes_csv"] = "nodes.csv";
-      files["edges_csv"] = "edges.csv";
-    } else if (fmt == "vtp") {
-      writeText(dir / "centerlines.vtp", [&](std::ostream& o) { writeVtp(o, tree); });
-      files["vtp"] = "centerlines.vtp";
-    } else if (fmt == "swc") {
-      writeText(dir / "tree.swc", [&](std::ostream& o) { writeSwc(o, tree); });
-      files["swc"] = "tree.swc";
-    } else if (fmt == "graphml") {
-      writeText(dir / "tree.graphml", [&](std::ostream& o) { writeGraphml(o, tree); });
-      files["graphml"] = "tree.graphml";
-    }
-  }
   std::int64_t mask_voxels = 0;
   for (auto m : gt.mask.data) mask_voxels += m;
-  stats["image_size"] = {g.dims[0], g.dims[1], g.dims[2]};
-  stats["image_voxel_size"] = Json{{"value", {g.spacing_mm.x, g.spacing_mm.y, g.spacing_mm.z}}, {"unit", "mm"}};
-  stats["image_origin"] = Json{{"value", {g.origin_mm.x, g.origin_mm.y, g.origin_mm.z}},
-                               {"unit", "mm"},
-                               {"definition", "centre of voxel (0,0,0); world frame RAS+ (NIfTI), LPS in NRRD"}};
   stats["mask_voxels"] = mask_voxels;
 }
 
