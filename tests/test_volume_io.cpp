@@ -113,3 +113,44 @@ print('root', g.nodes['n0']['type'], repr(g.edges['n0', list(g.successors('n0'))
 }
 
 }  // namespace
+
+#include <OpenImageIO/imageio.h>
+
+namespace {
+
+TEST_F(VolumeFiles, TiffHasOnePagePerSliceAndPngMipIsTheMaximum) {
+  Volume<std::uint16_t> v(grid_);
+  for (std::size_t i = 0; i < v.data.size(); ++i) v.data[i] = static_cast<std::uint16_t>(i * 97 % 60000);
+  writeTiff(dir_ / "v.tif", viewOf(v, false, "test"));
+  auto in = OIIO::ImageInput::open((dir_ / "v.tif").string());
+  ASSERT_TRUE(in);
+  int pages = 0;
+  std::vector<std::uint16_t> page(std::size_t(grid_.dims[0]) * grid_.dims[1]);
+  bool exact = true;
+  while (in->seek_subimage(pages, 0)) {
+    EXPECT_EQ(in->spec().width, 7);
+    EXPECT_EQ(in->spec().height, 5);
+    ASSERT_TRUE(in->read_image(pages, 0, 0, 1, OIIO::TypeDesc::UINT16, page.data()));
+    for (std::size_t p = 0; p < page.size(); ++p) exact &= page[p] == v.data[pages * page.size() + p];
+    ++pages;
+  }
+  EXPECT_EQ(pages, 3);
+  EXPECT_TRUE(exact);
+
+  Volume<float> f(grid_);
+  f.at(2, 3, 1) = 1.0f;
+  f.at(2, 3, 2) = 0.5f;
+  f.at(6, 0, 0) = 0.25f;
+  writePng(dir_ / "mip_z.png", maximumProjection(f, 2, 0.0, 1.0));
+  auto png = OIIO::ImageInput::open((dir_ / "mip_z.png").string());
+  ASSERT_TRUE(png);
+  EXPECT_EQ(png->spec().width, 7);
+  EXPECT_EQ(png->spec().height, 5);
+  std::vector<std::uint8_t> px(35);
+  ASSERT_TRUE(png->read_image(0, 0, 0, 1, OIIO::TypeDesc::UINT8, px.data()));
+  EXPECT_EQ(px[2 + 7 * 3], 255);
+  EXPECT_EQ(px[6], 64);
+  EXPECT_EQ(px[0], 0);
+}
+
+}  // namespace
