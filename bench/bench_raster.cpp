@@ -4,6 +4,7 @@
 
 #include <map>
 
+#include "bench_common.hpp"
 #include "core/memory.hpp"
 #include "grow/vascusynth_grower.hpp"
 #include "raster/ground_truth.hpp"
@@ -13,34 +14,9 @@ using namespace angiosynth;
 namespace {
 
 VascularTree grownTree(std::int64_t n) {
-  DemandMap m;
-  m.dims = {100, 100, 100};
-  m.voxel_mm = 0.4;
-  m.demand.assign(std::size_t(100) * 100 * 100, 1.0f);
-  for (int axis = 0; axis < 3; ++axis)
-    for (int a : {35, 55})
-      for (int b : {35, 55})
-        for (int k = 0; k < 100; ++k)
-          for (int j = a; j < a + 10; ++j)
-            for (int i = b; i < b + 10; ++i) {
-              int c[3];
-              c[axis] = k;
-              c[(axis + 1) % 3] = j;
-              c[(axis + 2) % 3] = i;
-              m.demand[m.flat(c[0], c[1], c[2])] = 0.0f;
-            }
-  m.supply_index.assign(m.demand.size(), 0);
-  m.supply_sets = {{0.65, 0.34, 0.01, 7}};
-  GrowthOptions o;
-  o.terminals = n;
-  o.root_mm = Vec3(0, 20, 20);
-  o.min_distance_mm = 0.4;
-  o.physics.viscosity = 3.6e-3;
-  o.physics.perfusion_pressure = 13300;
-  o.physics.terminal_pressure = 8300;
-  o.physics.perfusion_flow = 8330;
+  const DemandMap m = bench::vascusynthMap(100, true);
   GrowthReport r;
-  return growVascuSynth(m, o, r);
+  return growVascuSynth(m, bench::vascusynthOptions(m, n), r);
 }
 
 void BM_Rasterize(benchmark::State& state) {

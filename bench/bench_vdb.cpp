@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "bench_common.hpp"
 #include "core/memory.hpp"
 #include "grow/vascusynth_grower.hpp"
 #include "io/vdb_writer.hpp"
@@ -12,22 +13,9 @@ using namespace angiosynth;
 
 int main(int argc, char** argv) {
   const int size = argc > 1 ? std::atoi(argv[1]) : 2048;
-  DemandMap m;
-  m.dims = {100, 100, 100};
-  m.voxel_mm = 0.4;
-  m.demand.assign(std::size_t(100) * 100 * 100, 1.0f);
-  m.supply_index.assign(m.demand.size(), 0);
-  m.supply_sets = {{0.65, 0.34, 0.01, 7}};
-  GrowthOptions o;
-  o.terminals = 10000;
-  o.root_mm = Vec3(0, 20, 20);
-  o.min_distance_mm = 0.4;
-  o.physics.viscosity = 3.6e-3;
-  o.physics.perfusion_pressure = 13300;
-  o.physics.terminal_pressure = 8300;
-  o.physics.perfusion_flow = 8330;
+  const DemandMap m = bench::vascusynthMap(100, false);
   GrowthReport r;
-  const VascularTree tree = growVascuSynth(m, o, r);
+  const VascularTree tree = growVascuSynth(m, bench::vascusynthOptions(m, 10000), r);
   const auto grown_rss = peakRssBytes();
   VolumeGrid g;
   g.dims = {size, size, size};

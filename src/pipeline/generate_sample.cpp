@@ -2,13 +2,13 @@
 
 #include <chrono>
 #include <cmath>
-#include <fstream>
 
 #include "angiosynth/version.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "io/graph_writers.hpp"
 #include "io/map_files.hpp"
+#include "io/text_file.hpp"
 #include "pipeline/volume_outputs.hpp"
 #include "physics/hemodynamics.hpp"
 
@@ -21,20 +21,6 @@ using Clock = std::chrono::steady_clock;
 double seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
 
 Json q(double v, const char* unit) { return Json{{"value", v}, {"unit", unit}}; }
-
-void writeText(const std::filesystem::path& file, const std::string& text) {
-  std::ofstream out(file, std::ios::binary);
-  out << text;
-  if (!out) throw InputError(file.string(), 0, "cannot write this file (disk full or no permission?)");
-}
-
-template <class F>
-void writeWith(const std::filesystem::path& file, F&& f) {
-  std::ofstream out(file, std::ios::binary);
-  f(out);
-  out.flush();
-  if (!out) throw InputError(file.string(), 0, "cannot write this file (disk full or no permission?)");
-}
 
 }  // namespace
 
@@ -117,15 +103,15 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   GraphFrame frame{map.voxel_mm, sc.input_units};
   Json files;
   if (req.vascusynth_layout) {
-    writeWith(dir / "tree_structure.xml", [&](std::ostream& o) { writeVascuSynthGxl(o, tree, frame, req.graph_id); });
+    writeTextFile(dir / "tree_structure.xml", [&](std::ostream& o) { writeVascuSynthGxl(o, tree, frame, req.graph_id); });
     files["gxl"] = "tree_structure.xml";
   } else {
-    writeWith(dir / "tree.gxl", [&](std::ostream& o) {
+    writeTextFile(dir / "tree.gxl", [&](std::ostream& o) {
       if (req.gxl_dialect == "vascusynth") writeVascuSynthGxl(o, tree, frame, req.graph_id);
       else writeGxl(o, tree, frame, req.graph_id);
     });
     files["gxl"] = "tree.gxl";
-    writeWith(dir / "tree.dot", [&](std::ostream& o) { writeDot(o, tree, frame); });
+    writeTextFile(dir / "tree.dot", [&](std::ostream& o) { writeDot(o, tree, frame); });
     files["dot"] = "tree.dot";
   }
   timing["write_graphs"] = seconds(t0);
@@ -193,7 +179,7 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   j["statistics"] = stats;
   j["files"] = files;
   j["timing_seconds"] = timing;
-  writeText(dir / "sample.json", j.dump(2) + "\n");
+  writeTextFile(dir / "sample.json", [&](std::ostream& o) { o << j.dump(2) << "\n"; });
   return j;
 }
 

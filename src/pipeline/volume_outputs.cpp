@@ -2,12 +2,12 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "core/memory.hpp"
 #include "io/graph_writers.hpp"
+#include "io/text_file.hpp"
 #include "io/vdb_writer.hpp"
 #include "io/volume_writers.hpp"
 #include "raster/ground_truth.hpp"
@@ -16,14 +16,6 @@ namespace angiosynth {
 namespace {
 
 using Json = nlohmann::ordered_json;
-
-template <class F>
-void writeText(const std::filesystem::path& file, F&& f) {
-  std::ofstream out(file, std::ios::binary);
-  f(out);
-  out.flush();
-  if (!out) throw InputError(file.string(), 0, "cannot write this file (disk full or no permission?)");
-}
 
 template <class T>
 Volume<T> convert(const Volume<float>& fraction, double background, double vessel) {
@@ -51,22 +43,22 @@ void writeKeypoints(std::ostream& out, const VascularTree& t, const VolumeGrid& 
 // Key points and the graph formats besides GXL and DOT.
 void writeGraphFiles(const VascularTree& tree, const VolumeGrid& g, const ImageParameters& ip,
                      const std::filesystem::path& dir, Json& files) {
-  writeText(dir / "keypoints.csv", [&](std::ostream& o) { writeKeypoints(o, tree, g); });
+  writeTextFile(dir / "keypoints.csv", [&](std::ostream& o) { writeKeypoints(o, tree, g); });
   files["keypoints"] = "keypoints.csv";
   for (const auto& fmt : ip.graph_formats) {
     if (fmt == "csv") {
-      writeText(dir / "nodes.csv", [&](std::ostream& o) { writeNodesCsv(o, tree); });
-      writeText(dir / "edges.csv", [&](std::ostream& o) { writeEdgesCsv(o, tree); });
+      writeTextFile(dir / "nodes.csv", [&](std::ostream& o) { writeNodesCsv(o, tree); });
+      writeTextFile(dir / "edges.csv", [&](std::ostream& o) { writeEdgesCsv(o, tree); });
       files["nodes_csv"] = "nodes.csv";
       files["edges_csv"] = "edges.csv";
     } else if (fmt == "vtp") {
-      writeText(dir / "centerlines.vtp", [&](std::ostream& o) { writeVtp(o, tree); });
+      writeTextFile(dir / "centerlines.vtp", [&](std::ostream& o) { writeVtp(o, tree); });
       files["vtp"] = "centerlines.vtp";
     } else if (fmt == "swc") {
-      writeText(dir / "tree.swc", [&](std::ostream& o) { writeSwc(o, tree); });
+      writeTextFile(dir / "tree.swc", [&](std::ostream& o) { writeSwc(o, tree); });
       files["swc"] = "tree.swc";
     } else if (fmt == "graphml") {
-      writeText(dir / "tree.graphml", [&](std::ostream& o) { writeGraphml(o, tree); });
+      writeTextFile(dir / "tree.graphml", [&](std::ostream& o) { writeGraphml(o, tree); });
       files["graphml"] = "tree.graphml";
     }
   }
