@@ -19,6 +19,11 @@ CLI::App* addGenerate(CLI::App& app, GenerateArgs& a) {
       ->delimiter(',')
       ->check(CLI::IsMember({"nifti", "nrrd", "tiff", "png", "vdb"}));
   c->add_flag("--no-image", a.no_image, "grow and write graphs only, no volumes");
+  c->add_option("--profile", a.profiles,
+                "degradation profiles, overriding [degrade] profiles: shipped names (clean, vascusynth, cta, tof_mra, "
+                "two_photon, domain_randomisation), .toml profiles, or VascuSynth noise files; one image_<name> each")
+      ->delimiter(',');
+  c->add_flag("--no-profiles", a.no_profiles, "write the clean image only, ignoring [degrade] profiles");
   c->add_flag("--force", a.force, "replace the output directory if it exists");
   addCommonOptions(*c, a.common);
   return c;
@@ -42,6 +47,11 @@ int runGenerate(const GenerateArgs& a, const std::string& command_line) {
   req.progress = progressPrinter(a.common, "growing");
   req.formats = a.formats;
   req.no_image = a.no_image;
+  if (a.no_profiles) req.profiles.emplace();
+  if (!a.profiles.empty()) {
+    req.profiles.emplace();
+    for (const auto& p : a.profiles) req.profiles->push_back(loadProfile(p, "--profile", 0));
+  }
   const auto j = generateSample(req, dir.path());
   dir.commit();
   if (!a.common.quiet) {

@@ -18,7 +18,7 @@ CLI::App* addVascuSynth(CLI::App& app, VascuSynthArgs& a) {
   c->add_option("VOXEL_WIDTH", a.output_voxel_width, "output image voxel width, in VOXEL_WIDTH's unit")
       ->required()
       ->check(CLI::PositiveNumber);
-  c->add_option("NOISE_FILE", a.noise_files, "VascuSynth noise files (checked to exist; noisy images arrive with the degradation stage)");
+  c->add_option("NOISE_FILE", a.noise_files, "VascuSynth noise files (GAUSSIAN:, UNIFORM:, SALTPEPPER:, SHADOW: lines); file i gives NAME/noise_image_<i>/");
   addCommonOptions(*c, a.common);
   return c;
 }
@@ -32,15 +32,18 @@ int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line) {
                      std::to_string(names.size()) + " names for " + std::to_string(params.size()) +
                          " parameter files in " + a.param_list + "; give one name per parameter file");
   if (params.empty()) throw InputError(a.param_list, 0, "lists no parameter file");
-  for (const auto& n : a.noise_files)
-    if (!std::filesystem::exists(n)) throw InputError(n, 0, "no such noise file");
+  // Noise files are read (and every line checked) before anything is grown or written.
+  std::vector<Profile> noise;
+  for (std::size_t i = 0; i < a.noise_files.size(); ++i) {
+    if (!std::filesystem::exists(a.noise_files[i])) throw InputError(a.noise_files[i], 0, "no such noise file");
+    noise.push_back(readVascuSynthNoiseFile(a.noise_files[i]));
+    noise.back().name = "noise_image_" + std::to_string(i + 1);
+  }
   ReadOptions ro;
   ro.vascusynth_length_unit = a.common.vascusynth_unit;
   // Read every parameter file before writing anything, so a typo in the last one costs nothing.
   std::vector<Scenario> scenarios;
   for (const auto& l : params) scenarios.push_back(readParameters(resolveInputPath(l.text, a.param_list, l.number), ro));
-  if (!a.noise_files.empty() && !a.common.quiet)
-    std::cerr << "note: noise files were checked but noisy images are not produced by this version\n";
   for (std::size_t i = 0; i < scenarios.size(); ++i) {
     const Scenario& sc = scenarios[i];
     StagedDirectory dir(names[i].text, /*replace=*/true);  // VascuSynth overwrites its outputs too
@@ -52,6 +55,8 @@ int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line) {
     req.command_line = command_line;
     req.memory_limit = memoryLimit(a.common);
     req.progress = progressPrinter(a.common, names[i].text);
+    req.profiles = noise;
+    req.vascusynth_noise_layout = true;
     req.output_voxel_mm = a.output_voxel_width * sc.input_units.mm_per_length;
     req.extra["output_voxel_width"] = {{"value", a.output_voxel_width * sc.input_units.mm_per_length}, {"unit", "mm"}};
     generateSample(req, dir.path());

@@ -18,6 +18,8 @@ struct GenerateArgs {
   std::vector<std::string> formats;
   bool no_image = false;
   bool force = false;
+  std::vector<std::string> profiles;
+  bool no_profiles = false;
   CommonOptions common;
 };
 CLI::App* addGenerate(CLI::App& app, GenerateArgs& a);

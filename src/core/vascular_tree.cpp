@@ -9,6 +9,7 @@ const char* nodeTypeName(NodeType t) {
     case NodeType::Root: return "root";
     case NodeType::Bifurcation: return "bifurcation";
     case NodeType::Terminal: return "terminal";
+    case NodeType::Continuation: return "continuation";
   }
   return "";
 }

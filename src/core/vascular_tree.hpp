@@ -9,7 +9,8 @@
 
 namespace angiosynth {
 
-enum class NodeType { Root, Bifurcation, Terminal };
+// Continuation: a node inside a vessel with one child, as in polyline trees (warped graphs).
+enum class NodeType { Root, Bifurcation, Terminal, Continuation };
 
 struct VascularTree {
   std::vector<Vec3> position;               // mm
@@ -32,7 +33,9 @@ struct VascularTree {
   std::int32_t rootSegment() const { return child0.empty() ? -1 : child0[0]; }
   bool isTerminal(std::int32_t i) const { return i > 0 && child0[i] < 0; }
   NodeType type(std::int32_t i) const {
-    return i == 0 ? NodeType::Root : (child0[i] < 0 ? NodeType::Terminal : NodeType::Bifurcation);
+    if (i == 0) return NodeType::Root;
+    if (child0[i] < 0) return NodeType::Terminal;
+    return child1[i] < 0 ? NodeType::Continuation : NodeType::Bifurcation;
   }
   // The other segment leaving the proximal node of segment i (-1 if none).
   std::int32_t sibling(std::int32_t i) const {

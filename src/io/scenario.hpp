@@ -41,6 +41,8 @@ struct Scenario {
   ImageParameters image;
   int image_line = 0;                          // line of [image], for errors about its size
   std::string gxl_dialect = "gxl";             // "gxl" (GXL 1.0) or "vascusynth"
+  std::vector<std::string> profiles;           // [degrade] profiles: names or files
+  int profiles_line = 0;
   CoherentUnits input_units;                   // only for VascuSynth files
   nlohmann::ordered_json parameters;           // resolved values with units, for sample.json
   std::string units_note;

@@ -110,7 +110,7 @@ Scenario readTomlParameters(const std::filesystem::path& path) {
     throw InputError(file, static_cast<int>(e.source().begin.line), std::string("not valid TOML: ") + std::string(e.description()));
   }
   TomlReader r(root, file);
-  r.checkKeys(root, {"seed", "domain", "tree", "physics", "image", "output"}, "the top level");
+  r.checkKeys(root, {"seed", "domain", "tree", "physics", "image", "degrade", "output"}, "the top level");
   Scenario sc;
   sc.parameter_file = file;
   sc.format = "toml";
@@ -247,6 +247,18 @@ Scenario readTomlParameters(const std::filesystem::path& path) {
   };
   if (im.get("formats")) ip.formats = strings("formats", {"nifti", "nrrd", "tiff", "png", "vdb"});
   if (im.get("graph_formats")) ip.graph_formats = strings("graph_formats", {"csv", "vtp", "swc", "graphml"});
+
+  const auto& deg = r.table("degrade", {"profiles"});
+  if (const auto* n = deg.get("profiles")) {
+    sc.profiles_line = r.lineOf(n);
+    const auto* arr = n->as_array();
+    if (!arr) throw InputError(file, r.lineOf(n), "profiles must be an array of profile names or files, e.g. [\"clean\", \"cta\"]");
+    for (const auto& e : *arr) {
+      const auto v = e.value<std::string>();
+      if (!v || v->empty()) throw InputError(file, r.lineOf(n), "profiles must hold names (\"cta\") or paths to .toml profiles or VascuSynth noise files");
+      sc.profiles.push_back(*v);
+    }
+  }
 
   const auto& out = r.table("output", {"gxl_dialect"});
   if (out.get("gxl_dialect")) {

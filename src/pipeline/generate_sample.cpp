@@ -60,6 +60,7 @@ Json describeParameters(const Scenario& sc) {
                     {"dtype", im.dtype},
                     {"formats", im.formats},
                     {"graph_formats", im.graph_formats}};
+  j["profiles"] = sc.profiles;
   return j;
 }
 
@@ -76,6 +77,15 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   if (req.vascusynth_layout) ip.formats = {"nifti"};  // beside the PNG slices of original_image
   const bool volumes = ip.enabled && !req.no_image;
   VolumeRequest vr;
+  std::vector<Profile> profiles;
+  if (req.profiles) profiles = *req.profiles;
+  else
+    for (const auto& ref : sc.profiles) profiles.push_back(loadProfile(ref, sc.parameter_file, sc.profiles_line));
+  for (std::size_t i = 0; i < profiles.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (profiles[i].name == profiles[j].name)
+        throw InputError(profiles[i].file, 0, "two profiles are named '" + profiles[i].name +
+                                                  "' (roles image_<name> must differ); rename one file");
   if (volumes) {
     vr.grid = req.vascusynth_layout ? vascusynthGrid(map, req.output_voxel_mm) : imageGrid(map, ip);
     vr.image = ip;
@@ -83,6 +93,11 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
     vr.parameter_file = sc.parameter_file;
     vr.image_line = sc.image_line;
     vr.slices = req.vascusynth_layout;
+    vr.profiles = profiles;
+    vr.seed = req.seed;
+    vr.sample = req.sample;
+    vr.frame = GraphFrame{map.voxel_mm, sc.input_units};
+    vr.vascusynth_noise_layout = req.vascusynth_noise_layout;
     checkVolumeMemory(vr);
   }
 
@@ -116,10 +131,10 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   }
   timing["write_graphs"] = seconds(t0);
 
-  Json stats;
+  Json stats, degradation;
   if (volumes) {
     t0 = Clock::now();
-    writeVolumes(tree, vr, dir, files, stats);
+    writeVolumes(tree, vr, dir, files, stats, degradation);
     timing["rasterize_and_write_volumes"] = seconds(t0);
   }
 
@@ -168,6 +183,7 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   j["tool"] = Json{{"name", "angiosynth"}, {"version", kVersion}};
   j["command_line"] = req.command_line;
   j["seed"] = req.seed;
+  j["sample"] = req.sample;
   j["parameter_file"] = sc.parameter_file;
   j["parameter_format"] = sc.format;
   j["units"] = Json{{"length", "mm"}, {"flow", "mm^3/s"}, {"pressure", "Pa"}, {"viscosity", "Pa*s"},
@@ -176,6 +192,7 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
                               "position_voxel in map voxels"}};
   j["parameters"] = describeParameters(sc);
   for (const auto& [k, v] : req.extra.items()) j["parameters"][k] = v;
+  if (!profiles.empty()) j["degradation"] = degradation;
   j["statistics"] = stats;
   j["files"] = files;
   j["timing_seconds"] = timing;

@@ -2,10 +2,12 @@
 // One sample through the pipeline: scenario → domain → growth → graph files and sample.json.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
+#include "degrade/profile.hpp"
 #include "grow/vascusynth_grower.hpp"
 #include "io/scenario.hpp"
 
@@ -24,6 +26,10 @@ struct SampleRequest {
   double output_voxel_mm = 0;             // VascuSynth layout: the image voxel width
   std::vector<std::string> formats;       // volume formats overriding the parameters' (empty: keep)
   bool no_image = false;                  // graphs only
+  std::uint64_t sample = 0;               // index within a dataset (part of every random stream)
+  // Degradation profiles overriding the parameter file's [degrade] profiles when set.
+  std::optional<std::vector<Profile>> profiles;
+  bool vascusynth_noise_layout = false;   // profiles write <name>/image.nii.gz + PNG slices
 };
 
 // Writes the sample's files into `dir` and returns the content of its sample.json.

@@ -6,7 +6,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "degrade/profile.hpp"
 #include "domain/demand_map.hpp"
+#include "io/graph_writers.hpp"
 #include "io/scenario.hpp"
 #include "raster/volume.hpp"
 
@@ -27,14 +29,19 @@ struct VolumeRequest {
   int image_line = 0;
   bool slices = false;            // also one lossless PNG per z slice (VascuSynth's layout)
   std::string slice_dir = "original_image";
+  // Degradation: one image per profile (role image_<profile>), drawn from (seed, sample).
+  std::vector<Profile> profiles;
+  std::uint64_t seed = 1, sample = 0;
+  GraphFrame frame;               // for the GXL of warped trees
+  bool vascusynth_noise_layout = false;  // <profile>/image.nii.gz + slices, as VascuSynth's noise_image_<i>
 };
 
 // Throws InputError when the request's volumes would exceed its memory limit.
 void checkVolumeMemory(const VolumeRequest& req);
 
 // Writes the volumes and graph files into dir; adds {role: path} to `files` and figures to
-// `stats`. Throws InputError before allocating when the volumes would exceed the memory limit.
+// `stats`, and the drawn values of each profile to `degradation`. Throws InputError before allocating when the volumes would exceed the memory limit.
 void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std::filesystem::path& dir,
-                  nlohmann::ordered_json& files, nlohmann::ordered_json& stats);
+                  nlohmann::ordered_json& files, nlohmann::ordered_json& stats, nlohmann::ordered_json& degradation);
 
 }  // namespace angiosynth

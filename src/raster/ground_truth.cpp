@@ -40,6 +40,45 @@ void centerlineVoxels(const VolumeGrid& g, const Vec3& a_mm, const Vec3& b_mm,
   }
 }
 
+void addCenterlines(const VascularTree& t, GroundTruthVolumes& gt, const std::vector<std::int32_t>* label_of_segment) {
+  // Thin vessels stay connected: every voxel a centreline crosses belongs to the mask. Segments
+  // run in parallel; every write is order-independent (stores of 1, a maximum for the radius,
+  // the lowest segment id for an instance the partial volume did not set), so the result is the
+  // same for any thread count, and page faults are taken on both cores.
+  const VolumeGrid& g = gt.fraction.grid;
+  tbb::parallel_for(tbb::blocked_range<std::int32_t>(1, t.nodeCount(), 64), [&](const tbb::blocked_range<std::int32_t>& r) {
+    std::vector<std::array<std::int64_t, 3>> curve;
+    const auto claim = [&](std::int64_t v, std::int32_t seg) {
+      const std::uint32_t s = label_of_segment ? std::uint32_t((*label_of_segment)[seg]) : std::uint32_t(seg);
+      std::atomic_ref<std::uint8_t>(gt.mask.data[v]).store(1, std::memory_order_relaxed);
+      if (gt.fraction.data[v] >= 0.5f) return;  // labelled by the partial volume
+      std::atomic_ref<std::uint32_t> id(gt.instances.data[v]);
+      std::uint32_t cur = id.load(std::memory_order_relaxed);
+      while ((cur == 0 || s < cur) && !id.compare_exchange_weak(cur, s, std::memory_order_relaxed)) {
+      }
+    };
+    for (std::int32_t s = r.begin(); s != r.end(); ++s) {
+      const Vec3& a = t.position[t.parent[s]];
+      const Vec3& b = t.position[s];
+      forEachCrossedVoxel(g, a, b, [&](std::int64_t i, std::int64_t j, std::int64_t k) { claim(g.flat(i, j, k), s); });
+      centerlineVoxels(g, a, b, curve);
+      // Radii are positive, so their bit patterns order like the floats: a maximum on integers.
+      const float rs = static_cast<float>(t.radius[s]);
+      std::uint32_t rbits;
+      std::memcpy(&rbits, &rs, sizeof rbits);
+      for (const auto& c : curve) {
+        const auto v = g.flat(c[0], c[1], c[2]);
+        std::atomic_ref<std::uint8_t>(gt.centerline.data[v]).store(1, std::memory_order_relaxed);
+        std::atomic_ref<std::uint32_t> rad(*reinterpret_cast<std::uint32_t*>(&gt.radius.data[v]));
+        std::uint32_t cur = rad.load(std::memory_order_relaxed);
+        while (rbits > cur && !rad.compare_exchange_weak(cur, rbits, std::memory_order_relaxed)) {
+        }
+        claim(v, s);
+      }
+    }
+  });
+}
+
 GroundTruthVolumes rasterizeGroundTruth(const VascularTree& t, const VolumeGrid& g, const RasterOptions& opt) {
   GroundTruthVolumes gt;
   gt.fraction = Volume<float>(g);
@@ -67,40 +106,7 @@ GroundTruthVolumes rasterizeGroundTruth(const VascularTree& t, const VolumeGrid&
           }
         }
   });
-  // Thin vessels stay connected: every voxel a centreline crosses belongs to the mask. Segments
-  // run in parallel; every write is order-independent (stores of 1, a maximum for the radius,
-  // the lowest segment id for an instance the partial volume did not set), so the result is the
-  // same for any thread count, and page faults are taken on both cores.
-  tbb::parallel_for(tbb::blocked_range<std::int32_t>(1, t.nodeCount(), 64), [&](const tbb::blocked_range<std::int32_t>& r) {
-    std::vector<std::array<std::int64_t, 3>> curve;
-    const auto claim = [&](std::int64_t v, std::int32_t s) {
-      std::atomic_ref<std::uint8_t>(gt.mask.data[v]).store(1, std::memory_order_relaxed);
-      if (gt.fraction.data[v] >= 0.5f) return;  // labelled by the partial volume
-      std::atomic_ref<std::uint32_t> id(gt.instances.data[v]);
-      std::uint32_t cur = id.load(std::memory_order_relaxed);
-      while ((cur == 0 || std::uint32_t(s) < cur) && !id.compare_exchange_weak(cur, std::uint32_t(s), std::memory_order_relaxed)) {
-      }
-    };
-    for (std::int32_t s = r.begin(); s != r.end(); ++s) {
-      const Vec3& a = t.position[t.parent[s]];
-      const Vec3& b = t.position[s];
-      forEachCrossedVoxel(g, a, b, [&](std::int64_t i, std::int64_t j, std::int64_t k) { claim(g.flat(i, j, k), s); });
-      centerlineVoxels(g, a, b, curve);
-      // Radii are positive, so their bit patterns order like the floats: a maximum on integers.
-      const float rs = static_cast<float>(t.radius[s]);
-      std::uint32_t rbits;
-      std::memcpy(&rbits, &rs, sizeof rbits);
-      for (const auto& c : curve) {
-        const auto v = g.flat(c[0], c[1], c[2]);
-        std::atomic_ref<std::uint8_t>(gt.centerline.data[v]).store(1, std::memory_order_relaxed);
-        std::atomic_ref<std::uint32_t> rad(*reinterpret_cast<std::uint32_t*>(&gt.radius.data[v]));
-        std::uint32_t cur = rad.load(std::memory_order_relaxed);
-        while (rbits > cur && !rad.compare_exchange_weak(cur, rbits, std::memory_order_relaxed)) {
-        }
-        claim(v, s);
-      }
-    }
-  });
+  addCenterlines(t, gt, nullptr);
   return gt;
 }
 

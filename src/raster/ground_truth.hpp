@@ -24,6 +24,11 @@ std::uint64_t denseRasterBytes(const VolumeGrid& grid);
 
 GroundTruthVolumes rasterizeGroundTruth(const VascularTree& tree, const VolumeGrid& grid, const RasterOptions& opt);
 
+// The centreline pass: marks centreline and radius, and adds to the mask (and, where the
+// partial volume left no label, to the instances) every voxel a segment's centreline crosses.
+// Instances are segment ids, or label_of_segment[segment] when given.
+void addCenterlines(const VascularTree& tree, GroundTruthVolumes& gt, const std::vector<std::int32_t>* label_of_segment);
+
 // The 26-connected voxel curve (3D Bresenham) between the voxels containing a and b (mm),
 // clipped to the grid.
 void centerlineVoxels(const VolumeGrid& grid, const Vec3& a_mm, const Vec3& b_mm,

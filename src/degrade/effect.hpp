@@ -1,0 +1,75 @@
+#pragma once
+// A degradation effect: a named operation on the image (and, for warps, on everything aligned
+// with it), with declared parameters. Each effect lives in its own file and registers here.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/rng.hpp"
+#include "core/vascular_tree.hpp"
+#include "degrade/effect_params.hpp"
+#include "raster/volume.hpp"
+
+namespace angiosynth {
+
+class BSplineWarp;
+
+// The image being degraded and the ground truth aligned with it. Until a warp, `fraction`
+// and `tree` point at the clean raster and tree; a warp replaces them with warped copies.
+struct DegradeState {
+  VolumeGrid grid;
+  Volume<float> image;                       // intensities in the profile's scale
+  double background = 0, vessel = 255;       // the profile's tissue and full-vessel intensities
+  const Volume<float>* fraction = nullptr;   // vessel partial volume, aligned with `image`
+  const VascularTree* tree = nullptr;        // vessels, aligned with `image`
+  // Segment id of the clean tree for each segment of `tree` (empty: the same ids).
+  std::vector<std::int32_t> segment_origin;
+  // Set by a warp: the pull-back map (clean position of each warped voxel) and owned copies.
+  std::shared_ptr<const BSplineWarp> warp;
+  std::shared_ptr<Volume<float>> warped_fraction;
+  std::shared_ptr<VascularTree> warped_tree;
+  std::int32_t originalSegment(std::int32_t s) const { return segment_origin.empty() ? s : segment_origin[s]; }
+};
+
+struct EffectContext {
+  DegradeState& state;
+  Rng& rng;                         // the effect's own stream, after its parameters were drawn
+  nlohmann::ordered_json& record;   // drawn values go here (sample.json)
+  std::string file;                 // the profile, for errors
+  int line = 0;
+};
+
+struct EffectType {
+  const char* name;
+  const char* summary;              // one line for the README and `--help`
+  std::vector<ParamDecl> params;
+  void (*apply)(const Drawn& p, EffectContext& ctx);
+  bool moves_geometry = false;      // a warp: at most one per profile
+};
+
+// Every effect, in the order the README lists them.
+const std::vector<const EffectType*>& effectTypes();
+const EffectType* findEffectType(const std::string& name);
+
+// Applies f(v) to every voxel index in parallel; f must depend on v only (not on scheduling).
+template <class F>
+void forEachVoxel(std::int64_t count, F&& f);
+
+}  // namespace angiosynth
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace angiosynth {
+
+template <class F>
+void forEachVoxel(std::int64_t count, F&& f) {
+  tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, count, 1 << 14), [&](const tbb::blocked_range<std::int64_t>& r) {
+    for (std::int64_t v = r.begin(); v < r.end(); ++v) f(v);
+  });
+}
+
+}  // namespace angiosynth

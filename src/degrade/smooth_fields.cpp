@@ -1,0 +1,118 @@
+// Smooth random fields over the image: a multiplicative bias field (coil sensitivity, beam
+// hardening) and an additive background texture (tissue that is not vessel).
+#include <cmath>
+
+#include "degrade/bspline_field.hpp"
+#include "degrade/effect.hpp"
+
+namespace angiosynth {
+namespace {
+
+// A unit-variance random field with correlation length ~ spacing (iid normal coefficients).
+BSplineField randomField(const VolumeGrid& g, const Vec3& spacing, Rng& rng) {
+  BSplineField f(g, spacing);
+  for (auto& c : f.coefficients()) c = static_cast<float>(rng.normal() * BSplineField::kCoefficientGainFor3d);
+  f.prepare();
+  return f;
+}
+
+void applyBias(const Drawn& p, EffectContext& ctx) {
+  auto& s = ctx.state;
+  const double sigma = std::log1p(p("amplitude"));
+  const BSplineField f = randomField(s.grid, p.vec("scale"), ctx.rng);
+  const std::int64_t nx = s.grid.dims[0], ny = s.grid.dims[1];
+  // exp of a normal field: the gain is always positive, with median 1.
+  forEachVoxel(s.grid.voxelCount(), [&](std::int64_t v) {
+    s.image.data[v] *= static_cast<float>(std::exp(sigma * f.atVoxel(v % nx, (v / nx) % ny, v / (nx * ny))));
+  });
+}
+
+void applyTexture(const Drawn& p, EffectContext& ctx) {
+  auto& s = ctx.state;
+  const int octaves = static_cast<int>(p("octaves"));
+  const double persistence = p("persistence");
+  Vec3 scale = p.vec("scale");
+  std::vector<BSplineField> fields;
+  std::vector<float> weight;
+  double norm = 0;
+  for (int o = 0; o < octaves; ++o) {
+    // Octaves finer than two voxels add nothing a voxel can show.
+    if (scale.x < 2 * s.grid.spacing_mm.x && scale.y < 2 * s.grid.spacing_mm.y && scale.z < 2 * s.grid.spacing_mm.z) break;
+    fields.push_back(randomField(s.grid, scale, ctx.rng));
+    weight.push_back(static_cast<float>(std::pow(persistence, o)));
+    norm += double(weight.back()) * weight.back();
+    scale = scale * 0.5;
+  }
+  ctx.record["octaves_used"] = fields.size();
+  if (fields.empty()) return;
+  for (auto& w : weight) w = static_cast<float>(w * p("amplitude") / std::sqrt(norm));
+  const std::int64_t nx = s.grid.dims[0], ny = s.grid.dims[1];
+  const float mean = static_cast<float>(p("mean"));
+  // Tissue fills what the vessels leave of each voxel.
+  forEachVoxel(s.grid.voxelCount(), [&](std::int64_t v) {
+    const std::int64_t i = v % nx, j = (v / nx) % ny, k = v / (nx * ny);
+    float t = mean;
+    for (std::size_t o = 0; o < fields.size(); ++o) t += weight[o] * fields[o].atVoxel(i, j, k);
+    s.image.data[v] += (1.0f - s.fraction->data[v]) * t;
+  });
+}
+
+void applyContrast(const Drawn& p, EffectContext& ctx) {
+  auto& s = ctx.state;
+  const double bg = s.background, c = s.vessel - s.background;
+  const double gamma = p("gamma"), gain = p("gain"), offset = p("offset");
+  if (c == 0) return;
+  forEachVoxel(s.grid.voxelCount(), [&](std::int64_t v) {
+    const double t = (s.image.data[v] - bg) / c;
+    const double g = t >= 0 ? std::pow(t, gamma) : -std::pow(-t, gamma);
+    s.image.data[v] = static_cast<float>(bg + offset + gain * c * g);
+  });
+}
+
+void applyAttenuation(const Drawn& p, EffectContext& ctx) {
+  auto& s = ctx.state;
+  const int axis = static_cast<int>(p("axis"));
+  const double length = p("length");
+  const std::int64_t nx = s.grid.dims[0], ny = s.grid.dims[1];
+  forEachVoxel(s.grid.voxelCount(), [&](std::int64_t v) {
+    const std::int64_t idx[3] = {v % nx, (v / nx) % ny, v / (nx * ny)};
+    const double depth = (idx[axis] + 0.5) * s.grid.spacing_mm[axis];
+    s.image.data[v] *= static_cast<float>(std::exp(-depth / length));
+  });
+}
+
+}  // namespace
+
+extern const EffectType kBiasField{
+    "bias",
+    "smooth multiplicative bias field exp(N(0, log(1 + amplitude)²)) with correlation length ~ scale (coil sensitivity, beam hardening)",
+    {{"amplitude", ParamKind::Number, 0, 10, nullptr, "typical relative gain deviation (0.2: about ±20 %)"},
+     {"scale", ParamKind::Length3, 1e-9, 1e9, "0.5 fov", "control-point spacing of the field (its correlation length)"}},
+    applyBias};
+
+extern const EffectType kTexture{
+    "texture",
+    "smooth random background texture (tissue), added where the vessels leave room: mean + amplitude × fractal field",
+    {{"amplitude", ParamKind::Intensity, 0, 1e9, nullptr, "standard deviation of the texture"},
+     {"mean", ParamKind::Intensity, -1e9, 1e9, "0", "added to the background before the texture"},
+     {"scale", ParamKind::Length3, 1e-9, 1e9, "0.125 fov", "control-point spacing of the coarsest octave"},
+     {"octaves", ParamKind::Count, 1, 8, "3", "octaves, each at half the spacing of the previous one"},
+     {"persistence", ParamKind::Number, 0, 1, "0.5", "amplitude ratio of successive octaves"}},
+    applyTexture};
+
+extern const EffectType kContrast{
+    "contrast",
+    "intensity transfer: background + offset + gain·(vessel − background)·t^gamma, t = (I − background)/(vessel − background)",
+    {{"gamma", ParamKind::Number, 1e-3, 1e3, "1", "exponent on the normalised intensity"},
+     {"gain", ParamKind::Number, -1e3, 1e3, "1", "contrast gain (negative inverts vessels)"},
+     {"offset", ParamKind::Intensity, -1e9, 1e9, "0", "intensity offset"}},
+    applyContrast};
+
+extern const EffectType kAttenuation{
+    "attenuation",
+    "depth attenuation along an axis (two-photon, light-sheet): I = I·exp(−depth/length), depth from the first voxel face",
+    {{"axis", ParamKind::Count, 0, 2, "2", "axis of depth: 0 = x, 1 = y, 2 = z (depth grows with the index)"},
+     {"length", ParamKind::Length, 1e-9, 1e9, nullptr, "attenuation length"}},
+    applyAttenuation};
+
+}  // namespace angiosynth

@@ -1,0 +1,58 @@
+#include "pipeline/degraded_outputs.hpp"
+
+#include "degrade/degrade.hpp"
+#include "io/graph_writers.hpp"
+#include "io/text_file.hpp"
+#include "pipeline/volume_files.hpp"
+
+namespace angiosynth {
+
+std::uint64_t degradedImageBytes(const Profile& p, const VolumeGrid& g) {
+  bool warps = false;
+  for (const auto& e : p.effects) warps |= e.type->moves_geometry;
+  // Float image + a working copy (blur, warp) + the typed image; a warp adds its fraction and labels.
+  const std::uint64_t per_voxel = 4 + 4 + 4 + (warps ? 4 + 1 + 1 + 4 + 4 : 0);
+  return per_voxel * static_cast<std::uint64_t>(g.voxelCount());
+}
+
+void writeDegradedImages(const VascularTree& tree, const GroundTruthVolumes& gt, const VolumeRequest& req,
+                         const std::filesystem::path& dir, nlohmann::ordered_json& files, nlohmann::ordered_json& degradation) {
+  const ImageParameters& ip = req.image;
+  for (const Profile& profile : req.profiles) {
+    DegradeInput in;
+    in.tree = &tree;
+    in.truth = &gt;
+    in.seed = req.seed;
+    in.sample = req.sample;
+    in.background = ip.background;
+    in.vessel = ip.vessel;
+    in.dtype = ip.dtype;
+    DegradedImage d = degradeImage(profile, in);
+    const std::string suffix = "_" + profile.name;
+    TypedImage image;
+    makeTypedImage(image, d.image, 0, 1, d.dtype, "angiosynth image, profile " + profile.name);
+    // Previews span the profile's background to vessel intensities.
+    const double lo = std::min(d.background, d.vessel), hi = std::max(d.background, d.vessel);
+    if (req.vascusynth_noise_layout) {
+      writeSlices(image.view, d.image, lo, hi, profile.name, profile.name, dir, files);
+    } else {
+      std::vector<Channel> channels{{"image" + suffix, image.view}};
+      if (d.labels)
+        for (auto& c : labelChannels(*d.labels, suffix)) channels.push_back(c);
+      writeChannels(channels, ip.formats, dir, files);
+      if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end()) writeMips(d.image, lo, hi, suffix, dir, files);
+    }
+    if (d.tree) {
+      const std::string gxl = "tree" + suffix + ".gxl";
+      writeTextFile(dir / gxl, [&](std::ostream& o) { writeGxl(o, *d.tree, req.frame, "tree" + suffix); });
+      files["gxl" + suffix] = gxl;
+      writeGraphFiles(*d.tree, gt.fraction.grid, ip.graph_formats, suffix, dir, files);
+      std::int64_t mask_voxels = 0;
+      for (auto m : d.labels->mask.data) mask_voxels += m;
+      d.record["mask_voxels"] = mask_voxels;
+    }
+    degradation[profile.name] = d.record;
+  }
+}
+
+}  // namespace angiosynth

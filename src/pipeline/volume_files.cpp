@@ -1,0 +1,119 @@
+#include "pipeline/volume_files.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "core/format.hpp"
+#include "degrade/effect.hpp"
+#include "io/graph_writers.hpp"
+#include "io/text_file.hpp"
+
+namespace angiosynth {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+template <class T>
+void convert(Volume<T>& out, const Volume<float>& src, double offset, double scale) {
+  out = Volume<T>(src.grid);
+  constexpr bool integral = std::is_integral_v<T>;
+  const double lo = integral ? double(std::numeric_limits<T>::lowest()) : -INFINITY;
+  const double hi = integral ? double(std::numeric_limits<T>::max()) : INFINITY;
+  forEachVoxel(static_cast<std::int64_t>(src.data.size()), [&](std::int64_t v) {
+    const double x = offset + scale * src.data[v];
+    out.data[v] = static_cast<T>(integral ? std::clamp(std::round(x), lo, hi) : x);
+  });
+}
+
+void writeKeypoints(std::ostream& out, const VascularTree& t, const VolumeGrid& g) {
+  out << "id,type,x_voxel,y_voxel,z_voxel,x_mm,y_mm,z_mm,radius_mm\n";
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    const Vec3& p = t.position[i];
+    const Vec3 v = g.index(p);
+    out << i << ',' << nodeTypeName(t.type(i)) << ',' << exactNumber(v.x) << ',' << exactNumber(v.y) << ',' << exactNumber(v.z)
+        << ',' << exactNumber(p.x) << ',' << exactNumber(p.y) << ',' << exactNumber(p.z) << ',' << exactNumber(nodeRadius(t, i))
+        << '\n';
+  }
+}
+
+}  // namespace
+
+void makeTypedImage(TypedImage& out, const Volume<float>& src, double offset, double scale, const std::string& dtype,
+                    const std::string& description) {
+  if (dtype == "uint8") convert(out.u8, src, offset, scale), out.view = viewOf(out.u8, false, description);
+  else if (dtype == "uint16") convert(out.u16, src, offset, scale), out.view = viewOf(out.u16, false, description);
+  else if (dtype == "int16") convert(out.s16, src, offset, scale), out.view = viewOf(out.s16, false, description);
+  else convert(out.f32, src, offset, scale), out.view = viewOf(out.f32, false, description);
+}
+
+std::vector<Channel> labelChannels(const GroundTruthVolumes& gt, const std::string& suffix) {
+  return {{"mask" + suffix, viewOf(gt.mask, true, "angiosynth vessel mask")},
+          {"centerline" + suffix, viewOf(gt.centerline, true, "angiosynth centreline")},
+          {"radius" + suffix, viewOf(gt.radius, false, "angiosynth radius (mm) on centreline")},
+          {"instances" + suffix, viewOf(gt.instances, true, "angiosynth segment id")}};
+}
+
+void writeChannels(const std::vector<Channel>& channels, const std::vector<std::string>& formats,
+                   const std::filesystem::path& dir, Json& files) {
+  bool first = true;
+  for (const auto& fmt : formats) {
+    if (fmt == "vdb" || fmt == "png") continue;
+    const std::string ext = fmt == "nifti" ? ".nii.gz" : (fmt == "nrrd" ? ".nrrd" : ".tif");
+    for (const auto& c : channels) {
+      const std::string name = c.role + ext;
+      if (fmt == "nifti") writeNifti(dir / name, c.view);
+      else if (fmt == "nrrd") writeNrrd(dir / name, c.view);
+      else writeTiff(dir / name, c.view);
+      files[first ? c.role : c.role + "_" + fmt] = name;
+    }
+    first = false;
+  }
+}
+
+void writeMips(const Volume<float>& v, double lo, double hi, const std::string& suffix, const std::filesystem::path& dir,
+               Json& files) {
+  const char* axes[] = {"mip_x", "mip_y", "mip_z"};
+  for (int ax = 0; ax < 3; ++ax) {
+    const std::string role = std::string(axes[ax]) + suffix;
+    writePng(dir / (role + ".png"), maximumProjection(v, ax, lo, hi));
+    files[role] = role + ".png";
+  }
+}
+
+void writeSlices(const VolumeView& image, const Volume<float>& shown, double lo, double hi, const std::string& sub,
+                 const std::string& role, const std::filesystem::path& dir, Json& files) {
+  std::filesystem::create_directories(dir / sub);
+  writeNifti(dir / sub / "image.nii.gz", image);
+  files[role] = sub + "/image.nii.gz";
+  for (std::int32_t z = 0; z < shown.grid.dims[2]; ++z) {
+    char name[32];
+    std::snprintf(name, sizeof name, "image%03d.png", z);
+    writePng(dir / sub / name, sliceZ(shown, z, lo, hi));
+  }
+  files[role + "_slices"] = sub + "/image%03d.png";
+}
+
+void writeGraphFiles(const VascularTree& tree, const VolumeGrid& g, const std::vector<std::string>& graph_formats,
+                     const std::string& suffix, const std::filesystem::path& dir, Json& files) {
+  const auto file = [&](const std::string& stem, const std::string& ext, const std::string& role, auto&& write) {
+    const std::string name = stem + suffix + ext;
+    writeTextFile(dir / name, write);
+    files[role + suffix] = name;
+  };
+  file("keypoints", ".csv", "keypoints", [&](std::ostream& o) { writeKeypoints(o, tree, g); });
+  for (const auto& fmt : graph_formats) {
+    if (fmt == "csv") {
+      file("nodes", ".csv", "nodes_csv", [&](std::ostream& o) { writeNodesCsv(o, tree); });
+      file("edges", ".csv", "edges_csv", [&](std::ostream& o) { writeEdgesCsv(o, tree); });
+    } else if (fmt == "vtp") {
+      file("centerlines", ".vtp", "vtp", [&](std::ostream& o) { writeVtp(o, tree); });
+    } else if (fmt == "swc") {
+      file("tree", ".swc", "swc", [&](std::ostream& o) { writeSwc(o, tree); });
+    } else if (fmt == "graphml") {
+      file("tree", ".graphml", "graphml", [&](std::ostream& o) { writeGraphml(o, tree); });
+    }
+  }
+}
+
+}  // namespace angiosynth

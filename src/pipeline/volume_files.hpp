@@ -1,0 +1,52 @@
+#pragma once
+// Writing a set of volumes (one sample's channels, clean or degraded) in every requested format,
+// recorded by role: the first volume format owns the plain role, later ones add _<format>.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/vascular_tree.hpp"
+#include "io/volume_writers.hpp"
+#include "raster/ground_truth.hpp"
+
+namespace angiosynth {
+
+// A float volume converted to the sample's dtype (rounded and clamped for integer types);
+// owns its voxels, `view` points at them.
+struct TypedImage {
+  Volume<std::uint8_t> u8;
+  Volume<std::uint16_t> u16;
+  Volume<std::int16_t> s16;
+  Volume<float> f32;
+  VolumeView view;
+};
+// offset + scale × src, as dtype (uint8, uint16, int16, float32).
+void makeTypedImage(TypedImage& out, const Volume<float>& src, double offset, double scale, const std::string& dtype,
+                    const std::string& description);
+
+struct Channel {
+  std::string role;   // also the file stem
+  VolumeView view;
+};
+
+// The label channels of a ground truth (mask, centerline, radius, instances), with `suffix`
+// appended to each role ("" or "_<profile>").
+std::vector<Channel> labelChannels(const GroundTruthVolumes& gt, const std::string& suffix);
+
+// Writes the channels in each volume format (nifti, nrrd, tiff; png and vdb are skipped).
+void writeChannels(const std::vector<Channel>& channels, const std::vector<std::string>& formats,
+                   const std::filesystem::path& dir, nlohmann::ordered_json& files);
+// Maximum-intensity projections along x, y, z as mip_<axis><suffix>.png, [lo, hi] → [0, 255].
+void writeMips(const Volume<float>& v, double lo, double hi, const std::string& suffix, const std::filesystem::path& dir,
+               nlohmann::ordered_json& files);
+// VascuSynth's layout: <sub>/image.nii.gz and one lossless PNG per z slice, [lo, hi] → [0, 255].
+void writeSlices(const VolumeView& image, const Volume<float>& shown, double lo, double hi, const std::string& sub,
+                 const std::string& role, const std::filesystem::path& dir, nlohmann::ordered_json& files);
+// Key points and the graph formats besides GXL and DOT (csv, vtp, swc, graphml), with `suffix`
+// appended to file stems and roles.
+void writeGraphFiles(const VascularTree& tree, const VolumeGrid& g, const std::vector<std::string>& graph_formats,
+                     const std::string& suffix, const std::filesystem::path& dir, nlohmann::ordered_json& files);
+
+}  // namespace angiosynth
