@@ -181,6 +181,66 @@ TEST_F(Cli, OversizedImagesAreRefusedBeforeAllocating) {
   EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
 
+// A parameter file of the example with absolute map paths, written into the test directory.
+std::string exampleWithProfiles(const fs::path& src, const std::string& profiles) {
+  std::string t = slurp(src / "examples/vascusynth_like.toml");
+  const std::string rel = "\"../demand_maps/";
+  t.replace(t.find(rel), rel.size(), "\"" + (src / "demand_maps").string() + "/");
+  t.replace(t.find("[output]"), 8, "[degrade]\nprofiles = [" + profiles + "]\n\n[output]");
+  return t;
+}
+
+TEST_F(Cli, ProfilesGiveOneDegradedImageEachWithWarpedLabelsAndTheSameBytesForAnyThreads) {
+  std::ofstream(dir_ / "warpy.toml") << "[[effect]]\ntype = \"warp\"\nspacing = \"10 mm\"\nmax_displacement = \"2 mm\"\n"
+                                        "[[effect]]\ntype = \"rician\"\nsigma = 12\n";
+  std::ofstream(dir_ / "p.toml") << exampleWithProfiles(src_, "\"cta\", \"warpy.toml\"");
+  ASSERT_EQ(run("generate p.toml --out one --threads 1 --quiet", dir_).code, 0);
+  ASSERT_EQ(run("generate p.toml --out two --threads 2 --quiet", dir_).code, 0);
+  for (const char* f : {"image_cta.nii.gz", "image_warpy.nii.gz", "mask_warpy.nii.gz", "centerline_warpy.nii.gz",
+                        "radius_warpy.nii.gz", "instances_warpy.nii.gz", "tree_warpy.gxl", "mip_z_cta.png"}) {
+    ASSERT_TRUE(fs::exists(dir_ / "one" / f)) << f;
+    EXPECT_EQ(slurp(dir_ / "one" / f), slurp(dir_ / "two" / f)) << f;
+  }
+  const Json j = Json::parse(slurp(dir_ / "one/sample.json"));
+  EXPECT_EQ(j["files"]["image_cta"], "image_cta.nii.gz");
+  EXPECT_EQ(j["degradation"]["cta"]["dtype"], "int16");
+  EXPECT_EQ(j["degradation"]["cta"]["effects"].size(), 3u);
+  const double sigma = j["degradation"]["cta"]["effects"][2]["parameters"]["sigma"];
+  EXPECT_TRUE(sigma >= 10 && sigma <= 25) << sigma;
+  EXPECT_GT(j["degradation"]["warpy"]["effects"][0]["min_jacobian_determinant"].get<double>(), 0);
+  // The clean outputs are untouched by the profiles.
+  ASSERT_EQ(run("generate p.toml --out plain --no-profiles --quiet", dir_).code, 0);
+  EXPECT_EQ(slurp(dir_ / "one/mask.nii.gz"), slurp(dir_ / "plain/mask.nii.gz"));
+  EXPECT_FALSE(fs::exists(dir_ / "plain/image_cta.nii.gz"));
+}
+
+TEST_F(Cli, VascuSynthNoiseFilesGiveNoiseImagesAndMisspellingsStopEverything) {
+  fs::copy_file(src_ / "examples/vascusynth/param_rods_1000.txt", dir_ / "p.txt");
+  std::string t = slurp(dir_ / "p.txt");
+  for (auto pos = t.find("../../demand_maps"); pos != std::string::npos; pos = t.find("../../demand_maps"))
+    t.replace(pos, 17, (src_ / "demand_maps").string());
+  std::ofstream(dir_ / "p.txt", std::ios::binary) << t;
+  std::ofstream(dir_ / "params.txt") << "p.txt\n";
+  std::ofstream(dir_ / "names.txt") << "img\n";
+  std::ofstream(dir_ / "noise.txt") << "GAUSSIAN: 0 20\nSHADOW: 2\n";
+  std::ofstream(dir_ / "typo.txt") << "GAUSSIAN: 0 20\nSALTPEPER 255 0.05 0 0.05\n";
+  const auto bad = run("vascusynth params.txt names.txt 0.04 noise.txt typo.txt", dir_);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_EQ(bad.err.rfind("typo.txt:2: unknown noise directive 'SALTPEPER'", 0), 0u) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ / "img"));
+  const auto ok = run("vascusynth params.txt names.txt 0.04 noise.txt noise.txt --quiet", dir_);
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  for (const char* sub : {"noise_image_1", "noise_image_2"}) {
+    EXPECT_TRUE(fs::exists(dir_ / "img" / sub / "image.nii.gz")) << sub;
+    EXPECT_TRUE(fs::exists(dir_ / "img" / sub / "image000.png")) << sub;
+    EXPECT_TRUE(fs::exists(dir_ / "img" / sub / "image100.png")) << sub;
+  }
+  // Two copies of one noise file are two independent draws.
+  EXPECT_NE(slurp(dir_ / "img/noise_image_1/image.nii.gz"), slurp(dir_ / "img/noise_image_2/image.nii.gz"));
+  const Json j = Json::parse(slurp(dir_ / "img/sample.json"));
+  EXPECT_EQ(j["degradation"]["noise_image_1"]["effects"][1]["shadows"].size(), 2u);
+}
+
 TEST_F(Cli, HelpAndVersion) {
   EXPECT_EQ(run("--version", dir_).code, 0);
   EXPECT_EQ(run("generate --help", dir_).code, 0);

@@ -104,6 +104,7 @@ DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
     out.labels = warpedLabels(*s.warped_fraction, *s.warped_tree, s.segment_origin, in.truth->instances, *s.warp);
     out.tree = s.warped_tree;
     out.segment_origin = s.segment_origin;
+    out.warp = s.warp;
   }
   out.image = std::move(s.image);
   return out;

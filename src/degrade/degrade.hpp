@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "degrade/profile.hpp"
+#include "degrade/warp.hpp"
 #include "raster/ground_truth.hpp"
 
 namespace angiosynth {
@@ -31,6 +32,7 @@ struct DegradedImage {
   std::optional<GroundTruthVolumes> labels;
   std::shared_ptr<VascularTree> tree;
   std::vector<std::int32_t> segment_origin;    // clean segment of each warped-tree segment
+  std::shared_ptr<const BSplineWarp> warp;
 };
 
 DegradedImage degradeImage(const Profile& profile, const DegradeInput& in);
