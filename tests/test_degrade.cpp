@@ -407,8 +407,9 @@ TEST(Degrade, ShippedProfilesDrawWithinTheirRangesAndFitTheirDtype) {
       }
     double lo, hi;
     dtypeRange(d.dtype, lo, hi);
-    if (p.clamp_each_step)
+    if (p.clamp_each_step) {
       for (float v : d.image.data) ASSERT_TRUE(v >= lo && v <= hi) << p.name;
+    }
   }
   EXPECT_EQ(profiles, 6);
 }

@@ -1,5 +1,6 @@
 #include "degrade/degrade.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -84,6 +85,7 @@ DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
     const Drawn drawn = drawParams(spec.type->params, spec.params, scale, rng, params, profile.file, spec.line);
     er["parameters"] = params;
     if (applied) {
+      const auto t0 = std::chrono::steady_clock::now();
       EffectContext ctx{s, rng, er, profile.file, spec.line};
       try {
         spec.type->apply(drawn, ctx);
@@ -94,6 +96,7 @@ DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
         forEachVoxel(s.grid.voxelCount(), [&](std::int64_t v) {
           s.image.data[v] = static_cast<float>(std::clamp(double(s.image.data[v]), lo, hi));
         });
+      out.seconds[std::to_string(e) + "_" + tname] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     effects.push_back(er);
   }
@@ -101,10 +104,12 @@ DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
   out.background = s.background;
   out.vessel = s.vessel;
   if (s.warp) {
+    const auto t0 = std::chrono::steady_clock::now();
     out.labels = warpedLabels(*s.warped_fraction, *s.warped_tree, s.segment_origin, in.truth->instances, *s.warp);
     out.tree = s.warped_tree;
     out.segment_origin = s.segment_origin;
     out.warp = s.warp;
+    out.seconds["warped_labels"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   out.image = std::move(s.image);
   return out;

@@ -33,6 +33,7 @@ struct DegradedImage {
   std::shared_ptr<VascularTree> tree;
   std::vector<std::int32_t> segment_origin;    // clean segment of each warped-tree segment
   std::shared_ptr<const BSplineWarp> warp;
+  nlohmann::ordered_json seconds;              // time per effect (kept out of `record`)
 };
 
 DegradedImage degradeImage(const Profile& profile, const DegradeInput& in);

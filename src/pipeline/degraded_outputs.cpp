@@ -16,7 +16,8 @@ std::uint64_t degradedImageBytes(const Profile& p, const VolumeGrid& g) {
 }
 
 void writeDegradedImages(const VascularTree& tree, const GroundTruthVolumes& gt, const VolumeRequest& req,
-                         const std::filesystem::path& dir, nlohmann::ordered_json& files, nlohmann::ordered_json& degradation) {
+                         const std::filesystem::path& dir, nlohmann::ordered_json& files, nlohmann::ordered_json& degradation,
+                         nlohmann::ordered_json* seconds) {
   const ImageParameters& ip = req.image;
   for (const Profile& profile : req.profiles) {
     DegradeInput in;
@@ -52,6 +53,7 @@ void writeDegradedImages(const VascularTree& tree, const GroundTruthVolumes& gt,
       d.record["mask_voxels"] = mask_voxels;
     }
     degradation[profile.name] = d.record;
+    if (seconds) (*seconds)[profile.name] = d.seconds;
   }
 }
 

@@ -14,6 +14,7 @@ namespace angiosynth {
 std::uint64_t degradedImageBytes(const Profile& p, const VolumeGrid& g);
 
 void writeDegradedImages(const VascularTree& tree, const GroundTruthVolumes& gt, const VolumeRequest& req,
-                         const std::filesystem::path& dir, nlohmann::ordered_json& files, nlohmann::ordered_json& degradation);
+                         const std::filesystem::path& dir, nlohmann::ordered_json& files, nlohmann::ordered_json& degradation,
+                         nlohmann::ordered_json* seconds = nullptr);
 
 }  // namespace angiosynth

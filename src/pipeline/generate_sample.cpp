@@ -134,7 +134,9 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   Json stats, degradation;
   if (volumes) {
     t0 = Clock::now();
-    writeVolumes(tree, vr, dir, files, stats, degradation);
+    Json degrade_seconds;
+    writeVolumes(tree, vr, dir, files, stats, degradation, &degrade_seconds);
+    if (!degrade_seconds.empty()) timing["degrade_effects"] = degrade_seconds;
     timing["rasterize_and_write_volumes"] = seconds(t0);
   }
 

@@ -65,7 +65,7 @@ void checkVolumeMemory(const VolumeRequest& req) {
 }
 
 void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std::filesystem::path& dir, Json& files,
-                  Json& stats, Json& degradation) {
+                  Json& stats, Json& degradation, Json* seconds) {
   const VolumeGrid& g = req.grid;
   const ImageParameters& ip = req.image;
   checkVolumeMemory(req);
@@ -101,7 +101,7 @@ void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std:
   std::int64_t mask_voxels = 0;
   for (auto m : gt.mask.data) mask_voxels += m;
   stats["mask_voxels"] = mask_voxels;
-  writeDegradedImages(tree, gt, req, dir, files, degradation);
+  writeDegradedImages(tree, gt, req, dir, files, degradation, seconds);
 }
 
 }  // namespace angiosynth
