@@ -186,7 +186,8 @@ std::string exampleWithProfiles(const fs::path& src, const std::string& profiles
   std::string t = slurp(src / "examples/vascusynth_like.toml");
   const std::string rel = "\"../demand_maps/";
   t.replace(t.find(rel), rel.size(), "\"" + (src / "demand_maps").string() + "/");
-  t.replace(t.find("[output]"), 8, "[degrade]\nprofiles = [" + profiles + "]\n\n[output]");
+  const auto at = t.find("profiles = [");
+  t.replace(at, t.find('\n', at) - at, "profiles = [" + profiles + "]");
   return t;
 }
 

@@ -414,6 +414,12 @@ TEST(Degrade, ShippedProfilesDrawWithinTheirRangesAndFitTheirDtype) {
   EXPECT_EQ(profiles, 6);
 }
 
+TEST(Degrade, ReadmeListsEveryEffectAsTheCodeDeclaresIt) {
+  std::ifstream in(test::sourceDir() / "README.md");
+  const std::string readme((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(readme.find(effectReference()), std::string::npos) << "paste the output of `angiosynth effects` into README.md";
+}
+
 TEST(Degrade, VascuSynthProfileAddsSigma20WhereTheImageIsNotClamped) {
   // Mid-grey everywhere: fraction ½ → 127.5, far from both clamps.
   auto gt = flatTruth(64);

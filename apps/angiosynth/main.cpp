@@ -7,6 +7,7 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "core/error.hpp"
+#include "degrade/effect.hpp"
 
 int main(int argc, char** argv) {
   using namespace angiosynth;
@@ -17,6 +18,7 @@ int main(int argc, char** argv) {
   cli::VascuSynthArgs vs;
   auto* g = cli::addGenerate(app, gen);
   auto* v = cli::addVascuSynth(app, vs);
+  auto* fx = app.add_subcommand("effects", "list the degradation effects and their parameters (Markdown)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -26,6 +28,10 @@ int main(int argc, char** argv) {
   try {
     if (g->parsed()) return cli::runGenerate(gen, cmdline);
     if (v->parsed()) return cli::runVascuSynth(vs, cmdline);
+    if (fx->parsed()) {
+      std::cout << effectReference();
+      return 0;
+    }
   } catch (const InputError& e) {
     std::cerr << e.what() << "\n";
     return 2;

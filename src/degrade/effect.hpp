@@ -53,6 +53,8 @@ struct EffectType {
 // Every effect, in the order the README lists them.
 const std::vector<const EffectType*>& effectTypes();
 const EffectType* findEffectType(const std::string& name);
+// Markdown list of every effect with its parameters (`angiosynth effects`, the README).
+std::string effectReference();
 
 // Applies f(v) to every voxel index in parallel; f must depend on v only (not on scheduling).
 template <class F>
