@@ -34,4 +34,16 @@ struct VascuSynthArgs {
 CLI::App* addVascuSynth(CLI::App& app, VascuSynthArgs& a);
 int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line);
 
+struct DatasetArgs {
+  std::string spec, out, dir;
+  std::string index, range, shard;
+  bool resume = false;
+  CommonOptions common;
+  CLI::App* describe = nullptr;
+  CLI::App* finalize = nullptr;
+  CLI::App* verify = nullptr;
+};
+CLI::App* addDataset(CLI::App& app, DatasetArgs& a);
+int runDatasetCommand(const DatasetArgs& a, const std::string& command_line);
+
 }  // namespace angiosynth::cli

@@ -18,6 +18,8 @@ int main(int argc, char** argv) {
   cli::VascuSynthArgs vs;
   auto* g = cli::addGenerate(app, gen);
   auto* v = cli::addVascuSynth(app, vs);
+  cli::DatasetArgs ds;
+  auto* d = cli::addDataset(app, ds);
   auto* fx = app.add_subcommand("effects", "list the degradation effects and their parameters (Markdown)");
   try {
     app.parse(argc, argv);
@@ -28,6 +30,7 @@ int main(int argc, char** argv) {
   try {
     if (g->parsed()) return cli::runGenerate(gen, cmdline);
     if (v->parsed()) return cli::runVascuSynth(vs, cmdline);
+    if (d->parsed()) return cli::runDatasetCommand(ds, cmdline);
     if (fx->parsed()) {
       std::cout << effectReference();
       return 0;

@@ -12,6 +12,12 @@
 #include "core/units.hpp"
 #include "grow/vascusynth_grower.hpp"
 
+namespace toml {
+inline namespace v3 {
+class table;
+}
+}  // namespace toml
+
 namespace angiosynth {
 
 // How the tree becomes volumes (issue: rasterizer). Defaults suit 8-bit images of the map.
@@ -56,6 +62,8 @@ struct ReadOptions {
 Scenario readVascuSynthParameters(const std::filesystem::path& file, const ReadOptions& opt = {});
 // Reads a native TOML parameter file.
 Scenario readTomlParameters(const std::filesystem::path& file);
+// The same from a parsed table; relative paths are resolved beside `file` (a dataset spec).
+Scenario readTomlParameters(const toml::table& root, const std::filesystem::path& file);
 // Chooses by extension: .toml is native, anything else VascuSynth.
 Scenario readParameters(const std::filesystem::path& file, const ReadOptions& opt = {});
 

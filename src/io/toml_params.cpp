@@ -109,6 +109,11 @@ Scenario readTomlParameters(const std::filesystem::path& path) {
   } catch (const toml::parse_error& e) {
     throw InputError(file, static_cast<int>(e.source().begin.line), std::string("not valid TOML: ") + std::string(e.description()));
   }
+  return readTomlParameters(root, path);
+}
+
+Scenario readTomlParameters(const toml::table& root, const std::filesystem::path& path) {
+  const std::string file = path.string();
   TomlReader r(root, file);
   r.checkKeys(root, {"seed", "domain", "tree", "physics", "image", "degrade", "output"}, "the top level");
   Scenario sc;

@@ -197,7 +197,7 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   if (!profiles.empty()) j["degradation"] = degradation;
   j["statistics"] = stats;
   j["files"] = files;
-  j["timing_seconds"] = timing;
+  if (req.record_timing) j["timing_seconds"] = timing;
   writeTextFile(dir / "sample.json", [&](std::ostream& o) { o << j.dump(2) << "\n"; });
   return j;
 }

@@ -30,6 +30,7 @@ struct SampleRequest {
   // Degradation profiles overriding the parameter file's [degrade] profiles when set.
   std::optional<std::vector<Profile>> profiles;
   bool vascusynth_noise_layout = false;   // profiles write <name>/image.nii.gz + PNG slices
+  bool record_timing = true;              // false: sample.json depends on seed and parameters only
 };
 
 // Writes the sample's files into `dir` and returns the content of its sample.json.

@@ -1,0 +1,252 @@
+#include "dataset/spec.hpp"
+
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <numeric>
+#include <set>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/rng.hpp"
+
+namespace angiosynth {
+namespace {
+
+int lineOf(const toml::node& n) { return static_cast<int>(n.source().begin.line); }
+
+const char* const kDistributions[] = {"uniform", "log_uniform", "normal", "integer", "choice"};
+
+bool isDistribution(const toml::node& n) {
+  const auto* t = n.as_table();
+  if (!t) return false;
+  for (const char* d : kDistributions)
+    if (t->contains(d)) return true;
+  return false;
+}
+
+// A number, or a quantity string "<number> <unit>": the number and the unit.
+struct Quantity {
+  double value = 0;
+  std::string unit;  // empty for a plain number
+  bool integer = false;
+};
+
+Quantity quantityOf(const toml::node& n, const std::string& file, const std::string& what) {
+  Quantity q;
+  if (n.is_integer()) {
+    q.value = double(*n.value<std::int64_t>());
+    q.integer = true;
+    return q;
+  }
+  if (n.is_floating_point()) {
+    q.value = *n.value<double>();
+    return q;
+  }
+  if (const auto s = n.value_exact<std::string>()) {
+    std::istringstream in(*s);
+    if (in >> q.value) {
+      std::getline(in >> std::ws, q.unit);
+      return q;
+    }
+  }
+  throw InputError(file, lineOf(n), what + " bounds must be numbers or quantities \"<number> <unit>\"");
+}
+
+std::unique_ptr<toml::node> valueOf(double v, const std::string& unit, bool integer) {
+  if (!unit.empty()) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return std::make_unique<toml::value<std::string>>(std::string(buf) + " " + unit);
+  }
+  if (integer) return std::make_unique<toml::value<std::int64_t>>(static_cast<std::int64_t>(v));
+  return std::make_unique<toml::value<double>>(v);
+}
+
+// Draws one value of a distribution node.
+std::unique_ptr<toml::node> draw(const toml::table& d, Rng& rng, const std::string& file) {
+  const int line = lineOf(d);
+  const auto bounds = [&](const char* key, Quantity& a, Quantity& b) {
+    const auto* arr = d.get(key)->as_array();
+    if (!arr || arr->size() != 2) throw InputError(file, line, std::string(key) + " takes [a, b]");
+    a = quantityOf(*arr->get(0), file, key);
+    b = quantityOf(*arr->get(1), file, key);
+    if (a.unit != b.unit) throw InputError(file, line, std::string(key) + ": both bounds need the same unit");
+  };
+  const std::set<std::string> allowed_extra = {"min", "max", "weights"};
+  int kinds = 0;
+  for (const auto& [k, v] : d) {
+    bool known = allowed_extra.count(std::string(k.str())) > 0;
+    for (const char* name : kDistributions) known |= k == name, kinds += k == name;
+    if (!known)
+      throw InputError(file, lineOf(v), "unknown key '" + std::string(k.str()) +
+                                            "' in a distribution; allowed: uniform, log_uniform, normal (with min, max), "
+                                            "integer, choice (with weights)");
+  }
+  if (kinds != 1) throw InputError(file, line, "a distribution names exactly one of uniform, log_uniform, normal, integer, choice");
+  const double u = rng.uniform();
+  Quantity a, b;
+  if (d.contains("uniform")) {
+    bounds("uniform", a, b);
+    if (a.value > b.value) throw InputError(file, line, "uniform: a > b");
+    return valueOf(a.value + u * (b.value - a.value), a.unit, false);
+  }
+  if (d.contains("log_uniform")) {
+    bounds("log_uniform", a, b);
+    if (!(a.value > 0 && b.value >= a.value)) throw InputError(file, line, "log_uniform needs 0 < a <= b");
+    return valueOf(std::exp(std::log(a.value) + u * (std::log(b.value) - std::log(a.value))), a.unit, false);
+  }
+  if (d.contains("integer")) {
+    bounds("integer", a, b);
+    if (!a.integer || !b.integer || a.value > b.value) throw InputError(file, line, "integer takes whole numbers [a, b] with a <= b");
+    const double span = b.value - a.value + 1;
+    return valueOf(std::min(b.value, a.value + std::floor(u * span)), a.unit, true);
+  }
+  if (d.contains("normal")) {
+    bounds("normal", a, b);
+    const double lo = d.contains("min") ? quantityOf(*d.get("min"), file, "min").value : -INFINITY;
+    const double hi = d.contains("max") ? quantityOf(*d.get("max"), file, "max").value : INFINITY;
+    if (!(b.value >= 0) || lo > hi) throw InputError(file, line, "normal takes [mean, sd] with sd >= 0 and min <= max");
+    // Truncated by rejection; a truncation that rejects nearly everything is a spec error.
+    for (int tries = 0; tries < 10000; ++tries) {
+      const double x = a.value + b.value * rng.normal();
+      if (x >= lo && x <= hi) return valueOf(x, a.unit, false);
+    }
+    throw InputError(file, line, "normal: min and max leave almost no probability; widen them");
+  }
+  const auto* arr = d.get("choice")->as_array();
+  if (!arr || arr->empty()) throw InputError(file, line, "choice takes a non-empty array of values");
+  std::vector<double> w(arr->size(), 1.0);
+  if (const auto* wn = d.get("weights")) {
+    const auto* wa = wn->as_array();
+    if (!wa || wa->size() != arr->size()) throw InputError(file, lineOf(*wn), "weights needs one number per choice");
+    for (std::size_t i = 0; i < w.size(); ++i) {
+      const auto x = wa->get(i)->value<double>();
+      if (!x || *x < 0) throw InputError(file, lineOf(*wn), "weights must be numbers >= 0");
+      w[i] = *x;
+    }
+  }
+  const double total = std::accumulate(w.begin(), w.end(), 0.0);
+  if (!(total > 0)) throw InputError(file, line, "weights must not all be 0");
+  double x = u * total;
+  std::size_t pick = 0;
+  while (pick + 1 < w.size() && x >= w[pick]) x -= w[pick++];
+  std::unique_ptr<toml::node> out;
+  arr->get(pick)->visit([&](const auto& v) { out = std::make_unique<std::decay_t<decltype(v)>>(v); });
+  return out;
+}
+
+// Replaces every distribution in `t` by a draw, in the table's (sorted) key order.
+void resolveTable(toml::table& t, Rng& rng, const std::string& file) {
+  for (auto&& [k, v] : t) {
+    if (isDistribution(v)) {
+      auto drawn = draw(*v.as_table(), rng, file);
+      drawn->visit([&](auto& x) { t.insert_or_assign(k, std::move(x)); });
+    } else if (auto* sub = v.as_table()) {
+      resolveTable(*sub, rng, file);
+    }
+  }
+}
+
+bool validName(const std::string& s) {
+  if (s.empty()) return false;
+  for (char c : s)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') return false;
+  return true;
+}
+
+}  // namespace
+
+DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
+  DatasetSpec s;
+  s.file = path.string();
+  if (!std::filesystem::exists(path)) throw InputError(s.file, 0, "no such dataset spec");
+  // One spelling of the spec's path, so every run (any working directory) records the same bytes.
+  s.file = std::filesystem::weakly_canonical(path).string();
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  s.text = ss.str();
+  auto root = std::make_shared<toml::table>();
+  try {
+    *root = toml::parse(s.text, s.file);
+  } catch (const toml::parse_error& e) {
+    throw InputError(s.file, static_cast<int>(e.source().begin.line), std::string("not valid TOML: ") + std::string(e.description()));
+  }
+  const auto* ds = root->get("dataset");
+  if (!ds || !ds->is_table()) throw InputError(s.file, 0, "a dataset spec needs a [dataset] table (name, id, samples, seed)");
+  const auto& d = *ds->as_table();
+  for (const auto& [k, v] : d)
+    if (k != "name" && k != "id" && k != "samples" && k != "seed" && k != "profile" && k != "channel_name")
+      throw InputError(s.file, lineOf(v), "unknown key '" + std::string(k.str()) +
+                                              "' in [dataset]; allowed: name, id, samples, seed, profile, channel_name");
+  const auto need = [&](const char* key) -> const toml::node& {
+    const auto* n = d.get(key);
+    if (!n) throw InputError(s.file, lineOf(d), std::string("missing key '") + key + "' in [dataset]");
+    return *n;
+  };
+  s.name = need("name").value_or<std::string>("");
+  if (!validName(s.name)) throw InputError(s.file, lineOf(need("name")), "name must be letters, digits, '-' or '_' (no dots or spaces)");
+  const auto id = need("id").value<std::int64_t>();
+  if (!id || *id < 1 || *id > 999) throw InputError(s.file, lineOf(need("id")), "id must be a whole number in 1…999 (nnU-Net's DatasetNNN)");
+  s.id = static_cast<int>(*id);
+  const auto n = need("samples").value<std::int64_t>();
+  if (!n || *n < 1 || *n > 100000000) throw InputError(s.file, lineOf(need("samples")), "samples must be a whole number in 1…10^8");
+  s.samples = *n;
+  const auto seed = need("seed").value<std::int64_t>();
+  if (!seed || *seed < 0) throw InputError(s.file, lineOf(need("seed")), "seed must be a whole number >= 0");
+  s.seed = static_cast<std::uint64_t>(*seed);
+  if (const auto* c = d.get("channel_name")) s.channel_name = c->value_or<std::string>("");
+  if (const auto* p = d.get("profile")) {
+    auto keep = std::make_shared<toml::table>();
+    keep->insert("profile", *p);
+    s.profile = keep;
+  }
+  if (root->contains("seed")) throw InputError(s.file, lineOf(*root->get("seed")), "the seed of a dataset goes in [dataset]");
+  root->erase("dataset");
+  s.table = root;
+  // Resolve one sample now, so a bad spec fails before any work starts.
+  resolveSample(s, 0);
+  return s;
+}
+
+std::string sampleId(const DatasetSpec& spec, std::int64_t index) {
+  int width = 4;
+  for (std::int64_t n = spec.samples - 1; n >= 10000; n /= 10) ++width;
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%0*lld", width, static_cast<long long>(index));
+  return spec.name + "_" + buf;
+}
+
+std::string datasetDirName(const DatasetSpec& spec) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "Dataset%03d_", spec.id);
+  return buf + spec.name;
+}
+
+ResolvedSample resolveSample(const DatasetSpec& spec, std::int64_t index) {
+  ResolvedSample r;
+  r.index = index;
+  r.id = sampleId(spec, index);
+  r.seed = Rng(spec.seed, static_cast<std::uint64_t>(index), Stage::Dataset, 0).nextU64() >> 1;  // fits TOML's int64
+  Rng rng(spec.seed, static_cast<std::uint64_t>(index), Stage::Dataset, 1);
+  auto t = std::make_shared<toml::table>(*static_cast<const toml::table*>(spec.table.get()));
+  r.profile = "clean";
+  if (spec.profile) {
+    toml::table p = *static_cast<const toml::table*>(spec.profile.get());
+    resolveTable(p, rng, spec.file);
+    const auto v = p.get("profile")->value<std::string>();
+    if (!v) throw InputError(spec.file, lineOf(*p.get("profile")), "profile must be a profile name or file (or a choice of them)");
+    r.profile = *v;
+  }
+  resolveTable(*t, rng, spec.file);
+  t->insert_or_assign("seed", static_cast<std::int64_t>(r.seed));
+  std::ostringstream o;
+  o << *t << "\n";
+  r.toml = o.str();
+  r.table = t;
+  return r;
+}
+
+}  // namespace angiosynth

@@ -1,0 +1,46 @@
+#pragma once
+// A dataset spec: a parameter file whose values may be distributions, plus a [dataset] table
+// (name, id, sample count, base seed, image profile). Sample i's parameters and seed are a pure
+// function of (base seed, i): any machine, shard or thread count resolves the same sample.
+//
+// A distribution replaces any value: {uniform = [a, b]}, {log_uniform = [a, b]},
+// {normal = [mean, sd], min = …, max = …}, {integer = [a, b]}, {choice = [v, …], weights = […]}.
+// Quantities with units ("0.3 mm") draw their number and keep their unit.
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace angiosynth {
+
+struct DatasetSpec {
+  std::string file;          // the spec, for errors and provenance
+  std::string text;          // its content, recorded in provenance.json
+  std::string name;          // nnU-Net dataset name (letters, digits, '-', '_')
+  int id = 1;                // nnU-Net dataset number, 1…999
+  std::int64_t samples = 0;
+  std::uint64_t seed = 0;
+  std::string channel_name;  // dataset.json channel 0 (default from the profile: "CT" for cta)
+  std::shared_ptr<const void> table;  // the parsed spec (a toml::table), without [dataset]
+  std::shared_ptr<const void> profile; // the [dataset] profile node (value or distribution), may be null
+};
+
+DatasetSpec readDatasetSpec(const std::filesystem::path& file);
+
+struct ResolvedSample {
+  std::int64_t index = 0;
+  std::string id;            // <name>_<index, fixed width>
+  std::uint64_t seed = 0;    // the growth and degradation seed
+  std::string profile;       // the image channel's profile
+  std::string toml;          // the resolved parameter file (what `describe` prints)
+  std::shared_ptr<const void> table;  // the same, parsed (a toml::table)
+};
+
+ResolvedSample resolveSample(const DatasetSpec& spec, std::int64_t index);
+// Fixed-width id of sample i: at least 4 digits, enough for every index of the dataset.
+std::string sampleId(const DatasetSpec& spec, std::int64_t index);
+std::string datasetDirName(const DatasetSpec& spec);  // DatasetNNN_Name
+
+}  // namespace angiosynth
