@@ -1,7 +1,6 @@
 // End-to-end tests of the angiosynth command line.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
-#include <sys/wait.h>
 #include <tinyxml2.h>
 
 #include <cstdio>
@@ -9,32 +8,12 @@
 #include <fstream>
 #include <sstream>
 
+#include "cli_run.hpp"
+
 using Json = nlohmann::json;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct Run {
-  int code;
-  std::string err;
-};
-
-Run run(const std::string& args, const fs::path& cwd) {
-  const fs::path err = cwd / "stderr.txt";
-  const std::string cmd = "cd '" + cwd.string() + "' && '" + ANGIOSYNTH_EXE + "' " + args + " 2>'" + err.string() + "' >/dev/null";
-  const int status = std::system(cmd.c_str());
-  std::ifstream in(err);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 class Cli : public ::testing::Test {
  protected:

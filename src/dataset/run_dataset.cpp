@@ -58,7 +58,7 @@ std::uint64_t sampleBytes(const DatasetSpec& spec, std::uint64_t limit) {
   const Scenario sc = scenarioOf(spec, r);
   const DemandMap map = loadDomain(sc, limit);
   const VolumeGrid g = imageGrid(map, sc.image);
-  const Profile p = loadProfile(r.profile, spec.file, 0);
+  loadProfile(r.profile, spec.file, 0);
   return denseRasterBytes(g) + 4ULL * g.voxelCount() + 24ULL * g.voxelCount() + map.demand.size() * 16;
 }
 
@@ -149,6 +149,8 @@ std::vector<std::int64_t> DatasetSelection::indices() const {
 DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent, const DatasetSelection& sel,
                             const DatasetRunOptions& opt) {
   DatasetRunReport rep;
+  // Reads sample 0's maps and profile: input errors surface before anything is written.
+  const std::uint64_t per_sample = std::max<std::uint64_t>(1, sampleBytes(spec, opt.memory_limit));
   const fs::path dir = out_parent / datasetDirName(spec);
   rep.dir = dir;
   for (const char* sub : {"imagesTr", "labelsTr", "groundtruth", "manifest", ".staging"}) fs::create_directories(dir / sub);
@@ -178,7 +180,6 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
     todo = left;
   }
   // Samples in flight: one per core, fewer if memory does not allow.
-  const std::uint64_t per_sample = std::max<std::uint64_t>(1, sampleBytes(spec, opt.memory_limit));
   const int cores = tbb::info::default_concurrency();
   rep.in_flight = static_cast<int>(std::max<std::uint64_t>(1, std::min<std::uint64_t>(cores, opt.memory_limit / per_sample)));
   const fs::path part = dir / "manifest" / (sel.part + ".jsonl");

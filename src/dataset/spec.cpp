@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "core/rng.hpp"
+#include "io/scenario.hpp"
 
 namespace angiosynth {
 namespace {
@@ -74,10 +75,10 @@ std::unique_ptr<toml::node> draw(const toml::table& d, Rng& rng, const std::stri
     b = quantityOf(*arr->get(1), file, key);
     if (a.unit != b.unit) throw InputError(file, line, std::string(key) + ": both bounds need the same unit");
   };
-  const std::set<std::string> allowed_extra = {"min", "max", "weights"};
   int kinds = 0;
   for (const auto& [k, v] : d) {
-    bool known = allowed_extra.count(std::string(k.str())) > 0;
+    // min and max belong to normal, weights to choice.
+    bool known = ((k == "min" || k == "max") && d.contains("normal")) || (k == "weights" && d.contains("choice"));
     for (const char* name : kDistributions) known |= k == name, kinds += k == name;
     if (!known)
       throw InputError(file, lineOf(v), "unknown key '" + std::string(k.str()) +
@@ -206,8 +207,9 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
   if (root->contains("seed")) throw InputError(s.file, lineOf(*root->get("seed")), "the seed of a dataset goes in [dataset]");
   root->erase("dataset");
   s.table = root;
-  // Resolve one sample now, so a bad spec fails before any work starts.
-  resolveSample(s, 0);
+  // Resolve and read one sample now, so a bad spec fails before any work starts.
+  const ResolvedSample first = resolveSample(s, 0);
+  readTomlParameters(*static_cast<const toml::table*>(first.table.get()), s.file);
   return s;
 }
 

@@ -1,0 +1,169 @@
+// Datasets: sample bytes independent of how they were made, the nnU-Net layout, describe,
+// verify and resume, failures.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <map>
+
+#include "cli_run.hpp"
+#include "dataset/manifest.hpp"
+#include "dataset/spec.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+class Dataset : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("angiosynth_ds_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  // path → sha256 of every file of every sample, per index.
+  static std::map<std::int64_t, std::map<std::string, std::string>> hashes(const fs::path& ds) {
+    std::map<std::int64_t, std::map<std::string, std::string>> out;
+    for (const auto& [i, e] : angiosynth::readManifests(ds))
+      for (const auto& f : e["files"]) out[i][f["path"]] = f["sha256"];
+    return out;
+  }
+  fs::path dir_;
+  const fs::path src_ = ANGIOSYNTH_SOURCE_DIR;
+  const std::string spec_ = "'" + (src_ / "tests/data/dataset_tiny.toml").string() + "'";
+  const std::string name_ = "Dataset902_VesselTiny";
+};
+
+TEST_F(Dataset, SampleBytesAreTheSameAloneInAFullRunInAnyShardAndForAnyThreads) {
+  ASSERT_EQ(run("dataset " + spec_ + " --out full2 --threads 2 --quiet", dir_).code, 0);
+  ASSERT_EQ(run("dataset " + spec_ + " --out full1 --threads 1 --quiet", dir_).code, 0);
+  ASSERT_EQ(run("dataset " + spec_ + " --out alone --index 4 --quiet", dir_).code, 0);
+  ASSERT_EQ(run("dataset " + spec_ + " --out shard --shard 1/2 --quiet", dir_).code, 0);
+  ASSERT_EQ(run("dataset " + spec_ + " --out range --range 2:5 --quiet", dir_).code, 0);
+  const auto full = hashes(dir_ / "full2" / name_);
+  ASSERT_EQ(full.size(), 6u);
+  EXPECT_EQ(hashes(dir_ / "full1" / name_), full);
+  const auto alone = hashes(dir_ / "alone" / name_);
+  ASSERT_EQ(alone.size(), 1u);
+  EXPECT_EQ(alone.at(4), full.at(4));
+  const auto shard = hashes(dir_ / "shard" / name_);
+  ASSERT_EQ(shard.size(), 3u);  // 1, 3, 5
+  for (const auto& [i, files] : shard) EXPECT_EQ(files, full.at(i)) << i;
+  const auto range = hashes(dir_ / "range" / name_);
+  ASSERT_EQ(range.size(), 3u);  // 2, 3, 4
+  for (const auto& [i, files] : range) EXPECT_EQ(files, full.at(i)) << i;
+  // Not vacuous: samples differ from each other, and each holds the nnU-Net pair.
+  EXPECT_NE(full.at(0).at("imagesTr/VesselTiny_0000_0000.nii.gz"), full.at(1).at("imagesTr/VesselTiny_0001_0000.nii.gz"));
+  EXPECT_TRUE(full.at(3).count("labelsTr/VesselTiny_0003.nii.gz"));
+  // Shards merged by finalize make the same dataset as a full run.
+  ASSERT_EQ(run("dataset " + spec_ + " --out merged --shard 0/2 --quiet", dir_).code, 0);
+  ASSERT_EQ(run("dataset " + spec_ + " --out merged --shard 1/2 --quiet", dir_).code, 0);
+  ASSERT_EQ(run("dataset finalize merged/" + name_, dir_).code, 0);
+  EXPECT_EQ(hashes(dir_ / "merged" / name_), full);
+  EXPECT_EQ(slurp(dir_ / "merged" / name_ / "dataset.json"), slurp(dir_ / "full2" / name_ / "dataset.json"));
+}
+
+TEST_F(Dataset, LayoutObeysTheRulesNnUNetChecks) {
+  ASSERT_EQ(run("dataset " + spec_ + " --out raw --quiet", dir_).code, 0);
+  const fs::path ds = dir_ / "raw" / name_;
+  const std::string cmd = "/usr/bin/python3 '" + (src_ / "tests/check_nnunet.py").string() + "' '" + ds.string() + "' > '" +
+                          (dir_ / "check.txt").string() + "' 2>&1";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << slurp(dir_ / "check.txt");
+  EXPECT_NE(slurp(dir_ / "check.txt").find("6 cases checked, 0 problems"), std::string::npos) << slurp(dir_ / "check.txt");
+  const Json j = Json::parse(slurp(ds / "dataset.json"));
+  EXPECT_EQ(j["channel_names"]["0"], "angio");
+  EXPECT_EQ(j["numTraining"], 6);
+  for (const char* f : {"manifest.jsonl", "provenance.json", "groundtruth/VesselTiny_0002.json",
+                        "groundtruth/VesselTiny_0002/centerline.nii.gz", "groundtruth/VesselTiny_0002/radius.nii.gz",
+                        "groundtruth/VesselTiny_0002/instances.nii.gz", "groundtruth/VesselTiny_0002/keypoints.csv",
+                        "groundtruth/VesselTiny_0002/tree.gxl", "groundtruth/VesselTiny_0002/image.nii.gz"})
+    EXPECT_TRUE(fs::exists(ds / f)) << f;
+  const Json prov = Json::parse(slurp(ds / "provenance.json"));
+  EXPECT_NE(prov["spec"].get<std::string>().find("VesselTiny"), std::string::npos);
+  EXPECT_EQ(prov["runs"].size(), 1u);
+  // Every manifest line names its files with size and hash.
+  std::ifstream in(ds / "manifest.jsonl");
+  int lines = 0;
+  for (std::string l; std::getline(in, l); ++lines) {
+    const Json e = Json::parse(l);
+    EXPECT_EQ(e["status"], "ok");
+    EXPECT_GE(e["files"].size(), 10u);
+    EXPECT_EQ(e["files"][0]["sha256"].get<std::string>().size(), 64u);
+  }
+  EXPECT_EQ(lines, 6);
+}
+
+TEST_F(Dataset, DescribeShowsTheParametersTheSampleIsMadeFrom) {
+  ASSERT_EQ(run("dataset " + spec_ + " --out raw --index 3 --quiet", dir_).code, 0);
+  const std::string cmd = "'" + std::string(ANGIOSYNTH_EXE) + "' dataset describe " + spec_ + " --index 3 > '" + (dir_ / "d.txt").string() + "'";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  const std::string described = slurp(dir_ / "d.txt");
+  const Json meta = Json::parse(slurp(dir_ / "raw" / name_ / "groundtruth/VesselTiny_0003.json"));
+  EXPECT_NE(described.find(meta["parameters_toml"].get<std::string>()), std::string::npos) << described;
+  EXPECT_EQ(described.rfind("# sample 3 (VesselTiny_0003), seed " + std::to_string(meta["seed"].get<std::uint64_t>()), 0), 0u);
+}
+
+TEST_F(Dataset, VerifyFindsCorruptAndMissingFilesAndResumeRepairsOnlyThose) {
+  ASSERT_EQ(run("dataset " + spec_ + " --out raw --quiet", dir_).code, 0);
+  const fs::path ds = dir_ / "raw" / name_;
+  ASSERT_EQ(run("dataset verify raw/" + name_, dir_).code, 0);
+  {
+    std::fstream f(ds / "labelsTr/VesselTiny_0002.nii.gz", std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(100);
+    f.put('\x5a');
+  }
+  fs::remove(ds / "groundtruth/VesselTiny_0004/radius.nii.gz");
+  const auto v = run("dataset verify raw/" + name_, dir_);
+  EXPECT_EQ(v.code, 1);
+  EXPECT_NE(v.err.find("corrupt VesselTiny_0002: labelsTr/VesselTiny_0002.nii.gz"), std::string::npos) << v.err;
+  EXPECT_NE(v.err.find("missing file of VesselTiny_0004: groundtruth/VesselTiny_0004/radius.nii.gz"), std::string::npos) << v.err;
+  const auto r = run("dataset " + spec_ + " --out raw --resume", dir_);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("2 generated, 4 skipped (verified), 0 failed"), std::string::npos) << r.err;
+  EXPECT_EQ(run("dataset verify raw/" + name_, dir_).code, 0);
+}
+
+TEST_F(Dataset, FailedSamplesAreRecordedAndMakeTheExitCodeNonZero) {
+  std::string t = slurp(src_ / "tests/data/dataset_tiny.toml");
+  t.replace(t.find("root_voxel"), 0, "min_distance = {choice = [\"1 voxel\", \"60 voxel\"]}\n");
+  t.replace(t.find("../../demand_maps"), 17, (src_ / "demand_maps").string());
+  std::ofstream(dir_ / "spec.toml") << t;
+  const auto r = run("dataset spec.toml --out raw --quiet", dir_);
+  EXPECT_EQ(r.code, 1) << r.err;
+  const auto entries = angiosynth::readManifests(dir_ / "raw" / name_);
+  int failed = 0, ok = 0;
+  for (const auto& [i, e] : entries) {
+    if (e["status"] == "failed") {
+      ++failed;
+      EXPECT_NE(e["error"].get<std::string>().find("could place only"), std::string::npos) << e.dump();
+      EXPECT_FALSE(fs::exists(dir_ / "raw" / name_ / "imagesTr" / (e["id"].get<std::string>() + "_0000.nii.gz")));
+    } else {
+      ++ok;
+    }
+  }
+  EXPECT_GT(failed, 0);
+  EXPECT_GT(ok, 0);
+  const Json j = Json::parse(slurp(dir_ / "raw" / name_ / "dataset.json"));
+  EXPECT_EQ(j["numTraining"], ok);
+  const auto v = run("dataset verify raw/" + name_, dir_);
+  EXPECT_EQ(v.code, 1);
+  EXPECT_NE(v.err.find("failed VesselTiny_"), std::string::npos) << v.err;
+}
+
+TEST_F(Dataset, BadSpecsNameFileAndLine) {
+  std::ofstream(dir_ / "bad.toml") << "[dataset]\nname = \"a.b\"\nid = 1\nsamples = 2\nseed = 1\n";
+  auto r = run("dataset bad.toml --out raw", dir_);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("bad.toml:2: name must be letters, digits"), std::string::npos) << r.err;
+  std::string t = slurp(src_ / "tests/data/dataset_tiny.toml");
+  t.replace(t.find("{integer = [60, 160]}"), 21, "{integer = [60, 160], max = 3}");
+  std::ofstream(dir_ / "bad2.toml") << t;
+  r = run("dataset bad2.toml --out raw", dir_);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("unknown key 'max' in a distribution"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "raw"));
+}
+
+}  // namespace
