@@ -128,8 +128,14 @@ class Grower {
       }
       if (!accepted) {
         ++report_.rejected_intersection;
+        // A run of collisions means the predicted radii leave no room anywhere (seen on a few
+        // early trees whose trunk lies along a face): relax the prediction towards the present
+        // radii; the exact check of the final tree repairs what this lets through.
+        if (++collisions_in_a_row_ % kCollisionsBeforeRelaxing == 0) relax_ *= 0.7;
         continue;
       }
+      collisions_in_a_row_ = 0;
+      relax_ = std::min(1.0, relax_ * 1.1);
       const auto n = tree_.nodeCount();
       index_.insert(tree_, n - 2);
       index_.insert(tree_, n - 1);
@@ -225,6 +231,10 @@ class Grower {
     }
   }
 
+  double relax_ = 1.0;                  // < 1 after runs of collision rejections
+  std::int64_t collisions_in_a_row_ = 0;
+  static constexpr std::int64_t kCollisionsBeforeRelaxing = 500;
+
   // Radius scale from now to the final tree.
   double finalScale() const {
     const std::int64_t n = tree_.terminalCount(), N = opt_.terminals;
@@ -232,7 +242,7 @@ class Grower {
     double a = 1.0 / params_.murray_exponent;
     if (n >= 16 && root_history_[n / 2] > 0)
       a = std::clamp(std::log(root_history_[n] / root_history_[n / 2]) / std::log(double(n) / double(n / 2)), 0.2, 0.4);
-    return std::min(kMaxPredictedScale, std::pow(double(N) / double(n), a));
+    return std::max(1.0, relax_ * std::min(kMaxPredictedScale, std::pow(double(N) / double(n), a)));
   }
 
   // True if the new segments (or the ancestors just above them) overlap another vessel, with
