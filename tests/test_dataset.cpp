@@ -63,6 +63,14 @@ TEST_F(Dataset, SampleBytesAreTheSameAloneInAFullRunInAnyShardAndForAnyThreads) 
   ASSERT_EQ(run("dataset finalize merged/" + name_, dir_).code, 0);
   EXPECT_EQ(hashes(dir_ / "merged" / name_), full);
   EXPECT_EQ(slurp(dir_ / "merged" / name_ / "dataset.json"), slurp(dir_ / "full2" / name_ / "dataset.json"));
+  // The cluster scripts' way: shard K from Slurm's or Kubernetes' index variable.
+  for (const std::string env : {"SLURM_ARRAY_TASK_ID=0", "JOB_COMPLETION_INDEX=1"}) {
+    const std::string cmd = "cd '" + dir_.string() + "' && env -u SLURM_ARRAY_TASK_ID -u JOB_COMPLETION_INDEX " + env + " '" +
+                            ANGIOSYNTH_EXE + "' dataset " + spec_ + " --out cluster --shard auto/2 --quiet >/dev/null 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << env;
+  }
+  ASSERT_EQ(run("dataset finalize cluster/" + name_, dir_).code, 0);
+  EXPECT_EQ(hashes(dir_ / "cluster" / name_), full);
 }
 
 TEST_F(Dataset, LayoutObeysTheRulesNnUNetChecks) {
