@@ -85,6 +85,8 @@ CLI::App* addDataset(CLI::App& app, DatasetArgs& a) {
   c->add_option("--range", a.range, "generate samples A to B-1");
   c->add_option("--shard", a.shard, "generate every M-th sample from K (K from 0); auto/M takes K from the environment");
   c->add_flag("--resume", a.resume, "skip samples whose files verify against the manifest");
+  c->add_option("--samples-in-flight", a.in_flight, "samples generated at once (default: one per thread, fewer if memory is short)")
+      ->check(CLI::PositiveNumber);
   addCommonOptions(*c, a.common);
   auto* d = c->add_subcommand("describe", "print sample I's resolved parameter file without generating it");
   d->add_option("SPEC", a.spec, "dataset spec (.toml)")->required();
@@ -117,6 +119,7 @@ int runDatasetCommand(const DatasetArgs& a, const std::string& command_line) {
   const DatasetSelection sel = selection(a, spec.samples);
   DatasetRunOptions opt;
   opt.resume = a.resume;
+  opt.samples_in_flight = a.in_flight;
   opt.memory_limit = memoryLimit(a.common);
   opt.command_line = command_line;
   const bool terminal = isatty(STDERR_FILENO) && !a.common.quiet;

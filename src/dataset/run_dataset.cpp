@@ -1,7 +1,7 @@
 #include "dataset/run_dataset.hpp"
 
 #include <toml++/toml.h>
-#include <tbb/info.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_pipeline.h>
 #include <unistd.h>
 
@@ -180,8 +180,9 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
     todo = left;
   }
   // Samples in flight: one per core, fewer if memory does not allow.
-  const int cores = tbb::info::default_concurrency();
-  rep.in_flight = static_cast<int>(std::max<std::uint64_t>(1, std::min<std::uint64_t>(cores, opt.memory_limit / per_sample)));
+  const auto cores = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);  // honours --threads
+  const std::uint64_t wanted = opt.samples_in_flight > 0 ? std::uint64_t(opt.samples_in_flight) : cores;
+  rep.in_flight = static_cast<int>(std::max<std::uint64_t>(1, std::min<std::uint64_t>(wanted, opt.memory_limit / per_sample)));
   const fs::path part = dir / "manifest" / (sel.part + ".jsonl");
   std::mutex m;
   std::size_t next = 0;

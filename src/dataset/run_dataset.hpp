@@ -32,6 +32,7 @@ struct DatasetSelection {
 struct DatasetRunOptions {
   bool resume = false;               // skip samples whose manifest entry verifies
   std::uint64_t memory_limit = 0;
+  int samples_in_flight = 0;         // 0: one per thread, fewer if memory is short
   std::string command_line;
   // Called after each sample (under a lock) with its manifest entry, samples done and total.
   std::function<void(const nlohmann::json& entry, std::int64_t done, std::int64_t total)> on_sample;
