@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <numeric>
+#include <unistd.h>
 
 #include "core/error.hpp"
 #include "degrade/degrade.hpp"
@@ -22,7 +23,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path writeTemp(const std::string& name, const std::string& text) {
-  const fs::path p = fs::temp_directory_path() / ("angiosynth_degrade_" + name);
+  // The pid keeps tests that ctest runs in parallel processes off each other's files.
+  const fs::path p = fs::temp_directory_path() / ("angiosynth_degrade_" + std::to_string(::getpid()) + "_" + name);
   std::ofstream(p, std::ios::binary) << text;
   return p;
 }

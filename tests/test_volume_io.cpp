@@ -1,6 +1,7 @@
 // Volume and graph files as other tools read them: NIfTI through nibabel, GraphML through
 // NetworkX, PNG/TIFF through OpenImageIO, NRRD by its header.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -19,7 +20,7 @@ namespace {
 // Debian's interpreter: nibabel and NetworkX come from Debian packages (python3 on PATH may be
 // another installation).
 std::string python(const std::string& script) {
-  const fs::path file = fs::temp_directory_path() / "angiosynth_check.py";
+  const fs::path file = fs::temp_directory_path() / ("angiosynth_check_" + std::to_string(::getpid()) + ".py");
   std::ofstream(file) << script;
   std::string out;
   if (FILE* p = popen(("/usr/bin/python3 '" + file.string() + "' 2>&1").c_str(), "r")) {
