@@ -177,7 +177,7 @@ TEST_F(Cli, ProfilesGiveOneDegradedImageEachWithWarpedLabelsAndTheSameBytesForAn
   ASSERT_EQ(run("generate p.toml --out one --threads 1 --quiet", dir_).code, 0);
   ASSERT_EQ(run("generate p.toml --out two --threads 2 --quiet", dir_).code, 0);
   for (const char* f : {"image_cta.nii.gz", "image_warpy.nii.gz", "mask_warpy.nii.gz", "centerline_warpy.nii.gz",
-                        "radius_warpy.nii.gz", "instances_warpy.nii.gz", "tree_warpy.gxl", "mip_z_cta.png"}) {
+                        "radius_warpy.nii.gz", "instances_warpy.nii.gz", "tree_warpy.gxl", "warp_warpy.json", "mip_z_cta.png"}) {
     ASSERT_TRUE(fs::exists(dir_ / "one" / f)) << f;
     EXPECT_EQ(slurp(dir_ / "one" / f), slurp(dir_ / "two" / f)) << f;
   }

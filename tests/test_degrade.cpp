@@ -295,6 +295,14 @@ TEST_F(Warp, IsInvertibleAndLabelsAreNeverInvented) {
   EXPECT_EQ(unlabelled, 0) << "of " << mask;
   EXPECT_GT(solid, 300);
   EXPECT_GE(double(same) / solid, 0.95) << same << " of " << solid;
+  // The published description of the warp reproduces it: a B-spline of the listed displacements.
+  const auto j = warp.describe();
+  BSplineField fx(grid_, Vec3(j["spacing_mm"][0], j["spacing_mm"][1], j["spacing_mm"][2]));
+  fx.coefficients() = j["displacement_x_mm"].get<std::vector<float>>();
+  for (int i = 0; i < 50; ++i) {
+    const Vec3 y(rng.uniform(0, 40), rng.uniform(0, 40), rng.uniform(0, 40));
+    EXPECT_NEAR(fx.at(y), warp.displacement(y).x, 1e-9);
+  }
   // Every piece of the warped graph knows its clean segment.
   ASSERT_EQ(w.segment_origin.size(), std::size_t(w.tree->nodeCount()));
   for (std::int32_t s = 1; s < w.tree->nodeCount(); ++s) ASSERT_GT(w.segment_origin[s], 0);

@@ -20,6 +20,7 @@ class BSplineField {
 
   const std::array<int, 3>& lattice() const { return n_; }
   Vec3 spacing() const { return h_; }
+  Vec3 latticeOrigin() const { return lattice_origin_; }  // control point (0,0,0), mm
   // Coefficients, x fastest; set them, then call prepare().
   std::vector<float>& coefficients() { return coef_; }
   const std::vector<float>& coefficients() const { return coef_; }

@@ -84,6 +84,19 @@ double BSplineWarp::minJacobianDeterminant(int stride) const {
       [](double a, double b) { return std::min(a, b); });
 }
 
+nlohmann::ordered_json BSplineWarp::describe() const {
+  const auto& f = u_[0];
+  const Vec3 o = f.latticeOrigin(), h = f.spacing();
+  nlohmann::ordered_json j;
+  j["definition"] = "warped image at y = clean image at y + u(y); u is a uniform cubic B-spline with control point (a,b,c) at "
+                    "origin + (a,b,c)*spacing; displacements are listed x fastest; clean points x move to the y solving y + u(y) = x";
+  j["lattice"] = {f.lattice()[0], f.lattice()[1], f.lattice()[2]};
+  j["origin_mm"] = {o.x, o.y, o.z};
+  j["spacing_mm"] = {h.x, h.y, h.z};
+  for (int c = 0; c < 3; ++c) j[std::string("displacement_") + "xyz"[c] + "_mm"] = u_[c].coefficients();
+  return j;
+}
+
 VascularTree warpTree(const VascularTree& t, const BSplineWarp& warp, double piece_mm, std::vector<std::int32_t>& origin) {
   VascularTree w;
   origin.assign(1, 0);

@@ -9,6 +9,8 @@
 #include <memory>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "core/rng.hpp"
 #include "core/vascular_tree.hpp"
 #include "degrade/bspline_field.hpp"
@@ -35,6 +37,8 @@ class BSplineWarp {
   // Smallest det(I + ∇u) over a lattice of sample points (> 0 for an invertible warp).
   double minJacobianDeterminant(int stride) const;
   const VolumeGrid& grid() const { return grid_; }
+  // The control lattice and its displacements, so users can move their own points (JSON).
+  nlohmann::ordered_json describe() const;
 
  private:
   VolumeGrid grid_;

@@ -47,6 +47,9 @@ void writeDegradedImages(const VascularTree& tree, const GroundTruthVolumes& gt,
       const std::string gxl = "tree" + suffix + ".gxl";
       writeTextFile(dir / gxl, [&](std::ostream& o) { writeGxl(o, *d.tree, req.frame, "tree" + suffix); });
       files["gxl" + suffix] = gxl;
+      const std::string warp = "warp" + suffix + ".json";
+      writeTextFile(dir / warp, [&](std::ostream& o) { o << d.warp->describe().dump(1) << "\n"; });
+      files["warp" + suffix] = warp;
       writeGraphFiles(*d.tree, gt.fraction.grid, ip.graph_formats, suffix, dir, files);
       std::int64_t mask_voxels = 0;
       for (auto m : d.labels->mask.data) mask_voxels += m;
