@@ -18,9 +18,7 @@ namespace {
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("angiosynth_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = freshTestDir("angiosynth_cli_");
   }
   void TearDown() override { fs::remove_all(dir_); }
   fs::path dir_;

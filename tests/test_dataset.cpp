@@ -15,12 +15,19 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
+// A path in single quotes for a shell command line (appended piecewise: GCC 12 warns falsely,
+// -Wrestrict, on "'" + string + "'").
+std::string quoted(const fs::path& p) {
+  std::string s(1, '\'');
+  s += p.string();
+  s += '\'';
+  return s;
+}
+
 class Dataset : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("angiosynth_ds_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = freshTestDir("angiosynth_ds_");
   }
   void TearDown() override { fs::remove_all(dir_); }
   // path → sha256 of every file of every sample, per index.
@@ -32,7 +39,7 @@ class Dataset : public ::testing::Test {
   }
   fs::path dir_;
   const fs::path src_ = ANGIOSYNTH_SOURCE_DIR;
-  const std::string spec_ = "'" + (src_ / "tests/data/dataset_tiny.toml").string() + "'";
+  const std::string spec_ = quoted(src_ / "tests/data/dataset_tiny.toml");
   const std::string name_ = "Dataset902_VesselTiny";
 };
 
@@ -105,7 +112,7 @@ TEST_F(Dataset, LayoutObeysTheRulesNnUNetChecks) {
 
 TEST_F(Dataset, DescribeShowsTheParametersTheSampleIsMadeFrom) {
   ASSERT_EQ(run("dataset " + spec_ + " --out raw --index 3 --quiet", dir_).code, 0);
-  const std::string cmd = "'" + std::string(ANGIOSYNTH_EXE) + "' dataset describe " + spec_ + " --index 3 > '" + (dir_ / "d.txt").string() + "'";
+  const std::string cmd = quoted(ANGIOSYNTH_EXE) + " dataset describe " + spec_ + " --index 3 > " + quoted(dir_ / "d.txt");
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   const std::string described = slurp(dir_ / "d.txt");
   const Json meta = Json::parse(slurp(dir_ / "raw" / name_ / "groundtruth/VesselTiny_0003.json"));

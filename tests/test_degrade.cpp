@@ -31,6 +31,15 @@ fs::path writeTemp(const std::string& name, const std::string& text) {
 
 Profile profileFrom(const std::string& name, const std::string& text) { return readProfileToml(writeTemp(name + ".toml", text)); }
 
+// n³ voxels over the example's 40 mm map, voxel centres at (i + ½)·40/n.
+VolumeGrid mapGrid(int n) {
+  VolumeGrid g;
+  g.dims = {n, n, n};
+  g.spacing_mm = Vec3(40.0 / n, 40.0 / n, 40.0 / n);
+  g.origin_mm = g.spacing_mm * 0.5;
+  return g;
+}
+
 GroundTruthVolumes flatTruth(int n, const Vec3& spacing = Vec3(1, 1, 1)) {
   VolumeGrid g;
   g.dims = {n, n, n};
@@ -165,10 +174,7 @@ TEST(Degrade, BlurredVoxelHasThePsfSigmaOnEachAxis) {
 TEST(Degrade, SameSeedSameImageWhateverTheThreadsAndStreamsDiffer) {
   const auto ex = test::vascusynthExample(300, 3);
   const VascularTree tree = test::grow(ex);
-  VolumeGrid g;
-  g.dims = {64, 64, 64};
-  g.spacing_mm = Vec3(40.0 / 64, 40.0 / 64, 40.0 / 64);
-  g.origin_mm = g.spacing_mm * 0.5;
+  const VolumeGrid g = mapGrid(64);
   const auto gt = rasterizeGroundTruth(tree, g, RasterOptions{2});
   const Profile p = readProfileToml(test::sourceDir() / "noise_profiles/domain_randomisation.toml");
   Profile all = p;  // every effect applied
@@ -201,9 +207,7 @@ class Warp : public ::testing::Test {
   static void SetUpTestSuite() {
     const auto ex = test::vascusynthExample(1000, 1);
     tree_ = new VascularTree(test::grow(ex));
-    grid_.dims = {100, 100, 100};
-    grid_.spacing_mm = Vec3(0.4, 0.4, 0.4);
-    grid_.origin_mm = Vec3(0.2, 0.2, 0.2);
+    grid_ = mapGrid(100);
     clean_ = new GroundTruthVolumes(rasterizeGroundTruth(*tree_, grid_, RasterOptions{4}));
     // Control spacing 10 mm, displacements up to 3 mm (7.5 voxels): strongly curved vessels.
     const Profile p = profileFrom("w", "[[effect]]\ntype = \"warp\"\nspacing = \"10 mm\"\nmax_displacement = \"3 mm\"\n");
@@ -311,10 +315,7 @@ TEST_F(Warp, IsInvertibleAndLabelsAreNeverInvented) {
 TEST(Degrade, DropoutsRemoveVesselContrastAtTheirGapsOnly) {
   const auto ex = test::vascusynthExample(1000, 2);
   const VascularTree tree = test::grow(ex);
-  VolumeGrid g;
-  g.dims = {100, 100, 100};
-  g.spacing_mm = Vec3(0.4, 0.4, 0.4);
-  g.origin_mm = Vec3(0.2, 0.2, 0.2);
+  const VolumeGrid g = mapGrid(100);
   const auto gt = rasterizeGroundTruth(tree, g, RasterOptions{4});
   const auto d = run(profileFrom("d", "[[effect]]\ntype = \"dropout\"\ncount = 60\nlength = \"2 mm\"\n"), gt, tree);
   const auto& gaps = d.record["effects"][0]["gaps"];
@@ -392,10 +393,7 @@ TEST(Degrade, ProfileErrorsNameFileAndLine) {
 TEST(Degrade, ShippedProfilesDrawWithinTheirRangesAndFitTheirDtype) {
   const auto ex = test::vascusynthExample(200, 4);
   const VascularTree tree = test::grow(ex);
-  VolumeGrid g;
-  g.dims = {48, 48, 48};
-  g.spacing_mm = Vec3(40.0 / 48, 40.0 / 48, 40.0 / 48);
-  g.origin_mm = g.spacing_mm * 0.5;
+  const VolumeGrid g = mapGrid(48);
   const auto gt = rasterizeGroundTruth(tree, g, RasterOptions{2});
   int profiles = 0;
   for (const auto& e : fs::directory_iterator(test::sourceDir() / "noise_profiles")) {

@@ -10,6 +10,7 @@
 
 #include "io/graph_writers.hpp"
 #include "io/volume_writers.hpp"
+#include "cli_run.hpp"
 #include "test_support.hpp"
 
 using namespace angiosynth;
@@ -34,9 +35,7 @@ std::string python(const std::string& script) {
 class VolumeFiles : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("angiosynth_vol_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = freshTestDir("angiosynth_vol_");
     grid_.dims = {7, 5, 3};
     grid_.spacing_mm = Vec3(0.5, 0.25, 2.0);
     grid_.origin_mm = Vec3(-3.0, 1.5, 10.0);

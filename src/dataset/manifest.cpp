@@ -56,8 +56,7 @@ std::map<std::int64_t, nlohmann::json> readManifests(const std::filesystem::path
       if (j.is_discarded() || !j.contains("index") || !j.contains("status")) continue;  // a torn last line
       const auto i = j["index"].get<std::int64_t>();
       auto it = out.find(i);
-      // Later entries win, except that a failure never hides an earlier success of another run
-      // unless it is newer.
+      // The entry that finished last wins, whichever part holds it.
       if (it == out.end() || j.value("finished_unix", 0.0) >= it->second.value("finished_unix", 0.0)) out[i] = j;
     }
   }
@@ -74,7 +73,7 @@ bool entryVerifies(const std::filesystem::path& dir, const nlohmann::json& entry
     std::error_code ec;
     const auto size = std::filesystem::file_size(path, ec);
     if (ec) {
-      if (why) *why = "missing " + f["path"].get<std::string>();
+      if (why) *why = "missing " + f["path"].get<std::string>();  // as `verify` reports it
       return false;
     }
     if (size != f["size"].get<std::uintmax_t>() || sha256File(path) != f["sha256"].get<std::string>()) {

@@ -19,11 +19,11 @@ std::string sha256File(const std::filesystem::path& file);
 // readers skip.
 void appendManifestLine(const std::filesystem::path& part, const nlohmann::json& entry);
 
-// Every readable entry of every part and of manifest.jsonl, the last one per index winning
-// (an "ok" entry beats a later failure only if it came later in time).
+// Every readable entry of every part and of manifest.jsonl; per index, the one that finished last.
 std::map<std::int64_t, nlohmann::json> readManifests(const std::filesystem::path& dataset_dir);
 
-// Whether every file of an entry exists with its recorded size and hash.
+// Whether every file of an entry exists with its recorded size and hash; if not, `why` says
+// "missing <path>", "corrupt <path>" or "status <status>".
 bool entryVerifies(const std::filesystem::path& dataset_dir, const nlohmann::json& entry, std::string* why = nullptr);
 
 }  // namespace angiosynth

@@ -45,7 +45,7 @@ void writeJsonAtomically(const fs::path& p, const Json& j) {
 }
 
 Scenario scenarioOf(const DatasetSpec& spec, const ResolvedSample& r) {
-  Scenario sc = readTomlParameters(*static_cast<const toml::table*>(r.table.get()), spec.file);
+  Scenario sc = readTomlParameters(*r.table, spec.file);
   sc.image.enabled = true;
   sc.image.formats = {"nifti"};
   sc.profiles = {r.profile};
@@ -134,7 +134,7 @@ Json machine() {
   ::gethostname(host, sizeof host - 1);
   return Json{{"hostname", host},
               {"cores", std::thread::hardware_concurrency()},
-              {"memory_bytes", defaultMemoryLimitBytes() / 3 * 4}};
+              {"memory_bytes", physicalMemoryBytes()}};
 }
 
 }  // namespace
@@ -235,10 +235,10 @@ DatasetCheck checkDataset(const fs::path& dir, bool rehash, std::map<std::int64_
       c.problems.push_back("failed " + id + ": " + it->second.value("error", "?"));
       continue;
     }
-    std::string why;
+    std::string why;  // "missing <path>" or "corrupt <path>"
     if (rehash && !entryVerifies(dir, it->second, &why)) {
-      c.problems.push_back(why.rfind("missing", 0) == 0 ? why.replace(0, 7, "missing file of " + id + ":")
-                                                        : "corrupt " + id + ": " + why.substr(why.find(' ') + 1));
+      const std::string kind = why.substr(0, why.find(' ')), path = why.substr(why.find(' ') + 1);
+      c.problems.push_back((kind == "missing" ? "missing file of " : "corrupt ") + id + ": " + path);
       continue;
     }
     ++c.ok;
@@ -299,13 +299,13 @@ DatasetCheck verifyDataset(const fs::path& dir) {
   Json info;
   DatasetCheck c = checkDataset(dir, /*rehash=*/true, entries, info);
   // Images or labels nobody recorded (a sample killed before its manifest line).
+  std::set<std::string> known;
+  for (const auto& [i, e] : entries)
+    for (const auto& file : e.value("files", Json::array())) known.insert(file["path"].get<std::string>());
   for (const char* sub : {"imagesTr", "labelsTr"})
     for (const auto& f : fs::directory_iterator(dir / sub)) {
-      const std::string name = f.path().filename().string();
-      bool known = false;
-      for (const auto& [i, e] : entries)
-        for (const auto& file : e.value("files", Json::array())) known |= file["path"] == std::string(sub) + "/" + name;
-      if (!known) c.problems.push_back(std::string("stray ") + sub + "/" + name);
+      const std::string rel = std::string(sub) + "/" + f.path().filename().string();
+      if (!known.count(rel)) c.problems.push_back("stray " + rel);
     }
   return c;
 }

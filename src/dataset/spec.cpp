@@ -209,7 +209,7 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
   s.table = root;
   // Resolve and read one sample now, so a bad spec fails before any work starts.
   const ResolvedSample first = resolveSample(s, 0);
-  readTomlParameters(*static_cast<const toml::table*>(first.table.get()), s.file);
+  readTomlParameters(*first.table, s.file);
   return s;
 }
 
@@ -233,10 +233,10 @@ ResolvedSample resolveSample(const DatasetSpec& spec, std::int64_t index) {
   r.id = sampleId(spec, index);
   r.seed = Rng(spec.seed, static_cast<std::uint64_t>(index), Stage::Dataset, 0).nextU64() >> 1;  // fits TOML's int64
   Rng rng(spec.seed, static_cast<std::uint64_t>(index), Stage::Dataset, 1);
-  auto t = std::make_shared<toml::table>(*static_cast<const toml::table*>(spec.table.get()));
+  auto t = std::make_shared<toml::table>(*spec.table);
   r.profile = "clean";
   if (spec.profile) {
-    toml::table p = *static_cast<const toml::table*>(spec.profile.get());
+    toml::table p = *spec.profile;
     resolveTable(p, rng, spec.file);
     const auto v = p.get("profile")->value<std::string>();
     if (!v) throw InputError(spec.file, lineOf(*p.get("profile")), "profile must be a profile name or file (or a choice of them)");

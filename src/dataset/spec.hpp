@@ -13,6 +13,12 @@
 
 #include <nlohmann/json.hpp>
 
+namespace toml {
+inline namespace v3 {
+class table;
+}
+}  // namespace toml
+
 namespace angiosynth {
 
 struct DatasetSpec {
@@ -23,8 +29,8 @@ struct DatasetSpec {
   std::int64_t samples = 0;
   std::uint64_t seed = 0;
   std::string channel_name;  // dataset.json channel 0 (default from the profile: "CT" for cta)
-  std::shared_ptr<const void> table;  // the parsed spec (a toml::table), without [dataset]
-  std::shared_ptr<const void> profile; // the [dataset] profile node (value or distribution), may be null
+  std::shared_ptr<const toml::table> table;    // the parsed spec, without [dataset]
+  std::shared_ptr<const toml::table> profile;  // {profile = value or distribution}; null: clean
 };
 
 DatasetSpec readDatasetSpec(const std::filesystem::path& file);
@@ -35,7 +41,7 @@ struct ResolvedSample {
   std::uint64_t seed = 0;    // the growth and degradation seed
   std::string profile;       // the image channel's profile
   std::string toml;          // the resolved parameter file (what `describe` prints)
-  std::shared_ptr<const void> table;  // the same, parsed (a toml::table)
+  std::shared_ptr<const toml::table> table;  // the same, parsed
 };
 
 ResolvedSample resolveSample(const DatasetSpec& spec, std::int64_t index);

@@ -14,17 +14,10 @@ using Json = nlohmann::ordered_json;
 
 std::uint64_t profileKey(const std::string& name) { return hashName(name.data(), name.size()); }
 
-double drawIntensity(const std::optional<ParamSpec>& spec, double fallback, const char* name, Rng& rng, Json& rec,
-                     const std::string& file) {
+// The profile's own intensities: plain values or ranges (one draw each, even when fixed).
+double drawIntensity(const std::optional<ParamSpec>& spec, double fallback, const char* name, Rng& rng, Json& rec) {
   const double u = rng.uniform();
-  if (!spec) {
-    rec[name] = fallback;
-    return fallback;
-  }
-  const ParamRange& r = spec->components[0];
-  const double v = !r.range ? r.lo.value
-                            : (r.log ? std::exp(std::log(r.lo.value) + u * (std::log(r.hi.value) - std::log(r.lo.value)))
-                                     : r.lo.value + u * (r.hi.value - r.lo.value));
+  const double v = spec ? drawComponent(spec->components[0], u, ParamScale{}, -1) : fallback;
   rec[name] = v;
   return v;
 }
@@ -51,8 +44,8 @@ DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
   Rng prng(in.seed, in.sample, Stage::Degrade, mix64(pkey));
   DegradeState s;
   s.grid = in.truth->fraction.grid;
-  s.background = drawIntensity(profile.background, in.background, "background", prng, rec, profile.file);
-  s.vessel = drawIntensity(profile.vessel, in.vessel, "vessel", prng, rec, profile.file);
+  s.background = drawIntensity(profile.background, in.background, "background", prng, rec);
+  s.vessel = drawIntensity(profile.vessel, in.vessel, "vessel", prng, rec);
   out.dtype = profile.dtype.empty() ? in.dtype : profile.dtype;
   rec["dtype"] = out.dtype;
   s.fraction = &in.truth->fraction;

@@ -59,6 +59,9 @@ std::string effectReference();
 // Applies f(v) to every voxel index in parallel; f must depend on v only (not on scheduling).
 template <class F>
 void forEachVoxel(std::int64_t count, F&& f);
+// The same with the voxel's (i, j, k): rows in parallel, i contiguous within a row.
+template <class F>
+void forEachVoxelIjk(const VolumeGrid& g, F&& f);
 
 }  // namespace angiosynth
 
@@ -71,6 +74,17 @@ template <class F>
 void forEachVoxel(std::int64_t count, F&& f) {
   tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, count, 1 << 14), [&](const tbb::blocked_range<std::int64_t>& r) {
     for (std::int64_t v = r.begin(); v < r.end(); ++v) f(v);
+  });
+}
+
+template <class F>
+void forEachVoxelIjk(const VolumeGrid& g, F&& f) {
+  const std::int64_t nx = g.dims[0], ny = g.dims[1];
+  tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, ny * g.dims[2]), [&](const tbb::blocked_range<std::int64_t>& r) {
+    for (std::int64_t row = r.begin(); row < r.end(); ++row) {
+      const std::int64_t j = row % ny, k = row / ny;
+      for (std::int64_t i = 0; i < nx; ++i) f(row * nx + i, i, j, k);
+    }
   });
 }
 

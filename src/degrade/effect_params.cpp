@@ -131,6 +131,23 @@ double resolveAmount(const Amount& a, const ParamScale& s, int axis) {
   return a.value;
 }
 
+double drawComponent(const ParamRange& r, double u, const ParamScale& s, int axis) {
+  const double lo = resolveAmount(r.lo, s, axis);
+  if (!r.range) return lo;
+  const double hi = resolveAmount(r.hi, s, axis);
+  return r.log ? std::exp(std::log(lo) + u * (std::log(hi) - std::log(lo))) : lo + u * (hi - lo);
+}
+
+ParamSpec fixedParam(double value, const std::string& file, int line) {
+  ParamSpec s;
+  s.file = file;
+  s.line = line;
+  ParamRange r;
+  r.lo.value = r.hi.value = value;
+  s.components.push_back(r);
+  return s;
+}
+
 Drawn drawParams(const std::vector<ParamDecl>& decls, const std::map<std::string, ParamSpec>& given,
                  const ParamScale& scale, Rng& rng, nlohmann::ordered_json& record, const std::string& file, int line) {
   Drawn d;
@@ -157,7 +174,7 @@ Drawn drawParams(const std::vector<ParamDecl>& decls, const std::map<std::string
       const double lo = resolveAmount(r.lo, scale, res_axis), hi = resolveAmount(r.hi, scale, res_axis);
       if (r.range && lo > hi)
         throw InputError(file, where_line, std::string("the range of ") + decl.name + " resolves to min " + show(lo) + " > max " + show(hi));
-      double x = !r.range ? lo : (r.log ? std::exp(std::log(lo) + u * (std::log(hi) - std::log(lo))) : lo + u * (hi - lo));
+      double x = drawComponent(r, u, scale, res_axis);
       if (decl.kind == ParamKind::Count) x = r.range ? std::min(std::floor(lo + u * (std::floor(hi) - lo + 1)), std::floor(hi)) : std::round(x);
       checkRange(x, decl.lo, false, decl.hi, false, Where{file, where_line}, decl.name);
       out[ax] = x;

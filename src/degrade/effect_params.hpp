@@ -89,6 +89,10 @@ Drawn drawParams(const std::vector<ParamDecl>& decls, const std::map<std::string
 
 // One amount resolved on an axis (-1: the mean over axes).
 double resolveAmount(const Amount& a, const ParamScale& s, int axis);
+// A component's value for the uniform draw u: its value, or uniform (log-uniform) in its range.
+double drawComponent(const ParamRange& r, double u, const ParamScale& s, int axis);
+// A fixed plain value (VascuSynth noise files, code-built profiles).
+ParamSpec fixedParam(double value, const std::string& file = "", int line = 0);
 
 // "a value", "a range" etc. as written in the README.
 std::string describeKind(ParamKind kind);

@@ -1,6 +1,6 @@
 #include "degrade/profile.hpp"
 
-#include <toml++/toml.h>
+#include "io/toml_file.hpp"
 
 #include <cstdlib>
 #include <set>
@@ -67,27 +67,11 @@ EffectSpec readEffect(const toml::table& t, const std::string& file, bool& has_w
   return e;
 }
 
-ParamSpec fixedSpec(double v, const std::string& file, int line) {
-  ParamSpec s;
-  s.file = file;
-  s.line = line;
-  ParamRange r;
-  r.lo.value = r.hi.value = v;
-  s.components.push_back(r);
-  return s;
-}
-
 }  // namespace
 
 Profile readProfileToml(const std::filesystem::path& path) {
   const std::string file = path.string();
-  if (!std::filesystem::exists(path)) throw InputError(file, 0, "no such profile file");
-  toml::table root;
-  try {
-    root = toml::parse_file(file);
-  } catch (const toml::parse_error& e) {
-    throw InputError(file, static_cast<int>(e.source().begin.line), std::string("not valid TOML: ") + std::string(e.description()));
-  }
+  const toml::table root = parseTomlFile(path, "profile file");
   Profile p;
   p.name = path.stem().string();
   p.file = file;
@@ -126,8 +110,8 @@ Profile readVascuSynthNoiseFile(const std::filesystem::path& path) {
   p.name = path.stem().string();
   p.file = file;
   p.description = "VascuSynth noise file";
-  p.background = fixedSpec(0, file, 0);
-  p.vessel = fixedSpec(255, file, 0);
+  p.background = fixedParam(0, file, 0);
+  p.vessel = fixedParam(255, file, 0);
   p.dtype = "uint8";
   p.clamp_each_step = true;
   struct Directive {
@@ -169,7 +153,7 @@ Profile readVascuSynthNoiseFile(const std::filesystem::path& path) {
       const double v = std::string(d->key) == "SHADOW"
                            ? static_cast<double>(parseInteger(words[i], file, line.number, std::string(d->key) + " count"))
                            : parseNumber(words[i], file, line.number, std::string(d->key) + " " + d->params[i]);
-      e.params[d->params[i]] = fixedSpec(v, file, line.number);
+      e.params[d->params[i]] = fixedParam(v, file, line.number);
     }
     p.effects.push_back(std::move(e));
   }
@@ -200,14 +184,14 @@ Profile loadProfile(const std::string& ref, const std::filesystem::path& named_i
   const std::filesystem::path r(ref);
   const bool bare = !r.has_parent_path() && !r.has_extension();
   if (bare) {
-    std::string looked;
-    for (const auto& d : profileSearchPath()) {
+    const auto dirs = profileSearchPath();
+    std::string looked, names;
+    for (const auto& d : dirs) {
       const auto f = d / (ref + ".toml");
       if (std::filesystem::exists(f)) return readProfileToml(f);
       looked += (looked.empty() ? "" : ", ") + d.string();
     }
-    std::string names;
-    for (const auto& d : profileSearchPath()) {
+    for (const auto& d : dirs) {
       std::error_code ec;
       for (const auto& e : std::filesystem::directory_iterator(d, ec))
         if (e.path().extension() == ".toml") names += (names.empty() ? "" : ", ") + e.path().stem().string();

@@ -20,10 +20,9 @@ void applyBias(const Drawn& p, EffectContext& ctx) {
   auto& s = ctx.state;
   const double sigma = std::log1p(p("amplitude"));
   const BSplineField f = randomField(s.grid, p.vec("scale"), ctx.rng);
-  const std::int64_t nx = s.grid.dims[0], ny = s.grid.dims[1];
   // exp of a normal field: the gain is always positive, with median 1.
-  forEachVoxel(s.grid.voxelCount(), [&](std::int64_t v) {
-    s.image.data[v] *= static_cast<float>(std::exp(sigma * f.atVoxel(v % nx, (v / nx) % ny, v / (nx * ny))));
+  forEachVoxelIjk(s.grid, [&](std::int64_t v, std::int64_t i, std::int64_t j, std::int64_t k) {
+    s.image.data[v] *= static_cast<float>(std::exp(sigma * f.atVoxel(i, j, k)));
   });
 }
 
@@ -46,11 +45,9 @@ void applyTexture(const Drawn& p, EffectContext& ctx) {
   ctx.record["octaves_used"] = fields.size();
   if (fields.empty()) return;
   for (auto& w : weight) w = static_cast<float>(w * p("amplitude") / std::sqrt(norm));
-  const std::int64_t nx = s.grid.dims[0], ny = s.grid.dims[1];
   const float mean = static_cast<float>(p("mean"));
   // Tissue fills what the vessels leave of each voxel.
-  forEachVoxel(s.grid.voxelCount(), [&](std::int64_t v) {
-    const std::int64_t i = v % nx, j = (v / nx) % ny, k = v / (nx * ny);
+  forEachVoxelIjk(s.grid, [&](std::int64_t v, std::int64_t i, std::int64_t j, std::int64_t k) {
     float t = mean;
     for (std::size_t o = 0; o < fields.size(); ++o) t += weight[o] * fields[o].atVoxel(i, j, k);
     s.image.data[v] += (1.0f - s.fraction->data[v]) * t;
@@ -73,9 +70,8 @@ void applyAttenuation(const Drawn& p, EffectContext& ctx) {
   auto& s = ctx.state;
   const int axis = static_cast<int>(p("axis"));
   const double length = p("length");
-  const std::int64_t nx = s.grid.dims[0], ny = s.grid.dims[1];
-  forEachVoxel(s.grid.voxelCount(), [&](std::int64_t v) {
-    const std::int64_t idx[3] = {v % nx, (v / nx) % ny, v / (nx * ny)};
+  forEachVoxelIjk(s.grid, [&](std::int64_t v, std::int64_t i, std::int64_t j, std::int64_t k) {
+    const std::int64_t idx[3] = {i, j, k};
     const double depth = (idx[axis] + 0.5) * s.grid.spacing_mm[axis];
     s.image.data[v] *= static_cast<float>(std::exp(-depth / length));
   });

@@ -173,9 +173,7 @@ float sampleTrilinear(const Volume<float>& v, const Vec3& p) {
 Volume<float> warpVolume(const Volume<float>& v, const BSplineWarp& warp) {
   const VolumeGrid& g = v.grid;
   Volume<float> out(g);
-  const std::int64_t nx = g.dims[0], ny = g.dims[1];
-  forEachVoxel(g.voxelCount(), [&](std::int64_t q) {
-    const std::int64_t i = q % nx, j = (q / nx) % ny, k = q / (nx * ny);
+  forEachVoxelIjk(g, [&](std::int64_t q, std::int64_t i, std::int64_t j, std::int64_t k) {
     const Vec3 u = warp.displacementAtVoxel(i, j, k);
     out.data[q] = sampleTrilinear(v, Vec3(i + u.x / g.spacing_mm.x, j + u.y / g.spacing_mm.y, k + u.z / g.spacing_mm.z));
   });
@@ -191,11 +189,9 @@ GroundTruthVolumes warpedLabels(const Volume<float>& wf, const VascularTree& wt,
   gt.centerline = Volume<std::uint8_t>(g);
   gt.radius = Volume<float>(g);
   gt.instances = Volume<std::uint32_t>(g);
-  const std::int64_t nx = g.dims[0], ny = g.dims[1];
-  forEachVoxel(g.voxelCount(), [&](std::int64_t q) {
+  forEachVoxelIjk(g, [&](std::int64_t q, std::int64_t i, std::int64_t j, std::int64_t k) {
     if (wf.data[q] < 0.5f) return;
     gt.mask.data[q] = 1;
-    const std::int64_t i = q % nx, j = (q / nx) % ny, k = q / (nx * ny);
     const Vec3 u = warp.displacementAtVoxel(i, j, k);
     const Vec3 p(i + u.x / g.spacing_mm.x, j + u.y / g.spacing_mm.y, k + u.z / g.spacing_mm.z);
     // The labelled corner of the trilinear stencil with the largest weight.

@@ -1,6 +1,6 @@
 // The native parameter format: TOML with units written out ("0.4 mm", "100 mmHg",
 // "3.6 mPa*s", "8330 mm3/s"). Every key is checked; unknown keys are errors.
-#include <toml++/toml.h>
+#include "io/toml_file.hpp"
 
 #include <algorithm>
 #include <set>
@@ -101,15 +101,7 @@ class TomlReader {
 }  // namespace
 
 Scenario readTomlParameters(const std::filesystem::path& path) {
-  const std::string file = path.string();
-  if (!std::filesystem::exists(path)) throw InputError(file, 0, "no such parameter file");
-  toml::table root;
-  try {
-    root = toml::parse_file(file);
-  } catch (const toml::parse_error& e) {
-    throw InputError(file, static_cast<int>(e.source().begin.line), std::string("not valid TOML: ") + std::string(e.description()));
-  }
-  return readTomlParameters(root, path);
+  return readTomlParameters(parseTomlFile(path, "parameter file"), path);
 }
 
 Scenario readTomlParameters(const toml::table& root, const std::filesystem::path& path) {
