@@ -9,10 +9,15 @@ void SegmentIndex::refresh(const VascularTree& tree, bool force) {
   const auto n = tree.segmentCount();
   if (!force && cell_ > 0 && n < 2 * std::max<std::int32_t>(built_for_, 8)) return;
   const Vec3 ext = hi_ - lo_;
-  const double volume = std::max(ext.x * ext.y * ext.z, 1e-30);
   // About two segments per cell on average; never more than ~2^22 cells.
-  double cell = std::cbrt(2.0 * volume / std::max<std::int32_t>(n, 1));
-  cell = std::max(cell, std::cbrt(volume / double(1 << 22)));
+  double cell;
+  if (planar_) {
+    const double area = std::max(ext.x * ext.y, 1e-30);
+    cell = std::max(std::sqrt(2.0 * area / std::max<std::int32_t>(n, 1)), std::sqrt(area / double(1 << 22)));
+  } else {
+    const double volume = std::max(ext.x * ext.y * ext.z, 1e-30);
+    cell = std::max(std::cbrt(2.0 * volume / std::max<std::int32_t>(n, 1)), std::cbrt(volume / double(1 << 22)));
+  }
   build(tree, cell);
 }
 
@@ -103,12 +108,38 @@ void SegmentIndex::nearest(const VascularTree& tree, const Vec3& p, int k,
 }
 
 bool SegmentIndex::anyWithin(const VascularTree& tree, const Vec3& p, double radius) {
-  bool found = false;
-  const Vec3 r(radius, radius, radius);
-  forEachInBox(p - r, p + r, [&](std::int32_t s) {
-    if (!found && pointSegmentDistance(p, tree.position[tree.parent[s]], tree.position[s]) < radius) found = true;
-  });
-  return found;
+  // Rings of cells outward from p's cell, so that the usual hit (a segment close by) returns
+  // after a few cells; a segment within `radius` has its closest point, and so a registered
+  // cell, within ring ⌈radius / cell⌉.
+  int c[3];
+  for (int ax = 0; ax < 3; ++ax) {
+    const double u = (p[ax] - lo_[ax]) / cell_;
+    if (!(u >= 0 && u < n_[ax])) {
+      int a[3], b[3];
+      const Vec3 r(radius, radius, radius);
+      cellRange(p - r, p + r, a, b);
+      for (int k = a[2]; k <= b[2]; ++k)
+        for (int j = a[1]; j <= b[1]; ++j)
+          for (int i = a[0]; i <= b[0]; ++i)
+            for (auto s : cells_[cellId(i, j, k)])
+              if (mark(s) && pointSegmentDistance(p, tree.position[tree.parent[s]], tree.position[s]) < radius) return true;
+      return false;
+    }
+    c[ax] = static_cast<int>(u);
+  }
+  ++stamp_;
+  const int rings = std::min(static_cast<int>(std::ceil(radius / cell_)), std::max({n_[0], n_[1], n_[2]}));
+  for (int r = 0; r <= rings; ++r)
+    for (int kk = std::max(0, c[2] - r); kk <= std::min(n_[2] - 1, c[2] + r); ++kk)
+      for (int jj = std::max(0, c[1] - r); jj <= std::min(n_[1] - 1, c[1] + r); ++jj) {
+        const bool face = kk == c[2] - r || kk == c[2] + r || jj == c[1] - r || jj == c[1] + r;
+        for (int ii = c[0] - r; ii <= c[0] + r; ii += (face || r == 0) ? 1 : 2 * r) {
+          if (ii < 0 || ii >= n_[0]) continue;
+          for (auto s : cells_[cellId(ii, jj, kk)])
+            if (mark(s) && pointSegmentDistance(p, tree.position[tree.parent[s]], tree.position[s]) < radius) return true;
+        }
+      }
+  return false;
 }
 
 }  // namespace angiosynth

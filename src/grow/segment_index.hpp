@@ -15,7 +15,9 @@ namespace angiosynth {
 
 class SegmentIndex {
  public:
-  SegmentIndex(const Vec3& domain_lo, const Vec3& domain_hi) : lo_(domain_lo), hi_(domain_hi) {}
+  // `planar`: the domain is a slab one cell thick (2D trees); cells follow the area.
+  SegmentIndex(const Vec3& domain_lo, const Vec3& domain_hi, bool planar = false)
+      : lo_(domain_lo), hi_(domain_hi), planar_(planar) {}
 
   // Rebuilds when the tree has doubled since the last build (or on `force`).
   void refresh(const VascularTree& tree, bool force = false);
@@ -70,6 +72,7 @@ class SegmentIndex {
   }
 
   Vec3 lo_, hi_;
+  bool planar_ = false;
   double cell_ = 0;
   int n_[3] = {0, 0, 0};
   std::vector<std::vector<std::int32_t>> cells_;

@@ -10,6 +10,7 @@
 #include "domain/demand_sampler.hpp"
 #include "domain/supply.hpp"
 #include "grow/bifurcation_optimizer.hpp"
+#include "grow/connection_commit.hpp"
 #include "grow/intersections.hpp"
 #include "grow/segment_index.hpp"
 
@@ -119,7 +120,7 @@ class Grower {
         Connection& c = trials[i];
         opt.polish(c);
         opt.record(c);
-        const Undo undo = commit(c);
+        const ConnectionUndo undo = commit(c);
         if (!opt_.avoid_intersections || !collides(c)) {
           accepted = true;
           break;
@@ -147,89 +148,15 @@ class Grower {
     if (progress) progress(tree_.terminalCount(), target);
   }
 
-  struct Saved {
-    std::int32_t id, terminals;
-    double reduced_resistance, cost_ratio, beta, rel;
-  };
-  struct Undo {
-    std::int32_t s, proximal;
-    double length_s;
-    std::vector<Saved> saved;
-  };
-
-  void save(Undo& u, std::int32_t id) {
-    u.saved.push_back({id, tree_.terminals[id], tree_.reduced_resistance[id], tree_.cost_ratio[id], tree_.beta[id], rel_[id]});
-  }
-
   // Applies a recorded connection: new bifurcation b (splitting s) and terminal t.
-  Undo commit(const Connection& c) {
-    auto& t = tree_;
-    const auto s = c.segment, P = t.parent[s];
-    Undo u{s, P, t.length[s], {}};
-    save(u, s);
-    for (std::size_t k = 1; k < c.path.size(); ++k) {
-      save(u, c.path[k].segment);
-      save(u, c.path[k].other);
-    }
-    const auto b = t.addNode(c.bifurcation, -1);
-    t.parent[b] = P;
-    t.replaceChild(P, s, b);
-    t.parent[s] = b;
-    t.child0[b] = s;
-    t.length[b] = distance(t.position[P], c.bifurcation);
-    t.length[s] = distance(c.bifurcation, t.position[s]);
-    const auto term = t.addNode(c.terminal, b);
-    const PowerKernel k(params_);
+  ConnectionUndo commit(const Connection& c) {
     const BifurcationOptimizer opt(tree_, params_, map_, min_length_);
-    const auto sv = opt.shortened(s, t.length[s]);
-    t.reduced_resistance[s] = sv.reduced_resistance;
-    t.cost_ratio[s] = sv.cost_ratio;
-    t.reduced_resistance[term] = t.length[term];
-    t.cost_ratio[term] = k.lengthCost(t.length[term]);
-    rel_.resize(t.nodeCount());
-    // Write the path bottom-up, then relative radii top-down.
-    for (std::size_t lv = 0; lv < c.path.size(); ++lv) {
-      const auto& L = c.path[lv];
-      const auto seg = lv == 0 ? b : L.segment;
-      const auto child = lv == 0 ? s : (lv == 1 ? b : L.child);
-      const auto other = lv == 0 ? term : L.other;
-      t.terminals[seg] = L.terminals;
-      t.reduced_resistance[seg] = L.reduced_resistance;
-      t.cost_ratio[seg] = L.cost_ratio;
-      t.beta[child] = L.beta_child;
-      t.beta[other] = L.beta_other;
-    }
-    const auto top = c.path.size() == 1 ? b : c.path.back().segment;
-    t.beta[top] = 1;
-    rel_[top] = 1;
-    for (std::size_t lv = c.path.size(); lv-- > 0;) {
-      const auto& L = c.path[lv];
-      const auto seg = lv == 0 ? b : L.segment;
-      const auto child = lv == 0 ? s : (lv == 1 ? b : L.child);
-      const auto other = lv == 0 ? term : L.other;
-      rel_[child] = rel_[seg] * L.beta_child;
-      rel_[other] = rel_[seg] * L.beta_other;
-    }
-    root_history_[t.terminalCount()] = c.root_radius;
+    auto u = commitConnection(tree_, c, opt, PowerKernel(params_), rel_);
+    root_history_[tree_.terminalCount()] = c.root_radius;
     return u;
   }
 
-  void rollback(const Undo& u) {
-    auto& t = tree_;
-    const auto b = t.nodeCount() - 2;
-    t.replaceChild(u.proximal, b, u.s);
-    t.parent[u.s] = u.proximal;
-    t.length[u.s] = u.length_s;
-    t.truncate(b);
-    rel_.resize(b);
-    for (auto it = u.saved.rbegin(); it != u.saved.rend(); ++it) {
-      t.terminals[it->id] = it->terminals;
-      t.reduced_resistance[it->id] = it->reduced_resistance;
-      t.cost_ratio[it->id] = it->cost_ratio;
-      t.beta[it->id] = it->beta;
-      rel_[it->id] = it->rel;
-    }
-  }
+  void rollback(const ConnectionUndo& u) { rollbackConnection(tree_, u, rel_); }
 
   double relax_ = 1.0;                  // < 1 after runs of collision rejections
   std::int64_t collisions_in_a_row_ = 0;

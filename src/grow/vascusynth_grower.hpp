@@ -45,6 +45,12 @@ struct GrowthReport {
   std::int64_t repaired_terminals = 0;     // terminals removed and regrown by the final check
   int repair_rounds = 0;
   std::int64_t intersecting_pairs = 0;     // in the final tree (target 0)
+  // CCO only.
+  std::int64_t threshold_relaxations = 0;  // δ_max × 0.9 after a run of failed draws
+  std::int64_t neighbour_doublings = 0;    // ν doubled because every candidate failed
+  std::int64_t kamiya_failures = 0;        // Kamiya's iteration found no bifurcation
+  std::int64_t short_segments = 0;         // final segments with length <= 2 r (target 0)
+  std::int64_t outside_segments = 0;       // final segments leaving the domain (target 0)
   double root_radius_mm = 0;
 };
 

@@ -1,0 +1,53 @@
+// CCO growth time and memory for N terminals in the seed 000 §5 sphere (or the 2D disc):
+//   bench_cco [N ...] [--disc] [--threads T]
+// One line per N: seconds, µs per terminal, µs per terminal / log2 N, peak RSS, checks.
+#include <tbb/global_control.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "core/memory.hpp"
+#include "grow/cco_grower.hpp"
+
+using namespace angiosynth;
+
+int main(int argc, char** argv) {
+  std::vector<long> sizes;
+  bool disc = false;
+  int threads = 0;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--disc")) disc = true;
+    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::atoi(argv[++i]);
+    else sizes.push_back(std::atol(argv[i]));
+  }
+  if (sizes.empty()) sizes = {1000, 4000};
+  std::unique_ptr<tbb::global_control> gc;
+  if (threads > 0) gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+  // Seed 000 §5 / Karch 1999: 100 cm³ perfused by 4000 terminals of 0.125 mL/min each.
+  const double radius = disc ? 50.0 : std::cbrt(3 * 1e5 / (4 * M_PI));
+  const auto dom = GrowthDomain::analytic(disc ? DomainShape::Disc : DomainShape::Sphere, radius, radius / 50);
+  std::printf("%-7s %9s %9s %12s %16s %10s %6s %6s %9s\n", "domain", "terminals", "time (s)", "us/terminal",
+              "us/term/log2(N)", "peak MiB", "pairs", "short", "volume mm3");
+  for (long n : sizes) {
+    CcoOptions o;
+    o.terminals = n;
+    o.root_mm = dom.defaultRoot();
+    o.physics.perfusion_flow = n * 0.125 * 1000.0 / 60.0;  // mm³/s
+    o.physics.perfusion_pressure = 100 * 133.322;
+    o.physics.terminal_pressure = 60 * 133.322;
+    GrowthReport rep;
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto tree = growCco(dom, o, rep);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("%-7s %9ld %9.3f %12.1f %16.2f %10.1f %6lld %6lld %9.1f\n", disc ? "disc" : "sphere", n, s, s / n * 1e6,
+                s / n * 1e6 / std::log2(double(n)), peakRssBytes() / 1048576.0, (long long)rep.intersecting_pairs,
+                (long long)rep.short_segments, treeVolume(tree));
+    std::fprintf(stderr, "  draws too close %lld, candidates %lld, unconnectable %lld, relaxations %lld, doublings %lld, kamiya failures %lld, collisions %lld, repair rounds %d, repaired %lld\n", (long long)rep.rejected_too_close, (long long)rep.candidates, (long long)rep.rejected_unreachable, (long long)rep.threshold_relaxations, (long long)rep.neighbour_doublings, (long long)rep.kamiya_failures, (long long)rep.rejected_intersection, rep.repair_rounds, (long long)rep.repaired_terminals);
+    std::fflush(stdout);
+  }
+}

@@ -1,0 +1,44 @@
+#pragma once
+// Constrained constructive optimisation as Schreiner & Buxbaum 1993 and Karch et al. 1999 define
+// it, following OpenCCO's reading (seed 000 §2–6), without its quadratic costs:
+// - the domain grows with the tree (§3.3.1): positions live in the final domain and lengths are
+//   scaled by s = (n/N)^(1/d), so radii in final-domain units are r·s^(-3/4);
+// - a terminal is drawn uniformly (or ∝ a demand map) and kept when it lies farther than
+//   δ = (|Ω|/n)^(1/d) from every segment, δ × 0.9 after every 100 failed draws (§3.3.2);
+// - its ν nearest segments (uniform grid, O(1)) each get Kamiya's bifurcation (§3.2), kept when
+//   all three new segments lie in the domain, are longer than 2r and, with the path to the root
+//   that thickens, overlap no vessel more than one segment away (§3.3.3, §4.4); ν doubles when
+//   every candidate fails; the connection of least total volume wins (§4.5);
+// - R̃, β, ρ and terminal counts are updated along the path to the root only (§3.1.3).
+// The exact final tree is checked again for intersections, short and outside segments; the few
+// offending branches are removed and regrown until none is left.
+#include <cstdint>
+
+#include "core/vascular_tree.hpp"
+#include "domain/growth_domain.hpp"
+#include "grow/vascusynth_grower.hpp"
+
+namespace angiosynth {
+
+struct CcoOptions {
+  std::int64_t terminals = 4000;      // N
+  Vec3 root_mm;                       // in the domain's frame
+  int closest_neighbours = 20;        // ν
+  int max_neighbours = 80;            // ν doubles up to this, then the point is dropped (measured: of
+                                      // 4000 terminals 4098 connect at ν = 20, 28 at 40–80, 4 beyond)
+  int kamiya_iterations = 100;
+  double kamiya_tolerance = 1e-6;     // of the bifurcation's step, relative to its three lengths
+  int draws_before_relaxing = 100;
+  double relaxation = 0.9;
+  PhysicsParameters physics;          // λ = 2 and μ = 1 (volume) are imposed
+  std::uint64_t seed = 1;
+  std::uint64_t sample = 0;
+  int max_repair_rounds = 30;
+  std::int64_t max_draws = 2000000;   // consecutive failed draws before giving up
+};
+
+// Grows the tree; throws GrowthError when the domain cannot take N terminals.
+VascularTree growCco(const GrowthDomain& domain, const CcoOptions& options, GrowthReport& report,
+                     const ProgressFn& progress = {});
+
+}  // namespace angiosynth
