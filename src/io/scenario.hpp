@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/units.hpp"
+#include "domain/growth_domain.hpp"
+#include "grow/cco_grower.hpp"
 #include "grow/vascusynth_grower.hpp"
 
 namespace toml {
@@ -32,9 +34,25 @@ struct ImageParameters {
   std::vector<std::string> graph_formats{"csv", "vtp", "swc", "graphml"};  // besides GXL and DOT
 };
 
+// The domain of method "cco": an analytic shape or a mask file.
+struct CcoDomainSpec {
+  DomainShape shape = DomainShape::Sphere;
+  double size_mm = 0;            // radius (sphere, disc) or side (cube, square)
+  std::filesystem::path mask;    // shape mask: NIfTI (.nii, .nii.gz) or a VascuSynth box map
+  bool demand_weighted = false;  // sampling = "demand": terminals drawn ∝ mask value
+  bool has_root_offset = false;  // analytic shapes: root = centre + offset (default: the top, +y)
+  Vec3 root_offset_mm;
+  bool root_in_mm = false;       // masks: `root` (mm in the frame) rather than root_voxel
+  Vec3 root_mm;
+  int line = 0;                  // of [domain]
+};
+
 struct Scenario {
   std::string parameter_file;
   std::string format;  // "vascusynth" or "toml"
+  std::string method = "vascusynth";  // growth method: "vascusynth" or "cco"
+  CcoDomainSpec cco_domain;
+  CcoOptions cco;                     // method "cco": everything but the root
   std::filesystem::path demand_map;
   std::filesystem::path supply_map;            // empty: supply_coefficients everywhere
   std::vector<double> supply_coefficients{0.65, 0.34, 0.01, 7};

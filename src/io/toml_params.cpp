@@ -90,6 +90,21 @@ class TomlReader {
     return out;
   }
 
+  // Keys that belong to another growth method.
+  void forbid(const toml::table& t, const std::string& section, const std::set<std::string>& keys, const std::string& why) {
+    for (const auto& k : keys)
+      if (const auto* n = t.get(k)) throw InputError(file_, lineOf(n), "'" + k + "' in [" + section + "] " + why);
+  }
+
+  Vec3 point(const toml::node* n, const std::string& key, bool allow_2d) {
+    const auto* arr = n->as_array();
+    const std::size_t size = arr ? arr->size() : 0;
+    if (!(size == 3 || (allow_2d && size == 2)))
+      throw InputError(file_, lineOf(n), key + " must be an array of " + (allow_2d ? "2 or 3" : "3") + " numbers");
+    const auto v = numbers(n, key, size);
+    return Vec3(v[0], v[1], size == 3 ? v[2] : 0.0);
+  }
+
   Where at(const toml::table& t, const std::string& key) const { return {file_, lineOf(t.get(key))}; }
   const std::string& file() const { return file_; }
 
@@ -97,6 +112,126 @@ class TomlReader {
   const toml::table& root_;
   std::string file_;
 };
+
+void readVascuSynthDomain(TomlReader& r, const toml::table& dom, const toml::table& tree, Scenario& sc,
+                          const std::filesystem::path& path, const std::set<std::string>& cco_domain,
+                          const std::set<std::string>& cco_tree) {
+  const std::string file = path.string();
+  r.forbid(dom, "domain", cco_domain, "is for method cco; this file grows with method vascusynth (set [tree] method = \"cco\")");
+  r.forbid(tree, "tree", cco_tree, "is for method cco; this file grows with method vascusynth (set [tree] method = \"cco\")");
+  auto& g = sc.growth;
+  sc.voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
+  checkRange(sc.voxel_mm, 0, true, INFINITY, true, r.at(dom, "voxel_size"), "voxel_size (mm)");
+  sc.demand_map = resolveInputPath(r.string(dom, "domain", "demand_map"), path, r.lineOf(dom.get("demand_map")));
+  if (dom.get("supply_map") && dom.get("supply_coefficients"))
+    throw InputError(file, r.lineOf(dom.get("supply_coefficients")), "give supply_map or supply_coefficients, not both");
+  if (dom.get("supply_map")) {
+    sc.supply_map = resolveInputPath(r.string(dom, "domain", "supply_map"), path, r.lineOf(dom.get("supply_map")));
+    sc.supply_line = r.lineOf(dom.get("supply_map"));
+  } else if (const auto* c = dom.get("supply_coefficients")) {
+    sc.supply_coefficients = r.numbers(c, "supply_coefficients", 0);
+    if (sc.supply_coefficients.back() < 0)
+      throw InputError(file, r.lineOf(c), "supply_coefficients: the last value is the cut-off radius (map voxels) and must be >= 0");
+  }
+
+  if (tree.get("root_voxel") && tree.get("root"))
+    throw InputError(file, r.lineOf(tree.get("root")), "give root (mm) or root_voxel (map voxels), not both");
+  if (const auto* n = tree.get("root_voxel")) {
+    sc.root_voxel = r.point(n, "root_voxel", false);
+    sc.root_line = r.lineOf(n);
+  } else if (const auto* n2 = tree.get("root")) {
+    sc.root_voxel = r.point(n2, "root (mm)", false) / sc.voxel_mm;
+    sc.root_line = r.lineOf(n2);
+  } else {
+    throw InputError(file, r.lineOf(&tree), "missing key 'root' (mm) or 'root_voxel' (map voxels) in [tree]");
+  }
+  g.min_distance_mm = tree.get("min_distance") ? r.quantity(tree, "tree", "min_distance", Dimension::Length, sc.voxel_mm) : sc.voxel_mm;
+  checkRange(g.min_distance_mm, 0, false, INFINITY, true, r.at(tree, "min_distance"), "min_distance (mm)");
+  if (tree.get("min_segment_length")) {
+    g.min_segment_length_mm = r.quantity(tree, "tree", "min_segment_length", Dimension::Length, sc.voxel_mm);
+    checkRange(g.min_segment_length_mm, 0, true, INFINITY, true, r.at(tree, "min_segment_length"), "min_segment_length (mm)");
+  }
+  if (const auto* n = tree.get("avoid_intersections")) {
+    if (!n->is_boolean()) throw InputError(file, r.lineOf(n), "avoid_intersections must be true or false");
+    g.avoid_intersections = *n->value<bool>();
+  }
+
+}
+
+void readCcoDomain(TomlReader& r, const toml::table& dom, const toml::table& tree, Scenario& sc,
+                   const std::filesystem::path& path, const std::set<std::string>& vs_domain,
+                   const std::set<std::string>& vs_tree) {
+  const std::string file = path.string();
+  r.forbid(dom, "domain", vs_domain, "is for method vascusynth; for cco give shape = \"mask\" and mask = <file>");
+  r.forbid(tree, "tree", vs_tree, "is for method vascusynth; cco keeps every segment longer than twice its radius");
+  auto& d = sc.cco_domain;
+  d.line = r.lineOf(&dom);
+  const std::string shape = dom.get("shape") ? r.string(dom, "domain", "shape") : "sphere";
+  const std::pair<const char*, DomainShape> shapes[] = {{"sphere", DomainShape::Sphere}, {"cube", DomainShape::Cube},
+                                                        {"disc", DomainShape::Disc},     {"square", DomainShape::Square},
+                                                        {"mask", DomainShape::Mask}};
+  bool known = false;
+  for (const auto& [name, value] : shapes)
+    if (shape == name) {
+      d.shape = value;
+      known = true;
+    }
+  if (!known) throw InputError(file, r.lineOf(dom.get("shape")), "shape '" + shape + "'; allowed: sphere, cube, disc, square (2D), mask");
+  const bool round = d.shape == DomainShape::Sphere || d.shape == DomainShape::Disc;
+  if (d.shape == DomainShape::Mask) {
+    r.forbid(dom, "domain", {"radius", "side"}, "is for analytic shapes; a mask's extent comes from its file");
+    r.forbid(tree, "tree", {"root_offset"}, "is for analytic shapes; give the root of a mask domain as root (mm) or root_voxel");
+    d.mask = resolveInputPath(r.string(dom, "domain", "mask"), path, r.lineOf(dom.get("mask")));
+    const auto m = d.mask.string();
+    const bool nifti = m.ends_with(".nii") || m.ends_with(".nii.gz");
+    if (nifti) {
+      if (dom.get("voxel_size"))
+        throw InputError(file, r.lineOf(dom.get("voxel_size")), "a NIfTI mask carries its voxel size; remove voxel_size");
+    } else {
+      sc.voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
+      checkRange(sc.voxel_mm, 0, true, INFINITY, true, r.at(dom, "voxel_size"), "voxel_size (mm)");
+      sc.demand_map = d.mask;  // a VascuSynth box map
+      sc.supply_coefficients = {1, 0};
+    }
+    if (dom.get("sampling")) {
+      const auto v = r.string(dom, "domain", "sampling");
+      if (v != "uniform" && v != "demand")
+        throw InputError(file, r.lineOf(dom.get("sampling")), "sampling '" + v + "'; allowed: uniform, demand (∝ mask value)");
+      d.demand_weighted = v == "demand";
+    }
+    if (tree.get("root_voxel") && tree.get("root"))
+      throw InputError(file, r.lineOf(tree.get("root")), "give root (mm) or root_voxel (mask voxels), not both");
+    if (const auto* n = tree.get("root_voxel")) {
+      sc.root_voxel = r.point(n, "root_voxel", false);
+      sc.root_line = r.lineOf(n);
+    } else if (const auto* n2 = tree.get("root")) {
+      d.root_mm = r.point(n2, "root (mm)", false);
+      d.root_in_mm = true;
+      sc.root_line = r.lineOf(n2);
+      if (!nifti) {
+        sc.root_voxel = d.root_mm / sc.voxel_mm;
+        d.root_in_mm = false;
+      }
+    } else {
+      throw InputError(file, r.lineOf(&tree), "missing key 'root' (mm) or 'root_voxel' (mask voxels) in [tree]: a mask domain has no default root");
+    }
+    return;
+  }
+  r.forbid(dom, "domain", {"mask", "sampling"}, "is for shape = \"mask\"");
+  r.forbid(tree, "tree", {"root", "root_voxel"}, "is for mask domains; an analytic shape takes root_offset (mm from its centre)");
+  const char* size_key = round ? "radius" : "side";
+  r.forbid(dom, "domain", {round ? "side" : "radius"}, std::string("does not size a ") + shape + "; give " + size_key);
+  d.size_mm = r.quantity(dom, "domain", size_key, Dimension::Length);
+  checkRange(d.size_mm, 0, true, INFINITY, true, r.at(dom, size_key), std::string(size_key) + " (mm)");
+  sc.voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
+  checkRange(sc.voxel_mm, 0, true, d.size_mm, true, r.at(dom, "voxel_size"), "voxel_size (mm)");
+  if (const auto* n = tree.get("root_offset")) {
+    const bool flat = d.shape == DomainShape::Disc || d.shape == DomainShape::Square;
+    d.root_offset_mm = r.point(n, "root_offset (mm from the centre)", flat);
+    d.has_root_offset = true;
+    sc.root_line = r.lineOf(n);
+  }
+}
 
 }  // namespace
 
@@ -117,76 +252,84 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     sc.seed = static_cast<std::uint64_t>(*s->value<std::int64_t>());
   }
 
-  const auto& dom = r.table("domain", {"demand_map", "supply_map", "supply_coefficients", "voxel_size"});
-  sc.voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
-  checkRange(sc.voxel_mm, 0, true, INFINITY, true, r.at(dom, "voxel_size"), "voxel_size (mm)");
-  sc.demand_map = resolveInputPath(r.string(dom, "domain", "demand_map"), path, r.lineOf(dom.get("demand_map")));
-  if (dom.get("supply_map") && dom.get("supply_coefficients"))
-    throw InputError(file, r.lineOf(dom.get("supply_coefficients")), "give supply_map or supply_coefficients, not both");
-  if (dom.get("supply_map")) {
-    sc.supply_map = resolveInputPath(r.string(dom, "domain", "supply_map"), path, r.lineOf(dom.get("supply_map")));
-    sc.supply_line = r.lineOf(dom.get("supply_map"));
-  } else if (const auto* c = dom.get("supply_coefficients")) {
-    sc.supply_coefficients = r.numbers(c, "supply_coefficients", 0);
-    if (sc.supply_coefficients.back() < 0)
-      throw InputError(file, r.lineOf(c), "supply_coefficients: the last value is the cut-off radius (map voxels) and must be >= 0");
+  // [tree] first: the growth method decides what [domain] and [physics] hold.
+  const std::set<std::string> vascusynth_tree{"min_distance", "min_segment_length", "avoid_intersections"};
+  const std::set<std::string> cco_tree{"root_offset", "max_closest_neighbours", "kamiya_iterations", "kamiya_tolerance",
+                                       "draws_before_relaxing", "relaxation"};
+  std::set<std::string> tree_keys{"method", "terminals", "root_voxel", "root", "closest_neighbours"};
+  tree_keys.insert(vascusynth_tree.begin(), vascusynth_tree.end());
+  tree_keys.insert(cco_tree.begin(), cco_tree.end());
+  const auto& tree = r.table("tree", tree_keys);
+  if (tree.get("method")) {
+    sc.method = r.string(tree, "tree", "method");
+    if (sc.method != "vascusynth" && sc.method != "cco")
+      throw InputError(file, r.lineOf(tree.get("method")), "method '" + sc.method + "' is not available; allowed: vascusynth, cco");
   }
+  const bool cco = sc.method == "cco";
+  const std::set<std::string> cco_domain_keys{"shape", "radius", "side", "mask", "sampling"};
+  const std::set<std::string> vs_domain_keys{"demand_map", "supply_map", "supply_coefficients"};
+  std::set<std::string> domain_keys{"voxel_size"};
+  domain_keys.insert(cco_domain_keys.begin(), cco_domain_keys.end());
+  domain_keys.insert(vs_domain_keys.begin(), vs_domain_keys.end());
+  const auto& dom = r.table("domain", domain_keys);
+  if (cco) readCcoDomain(r, dom, tree, sc, path, vs_domain_keys, vascusynth_tree);
+  else readVascuSynthDomain(r, dom, tree, sc, path, cco_domain_keys, cco_tree);
 
   auto& g = sc.growth;
-  const auto& tree = r.table("tree", {"method", "terminals", "root_voxel", "root", "min_distance", "closest_neighbours",
-                                       "min_segment_length", "avoid_intersections"});
-  if (tree.get("method")) {
-    const auto m = r.string(tree, "tree", "method");
-    if (m != "vascusynth")
-      throw InputError(file, r.lineOf(tree.get("method")), "method '" + m + "' is not available; allowed: vascusynth");
-  }
   g.terminals = r.integer(tree, "tree", "terminals");
   checkRange(double(g.terminals), 1, false, Limits::kMaxTerminals, false, r.at(tree, "terminals"), "terminals");
-  if (tree.get("root_voxel") && tree.get("root"))
-    throw InputError(file, r.lineOf(tree.get("root")), "give root (mm) or root_voxel (map voxels), not both");
-  if (const auto* n = tree.get("root_voxel")) {
-    const auto v = r.numbers(n, "root_voxel", 3);
-    sc.root_voxel = Vec3(v[0], v[1], v[2]);
-    sc.root_line = r.lineOf(n);
-  } else if (const auto* n2 = tree.get("root")) {
-    const auto v = r.numbers(n2, "root (mm)", 3);
-    sc.root_voxel = Vec3(v[0], v[1], v[2]) / sc.voxel_mm;
-    sc.root_line = r.lineOf(n2);
-  } else {
-    throw InputError(file, r.lineOf(&tree), "missing key 'root' (mm) or 'root_voxel' (map voxels) in [tree]");
-  }
-  g.min_distance_mm = tree.get("min_distance") ? r.quantity(tree, "tree", "min_distance", Dimension::Length, sc.voxel_mm) : sc.voxel_mm;
-  checkRange(g.min_distance_mm, 0, false, INFINITY, true, r.at(tree, "min_distance"), "min_distance (mm)");
-  g.closest_neighbours = tree.get("closest_neighbours") ? static_cast<int>(r.integer(tree, "tree", "closest_neighbours")) : 5;
+  g.closest_neighbours = tree.get("closest_neighbours") ? static_cast<int>(r.integer(tree, "tree", "closest_neighbours")) : (cco ? 20 : 5);
   checkRange(g.closest_neighbours, 1, false, Limits::kMaxNeighbours, false, r.at(tree, "closest_neighbours"), "closest_neighbours");
-  if (tree.get("min_segment_length")) {
-    g.min_segment_length_mm = r.quantity(tree, "tree", "min_segment_length", Dimension::Length, sc.voxel_mm);
-    checkRange(g.min_segment_length_mm, 0, true, INFINITY, true, r.at(tree, "min_segment_length"), "min_segment_length (mm)");
-  }
-  if (const auto* n = tree.get("avoid_intersections")) {
-    if (!n->is_boolean()) throw InputError(file, r.lineOf(n), "avoid_intersections must be true or false");
-    g.avoid_intersections = *n->value<bool>();
-  }
 
   const auto& ph = r.table("physics", {"murray_exponent", "cost_radius_exponent", "cost_length_exponent", "viscosity",
                                         "perfusion_pressure", "terminal_pressure", "perfusion_flow"});
   auto& p = g.physics;
+  if (cco) r.forbid(ph, "physics", {"cost_radius_exponent", "cost_length_exponent"},
+                    "is for method vascusynth; cco minimises the total volume (radius exponent 2, length exponent 1)");
+  // Method cco defaults to seed 000 §5 (Karch 1999): 3.6 cP, 100 and 60 mmHg, 500 mL/min.
+  const auto optional = [&](const char* key, Dimension dim, double fallback) {
+    return (cco && !ph.get(key)) ? fallback : r.quantity(ph, "physics", key, dim);
+  };
   p.murray_exponent = ph.get("murray_exponent") ? r.number(ph, "physics", "murray_exponent") : 3.0;
   checkRange(p.murray_exponent, Limits::kMinMurray, true, Limits::kMaxMurray, false, r.at(ph, "murray_exponent"), "murray_exponent");
   p.cost_radius_exponent = ph.get("cost_radius_exponent") ? r.number(ph, "physics", "cost_radius_exponent") : 2.0;
   checkRange(p.cost_radius_exponent, 0, false, Limits::kMaxCostExponent, false, r.at(ph, "cost_radius_exponent"), "cost_radius_exponent");
   p.cost_length_exponent = ph.get("cost_length_exponent") ? r.number(ph, "physics", "cost_length_exponent") : 1.0;
   checkRange(p.cost_length_exponent, 0, false, Limits::kMaxCostExponent, false, r.at(ph, "cost_length_exponent"), "cost_length_exponent");
-  p.viscosity = r.quantity(ph, "physics", "viscosity", Dimension::Viscosity);
+  p.viscosity = optional("viscosity", Dimension::Viscosity, 3.6e-3);
   checkRange(p.viscosity, 0, true, INFINITY, true, r.at(ph, "viscosity"), "viscosity (Pa*s)");
-  p.perfusion_pressure = r.quantity(ph, "physics", "perfusion_pressure", Dimension::Pressure);
-  p.terminal_pressure = r.quantity(ph, "physics", "terminal_pressure", Dimension::Pressure);
+  p.perfusion_pressure = optional("perfusion_pressure", Dimension::Pressure, 100 * 133.322387415);
+  p.terminal_pressure = optional("terminal_pressure", Dimension::Pressure, 60 * 133.322387415);
   checkRange(p.terminal_pressure, 0, false, INFINITY, true, r.at(ph, "terminal_pressure"), "terminal_pressure (Pa)");
   if (!(p.perfusion_pressure > p.terminal_pressure))
     throw InputError(file, r.lineOf(ph.get("perfusion_pressure")), "perfusion_pressure must exceed terminal_pressure");
-  p.perfusion_flow = r.quantity(ph, "physics", "perfusion_flow", Dimension::Flow);
+  p.perfusion_flow = optional("perfusion_flow", Dimension::Flow, 500 * 1e3 / 60);
   checkRange(p.perfusion_flow, 0, true, INFINITY, true, r.at(ph, "perfusion_flow"), "perfusion_flow (mm^3/s)");
   p.total_terminals = g.terminals;
+
+  if (cco) {
+    auto& c = sc.cco;
+    c.terminals = g.terminals;
+    c.physics = p;
+    c.closest_neighbours = g.closest_neighbours;
+    const auto whole = [&](const char* key, int& out, int lo, int hi) {
+      if (!tree.get(key)) return;
+      out = static_cast<int>(r.integer(tree, "tree", key));
+      checkRange(out, lo, false, hi, false, r.at(tree, key), key);
+    };
+    whole("max_closest_neighbours", c.max_neighbours, c.closest_neighbours, Limits::kMaxNeighbours * 64);
+    c.max_neighbours = std::max(c.max_neighbours, c.closest_neighbours);
+    whole("kamiya_iterations", c.kamiya_iterations, 1, 100000);
+    whole("draws_before_relaxing", c.draws_before_relaxing, 1, 1000000);
+    if (tree.get("kamiya_tolerance")) {
+      c.kamiya_tolerance = r.number(tree, "tree", "kamiya_tolerance");
+      checkRange(c.kamiya_tolerance, 0, true, 1, true, r.at(tree, "kamiya_tolerance"), "kamiya_tolerance");
+    }
+    if (tree.get("relaxation")) {
+      c.relaxation = r.number(tree, "tree", "relaxation");
+      checkRange(c.relaxation, 0, true, 1, true, r.at(tree, "relaxation"), "relaxation");
+    }
+  }
 
   const auto& im = r.table("image", {"enabled", "voxel_size", "field_of_view", "supersampling", "background", "vessel",
                                      "dtype", "formats", "graph_formats"});

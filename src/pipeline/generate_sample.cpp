@@ -6,7 +6,10 @@
 #include "angiosynth/version.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "grow/cco_grower.hpp"
 #include "io/graph_writers.hpp"
+#include "io/growth_domain_files.hpp"
+#include "io/svg_writer.hpp"
 #include "io/map_files.hpp"
 #include "io/text_file.hpp"
 #include "pipeline/volume_outputs.hpp"
@@ -28,22 +31,48 @@ Json describeParameters(const Scenario& sc) {
   const auto& g = sc.growth;
   const auto& p = g.physics;
   Json j;
-  j["method"] = "vascusynth";
-  j["demand_map"] = sc.demand_map.string();
-  if (sc.supply_map.empty()) j["supply_coefficients"] = sc.supply_coefficients;
-  else j["supply_map"] = sc.supply_map.string();
-  j["voxel_size"] = q(sc.voxel_mm, "mm");
-  j["root"] = Json{{"value", {sc.root_voxel.x * sc.voxel_mm, sc.root_voxel.y * sc.voxel_mm, sc.root_voxel.z * sc.voxel_mm}},
-                   {"unit", "mm"}};
-  j["root_voxel"] = {sc.root_voxel.x, sc.root_voxel.y, sc.root_voxel.z};
-  j["terminals"] = g.terminals;
-  j["min_distance"] = q(g.min_distance_mm, "mm");
-  j["closest_neighbours"] = g.closest_neighbours;
-  j["min_segment_length"] = q(g.minSegmentLength(sc.voxel_mm), "mm");
-  j["avoid_intersections"] = g.avoid_intersections;
+  j["method"] = sc.method;
+  if (sc.method == "cco") {
+    const auto& d = sc.cco_domain;
+    const auto& c = sc.cco;
+    j["shape"] = domainShapeName(d.shape);
+    if (d.shape == DomainShape::Mask) {
+      j["mask"] = d.mask.string();
+      j["sampling"] = d.demand_weighted ? "demand" : "uniform";
+      if (d.root_in_mm) j["root"] = Json{{"value", {d.root_mm.x, d.root_mm.y, d.root_mm.z}}, {"unit", "mm"}};
+      else j["root_voxel"] = {sc.root_voxel.x, sc.root_voxel.y, sc.root_voxel.z};
+    } else {
+      j[d.shape == DomainShape::Sphere || d.shape == DomainShape::Disc ? "radius" : "side"] = q(d.size_mm, "mm");
+      j["root_offset"] = d.has_root_offset ? Json{{"value", {d.root_offset_mm.x, d.root_offset_mm.y, d.root_offset_mm.z}}, {"unit", "mm"}}
+                                           : Json("the top of the domain (+y)");
+    }
+    if (sc.voxel_mm > 0) j["voxel_size"] = q(sc.voxel_mm, "mm");
+    j["terminals"] = g.terminals;
+    j["closest_neighbours"] = c.closest_neighbours;
+    j["max_closest_neighbours"] = c.max_neighbours;
+    j["kamiya_iterations"] = c.kamiya_iterations;
+    j["kamiya_tolerance"] = c.kamiya_tolerance;
+    j["draws_before_relaxing"] = c.draws_before_relaxing;
+    j["relaxation"] = c.relaxation;
+  } else {
+    j["demand_map"] = sc.demand_map.string();
+    if (sc.supply_map.empty()) j["supply_coefficients"] = sc.supply_coefficients;
+    else j["supply_map"] = sc.supply_map.string();
+    j["voxel_size"] = q(sc.voxel_mm, "mm");
+    j["root"] = Json{{"value", {sc.root_voxel.x * sc.voxel_mm, sc.root_voxel.y * sc.voxel_mm, sc.root_voxel.z * sc.voxel_mm}},
+                     {"unit", "mm"}};
+    j["root_voxel"] = {sc.root_voxel.x, sc.root_voxel.y, sc.root_voxel.z};
+    j["terminals"] = g.terminals;
+    j["min_distance"] = q(g.min_distance_mm, "mm");
+    j["closest_neighbours"] = g.closest_neighbours;
+    j["min_segment_length"] = q(g.minSegmentLength(sc.voxel_mm), "mm");
+    j["avoid_intersections"] = g.avoid_intersections;
+  }
   j["murray_exponent"] = p.murray_exponent;
-  j["cost_radius_exponent"] = p.cost_radius_exponent;
-  j["cost_length_exponent"] = p.cost_length_exponent;
+  if (sc.method != "cco") {
+    j["cost_radius_exponent"] = p.cost_radius_exponent;
+    j["cost_length_exponent"] = p.cost_length_exponent;
+  }
   j["viscosity"] = q(p.viscosity, "Pa*s");
   j["perfusion_pressure"] = q(p.perfusion_pressure, "Pa");
   j["terminal_pressure"] = q(p.terminal_pressure, "Pa");
@@ -67,8 +96,12 @@ Json describeParameters(const Scenario& sc) {
 Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) {
   const Scenario& sc = *req.scenario;
   Json timing;
+  std::optional<DemandMap> owned_map;
   auto t0 = Clock::now();
-  const DemandMap map = loadDomain(sc, req.memory_limit);
+  const bool cco = sc.method == "cco";
+  std::optional<GrowthDomain> domain;
+  if (cco) domain.emplace(loadGrowthDomain(sc, req.memory_limit));
+  const DemandMap& map = cco ? domain->frame() : owned_map.emplace(loadDomain(sc, req.memory_limit));
   timing["read_maps"] = seconds(t0);
 
   // The volume request is settled, and its size checked, before the (possibly long) growth.
@@ -102,13 +135,22 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   }
 
   GrowthOptions opt = sc.growth;
-  opt.root_mm = map.toMm(sc.root_voxel);
+  opt.root_mm = cco ? ccoRoot(sc, *domain) : map.toMm(sc.root_voxel);
   opt.seed = req.seed;
+  opt.sample = req.sample;
   GrowthReport report;
   t0 = Clock::now();
   VascularTree tree;
   try {
-    tree = growVascuSynth(map, opt, report, req.progress);
+    if (cco) {
+      CcoOptions co = sc.cco;
+      co.root_mm = opt.root_mm;
+      co.seed = req.seed;
+      co.sample = req.sample;
+      tree = growCco(*domain, co, report, req.progress);
+    } else {
+      tree = growVascuSynth(map, opt, report, req.progress);
+    }
   } catch (const GrowthError& e) {
     throw InputError(sc.parameter_file, 0, e.what());
   }
@@ -128,6 +170,10 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
     files["gxl"] = "tree.gxl";
     writeTextFile(dir / "tree.dot", [&](std::ostream& o) { writeDot(o, tree, frame); });
     files["dot"] = "tree.dot";
+    if (cco && domain->dimension() == 2) {
+      writeTextFile(dir / "tree.svg", [&](std::ostream& o) { writeSvg(o, tree, *domain); });
+      files["svg"] = "tree.svg";
+    }
   }
   timing["write_graphs"] = seconds(t0);
 
@@ -180,6 +226,31 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   stats["retracted_terminals"] = report.retracted_terminals;
   stats["moved_nodes"] = report.moved_nodes;
   stats["repaired_terminals"] = report.repaired_terminals;
+  if (cco) {
+    stats["threshold_relaxations"] = report.threshold_relaxations;
+    stats["neighbour_doublings"] = report.neighbour_doublings;
+    stats["kamiya_failures"] = report.kamiya_failures;
+    stats["short_segments"] = report.short_segments;
+    stats["short_segments_definition"] = "segments not longer than twice their radius";
+    stats["outside_segments"] = report.outside_segments;
+    stats["domain_dimension"] = domain->dimension();
+    stats["domain_measure"] = q(domain->measure(), domain->dimension() == 2 ? "mm^2" : "mm^3");
+  }
+  // Mean radius per bifurcation level (the root segment is level 0), as in seed 000 Fig. 6–7.
+  {
+    std::vector<double> sum;
+    std::vector<std::int64_t> count;
+    for (std::int32_t i = 1; i < tree.nodeCount(); ++i) {
+      const auto level = static_cast<std::size_t>(tree.depth[i] - 1);
+      if (level >= sum.size()) sum.resize(level + 1, 0.0), count.resize(level + 1, 0);
+      sum[level] += tree.radius[i];
+      ++count[level];
+    }
+    Json levels = Json::array();
+    for (std::size_t l = 0; l < sum.size(); ++l)
+      levels.push_back(Json{{"level", l}, {"segments", count[l]}, {"mean_radius_mm", count[l] ? sum[l] / double(count[l]) : 0.0}});
+    stats["radius_by_bifurcation_level"] = levels;
+  }
 
   Json j;
   j["tool"] = Json{{"name", "angiosynth"}, {"version", kVersion}};

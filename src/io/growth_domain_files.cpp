@@ -1,0 +1,120 @@
+#include "io/growth_domain_files.hpp"
+
+#include <nifti/nifti1_io.h>
+
+#include <cmath>
+#include <memory>
+
+#include "core/error.hpp"
+#include "core/memory.hpp"
+#include "io/map_files.hpp"
+#include "io/param_checks.hpp"
+
+namespace angiosynth {
+namespace {
+
+// Bytes per voxel a mask domain needs: value, depth, supply index, sampler (two doubles).
+constexpr std::uint64_t kMaskBytesPerVoxel = 4 + 4 + 2 + 16 + 4;
+
+void checkMemory(std::int64_t voxels, std::uint64_t limit, const std::string& file, int line, const std::string& what) {
+  const std::uint64_t need = std::uint64_t(voxels) * kMaskBytesPerVoxel;
+  if (need > limit)
+    throw InputError(file, line, what + " of " + std::to_string(voxels) + " voxels needs " + formatBytes(need) +
+                                     " to grow in, more than the limit of " + formatBytes(limit) +
+                                     "; use a coarser voxel_size or raise --memory-limit");
+}
+
+bool isNifti(const std::filesystem::path& p) {
+  const auto s = p.string();
+  return s.ends_with(".nii") || s.ends_with(".nii.gz");
+}
+
+}  // namespace
+
+DemandMap readNiftiMask(const std::filesystem::path& file, std::uint64_t limit) {
+  const std::string f = file.string();
+  std::unique_ptr<nifti_image, decltype(&nifti_image_free)> head(nifti_image_read(f.c_str(), 0), &nifti_image_free);
+  if (!head) throw InputError(f, 0, "cannot read this file as a NIfTI image");
+  if (head->nx < 1 || head->ny < 1 || head->nz < 1 || head->nt > 1 || head->nu > 1)
+    throw InputError(f, 0, "a mask must be one 3D (or one-slice 2D) volume; this one has dims " + std::to_string(head->nx) +
+                               " " + std::to_string(head->ny) + " " + std::to_string(head->nz) + " " + std::to_string(head->nt));
+  const double dx = std::abs(head->dx), dy = std::abs(head->dy), dz = std::abs(head->dz);
+  if (!(dx > 0) || std::abs(dy - dx) > 1e-6 * dx || (head->nz > 1 && std::abs(dz - dx) > 1e-6 * dx))
+    throw InputError(f, 0, "mask voxels must be isotropic (got " + show(dx) + " x " + show(dy) + " x " + show(dz) +
+                               "); resample the mask");
+  DemandMap m;
+  m.dims = {head->nx, head->ny, head->nz};
+  checkMemory(m.voxelCount(), limit, f, 0, "the mask");
+  std::unique_ptr<nifti_image, decltype(&nifti_image_free)> img(nifti_image_read(f.c_str(), 1), &nifti_image_free);
+  if (!img || !img->data) throw InputError(f, 0, "cannot read the voxels of this NIfTI image");
+  // Lengths in mm whatever the header's unit.
+  const int unit = XYZT_TO_SPACE(img->xyz_units);
+  const double to_mm = unit == NIFTI_UNITS_METER ? 1e3 : unit == NIFTI_UNITS_MICRON ? 1e-3 : 1.0;
+  m.voxel_mm = dx * to_mm;
+  m.demand.resize(m.voxelCount());
+  const auto n = static_cast<std::size_t>(m.voxelCount());
+  const auto convert = [&](auto* p) {
+    for (std::size_t i = 0; i < n; ++i) m.demand[i] = static_cast<float>(p[i]);
+  };
+  switch (img->datatype) {
+    case DT_UINT8: convert(static_cast<const std::uint8_t*>(img->data)); break;
+    case DT_INT8: convert(static_cast<const std::int8_t*>(img->data)); break;
+    case DT_INT16: convert(static_cast<const std::int16_t*>(img->data)); break;
+    case DT_UINT16: convert(static_cast<const std::uint16_t*>(img->data)); break;
+    case DT_INT32: convert(static_cast<const std::int32_t*>(img->data)); break;
+    case DT_UINT32: convert(static_cast<const std::uint32_t*>(img->data)); break;
+    case DT_FLOAT32: convert(static_cast<const float*>(img->data)); break;
+    case DT_FLOAT64: convert(static_cast<const double*>(img->data)); break;
+    default: throw InputError(f, 0, std::string("unsupported NIfTI data type ") + nifti_datatype_string(img->datatype) +
+                                        "; allowed: 8/16/32-bit integers, float32, float64");
+  }
+  if (img->scl_slope != 0 && (img->scl_slope != 1 || img->scl_inter != 0))
+    for (auto& v : m.demand) v = static_cast<float>(v * img->scl_slope + img->scl_inter);
+  for (auto& v : m.demand)
+    if (!(v > 0)) v = 0;  // negative and NaN values are outside
+  m.supply_index.assign(m.demand.size(), 0);
+  m.supply_sets = {{}};
+  return m;
+}
+
+GrowthDomain loadGrowthDomain(const Scenario& sc, std::uint64_t limit) {
+  const auto& spec = sc.cco_domain;
+  if (spec.shape != DomainShape::Mask) {
+    const bool flat = spec.shape == DomainShape::Disc || spec.shape == DomainShape::Square;
+    const double half = (spec.shape == DomainShape::Sphere || spec.shape == DomainShape::Disc) ? spec.size_mm : spec.size_mm / 2;
+    const double n = 2 * (std::ceil(half / sc.voxel_mm) + 2);
+    checkMemory(static_cast<std::int64_t>(n * n * (flat ? 1 : n)), limit, sc.parameter_file, spec.line,
+                std::string("a ") + domainShapeName(spec.shape) + " frame");
+    return GrowthDomain::analytic(spec.shape, spec.size_mm, sc.voxel_mm);
+  }
+  DemandMap m;
+  if (isNifti(spec.mask)) {
+    m = readNiftiMask(spec.mask, limit);
+  } else {
+    m = loadDomain(sc, limit);  // a VascuSynth box map; checks the root too
+  }
+  std::int64_t inside = 0;
+  for (float v : m.demand) inside += v > 0;
+  if (inside == 0) throw InputError(spec.mask.string(), 0, "the mask has no voxel > 0; nothing to perfuse");
+  return GrowthDomain::mask(std::move(m), spec.demand_weighted);
+}
+
+Vec3 ccoRoot(const Scenario& sc, const GrowthDomain& d) {
+  const auto& spec = sc.cco_domain;
+  Vec3 root;
+  if (spec.shape != DomainShape::Mask) {
+    root = spec.has_root_offset ? d.center() + spec.root_offset_mm : d.defaultRoot();
+  } else {
+    root = spec.root_in_mm ? spec.root_mm : d.frame().toMm(sc.root_voxel);
+  }
+  if (d.dimension() == 2) root.z = d.planeZ();
+  // The root may sit on the border (where the vessel enters), not outside it.
+  const double tolerance = d.frame().voxel_mm * 1e-6;
+  if (d.depth(root) < -tolerance)
+    throw InputError(sc.parameter_file, sc.root_line,
+                     "the root (" + show3(root) + " mm in the frame) lies outside the " + domainShapeName(d.shape()) +
+                         " domain (" + show(-d.depth(root)) + " mm beyond its border); place it inside or on the border");
+  return root;
+}
+
+}  // namespace angiosynth
