@@ -1,6 +1,10 @@
 #pragma once
 // Helpers shared by the tests: VascuSynth's example domain and grown trees.
+#include <gtest/gtest.h>
+
+#include <cmath>
 #include <filesystem>
+#include <numbers>
 #include <string>
 
 #include "domain/demand_map.hpp"
@@ -35,6 +39,37 @@ inline VascularTree grow(const Example& e, GrowthReport* report = nullptr) {
   GrowthReport r;
   auto t = growVascuSynth(e.map, e.options, report ? *report : r);
   return t;
+}
+
+// Murray's law, flow conservation, equal terminal flows and pressures, and Poiseuille drops on
+// both sides of every bifurcation, each to 1e-9 relative; root flow Q_perf at P_perf.
+inline void expectHemodynamicInvariants(const VascularTree& t, const PhysicsParameters& p, std::int64_t terminals) {
+  ASSERT_EQ(t.terminalCount(), terminals);
+  ASSERT_EQ(t.nodeCount(), 2 * terminals);
+  const double q_term = p.perfusion_flow / double(terminals);
+  const double drop = p.perfusion_pressure - p.terminal_pressure;
+  const double k = 8 * p.viscosity / std::numbers::pi;
+  std::int64_t bifurcations = 0;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    if (t.isTerminal(i)) {
+      EXPECT_NEAR(t.flow[i], q_term, 1e-9 * q_term);
+      EXPECT_NEAR(t.pressure[i], p.terminal_pressure, 1e-9 * drop) << "terminal " << i;
+      continue;
+    }
+    ++bifurcations;
+    const auto a = t.child0[i], b = t.child1[i];
+    EXPECT_NEAR(t.flow[i], t.flow[a] + t.flow[b], 1e-9 * t.flow[i]);
+    const double g = p.murray_exponent;
+    const double lhs = std::pow(t.radius[i], g), rhs = std::pow(t.radius[a], g) + std::pow(t.radius[b], g);
+    EXPECT_NEAR(lhs, rhs, 1e-9 * lhs) << "segment " << i;
+    for (auto c : {a, b}) {
+      const double dp = t.flow[c] * k * t.length[c] / std::pow(t.radius[c], 4);
+      EXPECT_NEAR(t.pressure[c], t.pressure[i] - dp, 1e-9 * drop) << "segment " << c;
+    }
+  }
+  EXPECT_EQ(bifurcations, terminals - 1);
+  EXPECT_NEAR(t.flow[t.rootSegment()], p.perfusion_flow, 1e-9 * p.perfusion_flow);
+  EXPECT_EQ(t.pressure[0], p.perfusion_pressure);
 }
 
 }  // namespace angiosynth::test

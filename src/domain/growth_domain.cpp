@@ -56,6 +56,9 @@ GrowthDomain GrowthDomain::mask(DemandMap map, bool demand_weighted) {
       ++inside;
       weights[v] = demand_weighted ? m.demand[v] : 1.0f;
     }
+  double total = 0;
+  for (float w : weights) total += w;
+  d.mean_weight_ = inside ? total / double(inside) : 1.0;
   const double h = m.voxel_mm;
   d.measure_ = double(inside) * (d.dimension_ == 2 ? h * h : h * h * h);
   d.center_ = m.extentMm() * 0.5;
@@ -138,6 +141,13 @@ Vec3 GrowthDomain::sample(Rng& rng) const {
     const Vec3 p = m.toMm(Vec3(double(v % nx), double((v / nx) % ny), double(v / (nx * ny))) + jitter);
     if (depth(p) > 0) return p;
   }
+}
+
+double GrowthDomain::spacingScale(const Vec3& p) const {
+  if (!demand_weighted_) return 1.0;
+  const auto v = map_.voxelAt(p);
+  const double w = v >= 0 ? map_.demand[v] : 0.0;
+  return w > 0 ? std::pow(mean_weight_ / w, 1.0 / dimension_) : 1.0;
 }
 
 Vec3 GrowthDomain::defaultRoot() const {

@@ -22,7 +22,9 @@ class GrowthDomain {
   // empty voxels around them. `size` is the radius (sphere, disc) or the side (cube, square).
   static GrowthDomain analytic(DomainShape shape, double size_mm, double voxel_mm, int margin_voxels = 2);
   // A mask: voxels with weight > 0 are inside. Depth comes from a distance map of the mask
-  // border (OpenVDB fast sweeping). `demand_weighted`: terminals are drawn ∝ weight, else uniformly.
+  // border (OpenVDB fast sweeping): within a few voxels of the border (where it is compared with
+  // vessel radii) it is exact to a tenth of a voxel; deeper, its first-order error only makes
+  // it smaller, which keeps vessels further in. `demand_weighted`: terminals are drawn ∝ weight, else uniformly.
   static GrowthDomain mask(DemandMap map, bool demand_weighted);
 
   DomainShape shape() const { return shape_; }
@@ -44,6 +46,9 @@ class GrowthDomain {
   bool capsuleInside(const Vec3& a, const Vec3& b, double r, bool starts_at_root) const;
   // A point drawn uniformly in the domain (∝ weight when demand-weighted).
   Vec3 sample(Rng& rng) const;
+  // The factor on δ_max at p: (mean weight / weight at p)^(1/d) when demand-weighted, so that
+  // terminals are as much denser where demand is higher as sampling makes them; else 1.
+  double spacingScale(const Vec3& p) const;
   // A root on the border: the domain's top (+y) point for analytic shapes.
   Vec3 defaultRoot() const;
 
@@ -57,6 +62,7 @@ class GrowthDomain {
   Vec3 center_;
   double size_ = 0;  // radius, or half the side
   bool demand_weighted_ = false;
+  double mean_weight_ = 1;
   std::vector<float> depth_;  // masks: depth at voxel centres, mm
   std::shared_ptr<const DemandSampler> sampler_;
 };

@@ -110,6 +110,7 @@ class CcoGrower {
     Connection& c = t.c;
     c.segment = s;
     c.bifurcation = k.x;
+    if (dom_.dimension() == 2) c.bifurcation.z = dom_.planeZ();  // in the plane to the last bit
     c.terminal = p;
     const double l[3] = {distance(kp.x0, k.x), distance(k.x, kp.x1), distance(k.x, p)};
     c.cost = opt.cost(s, l[0], l[1], l[2], &c.path);
@@ -233,7 +234,7 @@ class CcoGrower {
                             "(too close " + std::to_string(report_.rejected_too_close) + ", unconnectable " +
                             std::to_string(report_.rejected_unreachable) + "); lower the number of terminals or enlarge the domain");
         const Vec3 p = dom_.sample(rng_);
-        if (index_.anyWithin(tree_, p, delta)) {
+        if (index_.anyWithin(tree_, p, delta * dom_.spacingScale(p))) {
           ++report_.rejected_too_close;
         } else {
           ++report_.candidates;

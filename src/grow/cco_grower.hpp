@@ -4,7 +4,8 @@
 // - the domain grows with the tree (§3.3.1): positions live in the final domain and lengths are
 //   scaled by s = (n/N)^(1/d), so radii in final-domain units are r·s^(-3/4);
 // - a terminal is drawn uniformly (or ∝ a demand map) and kept when it lies farther than
-//   δ = (|Ω|/n)^(1/d) from every segment, δ × 0.9 after every 100 failed draws (§3.3.2);
+//   δ = (|Ω|/n)^(1/d) from every segment, δ × 0.9 after every 100 failed draws (§3.3.2); with a
+//   demand map, δ shrinks where demand is above average, by (mean / local)^(1/d);
 // - its ν nearest segments (uniform grid, O(1)) each get Kamiya's bifurcation (§3.2), kept when
 //   all three new segments lie in the domain, are longer than 2r and, with the path to the root
 //   that thickens, overlap no vessel more than one segment away (§3.3.3, §4.4); ν doubles when

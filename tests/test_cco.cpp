@@ -1,0 +1,278 @@
+// Faithful CCO (seed 000): Kamiya's bifurcation, domains, and the invariants of real grown trees
+// in 3D, 2D and a non-convex mask.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "domain/growth_domain.hpp"
+#include "grow/cco_grower.hpp"
+#include "grow/intersections.hpp"
+#include "grow/kamiya.hpp"
+#include "physics/hemodynamics.hpp"
+#include "test_support.hpp"
+
+using namespace angiosynth;
+
+namespace {
+
+// Seed 000 §5 / Karch 1999 physics: 500 mL/min at 100 → 60 mmHg, 3.6 cP, γ = 3.
+CcoOptions karch(std::int64_t n, const GrowthDomain& d, std::uint64_t seed = 1) {
+  CcoOptions o;
+  o.terminals = n;
+  if (d.shape() != DomainShape::Mask) o.root_mm = d.defaultRoot();
+  o.physics.perfusion_flow = 500 * 1e3 / 60;
+  o.physics.perfusion_pressure = 100 * 133.322387415;
+  o.physics.terminal_pressure = 60 * 133.322387415;
+  o.physics.total_terminals = n;
+  o.seed = seed;
+  return o;
+}
+
+// Every pair of segments more than one segment apart, by brute force (independent of the grid
+// the grower and its final check use): their capsules must not overlap.
+std::int64_t bruteForceIntersections(const VascularTree& t) {
+  std::int64_t hits = 0;
+  for (std::int32_t x = 1; x < t.nodeCount(); ++x)
+    for (std::int32_t y = x + 1; y < t.nodeCount(); ++y) {
+      const Vec3 &a0 = t.position[t.parent[x]], &a1 = t.position[x], &b0 = t.position[t.parent[y]], &b1 = t.position[y];
+      // Bounding boxes first.
+      bool apart = false;
+      for (int ax = 0; ax < 3 && !apart; ++ax)
+        apart = std::min(a0[ax], a1[ax]) - t.radius[x] > std::max(b0[ax], b1[ax]) + t.radius[y] ||
+                std::min(b0[ax], b1[ax]) - t.radius[y] > std::max(a0[ax], a1[ax]) + t.radius[x];
+      if (apart) continue;
+      if (withinTwoSegments(t, x, y)) continue;
+      if (segmentSegmentDistance(a0, a1, b0, b1) < t.radius[x] + t.radius[y]) ++hits;
+    }
+  return hits;
+}
+
+// Geometry invariants of a final tree: length > 2r, inside the domain (checked by sampling the
+// capsule's centreline against the domain's depth), no intersecting pair.
+void expectGeometry(const VascularTree& t, const GrowthDomain& d) {
+  std::int64_t short_segments = 0, outside = 0;
+  for (std::int32_t s = 1; s < t.nodeCount(); ++s) {
+    if (!(t.length[s] > 2 * t.radius[s])) ++short_segments;
+    const Vec3 a = t.position[t.parent[s]], b = t.position[s];
+    for (int k = 0; k <= 64; ++k) {
+      const Vec3 p = a + (b - a) * (k / 64.0);
+      const double from_root = distance(p, t.position[0]);
+      const double need = t.parent[s] == 0 ? std::min(t.radius[s], from_root - t.radius[s]) : t.radius[s];
+      if (d.depth(p) < need - 1e-9) {
+        ++outside;
+        break;
+      }
+    }
+  }
+  EXPECT_EQ(short_segments, 0);
+  EXPECT_EQ(outside, 0);
+  EXPECT_EQ(bruteForceIntersections(t), 0);
+}
+
+}  // namespace
+
+TEST(Kamiya, SolvesKamiyasLawAndPressureDropsAndStopsAtTheVolumeWeightedCentre) {
+  KamiyaProblem p;
+  p.x0 = Vec3(0, 0, 0);
+  p.x1 = Vec3(-3, 10, 0.5);
+  p.x2 = Vec3(3, 10, -0.5);
+  p.f1 = 3;
+  p.f2 = 1;
+  const auto k = kamiyaBifurcation(p, 200, 1e-12);
+  ASSERT_TRUE(k.converged);
+  EXPECT_FALSE(k.merged);
+  const double f0 = p.f1 + p.f2;
+  // Kamiya's law r0⁶/f0 = r1⁶/f1 + r2⁶/f2.
+  EXPECT_NEAR(std::pow(k.r0, 6) / f0, std::pow(k.r1, 6) / p.f1 + std::pow(k.r2, 6) / p.f2, 1e-9 * std::pow(k.r0, 6) / f0);
+  // The pressure drops of step 1 (equal starting radii, x at the midpoint of x0–x1) are reproduced.
+  const Vec3 mid = (p.x0 + p.x1) * 0.5;
+  const double l0 = distance(p.x0, mid), l1 = distance(p.x1, mid), l2 = distance(p.x2, mid);
+  const double d1 = f0 * l0 + p.f1 * l1, d2 = f0 * l0 + p.f2 * l2;  // radii 1
+  EXPECT_NEAR(f0 * l0 / std::pow(k.r0, 4) + p.f1 * l1 / std::pow(k.r1, 4), d1, 1e-8 * d1);
+  EXPECT_NEAR(f0 * l0 / std::pow(k.r0, 4) + p.f2 * l2 / std::pow(k.r2, 4), d2, 1e-8 * d2);
+  // Eq. (13) at its fixed point: Σ r_i² (x_i − x)/l_i = 0, and x lies in the plane of the points.
+  Vec3 pull(0, 0, 0);
+  const Vec3 xs[3] = {p.x0, p.x1, p.x2};
+  const double a[3] = {k.r0 * k.r0, k.r1 * k.r1, k.r2 * k.r2};
+  for (int i = 0; i < 3; ++i) pull = pull + (xs[i] - k.x) * (a[i] / distance(xs[i], k.x));
+  EXPECT_LT(norm(pull), 1e-8 * a[0]);
+  const Vec3 n = cross(p.x1 - p.x0, p.x2 - p.x0);
+  EXPECT_NEAR(dot(k.x - p.x0, n) / norm(n), 0.0, 1e-9);
+  // The thicker branch pulls the bifurcation towards itself: r1 > r2 for f1 > f2.
+  EXPECT_GT(k.r1, k.r2);
+}
+
+TEST(Kamiya, ATerminalBesideANodeMergesIntoIt) {
+  // A new terminal almost on the distal node of a thick segment: the optimum is that node.
+  KamiyaProblem q;
+  q.x0 = Vec3(0, 0, 0);
+  q.x1 = Vec3(0, 10, 0);
+  q.x2 = Vec3(0.01, 10.5, 0);
+  q.f1 = 50;
+  q.f2 = 1;
+  const auto m = kamiyaBifurcation(q, 200, 1e-12);
+  ASSERT_TRUE(m.merged);
+  // The bifurcation is one of the three points, the one where the weighted Fermat condition
+  // |Σ_{i≠j} r_i² u_ij| ≤ r_j² holds for the radii found.
+  const Vec3 xs[3] = {q.x0, q.x1, q.x2};
+  const double a[3] = {m.r0 * m.r0, m.r1 * m.r1, m.r2 * m.r2};
+  int at = -1;
+  for (int j = 0; j < 3; ++j)
+    if (m.x == xs[j]) at = j;
+  ASSERT_GE(at, 0);
+  Vec3 pull(0, 0, 0);
+  for (int i = 0; i < 3; ++i)
+    if (i != at) pull = pull + (xs[i] - xs[at]) * (a[i] / distance(xs[i], xs[at]));
+  EXPECT_LE(norm(pull), a[at]);
+}
+
+TEST(GrowthDomain, MaskDepthFromOpenVdbMatchesTheBallItVoxelises) {
+  // A ball of radius 12 voxels; depth at voxel centres against the exact distance to the sphere
+  // (the voxelised border lies within half a voxel of it).
+  DemandMap m;
+  m.dims = {40, 40, 40};
+  m.voxel_mm = 0.5;
+  m.demand.assign(m.voxelCount(), 0.0f);
+  const Vec3 c(10, 10, 10);
+  for (int k = 0; k < 40; ++k)
+    for (int j = 0; j < 40; ++j)
+      for (int i = 0; i < 40; ++i)
+        if (distance(Vec3(i + 0.5, j + 0.5, k + 0.5) * 0.5, c) < 6.0) m.demand[m.flat(i, j, k)] = 1;
+  const auto d = GrowthDomain::mask(m, false);
+  EXPECT_EQ(d.dimension(), 3);
+  EXPECT_NEAR(d.measure(), 4.0 / 3.0 * std::numbers::pi * 216, 0.03 * 4.0 / 3.0 * std::numbers::pi * 216);
+  // Within four voxels of the border (where vessel radii are compared with it) the depth follows
+  // the voxelised border to half a voxel; deeper, fast sweeping's first-order error only ever makes it
+  // smaller, which keeps vessels further inside, never outside.
+  double worst_band = 0, worst_over = 0;
+  for (double r = 0; r <= 8; r += 0.25)
+    for (const Vec3 dir : {Vec3(1, 0, 0), Vec3(0, -1, 0), Vec3(0.6, 0.8, 0), Vec3(0.48, 0.6, 0.64)}) {
+      const double exact = 6.0 - r, got = d.depth(c + dir * r);
+      if (std::abs(exact) <= 2.0) worst_band = std::max(worst_band, std::abs(got - exact));
+      worst_over = std::max(worst_over, got - exact);
+    }
+  EXPECT_LT(worst_band, 0.25);  // half a voxel: the staircase of the voxelised sphere
+  EXPECT_LT(worst_over, 0.25);
+  EXPECT_GT(d.depth(c), 4.5);
+  EXPECT_LT(d.depth(c + Vec3(7, 0, 0)), 0);
+}
+
+TEST(Cco, SphereTreeMeetsEveryConstraintAndHemodynamicInvariant) {
+  const double radius = std::cbrt(3 * 1e5 / (4 * std::numbers::pi));  // 100 cm³
+  const auto d = GrowthDomain::analytic(DomainShape::Sphere, radius, radius / 50);
+  const auto o = karch(4000, d);
+  GrowthReport rep;
+  const auto t = growCco(d, o, rep);
+  PhysicsParameters p = o.physics;
+  test::expectHemodynamicInvariants(t, p, 4000);
+  expectGeometry(t, d);
+  EXPECT_EQ(rep.intersecting_pairs, 0);
+  // Mean radius falls with the bifurcation level over the first levels (seed 000 Fig. 6–7),
+  // from a root of about a millimetre (Karch 1999: 1.3–1.5 mm) to terminals under 0.15 mm.
+  std::vector<double> sum(64, 0.0), count(64, 0.0);
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) sum[t.depth[i] - 1] += t.radius[i], count[t.depth[i] - 1] += 1;
+  for (int l = 1; l <= 10; ++l) EXPECT_LT(sum[l] / count[l], sum[l - 1] / count[l - 1]) << "level " << l;
+  EXPECT_GT(rep.root_radius_mm, 0.8);
+  EXPECT_LT(rep.root_radius_mm, 2.0);
+  double terminal_radius = 0;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i)
+    if (t.isTerminal(i)) terminal_radius += t.radius[i] / 4000;
+  EXPECT_LT(terminal_radius, 0.15);
+}
+
+TEST(Cco, DiscTreeIsPlanarAndMeetsEveryConstraint) {
+  const auto d = GrowthDomain::analytic(DomainShape::Disc, 40, 0.2);
+  const auto o = karch(1500, d, 3);
+  GrowthReport rep;
+  const auto t = growCco(d, o, rep);
+  test::expectHemodynamicInvariants(t, o.physics, 1500);
+  expectGeometry(t, d);
+  for (const auto& p : t.position) ASSERT_EQ(p.z, d.planeZ());
+}
+
+TEST(Cco, NonConvexMaskKeepsEveryVesselInsideTheMask) {
+  // An L-shaped slab: the straight line between its arms leaves the domain.
+  DemandMap m;
+  m.dims = {60, 60, 16};
+  m.voxel_mm = 0.5;
+  m.demand.assign(m.voxelCount(), 0.0f);
+  for (int k = 2; k < 14; ++k)
+    for (int j = 2; j < 58; ++j)
+      for (int i = 2; i < 58; ++i)
+        if (i < 22 || j < 22) m.demand[m.flat(i, j, k)] = 1;
+  const auto d = GrowthDomain::mask(m, false);
+  auto o = karch(600, d, 5);
+  o.root_mm = Vec3(1.0, 1.0, 4.0);  // on the corner face of the L
+  GrowthReport rep;
+  const auto t = growCco(d, o, rep);
+  test::expectHemodynamicInvariants(t, o.physics, 600);
+  expectGeometry(t, d);
+  // Independently of the depth map: every centreline sample lies in a mask voxel.
+  std::int64_t outside = 0;
+  for (std::int32_t s = 1; s < t.nodeCount(); ++s)
+    for (int k = 0; k <= 32; ++k) {
+      const Vec3 p = t.position[t.parent[s]] + (t.position[s] - t.position[t.parent[s]]) * (k / 32.0);
+      if (!m.perfusable(p)) ++outside;
+    }
+  EXPECT_EQ(outside, 0);
+  // Terminals reach the far end of both arms (x > 11 mm, or y > 11 mm).
+  int arm_x = 0, arm_y = 0;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    if (!t.isTerminal(i)) continue;
+    arm_x += t.position[i].x > 11;
+    arm_y += t.position[i].y > 11;
+  }
+  EXPECT_GT(arm_x, 100);
+  EXPECT_GT(arm_y, 100);
+}
+
+TEST(Cco, DemandWeightedSamplingPutsTerminalsWhereDemandIsHigh) {
+  // A cube map whose upper half in x asks for nine times the demand of the lower half.
+  DemandMap m;
+  m.dims = {40, 40, 40};
+  m.voxel_mm = 0.5;
+  m.demand.assign(m.voxelCount(), 0.0f);
+  for (int k = 1; k < 39; ++k)
+    for (int j = 1; j < 39; ++j)
+      for (int i = 1; i < 39; ++i) m.demand[m.flat(i, j, k)] = i < 20 ? 1.0f : 9.0f;
+  const auto share_high = [&](bool weighted) {
+    const auto d = GrowthDomain::mask(m, weighted);
+    auto o = karch(800, d, 7);
+    o.root_mm = Vec3(10, 0.6, 10);
+    GrowthReport rep;
+    const auto t = growCco(d, o, rep);
+    expectGeometry(t, d);
+    double high = 0;
+    for (std::int32_t i = 1; i < t.nodeCount(); ++i)
+      if (t.isTerminal(i)) high += t.position[i].x > 10;
+    return high / 800;
+  };
+  const double uniform = share_high(false), weighted = share_high(true);
+  EXPECT_NEAR(uniform, 0.5, 0.06);
+  // 90 % of the demand; δ_max, scaled by the local demand, lets the terminals follow it.
+  EXPECT_NEAR(weighted, 0.9, 0.04);
+}
+
+TEST(Cco, SameSeedSameTreeWhateverTheThreads) {
+  const auto d = GrowthDomain::analytic(DomainShape::Cube, 30, 0.6);
+  const auto o = karch(1000, d, 11);
+  const auto run = [&](int threads) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+    GrowthReport rep;
+    return growCco(d, o, rep);
+  };
+  const auto a = run(1), b = run(2);
+  ASSERT_EQ(a.nodeCount(), b.nodeCount());
+  for (std::int32_t i = 0; i < a.nodeCount(); ++i) {
+    EXPECT_EQ(a.position[i], b.position[i]);
+    EXPECT_EQ(a.radius[i], b.radius[i]);
+    EXPECT_EQ(a.parent[i], b.parent[i]);
+  }
+  auto o2 = o;
+  o2.seed = 12;
+  GrowthReport rep;
+  const auto c = growCco(d, o2, rep);
+  EXPECT_NE(c.position[1], a.position[1]);
+}
