@@ -284,15 +284,24 @@ class CcoGrower {
   }
 
   // A trunk that thickened past half its length since it was made: slide its distal
-  // bifurcation outwards, or its proximal one back, to 2.1 r.
+  // bifurcation outwards (along the trunk, or towards its children), or its proximal one back,
+  // to 2.1–3 r, whichever first fits.
   bool lengthen(std::int32_t s) {
     auto& T = tree_;
     const auto P = T.parent[s];
     const Vec3 a = T.position[P], e = T.position[s];
     const Vec3 u = (e - a) / distance(a, e);
-    const double L = 2.1 * T.radius[s];
-    if (!T.isTerminal(s) && tryMove(s, a + u * L)) return true;
-    return P > 0 && tryMove(P, e - u * L);
+    Vec3 w = u;
+    if (!T.isTerminal(s)) {
+      const Vec3 m = (T.position[T.child0[s]] + T.position[T.child1[s]]) * 0.5 - e;
+      if (norm(m) > 0) w = m / norm(m);
+    }
+    for (double f : {2.1, 2.5, 3.0}) {
+      const double L = f * T.radius[s], grow = L - distance(a, e);
+      if (!T.isTerminal(s) && (tryMove(s, a + u * L) || tryMove(s, e + w * grow))) return true;
+      if (P > 0 && tryMove(P, e - u * L)) return true;
+    }
+    return false;
   }
 
   // Segments of the solved tree that break a constraint: intersecting pairs, length <= 2r, or
