@@ -22,6 +22,8 @@ constexpr std::int64_t kRefreshEvery = 64;
 constexpr double kMaxRepairShare = 0.05;
 // An ancestor is checked again for collisions once its radius has grown by this factor.
 constexpr double kRecheckGrowth = 1.02;
+// Segments with ρ at least this are "thick": checked from a list rather than through the grid.
+constexpr double kThick = 0.25;
 
 struct Trial {
   Connection c;
@@ -150,13 +152,34 @@ class CcoGrower {
       const Vec3& a1 = T.position[x];
       const double rx = rel_[x] * rr;
       bool hit = false;
-      index_.forEachNearSegment(a0, a1, rx + rr, [&](std::int32_t y) {
+      const auto test = [&](std::int32_t y) {
         if (hit || y == x || y >= T.nodeCount() || withinTwoSegments(T, x, y)) return;
         hit = capsulesOverlap(a0, a1, rx, T.position[T.parent[y]], T.position[y], rel_[y] * rr);
-      });
+      };
+      // The grid is searched as far as thin vessels reach; the few thick ones are listed apart,
+      // so the search does not widen with the root radius as the cells shrink.
+      index_.forEachNearSegment(a0, a1, rx + kThick * rr, test);
+      const Vec3 mid = (a0 + a1) * 0.5;
+      const double half = 0.5 * distance(a0, a1);
+      for (auto y : thick_) {
+        if (hit) break;
+        if (y >= T.nodeCount()) continue;
+        const Vec3& b0 = T.position[T.parent[y]];
+        const Vec3& b1 = T.position[y];
+        if (distance(mid, (b0 + b1) * 0.5) > half + 0.5 * distance(b0, b1) + rx + rel_[y] * rr) continue;
+        test(y);
+      }
       if (hit) return true;
     }
     return false;
+  }
+
+  // ρ of the whole tree, and the list of thick segments.
+  void refreshRelativeRadii() {
+    refreshRelative(tree_, rel_);
+    thick_.clear();
+    for (std::int32_t s = 1; s < tree_.nodeCount(); ++s)
+      if (rel_[s] >= kThick) thick_.push_back(s);
   }
 
   void markChecked(double rr) {
@@ -201,7 +224,8 @@ class CcoGrower {
           index_.insert(tree_, n - 1);
           index_.insert(tree_, c.segment);
           index_.refresh(tree_);
-          if (tree_.terminalCount() % kRefreshEvery == 0) refreshRelative(tree_, rel_);
+          if (rel_[n - 2] >= kThick) thick_.push_back(n - 2);
+          if (tree_.terminalCount() % kRefreshEvery == 0) refreshRelativeRadii();
           return true;
         }
         rollbackConnection(tree_, undo, rel_);
@@ -352,7 +376,7 @@ class CcoGrower {
         report_.repaired_terminals += before - tree_.terminalCount();
       }
       solveTree(tree_, params_);
-      refreshRelative(tree_, rel_);
+      refreshRelativeRadii();
       checked_ = tree_.radius;  // the exact check just passed every kept segment
       index_.refresh(tree_, true);
       growUntil(opt_.terminals, progress);
@@ -372,7 +396,8 @@ class CcoGrower {
   std::vector<Trial> trials_;
   std::vector<std::size_t> order_;
   std::vector<std::int32_t> check_;
-  std::vector<double> checked_;   // radius (final units) at which each segment was last found clear
+  std::vector<double> checked_;
+  std::vector<std::int32_t> thick_{1};  // segments with ρ >= kThick (the first is the root segment)   // radius (final units) at which each segment was last found clear
 };
 
 }  // namespace
