@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -28,6 +30,19 @@ CcoOptions karch(std::int64_t n, const GrowthDomain& d, std::uint64_t seed = 1) 
   o.physics.total_terminals = n;
   o.seed = seed;
   return o;
+}
+
+// A map of the given size whose voxel (i,j,k) holds value(i,j,k).
+template <class F>
+DemandMap voxelMap(std::array<std::int32_t, 3> dims, double voxel_mm, F&& value) {
+  DemandMap m;
+  m.dims = dims;
+  m.voxel_mm = voxel_mm;
+  m.demand.assign(m.voxelCount(), 0.0f);
+  for (int k = 0; k < dims[2]; ++k)
+    for (int j = 0; j < dims[1]; ++j)
+      for (int i = 0; i < dims[0]; ++i) m.demand[m.flat(i, j, k)] = static_cast<float>(value(i, j, k));
+  return m;
 }
 
 // Every pair of segments more than one segment apart, by brute force (independent of the grid
@@ -131,15 +146,8 @@ TEST(Kamiya, ATerminalBesideANodeMergesIntoIt) {
 TEST(GrowthDomain, MaskDepthFromOpenVdbMatchesTheBallItVoxelises) {
   // A ball of radius 12 voxels; depth at voxel centres against the exact distance to the sphere
   // (the voxelised border lies within half a voxel of it).
-  DemandMap m;
-  m.dims = {40, 40, 40};
-  m.voxel_mm = 0.5;
-  m.demand.assign(m.voxelCount(), 0.0f);
   const Vec3 c(10, 10, 10);
-  for (int k = 0; k < 40; ++k)
-    for (int j = 0; j < 40; ++j)
-      for (int i = 0; i < 40; ++i)
-        if (distance(Vec3(i + 0.5, j + 0.5, k + 0.5) * 0.5, c) < 6.0) m.demand[m.flat(i, j, k)] = 1;
+  const auto m = voxelMap({40, 40, 40}, 0.5, [&](int i, int j, int k) { return distance(Vec3(i + 0.5, j + 0.5, k + 0.5) * 0.5, c) < 6.0; });
   const auto d = GrowthDomain::mask(m, false);
   EXPECT_EQ(d.dimension(), 3);
   EXPECT_NEAR(d.measure(), 4.0 / 3.0 * std::numbers::pi * 216, 0.03 * 4.0 / 3.0 * std::numbers::pi * 216);
@@ -194,14 +202,9 @@ TEST(Cco, DiscTreeIsPlanarAndMeetsEveryConstraint) {
 
 TEST(Cco, NonConvexMaskKeepsEveryVesselInsideTheMask) {
   // An L-shaped slab: the straight line between its arms leaves the domain.
-  DemandMap m;
-  m.dims = {60, 60, 16};
-  m.voxel_mm = 0.5;
-  m.demand.assign(m.voxelCount(), 0.0f);
-  for (int k = 2; k < 14; ++k)
-    for (int j = 2; j < 58; ++j)
-      for (int i = 2; i < 58; ++i)
-        if (i < 22 || j < 22) m.demand[m.flat(i, j, k)] = 1;
+  const auto m = voxelMap({60, 60, 16}, 0.5, [](int i, int j, int k) {
+    return k >= 2 && k < 14 && j >= 2 && j < 58 && i >= 2 && i < 58 && (i < 22 || j < 22);
+  });
   const auto d = GrowthDomain::mask(m, false);
   auto o = karch(600, d, 5);
   o.root_mm = Vec3(1.0, 1.0, 4.0);  // on the corner face of the L
@@ -230,13 +233,10 @@ TEST(Cco, NonConvexMaskKeepsEveryVesselInsideTheMask) {
 
 TEST(Cco, DemandWeightedSamplingPutsTerminalsWhereDemandIsHigh) {
   // A cube map whose upper half in x asks for nine times the demand of the lower half.
-  DemandMap m;
-  m.dims = {40, 40, 40};
-  m.voxel_mm = 0.5;
-  m.demand.assign(m.voxelCount(), 0.0f);
-  for (int k = 1; k < 39; ++k)
-    for (int j = 1; j < 39; ++j)
-      for (int i = 1; i < 39; ++i) m.demand[m.flat(i, j, k)] = i < 20 ? 1.0f : 9.0f;
+  const auto m = voxelMap({40, 40, 40}, 0.5, [](int i, int j, int k) {
+    const bool in = std::min({i, j, k}) >= 1 && std::max({i, j, k}) < 39;
+    return in ? (i < 20 ? 1.0 : 9.0) : 0.0;
+  });
   const auto share_high = [&](bool weighted) {
     const auto d = GrowthDomain::mask(m, weighted);
     auto o = karch(800, d, 7);

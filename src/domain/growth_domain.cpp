@@ -18,18 +18,30 @@ const char* domainShapeName(DomainShape s) {
   return "?";
 }
 
+namespace {
+
+bool isRound(DomainShape s) { return s == DomainShape::Sphere || s == DomainShape::Disc; }
+bool isFlat(DomainShape s) { return s == DomainShape::Disc || s == DomainShape::Square; }
+
+}  // namespace
+
+std::array<std::int32_t, 3> GrowthDomain::analyticDims(DomainShape shape, double size_mm, double voxel_mm, int margin_voxels) {
+  const double half = isRound(shape) ? size_mm : size_mm / 2;
+  const int n = 2 * (static_cast<int>(std::ceil(half / voxel_mm - 1e-9)) + margin_voxels);
+  return {n, n, isFlat(shape) ? 1 : n};
+}
+
 GrowthDomain GrowthDomain::analytic(DomainShape shape, double size_mm, double voxel_mm, int margin_voxels) {
   GrowthDomain d;
   d.shape_ = shape;
-  const bool round = shape == DomainShape::Sphere || shape == DomainShape::Disc;
-  d.dimension_ = (shape == DomainShape::Disc || shape == DomainShape::Square) ? 2 : 3;
+  const bool round = isRound(shape);
+  d.dimension_ = isFlat(shape) ? 2 : 3;
   d.size_ = round ? size_mm : size_mm / 2;
   const double h = d.size_;
-  const int n = 2 * (static_cast<int>(std::ceil(h / voxel_mm - 1e-9)) + margin_voxels);
   auto& m = d.map_;
   m.voxel_mm = voxel_mm;
-  m.dims = {n, n, d.dimension_ == 2 ? 1 : n};
-  d.center_ = Vec3(n, n, m.dims[2]) * (voxel_mm / 2);
+  m.dims = analyticDims(shape, size_mm, voxel_mm, margin_voxels);
+  d.center_ = Vec3(m.dims[0], m.dims[1], m.dims[2]) * (voxel_mm / 2);
   if (d.dimension_ == 2) d.measure_ = round ? std::numbers::pi * h * h : 4 * h * h;
   else d.measure_ = round ? 4.0 / 3.0 * std::numbers::pi * h * h * h : 8 * h * h * h;
   m.demand.assign(m.voxelCount(), 0.0f);

@@ -4,6 +4,8 @@
 // pipeline works in (a DemandMap whose demand is the sampling weight, 0 outside), so CCO and
 // VascuSynth growth share one domain model. Disc, square and one-slice masks are 2D: the tree
 // lies in the plane z = plane_z and CCO's scaling laws use d = 2.
+#include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -21,6 +23,8 @@ class GrowthDomain {
   // Analytic shapes centred in a voxel frame of the given voxel size, with `margin_voxels`
   // empty voxels around them. `size` is the radius (sphere, disc) or the side (cube, square).
   static GrowthDomain analytic(DomainShape shape, double size_mm, double voxel_mm, int margin_voxels = 2);
+  // The voxel frame `analytic` builds, known before anything is allocated.
+  static std::array<std::int32_t, 3> analyticDims(DomainShape shape, double size_mm, double voxel_mm, int margin_voxels = 2);
   // A mask: voxels with weight > 0 are inside. Depth comes from a distance map of the mask
   // border (OpenVDB fast sweeping): within a few voxels of the border (where it is compared with
   // vessel radii) it is exact to a tenth of a voxel; deeper, its first-order error only makes

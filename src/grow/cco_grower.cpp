@@ -27,19 +27,23 @@ constexpr double kThick = 0.25;
 
 struct Trial {
   Connection c;
-  double radius[3] = {0, 0, 0};  // final-domain units: new bifurcation segment, split part, terminal
   bool kamiya_failed = false;
 };
+
+// The physics with CCO's cost, the total volume Σ π r² l (λ = 2, μ = 1).
+PhysicsParameters volumePhysics(const CcoOptions& o) {
+  PhysicsParameters p = o.physics;
+  p.total_terminals = o.terminals;
+  p.cost_radius_exponent = 2;
+  p.cost_length_exponent = 1;
+  return p;
+}
 
 class CcoGrower {
  public:
   CcoGrower(const GrowthDomain& d, const CcoOptions& o, GrowthReport& r)
-      : dom_(d), opt_(o), report_(r), params_(o.physics), kernel_(params_), index_(d.lo(), d.hi(), d.dimension() == 2),
-        rng_(o.seed, o.sample, Stage::Growth) {
-    params_.total_terminals = o.terminals;
-    params_.cost_radius_exponent = 2;  // CCO minimises volume, Σ π r² l
-    params_.cost_length_exponent = 1;
-    kernel_ = PowerKernel(params_);
+      : dom_(d), opt_(o), report_(r), params_(volumePhysics(o)), kernel_(params_),
+        index_(d.lo(), d.hi(), d.dimension() == 2), rng_(o.seed, o.sample, Stage::Growth) {
     tree_.reserve(2 * o.terminals + 1);
     tree_.addNode(o.root_mm, -1);
   }
@@ -122,13 +126,12 @@ class CcoGrower {
     double rho_b = 1;
     for (std::size_t lv = 1; lv < c.path.size(); ++lv) rho_b *= c.path[lv].beta_child;
     const double rr = rootRadiusFinal(n_new, top.reduced_resistance, shrink_new);
-    t.radius[0] = rr * rho_b;
-    t.radius[1] = t.radius[0] * c.path[0].beta_child;
-    t.radius[2] = t.radius[0] * c.path[0].beta_other;
+    // Radii in final-domain units: new bifurcation segment, split part, terminal.
+    const double r[3] = {rr * rho_b, rr * rho_b * c.path[0].beta_child, rr * rho_b * c.path[0].beta_other};
     for (int j = 0; j < 3; ++j)
-      if (!(l[j] > 2 * t.radius[j])) return t;  // §4.4: length / radius > 2
-    if (!dom_.capsuleInside(kp.x0, k.x, t.radius[0], startsAtRoot(s)) || !dom_.capsuleInside(k.x, kp.x1, t.radius[1], false) ||
-        !dom_.capsuleInside(k.x, p, t.radius[2], false))
+      if (!(l[j] > 2 * r[j])) return t;  // §4.4: length / radius > 2
+    if (!dom_.capsuleInside(kp.x0, k.x, r[0], startsAtRoot(s)) || !dom_.capsuleInside(k.x, kp.x1, r[1], false) ||
+        !dom_.capsuleInside(k.x, p, r[2], false))
       return t;
     c.valid = true;
     return t;
@@ -147,29 +150,25 @@ class CcoGrower {
       const auto x = c.path[lv].segment;
       if (rel_[x] * rr > kRecheckGrowth * checked_[x]) check_.push_back(x);
     }
+    const auto radius_of = [&](std::int32_t y) { return rel_[y] * rr; };
     for (auto x : check_) {
       const Vec3& a0 = T.position[T.parent[x]];
       const Vec3& a1 = T.position[x];
       const double rx = rel_[x] * rr;
-      bool hit = false;
-      const auto test = [&](std::int32_t y) {
-        if (hit || y == x || y >= T.nodeCount() || withinTwoSegments(T, x, y)) return;
-        hit = capsulesOverlap(a0, a1, rx, T.position[T.parent[y]], T.position[y], rel_[y] * rr);
-      };
       // The grid is searched as far as thin vessels reach; the few thick ones are listed apart,
       // so the search does not widen with the root radius as the cells shrink.
-      index_.forEachNearSegment(a0, a1, rx + kThick * rr, test);
-      const Vec3 mid = (a0 + a1) * 0.5;
-      const double half = 0.5 * distance(a0, a1);
-      for (auto y : thick_) {
-        if (hit) break;
-        if (y >= T.nodeCount()) continue;
-        const Vec3& b0 = T.position[T.parent[y]];
-        const Vec3& b1 = T.position[y];
-        if (distance(mid, (b0 + b1) * 0.5) > half + 0.5 * distance(b0, b1) + rx + rel_[y] * rr) continue;
-        test(y);
-      }
-      if (hit) return true;
+      const auto candidates = [&](auto&& f) {
+        index_.forEachNearSegment(a0, a1, rx + kThick * rr, f);
+        const Vec3 mid = (a0 + a1) * 0.5;
+        const double half = 0.5 * distance(a0, a1);
+        for (auto y : thick_) {
+          if (y >= T.nodeCount()) continue;
+          const Vec3& b0 = T.position[T.parent[y]];
+          const Vec3& b1 = T.position[y];
+          if (distance(mid, (b0 + b1) * 0.5) <= half + 0.5 * distance(b0, b1) + rx + radius_of(y)) f(y);
+        }
+      };
+      if (overlapsOtherVessel(T, x, a0, a1, rx, candidates, radius_of)) return true;
     }
     return false;
   }
@@ -280,13 +279,10 @@ class CcoGrower {
     const auto& T = tree_;
     const double rx = 1.02 * T.radius[x];
     if (!(distance(a, e) > 2 * rx) || !dom_.capsuleInside(a, e, rx, startsAtRoot(x))) return false;
-    const double r_max = 1.02 * T.radius[T.rootSegment()];
-    bool hit = false;
-    index_.forEachNearSegment(a, e, rx + r_max, [&](std::int32_t y) {
-      if (hit || y == x || y >= T.nodeCount() || withinTwoSegments(T, x, y)) return;
-      hit = capsulesOverlap(a, e, rx, T.position[T.parent[y]], T.position[y], 1.02 * T.radius[y]);
-    });
-    return !hit;
+    const double reach = rx + 1.02 * T.radius[T.rootSegment()];
+    return !overlapsOtherVessel(
+        T, x, a, e, rx, [&](auto&& f) { index_.forEachNearSegment(a, e, reach, f); },
+        [&](std::int32_t y) { return 1.02 * T.radius[y]; });
   }
 
   // Moves node v to q if every segment meeting there still fits; restores it otherwise.
@@ -396,8 +392,8 @@ class CcoGrower {
   std::vector<Trial> trials_;
   std::vector<std::size_t> order_;
   std::vector<std::int32_t> check_;
-  std::vector<double> checked_;
-  std::vector<std::int32_t> thick_{1};  // segments with ρ >= kThick (the first is the root segment)   // radius (final units) at which each segment was last found clear
+  std::vector<double> checked_;         // radius (final units) at which each segment was last found clear
+  std::vector<std::int32_t> thick_{1};  // segments with ρ >= kThick (the first is the root segment)
 };
 
 }  // namespace

@@ -17,6 +17,20 @@ inline bool capsulesOverlap(const Vec3& a0, const Vec3& a1, double ra, const Vec
   return segmentSegmentDistance(a0, a1, b0, b1) < ra + rb;
 }
 
+// True if the capsule a–e of radius r, which segment x occupies (or is about to), overlaps a
+// vessel more than two segments from x. `for_each_candidate(f)` calls f(y) for the segments to
+// consider (e.g. SegmentIndex::forEachNearSegment); `radius_of(y)` gives y's radius.
+template <class Candidates, class Radius>
+bool overlapsOtherVessel(const VascularTree& t, std::int32_t x, const Vec3& a, const Vec3& e, double r,
+                         Candidates&& for_each_candidate, Radius&& radius_of) {
+  bool hit = false;
+  for_each_candidate([&](std::int32_t y) {
+    if (hit || y == x || y >= t.nodeCount() || withinTwoSegments(t, x, y)) return;
+    hit = capsulesOverlap(a, e, r, t.position[t.parent[y]], t.position[y], radius_of(y));
+  });
+  return hit;
+}
+
 // Every intersecting pair of the tree with its current radii, (smaller id, larger id), sorted.
 // O(N) expected with a uniform grid over [lo, hi].
 std::vector<std::pair<std::int32_t, std::int32_t>> intersectingPairs(const VascularTree& tree, const Vec3& lo,

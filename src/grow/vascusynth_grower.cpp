@@ -185,12 +185,10 @@ class Grower {
       const Vec3& a0 = t.position[t.parent[x]];
       const Vec3& a1 = t.position[x];
       const double rx = rel_[x] * scale;
-      bool hit = false;
-      index_.forEachNearSegment(a0, a1, rx + r_max, [&](std::int32_t y) {
-        if (hit || y == x || withinTwoSegments(t, x, y)) return;
-        if (capsulesOverlap(a0, a1, rx, t.position[t.parent[y]], t.position[y], rel_[y] * scale)) hit = true;
-      });
-      if (hit) return true;
+      if (overlapsOtherVessel(
+              t, x, a0, a1, rx, [&](auto&& f) { index_.forEachNearSegment(a0, a1, rx + r_max, f); },
+              [&](std::int32_t y) { return rel_[y] * scale; }))
+        return true;
     }
     return false;
   }
@@ -213,12 +211,9 @@ class Grower {
   // (radii with 1 % margin, as the physics re-solve after a repair shifts them slightly).
   bool capsuleClear(std::int32_t s, const Vec3& a, const Vec3& e, SegmentIndex& index) const {
     const double rs = 1.01 * tree_.radius[s];
-    bool hit = false;
-    index.forEachNearSegment(a, e, rs + 1.01 * r_max_, [&](std::int32_t y) {
-      if (hit || y == s || withinTwoSegments(tree_, s, y)) return;
-      hit = capsulesOverlap(a, e, rs, tree_.position[tree_.parent[y]], tree_.position[y], 1.01 * tree_.radius[y]);
-    });
-    return !hit;
+    return !overlapsOtherVessel(
+        tree_, s, a, e, rs, [&](auto&& f) { index.forEachNearSegment(a, e, rs + 1.01 * r_max_, f); },
+        [&](std::int32_t y) { return 1.01 * tree_.radius[y]; });
   }
 
   // Pulls terminal segment s back towards its bifurcation until it clears every vessel; false if

@@ -80,10 +80,8 @@ DemandMap readNiftiMask(const std::filesystem::path& file, std::uint64_t limit) 
 GrowthDomain loadGrowthDomain(const Scenario& sc, std::uint64_t limit) {
   const auto& spec = sc.cco_domain;
   if (spec.shape != DomainShape::Mask) {
-    const bool flat = spec.shape == DomainShape::Disc || spec.shape == DomainShape::Square;
-    const double half = (spec.shape == DomainShape::Sphere || spec.shape == DomainShape::Disc) ? spec.size_mm : spec.size_mm / 2;
-    const double n = 2 * (std::ceil(half / sc.voxel_mm) + 2);
-    checkMemory(static_cast<std::int64_t>(n * n * (flat ? 1 : n)), limit, sc.parameter_file, spec.line,
+    const auto n = GrowthDomain::analyticDims(spec.shape, spec.size_mm, sc.voxel_mm);
+    checkMemory(std::int64_t(n[0]) * n[1] * n[2], limit, sc.parameter_file, spec.line,
                 std::string("a ") + domainShapeName(spec.shape) + " frame");
     return GrowthDomain::analytic(spec.shape, spec.size_mm, sc.voxel_mm);
   }

@@ -3,6 +3,7 @@
 #include "io/toml_file.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <set>
 
 #include "core/error.hpp"
@@ -113,6 +114,24 @@ class TomlReader {
   std::string file_;
 };
 
+// The root from [tree]: root_voxel (`voxels`) goes to sc.root_voxel; root (mm) is returned.
+// Exactly one of them is required.
+std::optional<Vec3> readRoot(TomlReader& r, const toml::table& tree, Scenario& sc, const std::string& voxels,
+                             const std::string& why_required) {
+  if (tree.get("root_voxel") && tree.get("root"))
+    throw InputError(r.file(), r.lineOf(tree.get("root")), "give root (mm) or root_voxel (" + voxels + "), not both");
+  if (const auto* n = tree.get("root_voxel")) {
+    sc.root_voxel = r.point(n, "root_voxel", false);
+    sc.root_line = r.lineOf(n);
+    return std::nullopt;
+  }
+  if (const auto* n = tree.get("root")) {
+    sc.root_line = r.lineOf(n);
+    return r.point(n, "root (mm)", false);
+  }
+  throw InputError(r.file(), r.lineOf(&tree), "missing key 'root' (mm) or 'root_voxel' (" + voxels + ") in [tree]" + why_required);
+}
+
 void readVascuSynthDomain(TomlReader& r, const toml::table& dom, const toml::table& tree, Scenario& sc,
                           const std::filesystem::path& path, const std::set<std::string>& cco_domain,
                           const std::set<std::string>& cco_tree) {
@@ -134,17 +153,7 @@ void readVascuSynthDomain(TomlReader& r, const toml::table& dom, const toml::tab
       throw InputError(file, r.lineOf(c), "supply_coefficients: the last value is the cut-off radius (map voxels) and must be >= 0");
   }
 
-  if (tree.get("root_voxel") && tree.get("root"))
-    throw InputError(file, r.lineOf(tree.get("root")), "give root (mm) or root_voxel (map voxels), not both");
-  if (const auto* n = tree.get("root_voxel")) {
-    sc.root_voxel = r.point(n, "root_voxel", false);
-    sc.root_line = r.lineOf(n);
-  } else if (const auto* n2 = tree.get("root")) {
-    sc.root_voxel = r.point(n2, "root (mm)", false) / sc.voxel_mm;
-    sc.root_line = r.lineOf(n2);
-  } else {
-    throw InputError(file, r.lineOf(&tree), "missing key 'root' (mm) or 'root_voxel' (map voxels) in [tree]");
-  }
+  if (const auto mm = readRoot(r, tree, sc, "map voxels", "")) sc.root_voxel = *mm / sc.voxel_mm;
   g.min_distance_mm = tree.get("min_distance") ? r.quantity(tree, "tree", "min_distance", Dimension::Length, sc.voxel_mm) : sc.voxel_mm;
   checkRange(g.min_distance_mm, 0, false, INFINITY, true, r.at(tree, "min_distance"), "min_distance (mm)");
   if (tree.get("min_segment_length")) {
@@ -199,21 +208,14 @@ void readCcoDomain(TomlReader& r, const toml::table& dom, const toml::table& tre
         throw InputError(file, r.lineOf(dom.get("sampling")), "sampling '" + v + "'; allowed: uniform, demand (∝ mask value)");
       d.demand_weighted = v == "demand";
     }
-    if (tree.get("root_voxel") && tree.get("root"))
-      throw InputError(file, r.lineOf(tree.get("root")), "give root (mm) or root_voxel (mask voxels), not both");
-    if (const auto* n = tree.get("root_voxel")) {
-      sc.root_voxel = r.point(n, "root_voxel", false);
-      sc.root_line = r.lineOf(n);
-    } else if (const auto* n2 = tree.get("root")) {
-      d.root_mm = r.point(n2, "root (mm)", false);
-      d.root_in_mm = true;
-      sc.root_line = r.lineOf(n2);
-      if (!nifti) {
-        sc.root_voxel = d.root_mm / sc.voxel_mm;
-        d.root_in_mm = false;
+    // A NIfTI mask's voxel size is known only once it is read: its root stays in mm until then.
+    if (const auto mm = readRoot(r, tree, sc, "mask voxels", ": a mask domain has no default root")) {
+      if (nifti) {
+        d.root_mm = *mm;
+        d.root_in_mm = true;
+      } else {
+        sc.root_voxel = *mm / sc.voxel_mm;
       }
-    } else {
-      throw InputError(file, r.lineOf(&tree), "missing key 'root' (mm) or 'root_voxel' (mask voxels) in [tree]: a mask domain has no default root");
     }
     return;
   }
