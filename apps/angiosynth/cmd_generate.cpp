@@ -24,7 +24,7 @@ CLI::App* addGenerate(CLI::App& app, GenerateArgs& a) {
                 "two_photon, domain_randomisation), .toml profiles, or VascuSynth noise files; one image_<name> each")
       ->delimiter(',');
   c->add_flag("--no-profiles", a.no_profiles, "write the clean image only, ignoring [degrade] profiles");
-  c->add_flag("--force", a.force, "replace the output directory if it exists");
+  c->add_flag("--force", a.force, "replace an earlier angiosynth output in --out (only the files it wrote there)");
   addCommonOptions(*c, a.common);
   return c;
 }
@@ -36,7 +36,9 @@ int runGenerate(const GenerateArgs& a, const std::string& command_line) {
   const Scenario sc = readParameters(a.params, ro);
   const std::filesystem::path out = a.out.empty() ? std::filesystem::path("out") / std::filesystem::path(a.params).stem()
                                                   : std::filesystem::path(a.out);
-  StagedDirectory dir(out, a.force);
+  std::vector<std::filesystem::path> inputs = scenarioInputs(sc);
+  for (const auto& p : a.profiles) inputs.push_back(p);
+  StagedDirectory dir(out, a.force ? ExistingOutput::ReplaceOwn : ExistingOutput::Refuse, inputs);
   SampleRequest req;
   req.scenario = &sc;
   req.seed = a.seed ? *a.seed : (sc.seed ? *sc.seed : freshSeed());

@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "core/error.hpp"
+#include "io/output_guard.hpp"
 #include "io/staged_directory.hpp"
 #include "io/text_lines.hpp"
 #include "pipeline/generate_sample.hpp"
@@ -42,11 +43,21 @@ int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line) {
   ReadOptions ro;
   ro.vascusynth_length_unit = a.common.vascusynth_unit;
   // Read every parameter file before writing anything, so a typo in the last one costs nothing.
+  // Maps too, and every output name checked, so nothing is written when any of them is wrong.
   std::vector<Scenario> scenarios;
-  for (const auto& l : params) scenarios.push_back(readParameters(resolveInputPath(l.text, a.param_list, l.number), ro));
+  std::vector<std::filesystem::path> inputs{a.param_list, a.name_list};
+  for (const auto& f : a.noise_files) inputs.push_back(f);
+  for (const auto& l : params) {
+    scenarios.push_back(readParameters(resolveInputPath(l.text, a.param_list, l.number), ro));
+    for (const auto& f : scenarioInputs(scenarios.back())) inputs.push_back(f);
+  }
+  for (const auto& sc : scenarios) checkSampleInputs(sc, memoryLimit(a.common));
+  const auto lineOf = [&](std::size_t i) { return a.name_list + ":" + std::to_string(names[i].number); };
+  for (std::size_t i = 0; i < names.size(); ++i) checkOutputPath(names[i].text, inputs, lineOf(i));
   for (std::size_t i = 0; i < scenarios.size(); ++i) {
     const Scenario& sc = scenarios[i];
-    StagedDirectory dir(names[i].text, /*replace=*/true);  // VascuSynth overwrites its outputs too
+    // VascuSynth creates and overwrites its own files and leaves the others alone; so do we.
+    StagedDirectory dir(names[i].text, ExistingOutput::Merge, inputs, lineOf(i));
     SampleRequest req;
     req.scenario = &sc;
     req.seed = sc.seed ? *sc.seed : freshSeed();

@@ -60,6 +60,7 @@ struct Scenario {
   double voxel_mm = 0;
   Vec3 root_voxel;                             // map-voxel coordinates
   int root_line = 0;
+  int terminals_line = 0;                      // of the terminal count, for feasibility errors
   GrowthOptions growth;                        // root_mm is set once the map is known
   std::optional<std::uint64_t> seed;
   ImageParameters image;
@@ -84,6 +85,9 @@ Scenario readTomlParameters(const std::filesystem::path& file);
 Scenario readTomlParameters(const toml::table& root, const std::filesystem::path& file);
 // Chooses by extension: .toml is native, anything else VascuSynth.
 Scenario readParameters(const std::filesystem::path& file, const ReadOptions& opt = {});
+
+// Every file a scenario reads (parameter file, maps, mask, profile files): outputs must not hold them.
+std::vector<std::filesystem::path> scenarioInputs(const Scenario& sc);
 
 // Resolves a path named in a parameter file: relative to that file's directory if it exists
 // there, else relative to the working directory (VascuSynth's convention).

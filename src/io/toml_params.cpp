@@ -279,6 +279,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
 
   auto& g = sc.growth;
   g.terminals = r.integer(tree, "tree", "terminals");
+  sc.terminals_line = r.lineOf(tree.get("terminals"));
   checkRange(double(g.terminals), 1, false, Limits::kMaxTerminals, false, r.at(tree, "terminals"), "terminals");
   g.closest_neighbours = tree.get("closest_neighbours") ? static_cast<int>(r.integer(tree, "tree", "closest_neighbours")) : (cco ? 20 : 5);
   checkRange(g.closest_neighbours, 1, false, Limits::kMaxNeighbours, false, r.at(tree, "closest_neighbours"), "closest_neighbours");

@@ -122,6 +122,7 @@ Scenario readVascuSynthParameters(const std::filesystem::path& path, const ReadO
   sc.supply_line = entries.at("SUPPLY_MAP").line;
 
   auto& g = sc.growth;
+  sc.terminals_line = entries.at("NUM_NODES").line;
   g.terminals = n;
   g.closest_neighbours = static_cast<int>(k);
   g.min_distance_mm = min_dist * sc.voxel_mm;

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <numbers>
 
 #include "angiosynth/version.hpp"
 #include "core/error.hpp"
@@ -11,6 +12,7 @@
 #include "io/growth_domain_files.hpp"
 #include "io/svg_writer.hpp"
 #include "io/map_files.hpp"
+#include "io/param_checks.hpp"
 #include "io/text_file.hpp"
 #include "pipeline/volume_outputs.hpp"
 #include "physics/hemodynamics.hpp"
@@ -93,24 +95,97 @@ Json describeParameters(const Scenario& sc) {
   return j;
 }
 
-Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) {
-  const Scenario& sc = *req.scenario;
-  Json timing;
+namespace {
+
+// Everything read and checked before growth: domain, profiles, volume sizes, feasibility.
+struct PreparedSample {
   std::optional<DemandMap> owned_map;
-  auto t0 = Clock::now();
-  const bool cco = sc.method == "cco";
   std::optional<GrowthDomain> domain;
-  if (cco) domain.emplace(loadGrowthDomain(sc, req.memory_limit));
-  const DemandMap& map = cco ? domain->frame() : owned_map.emplace(loadDomain(sc, req.memory_limit));
-  timing["read_maps"] = seconds(t0);
+  const DemandMap* map = nullptr;
+  std::vector<Profile> profiles;
+  VolumeRequest vr;
+  bool volumes = false;
+};
+
+// Estimated radii of an N-terminal tree: a symmetric tree whose segments halve in flow and
+// shrink by 2^(-1/γ) in radius and 2^(-1/d) in length per level, with the given pressure drop.
+// It sits within 15 % of grown CCO trees' root and terminal radii (examples/cco_sphere_3d.toml:
+// 1.44 vs 1.25 mm, 0.091 vs 0.090 mm).
+struct RadiusEstimate {
+  double root = 0, terminal = 0, spacing = 0;
+};
+
+RadiusEstimate estimateRadii(const PhysicsParameters& p, std::int64_t terminals, double measure, int dim) {
+  const double n = double(terminals), levels = std::log2(std::max(1.0, n));
+  const double root_length = std::pow(measure, 1.0 / dim) / 2;
+  double path = 0;  // Σ over levels of 2^-k · 2^(-k/d) · 2^(4k/γ)
+  for (int k = 0; k <= int(levels); ++k)
+    path += std::pow(2.0, -k - double(k) / dim + 4.0 * k / p.murray_exponent);
+  const double dp = p.perfusion_pressure - p.terminal_pressure;
+  RadiusEstimate e;
+  e.root = std::pow(8 * p.viscosity * p.perfusion_flow * root_length * path / (std::numbers::pi * dp), 0.25);
+  e.terminal = e.root * std::pow(n, -1.0 / p.murray_exponent);
+  e.spacing = std::pow(measure / n, 1.0 / dim);
+  return e;
+}
+
+// Fails in milliseconds, naming the cause, where growth could only grind: more terminals than fit
+// at the minimum distance, or vessels too thick for the room each terminal has.
+void checkFeasibility(const Scenario& sc, const PreparedSample& ps) {
+  const bool cco = sc.method == "cco";
+  const DemandMap& m = *ps.map;
+  double measure = 0;
+  int dim = 3;
+  if (cco) {
+    measure = ps.domain->measure();
+    dim = ps.domain->dimension();
+  } else {
+    std::int64_t inside = 0;
+    for (float v : m.demand) inside += v > 0;
+    measure = double(inside) * m.voxel_mm * m.voxel_mm * m.voxel_mm;
+  }
+  const auto& g = sc.growth;
+  const std::int64_t n = cco ? sc.cco.terminals : g.terminals;
+  const std::string unit = dim == 2 ? " mm^2" : " mm^3";
+  if (!cco && g.min_distance_mm > 0) {
+    // Balls of diameter min_distance around the terminals cannot fill more than 74 % of space.
+    const double ball = std::numbers::pi / 6 * std::pow(g.min_distance_mm, 3);
+    const double capacity = 0.74 * measure / ball;
+    if (double(n) > capacity)
+      throw InputError(sc.parameter_file, sc.terminals_line,
+                       std::to_string(n) + " terminals cannot lie " + show(g.min_distance_mm) + " mm apart in the " +
+                           show(measure) + unit + " of non-zero demand: at most about " +
+                           std::to_string(std::int64_t(capacity)) +
+                           " fit (sphere packing); use fewer terminals, a smaller minimum distance, or a larger domain");
+  }
+  const RadiusEstimate e = estimateRadii(cco ? sc.cco.physics : g.physics, n, measure, dim);
+  // Terminal vessels wider than a quarter of the spacing between terminals leave no room to
+  // branch without collisions: measured on the shipped examples, growth slows 25-fold at 0.42 of
+  // that limit (100x their flow) and runs for minutes past it (300x), while 1x sits at 0.13.
+  if (2 * e.terminal > e.spacing / 4)
+    throw InputError(sc.parameter_file, sc.terminals_line,
+                     "vessels too thick for the domain: this flow, pressure drop and viscosity give terminal vessels of "
+                     "diameter about " + show(2 * e.terminal) + " mm (root radius about " + show(e.root) + " mm), but " +
+                         std::to_string(n) + " terminals in " + show(measure) + unit + " lie about " + show(e.spacing) +
+                         " mm apart, and growth needs diameters below a quarter of that; lower perfusion_flow or viscosity, raise the pressure drop, or use "
+                         "fewer terminals (vessel radius scales with flow^(1/4))");
+}
+
+PreparedSample prepareSample(const SampleRequest& req) {
+  const Scenario& sc = *req.scenario;
+  PreparedSample ps;
+  const bool cco = sc.method == "cco";
+  if (cco) ps.domain.emplace(loadGrowthDomain(sc, req.memory_limit));
+  ps.map = cco ? &ps.domain->frame() : &ps.owned_map.emplace(loadDomain(sc, req.memory_limit));
+  const DemandMap& map = *ps.map;
 
   // The volume request is settled, and its size checked, before the (possibly long) growth.
   ImageParameters ip = sc.image;
   if (!req.formats.empty()) ip.formats = req.formats;
   if (req.vascusynth_layout) ip.formats = {"nifti"};  // beside the PNG slices of original_image
-  const bool volumes = ip.enabled && !req.no_image;
-  VolumeRequest vr;
-  std::vector<Profile> profiles;
+  ps.volumes = ip.enabled && !req.no_image;
+  VolumeRequest& vr = ps.vr;
+  std::vector<Profile>& profiles = ps.profiles;
   if (req.profiles) profiles = *req.profiles;
   else
     for (const auto& ref : sc.profiles) profiles.push_back(loadProfile(ref, sc.parameter_file, sc.profiles_line));
@@ -119,7 +194,7 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
       if (profiles[i].name == profiles[j].name)
         throw InputError(profiles[i].file, 0, "two profiles are named '" + profiles[i].name +
                                                   "' (roles image_<name> must differ); rename one file");
-  if (volumes) {
+  if (ps.volumes) {
     vr.grid = req.vascusynth_layout ? vascusynthGrid(map, req.output_voxel_mm) : imageGrid(map, ip);
     vr.image = ip;
     vr.memory_limit = req.memory_limit;
@@ -133,6 +208,32 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
     vr.vascusynth_noise_layout = req.vascusynth_noise_layout;
     checkVolumeMemory(vr);
   }
+  checkFeasibility(sc, ps);
+  return ps;
+}
+
+}  // namespace
+
+void checkSampleInputs(const Scenario& sc, std::uint64_t memory_limit) {
+  SampleRequest req;
+  req.scenario = &sc;
+  req.memory_limit = memory_limit;
+  req.no_image = !sc.image.enabled;
+  prepareSample(req);
+}
+
+Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) {
+  const Scenario& sc = *req.scenario;
+  Json timing;
+  auto t0 = Clock::now();
+  const bool cco = sc.method == "cco";
+  PreparedSample ps = prepareSample(req);
+  std::optional<GrowthDomain>& domain = ps.domain;
+  const DemandMap& map = *ps.map;
+  const VolumeRequest& vr = ps.vr;
+  const bool volumes = ps.volumes;
+  const std::vector<Profile>& profiles = ps.profiles;
+  timing["read_maps"] = seconds(t0);
 
   GrowthOptions opt = sc.growth;
   opt.root_mm = cco ? ccoRoot(sc, *domain) : map.toMm(sc.root_voxel);

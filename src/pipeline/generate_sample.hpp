@@ -36,6 +36,11 @@ struct SampleRequest {
 // Writes the sample's files into `dir` and returns the content of its sample.json.
 nlohmann::ordered_json generateSample(const SampleRequest& request, const std::filesystem::path& dir);
 
+// Reads and checks everything a sample needs before growth (maps, masks, profiles, volume sizes,
+// feasibility of the growth), writing nothing: so a batch can refuse a bad input before its first
+// sample is written.
+void checkSampleInputs(const Scenario& sc, std::uint64_t memory_limit);
+
 // The resolved parameters of a scenario with their units, as recorded in sample.json.
 nlohmann::ordered_json describeParameters(const Scenario& sc);
 
