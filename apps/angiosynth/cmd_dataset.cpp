@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <climits>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -20,7 +21,8 @@ std::int64_t parseIndex(const std::string& text, const std::string& what) {
     v = std::stoll(text, &used);
   } catch (const std::exception&) {
   }
-  if (used != text.size() || v < 0) throw InputError("", 0, what + ": '" + text + "' is not a whole number >= 0");
+  if (text.empty() || used != text.size() || v < 0)
+    throw InputError("", 0, what + ": '" + text + "' is not a whole number in 0…" + std::to_string(LLONG_MAX));
   return v;
 }
 
@@ -38,6 +40,9 @@ DatasetSelection selection(const DatasetArgs& a, std::int64_t samples) {
   if (given > 1) throw InputError("", 0, "give at most one of --index, --range, --shard");
   if (!a.index.empty()) {
     s.begin = a.index == "auto" ? indexFromEnvironment("--index") : parseIndex(a.index, "--index");
+    if (s.begin >= samples)
+      throw InputError("", 0, "--index " + std::to_string(s.begin) + " is beyond the dataset's " + std::to_string(samples) +
+                                  " samples; allowed: 0…" + std::to_string(samples - 1));
     s.end = s.begin + 1;
     s.part = "index-" + std::to_string(s.begin);
   } else if (!a.range.empty()) {
@@ -69,6 +74,7 @@ std::string duration(double s) {
 }
 
 int report(const DatasetCheck& c, const char* verb) {
+  for (const auto& w : c.warnings) std::cerr << "warning: " << w << "\n";
   for (const auto& p : c.problems) std::cerr << p << "\n";
   std::cerr << verb << ": " << c.ok << " of " << c.samples << " samples ok, " << c.problems.size() << " problem"
             << (c.problems.size() == 1 ? "" : "s") << "\n";
@@ -85,6 +91,8 @@ CLI::App* addDataset(CLI::App& app, DatasetArgs& a) {
   c->add_option("--range", a.range, "generate samples A to B-1");
   c->add_option("--shard", a.shard, "generate every M-th sample from K (K from 0); auto/M takes K from the environment");
   c->add_flag("--resume", a.resume, "skip samples whose files verify against the manifest");
+  c->add_flag("--regenerate-changed", a.regenerate_changed,
+              "with --resume: accept an edited spec and regenerate exactly the samples whose resolved parameters changed");
   c->add_option("--samples-in-flight", a.in_flight, "samples generated at once (default: one per thread, fewer if memory is short)")
       ->check(CLI::PositiveNumber);
   addCommonOptions(*c, a.common);
@@ -119,6 +127,8 @@ int runDatasetCommand(const DatasetArgs& a, const std::string& command_line) {
   const DatasetSelection sel = selection(a, spec.samples);
   DatasetRunOptions opt;
   opt.resume = a.resume;
+  opt.regenerate_changed = a.regenerate_changed;
+  if (a.regenerate_changed && !a.resume) throw InputError("", 0, "--regenerate-changed goes with --resume");
   opt.samples_in_flight = a.in_flight;
   opt.memory_limit = memoryLimit(a.common);
   opt.command_line = command_line;

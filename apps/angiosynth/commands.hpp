@@ -38,6 +38,7 @@ struct DatasetArgs {
   std::string spec, out, dir;
   std::string index, range, shard;
   bool resume = false;
+  bool regenerate_changed = false;
   int in_flight = 0;
   CommonOptions common;
   CLI::App* describe = nullptr;

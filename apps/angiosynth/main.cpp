@@ -7,10 +7,12 @@
 #include "cli_support.hpp"
 #include "commands.hpp"
 #include "core/error.hpp"
+#include "core/interrupt_cleanup.hpp"
 #include "degrade/effect.hpp"
 
 int main(int argc, char** argv) {
   using namespace angiosynth;
+  installInterruptCleanup();  // before any thread starts, so every thread leaves the signals to it
   CLI::App app{"angiosynth: synthetic vascular trees and angiography volumes with exact ground truth"};
   app.set_version_flag("--version", std::string("angiosynth ") + kVersion);
   app.require_subcommand(1);
@@ -24,7 +26,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    const int code = app.exit(e);  // prints help, version or the error
+    return code == 0 ? 0 : 2;      // a usage error is bad input: exit 2, as for files
   }
   const std::string cmdline = cli::commandLine(argc, argv);
   try {

@@ -17,6 +17,8 @@
 #include "dataset/manifest.hpp"
 #include "degrade/profile.hpp"
 #include "io/map_files.hpp"
+#include "core/interrupt_cleanup.hpp"
+#include "io/output_guard.hpp"
 #include "io/text_file.hpp"
 #include "pipeline/generate_sample.hpp"
 #include "pipeline/volume_outputs.hpp"
@@ -35,7 +37,24 @@ double nowUnix() {
 Json readJson(const fs::path& p) {
   std::ifstream in(p);
   if (!in) throw InputError(p.string(), 0, "missing; is this a dataset directory made by `angiosynth dataset`?");
-  return Json::parse(in);
+  const Json j = Json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded() || !j.is_object())
+    throw InputError(p.string(), 0, "is not a JSON object; the dataset directory is damaged (restore it, or generate again into a new directory)");
+  return j;
+}
+
+// spec.json as written by runDataset; its fields checked before use.
+Json readSpecRecord(const fs::path& dir) {
+  Json j = readJson(dir / "spec.json");
+  const auto bad = [&](const std::string& why) {
+    throw InputError((dir / "spec.json").string(), 0, why + "; the dataset directory is damaged");
+  };
+  if (!j.contains("samples") || !j["samples"].is_number_integer() || j["samples"].get<std::int64_t>() < 1 ||
+      j["samples"].get<std::int64_t>() > 100000000)
+    bad("samples must be a whole number in 1…10^8");
+  if (!j.contains("name") || !j["name"].is_string() || j["name"].get<std::string>().empty()) bad("name must be a string");
+  if (!j.contains("spec") || !j["spec"].is_string()) bad("spec must be the spec's text");
+  return j;
 }
 
 void writeJsonAtomically(const fs::path& p, const Json& j) {
@@ -67,14 +86,28 @@ Json fileEntry(const fs::path& dir, const std::string& rel) {
 }
 
 // One sample: generate in a staging directory, then rename into the nnU-Net layout.
-Json generateOne(const DatasetSpec& spec, const fs::path& dir, const ResolvedSample& r, const DatasetRunOptions& opt) {
-  const auto t0 = std::chrono::steady_clock::now();
-  Json e{{"id", r.id}, {"index", r.index}, {"seed", r.seed}, {"profile", r.profile}};
-  const fs::path staging = dir / ".staging" / (r.id + "." + std::to_string(::getpid()));
+// Moves `fresh` to `target`, replacing a directory that may be there without deleting it before
+// the new one is in place: the old one is first moved aside into `aside`.
+void replaceDirectory(const fs::path& fresh, const fs::path& target, const fs::path& aside) {
+  std::error_code ec;
+  const bool had = fs::exists(target, ec);
+  if (had) fs::rename(target, aside);
   try {
-    // Leftovers of this sample from a killed run (any process: a sample belongs to one shard).
-    for (const auto& f : fs::directory_iterator(dir / ".staging"))
-      if (f.path().filename().string().rfind(r.id + ".", 0) == 0) fs::remove_all(f.path());
+    fs::rename(fresh, target);
+  } catch (...) {
+    if (had) fs::rename(aside, target, ec);
+    throw;
+  }
+  if (had) fs::remove_all(aside, ec);
+}
+
+Json generateOne(const DatasetSpec& spec, const fs::path& dir, const fs::path& process_staging, const ResolvedSample& r,
+                 const DatasetRunOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Json e{{"id", r.id}, {"index", r.index}, {"seed", r.seed}, {"profile", r.profile}, {"sample_sha256", r.sha256}};
+  const fs::path staging = process_staging / r.id;
+  try {
+    fs::remove_all(staging);
     fs::create_directories(staging);
     const Scenario sc = scenarioOf(spec, r);
     SampleRequest req;
@@ -100,15 +133,15 @@ Json generateOne(const DatasetSpec& spec, const fs::path& dir, const ResolvedSam
               {"parameters_toml", r.toml},
               {"sample", sample}};
     writeTextFile(staging / "meta.json", [&](std::ostream& o) { o << meta.dump(2) << "\n"; });
-    // Renames: ground truth first, the image last, then the manifest line.
-    fs::remove_all(dir / gt_rel);
+    // Renames: ground truth first, the image last, then the manifest line. Each replaces an
+    // earlier copy only once the new one is complete.
     fs::rename(staging / "meta.json", dir / json_rel);
     fs::rename(label, dir / label_rel);
     fs::path image = staging / ("image" + suffix + ".nii.gz");
     if (!fs::exists(image)) image = staging / "image.nii.gz";
     const fs::path image_tmp = dir / (image_rel + ".part");
     fs::rename(image, image_tmp);
-    fs::rename(staging, dir / gt_rel);
+    replaceDirectory(staging, dir / gt_rel, process_staging / (r.id + ".previous"));
     fs::rename(image_tmp, dir / image_rel);
     Json files = Json::array({fileEntry(dir, image_rel), fileEntry(dir, label_rel), fileEntry(dir, json_rel)});
     std::vector<std::string> gt;
@@ -146,14 +179,74 @@ std::vector<std::int64_t> DatasetSelection::indices() const {
   return out;
 }
 
+namespace {
+
+// Refuses to mix specs or to overwrite silently: a directory made from another spec needs
+// --resume --regenerate-changed; samples of this selection already made need --resume.
+void checkExistingDataset(const DatasetSpec& spec, const fs::path& dir, const std::vector<std::int64_t>& todo,
+                          const DatasetRunOptions& opt, bool& spec_changed) {
+  spec_changed = false;
+  std::error_code ec;
+  if (!fs::exists(dir / "spec.json", ec)) return;
+  const Json old = readSpecRecord(dir);
+  const std::string old_text = old["spec"].get<std::string>();
+  std::string old_hash;
+  try {
+    old_hash = canonicalSpecSha256(old_text, (dir / "spec.json").string());
+  } catch (const InputError&) {
+  }
+  spec_changed = old_hash != spec.sha256;
+  if (spec_changed) {
+    const auto keys = changedSpecKeys(old_text, spec.text);
+    std::string list;
+    for (std::size_t i = 0; i < keys.size() && i < 12; ++i) list += (i ? ", " : "") + keys[i];
+    if (keys.size() > 12) list += ", … (" + std::to_string(keys.size()) + " in all)";
+    if (!(opt.resume && opt.regenerate_changed))
+      throw InputError(spec.file, 0, dir.string() + " was made from another version of this spec (changed: " + list +
+                                         "); generate into a new directory, or add --resume --regenerate-changed to "
+                                         "regenerate the samples the change affects and keep the others");
+  }
+  if (opt.resume) return;
+  const auto done = readManifests(dir, spec.samples);
+  std::int64_t made = 0;
+  for (auto i : todo) made += done.count(i);
+  if (made > 0)
+    throw InputError(dir.string(), 0, "already holds " + std::to_string(made) + " of the " + std::to_string(todo.size()) +
+                                          " samples this run would make; add --resume to keep the verified ones and "
+                                          "redo the rest, or choose another --out");
+}
+
+// This process's staging directory; staging left by killed processes of this host is removed.
+fs::path processStaging(const fs::path& dir) {
+  const fs::path root = dir / ".staging";
+  fs::create_directories(root);
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(root, ec))
+    if (stagingOwnerIsGone(e.path().filename().string())) fs::remove_all(e.path(), ec);
+  const fs::path mine = root / stagingSuffix();
+  fs::remove_all(mine, ec);
+  fs::create_directories(mine);
+  registerStaging(mine);
+  return mine;
+}
+
+}  // namespace
+
 DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent, const DatasetSelection& sel,
                             const DatasetRunOptions& opt) {
   DatasetRunReport rep;
-  // Reads sample 0's maps and profile: input errors surface before anything is written.
+  std::vector<std::int64_t> todo = sel.indices();
+  // Every sample's draws, parameters and files, then sample 0's maps and profile: input errors
+  // surface before anything is written.
+  checkSampleDraws(spec, todo);
   const std::uint64_t per_sample = std::max<std::uint64_t>(1, sampleBytes(spec, opt.memory_limit));
+  checkOutputPath(out_parent, {spec.file}, "--out");
   const fs::path dir = out_parent / datasetDirName(spec);
   rep.dir = dir;
-  for (const char* sub : {"imagesTr", "labelsTr", "groundtruth", "manifest", ".staging"}) fs::create_directories(dir / sub);
+  bool spec_changed = false;
+  checkExistingDataset(spec, dir, todo, opt, spec_changed);
+  for (const char* sub : {"imagesTr", "labelsTr", "groundtruth", "manifest"}) fs::create_directories(dir / sub);
+  const fs::path staging = processStaging(dir);
   // The same content from every process, so concurrent shards may all write it.
   writeJsonAtomically(dir / "spec.json", Json{{"name", spec.name},
                                               {"id", spec.id},
@@ -161,6 +254,7 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
                                               {"seed", spec.seed},
                                               {"channel_name", spec.channel_name},
                                               {"spec_file", spec.file},
+                                              {"spec_sha256", spec.sha256},
                                               {"spec", spec.text}});
   writeJsonAtomically(dir / "manifest" / (sel.part + ".run.json"),
                       Json{{"tool", {{"name", "angiosynth"}, {"version", kVersion}}},
@@ -168,13 +262,17 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
                            {"part", sel.part},
                            {"machine", machine()},
                            {"started_unix", nowUnix()}});
-  std::vector<std::int64_t> todo = sel.indices();
   if (opt.resume) {
-    const auto done = readManifests(dir);
+    const auto done = readManifests(dir, spec.samples);
     std::vector<std::int64_t> left;
     for (auto i : todo) {
       const auto it = done.find(i);
-      if (it != done.end() && entryVerifies(dir, it->second)) ++rep.skipped;
+      // Made from the same resolved parameters (entries of older versions carry no hash: only
+      // an unchanged spec vouches for them), and every file intact.
+      const bool same = it != done.end() && (it->second.contains("sample_sha256")
+                                                 ? it->second["sample_sha256"] == resolveSample(spec, i).sha256
+                                                 : !spec_changed);
+      if (same && entryVerifies(dir, it->second)) ++rep.skipped;
       else left.push_back(i);
     }
     todo = left;
@@ -200,7 +298,7 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
                                            }) &
           tbb::make_filter<std::int64_t, void>(tbb::filter_mode::parallel, [&](std::int64_t i) {
             const ResolvedSample r = resolveSample(spec, i);
-            Json e = generateOne(spec, dir, r, opt);
+            Json e = generateOne(spec, dir, staging, r, opt);
             e["part"] = sel.part;
             std::lock_guard<std::mutex> lock(m);
             appendManifestLine(part, e);
@@ -209,18 +307,21 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
             else ++rep.failed;
             if (opt.on_sample) opt.on_sample(e, finished, total);
           }));
+  // Only this process's own staging: other shards may be writing theirs.
   std::error_code ec;
-  fs::remove(dir / ".staging", ec);  // only if empty: other processes may be staging
+  fs::remove_all(staging, ec);
+  unregisterStaging(staging);
   return rep;
 }
 
 namespace {
 
 DatasetCheck checkDataset(const fs::path& dir, bool rehash, std::map<std::int64_t, Json>& entries, Json& info) {
-  info = readJson(dir / "spec.json");
-  entries = readManifests(dir);
+  if (!fs::is_directory(dir)) throw InputError(dir.string(), 0, "no such dataset directory");
+  info = readSpecRecord(dir);
   DatasetCheck c;
   c.samples = info["samples"].get<std::int64_t>();
+  entries = readManifests(dir, c.samples, &c.warnings);
   DatasetSpec naming;
   naming.name = info["name"];
   naming.samples = c.samples;
@@ -260,7 +361,7 @@ DatasetCheck finalizeDataset(const fs::path& dir) {
   });
   fs::rename(tmp, dir / "manifest.jsonl");
   // nnU-Net's dataset.json; "CT" makes nnU-Net use its CT (global percentile) normalisation.
-  std::string channel = info.value("channel_name", "");
+  std::string channel = info.contains("channel_name") && info["channel_name"].is_string() ? info["channel_name"].get<std::string>() : "";
   if (channel.empty()) {
     std::set<std::string> profiles;
     for (const auto& [i, e] : entries) profiles.insert(e.value("profile", ""));
@@ -279,10 +380,16 @@ DatasetCheck finalizeDataset(const fs::path& dir) {
                            {"release", kVersion}});
   Json runs = Json::array();
   std::vector<fs::path> run_files;
-  for (const auto& f : fs::directory_iterator(dir / "manifest"))
-    if (f.path().string().size() > 9 && f.path().string().ends_with(".run.json")) run_files.push_back(f.path());
+  std::error_code ec;
+  for (const auto& f : fs::directory_iterator(dir / "manifest", ec))
+    if (f.path().string().ends_with(".run.json")) run_files.push_back(f.path());
   std::sort(run_files.begin(), run_files.end());
-  for (const auto& f : run_files) runs.push_back(readJson(f));
+  for (const auto& f : run_files) {
+    std::ifstream in(f);
+    const Json run = Json::parse(in, nullptr, /*allow_exceptions=*/false);
+    if (run.is_discarded()) c.warnings.push_back(fs::relative(f, dir).string() + ": not valid JSON; left out of provenance.json");
+    else runs.push_back(run);
+  }
   writeJsonAtomically(dir / "provenance.json", Json{{"tool", {{"name", "angiosynth"}, {"version", kVersion}}},
                                                     {"spec_file", info["spec_file"]},
                                                     {"spec", info["spec"]},
@@ -302,11 +409,16 @@ DatasetCheck verifyDataset(const fs::path& dir) {
   std::set<std::string> known;
   for (const auto& [i, e] : entries)
     for (const auto& file : e.value("files", Json::array())) known.insert(file["path"].get<std::string>());
-  for (const char* sub : {"imagesTr", "labelsTr"})
+  for (const char* sub : {"imagesTr", "labelsTr"}) {
+    if (!fs::is_directory(dir / sub)) {
+      c.problems.push_back(std::string("missing directory ") + sub + "/");
+      continue;
+    }
     for (const auto& f : fs::directory_iterator(dir / sub)) {
       const std::string rel = std::string(sub) + "/" + f.path().filename().string();
       if (!known.count(rel)) c.problems.push_back("stray " + rel);
     }
+  }
   return c;
 }
 

@@ -7,8 +7,9 @@
 //   DatasetNNN_Name/groundtruth/<id>.json        resolved parameters, seed, profile, statistics
 //   DatasetNNN_Name/manifest/<part>.jsonl        one line per finished sample, per process
 //   DatasetNNN_Name/manifest.jsonl, dataset.json, provenance.json   (finalize)
-// Files are written in a staging directory and renamed into place; the manifest line comes
-// last, so an entry always means complete files.
+// Files are written in a staging directory of this process (.staging/<host>-<pid>/, so
+// concurrent shards never share one) and renamed into place; the manifest line comes last, so an
+// entry always means complete files.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -31,6 +32,7 @@ struct DatasetSelection {
 
 struct DatasetRunOptions {
   bool resume = false;               // skip samples whose manifest entry verifies
+  bool regenerate_changed = false;   // with resume: accept a changed spec, redo the samples it changes
   std::uint64_t memory_limit = 0;
   int samples_in_flight = 0;         // 0: one per thread, fewer if memory is short
   std::string command_line;
@@ -50,6 +52,7 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const std::filesystem::path
 struct DatasetCheck {
   std::int64_t samples = 0, ok = 0;
   std::vector<std::string> problems;  // "missing <id>", "failed <id>: …", "corrupt <id>: <file>"
+  std::vector<std::string> warnings;  // manifest lines skipped as invalid or torn
 };
 
 // Merges the manifest parts into manifest.jsonl and writes dataset.json and provenance.json.

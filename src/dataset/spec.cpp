@@ -3,6 +3,7 @@
 #include <toml++/toml.h>
 
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <set>
 #include <fstream>
@@ -10,6 +11,8 @@
 
 #include "core/error.hpp"
 #include "core/rng.hpp"
+#include "dataset/manifest.hpp"
+#include "degrade/profile.hpp"
 #include "io/scenario.hpp"
 
 namespace angiosynth {
@@ -19,9 +22,12 @@ int lineOf(const toml::node& n) { return static_cast<int>(n.source().begin.line)
 
 const char* const kDistributions[] = {"uniform", "log_uniform", "normal", "integer", "choice"};
 
+// Parameter files use no inline tables of their own, so an inline table stands where a value
+// goes: a distribution, perhaps misspelt ({unifrom = …}), which draw() then names.
 bool isDistribution(const toml::node& n) {
   const auto* t = n.as_table();
   if (!t) return false;
+  if (t->is_inline()) return true;
   for (const char* d : kDistributions)
     if (t->contains(d)) return true;
   return false;
@@ -43,11 +49,12 @@ Quantity quantityOf(const toml::node& n, const std::string& file, const std::str
   }
   if (n.is_floating_point()) {
     q.value = *n.value<double>();
+    if (!std::isfinite(q.value)) throw InputError(file, lineOf(n), what + " bounds must be finite numbers");
     return q;
   }
   if (const auto s = n.value_exact<std::string>()) {
     std::istringstream in(*s);
-    if (in >> q.value) {
+    if (in >> q.value && std::isfinite(q.value)) {
       std::getline(in >> std::ws, q.unit);
       return q;
     }
@@ -100,7 +107,9 @@ std::unique_ptr<toml::node> draw(const toml::table& d, Rng& rng, const std::stri
   }
   if (d.contains("integer")) {
     bounds("integer", a, b);
-    if (!a.integer || !b.integer || a.value > b.value) throw InputError(file, line, "integer takes whole numbers [a, b] with a <= b");
+    constexpr double kExact = 9007199254740992.0;  // 2^53: whole numbers a double holds exactly
+    if (!a.integer || !b.integer || a.value > b.value || std::abs(a.value) > kExact || std::abs(b.value) > kExact)
+      throw InputError(file, line, "integer takes whole numbers [a, b] with a <= b, each within ±2^53");
     const double span = b.value - a.value + 1;
     return valueOf(std::min(b.value, a.value + std::floor(u * span)), a.unit, true);
   }
@@ -198,12 +207,16 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
   const auto seed = need("seed").value<std::int64_t>();
   if (!seed || *seed < 0) throw InputError(s.file, lineOf(need("seed")), "seed must be a whole number >= 0");
   s.seed = static_cast<std::uint64_t>(*seed);
-  if (const auto* c = d.get("channel_name")) s.channel_name = c->value_or<std::string>("");
+  if (const auto* c = d.get("channel_name")) {
+    if (!c->is_string()) throw InputError(s.file, lineOf(*c), "channel_name must be a string (nnU-Net's channel name, e.g. \"CT\")");
+    s.channel_name = *c->value<std::string>();
+  }
   if (const auto* p = d.get("profile")) {
     auto keep = std::make_shared<toml::table>();
     keep->insert("profile", *p);
     s.profile = keep;
   }
+  s.sha256 = canonicalSpecSha256(s.text, s.file);
   if (root->contains("seed")) throw InputError(s.file, lineOf(*root->get("seed")), "the seed of a dataset goes in [dataset]");
   root->erase("dataset");
   s.table = root;
@@ -247,8 +260,73 @@ ResolvedSample resolveSample(const DatasetSpec& spec, std::int64_t index) {
   std::ostringstream o;
   o << *t << "\n";
   r.toml = o.str();
+  r.sha256 = sha256Text(r.toml + "\nimage profile: " + r.profile + "\n");
   r.table = t;
   return r;
+}
+
+namespace {
+
+toml::table parseSpecText(const std::string& text, const std::string& file) {
+  try {
+    return toml::parse(text, file);
+  } catch (const toml::parse_error& e) {
+    throw InputError(file, static_cast<int>(e.source().begin.line), std::string("not valid TOML: ") + std::string(e.description()));
+  }
+}
+
+void flatten(const toml::table& t, const std::string& prefix, std::map<std::string, std::string>& out) {
+  for (const auto& [k, v] : t) {
+    const std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+    if (const auto* sub = v.as_table(); sub && !sub->is_inline()) {
+      flatten(*sub, key, out);
+      continue;
+    }
+    std::ostringstream o;
+    v.visit([&](const auto& x) { o << x; });
+    out[key] = o.str();
+  }
+}
+
+}  // namespace
+
+std::string canonicalSpecSha256(const std::string& text, const std::string& file) {
+  std::map<std::string, std::string> flat;
+  flatten(parseSpecText(text, file), "", flat);
+  std::string canonical;
+  for (const auto& [k, v] : flat) canonical += k + " = " + v + "\n";
+  return sha256Text(canonical);
+}
+
+std::vector<std::string> changedSpecKeys(const std::string& old_text, const std::string& new_text) {
+  std::map<std::string, std::string> a, b;
+  try {
+    flatten(parseSpecText(old_text, "old spec"), "", a);
+  } catch (const InputError&) {
+    return {"(the recorded spec is not valid TOML)"};
+  }
+  flatten(parseSpecText(new_text, "new spec"), "", b);
+  std::vector<std::string> out;
+  for (const auto& [k, v] : a)
+    if (!b.count(k)) out.push_back(k + " (removed)");
+    else if (b[k] != v) out.push_back(k + " (" + v + " -> " + b[k] + ")");
+  for (const auto& [k, v] : b)
+    if (!a.count(k)) out.push_back(k + " (added)");
+  return out;
+}
+
+void checkSampleDraws(const DatasetSpec& spec, const std::vector<std::int64_t>& indices) {
+  std::set<std::string> profiles;
+  for (const auto i : indices) {
+    const ResolvedSample r = resolveSample(spec, i);
+    try {
+      readTomlParameters(*r.table, spec.file);
+      if (profiles.insert(r.profile).second) loadProfile(r.profile, spec.file, 0);
+    } catch (const InputError& e) {
+      throw InputError("", 0, std::string(e.what()) + " (sample " + std::to_string(i) + ", " + r.id +
+                                  "; see `angiosynth dataset describe " + spec.file + " --index " + std::to_string(i) + "`)");
+    }
+  }
 }
 
 }  // namespace angiosynth

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -24,6 +25,7 @@ namespace angiosynth {
 struct DatasetSpec {
   std::string file;          // the spec, for errors and provenance
   std::string text;          // its content, recorded in provenance.json
+  std::string sha256;        // of its canonical form: comments, spacing and key order do not count
   std::string name;          // nnU-Net dataset name (letters, digits, '-', '_')
   int id = 1;                // nnU-Net dataset number, 1…999
   std::int64_t samples = 0;
@@ -35,12 +37,22 @@ struct DatasetSpec {
 
 DatasetSpec readDatasetSpec(const std::filesystem::path& file);
 
+// The canonical form of a spec's text (TOML re-serialised with sorted keys) and its SHA-256.
+std::string canonicalSpecSha256(const std::string& spec_text, const std::string& file);
+// Dotted keys whose values differ between two spec texts ("tree.terminals", "dataset.samples").
+std::vector<std::string> changedSpecKeys(const std::string& old_text, const std::string& new_text);
+
+// Reads every sample's draws and parameter file and every file they name (maps, masks,
+// profiles), so a bad draw or a missing file fails before the first sample is written.
+void checkSampleDraws(const DatasetSpec& spec, const std::vector<std::int64_t>& indices);
+
 struct ResolvedSample {
   std::int64_t index = 0;
   std::string id;            // <name>_<index, fixed width>
   std::uint64_t seed = 0;    // the growth and degradation seed
   std::string profile;       // the image channel's profile
   std::string toml;          // the resolved parameter file (what `describe` prints)
+  std::string sha256;        // of toml and profile: what the sample's files depend on
   std::shared_ptr<const toml::table> table;  // the same, parsed
 };
 
