@@ -91,7 +91,7 @@ TEST_F(Files, VascuSynthErrorsNameFileAndLine) {
   f = write("nan.txt", edited(s, "NUM_NODES: 20", "NUM_NODES: 2x"));
   EXPECT_TRUE(errorAt(f, 13, "'2x' is not a whole number", [&] { readVascuSynthParameters(f); }));
   f = write("range.txt", edited(s, "PERF_FLOW: 8.33", "PERF_FLOW: -1"));
-  EXPECT_TRUE(errorAt(f, 7, "PERF_FLOW = -1 is out of range", [&] { readVascuSynthParameters(f); }));
+  EXPECT_TRUE(errorAt(f, 7, "PERF_FLOW (cm^3/s) = -1 is out of range", [&] { readVascuSynthParameters(f); }));
   f = write("nofile.txt", edited(s, "OXYGENATION_MAP: demand.txt", "OXYGENATION_MAP: nowhere.txt"));
   EXPECT_TRUE(errorAt(f, 2, "no such file 'nowhere.txt'", [&] { readVascuSynthParameters(f); }));
 }

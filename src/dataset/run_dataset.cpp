@@ -76,7 +76,7 @@ std::uint64_t sampleBytes(const DatasetSpec& spec, std::uint64_t limit) {
   const ResolvedSample r = resolveSample(spec, 0);
   const Scenario sc = scenarioOf(spec, r);
   const DemandMap map = loadDomain(sc, limit);
-  const VolumeGrid g = imageGrid(map, sc.image);
+  const VolumeGrid g = imageGrid(map, sc.image, spec.file, 0);
   loadProfile(r.profile, spec.file, 0);
   return denseRasterBytes(g) + 4ULL * g.voxelCount() + 24ULL * g.voxelCount() + map.demand.size() * 16;
 }

@@ -62,14 +62,20 @@ Quantity quantityOf(const toml::node& n, const std::string& file, const std::str
   throw InputError(file, lineOf(n), what + " bounds must be numbers or quantities \"<number> <unit>\"");
 }
 
-std::unique_ptr<toml::node> valueOf(double v, const std::string& unit, bool integer) {
-  if (!unit.empty()) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.17g", v);
-    return std::make_unique<toml::value<std::string>>(std::string(buf) + " " + unit);
-  }
-  if (integer) return std::make_unique<toml::value<std::int64_t>>(static_cast<std::int64_t>(v));
-  return std::make_unique<toml::value<double>>(v);
+// A drawn value as a node that remembers the distribution's line, so that errors about the
+// resolved parameters (a draw out of range, say) still point into the spec: the value is parsed
+// from text placed on that line.
+std::unique_ptr<toml::node> valueOf(double v, const std::string& unit, bool integer, int line) {
+  char buf[64];
+  if (integer) std::snprintf(buf, sizeof buf, "%lld", static_cast<long long>(v));
+  else std::snprintf(buf, sizeof buf, "%.17g", v);
+  std::string text = buf;
+  if (!unit.empty()) text = "\"" + text + " " + unit + "\"";
+  else if (!integer && text.find_first_of(".en") == std::string::npos) text += ".0";  // stays a float
+  toml::table t = toml::parse(std::string(std::max(0, line - 1), '\n') + "v = " + text);
+  std::unique_ptr<toml::node> out;  // moved, not copied: a copy would lose the line
+  t.get("v")->visit([&](auto& x) { out = std::make_unique<std::decay_t<decltype(x)>>(std::move(x)); });
+  return out;
 }
 
 // Draws one value of a distribution node.
@@ -98,12 +104,12 @@ std::unique_ptr<toml::node> draw(const toml::table& d, Rng& rng, const std::stri
   if (d.contains("uniform")) {
     bounds("uniform", a, b);
     if (a.value > b.value) throw InputError(file, line, "uniform: a > b");
-    return valueOf(a.value + u * (b.value - a.value), a.unit, false);
+    return valueOf(a.value + u * (b.value - a.value), a.unit, false, line);
   }
   if (d.contains("log_uniform")) {
     bounds("log_uniform", a, b);
     if (!(a.value > 0 && b.value >= a.value)) throw InputError(file, line, "log_uniform needs 0 < a <= b");
-    return valueOf(std::exp(std::log(a.value) + u * (std::log(b.value) - std::log(a.value))), a.unit, false);
+    return valueOf(std::exp(std::log(a.value) + u * (std::log(b.value) - std::log(a.value))), a.unit, false, line);
   }
   if (d.contains("integer")) {
     bounds("integer", a, b);
@@ -111,7 +117,7 @@ std::unique_ptr<toml::node> draw(const toml::table& d, Rng& rng, const std::stri
     if (!a.integer || !b.integer || a.value > b.value || std::abs(a.value) > kExact || std::abs(b.value) > kExact)
       throw InputError(file, line, "integer takes whole numbers [a, b] with a <= b, each within ±2^53");
     const double span = b.value - a.value + 1;
-    return valueOf(std::min(b.value, a.value + std::floor(u * span)), a.unit, true);
+    return valueOf(std::min(b.value, a.value + std::floor(u * span)), a.unit, true, line);
   }
   if (d.contains("normal")) {
     bounds("normal", a, b);
@@ -121,7 +127,7 @@ std::unique_ptr<toml::node> draw(const toml::table& d, Rng& rng, const std::stri
     // Truncated by rejection; a truncation that rejects nearly everything is a spec error.
     for (int tries = 0; tries < 10000; ++tries) {
       const double x = a.value + b.value * rng.normal();
-      if (x >= lo && x <= hi) return valueOf(x, a.unit, false);
+      if (x >= lo && x <= hi) return valueOf(x, a.unit, false, line);
     }
     throw InputError(file, line, "normal: min and max leave almost no probability; widen them");
   }
@@ -152,7 +158,8 @@ void resolveTable(toml::table& t, Rng& rng, const std::string& file) {
   for (auto&& [k, v] : t) {
     if (isDistribution(v)) {
       auto drawn = draw(*v.as_table(), rng, file);
-      drawn->visit([&](auto& x) { t.insert_or_assign(k, std::move(x)); });
+      const toml::key key = k;  // (clang 14 cannot capture a structured binding)
+      drawn->visit([&](auto& x) { t.insert_or_assign(key, std::move(x)); });
     } else if (auto* sub = v.as_table()) {
       resolveTable(*sub, rng, file);
     }
@@ -172,6 +179,7 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
   DatasetSpec s;
   s.file = path.string();
   if (!std::filesystem::exists(path)) throw InputError(s.file, 0, "no such dataset spec");
+  if (!std::filesystem::is_regular_file(path)) throw InputError(s.file, 0, "the dataset spec is not a regular file (a directory or device)");
   // One spelling of the spec's path, so every run (any working directory) records the same bytes.
   s.file = std::filesystem::weakly_canonical(path).string();
   std::ifstream in(path, std::ios::binary);
@@ -211,15 +219,8 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
     if (!c->is_string()) throw InputError(s.file, lineOf(*c), "channel_name must be a string (nnU-Net's channel name, e.g. \"CT\")");
     s.channel_name = *c->value<std::string>();
   }
-  if (const auto* p = d.get("profile")) {
-    auto keep = std::make_shared<toml::table>();
-    keep->insert("profile", *p);
-    s.profile = keep;
-  }
   s.sha256 = canonicalSpecSha256(s.text, s.file);
   if (root->contains("seed")) throw InputError(s.file, lineOf(*root->get("seed")), "the seed of a dataset goes in [dataset]");
-  root->erase("dataset");
-  s.table = root;
   // Resolve and read one sample now, so a bad spec fails before any work starts.
   const ResolvedSample first = resolveSample(s, 0);
   readTomlParameters(*first.table, s.file);
@@ -246,15 +247,18 @@ ResolvedSample resolveSample(const DatasetSpec& spec, std::int64_t index) {
   r.id = sampleId(spec, index);
   r.seed = Rng(spec.seed, static_cast<std::uint64_t>(index), Stage::Dataset, 0).nextU64() >> 1;  // fits TOML's int64
   Rng rng(spec.seed, static_cast<std::uint64_t>(index), Stage::Dataset, 1);
-  auto t = std::make_shared<toml::table>(*spec.table);
+  // Parsed afresh, not copied: toml++ drops source lines on copy, and errors about a sample's
+  // values must point into the spec.
+  auto t = std::make_shared<toml::table>(toml::parse(spec.text, std::string_view(spec.file)));
   r.profile = "clean";
-  if (spec.profile) {
-    toml::table p = *spec.profile;
-    resolveTable(p, rng, spec.file);
-    const auto v = p.get("profile")->value<std::string>();
-    if (!v) throw InputError(spec.file, lineOf(*p.get("profile")), "profile must be a profile name or file (or a choice of them)");
+  auto& dataset = *t->get("dataset")->as_table();
+  if (dataset.contains("profile")) {
+    resolveTable(dataset, rng, spec.file);  // only the profile may be a distribution there
+    const auto v = dataset.get("profile")->value<std::string>();
+    if (!v) throw InputError(spec.file, lineOf(*dataset.get("profile")), "profile must be a profile name or file (or a choice of them)");
     r.profile = *v;
   }
+  t->erase("dataset");
   resolveTable(*t, rng, spec.file);
   t->insert_or_assign("seed", static_cast<std::int64_t>(r.seed));
   std::ostringstream o;

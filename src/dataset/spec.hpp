@@ -31,8 +31,6 @@ struct DatasetSpec {
   std::int64_t samples = 0;
   std::uint64_t seed = 0;
   std::string channel_name;  // dataset.json channel 0 (default from the profile: "CT" for cta)
-  std::shared_ptr<const toml::table> table;    // the parsed spec, without [dataset]
-  std::shared_ptr<const toml::table> profile;  // {profile = value or distribution}; null: clean
 };
 
 DatasetSpec readDatasetSpec(const std::filesystem::path& file);

@@ -80,7 +80,7 @@ void applyBlur(const Drawn& p, EffectContext& ctx) { gaussianBlur(ctx.state.imag
 extern const EffectType kBlur{
     "blur",
     "Gaussian point-spread function, σ per axis (separable; edges replicate the border)",
-    {{"sigma", ParamKind::Length3, 0, 1e6, nullptr, "PSF standard deviation per axis (FWHM = 2.355 σ)"},
+    {{"sigma", ParamKind::Length3, 0, 1e6, nullptr, "PSF standard deviation per axis (FWHM = 2.355 σ); at most the field of view", 0, 1},
      {"truncate", ParamKind::Number, 1, 10, "4", "kernel half-width in units of σ"}},
     applyBlur};
 

@@ -18,9 +18,15 @@ bool isLength(ParamKind k) { return k == ParamKind::Length || k == ParamKind::Le
 
 Amount amountOf(const toml::node& n, ParamKind kind, const std::string& name, const std::string& file) {
   const std::string where = file + ":" + std::to_string(lineOf(n));
+  // Finite and within ±1e12 in its own unit: no product of such values overflows later.
+  const auto bounded = [&](const Amount& a) {
+    if (!(std::abs(a.value) <= 1e12))
+      throw InputError(file, lineOf(n), name + " = " + show(a.value) + " is out of range; allowed: finite values within ±1e12");
+    return a;
+  };
   if (const auto s = n.value_exact<std::string>()) {
     try {
-      return parseAmount(*s, kind, name, where);
+      return bounded(parseAmount(*s, kind, name, where));
     } catch (const std::invalid_argument& e) {
       throw InputError(file, lineOf(n), e.what());
     }
@@ -30,7 +36,7 @@ Amount amountOf(const toml::node& n, ParamKind kind, const std::string& name, co
     a.value = *n.value<double>();
     if (kind == ParamKind::Count && !n.is_integer())
       throw InputError(file, lineOf(n), name + " must be a whole number");
-    return a;
+    return bounded(a);
   }
   throw InputError(file, lineOf(n), name + " must be " + describeKind(kind) + ", or a range {min = …, max = …}");
 }
@@ -148,6 +154,25 @@ ParamSpec fixedParam(double value, const std::string& file, int line) {
   return s;
 }
 
+namespace {
+
+void checkGridBounds(const ParamDecl& decl, double x, const VolumeGrid& g, int axis, const Where& w) {
+  if (decl.min_voxels <= 0 && decl.max_fov <= 0) return;
+  const auto& s = g.spacing_mm;
+  const double voxel = axis >= 0 ? s[axis] : (s.x + s.y + s.z) / 3;
+  const double fov = axis >= 0 ? g.dims[axis] * s[axis] : (g.dims[0] * s.x + g.dims[1] * s.y + g.dims[2] * s.z) / 3;
+  if (decl.min_voxels > 0 && x < decl.min_voxels * voxel)
+    throw InputError(w.file, w.line, std::string(decl.name) + " = " + show(x) + " mm is finer than " + show(decl.min_voxels) +
+                                         " voxel (" + show(voxel) + " mm) of this image; allowed: >= " + show(decl.min_voxels) +
+                                         " voxel (a finer lattice holds more control points than the image has voxels)");
+  if (decl.max_fov > 0 && x > decl.max_fov * fov)
+    throw InputError(w.file, w.line, std::string(decl.name) + " = " + show(x) + " mm exceeds " + show(decl.max_fov) +
+                                         " fov (" + show(decl.max_fov * fov) + " mm) of this image; allowed: <= " +
+                                         show(decl.max_fov) + " fov");
+}
+
+}  // namespace
+
 Drawn drawParams(const std::vector<ParamDecl>& decls, const std::map<std::string, ParamSpec>& given,
                  const ParamScale& scale, Rng& rng, nlohmann::ordered_json& record, const std::string& file, int line) {
   Drawn d;
@@ -177,6 +202,7 @@ Drawn drawParams(const std::vector<ParamDecl>& decls, const std::map<std::string
       double x = drawComponent(r, u, scale, res_axis);
       if (decl.kind == ParamKind::Count) x = r.range ? std::min(std::floor(lo + u * (std::floor(hi) - lo + 1)), std::floor(hi)) : std::round(x);
       checkRange(x, decl.lo, false, decl.hi, false, Where{file, where_line}, decl.name);
+      checkGridBounds(decl, x, scale.grid, res_axis, Where{file, where_line});
       out[ax] = x;
     }
     v = Vec3(out[0], axes == 3 ? out[1] : out[0], axes == 3 ? out[2] : out[0]);

@@ -61,6 +61,11 @@ struct ParamDecl {
   double lo, hi;              // allowed values after resolution, closed interval
   const char* fallback;       // default, written as in a profile ("0", "vessel", "1 voxel"); nullptr: required
   const char* meaning;        // for the README and errors
+  // Lengths only: bounds relative to the image grid (0: none), per axis. A B-spline lattice finer
+  // than a voxel has more control points than the image has voxels; a blur wider than the field
+  // of view only costs time.
+  double min_voxels = 0;
+  double max_fov = 0;
 };
 
 // What the amounts are resolved against.

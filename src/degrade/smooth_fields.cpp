@@ -35,8 +35,11 @@ void applyTexture(const Drawn& p, EffectContext& ctx) {
   std::vector<float> weight;
   double norm = 0;
   for (int o = 0; o < octaves; ++o) {
-    // Octaves finer than two voxels add nothing a voxel can show.
-    if (scale.x < 2 * s.grid.spacing_mm.x && scale.y < 2 * s.grid.spacing_mm.y && scale.z < 2 * s.grid.spacing_mm.z) break;
+    // Octaves finer than two voxels add nothing a voxel can show; none is finer than a voxel on
+    // any axis (the memory estimate counts on it).
+    const Vec3& h = s.grid.spacing_mm;
+    if (scale.x < 2 * h.x && scale.y < 2 * h.y && scale.z < 2 * h.z) break;
+    if (scale.x < h.x || scale.y < h.y || scale.z < h.z) break;
     fields.push_back(randomField(s.grid, scale, ctx.rng));
     weight.push_back(static_cast<float>(std::pow(persistence, o)));
     norm += double(weight.back()) * weight.back();
@@ -83,7 +86,7 @@ extern const EffectType kBiasField{
     "bias",
     "smooth multiplicative bias field exp(N(0, log(1 + amplitude)²)) with correlation length ~ scale (coil sensitivity, beam hardening)",
     {{"amplitude", ParamKind::Number, 0, 10, nullptr, "typical relative gain deviation (0.2: about ±20 %)"},
-     {"scale", ParamKind::Length3, 1e-9, 1e9, "0.5 fov", "control-point spacing of the field (its correlation length)"}},
+     {"scale", ParamKind::Length3, 1e-9, 1e9, "0.5 fov", "control-point spacing of the field (its correlation length); at least 1 voxel", 1}},
     applyBias};
 
 extern const EffectType kTexture{
@@ -91,7 +94,7 @@ extern const EffectType kTexture{
     "smooth random background texture (tissue), added where the vessels leave room: mean + amplitude × fractal field",
     {{"amplitude", ParamKind::Intensity, 0, 1e9, nullptr, "standard deviation of the texture"},
      {"mean", ParamKind::Intensity, -1e9, 1e9, "0", "added to the background before the texture"},
-     {"scale", ParamKind::Length3, 1e-9, 1e9, "0.125 fov", "control-point spacing of the coarsest octave"},
+     {"scale", ParamKind::Length3, 1e-9, 1e9, "0.125 fov", "control-point spacing of the coarsest octave; at least 1 voxel", 1},
      {"octaves", ParamKind::Count, 1, 8, "3", "octaves, each at half the spacing of the previous one"},
      {"persistence", ParamKind::Number, 0, 1, "0.5", "amplitude ratio of successive octaves"}},
     applyTexture};

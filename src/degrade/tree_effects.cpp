@@ -106,7 +106,7 @@ extern const EffectType kDropout{
     "dropout",
     "vessel dropouts: the contrast of randomly placed stretches of vessel fades to background (gaps a segmenter must bridge); "
     "ground truth keeps the vessel",
-    {{"count", ParamKind::Count, 0, 1e6, "3", "number of gaps (placed uniformly along the total vessel length)"},
+    {{"count", ParamKind::Count, 0, 10000, "3", "number of gaps (placed uniformly along the total vessel length)"},
      {"length", ParamKind::Length, 0, 1e9, "4 voxel", "length of each gap along its vessel"},
      {"depth", ParamKind::Probability, 0, 1, "1", "fraction of the vessel contrast removed at the centre of a gap"}},
     applyDropout};
@@ -115,7 +115,7 @@ extern const EffectType kShadow{
     "shadow",
     "VascuSynth's shadows: dark blobs on random segments, radius = segment length, gain strength at the centre rising "
     "linearly to 1 at the rim",
-    {{"count", ParamKind::Count, 0, 1e6, nullptr, "number of shadows"},
+    {{"count", ParamKind::Count, 0, 1000, nullptr, "number of shadows"},
      {"strength_min", ParamKind::Number, 0, 1, "0", "least gain at a shadow's centre"},
      {"strength_max", ParamKind::Number, 0, 1, "1", "greatest gain at a shadow's centre"},
      {"radius_scale", ParamKind::Number, 0, 1e3, "1", "shadow radius in segment lengths"}},

@@ -232,7 +232,8 @@ void applyWarp(const Drawn& p, EffectContext& ctx) {
   s.image = warpVolume(s.image, *warp);
   s.warped_fraction = std::make_shared<Volume<float>>(warpVolume(*s.fraction, *warp));
   const double min_spacing = std::min({s.grid.spacing_mm.x, s.grid.spacing_mm.y, s.grid.spacing_mm.z});
-  const double piece = std::min({p("piece_length") > 0 ? p("piece_length") : min_spacing, h.x / 8, h.y / 8, h.z / 8});
+  // Pieces shorter than 1/16 voxel add points, not accuracy: that is the floor.
+  const double piece = std::max(min_spacing / 16, std::min({p("piece_length") > 0 ? p("piece_length") : min_spacing, h.x / 8, h.y / 8, h.z / 8}));
   s.warped_tree = std::make_shared<VascularTree>(warpTree(*s.tree, *warp, piece, s.segment_origin));
   s.fraction = s.warped_fraction.get();
   s.tree = s.warped_tree.get();
@@ -249,10 +250,10 @@ void applyWarp(const Drawn& p, EffectContext& ctx) {
 extern const EffectType kWarp{
     "warp",
     "random cubic B-spline deformation of the image, the labels and the tree (curved vessels), invertible by construction",
-    {{"spacing", ParamKind::Length3, 1e-9, 1e9, "0.25 fov", "control-point spacing"},
+    {{"spacing", ParamKind::Length3, 1e-9, 1e9, "0.25 fov", "control-point spacing; at least 1 voxel", 1},
      {"max_displacement", ParamKind::Length3, 0, 1e9, "0.05 fov", "largest control displacement per axis (<= 0.4 × spacing)"},
      {"piece_length", ParamKind::Length, 0, 1e9, "0", "longest piece of a warped vessel in the warped graph (0: one voxel); "
-                                                       "never more than spacing / 8"}},
+                                                       "never more than spacing / 8, never less than 1/16 voxel"}},
     applyWarp,
     /*moves_geometry=*/true};
 

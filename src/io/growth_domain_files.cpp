@@ -33,8 +33,12 @@ bool isNifti(const std::filesystem::path& p) {
 
 DemandMap readNiftiMask(const std::filesystem::path& file, std::uint64_t limit) {
   const std::string f = file.string();
+  if (!std::filesystem::is_regular_file(file)) throw InputError(f, 0, "the mask is not a regular file (missing, a directory or a device)");
   std::unique_ptr<nifti_image, decltype(&nifti_image_free)> head(nifti_image_read(f.c_str(), 0), &nifti_image_free);
   if (!head) throw InputError(f, 0, "cannot read this file as a NIfTI image");
+  if (head->nx > Limits::kMaxVoxelsPerAxis || head->ny > Limits::kMaxVoxelsPerAxis || head->nz > Limits::kMaxVoxelsPerAxis)
+    throw InputError(f, 0, "a mask of " + std::to_string(head->nx) + " x " + std::to_string(head->ny) + " x " +
+                               std::to_string(head->nz) + " voxels; allowed: at most 100000 per axis");
   if (head->nx < 1 || head->ny < 1 || head->nz < 1 || head->nt > 1 || head->nu > 1)
     throw InputError(f, 0, "a mask must be one 3D (or one-slice 2D) volume; this one has dims " + std::to_string(head->nx) +
                                " " + std::to_string(head->ny) + " " + std::to_string(head->nz) + " " + std::to_string(head->nt));
@@ -42,8 +46,14 @@ DemandMap readNiftiMask(const std::filesystem::path& file, std::uint64_t limit) 
   if (!(dx > 0) || std::abs(dy - dx) > 1e-6 * dx || (head->nz > 1 && std::abs(dz - dx) > 1e-6 * dx))
     throw InputError(f, 0, "mask voxels must be isotropic (got " + show(dx) + " x " + show(dy) + " x " + show(dz) +
                                "); resample the mask");
+  {
+    const int unit = XYZT_TO_SPACE(head->xyz_units);
+    const double mm = dx * (unit == NIFTI_UNITS_METER ? 1e3 : unit == NIFTI_UNITS_MICRON ? 1e-3 : 1.0);
+    if (!(mm >= Limits::kMinVoxel && mm <= Limits::kMaxVoxel))
+      throw InputError(f, 0, "voxel size " + show(mm) + " mm (pixdim) is out of range; allowed: 1e-4 to 1e4 mm");
+  }
   DemandMap m;
-  m.dims = {head->nx, head->ny, head->nz};
+  m.dims = {static_cast<std::int32_t>(head->nx), static_cast<std::int32_t>(head->ny), static_cast<std::int32_t>(head->nz)};
   checkMemory(m.voxelCount(), limit, f, 0, "the mask");
   std::unique_ptr<nifti_image, decltype(&nifti_image_free)> img(nifti_image_read(f.c_str(), 1), &nifti_image_free);
   if (!img || !img->data) throw InputError(f, 0, "cannot read the voxels of this NIfTI image");

@@ -35,9 +35,10 @@ Box readBox(const TextLine& l, const std::string& file, const std::array<std::in
   if (w.size() != 6) throw InputError(file, l.number, "expected a box 'x0 y0 z0 x1 y1 z1' (6 whole numbers), got '" + l.text + "'");
   Box b{};
   for (int ax = 0; ax < 3; ++ax) {
-    b.lo[ax] = static_cast<std::int32_t>(parseInteger(w[ax], file, l.number, "box corner"));
-    b.hi[ax] = static_cast<std::int32_t>(parseInteger(w[ax + 3], file, l.number, "box corner"));
-    if (b.lo[ax] < 0 || b.hi[ax] > dims[ax] || b.lo[ax] >= b.hi[ax])
+    const auto lo = parseInteger(w[ax], file, l.number, "box corner"), hi = parseInteger(w[ax + 3], file, l.number, "box corner");
+    b.lo[ax] = static_cast<std::int32_t>(std::clamp<std::int64_t>(lo, -1, dims[ax] + 1));  // out of range stays out of range
+    b.hi[ax] = static_cast<std::int32_t>(std::clamp<std::int64_t>(hi, -1, dims[ax] + 1));
+    if (lo < 0 || hi > dims[ax] || lo >= hi)
       throw InputError(file, l.number, "box '" + l.text + "' lies outside the map or is empty; allowed: 0 <= x0 < x1 <= " +
                                            std::to_string(dims[0]) + ", 0 <= y0 < y1 <= " + std::to_string(dims[1]) +
                                            ", 0 <= z0 < z1 <= " + std::to_string(dims[2]) + " (half-open boxes)");
@@ -79,7 +80,7 @@ DemandMap loadDomain(const Scenario& sc, std::uint64_t memory_limit) {
     const auto w = splitWords(lines[i + 1].text);
     if (w.size() != 1) throw InputError(file, lines[i + 1].number, "expected one demand value, got '" + lines[i + 1].text + "'");
     const double v = parseNumber(w[0], file, lines[i + 1].number, "demand");
-    if (v < 0) throw InputError(file, lines[i + 1].number, "demand " + w[0] + " is negative; allowed: >= 0 (0 = obstacle)");
+    if (v < 0 || v > 1e30) throw InputError(file, lines[i + 1].number, "demand " + w[0] + " is out of range; allowed: 0 (obstacle) to 1e30");
     forBox(m, b, [&](std::int64_t x) { m.demand[x] = static_cast<float>(v); });
   }
 
@@ -107,7 +108,8 @@ DemandMap loadDomain(const Scenario& sc, std::uint64_t memory_limit) {
         throw InputError(sfile, sl[i + 1].number, "expected K = " + std::to_string(K) + " coefficients, got '" + sl[i + 1].text + "'");
       std::vector<double> c;
       for (const auto& x : w) c.push_back(parseNumber(x, sfile, sl[i + 1].number, "supply coefficient"));
-      if (c.back() < 0) throw InputError(sfile, sl[i + 1].number, "the last coefficient is the cut-off radius and must be >= 0");
+      if (c.back() < 0 || c.back() > Limits::kMaxSupplyCutoff)
+        throw InputError(sfile, sl[i + 1].number, "the last coefficient is the cut-off radius (map voxels); allowed: 0 to 1e6");
       auto it = std::find(m.supply_sets.begin(), m.supply_sets.end(), c);
       if (it == m.supply_sets.end()) {
         if (m.supply_sets.size() >= 65535) throw InputError(sfile, sl[i + 1].number, "more than 65534 distinct coefficient sets");

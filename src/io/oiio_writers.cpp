@@ -22,7 +22,8 @@ OIIO::TypeDesc oiioType(VoxelType t) {
 }
 
 std::uint8_t to8(float v, double lo, double scale) {
-  return static_cast<std::uint8_t>(std::clamp(std::lround((v - lo) * scale), 0L, 255L));
+  const double x = (v - lo) * scale;
+  return std::isnan(x) ? 0 : static_cast<std::uint8_t>(std::clamp(std::round(x), 0.0, 255.0));
 }
 
 [[noreturn]] void fail(const std::filesystem::path& file, const std::string& why) {

@@ -37,6 +37,17 @@ struct Limits {
   static constexpr double kMaxNeighbours = 100;
   static constexpr double kMinMurray = 1, kMaxMurray = 10;     // γ in (1, 10]
   static constexpr double kMaxCostExponent = 10;                // λ, μ in [0, 10]
+  // Finite, physically generous bounds: far beyond any vessel, small enough that no product of
+  // them overflows a double or a grid index.
+  static constexpr double kMinVoxel = 1e-4, kMaxVoxel = 1e4;    // mm: 0.1 µm to 10 m
+  static constexpr double kMaxLength = 1e6;                     // mm: lengths, distances, fields of view
+  static constexpr double kMaxVoxelsPerAxis = 1e5;
+  static constexpr double kMinViscosity = 1e-6, kMaxViscosity = 1e3;  // Pa*s (blood: 3.6e-3)
+  static constexpr double kMaxPressure = 1e8;                   // Pa (1000 bar)
+  static constexpr double kMinPressureDrop = 1e-3;              // Pa
+  static constexpr double kMinFlow = 1e-9, kMaxFlow = 1e12;     // mm^3/s
+  static constexpr double kMaxSupplyCutoff = 1e6;               // map voxels
+  static constexpr double kMaxIntensity = 1e12;                 // image intensities
 };
 
 }  // namespace angiosynth

@@ -16,6 +16,9 @@ std::string trimmed(const std::string& s) {
 }
 
 std::vector<TextLine> readTextLines(const std::filesystem::path& file, const std::string& what) {
+  std::error_code ec;
+  if (std::filesystem::exists(file, ec) && !std::filesystem::is_regular_file(file, ec))
+    throw InputError(file.string(), 0, what + " file is not a regular file (a directory or device); give a text file");
   std::ifstream in(file, std::ios::binary);
   if (!in) {
     const bool exists = std::filesystem::exists(file);

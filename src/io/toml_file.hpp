@@ -13,6 +13,7 @@ namespace angiosynth {
 inline toml::table parseTomlFile(const std::filesystem::path& path, const std::string& what) {
   const std::string file = path.string();
   if (!std::filesystem::exists(path)) throw InputError(file, 0, "no such " + what);
+  if (!std::filesystem::is_regular_file(path)) throw InputError(file, 0, "the " + what + " is not a regular file (a directory or device)");
   try {
     return toml::parse_file(file);
   } catch (const toml::parse_error& e) {

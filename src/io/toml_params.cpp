@@ -3,6 +3,7 @@
 #include "io/toml_file.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 #include <set>
 
@@ -61,7 +62,7 @@ class TomlReader {
   double number(const toml::table& t, const std::string& section, const std::string& key) {
     const toml::node* n = need(t, section, key);
     const auto v = n->value<double>();
-    if (!v || n->is_string()) throw InputError(file_, lineOf(n), key + " must be a number");
+    if (!v || n->is_string() || !std::isfinite(*v)) throw InputError(file_, lineOf(n), key + " must be a finite number");
     return *v;
   }
 
@@ -69,6 +70,15 @@ class TomlReader {
     const toml::node* n = need(t, section, key);
     if (!n->is_integer()) throw InputError(file_, lineOf(n), key + " must be a whole number");
     return *n->value<std::int64_t>();
+  }
+
+  // A whole number checked against [lo, hi] before it is narrowed.
+  int smallInteger(const toml::table& t, const std::string& section, const std::string& key, std::int64_t lo, std::int64_t hi) {
+    const std::int64_t v = integer(t, section, key);
+    if (v < lo || v > hi)
+      throw InputError(file_, lineOf(t.get(key)), key + " = " + std::to_string(v) + " is out of range; allowed: [" +
+                                                      std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return static_cast<int>(v);
   }
 
   std::string string(const toml::table& t, const std::string& section, const std::string& key) {
@@ -85,7 +95,7 @@ class TomlReader {
     std::vector<double> out;
     for (const auto& e : *arr) {
       const auto v = e.value<double>();
-      if (!v || e.is_string()) throw InputError(file_, lineOf(n), key + " must hold numbers only");
+      if (!v || e.is_string() || !std::isfinite(*v)) throw InputError(file_, lineOf(n), key + " must hold finite numbers only");
       out.push_back(*v);
     }
     return out;
@@ -140,7 +150,7 @@ void readVascuSynthDomain(TomlReader& r, const toml::table& dom, const toml::tab
   r.forbid(tree, "tree", cco_tree, "is for method cco; this file grows with method vascusynth (set [tree] method = \"cco\")");
   auto& g = sc.growth;
   sc.voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
-  checkRange(sc.voxel_mm, 0, true, INFINITY, true, r.at(dom, "voxel_size"), "voxel_size (mm)");
+  checkRange(sc.voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, r.at(dom, "voxel_size"), "voxel_size (mm)");
   sc.demand_map = resolveInputPath(r.string(dom, "domain", "demand_map"), path, r.lineOf(dom.get("demand_map")));
   if (dom.get("supply_map") && dom.get("supply_coefficients"))
     throw InputError(file, r.lineOf(dom.get("supply_coefficients")), "give supply_map or supply_coefficients, not both");
@@ -149,16 +159,16 @@ void readVascuSynthDomain(TomlReader& r, const toml::table& dom, const toml::tab
     sc.supply_line = r.lineOf(dom.get("supply_map"));
   } else if (const auto* c = dom.get("supply_coefficients")) {
     sc.supply_coefficients = r.numbers(c, "supply_coefficients", 0);
-    if (sc.supply_coefficients.back() < 0)
-      throw InputError(file, r.lineOf(c), "supply_coefficients: the last value is the cut-off radius (map voxels) and must be >= 0");
+    if (sc.supply_coefficients.back() < 0 || sc.supply_coefficients.back() > Limits::kMaxSupplyCutoff)
+      throw InputError(file, r.lineOf(c), "supply_coefficients: the last value is the cut-off radius (map voxels); allowed: 0 to 1e6");
   }
 
   if (const auto mm = readRoot(r, tree, sc, "map voxels", "")) sc.root_voxel = *mm / sc.voxel_mm;
   g.min_distance_mm = tree.get("min_distance") ? r.quantity(tree, "tree", "min_distance", Dimension::Length, sc.voxel_mm) : sc.voxel_mm;
-  checkRange(g.min_distance_mm, 0, false, INFINITY, true, r.at(tree, "min_distance"), "min_distance (mm)");
+  checkRange(g.min_distance_mm, 0, false, Limits::kMaxLength, false, r.at(tree, "min_distance"), "min_distance (mm)");
   if (tree.get("min_segment_length")) {
     g.min_segment_length_mm = r.quantity(tree, "tree", "min_segment_length", Dimension::Length, sc.voxel_mm);
-    checkRange(g.min_segment_length_mm, 0, true, INFINITY, true, r.at(tree, "min_segment_length"), "min_segment_length (mm)");
+    checkRange(g.min_segment_length_mm, 0, true, Limits::kMaxLength, false, r.at(tree, "min_segment_length"), "min_segment_length (mm)");
   }
   if (const auto* n = tree.get("avoid_intersections")) {
     if (!n->is_boolean()) throw InputError(file, r.lineOf(n), "avoid_intersections must be true or false");
@@ -198,7 +208,7 @@ void readCcoDomain(TomlReader& r, const toml::table& dom, const toml::table& tre
         throw InputError(file, r.lineOf(dom.get("voxel_size")), "a NIfTI mask carries its voxel size; remove voxel_size");
     } else {
       sc.voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
-      checkRange(sc.voxel_mm, 0, true, INFINITY, true, r.at(dom, "voxel_size"), "voxel_size (mm)");
+      checkRange(sc.voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, r.at(dom, "voxel_size"), "voxel_size (mm)");
       sc.demand_map = d.mask;  // a VascuSynth box map
       sc.supply_coefficients = {1, 0};
     }
@@ -224,9 +234,9 @@ void readCcoDomain(TomlReader& r, const toml::table& dom, const toml::table& tre
   const char* size_key = round ? "radius" : "side";
   r.forbid(dom, "domain", {round ? "side" : "radius"}, std::string("does not size a ") + shape + "; give " + size_key);
   d.size_mm = r.quantity(dom, "domain", size_key, Dimension::Length);
-  checkRange(d.size_mm, 0, true, INFINITY, true, r.at(dom, size_key), std::string(size_key) + " (mm)");
+  checkRange(d.size_mm, Limits::kMinVoxel, false, Limits::kMaxLength, false, r.at(dom, size_key), std::string(size_key) + " (mm)");
   sc.voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
-  checkRange(sc.voxel_mm, 0, true, d.size_mm, true, r.at(dom, "voxel_size"), "voxel_size (mm)");
+  checkRange(sc.voxel_mm, std::max(Limits::kMinVoxel, d.size_mm / Limits::kMaxVoxelsPerAxis), false, d.size_mm, true, r.at(dom, "voxel_size"), "voxel_size (mm)");
   if (const auto* n = tree.get("root_offset")) {
     const bool flat = d.shape == DomainShape::Disc || d.shape == DomainShape::Square;
     d.root_offset_mm = r.point(n, "root_offset (mm from the centre)", flat);
@@ -281,8 +291,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   g.terminals = r.integer(tree, "tree", "terminals");
   sc.terminals_line = r.lineOf(tree.get("terminals"));
   checkRange(double(g.terminals), 1, false, Limits::kMaxTerminals, false, r.at(tree, "terminals"), "terminals");
-  g.closest_neighbours = tree.get("closest_neighbours") ? static_cast<int>(r.integer(tree, "tree", "closest_neighbours")) : (cco ? 20 : 5);
-  checkRange(g.closest_neighbours, 1, false, Limits::kMaxNeighbours, false, r.at(tree, "closest_neighbours"), "closest_neighbours");
+  g.closest_neighbours = tree.get("closest_neighbours") ? r.smallInteger(tree, "tree", "closest_neighbours", 1, std::int64_t(Limits::kMaxNeighbours)) : (cco ? 20 : 5);
 
   const auto& ph = r.table("physics", {"murray_exponent", "cost_radius_exponent", "cost_length_exponent", "viscosity",
                                         "perfusion_pressure", "terminal_pressure", "perfusion_flow"});
@@ -300,14 +309,15 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   p.cost_length_exponent = ph.get("cost_length_exponent") ? r.number(ph, "physics", "cost_length_exponent") : 1.0;
   checkRange(p.cost_length_exponent, 0, false, Limits::kMaxCostExponent, false, r.at(ph, "cost_length_exponent"), "cost_length_exponent");
   p.viscosity = optional("viscosity", Dimension::Viscosity, 3.6e-3);
-  checkRange(p.viscosity, 0, true, INFINITY, true, r.at(ph, "viscosity"), "viscosity (Pa*s)");
+  checkRange(p.viscosity, Limits::kMinViscosity, false, Limits::kMaxViscosity, false, r.at(ph, "viscosity"), "viscosity (Pa*s)");
   p.perfusion_pressure = optional("perfusion_pressure", Dimension::Pressure, 100 * 133.322387415);
   p.terminal_pressure = optional("terminal_pressure", Dimension::Pressure, 60 * 133.322387415);
-  checkRange(p.terminal_pressure, 0, false, INFINITY, true, r.at(ph, "terminal_pressure"), "terminal_pressure (Pa)");
-  if (!(p.perfusion_pressure > p.terminal_pressure))
-    throw InputError(file, r.lineOf(ph.get("perfusion_pressure")), "perfusion_pressure must exceed terminal_pressure");
+  checkRange(p.terminal_pressure, 0, false, Limits::kMaxPressure, false, r.at(ph, "terminal_pressure"), "terminal_pressure (Pa)");
+  checkRange(p.perfusion_pressure, 0, false, Limits::kMaxPressure, false, r.at(ph, "perfusion_pressure"), "perfusion_pressure (Pa)");
+  if (!(p.perfusion_pressure - p.terminal_pressure >= Limits::kMinPressureDrop))
+    throw InputError(file, r.lineOf(ph.get("perfusion_pressure")), "perfusion_pressure must exceed terminal_pressure by at least 0.001 Pa");
   p.perfusion_flow = optional("perfusion_flow", Dimension::Flow, 500 * 1e3 / 60);
-  checkRange(p.perfusion_flow, 0, true, INFINITY, true, r.at(ph, "perfusion_flow"), "perfusion_flow (mm^3/s)");
+  checkRange(p.perfusion_flow, Limits::kMinFlow, false, Limits::kMaxFlow, false, r.at(ph, "perfusion_flow"), "perfusion_flow (mm^3/s)");
   p.total_terminals = g.terminals;
 
   if (cco) {
@@ -316,9 +326,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     c.physics = p;
     c.closest_neighbours = g.closest_neighbours;
     const auto whole = [&](const char* key, int& out, int lo, int hi) {
-      if (!tree.get(key)) return;
-      out = static_cast<int>(r.integer(tree, "tree", key));
-      checkRange(out, lo, false, hi, false, r.at(tree, key), key);
+      if (tree.get(key)) out = r.smallInteger(tree, "tree", key, lo, hi);
     };
     whole("max_closest_neighbours", c.max_neighbours, c.closest_neighbours, Limits::kMaxNeighbours * 64);
     c.max_neighbours = std::max(c.max_neighbours, c.closest_neighbours);
@@ -344,7 +352,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   }
   if (im.get("voxel_size")) {
     ip.voxel_mm = r.quantity(im, "image", "voxel_size", Dimension::Length, sc.voxel_mm);
-    checkRange(ip.voxel_mm, 0, true, INFINITY, true, r.at(im, "voxel_size"), "image voxel_size (mm)");
+    checkRange(ip.voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, r.at(im, "voxel_size"), "image voxel_size (mm)");
   }
   if (const auto* n = im.get("field_of_view")) {
     const auto* arr = n->as_array();
@@ -358,16 +366,18 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
       } catch (const std::invalid_argument& e) {
         throw InputError(file, r.lineOf(n), std::string("field_of_view: ") + e.what());
       }
-      checkRange(f[ax], 0, true, INFINITY, true, r.at(im, "field_of_view"), "field_of_view (mm)");
+      checkRange(f[ax], 0, true, Limits::kMaxLength, false, r.at(im, "field_of_view"), "field_of_view (mm)");
     }
     ip.field_of_view_mm = Vec3(f[0], f[1], f[2]);
   }
   if (im.get("supersampling")) {
-    ip.supersampling = static_cast<int>(r.integer(im, "image", "supersampling"));
-    checkRange(ip.supersampling, 1, false, 16, false, r.at(im, "supersampling"), "supersampling");
+    ip.supersampling = r.smallInteger(im, "image", "supersampling", 1, 16);
   }
   if (im.get("background")) ip.background = r.number(im, "image", "background");
   if (im.get("vessel")) ip.vessel = r.number(im, "image", "vessel");
+  for (const char* key : {"background", "vessel"})
+    if (im.get(key)) checkRange(std::string(key) == "vessel" ? ip.vessel : ip.background, -Limits::kMaxIntensity, false,
+                                Limits::kMaxIntensity, false, r.at(im, key), key);
   if (im.get("dtype")) {
     ip.dtype = r.string(im, "image", "dtype");
     if (ip.dtype != "uint8" && ip.dtype != "uint16" && ip.dtype != "int16" && ip.dtype != "float32")

@@ -83,7 +83,8 @@ Scenario readVascuSynthParameters(const std::filesystem::path& path, const ReadO
   }
 
   const double voxel = number("VOXEL_WIDTH");
-  checkRange(voxel, 0, true, INFINITY, true, where("VOXEL_WIDTH"), "VOXEL_WIDTH");
+  checkRange(voxel, Limits::kMinVoxel / u.mm_per_length, false, Limits::kMaxVoxel / u.mm_per_length, false, where("VOXEL_WIDTH"),
+             "VOXEL_WIDTH (" + u.length + ")");
   sc.voxel_mm = voxel * u.mm_per_length;
 
   const auto pp = splitWords(entries.at("PERF_POINT").value);
@@ -95,19 +96,23 @@ Scenario readVascuSynthParameters(const std::filesystem::path& path, const ReadO
   sc.root_line = entries.at("PERF_POINT").line;
 
   const double p_perf = number("PERF_PRESSURE"), p_term = number("TERM_PRESSURE");
-  checkRange(p_term, 0, false, INFINITY, true, where("TERM_PRESSURE"), "TERM_PRESSURE");
-  if (!(p_perf > p_term))
+  const double pa = u.pa_per_pressure();
+  checkRange(p_term, 0, false, Limits::kMaxPressure / pa, false, where("TERM_PRESSURE"), "TERM_PRESSURE (" + u.pressureName() + ")");
+  checkRange(p_perf, 0, false, Limits::kMaxPressure / pa, false, where("PERF_PRESSURE"), "PERF_PRESSURE (" + u.pressureName() + ")");
+  if (!((p_perf - p_term) * pa >= Limits::kMinPressureDrop))
     throw InputError(file, entries.at("PERF_PRESSURE").line, "PERF_PRESSURE = " + show(p_perf) +
                                                                  " must exceed TERM_PRESSURE = " + show(p_term));
   const double flow = number("PERF_FLOW"), rho = number("RHO");
-  checkRange(flow, 0, true, INFINITY, true, where("PERF_FLOW"), "PERF_FLOW");
-  checkRange(rho, 0, true, INFINITY, true, where("RHO"), "RHO");
+  checkRange(flow, Limits::kMinFlow / u.mm3s_per_flow(), false, Limits::kMaxFlow / u.mm3s_per_flow(), false, where("PERF_FLOW"),
+             "PERF_FLOW (" + u.flowName() + ")");
+  checkRange(rho, Limits::kMinViscosity / u.pas_per_viscosity(), false, Limits::kMaxViscosity / u.pas_per_viscosity(), false,
+             where("RHO"), "RHO (" + u.viscosityName() + ")");
   const double gamma = number("GAMMA"), lambda = number("LAMBDA"), mu = number("MU");
   checkRange(gamma, Limits::kMinMurray, true, Limits::kMaxMurray, false, where("GAMMA"), "GAMMA");
   checkRange(lambda, 0, false, Limits::kMaxCostExponent, false, where("LAMBDA"), "LAMBDA");
   checkRange(mu, 0, false, Limits::kMaxCostExponent, false, where("MU"), "MU");
   const double min_dist = number("MIN_DISTANCE");
-  checkRange(min_dist, 0, false, INFINITY, true, where("MIN_DISTANCE"), "MIN_DISTANCE");
+  checkRange(min_dist, 0, false, Limits::kMaxVoxelsPerAxis, false, where("MIN_DISTANCE"), "MIN_DISTANCE (map voxels)");
   const auto n = integer("NUM_NODES");
   checkRange(double(n), 1, false, Limits::kMaxTerminals, false, where("NUM_NODES"), "NUM_NODES");
   const auto k = integer("CLOSEST_NEIGHBOURS");

@@ -8,10 +8,15 @@
 namespace angiosynth {
 
 std::uint64_t degradedImageBytes(const Profile& p, const VolumeGrid& g) {
-  bool warps = false;
-  for (const auto& e : p.effects) warps |= e.type->moves_geometry;
-  // Float image + a working copy (blur, warp) + the typed image; a warp adds its fraction and labels.
-  const std::uint64_t per_voxel = 4 + 4 + 4 + (warps ? 4 + 1 + 1 + 4 + 4 : 0);
+  bool warps = false, fields = false;
+  for (const auto& e : p.effects) {
+    warps |= e.type->moves_geometry;
+    fields |= std::string(e.type->name) == "bias" || std::string(e.type->name) == "texture";
+  }
+  // Float image + a working copy (blur, warp) + the typed image; a warp adds its fraction and
+  // labels. B-spline lattices are at least a voxel apart, so a field holds at most about one
+  // coefficient per voxel plus its plane buffer (8 bytes); a warp keeps three.
+  const std::uint64_t per_voxel = 4 + 4 + 4 + (warps ? 4 + 1 + 1 + 4 + 4 + 24 : 0) + (fields ? 16 : 0);
   return per_voxel * static_cast<std::uint64_t>(g.voxelCount());
 }
 

@@ -158,6 +158,15 @@ void checkFeasibility(const Scenario& sc, const PreparedSample& ps) {
                            std::to_string(std::int64_t(capacity)) +
                            " fit (sphere packing); use fewer terminals, a smaller minimum distance, or a larger domain");
   }
+  if (cco) {
+    // A terminal per voxel of the domain at most: finer than its resolution the mask says nothing.
+    std::int64_t inside = 0;
+    for (float v : m.demand) inside += v > 0;
+    if (n > inside)
+      throw InputError(sc.parameter_file, sc.terminals_line,
+                       std::to_string(n) + " terminals exceed the " + std::to_string(inside) +
+                           " voxels of the domain; use fewer terminals or a finer voxel_size (mask)");
+  }
   const RadiusEstimate e = estimateRadii(cco ? sc.cco.physics : g.physics, n, measure, dim);
   // Terminal vessels wider than a quarter of the spacing between terminals leave no room to
   // branch without collisions: measured on the shipped examples, growth slows 25-fold at 0.42 of
@@ -195,7 +204,8 @@ PreparedSample prepareSample(const SampleRequest& req) {
         throw InputError(profiles[i].file, 0, "two profiles are named '" + profiles[i].name +
                                                   "' (roles image_<name> must differ); rename one file");
   if (ps.volumes) {
-    vr.grid = req.vascusynth_layout ? vascusynthGrid(map, req.output_voxel_mm) : imageGrid(map, ip);
+    vr.grid = req.vascusynth_layout ? vascusynthGrid(map, req.output_voxel_mm, "VOXEL_WIDTH", 0)
+                                     : imageGrid(map, ip, sc.parameter_file, sc.image_line);
     vr.image = ip;
     vr.memory_limit = req.memory_limit;
     vr.parameter_file = sc.parameter_file;

@@ -18,11 +18,11 @@ template <class T>
 void convert(Volume<T>& out, const Volume<float>& src, double offset, double scale) {
   out = Volume<T>(src.grid);
   constexpr bool integral = std::is_integral_v<T>;
-  const double lo = integral ? double(std::numeric_limits<T>::lowest()) : -INFINITY;
-  const double hi = integral ? double(std::numeric_limits<T>::max()) : INFINITY;
+  // Saturating: a value beyond the type (or NaN, as 0) never reaches an undefined conversion.
+  const double lo = double(std::numeric_limits<T>::lowest()), hi = double(std::numeric_limits<T>::max());
   forEachVoxel(static_cast<std::int64_t>(src.data.size()), [&](std::int64_t v) {
     const double x = offset + scale * src.data[v];
-    out.data[v] = static_cast<T>(integral ? std::clamp(std::round(x), lo, hi) : x);
+    out.data[v] = std::isnan(x) ? T(0) : static_cast<T>(std::clamp(integral ? std::round(x) : x, lo, hi));
   });
 }
 

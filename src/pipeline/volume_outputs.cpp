@@ -12,6 +12,7 @@
 #include "io/volume_writers.hpp"
 #include "pipeline/degraded_outputs.hpp"
 #include "pipeline/volume_files.hpp"
+#include "io/param_checks.hpp"
 #include "raster/ground_truth.hpp"
 
 namespace angiosynth {
@@ -21,23 +22,35 @@ using Json = nlohmann::ordered_json;
 
 }  // namespace
 
-VolumeGrid imageGrid(const DemandMap& map, const ImageParameters& p) {
+namespace {
+
+// Voxels along one axis, refused past 10^5 before any integer conversion.
+std::int32_t axisVoxels(double n, const std::string& file, int line) {
+  if (!(n <= 1e5))
+    throw InputError(file, line, "the image would be " + show(n) + " voxels along one axis; allowed: at most 100000 "
+                                 "(raise [image] voxel_size or shrink field_of_view)");
+  return std::max<std::int32_t>(1, static_cast<std::int32_t>(n));
+}
+
+}  // namespace
+
+VolumeGrid imageGrid(const DemandMap& map, const ImageParameters& p, const std::string& file, int line) {
   VolumeGrid g;
   const double h = p.voxel_mm > 0 ? p.voxel_mm : map.voxel_mm;
   const Vec3 fov = p.field_of_view_mm.x > 0 ? p.field_of_view_mm : map.extentMm();
   for (int ax = 0; ax < 3; ++ax) {
     // Whole voxels covering the field of view (a hair of rounding does not add a voxel).
-    g.dims[ax] = std::max(1, static_cast<int>(std::ceil(fov[ax] / h - 1e-9)));
+    g.dims[ax] = axisVoxels(std::ceil(fov[ax] / h - 1e-9), file, line);
   }
   g.spacing_mm = Vec3(h, h, h);
   g.origin_mm = Vec3(h / 2, h / 2, h / 2);
   return g;
 }
 
-VolumeGrid vascusynthGrid(const DemandMap& map, double output_voxel_mm) {
+VolumeGrid vascusynthGrid(const DemandMap& map, double output_voxel_mm, const std::string& file, int line) {
   VolumeGrid g;
   for (int ax = 0; ax < 3; ++ax)
-    g.dims[ax] = static_cast<int>(std::floor(map.dims[ax] * map.voxel_mm / output_voxel_mm + 1e-9)) + 1;
+    g.dims[ax] = axisVoxels(std::floor(map.dims[ax] * map.voxel_mm / output_voxel_mm + 1e-9) + 1, file, line);
   g.spacing_mm = Vec3(output_voxel_mm, output_voxel_mm, output_voxel_mm);
   g.origin_mm = Vec3(0, 0, 0);
   return g;
@@ -70,6 +83,12 @@ void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std:
   const ImageParameters& ip = req.image;
   checkVolumeMemory(req);
   if (std::find(ip.formats.begin(), ip.formats.end(), "vdb") != ip.formats.end()) {
+    const double pairs = brickPairBound(tree, g);  // 12 bytes each while binning
+    if (pairs * 12 > double(req.memory_limit))
+      throw InputError(req.parameter_file, req.image_line,
+                       "the sparse volume's bricks need about " + formatBytes(std::uint64_t(std::min(pairs * 12, 1e18))) +
+                           " to sort, more than the limit of " + formatBytes(req.memory_limit) +
+                           "; raise [image] voxel_size or --memory-limit");
     const BrickBins bins = binSegments(tree, g);
     const auto need = sparseRasterBytes(bins);
     if (need > req.memory_limit)

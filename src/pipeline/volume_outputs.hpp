@@ -16,10 +16,10 @@ namespace angiosynth {
 
 // The image grid over the demand map: voxel size and field of view from the parameters, by
 // default the map's own; voxel centres at (i + ½)·voxel from the map's corner.
-VolumeGrid imageGrid(const DemandMap& map, const ImageParameters& p);
+VolumeGrid imageGrid(const DemandMap& map, const ImageParameters& p, const std::string& file = "", int line = 0);
 // VascuSynth's output grid: floor(map size × VOXEL_WIDTH / OUTPUT_VOXEL_WIDTH) + 1 samples per
 // axis at i·OUTPUT_VOXEL_WIDTH (map-voxel corners), so a 100³ map at 0.04/0.04 gives 101³.
-VolumeGrid vascusynthGrid(const DemandMap& map, double output_voxel_mm);
+VolumeGrid vascusynthGrid(const DemandMap& map, double output_voxel_mm, const std::string& file = "", int line = 0);
 
 struct VolumeRequest {
   VolumeGrid grid;

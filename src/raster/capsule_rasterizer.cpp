@@ -41,6 +41,20 @@ Capsule capsuleOf(const VascularTree& t, std::int32_t s) {
 
 }  // namespace
 
+double brickPairBound(const VascularTree& tree, const VolumeGrid& g) {
+  double total = 0;
+  for (std::int32_t s = 1; s < tree.nodeCount(); ++s) {
+    const Vec3 a = tree.position[tree.parent[s]], b = tree.position[s];
+    double n = 1;
+    for (int ax = 0; ax < 3; ++ax) {
+      const double extent = (std::abs(a[ax] - b[ax]) + 2 * tree.radius[s]) / g.spacing_mm[ax] + 2;
+      n *= std::min(extent / kBrick + 1, (g.dims[ax] + kBrick - 1.0) / kBrick);
+    }
+    total += n;
+  }
+  return total;
+}
+
 BrickBins binSegments(const VascularTree& tree, const VolumeGrid& g) {
   BrickBins bins;
   for (int ax = 0; ax < 3; ++ax) bins.bricks[ax] = (g.dims[ax] + kBrick - 1) / kBrick;

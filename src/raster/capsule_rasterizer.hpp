@@ -26,6 +26,9 @@ struct BrickBins {
   std::vector<std::int64_t> brick_ids;                 // non-empty bricks, ascending
   std::vector<std::vector<std::int32_t>> segments;     // per non-empty brick, ascending ids
 };
+// Upper bound on the (brick, segment) pairs binSegments collects: the bricks of every capsule's
+// bounding box. Cheap (no allocation), so the sparse path can be refused before binning.
+double brickPairBound(const VascularTree& tree, const VolumeGrid& g);
 BrickBins binSegments(const VascularTree& tree, const VolumeGrid& grid);
 
 // Calls visit(brick_id, fraction[512], instance[512]) for every non-empty brick, in parallel.

@@ -1,0 +1,31 @@
+#pragma once
+// A small sample (24 terminals, 16^3 voxels) through the whole pipeline with a fuzzed profile.
+#include "fuzz_support.hpp"
+#include "io/scenario.hpp"
+#include "pipeline/generate_sample.hpp"
+
+namespace angiosynth::fuzz {
+
+inline void degradeSmallSample(const Profile& profile) {
+  static const Scenario sc = [] {
+    const auto map = scratchDir() / "map16.txt";
+    std::ofstream(map) << "16 16 16\n0 0 0 16 16 16\n1\n";
+    const auto params = scratchDir() / "small.toml";
+    std::ofstream(params) << "seed = 3\n[domain]\ndemand_map = \"" << map.string()
+                          << "\"\nvoxel_size = \"1 mm\"\n[tree]\nterminals = 24\nroot_voxel = [0, 8, 8]\n"
+                             "[physics]\nviscosity = \"3.6 mPa*s\"\nperfusion_pressure = \"13300 Pa\"\n"
+                             "terminal_pressure = \"8300 Pa\"\nperfusion_flow = \"100 mm3/s\"\n"
+                             "[image]\nformats = [\"nifti\"]\ngraph_formats = []\n";
+    return readTomlParameters(params);
+  }();
+  const auto out = scratchDir() / "out";
+  std::filesystem::remove_all(out);
+  std::filesystem::create_directories(out);
+  SampleRequest req;
+  req.scenario = &sc;
+  req.memory_limit = kMemoryLimit;
+  req.profiles = std::vector<Profile>{profile};
+  generateSample(req, out);
+}
+
+}  // namespace angiosynth::fuzz

@@ -1,0 +1,148 @@
+// Every input kind refuses values that used to overflow, hang or allocate without an estimate
+// (issue 17): exit 2, `file:line: what is wrong, what is allowed`, and no output written.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <vector>
+
+#include "cli_run.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct BadCase {
+  const char* name;
+  const char* file;     // written into the test directory, from the base text of `base`
+  const char* base;     // "toml", "vs" (VascuSynth parameters), "spec" (dataset spec), "" (text below as is)
+  const char* from;     // replaced in the base text ("" : append `to`)
+  const char* to;
+  const char* args;     // the command line; its output goes to out/
+  const char* expect;   // a piece of the first line of stderr, file:line included where there is one
+};
+
+const BadCase kCases[] = {
+    {"root_nan", "p.toml", "toml", "root_voxel = [0, 50, 50]", "root_voxel = [nan, 50, 50]", "generate p.toml --out out",
+     "p.toml:14: root_voxel must hold finite numbers only"},
+    {"background_nan", "p.toml", "toml", "[output]", "[image]\nbackground = nan\n[output]", "generate p.toml --out out",
+     "p.toml:31: background must be a finite number"},
+    {"supply_cutoff_huge", "p.toml", "toml", "[0.65, 0.34, 0.01, 7]", "[0.65, 0.34, 0.01, 1e300]",
+     "generate p.toml --out out", "p.toml:8: supply_coefficients: the last value is the cut-off radius (map voxels); allowed: 0 to 1e6"},
+    {"fov_huge", "p.toml", "toml", "[output]", "[image]\nfield_of_view = [\"1e300 mm\", \"1 mm\", \"1 mm\"]\n[output]",
+     "generate p.toml --out out", "p.toml:31: field_of_view (mm) = 1e+300 is out of range"},
+    {"fov_too_many_voxels", "p.toml", "toml", "[output]", "[image]\nvoxel_size = \"0.0001 mm\"\nformats = [\"vdb\"]\n[output]",
+     "generate p.toml --out out --no-profiles", "p.toml:30: the image would be 400000 voxels along one axis"},
+    {"closest_neighbours_wraps", "p.toml", "toml", "closest_neighbours = 5", "closest_neighbours = 4294967301",
+     "generate p.toml --out out", "p.toml:16: closest_neighbours = 4294967301 is out of range; allowed: [1, 100]"},
+    {"flow_1000x", "p.toml", "toml", "8330 mm3/s", "8330000 mm3/s", "generate p.toml --out out",
+     "p.toml:13: vessels too thick for the domain"},
+    {"terminals_5M_on_100cubed", "p.toml", "toml", "terminals = 60", "terminals = 5000000", "generate p.toml --out out",
+     "p.toml:13: 5000000 terminals cannot lie 0.4 mm apart"},
+    {"voxel_width_tiny", "p.txt", "vs", "VOXEL_WIDTH: 0.04", "VOXEL_WIDTH: 1e-12", "generate p.txt --out out",
+     "p.txt:14: VOXEL_WIDTH (cm) = 1e-12 is out of range"},
+    {"rho_huge", "p.txt", "vs", "RHO: 0.036", "RHO: 1e300", "generate p.txt --out out", "p.txt:8: RHO (g/(cm*s)) = 1e+300 is out of range"},
+    {"flow_huge", "p.txt", "vs", "PERF_FLOW: 8.33", "PERF_FLOW: 1e300", "generate p.txt --out out",
+     "p.txt:7: PERF_FLOW (cm^3/s) = 1e+300 is out of range"},
+    {"min_distance_huge", "p.txt", "vs", "MIN_DISTANCE: 1", "MIN_DISTANCE: 1e300", "generate p.txt --out out",
+     "p.txt:12: MIN_DISTANCE (map voxels) = 1e+300 is out of range"},
+    {"profile_intensity_huge", "prof.toml", "", "", "background = 1e30\n[[effect]]\ntype = \"gaussian\"\nsigma = 1\n",
+     "generate p.toml --out out --profile prof.toml", "prof.toml:1: background = 1e+30 is out of range"},
+    {"bias_scale_tiny", "prof.toml", "", "", "[[effect]]\ntype = \"bias\"\namplitude = 0.2\nscale = \"1e-9 mm\"\n",
+     "generate p.toml --out out --profile prof.toml", "prof.toml:4: scale = 1e-09 mm is finer than 1 voxel"},
+    {"blur_sigma_huge", "prof.toml", "", "", "[[effect]]\ntype = \"blur\"\nsigma = \"1e6 mm\"\n",
+     "generate p.toml --out out --profile prof.toml", "prof.toml:3: sigma = 1e+06 mm exceeds 1 fov"},
+    {"shadows_million", "prof.toml", "", "", "[[effect]]\ntype = \"shadow\"\ncount = 1000000\n",
+     "generate p.toml --out out --profile prof.toml", "prof.toml:3: count = 1e+06 is out of range; allowed: [0, 1000]"},
+    {"spec_integer_int64_max", "s.toml", "spec", "terminals = {integer = [60, 160]}",
+     "terminals = {integer = [9223372036854775807, 9223372036854775807]}", "dataset s.toml --out out",
+     "s.toml:15: integer takes whole numbers [a, b] with a <= b, each within ±2^53"},
+    {"spec_misspelt_distribution", "s.toml", "spec", "terminals = {integer = [60, 160]}", "terminals = {unifrom = [60, 160]}",
+     "dataset s.toml --out out", "s.toml:15: unknown key 'unifrom' in a distribution; allowed: uniform"},
+    {"spec_draw_out_of_range_names_its_line", "s.toml", "spec", "terminals = {integer = [60, 160]}",
+     "terminals = {uniform = [60, 160]}", "dataset s.toml --out out", "s.toml:15: terminals must be a whole number"},
+    {"dataset_index_int64_max", "s.toml", "spec", "", "", "dataset s.toml --out out --index 9223372036854775807",
+     "--index 9223372036854775807 is beyond the dataset's 6 samples"},
+    {"params_is_a_directory", "d/x", "", "", "", "generate d --out out", "d: is a directory; give a parameter file"},
+    {"usage_error", "x", "", "", "", "generate --out out", "PARAMS is required"},
+};
+
+class BadInput : public ::testing::TestWithParam<BadCase> {
+ protected:
+  void SetUp() override { dir_ = freshTestDir("angiosynth_bad_"); }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+  const fs::path src_ = ANGIOSYNTH_SOURCE_DIR;
+};
+
+std::string baseText(const std::string& kind, const fs::path& src) {
+  std::string t;
+  if (kind == "toml") {
+    t = slurp(src / "examples/vascusynth_like.toml");
+    t.replace(t.find("../demand_maps"), 14, (src / "demand_maps").string());
+    t.replace(t.find("terminals = 1000"), 16, "terminals = 60");
+  } else if (kind == "vs") {
+    t = slurp(src / "examples/vascusynth/param_rods_1000.txt");
+    for (auto pos = t.find("../../demand_maps"); pos != std::string::npos; pos = t.find("../../demand_maps"))
+      t.replace(pos, 17, (src / "demand_maps").string());
+  } else if (kind == "spec") {
+    t = slurp(src / "tests/data/dataset_tiny.toml");
+    t.replace(t.find("../../demand_maps"), 17, (src / "demand_maps").string());
+  }
+  return t;
+}
+
+TEST_P(BadInput, ExitsTwoNamingFileAndLineAndWritesNothing) {
+  const BadCase& c = GetParam();
+  // The plain parameter file every profile case uses.
+  std::string p = baseText("toml", src_);
+  p.replace(p.find("profiles = [\"vascusynth\", \"cta\"]"), std::string("profiles = [\"vascusynth\", \"cta\"]").size(), "profiles = []");
+  std::ofstream(dir_ / "p.toml") << p;
+  std::string text = baseText(c.base, src_);
+  if (std::string(c.from).empty()) text += c.to;
+  else {
+    ASSERT_NE(text.find(c.from), std::string::npos) << c.from;
+    text.replace(text.find(c.from), std::string(c.from).size(), c.to);
+  }
+  fs::create_directories((dir_ / c.file).parent_path());
+  std::ofstream(dir_ / c.file) << text;
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto r = run(c.args, dir_);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find(c.expect), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out")) << c.name;
+  for (const auto& e : fs::directory_iterator(dir_)) EXPECT_EQ(e.path().filename().string().find(".out.tmp"), std::string::npos);
+  RecordProperty("seconds", std::to_string(seconds));
+}
+
+INSTANTIATE_TEST_SUITE_P(Inputs, BadInput, ::testing::ValuesIn(kCases),
+                         [](const ::testing::TestParamInfo<BadCase>& i) { return std::string(i.param.name); });
+
+TEST(BadInputFiles, NiftiMaskWithMicroscopicVoxelsAndDamagedDatasetsAreInputErrors) {
+  const fs::path dir = freshTestDir("angiosynth_badnii_");
+  const fs::path src = ANGIOSYNTH_SOURCE_DIR;
+  // An 8^3 ball with pixdim 1e-9 mm, written by nibabel.
+  const std::string py = "/usr/bin/python3 -c \"import numpy as np, nibabel as nib; i,j,k = np.mgrid[:8,:8,:8]; "
+                         "m = (((i-3.5)**2+(j-3.5)**2+(k-3.5)**2) < 12).astype(np.uint8); "
+                         "nib.save(nib.Nifti1Image(m, np.diag([1e-9, 1e-9, 1e-9, 1])), '" + (dir / "m.nii").string() + "')\"";
+  ASSERT_EQ(std::system(py.c_str()), 0);
+  std::ofstream(dir / "p.toml") << "[domain]\nshape = \"mask\"\nmask = \"m.nii\"\n[tree]\nmethod = \"cco\"\nterminals = 10\n"
+                                   "root_voxel = [4, 4, 4]\n";
+  auto r = run("generate p.toml --out out", dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("m.nii: voxel size 1e-09 mm (pixdim) is out of range"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  // A dataset directory without imagesTr/: a problem verify reports, not an internal error.
+  std::string t = slurp(src / "tests/data/dataset_tiny.toml");
+  t.replace(t.find("../../demand_maps"), 17, (src / "demand_maps").string());
+  std::ofstream(dir / "s.toml") << t;
+  ASSERT_EQ(run("dataset s.toml --out raw --quiet", dir).code, 0);
+  fs::remove_all(dir / "raw/Dataset902_VesselTiny/imagesTr");
+  r = run("dataset verify raw/Dataset902_VesselTiny", dir);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("missing directory imagesTr/"), std::string::npos) << r.err;
+  fs::remove_all(dir);
+}
+
+}  // namespace
