@@ -4,7 +4,8 @@ set -euo pipefail
 pkgs=(build-essential cmake pkg-config ccache
       libtbb-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libtinyxml2-dev
       libgtest-dev libbenchmark-dev zlib1g-dev libnifti2-dev libopenimageio-dev python3-nibabel python3-networkx
-      libopenvdb-dev libboost-iostreams-dev libssl-dev libceres-dev)
+      libopenvdb-dev libboost-iostreams-dev libssl-dev libceres-dev
+      clang libclang-rt-14-dev)  # the sanitizer build and libFuzzer (scripts/sanitize.sh)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
