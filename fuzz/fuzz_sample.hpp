@@ -1,5 +1,6 @@
 #pragma once
-// A small sample (24 terminals, 16^3 voxels) through the whole pipeline with a fuzzed profile.
+// A small sample (24 terminals, 16^3 voxels) through the whole pipeline with a fuzzed profile;
+// no volume files are written (formats = []), the degradation itself runs in full.
 #include "fuzz_support.hpp"
 #include "io/scenario.hpp"
 #include "pipeline/generate_sample.hpp"
@@ -15,7 +16,7 @@ inline void degradeSmallSample(const Profile& profile) {
                           << "\"\nvoxel_size = \"1 mm\"\n[tree]\nterminals = 24\nroot_voxel = [0, 8, 8]\n"
                              "[physics]\nviscosity = \"3.6 mPa*s\"\nperfusion_pressure = \"13300 Pa\"\n"
                              "terminal_pressure = \"8300 Pa\"\nperfusion_flow = \"100 mm3/s\"\n"
-                             "[image]\nformats = [\"nifti\"]\ngraph_formats = []\n";
+                             "[image]\nformats = []\ngraph_formats = []\n";
     return readTomlParameters(params);
   }();
   const auto out = scratchDir() / "out";

@@ -324,6 +324,26 @@ class CcoGrower {
     return false;
   }
 
+  // A segment that the solved radii push out of the domain (its subtree too large to regrow):
+  // move its distal node, else its proximal one, up the depth gradient by 0.5–3 r, whichever
+  // first fits. Seen only where the final solve thickened a trunk next to a thin mask wall.
+  bool pushInside(std::int32_t s) {
+    auto& T = tree_;
+    const double h = dom_.frame().voxel_mm;
+    for (const std::int32_t v : {s, T.parent[s]}) {
+      if (v <= 0) continue;
+      const Vec3 p = T.position[v];
+      Vec3 g(dom_.depth(p + Vec3(h, 0, 0)) - dom_.depth(p - Vec3(h, 0, 0)),
+             dom_.depth(p + Vec3(0, h, 0)) - dom_.depth(p - Vec3(0, h, 0)),
+             dom_.dimension() == 2 ? 0.0 : dom_.depth(p + Vec3(0, 0, h)) - dom_.depth(p - Vec3(0, 0, h)));
+      if (!(norm(g) > 0)) continue;
+      g = g / norm(g);
+      for (double f : {0.5, 1.0, 2.0, 3.0})
+        if (tryMove(v, p + g * (f * T.radius[s]))) return true;
+    }
+    return false;
+  }
+
   // Segments of the solved tree that break a constraint: intersecting pairs, length <= 2r, or
   // leaving the domain. Short trunks are lengthened in place; for the rest, the segment whose
   // subtree removal costs fewest terminals is returned.
@@ -348,7 +368,8 @@ class CcoGrower {
       }
       if (!dom_.capsuleInside(T.position[T.parent[s]], T.position[s], T.radius[s], startsAtRoot(s))) {
         ++report_.outside_segments;
-        out.push_back(s);
+        if (T.terminals[s] > kMaxRepairShare * double(opt_.terminals) && pushInside(s)) ++report_.moved_nodes;
+        else out.push_back(s);
       }
     }
     std::sort(out.begin(), out.end());
