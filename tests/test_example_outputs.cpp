@@ -22,7 +22,7 @@ void normalise(Json& j) {
   if (j.is_object()) {
     for (const char* k : {"command_line", "timing_seconds", "parameter_file", "spec_file"}) j.erase(k);
     for (auto& [k, v] : j.items()) {
-      if (v.is_string() && (k == "demand_map" || k == "supply_map" || k == "mask"))
+      if (v.is_string() && (k == "demand_map" || k == "supply_map" || k == "mask" || k == "source"))
         v = fs::path(v.get<std::string>()).filename().string();
       else normalise(v);
     }
