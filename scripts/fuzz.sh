@@ -4,6 +4,7 @@
 # other than a file:line input error), time-out (10 s per case) or allocation over 2 GiB stops it
 # with the case saved in build-san/fuzz-findings/.
 #   bash scripts/fuzz.sh [SECONDS] [TARGET...]      e.g. bash scripts/fuzz.sh 3600 fuzz_profile
+#   FUZZ_RUNS=100000 bash scripts/fuzz.sh 7200       stop each target after 100000 cases (SECONDS caps it)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-20}
@@ -37,13 +38,15 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/sani
 status=0
 for t in "${targets[@]}"; do
   work=$(mktemp -d)
-  (cd "$work" && "$root/build-san/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
+  run_limit=()
+  [ -n "${FUZZ_RUNS:-}" ] && run_limit=(-runs="$FUZZ_RUNS")
+  (cd "$work" && "$root/build-san/$t" -max_total_time="$seconds" "${run_limit[@]}" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
       -artifact_prefix="$root/$findings/$t-" -print_final_stats=1 "$root/$corpus/$t" >"$work/log" 2>&1) || status=1
   runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$work/log" | grep -o '[0-9]*$' || echo 0)
   if [ $status -ne 0 ]; then
     echo "$t: FAILED after $runs cases"; tail -n 40 "$work/log"; rm -rf "$work"; exit 1
   fi
-  echo "$t: $runs cases, 0 crashes, 0 sanitizer reports, 0 internal errors, 0 time-outs"
+  echo "$t: $runs cases in $(grep -o 'Done [0-9]* runs in [0-9]* second' "$work/log" | grep -o 'in [0-9]* second' | grep -o '[0-9]*' || echo "$seconds") s, 0 crashes, 0 sanitizer reports, 0 internal errors, 0 time-outs"
   rm -rf "$work"
 done
 echo "fuzz: ${#targets[@]} passed, 0 failed"
