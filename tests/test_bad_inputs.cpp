@@ -64,6 +64,10 @@ const BadCase kCases[] = {
      "--index 9223372036854775807 is beyond the dataset's 6 samples"},
     {"params_is_a_directory", "d/x", "", "", "", "generate d --out out", "d: is a directory; give a parameter file"},
     {"usage_error", "x", "", "", "", "generate --out out", "PARAMS is required"},
+    {"cli_memory_limit_nan", "x", "", "", "", "generate p.toml --out out --memory-limit nan",
+     "--memory-limit: 'nan' is not a finite number in [0, 1e+06]"},
+    {"cli_seed_negative", "x", "", "", "", "generate p.toml --out out --seed -1", "--seed: Value -1 not in range 0 to 9223372036854775807"},
+    {"cli_voxel_width_nan", "x", "", "", "", "vascusynth list.txt names.txt nan", "VOXEL_WIDTH: 'nan' is not a finite number"},
 };
 
 class BadInput : public ::testing::TestWithParam<BadCase> {

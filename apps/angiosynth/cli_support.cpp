@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <random>
 
@@ -15,7 +16,7 @@ void addCommonOptions(CLI::App& cmd, CommonOptions& o) {
   cmd.add_option("--threads", o.threads, "worker threads (0 = all cores); outputs do not depend on it")
       ->check(CLI::Range(0, 1024));
   cmd.add_option("--memory-limit", o.memory_limit_gib, "refuse maps needing more than this many GiB (default: 75% of RAM)")
-      ->check(CLI::Range(0.0, 1e6));
+      ->check(finiteIn(0.0, 1e6));
   cmd.add_option("--vascusynth-unit", o.vascusynth_unit,
                  "length unit of VOXEL_WIDTH in VascuSynth parameter files; flows and pressures follow the "
                  "coherent (length, g, s) system, i.e. CGS for cm")
@@ -49,6 +50,23 @@ ProgressFn progressPrinter(const CommonOptions& o, const std::string& label) {
                  static_cast<long long>(total), s, done >= total ? "\n" : "");
     std::fflush(stderr);
   };
+}
+
+CLI::Validator finiteIn(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& text) -> std::string {
+        double v = 0;
+        std::size_t used = 0;
+        try {
+          v = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used != text.size() || !std::isfinite(v) || v < lo || v > hi)
+          return "'" + text + "' is not a finite number in [" + CLI::detail::to_string(lo) + ", " + CLI::detail::to_string(hi) + "]";
+        return {};
+      },
+      "FINITE in [" + CLI::detail::to_string(lo) + ", " + CLI::detail::to_string(hi) + "]");
 }
 
 std::string commandLine(int argc, char** argv) {

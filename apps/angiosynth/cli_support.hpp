@@ -27,6 +27,8 @@ std::uint64_t freshSeed();
 // Progress line on stderr when it is a terminal (and not --quiet); empty function otherwise.
 ProgressFn progressPrinter(const CommonOptions& o, const std::string& label);
 std::string commandLine(int argc, char** argv);
+// Command-line numbers: finite and within [lo, hi] (CLI11's Range lets NaN through).
+CLI::Validator finiteIn(double lo, double hi);
 
 
 }  // namespace angiosynth::cli

@@ -12,7 +12,8 @@ CLI::App* addGenerate(CLI::App& app, GenerateArgs& a) {
   auto* c = app.add_subcommand("generate", "grow one vascular tree from a parameter file (.toml, or VascuSynth's format)");
   c->add_option("PARAMS", a.params, "parameter file: .toml (native, with units) or a VascuSynth parameter file")->required();
   c->add_option("--out", a.out, "output directory (default: out/<PARAMS name>)");
-  c->add_option("--seed", a.seed, "random seed (default: the file's seed, else fresh and recorded in sample.json)");
+  c->add_option("--seed", a.seed, "random seed (default: the file's seed, else fresh and recorded in sample.json)")
+      ->check(CLI::Range(std::uint64_t(0), std::uint64_t(INT64_MAX)));  // as TOML seeds: int64 >= 0
   c->add_option("--gxl-dialect", a.gxl_dialect, "gxl: valid GXL 1.0 (default); vascusynth: VascuSynth 2011's dialect")
       ->check(CLI::IsMember({"gxl", "vascusynth"}));
   c->add_option("--format", a.formats, "volume formats, overriding [image] formats: nifti, nrrd, tiff, png (MIPs), vdb (sparse)")

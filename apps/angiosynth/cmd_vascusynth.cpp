@@ -5,6 +5,7 @@
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "io/output_guard.hpp"
+#include "io/param_checks.hpp"
 #include "io/staged_directory.hpp"
 #include "io/text_lines.hpp"
 #include "pipeline/generate_sample.hpp"
@@ -18,7 +19,7 @@ CLI::App* addVascuSynth(CLI::App& app, VascuSynthArgs& a) {
   c->add_option("NAME_LIST", a.name_list, "file listing one output directory per line")->required();
   c->add_option("VOXEL_WIDTH", a.output_voxel_width, "output image voxel width, in VOXEL_WIDTH's unit")
       ->required()
-      ->check(CLI::PositiveNumber);
+      ->check(finiteIn(1e-12, 1e12));
   c->add_option("NOISE_FILE", a.noise_files, "VascuSynth noise files (GAUSSIAN:, UNIFORM:, SALTPEPPER:, SHADOW: lines); file i gives NAME/noise_image_<i>/");
   addCommonOptions(*c, a.common);
   return c;
@@ -69,6 +70,8 @@ int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line) {
     req.profiles = noise;
     req.vascusynth_noise_layout = true;
     req.output_voxel_mm = a.output_voxel_width * sc.input_units.mm_per_length;
+    checkRange(req.output_voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, Where{"VOXEL_WIDTH", 0},
+               "VOXEL_WIDTH (mm)");
     req.extra["output_voxel_width"] = {{"value", a.output_voxel_width * sc.input_units.mm_per_length}, {"unit", "mm"}};
     generateSample(req, dir.path());
     dir.commit();
