@@ -42,4 +42,21 @@ inline std::string slurp(const std::filesystem::path& p) {
   return ss.str();
 }
 
+// `from` replaced by `to` once; a missing `from` fails the test (the shipped file changed).
+inline void replaceOnce(std::string& text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "'" << from << "' not found";
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+}
+
+// A shipped input (examples/, tests/data/) whose demand-map paths are made absolute, so that a
+// test may write it anywhere.
+inline std::string selfContained(const std::filesystem::path& file) {
+  std::string t = slurp(file);
+  const std::string maps = (std::filesystem::path(ANGIOSYNTH_SOURCE_DIR) / "demand_maps").string();
+  for (const std::string rel : {"../../demand_maps", "../demand_maps"})
+    for (auto at = t.find(rel); at != std::string::npos; at = t.find(rel, at + maps.size())) t.replace(at, rel.size(), maps);
+  return t;
+}
+
 }  // namespace

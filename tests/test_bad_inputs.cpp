@@ -81,16 +81,12 @@ class BadInput : public ::testing::TestWithParam<BadCase> {
 std::string baseText(const std::string& kind, const fs::path& src) {
   std::string t;
   if (kind == "toml") {
-    t = slurp(src / "examples/vascusynth_like.toml");
-    t.replace(t.find("../demand_maps"), 14, (src / "demand_maps").string());
-    t.replace(t.find("terminals = 1000"), 16, "terminals = 60");
+    t = selfContained(src / "examples/vascusynth_like.toml");
+    replaceOnce(t, "terminals = 1000", "terminals = 60");
   } else if (kind == "vs") {
-    t = slurp(src / "examples/vascusynth/param_rods_1000.txt");
-    for (auto pos = t.find("../../demand_maps"); pos != std::string::npos; pos = t.find("../../demand_maps"))
-      t.replace(pos, 17, (src / "demand_maps").string());
+    t = selfContained(src / "examples/vascusynth/param_rods_1000.txt");
   } else if (kind == "spec") {
-    t = slurp(src / "tests/data/dataset_tiny.toml");
-    t.replace(t.find("../../demand_maps"), 17, (src / "demand_maps").string());
+    t = selfContained(src / "tests/data/dataset_tiny.toml");
   }
   return t;
 }
@@ -99,14 +95,11 @@ TEST_P(BadInput, ExitsTwoNamingFileAndLineAndWritesNothing) {
   const BadCase& c = GetParam();
   // The plain parameter file every profile case uses.
   std::string p = baseText("toml", src_);
-  p.replace(p.find("profiles = [\"vascusynth\", \"cta\"]"), std::string("profiles = [\"vascusynth\", \"cta\"]").size(), "profiles = []");
+  replaceOnce(p, "profiles = [\"vascusynth\", \"cta\"]", "profiles = []");
   std::ofstream(dir_ / "p.toml") << p;
   std::string text = baseText(c.base, src_);
   if (std::string(c.from).empty()) text += c.to;
-  else {
-    ASSERT_NE(text.find(c.from), std::string::npos) << c.from;
-    text.replace(text.find(c.from), std::string(c.from).size(), c.to);
-  }
+  else replaceOnce(text, c.from, c.to);
   fs::create_directories((dir_ / c.file).parent_path());
   std::ofstream(dir_ / c.file) << text;
   const auto t0 = std::chrono::steady_clock::now();
@@ -138,9 +131,7 @@ TEST(BadInputFiles, NiftiMaskWithMicroscopicVoxelsAndDamagedDatasetsAreInputErro
   EXPECT_NE(r.err.find("m.nii: voxel size 1e-09 mm (pixdim) is out of range"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out"));
   // A dataset directory without imagesTr/: a problem verify reports, not an internal error.
-  std::string t = slurp(src / "tests/data/dataset_tiny.toml");
-  t.replace(t.find("../../demand_maps"), 17, (src / "demand_maps").string());
-  std::ofstream(dir / "s.toml") << t;
+  std::ofstream(dir / "s.toml") << selfContained(src / "tests/data/dataset_tiny.toml");
   ASSERT_EQ(run("dataset s.toml --out raw --quiet", dir).code, 0);
   fs::remove_all(dir / "raw/Dataset902_VesselTiny/imagesTr");
   r = run("dataset verify raw/Dataset902_VesselTiny", dir);

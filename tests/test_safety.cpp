@@ -33,11 +33,9 @@ class Safety : public ::testing::Test {
   void SetUp() override {
     dir_ = freshTestDir("angiosynth_safety_");
     // A self-contained VascuSynth-like parameter file (absolute map path), small and quick.
-    std::string t = slurp(src_ / "examples/vascusynth_like.toml");
-    t.replace(t.find("../demand_maps"), 14, (src_ / "demand_maps").string());
-    t.replace(t.find("terminals = 1000"), 16, "terminals = 60");
-    const std::string profiles = "profiles = [\"vascusynth\", \"cta\"]";
-    t.replace(t.find(profiles), profiles.size(), "profiles = []");
+    std::string t = selfContained(src_ / "examples/vascusynth_like.toml");
+    replaceOnce(t, "terminals = 1000", "terminals = 60");
+    replaceOnce(t, "profiles = [\"vascusynth\", \"cta\"]", "profiles = []");
     work_ = dir_ / "work";
     fs::create_directories(work_ / "notes");
     std::ofstream(work_ / "params.toml") << t;
@@ -95,10 +93,8 @@ TEST_F(Safety, ForceReplacesOnlyAngiosynthsOwnFiles) {
 
 TEST_F(Safety, VascuSynthRerunsOverwriteTheirFilesAndLeaveTheUsersAndRefuseDotNames) {
   const std::string params = (src_ / "examples/vascusynth/param_rods_1000.txt").string();
-  std::string p = slurp(params);
-  p.replace(p.find("NUM_NODES: 1000"), 15, "NUM_NODES: 50");
-  for (auto pos = p.find("../../demand_maps"); pos != std::string::npos; pos = p.find("../../demand_maps"))
-    p.replace(pos, 17, (src_ / "demand_maps").string());
+  std::string p = selfContained(params);
+  replaceOnce(p, "NUM_NODES: 1000", "NUM_NODES: 50");
   std::ofstream(work_ / "p.txt") << p;
   std::ofstream(work_ / "params.txt") << "p.txt\n";
   std::ofstream(work_ / "names.txt") << "img\n";
@@ -123,7 +119,7 @@ TEST_F(Safety, VascuSynthRerunsOverwriteTheirFilesAndLeaveTheUsersAndRefuseDotNa
   }
   // A bad map in the second parameter file: nothing written for the first either.
   std::string bad = p;
-  bad.replace(bad.find("vascusynth_rods_100.txt"), 23, "no_such_map.txt");
+  replaceOnce(bad, "vascusynth_rods_100.txt", "no_such_map.txt");
   std::ofstream(work_ / "bad.txt") << bad;
   std::ofstream(work_ / "params.txt") << "p.txt\nbad.txt\n";
   std::ofstream(work_ / "names.txt") << "first\nsecond\n";
@@ -183,10 +179,9 @@ class SafeDataset : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = freshTestDir("angiosynth_safeds_");
-    std::string t = slurp(src_ / "tests/data/dataset_tiny.toml");
-    t.replace(t.find("../../demand_maps"), 17, (src_ / "demand_maps").string());
-    t.replace(t.find("samples = 6"), 11, "samples = 16");
-    t.replace(t.find("integer = [60, 160]"), 19, "integer = [20, 60]");
+    std::string t = selfContained(src_ / "tests/data/dataset_tiny.toml");
+    replaceOnce(t, "samples = 6", "samples = 16");
+    replaceOnce(t, "integer = [60, 160]", "integer = [20, 60]");
     text_ = t;
     std::ofstream(dir_ / "spec.toml") << t;
   }
