@@ -5,6 +5,7 @@
 # with the case saved in build-san/fuzz-findings/.
 #   bash scripts/fuzz.sh [SECONDS] [TARGET...]      e.g. bash scripts/fuzz.sh 3600 fuzz_profile
 #   FUZZ_RUNS=100000 bash scripts/fuzz.sh 7200       stop each target after 100000 cases (SECONDS caps it)
+#   FUZZ_SEED=0 …                                    a random seed (default 1: CI explores the same cases every run)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-20}
@@ -31,6 +32,8 @@ m = (((i - 3.5) ** 2 + (j - 3.5) ** 2 + (k - 3.5) ** 2) < 12).astype(np.uint8)
 nib.save(nib.Nifti1Image(m, np.diag([0.5, 0.5, 0.5, 1])), sys.argv[1])
 PY
 fi
+# Inputs that once failed, kept so every run tries them first.
+for d in fuzz/regressions/*/; do cp "$d"* "$corpus/$(basename "$d")/" 2>/dev/null || true; done
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(fuzz_toml_params fuzz_vascusynth_params fuzz_box_map fuzz_noise_file fuzz_profile fuzz_dataset_spec fuzz_manifest fuzz_nifti_mask)
 export ASAN_OPTIONS="detect_leaks=0"
@@ -40,7 +43,7 @@ for t in "${targets[@]}"; do
   work=$(mktemp -d)
   run_limit=()
   [ -n "${FUZZ_RUNS:-}" ] && run_limit=(-runs="$FUZZ_RUNS")
-  (cd "$work" && "$root/build-san/$t" -max_total_time="$seconds" "${run_limit[@]}" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
+  (cd "$work" && "$root/build-san/$t" -max_total_time="$seconds" "${run_limit[@]}" -seed="${FUZZ_SEED:-1}" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
       -artifact_prefix="$root/$findings/$t-" -print_final_stats=1 "$root/$corpus/$t" >"$work/log" 2>&1) || status=1
   runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$work/log" | grep -o '[0-9]*$' || echo 0)
   if [ $status -ne 0 ]; then

@@ -130,6 +130,17 @@ TEST(BadInputFiles, NiftiMaskWithMicroscopicVoxelsAndDamagedDatasetsAreInputErro
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("m.nii: voxel size 1e-09 mm (pixdim) is out of range"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out"));
+  // Dimensions 5 to 7 count too (fuzzing found a header whose dim[6], dim[7] made the library
+  // read 2 GB past the 3D memory estimate).
+  const std::string py7 = "/usr/bin/python3 -c \"import numpy as np, nibabel as nib; "
+                          "nib.save(nib.Nifti1Image(np.ones((8, 8, 8, 1, 1, 1, 3), np.uint8), np.eye(4)), '" +
+                          (dir / "m.nii").string() + "')\"";
+  ASSERT_EQ(std::system(py7.c_str()), 0);
+  r = run("generate p.toml --out out", dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("m.nii: a mask must be one 3D (or one-slice 2D) volume; this one has dims 8 8 8 1 1 1 3"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
   // A dataset directory without imagesTr/: a problem verify reports, not an internal error.
   std::ofstream(dir / "s.toml") << selfContained(src / "tests/data/dataset_tiny.toml");
   ASSERT_EQ(run("dataset s.toml --out raw --quiet", dir).code, 0);

@@ -39,9 +39,12 @@ DemandMap readNiftiMask(const std::filesystem::path& file, std::uint64_t limit) 
   if (head->nx > Limits::kMaxVoxelsPerAxis || head->ny > Limits::kMaxVoxelsPerAxis || head->nz > Limits::kMaxVoxelsPerAxis)
     throw InputError(f, 0, "a mask of " + std::to_string(head->nx) + " x " + std::to_string(head->ny) + " x " +
                                std::to_string(head->nz) + " voxels; allowed: at most 100000 per axis");
-  if (head->nx < 1 || head->ny < 1 || head->nz < 1 || head->nt > 1 || head->nu > 1)
+  // All seven dimensions count: the library reads nvox = nx·…·nw values, whatever dim[0] says.
+  if (head->nx < 1 || head->ny < 1 || head->nz < 1 || head->nt > 1 || head->nu > 1 || head->nv > 1 || head->nw > 1 ||
+      head->nvox != std::size_t(head->nx) * std::size_t(head->ny) * std::size_t(head->nz))
     throw InputError(f, 0, "a mask must be one 3D (or one-slice 2D) volume; this one has dims " + std::to_string(head->nx) +
-                               " " + std::to_string(head->ny) + " " + std::to_string(head->nz) + " " + std::to_string(head->nt));
+                               " " + std::to_string(head->ny) + " " + std::to_string(head->nz) + " " + std::to_string(head->nt) +
+                               " " + std::to_string(head->nu) + " " + std::to_string(head->nv) + " " + std::to_string(head->nw));
   const double dx = std::abs(head->dx), dy = std::abs(head->dy), dz = std::abs(head->dz);
   if (!(dx > 0) || std::abs(dy - dx) > 1e-6 * dx || (head->nz > 1 && std::abs(dz - dx) > 1e-6 * dx))
     throw InputError(f, 0, "mask voxels must be isotropic (got " + show(dx) + " x " + show(dy) + " x " + show(dz) +
@@ -51,6 +54,12 @@ DemandMap readNiftiMask(const std::filesystem::path& file, std::uint64_t limit) 
     const double mm = dx * (unit == NIFTI_UNITS_METER ? 1e3 : unit == NIFTI_UNITS_MICRON ? 1e-3 : 1.0);
     if (!(mm >= Limits::kMinVoxel && mm <= Limits::kMaxVoxel))
       throw InputError(f, 0, "voxel size " + show(mm) + " mm (pixdim) is out of range; allowed: 1e-4 to 1e4 mm");
+  }
+  // The voxel type too, before the voxels are read (the memory check assumes at most 8 bytes each).
+  switch (head->datatype) {
+    case DT_UINT8: case DT_INT8: case DT_INT16: case DT_UINT16: case DT_INT32: case DT_UINT32: case DT_FLOAT32: case DT_FLOAT64: break;
+    default: throw InputError(f, 0, std::string("unsupported NIfTI data type ") + nifti_datatype_string(head->datatype) +
+                                        "; allowed: 8/16/32-bit integers, float32, float64");
   }
   DemandMap m;
   m.dims = {static_cast<std::int32_t>(head->nx), static_cast<std::int32_t>(head->ny), static_cast<std::int32_t>(head->nz)};
