@@ -49,12 +49,11 @@ DemandMap readNiftiMask(const std::filesystem::path& file, std::uint64_t limit) 
   if (!(dx > 0) || std::abs(dy - dx) > 1e-6 * dx || (head->nz > 1 && std::abs(dz - dx) > 1e-6 * dx))
     throw InputError(f, 0, "mask voxels must be isotropic (got " + show(dx) + " x " + show(dy) + " x " + show(dz) +
                                "); resample the mask");
-  {
-    const int unit = XYZT_TO_SPACE(head->xyz_units);
-    const double mm = dx * (unit == NIFTI_UNITS_METER ? 1e3 : unit == NIFTI_UNITS_MICRON ? 1e-3 : 1.0);
-    if (!(mm >= Limits::kMinVoxel && mm <= Limits::kMaxVoxel))
-      throw InputError(f, 0, "voxel size " + show(mm) + " mm (pixdim) is out of range; allowed: 1e-4 to 1e4 mm");
-  }
+  // Lengths in mm whatever the header's unit.
+  const int unit = XYZT_TO_SPACE(head->xyz_units);
+  const double voxel_mm = dx * (unit == NIFTI_UNITS_METER ? 1e3 : unit == NIFTI_UNITS_MICRON ? 1e-3 : 1.0);
+  if (!(voxel_mm >= Limits::kMinVoxel && voxel_mm <= Limits::kMaxVoxel))
+    throw InputError(f, 0, "voxel size " + show(voxel_mm) + " mm (pixdim) is out of range; allowed: 1e-4 to 1e4 mm");
   // The voxel type too, before the voxels are read (the memory check assumes at most 8 bytes each).
   switch (head->datatype) {
     case DT_UINT8: case DT_INT8: case DT_INT16: case DT_UINT16: case DT_INT32: case DT_UINT32: case DT_FLOAT32: case DT_FLOAT64: break;
@@ -66,10 +65,7 @@ DemandMap readNiftiMask(const std::filesystem::path& file, std::uint64_t limit) 
   checkMemory(m.voxelCount(), limit, f, 0, "the mask");
   std::unique_ptr<nifti_image, decltype(&nifti_image_free)> img(nifti_image_read(f.c_str(), 1), &nifti_image_free);
   if (!img || !img->data) throw InputError(f, 0, "cannot read the voxels of this NIfTI image");
-  // Lengths in mm whatever the header's unit.
-  const int unit = XYZT_TO_SPACE(img->xyz_units);
-  const double to_mm = unit == NIFTI_UNITS_METER ? 1e3 : unit == NIFTI_UNITS_MICRON ? 1e-3 : 1.0;
-  m.voxel_mm = dx * to_mm;
+  m.voxel_mm = voxel_mm;
   m.demand.resize(m.voxelCount());
   const auto n = static_cast<std::size_t>(m.voxelCount());
   const auto convert = [&](auto* p) {

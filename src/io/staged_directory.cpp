@@ -135,8 +135,9 @@ void StagedDirectory::commit() {
     for (fs::path d = old.parent_path(); d != target_ && isWithin(d, target_); d = d.parent_path())
       if (!fs::remove(d, ec)) break;
   }
-  writeRecord(target_ / (std::string(kOutputRecord) + ".tmp-" + stagingSuffix()), written);
-  fs::rename(target_ / (std::string(kOutputRecord) + ".tmp-" + stagingSuffix()), target_ / kOutputRecord, ec);
+  const fs::path record_tmp = target_ / (std::string(kOutputRecord) + ".tmp-" + stagingSuffix());
+  writeRecord(record_tmp, written);
+  fs::rename(record_tmp, target_ / kOutputRecord, ec);
   committed_ = true;
   fs::remove_all(staging_, ec);
   unregisterStaging(staging_);

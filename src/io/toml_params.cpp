@@ -375,9 +375,8 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   }
   if (im.get("background")) ip.background = r.number(im, "image", "background");
   if (im.get("vessel")) ip.vessel = r.number(im, "image", "vessel");
-  for (const char* key : {"background", "vessel"})
-    if (im.get(key)) checkRange(std::string(key) == "vessel" ? ip.vessel : ip.background, -Limits::kMaxIntensity, false,
-                                Limits::kMaxIntensity, false, r.at(im, key), key);
+  checkRange(ip.background, -Limits::kMaxIntensity, false, Limits::kMaxIntensity, false, r.at(im, "background"), "background");
+  checkRange(ip.vessel, -Limits::kMaxIntensity, false, Limits::kMaxIntensity, false, r.at(im, "vessel"), "vessel");
   if (im.get("dtype")) {
     ip.dtype = r.string(im, "image", "dtype");
     if (ip.dtype != "uint8" && ip.dtype != "uint16" && ip.dtype != "int16" && ip.dtype != "float32")

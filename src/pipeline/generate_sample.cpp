@@ -134,16 +134,10 @@ RadiusEstimate estimateRadii(const PhysicsParameters& p, std::int64_t terminals,
 void checkFeasibility(const Scenario& sc, const PreparedSample& ps) {
   const bool cco = sc.method == "cco";
   const DemandMap& m = *ps.map;
-  double measure = 0;
-  int dim = 3;
-  if (cco) {
-    measure = ps.domain->measure();
-    dim = ps.domain->dimension();
-  } else {
-    std::int64_t inside = 0;
-    for (float v : m.demand) inside += v > 0;
-    measure = double(inside) * m.voxel_mm * m.voxel_mm * m.voxel_mm;
-  }
+  std::int64_t inside = 0;  // voxels of the domain (non-zero demand)
+  for (float v : m.demand) inside += v > 0;
+  const double measure = cco ? ps.domain->measure() : double(inside) * m.voxel_mm * m.voxel_mm * m.voxel_mm;
+  const int dim = cco ? ps.domain->dimension() : 3;
   const auto& g = sc.growth;
   const std::int64_t n = cco ? sc.cco.terminals : g.terminals;
   const std::string unit = dim == 2 ? " mm^2" : " mm^3";
@@ -160,8 +154,6 @@ void checkFeasibility(const Scenario& sc, const PreparedSample& ps) {
   }
   if (cco) {
     // A terminal per voxel of the domain at most: finer than its resolution the mask says nothing.
-    std::int64_t inside = 0;
-    for (float v : m.demand) inside += v > 0;
     if (n > inside)
       throw InputError(sc.parameter_file, sc.terminals_line,
                        std::to_string(n) + " terminals exceed the " + std::to_string(inside) +
