@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "core/memory.hpp"
-#include "grow/cco_grower.hpp"
+#include "grow/cco/grower.hpp"
 
 using namespace angiosynth;
 

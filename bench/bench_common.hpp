@@ -3,7 +3,7 @@
 // 0.4 mm voxels, optionally with its twelve zero-demand rods, or a uniform map of n³), with
 // its CGS parameters converted (13300/8300 Pa, 8330 mm³/s, 3.6 mPa·s).
 #include "domain/demand_map.hpp"
-#include "grow/vascusynth_grower.hpp"
+#include "grow/vascusynth/grower.hpp"
 
 namespace angiosynth::bench {
 

@@ -6,7 +6,7 @@
 #include "bench_common.hpp"
 #include "core/memory.hpp"
 #include "degrade/degrade.hpp"
-#include "grow/vascusynth_grower.hpp"
+#include "grow/vascusynth/grower.hpp"
 
 using namespace angiosynth;
 

@@ -7,7 +7,7 @@
 
 #include "bench_common.hpp"
 #include "core/memory.hpp"
-#include "grow/vascusynth_grower.hpp"
+#include "grow/vascusynth/grower.hpp"
 
 using namespace angiosynth;
 

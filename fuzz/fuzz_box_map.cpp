@@ -5,7 +5,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace angiosynth;
   const auto file = fuzz::writeInput(data, size, "map.txt");
-  Scenario sc;
+  BoxMapSpec sc;
   sc.parameter_file = "fuzz.toml";
   sc.voxel_mm = 1;
   sc.demand_map = file;

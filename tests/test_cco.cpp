@@ -9,9 +9,9 @@
 #include <numbers>
 
 #include "domain/growth_domain.hpp"
-#include "grow/cco_grower.hpp"
-#include "grow/intersections.hpp"
-#include "grow/kamiya.hpp"
+#include "grow/cco/grower.hpp"
+#include "grow/common/intersections.hpp"
+#include "grow/common/kamiya.hpp"
 #include "physics/hemodynamics.hpp"
 #include "test_support.hpp"
 

@@ -57,6 +57,8 @@ TEST(ExampleOutputs, EveryFileTheShippedExamplesWriteIsByteIdenticalToTheRecord)
   ASSERT_EQ(run("generate " + ex("cco_disc_2d.toml") + " --out cco_disc_2d --quiet", dir).code, 0);
   ASSERT_EQ(run("dataset " + ex("dataset_small.toml") + " --out dataset_small --quiet", dir).code, 0);
   fs::copy(src / "examples/vascusynth", dir / "vascusynth", fs::copy_options::recursive);
+  for (const char* f : {"param_rods_1000.txt", "param_2008_crlf_200.txt"})
+    std::ofstream(dir / "vascusynth" / f, std::ios::binary) << selfContained(src / "examples/vascusynth" / f);
   ASSERT_EQ(run("vascusynth paramList.txt imageNames.txt 0.04 --quiet", dir / "vascusynth").code, 0);
   std::map<std::string, std::string> now;
   for (const char* out : {"vascusynth_like", "cco_sphere_3d", "cco_disc_2d", "dataset_small"}) hashTree(dir / out, out, now);

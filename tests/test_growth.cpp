@@ -8,9 +8,9 @@
 
 #include "core/rng.hpp"
 #include "domain/demand_sampler.hpp"
-#include "grow/bifurcation_optimizer.hpp"
-#include "grow/intersections.hpp"
-#include "grow/segment_index.hpp"
+#include "grow/common/bifurcation_optimizer.hpp"
+#include "grow/common/intersections.hpp"
+#include "grow/common/segment_index.hpp"
 #include "physics/hemodynamics.hpp"
 #include "test_support.hpp"
 

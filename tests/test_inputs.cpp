@@ -1,6 +1,15 @@
 // Parameter and map files: VascuSynth's spellings accepted, bad input reported as file:line.
 #include <gtest/gtest.h>
 
+#include "grow/vascusynth/setup.hpp"
+#include "io/scenario.hpp"
+
+namespace {
+const angiosynth::GrowthOptions& vsGrowth(const angiosynth::Scenario& s) {
+  return dynamic_cast<const angiosynth::VascuSynthSetup&>(*s.growth).growth;
+}
+}  // namespace
+
 #include <fstream>
 #include <functional>
 
@@ -67,14 +76,14 @@ TEST_F(Files, VascuSynthSpellingsAreAllAccepted) {
   b_text.replace(b_text.find("MU:"), 2, "MEW");
   b_text.insert(b_text.find("GAMMA"), "\r\n\r\n");
   const auto b = readVascuSynthParameters(write("b.txt", b_text));
-  EXPECT_EQ(a.growth.physics.viscosity, b.growth.physics.viscosity);
-  EXPECT_EQ(a.growth.physics.cost_length_exponent, b.growth.physics.cost_length_exponent);
-  EXPECT_EQ(a.growth.terminals, 20);
+  EXPECT_EQ(vsGrowth(a).physics.viscosity, vsGrowth(b).physics.viscosity);
+  EXPECT_EQ(vsGrowth(a).physics.cost_length_exponent, vsGrowth(b).physics.cost_length_exponent);
+  EXPECT_EQ(vsGrowth(a).terminals, 20);
   // CGS: 133000 dyn/cm^2 = 13300 Pa, 8.33 cm^3/s = 8330 mm^3/s, 0.036 P = 0.0036 Pa*s, 0.04 cm = 0.4 mm.
-  EXPECT_DOUBLE_EQ(a.growth.physics.perfusion_pressure, 13300);
-  EXPECT_DOUBLE_EQ(a.growth.physics.perfusion_flow, 8330);
-  EXPECT_DOUBLE_EQ(a.growth.physics.viscosity, 0.0036);
-  EXPECT_DOUBLE_EQ(a.voxel_mm, 0.4);
+  EXPECT_DOUBLE_EQ(vsGrowth(a).physics.perfusion_pressure, 13300);
+  EXPECT_DOUBLE_EQ(vsGrowth(a).physics.perfusion_flow, 8330);
+  EXPECT_DOUBLE_EQ(vsGrowth(a).physics.viscosity, 0.0036);
+  EXPECT_DOUBLE_EQ(a.growth->voxelMm(), 0.4);
   EXPECT_EQ(*a.seed, 3u);
 }
 
@@ -97,7 +106,7 @@ TEST_F(Files, VascuSynthErrorsNameFileAndLine) {
 }
 
 TEST_F(Files, MapErrorsNameFileAndLine) {
-  const auto ok = readVascuSynthParameters(write("p.txt", params()));
+  const auto ok = dynamic_cast<const VascuSynthSetup&>(*readVascuSynthParameters(write("p.txt", params())).growth).domain;
   auto sc = ok;
   sc.demand_map = write("box.txt", "20 20 20\n0 0 0 20 20 21\n1\n");
   EXPECT_TRUE(errorAt(sc.demand_map, 2, "lies outside the map", [&] { loadDomain(sc, 1ULL << 30); }));
@@ -140,10 +149,10 @@ perfusion_flow = "8330 mm3/s"
 )";
   const auto t = readTomlParameters(write("p.toml", toml));
   const auto v = readVascuSynthParameters(write("p.txt", params()));
-  EXPECT_DOUBLE_EQ(t.growth.physics.viscosity, v.growth.physics.viscosity);
-  EXPECT_DOUBLE_EQ(t.growth.physics.perfusion_pressure, v.growth.physics.perfusion_pressure);
-  EXPECT_DOUBLE_EQ(t.growth.physics.perfusion_flow, v.growth.physics.perfusion_flow);
-  EXPECT_DOUBLE_EQ(t.growth.min_distance_mm, v.growth.min_distance_mm);
+  EXPECT_DOUBLE_EQ(vsGrowth(t).physics.viscosity, vsGrowth(v).physics.viscosity);
+  EXPECT_DOUBLE_EQ(vsGrowth(t).physics.perfusion_pressure, vsGrowth(v).physics.perfusion_pressure);
+  EXPECT_DOUBLE_EQ(vsGrowth(t).physics.perfusion_flow, vsGrowth(v).physics.perfusion_flow);
+  EXPECT_DOUBLE_EQ(vsGrowth(t).min_distance_mm, vsGrowth(v).min_distance_mm);
   auto f = write("unit.toml", edited(toml, "\"13300 Pa\"", "\"13300 bar\""));
   EXPECT_TRUE(errorAt(f, 13, "unknown unit 'bar'", [&] { readTomlParameters(f); }));
   f = write("key.toml", toml + "colour = 1\n");

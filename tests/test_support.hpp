@@ -8,7 +8,8 @@
 #include <string>
 
 #include "domain/demand_map.hpp"
-#include "grow/vascusynth_grower.hpp"
+#include "grow/vascusynth/grower.hpp"
+#include "grow/vascusynth/setup.hpp"
 #include "io/map_files.hpp"
 #include "io/scenario.hpp"
 
@@ -26,11 +27,12 @@ struct Example {
 inline Example vascusynthExample(std::int64_t terminals, std::uint64_t seed) {
   Example e;
   e.scenario = readParameters(sourceDir() / "examples/vascusynth/param_rods_1000.txt");
-  e.map = loadDomain(e.scenario, 4ULL << 30);
-  e.options = e.scenario.growth;
+  const auto& vs = dynamic_cast<const VascuSynthSetup&>(*e.scenario.growth);
+  e.map = loadDomain(vs.domain, 4ULL << 30);
+  e.options = vs.growth;
   e.options.terminals = terminals;
   e.options.physics.total_terminals = terminals;
-  e.options.root_mm = e.map.toMm(e.scenario.root_voxel);
+  e.options.root_mm = e.map.toMm(vs.domain.root_voxel);
   e.options.seed = seed;
   return e;
 }

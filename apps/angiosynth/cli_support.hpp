@@ -7,7 +7,7 @@
 #include <optional>
 #include <string>
 
-#include "grow/vascusynth_grower.hpp"
+#include "grow/common/growth_report.hpp"
 
 namespace angiosynth::cli {
 

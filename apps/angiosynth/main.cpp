@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "core/interrupt_cleanup.hpp"
 #include "degrade/effect.hpp"
+#include "grow/method.hpp"
 
 int main(int argc, char** argv) {
   using namespace angiosynth;
@@ -23,6 +24,7 @@ int main(int argc, char** argv) {
   cli::DatasetArgs ds;
   auto* d = cli::addDataset(app, ds);
   auto* fx = app.add_subcommand("effects", "list the degradation effects and their parameters (Markdown)");
+  auto* gm = app.add_subcommand("methods", "list the growth methods and their parameters (Markdown)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -36,6 +38,10 @@ int main(int argc, char** argv) {
     if (d->parsed()) return cli::runDatasetCommand(ds, cmdline);
     if (fx->parsed()) {
       std::cout << effectReference();
+      return 0;
+    }
+    if (gm->parsed()) {
+      std::cout << methodReference();
       return 0;
     }
   } catch (const InputError& e) {

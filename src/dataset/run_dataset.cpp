@@ -16,7 +16,6 @@
 #include "core/memory.hpp"
 #include "dataset/manifest.hpp"
 #include "degrade/profile.hpp"
-#include "io/map_files.hpp"
 #include "core/interrupt_cleanup.hpp"
 #include "io/output_guard.hpp"
 #include "io/text_file.hpp"
@@ -75,7 +74,8 @@ Scenario scenarioOf(const DatasetSpec& spec, const ResolvedSample& r) {
 std::uint64_t sampleBytes(const DatasetSpec& spec, std::uint64_t limit) {
   const ResolvedSample r = resolveSample(spec, 0);
   const Scenario sc = scenarioOf(spec, r);
-  const DemandMap map = loadDomain(sc, limit);
+  const auto growth = sc.growth->prepare(limit);
+  const DemandMap& map = growth->frame();
   const VolumeGrid g = imageGrid(map, sc.image, spec.file, 0);
   loadProfile(r.profile, spec.file, 0);
   return denseRasterBytes(g) + 4ULL * g.voxelCount() + 24ULL * g.voxelCount() + map.demand.size() * 16;

@@ -16,7 +16,9 @@ namespace {
 // Bytes per voxel a mask domain needs: value, depth, supply index, sampler (two doubles).
 constexpr std::uint64_t kMaskBytesPerVoxel = 4 + 4 + 2 + 16 + 4;
 
-void checkMemory(std::int64_t voxels, std::uint64_t limit, const std::string& file, int line, const std::string& what) {
+}  // namespace
+
+void checkDomainMemory(std::int64_t voxels, std::uint64_t limit, const std::string& file, int line, const std::string& what) {
   const std::uint64_t need = std::uint64_t(voxels) * kMaskBytesPerVoxel;
   if (need > limit)
     throw InputError(file, line, what + " of " + std::to_string(voxels) + " voxels needs " + formatBytes(need) +
@@ -28,8 +30,6 @@ bool isNifti(const std::filesystem::path& p) {
   const auto s = p.string();
   return s.ends_with(".nii") || s.ends_with(".nii.gz");
 }
-
-}  // namespace
 
 DemandMap readNiftiMask(const std::filesystem::path& file, std::uint64_t limit) {
   const std::string f = file.string();
@@ -62,7 +62,7 @@ DemandMap readNiftiMask(const std::filesystem::path& file, std::uint64_t limit) 
   }
   DemandMap m;
   m.dims = {static_cast<std::int32_t>(head->nx), static_cast<std::int32_t>(head->ny), static_cast<std::int32_t>(head->nz)};
-  checkMemory(m.voxelCount(), limit, f, 0, "the mask");
+  checkDomainMemory(m.voxelCount(), limit, f, 0, "the mask");
   std::unique_ptr<nifti_image, decltype(&nifti_image_free)> img(nifti_image_read(f.c_str(), 1), &nifti_image_free);
   if (!img || !img->data) throw InputError(f, 0, "cannot read the voxels of this NIfTI image");
   m.voxel_mm = voxel_mm;
@@ -90,44 +90,6 @@ DemandMap readNiftiMask(const std::filesystem::path& file, std::uint64_t limit) 
   m.supply_index.assign(m.demand.size(), 0);
   m.supply_sets = {{}};
   return m;
-}
-
-GrowthDomain loadGrowthDomain(const Scenario& sc, std::uint64_t limit) {
-  const auto& spec = sc.cco_domain;
-  if (spec.shape != DomainShape::Mask) {
-    const auto n = GrowthDomain::analyticDims(spec.shape, spec.size_mm, sc.voxel_mm);
-    checkMemory(std::int64_t(n[0]) * n[1] * n[2], limit, sc.parameter_file, spec.line,
-                std::string("a ") + domainShapeName(spec.shape) + " frame");
-    return GrowthDomain::analytic(spec.shape, spec.size_mm, sc.voxel_mm);
-  }
-  DemandMap m;
-  if (isNifti(spec.mask)) {
-    m = readNiftiMask(spec.mask, limit);
-  } else {
-    m = loadDomain(sc, limit);  // a VascuSynth box map; checks the root too
-  }
-  std::int64_t inside = 0;
-  for (float v : m.demand) inside += v > 0;
-  if (inside == 0) throw InputError(spec.mask.string(), 0, "the mask has no voxel > 0; nothing to perfuse");
-  return GrowthDomain::mask(std::move(m), spec.demand_weighted);
-}
-
-Vec3 ccoRoot(const Scenario& sc, const GrowthDomain& d) {
-  const auto& spec = sc.cco_domain;
-  Vec3 root;
-  if (spec.shape != DomainShape::Mask) {
-    root = spec.has_root_offset ? d.center() + spec.root_offset_mm : d.defaultRoot();
-  } else {
-    root = spec.root_in_mm ? spec.root_mm : d.frame().toMm(sc.root_voxel);
-  }
-  if (d.dimension() == 2) root.z = d.planeZ();
-  // The root may sit on the border (where the vessel enters), not outside it.
-  const double tolerance = d.frame().voxel_mm * 1e-6;
-  if (d.depth(root) < -tolerance)
-    throw InputError(sc.parameter_file, sc.root_line,
-                     "the root (" + show3(root) + " mm in the frame) lies outside the " + domainShapeName(d.shape()) +
-                         " domain (" + show(-d.depth(root)) + " mm beyond its border); place it inside or on the border");
-  return root;
 }
 
 }  // namespace angiosynth

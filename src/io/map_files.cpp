@@ -59,7 +59,7 @@ std::uint64_t growthBytesFor(std::int64_t voxels) {
   return static_cast<std::uint64_t>(voxels) * (sizeof(float) + sizeof(std::uint16_t)) + DemandSampler::bytesFor(voxels);
 }
 
-DemandMap loadDomain(const Scenario& sc, std::uint64_t memory_limit) {
+DemandMap loadDomain(const BoxMapSpec& sc, std::uint64_t memory_limit) {
   const std::string file = sc.demand_map.string();
   const auto lines = readTextLines(sc.demand_map, "oxygen-demand map");
   if (lines.empty()) throw InputError(file, 0, "empty oxygen-demand map; expected 'DX DY DZ' then box and value lines");

@@ -24,8 +24,8 @@ Scenario readParameters(const std::filesystem::path& file, const ReadOptions& op
 
 std::vector<std::filesystem::path> scenarioInputs(const Scenario& sc) {
   std::vector<std::filesystem::path> in{sc.parameter_file};
-  for (const auto& p : {sc.demand_map, sc.supply_map, sc.cco_domain.mask})
-    if (!p.empty()) in.push_back(p);
+  if (sc.growth)
+    for (const auto& p : sc.growth->inputs()) in.push_back(p);
   for (const auto& p : sc.profiles)
     if (std::filesystem::exists(p)) in.push_back(p);
   return in;

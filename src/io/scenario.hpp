@@ -3,6 +3,7 @@
 // came from, so that later errors (e.g. a root in zero demand) can still point at a file line.
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -10,9 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/units.hpp"
-#include "domain/growth_domain.hpp"
-#include "grow/cco_grower.hpp"
-#include "grow/vascusynth_grower.hpp"
+#include "grow/method.hpp"
 
 namespace toml {
 inline namespace v3 {
@@ -34,34 +33,10 @@ struct ImageParameters {
   std::vector<std::string> graph_formats{"csv", "vtp", "swc", "graphml"};  // besides GXL and DOT
 };
 
-// The domain of method "cco": an analytic shape or a mask file.
-struct CcoDomainSpec {
-  DomainShape shape = DomainShape::Sphere;
-  double size_mm = 0;            // radius (sphere, disc) or side (cube, square)
-  std::filesystem::path mask;    // shape mask: NIfTI (.nii, .nii.gz) or a VascuSynth box map
-  bool demand_weighted = false;  // sampling = "demand": terminals drawn ∝ mask value
-  bool has_root_offset = false;  // analytic shapes: root = centre + offset (default: the top, +y)
-  Vec3 root_offset_mm;
-  bool root_in_mm = false;       // masks: `root` (mm in the frame) rather than root_voxel
-  Vec3 root_mm;
-  int line = 0;                  // of [domain]
-};
-
 struct Scenario {
   std::string parameter_file;
   std::string format;  // "vascusynth" or "toml"
-  std::string method = "vascusynth";  // growth method: "vascusynth" or "cco"
-  CcoDomainSpec cco_domain;
-  CcoOptions cco;                     // method "cco": everything but the root
-  std::filesystem::path demand_map;
-  std::filesystem::path supply_map;            // empty: supply_coefficients everywhere
-  std::vector<double> supply_coefficients{0.65, 0.34, 0.01, 7};
-  int supply_line = 0;
-  double voxel_mm = 0;
-  Vec3 root_voxel;                             // map-voxel coordinates
-  int root_line = 0;
-  int terminals_line = 0;                      // of the terminal count, for feasibility errors
-  GrowthOptions growth;                        // root_mm is set once the map is known
+  std::shared_ptr<const GrowthSetup> growth;   // the growth method and its options
   std::optional<std::uint64_t> seed;
   ImageParameters image;
   int image_line = 0;                          // line of [image], for errors about its size
@@ -69,7 +44,6 @@ struct Scenario {
   std::vector<std::string> profiles;           // [degrade] profiles: names or files
   int profiles_line = 0;
   CoherentUnits input_units;                   // only for VascuSynth files
-  nlohmann::ordered_json parameters;           // resolved values with units, for sample.json
   std::string units_note;
 };
 

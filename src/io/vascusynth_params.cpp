@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "io/param_checks.hpp"
+#include "grow/vascusynth/setup.hpp"
 #include "io/scenario.hpp"
 #include "io/text_lines.hpp"
 
@@ -85,15 +86,18 @@ Scenario readVascuSynthParameters(const std::filesystem::path& path, const ReadO
   const double voxel = number("VOXEL_WIDTH");
   checkRange(voxel, Limits::kMinVoxel / u.mm_per_length, false, Limits::kMaxVoxel / u.mm_per_length, false, where("VOXEL_WIDTH"),
              "VOXEL_WIDTH (" + u.length + ")");
-  sc.voxel_mm = voxel * u.mm_per_length;
+  auto setup = std::make_shared<VascuSynthSetup>();
+  BoxMapSpec& d = setup->domain;
+  d.parameter_file = file;
+  d.voxel_mm = voxel * u.mm_per_length;
 
   const auto pp = splitWords(entries.at("PERF_POINT").value);
   if (pp.size() != 3)
     throw InputError(file, entries.at("PERF_POINT").line, "PERF_POINT takes 3 numbers (map voxels), got '" + entries.at("PERF_POINT").value + "'");
-  sc.root_voxel = Vec3(parseNumber(pp[0], file, entries.at("PERF_POINT").line, "PERF_POINT"),
+  d.root_voxel = Vec3(parseNumber(pp[0], file, entries.at("PERF_POINT").line, "PERF_POINT"),
                        parseNumber(pp[1], file, entries.at("PERF_POINT").line, "PERF_POINT"),
                        parseNumber(pp[2], file, entries.at("PERF_POINT").line, "PERF_POINT"));
-  sc.root_line = entries.at("PERF_POINT").line;
+  d.root_line = entries.at("PERF_POINT").line;
 
   const double p_perf = number("PERF_PRESSURE"), p_term = number("TERM_PRESSURE");
   const double pa = u.pa_per_pressure();
@@ -122,15 +126,15 @@ Scenario readVascuSynthParameters(const std::filesystem::path& path, const ReadO
     if (seed > 0) sc.seed = static_cast<std::uint64_t>(seed);  // 0 or negative: a new tree every run
   }
 
-  sc.demand_map = resolveInputPath(entries.at("OXYGENATION_MAP").value, path, entries.at("OXYGENATION_MAP").line);
-  sc.supply_map = resolveInputPath(entries.at("SUPPLY_MAP").value, path, entries.at("SUPPLY_MAP").line);
-  sc.supply_line = entries.at("SUPPLY_MAP").line;
+  d.demand_map = resolveInputPath(entries.at("OXYGENATION_MAP").value, path, entries.at("OXYGENATION_MAP").line);
+  d.supply_map = resolveInputPath(entries.at("SUPPLY_MAP").value, path, entries.at("SUPPLY_MAP").line);
+  d.supply_line = entries.at("SUPPLY_MAP").line;
 
-  auto& g = sc.growth;
-  sc.terminals_line = entries.at("NUM_NODES").line;
+  auto& g = setup->growth;
+  setup->terminals_line = entries.at("NUM_NODES").line;
   g.terminals = n;
   g.closest_neighbours = static_cast<int>(k);
-  g.min_distance_mm = min_dist * sc.voxel_mm;
+  g.min_distance_mm = min_dist * d.voxel_mm;
   g.physics.murray_exponent = gamma;
   g.physics.cost_radius_exponent = lambda;
   g.physics.cost_length_exponent = mu;
@@ -139,6 +143,7 @@ Scenario readVascuSynthParameters(const std::filesystem::path& path, const ReadO
   g.physics.terminal_pressure = p_term * u.pa_per_pressure();
   g.physics.perfusion_flow = flow * u.mm3s_per_flow();
   g.physics.total_terminals = n;
+  sc.growth = std::move(setup);
 
   sc.units_note = "VascuSynth files carry no units: lengths (VOXEL_WIDTH, radii) were read in " + u.length +
                   ", flows in " + u.flowName() + ", pressures in " + u.pressureName() + " and viscosity in " +

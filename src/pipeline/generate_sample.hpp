@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "degrade/profile.hpp"
-#include "grow/vascusynth_grower.hpp"
+#include "grow/common/growth_report.hpp"
 #include "io/scenario.hpp"
 
 namespace angiosynth {

@@ -1,4 +1,4 @@
-#include "grow/connection_commit.hpp"
+#include "grow/common/connection_commit.hpp"
 
 namespace angiosynth {
 namespace {

@@ -1,4 +1,4 @@
-#include "grow/cco_grower.hpp"
+#include "grow/cco/grower.hpp"
 
 #include <tbb/parallel_for.h>
 
@@ -6,11 +6,11 @@
 #include <cmath>
 #include <tuple>
 
-#include "grow/bifurcation_optimizer.hpp"
-#include "grow/connection_commit.hpp"
-#include "grow/intersections.hpp"
-#include "grow/kamiya.hpp"
-#include "grow/segment_index.hpp"
+#include "grow/common/bifurcation_optimizer.hpp"
+#include "grow/common/connection_commit.hpp"
+#include "grow/common/intersections.hpp"
+#include "grow/common/kamiya.hpp"
+#include "grow/common/segment_index.hpp"
 
 namespace angiosynth {
 namespace {

@@ -1,8 +1,8 @@
-#include "grow/intersections.hpp"
+#include "grow/common/intersections.hpp"
 
 #include <algorithm>
 
-#include "grow/segment_index.hpp"
+#include "grow/common/segment_index.hpp"
 
 namespace angiosynth {
 

@@ -1,4 +1,4 @@
-#include "grow/segment_index.hpp"
+#include "grow/common/segment_index.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "grow/kamiya.hpp"
+#include "grow/common/kamiya.hpp"
 
 #include <ceres/tiny_solver.h>
 #include <ceres/tiny_solver_autodiff_function.h>

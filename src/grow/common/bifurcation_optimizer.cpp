@@ -1,4 +1,4 @@
-#include "grow/bifurcation_optimizer.hpp"
+#include "grow/common/bifurcation_optimizer.hpp"
 
 #include <algorithm>
 #include <array>

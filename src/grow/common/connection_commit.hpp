@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/vascular_tree.hpp"
-#include "grow/bifurcation_optimizer.hpp"
+#include "grow/common/bifurcation_optimizer.hpp"
 
 namespace angiosynth {
 

@@ -17,7 +17,8 @@
 
 #include "core/vascular_tree.hpp"
 #include "domain/growth_domain.hpp"
-#include "grow/vascusynth_grower.hpp"
+#include "grow/common/growth_report.hpp"
+#include "physics/hemodynamics.hpp"
 
 namespace angiosynth {
 

@@ -1,4 +1,4 @@
-#include "grow/vascusynth_grower.hpp"
+#include "grow/vascusynth/grower.hpp"
 
 #include <tbb/parallel_for.h>
 
@@ -9,10 +9,10 @@
 #include "core/rng.hpp"
 #include "domain/demand_sampler.hpp"
 #include "domain/supply.hpp"
-#include "grow/bifurcation_optimizer.hpp"
-#include "grow/connection_commit.hpp"
-#include "grow/intersections.hpp"
-#include "grow/segment_index.hpp"
+#include "grow/common/bifurcation_optimizer.hpp"
+#include "grow/common/connection_commit.hpp"
+#include "grow/common/intersections.hpp"
+#include "grow/common/segment_index.hpp"
 
 namespace angiosynth {
 namespace {

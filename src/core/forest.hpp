@@ -1,0 +1,32 @@
+#pragma once
+// A forest: one or more vascular trees that share one frame (inlets of one organ, an arterial
+// and a venous tree). Its vessels are stored as one VascularTree with one root per tree, so
+// node and segment ids are unique across the forest and every stage after growth works on all
+// trees at once; `vessels.tree[i]` says which tree node i (and segment i) belongs to.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/vascular_tree.hpp"
+
+namespace angiosynth {
+
+struct TreeInfo {
+  std::string id;    // unique in the forest ("tree", "artery", "inlet_2", ...)
+  std::string kind;  // "artery", "vein", or a free name
+  int class_label = 1;  // its kind's label in the classes volume (1 artery, 2 vein, further kinds on)
+};
+
+struct Forest {
+  VascularTree vessels;
+  std::vector<TreeInfo> trees;
+};
+
+// Class labels of kinds: artery 1, vein 2, other kinds 3, 4, ... in order of first appearance.
+void assignClassLabels(std::vector<TreeInfo>& trees);
+// The kinds in label order (index 0 is label 1).
+std::vector<std::string> kindsByLabel(const std::vector<TreeInfo>& trees);
+// One tree as a forest of one (id "tree").
+Forest singleTreeForest(VascularTree tree, const std::string& kind = "artery");
+
+}  // namespace angiosynth

@@ -1,0 +1,85 @@
+#pragma once
+// A growth method as one unit: its parameters (declared once, for the reader, the defaults and
+// `angiosynth methods`), the reader of its TOML tables, its description for sample.json and its
+// grow function. The pipeline, the dataset engine and the command line see only this interface;
+// each method lives in its own folder under src/grow/ and registers in method_registry.cpp.
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/forest.hpp"
+#include "domain/demand_map.hpp"
+#include "grow/common/growth_report.hpp"
+#include "physics/hemodynamics.hpp"
+
+namespace angiosynth {
+
+class GrowthDomain;
+class TomlReader;
+
+// One key of a method's tables, as the README and `angiosynth methods` list it.
+struct MethodParam {
+  const char* table;     // "domain", "tree", "physics", or a sub-table such as "tree.inlet"
+  const char* key;
+  const char* unit;      // "mm", "Pa", "mm^3/s", "Pa*s", "" for numbers, "text", "true/false", "[x, y, z] mm", ...
+  const char* fallback;  // the default as written in a file ("3.6 mPa*s"); nullptr: required
+  const char* meaning;
+};
+
+// A method's domain read and checked, ready to grow (possibly several samples from it).
+class PreparedGrowth {
+ public:
+  virtual ~PreparedGrowth() = default;
+  // The voxel frame of the domain: the image grid, graph voxel coordinates and maps refer to it.
+  virtual const DemandMap& frame() const = 0;
+  // Checks, in milliseconds, that growth can succeed (root, room for the terminals and vessels).
+  virtual void checkFeasibility() const = 0;
+  // The analytic or mask domain, when the method grows in one (2D domains get an SVG figure).
+  virtual const GrowthDomain* domain() const { return nullptr; }
+  // Grows the forest for (seed, sample); throws GrowthError when the domain cannot be filled.
+  virtual Forest grow(std::uint64_t seed, std::uint64_t sample, GrowthReport& report, const ProgressFn& progress) const = 0;
+  // Figures only this method reports, added to sample.json's statistics.
+  virtual void addStatistics(const GrowthReport&, nlohmann::ordered_json&) const {}
+};
+
+// A method's options as read from a parameter file: immutable, shared by the samples of a run.
+class GrowthSetup {
+ public:
+  virtual ~GrowthSetup() = default;
+  virtual const char* method() const = 0;
+  // The resolved parameters with their units, for sample.json (the pipeline adds image and profiles).
+  virtual nlohmann::ordered_json describe() const = 0;
+  // Every file growth reads (maps, masks): outputs must not hold them.
+  virtual std::vector<std::filesystem::path> inputs() const = 0;
+  // Reads and checks the domain files; writes nothing.
+  virtual std::unique_ptr<PreparedGrowth> prepare(std::uint64_t memory_limit) const = 0;
+  // The physics of the (first) tree: cost exponents for the statistics.
+  virtual const PhysicsParameters& physics() const = 0;
+  virtual std::int64_t terminals() const = 0;
+  // The voxel of the domain in mm, for lengths written in "voxel" (0 until a mask is read).
+  virtual double voxelMm() const = 0;
+};
+
+struct GrowthMethod {
+  const char* name;
+  const char* summary;            // one line for the README and `angiosynth methods`
+  std::vector<MethodParam> params;
+  // Reads [domain], [tree] and [physics] of a TOML parameter file.
+  std::shared_ptr<const GrowthSetup> (*read)(const TomlReader& reader, const GrowthMethod& self);
+};
+
+// Every method, in the order the README lists them.
+const std::vector<const GrowthMethod*>& growthMethods();
+const GrowthMethod* findGrowthMethod(const std::string& name);
+// The names, comma-separated, for errors.
+std::string growthMethodNames();
+// Markdown reference of every method with its parameters (`angiosynth methods`, the README).
+std::string methodReference();
+// The method (other than `self`) that declares table.key, or nullptr: for "is for method X" errors.
+const GrowthMethod* methodDeclaring(const std::string& table, const std::string& key, const GrowthMethod* self);
+
+}  // namespace angiosynth

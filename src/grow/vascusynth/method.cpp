@@ -1,0 +1,145 @@
+// Method "vascusynth": its parameters, TOML reader, description and grow function.
+#include <cmath>
+
+#include "core/error.hpp"
+#include "grow/common/feasibility.hpp"
+#include "grow/common/method_tables.hpp"
+#include "grow/vascusynth/setup.hpp"
+#include "io/scenario.hpp"
+
+namespace angiosynth {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+Json q(double v, const char* unit) { return Json{{"value", v}, {"unit", unit}}; }
+
+class PreparedVascuSynth final : public PreparedGrowth {
+ public:
+  PreparedVascuSynth(const VascuSynthSetup& s, DemandMap map) : setup_(s), map_(std::move(map)) {}
+  const DemandMap& frame() const override { return map_; }
+  void checkFeasibility() const override {
+    std::int64_t inside = 0;  // voxels of non-zero demand
+    for (float v : map_.demand) inside += v > 0;
+    const double measure = double(inside) * map_.voxel_mm * map_.voxel_mm * map_.voxel_mm;
+    const auto& g = setup_.growth;
+    const std::string& file = setup_.domain.parameter_file;
+    checkPacking(g.terminals, g.min_distance_mm, measure, file, setup_.terminals_line);
+    checkVesselRoom(g.physics, g.terminals, measure, 3, file, setup_.terminals_line);
+  }
+  Forest grow(std::uint64_t seed, std::uint64_t sample, GrowthReport& report, const ProgressFn& progress) const override {
+    GrowthOptions opt = setup_.growth;
+    opt.root_mm = map_.toMm(setup_.domain.root_voxel);
+    opt.seed = seed;
+    opt.sample = sample;
+    return singleTreeForest(growVascuSynth(map_, opt, report, progress));
+  }
+
+ private:
+  const VascuSynthSetup& setup_;
+  DemandMap map_;
+};
+
+std::shared_ptr<const GrowthSetup> readVascuSynthToml(const TomlReader& r, const GrowthMethod& m) {
+  auto s = std::make_shared<VascuSynthSetup>();
+  const std::string file = r.file();
+  const std::filesystem::path path = file;
+  const auto& dom = methodTable(r, m, "domain");
+  const auto& tree = methodTable(r, m, "tree");
+  BoxMapSpec& d = s->domain;
+  d.parameter_file = file;
+  auto& g = s->growth;
+  d.voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
+  checkRange(d.voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, r.at(dom, "voxel_size"), "voxel_size (mm)");
+  d.demand_map = resolveInputPath(r.string(dom, "domain", "demand_map"), path, r.lineOf(dom.get("demand_map")));
+  if (dom.get("supply_map") && dom.get("supply_coefficients"))
+    throw InputError(file, r.lineOf(dom.get("supply_coefficients")), "give supply_map or supply_coefficients, not both");
+  if (dom.get("supply_map")) {
+    d.supply_map = resolveInputPath(r.string(dom, "domain", "supply_map"), path, r.lineOf(dom.get("supply_map")));
+    d.supply_line = r.lineOf(dom.get("supply_map"));
+  } else if (const auto* c = dom.get("supply_coefficients")) {
+    d.supply_coefficients = r.numbers(c, "supply_coefficients", 0);
+    if (d.supply_coefficients.back() < 0 || d.supply_coefficients.back() > Limits::kMaxSupplyCutoff)
+      throw InputError(file, r.lineOf(c), "supply_coefficients: the last value is the cut-off radius (map voxels); allowed: 0 to 1e6");
+  }
+
+  if (const auto mm = readRoot(r, tree, d.root_voxel, d.root_line, "map voxels", "")) d.root_voxel = *mm / d.voxel_mm;
+  g.min_distance_mm = declaredQuantity(r, m, tree, "tree", "min_distance", Dimension::Length, d.voxel_mm);
+  checkRange(g.min_distance_mm, 0, false, Limits::kMaxLength, false, r.at(tree, "min_distance"), "min_distance (mm)");
+  if (tree.get("min_segment_length")) {
+    g.min_segment_length_mm = r.quantity(tree, "tree", "min_segment_length", Dimension::Length, d.voxel_mm);
+    checkRange(g.min_segment_length_mm, 0, true, Limits::kMaxLength, false, r.at(tree, "min_segment_length"), "min_segment_length (mm)");
+  }
+  g.avoid_intersections = r.boolean(tree, "avoid_intersections", true);
+  g.terminals = readTerminals(r, tree, s->terminals_line);
+  g.closest_neighbours = int(declaredNumber(r, m, tree, "tree", "closest_neighbours"));
+  if (tree.get("closest_neighbours"))
+    g.closest_neighbours = r.smallInteger(tree, "tree", "closest_neighbours", 1, std::int64_t(Limits::kMaxNeighbours));
+  g.physics = readPhysics(r, m, methodTable(r, m, "physics"));
+  g.physics.total_terminals = g.terminals;
+  return s;
+}
+
+}  // namespace
+
+Json VascuSynthSetup::describe() const {
+  const auto& g = growth;
+  const auto& p = g.physics;
+  const auto& d = domain;
+  Json j;
+  j["method"] = "vascusynth";
+  j["demand_map"] = d.demand_map.string();
+  if (d.supply_map.empty()) j["supply_coefficients"] = d.supply_coefficients;
+  else j["supply_map"] = d.supply_map.string();
+  j["voxel_size"] = q(d.voxel_mm, "mm");
+  j["root"] = Json{{"value", {d.root_voxel.x * d.voxel_mm, d.root_voxel.y * d.voxel_mm, d.root_voxel.z * d.voxel_mm}}, {"unit", "mm"}};
+  j["root_voxel"] = {d.root_voxel.x, d.root_voxel.y, d.root_voxel.z};
+  j["terminals"] = g.terminals;
+  j["min_distance"] = q(g.min_distance_mm, "mm");
+  j["closest_neighbours"] = g.closest_neighbours;
+  j["min_segment_length"] = q(g.minSegmentLength(d.voxel_mm), "mm");
+  j["avoid_intersections"] = g.avoid_intersections;
+  j["murray_exponent"] = p.murray_exponent;
+  j["cost_radius_exponent"] = p.cost_radius_exponent;
+  j["cost_length_exponent"] = p.cost_length_exponent;
+  describePhysics(p, g.terminals, j);
+  return j;
+}
+
+std::vector<std::filesystem::path> VascuSynthSetup::inputs() const {
+  std::vector<std::filesystem::path> in{domain.demand_map};
+  if (!domain.supply_map.empty()) in.push_back(domain.supply_map);
+  return in;
+}
+
+std::unique_ptr<PreparedGrowth> VascuSynthSetup::prepare(std::uint64_t memory_limit) const {
+  return std::make_unique<PreparedVascuSynth>(*this, loadDomain(domain, memory_limit));
+}
+
+const GrowthMethod kVascuSynthMethod{
+    "vascusynth",
+    "VascuSynth's oxygen-demand CCO (seed 002) on box maps: terminals drawn ∝ the remaining demand, each joined to the "
+    "cheapest of its nearest segments for the cost Σ l^μ r^λ, radii by Poiseuille flow and Murray's law",
+    {
+        {"domain", "demand_map", "file", nullptr, "the oxygen-demand box map (VascuSynth format), beside the parameter file or the working directory"},
+        {"domain", "supply_map", "file", "none", "the supply box map; without it supply_coefficients hold everywhere"},
+        {"domain", "supply_coefficients", "numbers", "[0.65, 0.34, 0.01, 7]", "supply reduction coefficients, the last one the cut-off radius in map voxels"},
+        {"domain", "voxel_size", "mm", nullptr, "the edge of a map voxel"},
+        {"tree", "terminals", "count", nullptr, "N, the number of terminal segments"},
+        {"tree", "root_voxel", "[x, y, z] map voxels", nullptr, "the perforation point (or root in mm; one of the two)"},
+        {"tree", "root", "[x, y, z] mm", nullptr, "the perforation point in mm from the map's corner (or root_voxel)"},
+        {"tree", "closest_neighbours", "count", "5", "segments tried per candidate terminal"},
+        {"tree", "min_distance", "mm", "1 voxel", "candidates closer than this to any vessel are drawn again"},
+        {"tree", "min_segment_length", "mm", "0.05 voxel", "no segment shorter than this"},
+        {"tree", "avoid_intersections", "true/false", "true", "refuse connections whose vessels would overlap"},
+        {"physics", "murray_exponent", "", "3", "γ in r_parent^γ = r_a^γ + r_b^γ"},
+        {"physics", "cost_radius_exponent", "", "2", "λ of the cost Σ l^μ r^λ"},
+        {"physics", "cost_length_exponent", "", "1", "μ of the cost Σ l^μ r^λ"},
+        {"physics", "viscosity", "Pa*s", nullptr, "blood viscosity η"},
+        {"physics", "perfusion_pressure", "Pa", nullptr, "pressure at the root"},
+        {"physics", "terminal_pressure", "Pa", nullptr, "pressure at every terminal"},
+        {"physics", "perfusion_flow", "mm^3/s", nullptr, "flow into the root, split equally among the terminals"},
+    },
+    &readVascuSynthToml};
+
+}  // namespace angiosynth
