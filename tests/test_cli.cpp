@@ -49,7 +49,7 @@ TEST_F(Cli, GenerateWritesValidRoundTrippingGxlAndSidecar) {
   const auto* graph = doc.FirstChildElement("gxl")->FirstChildElement("graph");
   ASSERT_NE(graph, nullptr);
   EXPECT_STREQ(graph->Attribute("edgemode"), "directed");
-  int nodes = 0, edges = 0, roots = 0, terminals = 0;
+  int nodes = 0, edges = 0, roots = 0, terminals = 0, kinds = 0;
   double volume = 0;
   for (const auto* n = graph->FirstChildElement("node"); n; n = n->NextSiblingElement("node")) {
     ++nodes;
@@ -62,6 +62,8 @@ TEST_F(Cli, GenerateWritesValidRoundTrippingGxlAndSidecar) {
     double radius = 0, length = 0;
     for (const auto* a = e->FirstChildElement("attr"); a; a = a->NextSiblingElement("attr")) {
       const std::string name = a->Attribute("name");
+      if (name == "kind") kinds += a->FirstChildElement("string")->GetText() == std::string("artery");
+      if (!a->FirstChildElement("float")) continue;  // tree and kind are strings
       const double v = std::stod(a->FirstChildElement("float")->GetText());
       if (name == "radius") radius = v;
       if (name == "length") length = v;
@@ -72,6 +74,7 @@ TEST_F(Cli, GenerateWritesValidRoundTrippingGxlAndSidecar) {
   EXPECT_EQ(edges, 1999);
   EXPECT_EQ(roots, 1);
   EXPECT_EQ(terminals, 1000);
+  EXPECT_EQ(kinds, 1999);  // one tree, an artery: every edge says so
   // Numbers round-trip: the volume from the GXL equals the recorded one to the last bits.
   EXPECT_NEAR(volume, j["statistics"]["total_volume"]["value"].get<double>(), 1e-12 * volume);
 }

@@ -96,7 +96,7 @@ TEST(GraphFiles, GraphmlLoadsInNetworkxAndMatchesTheTree) {
   const fs::path file = fs::temp_directory_path() / "angiosynth_tree.graphml";
   std::ofstream(file) << [&] {
     std::ostringstream s;
-    writeGraphml(s, t);
+    writeGraphml(s, t, singleTreeForest(VascularTree{}).trees);
     return s.str();
   }();
   const std::string out = python(R"(

@@ -22,6 +22,18 @@ std::vector<std::string> kindsByLabel(const std::vector<TreeInfo>& trees) {
   return kinds;
 }
 
+std::vector<std::uint8_t> segmentClasses(const VascularTree& v, const std::vector<TreeInfo>& trees) {
+  std::vector<std::uint8_t> c(v.nodeCount(), 0);
+  for (std::int32_t i = 0; i < v.nodeCount(); ++i)
+    if (!v.isRoot(i)) c[i] = static_cast<std::uint8_t>(trees.at(v.tree.empty() ? 0 : v.tree[i]).class_label);
+  return c;
+}
+
+std::uint32_t classColour(int class_label) {
+  static const std::uint32_t palette[] = {0xb3262e, 0x2b4c9a, 0x2e8b57, 0xe08a1e, 0x7b3f9e, 0x1e9aa8};
+  return palette[(std::max(class_label, 1) - 1) % 6];
+}
+
 Forest singleTreeForest(VascularTree tree, const std::string& kind) {
   Forest f;
   f.vessels = std::move(tree);

@@ -26,6 +26,11 @@ struct Forest {
 void assignClassLabels(std::vector<TreeInfo>& trees);
 // The kinds in label order (index 0 is label 1).
 std::vector<std::string> kindsByLabel(const std::vector<TreeInfo>& trees);
+// The class label of every segment (by node id; 0 for roots), for the classes volume.
+std::vector<std::uint8_t> segmentClasses(const VascularTree& vessels, const std::vector<TreeInfo>& trees);
+// Display colour of a class (SVG figures, MIP previews): artery red, vein blue, further kinds
+// green, orange, purple, ... as 0xRRGGBB.
+std::uint32_t classColour(int class_label);
 // One tree as a forest of one (id "tree").
 Forest singleTreeForest(VascularTree tree, const std::string& kind = "artery");
 

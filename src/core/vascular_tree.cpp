@@ -17,16 +17,16 @@ const char* nodeTypeName(NodeType t) {
 void VascularTree::reserve(std::size_t n) {
   position.reserve(n); parent.reserve(n); child0.reserve(n); child1.reserve(n);
   terminals.reserve(n); length.reserve(n); reduced_resistance.reserve(n); beta.reserve(n);
-  cost_ratio.reserve(n); radius.reserve(n); flow.reserve(n); pressure.reserve(n); depth.reserve(n);
+  cost_ratio.reserve(n); radius.reserve(n); flow.reserve(n); pressure.reserve(n); depth.reserve(n); tree.reserve(n);
 }
 
 void VascularTree::truncate(std::size_t n) {
   position.resize(n); parent.resize(n); child0.resize(n); child1.resize(n);
   terminals.resize(n); length.resize(n); reduced_resistance.resize(n); beta.resize(n);
-  cost_ratio.resize(n); radius.resize(n); flow.resize(n); pressure.resize(n); depth.resize(n);
+  cost_ratio.resize(n); radius.resize(n); flow.resize(n); pressure.resize(n); depth.resize(n); tree.resize(n);
 }
 
-std::int32_t VascularTree::addNode(const Vec3& p, std::int32_t parent_node) {
+std::int32_t VascularTree::addNode(const Vec3& p, std::int32_t parent_node, std::int32_t tree_id) {
   const auto id = nodeCount();
   position.push_back(p);
   parent.push_back(parent_node);
@@ -41,6 +41,7 @@ std::int32_t VascularTree::addNode(const Vec3& p, std::int32_t parent_node) {
   flow.push_back(0);
   pressure.push_back(0);
   depth.push_back(parent_node >= 0 ? depth[parent_node] + 1 : 0);
+  tree.push_back(parent_node >= 0 ? tree[parent_node] : tree_id);
   if (parent_node >= 0) {
     if (child0[parent_node] < 0) child0[parent_node] = id;
     else if (child1[parent_node] < 0) child1[parent_node] = id;
@@ -55,15 +56,53 @@ void VascularTree::replaceChild(std::int32_t node, std::int32_t old_child, std::
   else throw std::logic_error("replaceChild: not a child");
 }
 
+std::vector<std::int32_t> VascularTree::roots() const {
+  std::vector<std::int32_t> r;
+  for (std::int32_t i = 0; i < nodeCount(); ++i)
+    if (parent[i] < 0) r.push_back(i);
+  return r;
+}
+
+std::int64_t VascularTree::totalTerminals() const {
+  std::int64_t n = 0;
+  for (auto r : roots())
+    if (child0[r] >= 0) n += terminals[child0[r]];
+  return n;
+}
+
+void VascularTree::appendTree(const VascularTree& t, std::int32_t tree_id) {
+  const std::int32_t shift = nodeCount();
+  const auto moved = [&](std::int32_t i) { return i >= 0 ? i + shift : -1; };
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    position.push_back(t.position[i]);
+    parent.push_back(moved(t.parent[i]));
+    child0.push_back(moved(t.child0[i]));
+    child1.push_back(moved(t.child1[i]));
+    terminals.push_back(t.terminals[i]);
+    length.push_back(t.length[i]);
+    reduced_resistance.push_back(t.reduced_resistance[i]);
+    beta.push_back(t.beta[i]);
+    cost_ratio.push_back(t.cost_ratio[i]);
+    radius.push_back(t.radius[i]);
+    flow.push_back(t.flow[i]);
+    pressure.push_back(t.pressure[i]);
+    depth.push_back(t.depth[i]);
+    tree.push_back(tree_id);
+  }
+}
+
 std::vector<std::int32_t> VascularTree::topDownOrder() const {
   std::vector<std::int32_t> order;
-  if (position.empty()) return order;
   order.reserve(position.size());
-  order.push_back(0);
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    const auto i = order[k];
-    if (child0[i] >= 0) order.push_back(child0[i]);
-    if (child1[i] >= 0) order.push_back(child1[i]);
+  for (std::int32_t r = 0; r < nodeCount(); ++r) {
+    if (parent[r] >= 0) continue;
+    std::size_t k = order.size();
+    order.push_back(r);
+    for (; k < order.size(); ++k) {
+      const auto i = order[k];
+      if (child0[i] >= 0) order.push_back(child0[i]);
+      if (child1[i] >= 0) order.push_back(child1[i]);
+    }
   }
   return order;
 }
@@ -87,13 +126,13 @@ void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments, con
     child0[node] = child1[node] = -1;
   }
   for (auto s : segments) {
-    if (s <= 0 || removed[s]) continue;
+    if (s < 0 || parent[s] < 0 || removed[s]) continue;
     const auto p = parent[s];
     const auto sib = sibling(s);
     drop(s);
     replaceChild(p, s, -1);
     if (child0[p] < 0) std::swap(child0[p], child1[p]);
-    if (p != 0 && sib >= 0) {
+    if (parent[p] >= 0 && sib >= 0) {
       // Bifurcation p now has one child: splice it out, sib hangs from p's parent.
       const auto pp = parent[p];
       replaceChild(pp, p, sib);
@@ -114,6 +153,7 @@ void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments, con
     out.parent.push_back(parent[i] >= 0 ? remap[parent[i]] : -1);
     out.child0.push_back(child0[i] >= 0 ? remap[child0[i]] : -1);
     out.child1.push_back(child1[i] >= 0 ? remap[child1[i]] : -1);
+    out.tree.push_back(tree.empty() ? 0 : tree[i]);
   }
   const auto m = out.position.size();
   out.terminals.assign(m, 1); out.length.assign(m, 0); out.reduced_resistance.assign(m, 0);
@@ -121,12 +161,12 @@ void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments, con
   out.flow.assign(m, 0); out.pressure.assign(m, 0); out.depth.assign(m, 0);
   const auto order = out.topDownOrder();
   for (auto i : order) {
-    if (i == 0) continue;
+    if (out.parent[i] < 0) continue;
     out.length[i] = distance(out.position[out.parent[i]], out.position[i]);
     out.depth[i] = out.depth[out.parent[i]] + 1;
   }
   for (auto it = order.rbegin(); it != order.rend(); ++it)
-    if (*it > 0 && out.child0[*it] >= 0) out.terminals[*it] = out.terminals[out.child0[*it]] + out.terminals[out.child1[*it]];
+    if (out.parent[*it] >= 0 && out.child0[*it] >= 0) out.terminals[*it] = out.terminals[out.child0[*it]] + out.terminals[out.child1[*it]];
   *this = std::move(out);
 }
 

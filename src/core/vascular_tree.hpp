@@ -2,6 +2,8 @@
 // The vascular tree as struct-of-arrays. Node 0 is the root (perforation point); every other
 // node i is the distal end of exactly one segment, which also has id i and runs from node
 // parent[i] to node i. The root node has one child segment; bifurcations have two.
+// A forest stores several trees in one such structure: each tree has its own root (parent -1),
+// `tree[i]` says which tree node i belongs to, and node and segment ids stay unique.
 #include <cstdint>
 #include <vector>
 
@@ -25,15 +27,22 @@ struct VascularTree {
   std::vector<double> flow;                 // mm^3/s
   std::vector<double> pressure;             // Pa, at node i (distal end of segment i)
   std::vector<std::int32_t> depth;          // segments from the root to node i
+  std::vector<std::int32_t> tree;           // index of the tree node i belongs to (0 in a single tree)
 
   std::int32_t nodeCount() const { return static_cast<std::int32_t>(position.size()); }
   std::int32_t segmentCount() const { return nodeCount() > 0 ? nodeCount() - 1 : 0; }
+  // Terminals of the tree rooted at node 0 (growth works on one tree).
   std::int32_t terminalCount() const { return nodeCount() > 1 ? terminals[rootSegment()] : 0; }
+  bool isRoot(std::int32_t i) const { return parent[i] < 0; }
+  // Root nodes, ascending: one per tree of a forest.
+  std::vector<std::int32_t> roots() const;
+  // Terminals of every tree.
+  std::int64_t totalTerminals() const;
   // The segment leaving the root node.
   std::int32_t rootSegment() const { return child0.empty() ? -1 : child0[0]; }
   bool isTerminal(std::int32_t i) const { return i > 0 && child0[i] < 0; }
   NodeType type(std::int32_t i) const {
-    if (i == 0) return NodeType::Root;
+    if (parent[i] < 0) return NodeType::Root;
     if (child0[i] < 0) return NodeType::Terminal;
     return child1[i] < 0 ? NodeType::Continuation : NodeType::Bifurcation;
   }
@@ -43,13 +52,16 @@ struct VascularTree {
     return child0[p] == i ? child1[p] : child0[p];
   }
 
-  // Appends a node with its incoming segment from `parent_node` (-1 for the root); returns its id.
-  std::int32_t addNode(const Vec3& p, std::int32_t parent_node);
+  // Appends a node with its incoming segment from `parent_node` (-1 for a root, which starts
+  // tree `tree_id`); returns its id.
+  std::int32_t addNode(const Vec3& p, std::int32_t parent_node, std::int32_t tree_id = 0);
+  // Appends every node of `t` (a single tree) as tree `tree_id`, ids shifted by nodeCount().
+  void appendTree(const VascularTree& t, std::int32_t tree_id);
   void replaceChild(std::int32_t node, std::int32_t old_child, std::int32_t new_child);
   void reserve(std::size_t nodes);
   // Drops nodes >= n (their links must already be undone).
   void truncate(std::size_t n);
-  // Nodes ordered so that every parent precedes its children (breadth-first from the root).
+  // Nodes ordered so that every parent precedes its children (breadth-first from each root in turn).
   std::vector<std::int32_t> topDownOrder() const;
   // Removes the given segments together with their subtrees and merges each orphaned
   // bifurcation into one straight segment; node ids are compacted, order is preserved.

@@ -99,20 +99,21 @@ nlohmann::ordered_json BSplineWarp::describe() const {
 
 VascularTree warpTree(const VascularTree& t, const BSplineWarp& warp, double piece_mm, std::vector<std::int32_t>& origin) {
   VascularTree w;
-  origin.assign(1, 0);
+  origin.clear();
   if (t.nodeCount() == 0) return w;
   std::vector<std::int32_t> node_of(t.nodeCount(), -1);
   // Points first (in parallel; each is an independent Newton solve), then links in tree order.
   std::vector<std::int32_t> order = t.topDownOrder();
   std::vector<std::int64_t> first_point(t.nodeCount() + 1, 0);
   std::vector<int> pieces(t.nodeCount(), 0);
-  for (std::int32_t n = 1; n < t.nodeCount(); ++n) pieces[n] = std::max(1, static_cast<int>(std::ceil(t.length[n] / piece_mm)));
-  for (std::int32_t n = 0; n < t.nodeCount(); ++n) first_point[n + 1] = first_point[n] + (n == 0 ? 1 : pieces[n]);
+  for (std::int32_t n = 0; n < t.nodeCount(); ++n)
+    pieces[n] = t.isRoot(n) ? 1 : std::max(1, static_cast<int>(std::ceil(t.length[n] / piece_mm)));
+  for (std::int32_t n = 0; n < t.nodeCount(); ++n) first_point[n + 1] = first_point[n] + pieces[n];
   std::vector<Vec3> moved(first_point.back());
   std::vector<double> scale(first_point.back(), 1.0);
   tbb::parallel_for(std::int32_t(0), t.nodeCount(), [&](std::int32_t n) {
-    if (n == 0) {
-      moved[0] = warp.forward(t.position[0]);
+    if (t.isRoot(n)) {
+      moved[first_point[n]] = warp.forward(t.position[n]);
       return;
     }
     const Vec3 a = t.position[t.parent[n]], b = t.position[n];
@@ -130,10 +131,13 @@ VascularTree warpTree(const VascularTree& t, const BSplineWarp& warp, double pie
     }
   });
   w.reserve(moved.size());
-  node_of[0] = w.addNode(moved[0], -1);
-  w.pressure[0] = t.pressure[0];
   for (std::int32_t n : order) {
-    if (n == 0) continue;
+    if (t.isRoot(n)) {  // a root starts its tree (its segment id is its own)
+      node_of[n] = w.addNode(moved[first_point[n]], -1, t.tree[n]);
+      w.pressure[node_of[n]] = t.pressure[n];
+      origin.push_back(n);
+      continue;
+    }
     std::int32_t prev = node_of[t.parent[n]];
     for (int q = 1; q <= pieces[n]; ++q) {
       const std::int64_t at = first_point[n] + q - 1;

@@ -22,9 +22,18 @@ std::string tupAttr(const char* name, const Vec3& p) {
          exactNumber(p.y) + "</float><float>" + exactNumber(p.z) + "</float></tup></attr>\n";
 }
 
+std::string stringAttr(const char* name, const std::string& v) {
+  return std::string("      <attr name=\"") + name + "\"><string>" + v + "</string></attr>\n";
+}
+
 }  // namespace
 
-void writeGxl(std::ostream& out, const VascularTree& t, const GraphFrame& f, const std::string& graph_id) {
+const TreeInfo& treeOf(const std::vector<TreeInfo>& trees, const VascularTree& t, std::int32_t node) {
+  return trees.at(t.tree.empty() ? 0 : static_cast<std::size_t>(t.tree[node]));
+}
+
+void writeGxl(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees, const GraphFrame& f,
+              const std::string& graph_id) {
   out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
          "<!DOCTYPE gxl SYSTEM \"http://www.gupro.de/GXL/gxl-1.0.dtd\">\n"
          "<gxl xmlns:xlink=\"http://www.w3.org/1999/xlink\">\n"
@@ -32,11 +41,13 @@ void writeGxl(std::ostream& out, const VascularTree& t, const GraphFrame& f, con
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
     out << "    <node id=\"n" << i << "\">\n"
         << "      <attr name=\"type\"><string>" << nodeTypeName(t.type(i)) << "</string></attr>\n"
+        << stringAttr("tree", treeOf(trees, t, i).id) << stringAttr("kind", treeOf(trees, t, i).kind)
         << tupAttr("position", t.position[i]) << tupAttr("position_voxel", t.position[i] / f.voxel_mm) << "    </node>\n";
   }
   for (auto i : t.topDownOrder()) {
-    if (i == 0) continue;
+    if (t.isRoot(i)) continue;
     out << "    <edge id=\"e" << i << "\" from=\"n" << t.parent[i] << "\" to=\"n" << i << "\">\n"
+        << stringAttr("tree", treeOf(trees, t, i).id) << stringAttr("kind", treeOf(trees, t, i).kind)
         << floatAttr("radius", t.radius[i]) << floatAttr("length", t.length[i]) << floatAttr("flow", t.flow[i])
         << floatAttr("pressure_proximal", t.pressure[t.parent[i]]) << floatAttr("pressure_distal", t.pressure[i])
         << "    </edge>\n";
@@ -57,7 +68,7 @@ void writeVascuSynthGxl(std::ostream& out, const VascularTree& t, const GraphFra
         << "  </node>\n";
   }
   for (auto i : t.topDownOrder()) {
-    if (i == 0) continue;
+    if (t.isRoot(i)) continue;
     out << "  <edge id=\"e" << i << "\" to=\"n" << i << "\" from=\"n" << t.parent[i] << "\">\n"
         << "    <attr name=\" flow\"><float>" << sig6(t.flow[i] / f.vs_units.mm3s_per_flow()) << "</float></attr>\n"
         << "    <attr name=\" radius\"><float>" << sig6(t.radius[i] / len) << "</float></attr>\n"
@@ -66,16 +77,18 @@ void writeVascuSynthGxl(std::ostream& out, const VascularTree& t, const GraphFra
   out << "</graph></gxl>\n";
 }
 
-void writeDot(std::ostream& out, const VascularTree& t, const GraphFrame& f) {
+void writeDot(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees, const GraphFrame& f) {
   out << "digraph tree {\n  // positions in mm; radius and length in mm, flow in mm^3/s, pressure in Pa\n";
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
     const Vec3& p = t.position[i];
-    out << "  n" << i << " [type=" << nodeTypeName(t.type(i)) << ", position=\"" << exactNumber(p.x) << ","
+    out << "  n" << i << " [type=" << nodeTypeName(t.type(i)) << ", tree=\"" << treeOf(trees, t, i).id << "\", kind=\""
+        << treeOf(trees, t, i).kind << "\", position=\"" << exactNumber(p.x) << ","
         << exactNumber(p.y) << "," << exactNumber(p.z) << "\"];\n";
   }
   for (auto i : t.topDownOrder()) {
-    if (i == 0) continue;
-    out << "  n" << t.parent[i] << " -> n" << i << " [radius=" << exactNumber(t.radius[i])
+    if (t.isRoot(i)) continue;
+    out << "  n" << t.parent[i] << " -> n" << i << " [tree=\"" << treeOf(trees, t, i).id << "\", kind=\""
+        << treeOf(trees, t, i).kind << "\", radius=" << exactNumber(t.radius[i])
         << ", length=" << exactNumber(t.length[i]) << ", flow=" << exactNumber(t.flow[i])
         << ", pressure=" << exactNumber(t.pressure[i]) << "];\n";
   }

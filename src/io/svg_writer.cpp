@@ -1,16 +1,18 @@
 #include "io/svg_writer.hpp"
 
+#include <cstdio>
 #include <iomanip>
 
 namespace angiosynth {
 
-void writeSvg(std::ostream& o, const VascularTree& t, const GrowthDomain& d) {
+void writeSvg(std::ostream& o, const Forest& forest, const GrowthDomain& d) {
+  const VascularTree& t = forest.vessels;
   const Vec3 hi = d.hi();
   o << std::setprecision(9);
   o << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
     << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << hi.x << "mm\" height=\"" << hi.y << "mm\" viewBox=\"0 0 "
     << hi.x << ' ' << hi.y << "\">\n"
-    << "<title>angiosynth CCO tree, " << t.terminalCount() << " terminals, lengths in mm</title>\n"
+    << "<title>angiosynth CCO tree, " << t.totalTerminals() << " terminals, lengths in mm</title>\n"
     << "<g transform=\"matrix(1 0 0 -1 0 " << hi.y << ")\">\n";
   const Vec3 c = d.center();
   switch (d.shape()) {
@@ -40,9 +42,16 @@ void writeSvg(std::ostream& o, const VascularTree& t, const GrowthDomain& d) {
       o << "</g>\n";
     }
   }
-  o << "<g stroke=\"#b3262e\" stroke-linecap=\"round\" fill=\"none\">\n";
-  for (auto i : t.topDownOrder()) {
-    if (i == 0) continue;
+  const auto order = t.topDownOrder();
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const auto i = order[k];
+    if (t.isRoot(i)) {  // a tree's nodes follow its root in top-down order
+      if (k > 0) o << "</g>\n";
+      char colour[8];
+      std::snprintf(colour, sizeof colour, "%06x", unsigned(classColour(forest.trees.at(t.tree[i]).class_label)));
+      o << "<g stroke=\"#" << colour << "\" stroke-linecap=\"round\" fill=\"none\">\n";
+      continue;
+    }
     const Vec3& a = t.position[t.parent[i]];
     const Vec3& b = t.position[i];
     o << "<line x1=\"" << a.x << "\" y1=\"" << a.y << "\" x2=\"" << b.x << "\" y2=\"" << b.y << "\" stroke-width=\""

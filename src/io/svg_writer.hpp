@@ -4,11 +4,12 @@
 // frame, so the picture matches the image's orientation in viewers that put +y at the top.
 #include <ostream>
 
-#include "core/vascular_tree.hpp"
+#include "core/forest.hpp"
 #include "domain/growth_domain.hpp"
 
 namespace angiosynth {
 
-void writeSvg(std::ostream& out, const VascularTree& tree, const GrowthDomain& domain);
+// Each tree is drawn in its kind's colour (artery red, vein blue).
+void writeSvg(std::ostream& out, const Forest& forest, const GrowthDomain& domain);
 
 }  // namespace angiosynth

@@ -7,61 +7,81 @@
 namespace angiosynth {
 
 double nodeRadius(const VascularTree& t, std::int32_t i) {
-  if (i > 0) return t.radius[i];
-  return t.rootSegment() > 0 ? t.radius[t.rootSegment()] : 0.0;
+  if (!t.isRoot(i)) return t.radius[i];
+  return t.child0[i] > 0 ? t.radius[t.child0[i]] : 0.0;
 }
 
-void writeNodesCsv(std::ostream& out, const VascularTree& t) {
-  out << "id,pos_x,pos_y,pos_z,type,pressure\n";
+void writeNodesCsv(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees) {
+  out << "id,pos_x,pos_y,pos_z,type,pressure,tree,kind\n";
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
     const Vec3& p = t.position[i];
+    const TreeInfo& tr = treeOf(trees, t, i);
     out << i << ',' << exactNumber(p.x) << ',' << exactNumber(p.y) << ',' << exactNumber(p.z) << ','
-        << nodeTypeName(t.type(i)) << ',' << exactNumber(t.pressure[i]) << '\n';
+        << nodeTypeName(t.type(i)) << ',' << exactNumber(t.pressure[i]) << ',' << tr.id << ',' << tr.kind << '\n';
   }
 }
 
-void writeEdgesCsv(std::ostream& out, const VascularTree& t) {
-  out << "id,node1id,node2id,length,radius,flow,volume\n";
-  for (std::int32_t i = 1; i < t.nodeCount(); ++i)
+void writeEdgesCsv(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees) {
+  out << "id,node1id,node2id,length,radius,flow,volume,tree,kind\n";
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    if (t.isRoot(i)) continue;
+    const TreeInfo& tr = treeOf(trees, t, i);
     out << i << ',' << t.parent[i] << ',' << i << ',' << exactNumber(t.length[i]) << ',' << exactNumber(t.radius[i]) << ','
-        << exactNumber(t.flow[i]) << ',' << exactNumber(std::numbers::pi * t.radius[i] * t.radius[i] * t.length[i]) << '\n';
+        << exactNumber(t.flow[i]) << ',' << exactNumber(std::numbers::pi * t.radius[i] * t.radius[i] * t.length[i]) << ','
+        << tr.id << ',' << tr.kind << '\n';
+  }
 }
 
-void writeVtp(std::ostream& out, const VascularTree& t) {
+void writeVtp(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees) {
   const auto n = t.nodeCount();
+  std::vector<std::int32_t> segments;
+  for (std::int32_t i = 1; i < n; ++i)
+    if (!t.isRoot(i)) segments.push_back(i);
+  const auto treeIndex = [&](std::int32_t i) { return t.tree.empty() ? 0 : t.tree[i]; };
   out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\">\n<PolyData>\n"
-      << "<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"0\" NumberOfLines=\"" << t.segmentCount()
+      << "<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"0\" NumberOfLines=\"" << segments.size()
       << "\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
       << "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
   for (std::int32_t i = 0; i < n; ++i)
     out << exactNumber(t.position[i].x) << ' ' << exactNumber(t.position[i].y) << ' ' << exactNumber(t.position[i].z) << '\n';
   out << "</DataArray>\n</Points>\n<PointData Scalars=\"Radius\">\n<DataArray type=\"Float64\" Name=\"Radius\" format=\"ascii\">\n";
   for (std::int32_t i = 0; i < n; ++i) out << exactNumber(nodeRadius(t, i)) << '\n';
+  out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"Tree\" format=\"ascii\">\n";
+  for (std::int32_t i = 0; i < n; ++i) out << treeIndex(i) << '\n';
+  out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"Class\" format=\"ascii\">\n";
+  for (std::int32_t i = 0; i < n; ++i) out << treeOf(trees, t, i).class_label << '\n';
   out << "</DataArray>\n</PointData>\n<CellData Scalars=\"Radius\">\n<DataArray type=\"Float64\" Name=\"Radius\" format=\"ascii\">\n";
-  for (std::int32_t i = 1; i < n; ++i) out << exactNumber(t.radius[i]) << '\n';
+  for (auto i : segments) out << exactNumber(t.radius[i]) << '\n';
   out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"Flow\" format=\"ascii\">\n";
-  for (std::int32_t i = 1; i < n; ++i) out << exactNumber(t.flow[i]) << '\n';
+  for (auto i : segments) out << exactNumber(t.flow[i]) << '\n';
+  out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"Tree\" format=\"ascii\">\n";
+  for (auto i : segments) out << treeIndex(i) << '\n';
+  out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"Class\" format=\"ascii\">\n";
+  for (auto i : segments) out << treeOf(trees, t, i).class_label << '\n';
   out << "</DataArray>\n</CellData>\n<Lines>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (std::int32_t i = 1; i < n; ++i) out << t.parent[i] << ' ' << i << '\n';
+  for (auto i : segments) out << t.parent[i] << ' ' << i << '\n';
   out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  for (std::int32_t i = 1; i < n; ++i) out << 2 * i << '\n';
+  for (std::size_t k = 1; k <= segments.size(); ++k) out << 2 * k << '\n';
   out << "</DataArray>\n</Lines>\n</Piece>\n</PolyData>\n</VTKFile>\n";
 }
 
-void writeSwc(std::ostream& out, const VascularTree& t) {
-  out << "# angiosynth vascular tree; x y z R in mm; type 1 = root, 0 = vessel node\n";
+void writeSwc(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees) {
+  out << "# angiosynth vascular forest; x y z R in mm; type 1 = root, 1 + class for vessel nodes (2 artery, 3 vein, "
+         "further kinds on)\n";
   // SWC ids start at 1 and a parent must precede its children.
   const auto order = t.topDownOrder();
   std::vector<std::int64_t> id(t.nodeCount(), -1);
   for (std::size_t k = 0; k < order.size(); ++k) id[order[k]] = std::int64_t(k) + 1;
   for (auto i : order) {
     const Vec3& p = t.position[i];
-    out << id[i] << ' ' << (i == 0 ? 1 : 0) << ' ' << exactNumber(p.x) << ' ' << exactNumber(p.y) << ' ' << exactNumber(p.z)
-        << ' ' << exactNumber(nodeRadius(t, i)) << ' ' << (i == 0 ? -1 : id[t.parent[i]]) << '\n';
+    const bool root = t.isRoot(i);
+    out << id[i] << ' ' << (root ? 1 : 1 + treeOf(trees, t, i).class_label) << ' ' << exactNumber(p.x) << ' '
+        << exactNumber(p.y) << ' ' << exactNumber(p.z) << ' ' << exactNumber(nodeRadius(t, i)) << ' '
+        << (root ? -1 : id[t.parent[i]]) << '\n';
   }
 }
 
-void writeGraphml(std::ostream& out, const VascularTree& t) {
+void writeGraphml(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees) {
   out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
          "<graphml xmlns=\"http://graphml.graphdrawing.org/xmlns\" "
          "xmlns:xsi=\"http://www.w3.org/2001/XMLSchema-instance\" "
@@ -71,20 +91,30 @@ void writeGraphml(std::ostream& out, const VascularTree& t) {
          "  <key id=\"z\" for=\"node\" attr.name=\"z\" attr.type=\"double\"/>\n"
          "  <key id=\"type\" for=\"node\" attr.name=\"type\" attr.type=\"string\"/>\n"
          "  <key id=\"node_radius\" for=\"node\" attr.name=\"radius\" attr.type=\"double\"/>\n"
+         "  <key id=\"node_tree\" for=\"node\" attr.name=\"tree\" attr.type=\"string\"/>\n"
+         "  <key id=\"node_kind\" for=\"node\" attr.name=\"kind\" attr.type=\"string\"/>\n"
          "  <key id=\"length\" for=\"edge\" attr.name=\"length\" attr.type=\"double\"/>\n"
          "  <key id=\"radius\" for=\"edge\" attr.name=\"radius\" attr.type=\"double\"/>\n"
          "  <key id=\"flow\" for=\"edge\" attr.name=\"flow\" attr.type=\"double\"/>\n"
+         "  <key id=\"tree\" for=\"edge\" attr.name=\"tree\" attr.type=\"string\"/>\n"
+         "  <key id=\"kind\" for=\"edge\" attr.name=\"kind\" attr.type=\"string\"/>\n"
          "  <graph id=\"tree\" edgedefault=\"directed\">\n";
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
     const Vec3& p = t.position[i];
+    const TreeInfo& tr = treeOf(trees, t, i);
     out << "    <node id=\"n" << i << "\"><data key=\"x\">" << exactNumber(p.x) << "</data><data key=\"y\">" << exactNumber(p.y)
         << "</data><data key=\"z\">" << exactNumber(p.z) << "</data><data key=\"type\">" << nodeTypeName(t.type(i))
-        << "</data><data key=\"node_radius\">" << exactNumber(nodeRadius(t, i)) << "</data></node>\n";
+        << "</data><data key=\"node_radius\">" << exactNumber(nodeRadius(t, i)) << "</data><data key=\"node_tree\">" << tr.id
+        << "</data><data key=\"node_kind\">" << tr.kind << "</data></node>\n";
   }
-  for (std::int32_t i = 1; i < t.nodeCount(); ++i)
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    if (t.isRoot(i)) continue;
+    const TreeInfo& tr = treeOf(trees, t, i);
     out << "    <edge id=\"e" << i << "\" source=\"n" << t.parent[i] << "\" target=\"n" << i << "\"><data key=\"length\">"
         << exactNumber(t.length[i]) << "</data><data key=\"radius\">" << exactNumber(t.radius[i]) << "</data><data key=\"flow\">"
-        << exactNumber(t.flow[i]) << "</data></edge>\n";
+        << exactNumber(t.flow[i]) << "</data><data key=\"tree\">" << tr.id << "</data><data key=\"kind\">" << tr.kind
+        << "</data></edge>\n";
+  }
   out << "  </graph>\n</graphml>\n";
 }
 

@@ -51,13 +51,15 @@ void solveTree(VascularTree& t, const PhysicsParameters& p) {
 double treeCost(const VascularTree& t, const PhysicsParameters& p) {
   const PowerKernel k(p);
   double c = 0;
-  for (std::int32_t i = 1; i < t.nodeCount(); ++i) c += k.lengthCost(t.length[i]) * k.radiusCost(t.radius[i]);
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i)
+    if (!t.isRoot(i)) c += k.lengthCost(t.length[i]) * k.radiusCost(t.radius[i]);
   return c;
 }
 
 double treeVolume(const VascularTree& t) {
   double v = 0;
-  for (std::int32_t i = 1; i < t.nodeCount(); ++i) v += std::numbers::pi * t.radius[i] * t.radius[i] * t.length[i];
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i)
+    if (!t.isRoot(i)) v += std::numbers::pi * t.radius[i] * t.radius[i] * t.length[i];
   return v;
 }
 

@@ -20,13 +20,13 @@ std::uint64_t degradedImageBytes(const Profile& p, const VolumeGrid& g) {
   return per_voxel * static_cast<std::uint64_t>(g.voxelCount());
 }
 
-void writeDegradedImages(const VascularTree& tree, const GroundTruthVolumes& gt, const VolumeRequest& req,
+void writeDegradedImages(const Forest& forest, const std::vector<std::uint8_t>& segment_classes, const GroundTruthVolumes& gt, const VolumeRequest& req,
                          const std::filesystem::path& dir, nlohmann::ordered_json& files, nlohmann::ordered_json& degradation,
                          nlohmann::ordered_json* seconds) {
   const ImageParameters& ip = req.image;
   for (const Profile& profile : req.profiles) {
     DegradeInput in;
-    in.tree = &tree;
+    in.tree = &forest.vessels;
     in.truth = &gt;
     in.seed = req.seed;
     in.sample = req.sample;
@@ -43,19 +43,21 @@ void writeDegradedImages(const VascularTree& tree, const GroundTruthVolumes& gt,
       writeSlices(image.view, d.image, lo, hi, profile.name, profile.name, dir, files);
     } else {
       std::vector<Channel> channels{{"image" + suffix, image.view}};
-      if (d.labels)
+      if (d.labels) {
+        fillClasses(*d.labels, segment_classes);  // warped instances keep the clean segment ids
         for (auto& c : labelChannels(*d.labels, suffix)) channels.push_back(c);
+      }
       writeChannels(channels, ip.formats, dir, files);
       if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end()) writeMips(d.image, lo, hi, suffix, dir, files);
     }
     if (d.tree) {
       const std::string gxl = "tree" + suffix + ".gxl";
-      writeTextFile(dir / gxl, [&](std::ostream& o) { writeGxl(o, *d.tree, req.frame, "tree" + suffix); });
+      writeTextFile(dir / gxl, [&](std::ostream& o) { writeGxl(o, *d.tree, forest.trees, req.frame, "tree" + suffix); });
       files["gxl" + suffix] = gxl;
       const std::string warp = "warp" + suffix + ".json";
       writeTextFile(dir / warp, [&](std::ostream& o) { o << d.warp->describe().dump(1) << "\n"; });
       files["warp" + suffix] = warp;
-      writeGraphFiles(*d.tree, gt.fraction.grid, ip.graph_formats, suffix, dir, files);
+      writeGraphFiles(*d.tree, forest.trees, gt.fraction.grid, ip.graph_formats, suffix, dir, files);
       std::int64_t mask_voxels = 0;
       for (auto m : d.labels->mask.data) mask_voxels += m;
       d.record["mask_voxels"] = mask_voxels;

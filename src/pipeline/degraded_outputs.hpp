@@ -13,7 +13,7 @@ namespace angiosynth {
 // Peak extra memory while one profile runs on grid g.
 std::uint64_t degradedImageBytes(const Profile& p, const VolumeGrid& g);
 
-void writeDegradedImages(const VascularTree& tree, const GroundTruthVolumes& gt, const VolumeRequest& req,
+void writeDegradedImages(const Forest& forest, const std::vector<std::uint8_t>& segment_classes, const GroundTruthVolumes& gt, const VolumeRequest& req,
                          const std::filesystem::path& dir, nlohmann::ordered_json& files, nlohmann::ordered_json& degradation,
                          nlohmann::ordered_json* seconds = nullptr);
 

@@ -136,13 +136,13 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   } else {
     writeTextFile(dir / "tree.gxl", [&](std::ostream& o) {
       if (req.gxl_dialect == "vascusynth") writeVascuSynthGxl(o, tree, frame, req.graph_id);
-      else writeGxl(o, tree, frame, req.graph_id);
+      else writeGxl(o, tree, forest.trees, frame, req.graph_id);
     });
     files["gxl"] = "tree.gxl";
-    writeTextFile(dir / "tree.dot", [&](std::ostream& o) { writeDot(o, tree, frame); });
+    writeTextFile(dir / "tree.dot", [&](std::ostream& o) { writeDot(o, tree, forest.trees, frame); });
     files["dot"] = "tree.dot";
     if (domain && domain->dimension() == 2) {
-      writeTextFile(dir / "tree.svg", [&](std::ostream& o) { writeSvg(o, tree, *domain); });
+      writeTextFile(dir / "tree.svg", [&](std::ostream& o) { writeSvg(o, forest, *domain); });
       files["svg"] = "tree.svg";
     }
   }
@@ -152,7 +152,7 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   if (volumes) {
     t0 = Clock::now();
     Json degrade_seconds;
-    writeVolumes(tree, vr, dir, files, stats, degradation, &degrade_seconds);
+    writeVolumes(forest, vr, dir, files, stats, degradation, &degrade_seconds);
     if (!degrade_seconds.empty()) timing["degrade_effects"] = degrade_seconds;
     timing["rasterize_and_write_volumes"] = seconds(t0);
   }
@@ -162,6 +162,7 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   std::int64_t depth_max = 0;
   double depth_sum = 0, r_min = INFINITY, r_max = 0;
   for (std::int32_t i = 1; i < tree.nodeCount(); ++i) {
+    if (tree.isRoot(i)) continue;
     r_min = std::min(r_min, tree.radius[i]);
     r_max = std::max(r_max, tree.radius[i]);
     if (!tree.isTerminal(i)) continue;
@@ -172,7 +173,7 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   pp.total_terminals = sc.growth->terminals();
   const double cost = treeCost(tree, pp);
   const double len_unit = sc.input_units.mm_per_length;
-  stats["terminals"] = tree.terminalCount();
+  stats["terminals"] = tree.totalTerminals();
   stats["nodes"] = tree.nodeCount();
   stats["segments"] = tree.segmentCount();
   stats["total_volume"] = q(treeVolume(tree), "mm^3");
@@ -183,7 +184,7 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
       Json{{"value", cost / std::pow(len_unit, p.cost_length_exponent + p.cost_radius_exponent)},
            {"unit", sc.input_units.length + "^" + exactNumber(p.cost_length_exponent + p.cost_radius_exponent)}};
   stats["depth_max"] = depth_max;
-  stats["depth_mean"] = tree.terminalCount() ? depth_sum / double(tree.terminalCount()) : 0.0;
+  stats["depth_mean"] = tree.totalTerminals() ? depth_sum / double(tree.totalTerminals()) : 0.0;
   stats["root_radius"] = q(report.root_radius_mm, "mm");
   stats["min_radius"] = q(r_min, "mm");
   stats["max_radius"] = q(r_max, "mm");
@@ -203,6 +204,7 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
     std::vector<double> sum;
     std::vector<std::int64_t> count;
     for (std::int32_t i = 1; i < tree.nodeCount(); ++i) {
+      if (tree.isRoot(i)) continue;
       const auto level = static_cast<std::size_t>(tree.depth[i] - 1);
       if (level >= sum.size()) sum.resize(level + 1, 0.0), count.resize(level + 1, 0);
       sum[level] += tree.radius[i];
@@ -226,6 +228,24 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
                     {"frame", "positions in mm from the corner of map voxel (0,0,0), axes along the map's x, y, z; "
                               "position_voxel in map voxels"}};
   j["parameters"] = describeParameters(sc);
+  // The trees of the forest: their ids and kinds, and the class label of each kind in `classes`.
+  Json trees = Json::array();
+  for (std::size_t k = 0; k < forest.trees.size(); ++k) {
+    const auto& t = forest.trees[k];
+    const auto root = tree.roots().at(k);
+    const auto seg = tree.child0[root];
+    trees.push_back(Json{{"index", k}, {"id", t.id}, {"kind", t.kind}, {"class", t.class_label},
+                         {"root_node", root}, {"terminals", seg >= 0 ? tree.terminals[seg] : 0},
+                         {"root_radius", q(seg >= 0 ? tree.radius[seg] : 0.0, "mm")},
+                         {"flow", q(seg >= 0 ? tree.flow[seg] : 0.0, "mm^3/s")}});
+  }
+  j["trees"] = trees;
+  Json legend = Json::object();
+  legend["0"] = "background";
+  const auto kinds = kindsByLabel(forest.trees);
+  for (std::size_t c = 0; c < kinds.size(); ++c)
+    if (!kinds[c].empty()) legend[std::to_string(c + 1)] = kinds[c];
+  j["classes"] = legend;
   for (const auto& [k, v] : req.extra.items()) j["parameters"][k] = v;
   if (!profiles.empty()) j["degradation"] = degradation;
   j["statistics"] = stats;

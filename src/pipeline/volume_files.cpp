@@ -26,14 +26,14 @@ void convert(Volume<T>& out, const Volume<float>& src, double offset, double sca
   });
 }
 
-void writeKeypoints(std::ostream& out, const VascularTree& t, const VolumeGrid& g) {
-  out << "id,type,x_voxel,y_voxel,z_voxel,x_mm,y_mm,z_mm,radius_mm\n";
+void writeKeypoints(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees, const VolumeGrid& g) {
+  out << "id,type,x_voxel,y_voxel,z_voxel,x_mm,y_mm,z_mm,radius_mm,tree,kind\n";
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
     const Vec3& p = t.position[i];
     const Vec3 v = g.index(p);
     out << i << ',' << nodeTypeName(t.type(i)) << ',' << exactNumber(v.x) << ',' << exactNumber(v.y) << ',' << exactNumber(v.z)
         << ',' << exactNumber(p.x) << ',' << exactNumber(p.y) << ',' << exactNumber(p.z) << ',' << exactNumber(nodeRadius(t, i))
-        << '\n';
+        << ',' << treeOf(trees, t, i).id << ',' << treeOf(trees, t, i).kind << '\n';
   }
 }
 
@@ -48,10 +48,12 @@ void makeTypedImage(TypedImage& out, const Volume<float>& src, double offset, do
 }
 
 std::vector<Channel> labelChannels(const GroundTruthVolumes& gt, const std::string& suffix) {
-  return {{"mask" + suffix, viewOf(gt.mask, true, "angiosynth vessel mask")},
-          {"centerline" + suffix, viewOf(gt.centerline, true, "angiosynth centreline")},
-          {"radius" + suffix, viewOf(gt.radius, false, "angiosynth radius (mm) on centreline")},
-          {"instances" + suffix, viewOf(gt.instances, true, "angiosynth segment id")}};
+  std::vector<Channel> c{{"mask" + suffix, viewOf(gt.mask, true, "angiosynth vessel mask")},
+                         {"centerline" + suffix, viewOf(gt.centerline, true, "angiosynth centreline")},
+                         {"radius" + suffix, viewOf(gt.radius, false, "angiosynth radius (mm) on centreline")},
+                         {"instances" + suffix, viewOf(gt.instances, true, "angiosynth segment id")}};
+  if (!gt.classes.data.empty()) c.push_back({"classes" + suffix, viewOf(gt.classes, true, "angiosynth kind: 1 artery, 2 vein")});
+  return c;
 }
 
 void writeChannels(const std::vector<Channel>& channels, const std::vector<std::string>& formats,
@@ -94,24 +96,24 @@ void writeSlices(const VolumeView& image, const Volume<float>& shown, double lo,
   files[role + "_slices"] = sub + "/image%03d.png";
 }
 
-void writeGraphFiles(const VascularTree& tree, const VolumeGrid& g, const std::vector<std::string>& graph_formats,
+void writeGraphFiles(const VascularTree& tree, const std::vector<TreeInfo>& trees, const VolumeGrid& g, const std::vector<std::string>& graph_formats,
                      const std::string& suffix, const std::filesystem::path& dir, Json& files) {
   const auto file = [&](const std::string& stem, const std::string& ext, const std::string& role, auto&& write) {
     const std::string name = stem + suffix + ext;
     writeTextFile(dir / name, write);
     files[role + suffix] = name;
   };
-  file("keypoints", ".csv", "keypoints", [&](std::ostream& o) { writeKeypoints(o, tree, g); });
+  file("keypoints", ".csv", "keypoints", [&](std::ostream& o) { writeKeypoints(o, tree, trees, g); });
   for (const auto& fmt : graph_formats) {
     if (fmt == "csv") {
-      file("nodes", ".csv", "nodes_csv", [&](std::ostream& o) { writeNodesCsv(o, tree); });
-      file("edges", ".csv", "edges_csv", [&](std::ostream& o) { writeEdgesCsv(o, tree); });
+      file("nodes", ".csv", "nodes_csv", [&](std::ostream& o) { writeNodesCsv(o, tree, trees); });
+      file("edges", ".csv", "edges_csv", [&](std::ostream& o) { writeEdgesCsv(o, tree, trees); });
     } else if (fmt == "vtp") {
-      file("centerlines", ".vtp", "vtp", [&](std::ostream& o) { writeVtp(o, tree); });
+      file("centerlines", ".vtp", "vtp", [&](std::ostream& o) { writeVtp(o, tree, trees); });
     } else if (fmt == "swc") {
-      file("tree", ".swc", "swc", [&](std::ostream& o) { writeSwc(o, tree); });
+      file("tree", ".swc", "swc", [&](std::ostream& o) { writeSwc(o, tree, trees); });
     } else if (fmt == "graphml") {
-      file("tree", ".graphml", "graphml", [&](std::ostream& o) { writeGraphml(o, tree); });
+      file("tree", ".graphml", "graphml", [&](std::ostream& o) { writeGraphml(o, tree, trees); });
     }
   }
 }

@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/vascular_tree.hpp"
+#include "core/forest.hpp"
 #include "io/volume_writers.hpp"
 #include "raster/ground_truth.hpp"
 
@@ -31,7 +31,7 @@ struct Channel {
   VolumeView view;
 };
 
-// The label channels of a ground truth (mask, centerline, radius, instances), with `suffix`
+// The label channels of a ground truth (mask, centerline, radius, instances, classes when filled), with `suffix`
 // appended to each role ("" or "_<profile>").
 std::vector<Channel> labelChannels(const GroundTruthVolumes& gt, const std::string& suffix);
 
@@ -46,7 +46,7 @@ void writeSlices(const VolumeView& image, const Volume<float>& shown, double lo,
                  const std::string& role, const std::filesystem::path& dir, nlohmann::ordered_json& files);
 // Key points and the graph formats besides GXL and DOT (csv, vtp, swc, graphml), with `suffix`
 // appended to file stems and roles.
-void writeGraphFiles(const VascularTree& tree, const VolumeGrid& g, const std::vector<std::string>& graph_formats,
+void writeGraphFiles(const VascularTree& tree, const std::vector<TreeInfo>& trees, const VolumeGrid& g, const std::vector<std::string>& graph_formats,
                      const std::string& suffix, const std::filesystem::path& dir, nlohmann::ordered_json& files);
 
 }  // namespace angiosynth

@@ -77,8 +77,9 @@ void checkVolumeMemory(const VolumeRequest& req) {
                          "; raise [image] voxel_size, shrink [image] field_of_view, or raise --memory-limit");
 }
 
-void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std::filesystem::path& dir, Json& files,
+void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::filesystem::path& dir, Json& files,
                   Json& stats, Json& degradation, Json* seconds) {
+  const VascularTree& tree = forest.vessels;
   const VolumeGrid& g = req.grid;
   const ImageParameters& ip = req.image;
   checkVolumeMemory(req);
@@ -105,9 +106,11 @@ void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std:
   stats["image_origin"] = Json{{"value", {g.origin_mm.x, g.origin_mm.y, g.origin_mm.z}},
                                {"unit", "mm"},
                                {"definition", "centre of voxel (0,0,0); world frame RAS+ (NIfTI, VDB), LPS in NRRD"}};
-  writeGraphFiles(tree, g, ip.graph_formats, "", dir, files);
+  writeGraphFiles(tree, forest.trees, g, ip.graph_formats, "", dir, files);
   if (!needsDense(req)) return;
-  const GroundTruthVolumes gt = rasterizeGroundTruth(tree, g, RasterOptions{ip.supersampling});
+  GroundTruthVolumes gt = rasterizeGroundTruth(tree, g, RasterOptions{ip.supersampling});
+  const std::vector<std::uint8_t> classes = segmentClasses(tree, forest.trees);
+  fillClasses(gt, classes);
   {
     TypedImage image;
     makeTypedImage(image, gt.fraction, ip.background, ip.vessel - ip.background, ip.dtype, "angiosynth image");
@@ -120,7 +123,7 @@ void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std:
   std::int64_t mask_voxels = 0;
   for (auto m : gt.mask.data) mask_voxels += m;
   stats["mask_voxels"] = mask_voxels;
-  writeDegradedImages(tree, gt, req, dir, files, degradation, seconds);
+  writeDegradedImages(forest, classes, gt, req, dir, files, degradation, seconds);
 }
 
 }  // namespace angiosynth

@@ -8,6 +8,7 @@
 
 #include "degrade/profile.hpp"
 #include "domain/demand_map.hpp"
+#include "core/forest.hpp"
 #include "io/graph_writers.hpp"
 #include "io/scenario.hpp"
 #include "raster/volume.hpp"
@@ -41,7 +42,7 @@ void checkVolumeMemory(const VolumeRequest& req);
 
 // Writes the volumes and graph files into dir; adds {role: path} to `files` and figures to
 // `stats`, and the drawn values of each profile to `degradation`. Throws InputError before allocating when the volumes would exceed the memory limit.
-void writeVolumes(const VascularTree& tree, const VolumeRequest& req, const std::filesystem::path& dir,
+void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::filesystem::path& dir,
                   nlohmann::ordered_json& files, nlohmann::ordered_json& stats, nlohmann::ordered_json& degradation,
                   nlohmann::ordered_json* seconds = nullptr);
 

@@ -44,6 +44,7 @@ Capsule capsuleOf(const VascularTree& t, std::int32_t s) {
 double brickPairBound(const VascularTree& tree, const VolumeGrid& g) {
   double total = 0;
   for (std::int32_t s = 1; s < tree.nodeCount(); ++s) {
+    if (tree.isRoot(s)) continue;
     const Vec3 a = tree.position[tree.parent[s]], b = tree.position[s];
     double n = 1;
     for (int ax = 0; ax < 3; ++ax) {
@@ -62,6 +63,7 @@ BrickBins binSegments(const VascularTree& tree, const VolumeGrid& g) {
   const double brick_half_diag = 0.5 * kBrick * std::sqrt(dot(sp, sp));
   std::vector<std::pair<std::int64_t, std::int32_t>> pairs;
   for (std::int32_t s = 1; s < tree.nodeCount(); ++s) {
+    if (tree.isRoot(s)) continue;
     const Vec3 a = tree.position[tree.parent[s]], b = tree.position[s];
     const double r = tree.radius[s];
     // Voxel x (cube [x−½, x+½] in index units) can touch the capsule's box if

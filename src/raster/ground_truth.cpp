@@ -11,8 +11,19 @@ namespace angiosynth {
 
 std::uint64_t denseRasterBytes(const VolumeGrid& g) {
   const std::uint64_t per_voxel = sizeof(float) /*fraction*/ + 1 /*mask*/ + 1 /*centerline*/ + sizeof(float) /*radius*/ +
-                                  sizeof(std::uint32_t) /*instances*/ + sizeof(float) /*image*/;
+                                  sizeof(std::uint32_t) /*instances*/ + 1 /*classes*/ + sizeof(float) /*image*/;
   return static_cast<std::uint64_t>(g.voxelCount()) * per_voxel;
+}
+
+void fillClasses(GroundTruthVolumes& gt, const std::vector<std::uint8_t>& class_of_segment) {
+  gt.classes = Volume<std::uint8_t>(gt.instances.grid);
+  const std::int64_t n = static_cast<std::int64_t>(gt.instances.data.size());
+  tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, n, 1 << 16), [&](const tbb::blocked_range<std::int64_t>& r) {
+    for (std::int64_t v = r.begin(); v < r.end(); ++v) {
+      const std::uint32_t s = gt.instances.data[v];
+      if (gt.mask.data[v] && s > 0 && s < class_of_segment.size()) gt.classes.data[v] = class_of_segment[s];
+    }
+  });
 }
 
 void centerlineVoxels(const VolumeGrid& g, const Vec3& a_mm, const Vec3& b_mm,
@@ -58,6 +69,7 @@ void addCenterlines(const VascularTree& t, GroundTruthVolumes& gt, const std::ve
       }
     };
     for (std::int32_t s = r.begin(); s != r.end(); ++s) {
+      if (t.isRoot(s)) continue;
       const Vec3& a = t.position[t.parent[s]];
       const Vec3& b = t.position[s];
       forEachCrossedVoxel(g, a, b, [&](std::int64_t i, std::int64_t j, std::int64_t k) { claim(g.flat(i, j, k), s); });

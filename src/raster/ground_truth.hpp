@@ -17,10 +17,17 @@ struct GroundTruthVolumes {
   Volume<std::uint8_t> centerline;   // 26-connected voxel curve of every segment
   Volume<float> radius;              // mm, on centreline voxels (the thicker vessel at joints)
   Volume<std::uint32_t> instances;   // segment id (= distal node id) on mask voxels, else 0
+  // The kind of the vessel on mask voxels (1 artery, 2 vein, further kinds on), else 0: that of
+  // the voxel's instance, so a voxel two kinds share takes the kind whose vessel surface lies
+  // deepest around it (the partial-volume rule), and a centreline voxel the lower segment id.
+  Volume<std::uint8_t> classes;
 };
 
 // Bytes of all dense channels plus a float image, for the size guard.
 std::uint64_t denseRasterBytes(const VolumeGrid& grid);
+
+// Fills gt.classes from gt.instances: class_of_segment[instance] on mask voxels.
+void fillClasses(GroundTruthVolumes& gt, const std::vector<std::uint8_t>& class_of_segment);
 
 GroundTruthVolumes rasterizeGroundTruth(const VascularTree& tree, const VolumeGrid& grid, const RasterOptions& opt);
 

@@ -30,6 +30,7 @@ std::vector<std::pair<std::int32_t, std::int32_t>> intersectingPairs(const Vascu
   double r_max = 0;
   for (std::int32_t s = 1; s < t.nodeCount(); ++s) r_max = std::max(r_max, t.radius[s]);
   for (std::int32_t x = 1; x < t.nodeCount(); ++x) {
+    if (t.isRoot(x)) continue;
     const Vec3& a0 = t.position[t.parent[x]];
     const Vec3& a1 = t.position[x];
     const double reach = t.radius[x] + r_max;

@@ -27,7 +27,8 @@ void SegmentIndex::build(const VascularTree& tree, double cell) {
   for (int ax = 0; ax < 3; ++ax) n_[ax] = std::max(1, static_cast<int>(std::ceil(ext[ax] / cell_)));
   cells_.assign(std::size_t(n_[0]) * n_[1] * n_[2], {});
   built_for_ = tree.segmentCount();
-  for (std::int32_t s = 1; s < tree.nodeCount(); ++s) insert(tree, s);
+  for (std::int32_t s = 1; s < tree.nodeCount(); ++s)
+    if (!tree.isRoot(s)) insert(tree, s);
 }
 
 void SegmentIndex::cellRange(const Vec3& lo, const Vec3& hi, int* a, int* b) const {
