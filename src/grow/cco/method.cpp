@@ -125,10 +125,7 @@ std::shared_ptr<const GrowthSetup> readCcoToml(const TomlReader& r, const Growth
 
   auto& c = s->cco;
   c.terminals = readTerminals(r, tree, s->terminals_line);
-  const auto whole = [&](const char* key, int& out, int lo, int hi) {
-    out = int(declaredNumber(r, m, tree, "tree", key));
-    if (tree.get(key)) out = r.smallInteger(tree, "tree", key, lo, hi);
-  };
+  const auto whole = [&](const char* key, int& out, int lo, int hi) { out = declaredCount(r, m, tree, "tree", key, lo, hi); };
   whole("closest_neighbours", c.closest_neighbours, 1, Limits::kMaxNeighbours);
   c.physics = readPhysics(r, m, methodTable(r, m, "physics"));
   c.physics.total_terminals = c.terminals;

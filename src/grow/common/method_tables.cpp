@@ -64,6 +64,13 @@ double declaredNumber(const TomlReader& r, const GrowthMethod& m, const toml::ta
   return std::stod(fallback);
 }
 
+int declaredCount(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table,
+                  const std::string& key, std::int64_t lo, std::int64_t hi) {
+  const char* fallback = fallbackOf(m, table, key);
+  if (t.get(key) || !fallback) return r.smallInteger(t, table, key, lo, hi);
+  return std::stoi(fallback);
+}
+
 PhysicsParameters readPhysics(const TomlReader& r, const GrowthMethod& m, const toml::table& ph) {
   PhysicsParameters p;
   p.murray_exponent = declaredNumber(r, m, ph, "physics", "murray_exponent");

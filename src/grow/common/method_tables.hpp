@@ -27,6 +27,10 @@ double declaredQuantity(const TomlReader& r, const GrowthMethod& m, const toml::
 double declaredNumber(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table,
                       const std::string& key);
 
+// table.key as a whole number in [lo, hi] (checked before it is narrowed), or the declared default.
+int declaredCount(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table,
+                  const std::string& key, std::int64_t lo, std::int64_t hi);
+
 // [physics] with m's defaults and the shared range checks; cost exponents only when m declares them.
 PhysicsParameters readPhysics(const TomlReader& r, const GrowthMethod& m, const toml::table& ph);
 

@@ -72,9 +72,7 @@ std::shared_ptr<const GrowthSetup> readVascuSynthToml(const TomlReader& r, const
   }
   g.avoid_intersections = r.boolean(tree, "avoid_intersections", true);
   g.terminals = readTerminals(r, tree, s->terminals_line);
-  g.closest_neighbours = int(declaredNumber(r, m, tree, "tree", "closest_neighbours"));
-  if (tree.get("closest_neighbours"))
-    g.closest_neighbours = r.smallInteger(tree, "tree", "closest_neighbours", 1, std::int64_t(Limits::kMaxNeighbours));
+  g.closest_neighbours = declaredCount(r, m, tree, "tree", "closest_neighbours", 1, std::int64_t(Limits::kMaxNeighbours));
   g.physics = readPhysics(r, m, methodTable(r, m, "physics"));
   g.physics.total_terminals = g.terminals;
   return s;
