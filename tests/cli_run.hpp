@@ -2,7 +2,9 @@
 // Running the angiosynth executable from tests, and reading files back.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +17,21 @@ struct Run {
   int code;
   std::string err;
 };
+
+// Runs a script with Debian's interpreter in `dir` (nibabel and NetworkX come from Debian
+// packages; the python3 first on PATH may be another installation); returns stdout and stderr.
+inline std::string debianPython(const std::string& script, const std::filesystem::path& dir) {
+  const std::string name = "angiosynth_check_" + std::to_string(::getpid()) + ".py";
+  std::ofstream(dir / name) << script;
+  std::string out;
+  if (FILE* p = popen(("cd '" + dir.string() + "' && /usr/bin/python3 " + name + " 2>&1").c_str(), "r")) {
+    char buf[4096];
+    while (fgets(buf, sizeof buf, p)) out += buf;
+    pclose(p);
+  }
+  std::filesystem::remove(dir / name);
+  return out;
+}
 
 inline Run run(const std::string& args, const std::filesystem::path& cwd) {
   const std::filesystem::path err = cwd / "stderr.txt";

@@ -23,18 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string python(const std::string& script, const fs::path& dir) {
-  const fs::path file = dir / "check.py";
-  std::ofstream(file) << script;
-  std::string out;
-  if (FILE* p = popen(("cd '" + dir.string() + "' && /usr/bin/python3 check.py 2>&1").c_str(), "r")) {
-    char buf[4096];
-    while (fgets(buf, sizeof buf, p)) out += buf;
-    pclose(p);
-  }
-  return out;
-}
-
 // A CCO tree in a sphere of radius 10 mm and the same tree 24 mm further along x, as artery and vein.
 Forest twoTreeForest() {
   static const Forest forest = [] {
@@ -105,7 +93,7 @@ TEST(Forest, GraphFilesNameTreeAndKindAndLoadAsOneTreePerInlet) {
   write("tree.swc", [&](std::ostream& o) { writeSwc(o, f.vessels, f.trees); });
   write("edges.csv", [&](std::ostream& o) { writeEdgesCsv(o, f.vessels, f.trees); });
   write("tree.gxl", [&](std::ostream& o) { writeGxl(o, f.vessels, f.trees, GraphFrame{}, "forest"); });
-  const std::string out = python(R"(
+  const std::string out = debianPython(R"(
 import networkx as nx, csv, collections
 g = nx.read_graphml('tree.graphml')
 comps = list(nx.weakly_connected_components(g))
@@ -156,7 +144,7 @@ TEST(Forest, ClassesVolumeGivesEveryMaskVoxelOneKindAndEachCentrelineItsOwn) {
       }
     }
   }
-  const std::string out = python(R"(
+  const std::string out = debianPython(R"(
 import nibabel as nib, numpy as np
 c = np.asarray(nib.load('classes.nii.gz').dataobj); m = np.asarray(nib.load('mask.nii.gz').dataobj)
 print('mask', int(m.sum()), 'unlabelled', int(((m > 0) & (c == 0)).sum()), 'outside', int(((m == 0) & (c > 0)).sum()),

@@ -18,19 +18,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Debian's interpreter: nibabel and NetworkX come from Debian packages (python3 on PATH may be
-// another installation).
-std::string python(const std::string& script) {
-  const fs::path file = fs::temp_directory_path() / ("angiosynth_check_" + std::to_string(::getpid()) + ".py");
-  std::ofstream(file) << script;
-  std::string out;
-  if (FILE* p = popen(("/usr/bin/python3 '" + file.string() + "' 2>&1").c_str(), "r")) {
-    char buf[4096];
-    while (fgets(buf, sizeof buf, p)) out += buf;
-    pclose(p);
-  }
-  return out;
-}
+std::string python(const std::string& script) { return debianPython(script, fs::temp_directory_path()); }
 
 class VolumeFiles : public ::testing::Test {
  protected:

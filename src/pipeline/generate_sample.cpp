@@ -5,6 +5,7 @@
 
 #include "angiosynth/version.hpp"
 #include "core/error.hpp"
+#include "core/quantity_json.hpp"
 #include "core/format.hpp"
 #include "domain/growth_domain.hpp"
 #include "io/graph_writers.hpp"
@@ -21,15 +22,13 @@ using Clock = std::chrono::steady_clock;
 
 double seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
 
-Json q(double v, const char* unit) { return Json{{"value", v}, {"unit", unit}}; }
-
 }  // namespace
 
 Json describeParameters(const Scenario& sc) {
   Json j = sc.growth->describe();
   const auto& im = sc.image;
   j["image"] = Json{{"enabled", im.enabled},
-                    {"voxel_size", q(im.voxel_mm > 0 ? im.voxel_mm : sc.growth->voxelMm(), "mm")},
+                    {"voxel_size", quantityJson(im.voxel_mm > 0 ? im.voxel_mm : sc.growth->voxelMm(), "mm")},
                     {"field_of_view", im.field_of_view_mm.x > 0 ? Json{{"value", {im.field_of_view_mm.x, im.field_of_view_mm.y, im.field_of_view_mm.z}}, {"unit", "mm"}}
                                                                : Json("the demand map's extent")},
                     {"supersampling", im.supersampling},
@@ -173,10 +172,11 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   pp.total_terminals = sc.growth->terminals();
   const double cost = treeCost(tree, pp);
   const double len_unit = sc.input_units.mm_per_length;
-  stats["terminals"] = tree.totalTerminals();
+  const std::int64_t terminals = tree.totalTerminals();
+  stats["terminals"] = terminals;
   stats["nodes"] = tree.nodeCount();
   stats["segments"] = tree.segmentCount();
-  stats["total_volume"] = q(treeVolume(tree), "mm^3");
+  stats["total_volume"] = quantityJson(treeVolume(tree), "mm^3");
   stats["cost"] = Json{{"value", cost},
                        {"unit", "mm^" + exactNumber(p.cost_length_exponent + p.cost_radius_exponent)},
                        {"definition", "sum over segments of length^mu * radius^lambda"}};
@@ -184,10 +184,10 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
       Json{{"value", cost / std::pow(len_unit, p.cost_length_exponent + p.cost_radius_exponent)},
            {"unit", sc.input_units.length + "^" + exactNumber(p.cost_length_exponent + p.cost_radius_exponent)}};
   stats["depth_max"] = depth_max;
-  stats["depth_mean"] = tree.totalTerminals() ? depth_sum / double(tree.totalTerminals()) : 0.0;
-  stats["root_radius"] = q(report.root_radius_mm, "mm");
-  stats["min_radius"] = q(r_min, "mm");
-  stats["max_radius"] = q(r_max, "mm");
+  stats["depth_mean"] = terminals ? depth_sum / double(terminals) : 0.0;
+  stats["root_radius"] = quantityJson(report.root_radius_mm, "mm");
+  stats["min_radius"] = quantityJson(r_min, "mm");
+  stats["max_radius"] = quantityJson(r_max, "mm");
   stats["intersecting_pairs"] = report.intersecting_pairs;
   stats["intersecting_pairs_definition"] = "segment capsules that overlap and are more than two segments apart";
   stats["candidates_drawn"] = report.candidates;
@@ -230,14 +230,15 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   j["parameters"] = describeParameters(sc);
   // The trees of the forest: their ids and kinds, and the class label of each kind in `classes`.
   Json trees = Json::array();
+  const auto roots = tree.roots();
   for (std::size_t k = 0; k < forest.trees.size(); ++k) {
     const auto& t = forest.trees[k];
-    const auto root = tree.roots().at(k);
+    const auto root = roots.at(k);
     const auto seg = tree.child0[root];
     trees.push_back(Json{{"index", k}, {"id", t.id}, {"kind", t.kind}, {"class", t.class_label},
                          {"root_node", root}, {"terminals", seg >= 0 ? tree.terminals[seg] : 0},
-                         {"root_radius", q(seg >= 0 ? tree.radius[seg] : 0.0, "mm")},
-                         {"flow", q(seg >= 0 ? tree.flow[seg] : 0.0, "mm^3/s")}});
+                         {"root_radius", quantityJson(seg >= 0 ? tree.radius[seg] : 0.0, "mm")},
+                         {"flow", quantityJson(seg >= 0 ? tree.flow[seg] : 0.0, "mm^3/s")}});
   }
   j["trees"] = trees;
   Json legend = Json::object();

@@ -1,5 +1,6 @@
 // Method "cco": its parameters, TOML reader, description, domain and grow function.
 #include "core/error.hpp"
+#include "core/quantity_json.hpp"
 #include "grow/cco/setup.hpp"
 #include "grow/common/feasibility.hpp"
 #include "grow/common/method_tables.hpp"
@@ -11,8 +12,6 @@ namespace angiosynth {
 namespace {
 
 using Json = nlohmann::ordered_json;
-
-Json q(double v, const char* unit) { return Json{{"value", v}, {"unit", unit}}; }
 
 class PreparedCco final : public PreparedGrowth {
  public:
@@ -46,7 +45,7 @@ class PreparedCco final : public PreparedGrowth {
     stats["short_segments_definition"] = "segments not longer than twice their radius";
     stats["outside_segments"] = report.outside_segments;
     stats["domain_dimension"] = domain_.dimension();
-    stats["domain_measure"] = q(domain_.measure(), domain_.dimension() == 2 ? "mm^2" : "mm^3");
+    stats["domain_measure"] = quantityJson(domain_.measure(), domain_.dimension() == 2 ? "mm^2" : "mm^3");
   }
 
  private:
@@ -199,11 +198,11 @@ Json CcoSetup::describe() const {
     if (d.root_in_mm) j["root"] = Json{{"value", {d.root_mm.x, d.root_mm.y, d.root_mm.z}}, {"unit", "mm"}};
     else j["root_voxel"] = {d.root_voxel.x, d.root_voxel.y, d.root_voxel.z};
   } else {
-    j[d.shape == DomainShape::Sphere || d.shape == DomainShape::Disc ? "radius" : "side"] = q(d.size_mm, "mm");
+    j[d.shape == DomainShape::Sphere || d.shape == DomainShape::Disc ? "radius" : "side"] = quantityJson(d.size_mm, "mm");
     j["root_offset"] = d.has_root_offset ? Json{{"value", {d.root_offset_mm.x, d.root_offset_mm.y, d.root_offset_mm.z}}, {"unit", "mm"}}
                                          : Json("the top of the domain (+y)");
   }
-  if (d.voxel_mm > 0) j["voxel_size"] = q(d.voxel_mm, "mm");
+  if (d.voxel_mm > 0) j["voxel_size"] = quantityJson(d.voxel_mm, "mm");
   j["terminals"] = c.terminals;
   j["closest_neighbours"] = c.closest_neighbours;
   j["max_closest_neighbours"] = c.max_neighbours;
@@ -230,7 +229,8 @@ const GrowthMethod kCcoMethod{
     "constrained constructive optimisation (Karch 1999, OpenCCO; seed 000) in a sphere, cube, disc, square or mask: the "
     "domain grows with the tree, each terminal joins the one of its nearest segments whose Kamiya bifurcation gives the "
     "least total volume, no vessel leaves the domain or overlaps another",
-    {
+    // Seed 000 §5 (Karch 1999): 3.6 cP, written in Pa*s, since "3.6 cP" parses one ulp off 3.6e-3.
+    withPhysicsParams({
         {"domain", "shape", "text", "sphere", "sphere, cube, disc or square (2D), or mask"},
         {"domain", "radius", "mm", nullptr, "sphere and disc: the radius"},
         {"domain", "side", "mm", nullptr, "cube and square: the side"},
@@ -247,12 +247,7 @@ const GrowthMethod kCcoMethod{
         {"tree", "kamiya_tolerance", "", "1e-6", "its step, relative to the three lengths, at convergence"},
         {"tree", "draws_before_relaxing", "count", "100", "failed draws before the distance threshold shrinks"},
         {"tree", "relaxation", "", "0.9", "the factor on the distance threshold after such a run"},
-        {"physics", "murray_exponent", "", "3", "γ in r_parent^γ = r_a^γ + r_b^γ"},
-        {"physics", "viscosity", "Pa*s", "0.0036 Pa*s", "blood viscosity η (3.6 cP, Karch 1999)"},
-        {"physics", "perfusion_pressure", "Pa", "100 mmHg", "pressure at the root"},
-        {"physics", "terminal_pressure", "Pa", "60 mmHg", "pressure at every terminal"},
-        {"physics", "perfusion_flow", "mm^3/s", "500 mL/min", "flow into the root, split equally among the terminals"},
-    },
+    }, false, "0.0036 Pa*s", "100 mmHg", "60 mmHg", "500 mL/min"),
     &readCcoToml};
 
 }  // namespace angiosynth

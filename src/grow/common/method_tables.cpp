@@ -1,5 +1,6 @@
 #include "grow/common/method_tables.hpp"
 
+#include "core/quantity_json.hpp"
 #include "io/param_checks.hpp"
 
 namespace angiosynth {
@@ -71,6 +72,21 @@ int declaredCount(const TomlReader& r, const GrowthMethod& m, const toml::table&
   return std::stoi(fallback);
 }
 
+std::vector<MethodParam> withPhysicsParams(std::vector<MethodParam> rows, bool cost_exponents, const char* viscosity,
+                                           const char* perfusion_pressure, const char* terminal_pressure,
+                                           const char* perfusion_flow) {
+  rows.push_back({"physics", "murray_exponent", "", "3", "γ in r_parent^γ = r_a^γ + r_b^γ"});
+  if (cost_exponents) {
+    rows.push_back({"physics", "cost_radius_exponent", "", "2", "λ of the cost Σ l^μ r^λ"});
+    rows.push_back({"physics", "cost_length_exponent", "", "1", "μ of the cost Σ l^μ r^λ"});
+  }
+  rows.push_back({"physics", "viscosity", "Pa*s", viscosity, "blood viscosity η"});
+  rows.push_back({"physics", "perfusion_pressure", "Pa", perfusion_pressure, "pressure at the root"});
+  rows.push_back({"physics", "terminal_pressure", "Pa", terminal_pressure, "pressure at every terminal"});
+  rows.push_back({"physics", "perfusion_flow", "mm^3/s", perfusion_flow, "flow into the root, split equally among the terminals"});
+  return rows;
+}
+
 PhysicsParameters readPhysics(const TomlReader& r, const GrowthMethod& m, const toml::table& ph) {
   PhysicsParameters p;
   p.murray_exponent = declaredNumber(r, m, ph, "physics", "murray_exponent");
@@ -118,13 +134,11 @@ std::int64_t readTerminals(const TomlReader& r, const toml::table& tree, int& li
 }
 
 void describePhysics(const PhysicsParameters& p, std::int64_t terminals, nlohmann::ordered_json& j) {
-  using Json = nlohmann::ordered_json;
-  const auto q = [](double v, const char* unit) { return Json{{"value", v}, {"unit", unit}}; };
-  j["viscosity"] = q(p.viscosity, "Pa*s");
-  j["perfusion_pressure"] = q(p.perfusion_pressure, "Pa");
-  j["terminal_pressure"] = q(p.terminal_pressure, "Pa");
-  j["perfusion_flow"] = q(p.perfusion_flow, "mm^3/s");
-  j["terminal_flow"] = q(p.perfusion_flow / double(terminals), "mm^3/s");
+  j["viscosity"] = quantityJson(p.viscosity, "Pa*s");
+  j["perfusion_pressure"] = quantityJson(p.perfusion_pressure, "Pa");
+  j["terminal_pressure"] = quantityJson(p.terminal_pressure, "Pa");
+  j["perfusion_flow"] = quantityJson(p.perfusion_flow, "mm^3/s");
+  j["terminal_flow"] = quantityJson(p.perfusion_flow / double(terminals), "mm^3/s");
 }
 
 }  // namespace angiosynth

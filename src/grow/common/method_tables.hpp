@@ -31,6 +31,13 @@ double declaredNumber(const TomlReader& r, const GrowthMethod& m, const toml::ta
 int declaredCount(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table,
                   const std::string& key, std::int64_t lo, std::int64_t hi);
 
+// The [physics] declarations of a flow-driven method, appended to `rows`: murray_exponent, the
+// cost exponents when `cost_exponents`, viscosity, pressures and flow with the given defaults
+// (nullptr: required).
+std::vector<MethodParam> withPhysicsParams(std::vector<MethodParam> rows, bool cost_exponents, const char* viscosity,
+                                           const char* perfusion_pressure, const char* terminal_pressure,
+                                           const char* perfusion_flow);
+
 // [physics] with m's defaults and the shared range checks; cost exponents only when m declares them.
 PhysicsParameters readPhysics(const TomlReader& r, const GrowthMethod& m, const toml::table& ph);
 

@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "core/quantity_json.hpp"
 #include "grow/common/feasibility.hpp"
 #include "grow/common/method_tables.hpp"
 #include "grow/vascusynth/setup.hpp"
@@ -11,8 +12,6 @@ namespace angiosynth {
 namespace {
 
 using Json = nlohmann::ordered_json;
-
-Json q(double v, const char* unit) { return Json{{"value", v}, {"unit", unit}}; }
 
 class PreparedVascuSynth final : public PreparedGrowth {
  public:
@@ -89,13 +88,13 @@ Json VascuSynthSetup::describe() const {
   j["demand_map"] = d.demand_map.string();
   if (d.supply_map.empty()) j["supply_coefficients"] = d.supply_coefficients;
   else j["supply_map"] = d.supply_map.string();
-  j["voxel_size"] = q(d.voxel_mm, "mm");
+  j["voxel_size"] = quantityJson(d.voxel_mm, "mm");
   j["root"] = Json{{"value", {d.root_voxel.x * d.voxel_mm, d.root_voxel.y * d.voxel_mm, d.root_voxel.z * d.voxel_mm}}, {"unit", "mm"}};
   j["root_voxel"] = {d.root_voxel.x, d.root_voxel.y, d.root_voxel.z};
   j["terminals"] = g.terminals;
-  j["min_distance"] = q(g.min_distance_mm, "mm");
+  j["min_distance"] = quantityJson(g.min_distance_mm, "mm");
   j["closest_neighbours"] = g.closest_neighbours;
-  j["min_segment_length"] = q(g.minSegmentLength(d.voxel_mm), "mm");
+  j["min_segment_length"] = quantityJson(g.minSegmentLength(d.voxel_mm), "mm");
   j["avoid_intersections"] = g.avoid_intersections;
   j["murray_exponent"] = p.murray_exponent;
   j["cost_radius_exponent"] = p.cost_radius_exponent;
@@ -118,7 +117,7 @@ const GrowthMethod kVascuSynthMethod{
     "vascusynth",
     "VascuSynth's oxygen-demand CCO (seed 002) on box maps: terminals drawn ∝ the remaining demand, each joined to the "
     "cheapest of its nearest segments for the cost Σ l^μ r^λ, radii by Poiseuille flow and Murray's law",
-    {
+    withPhysicsParams({
         {"domain", "demand_map", "file", nullptr, "the oxygen-demand box map (VascuSynth format), beside the parameter file or the working directory"},
         {"domain", "supply_map", "file", "none", "the supply box map; without it supply_coefficients hold everywhere"},
         {"domain", "supply_coefficients", "numbers", "[0.65, 0.34, 0.01, 7]", "supply reduction coefficients, the last one the cut-off radius in map voxels"},
@@ -130,14 +129,7 @@ const GrowthMethod kVascuSynthMethod{
         {"tree", "min_distance", "mm", "1 voxel", "candidates closer than this to any vessel are drawn again"},
         {"tree", "min_segment_length", "mm", "0.05 voxel", "no segment shorter than this"},
         {"tree", "avoid_intersections", "true/false", "true", "refuse connections whose vessels would overlap"},
-        {"physics", "murray_exponent", "", "3", "γ in r_parent^γ = r_a^γ + r_b^γ"},
-        {"physics", "cost_radius_exponent", "", "2", "λ of the cost Σ l^μ r^λ"},
-        {"physics", "cost_length_exponent", "", "1", "μ of the cost Σ l^μ r^λ"},
-        {"physics", "viscosity", "Pa*s", nullptr, "blood viscosity η"},
-        {"physics", "perfusion_pressure", "Pa", nullptr, "pressure at the root"},
-        {"physics", "terminal_pressure", "Pa", nullptr, "pressure at every terminal"},
-        {"physics", "perfusion_flow", "mm^3/s", nullptr, "flow into the root, split equally among the terminals"},
-    },
+    }, true, nullptr, nullptr, nullptr, nullptr),
     &readVascuSynthToml};
 
 }  // namespace angiosynth
