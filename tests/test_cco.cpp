@@ -14,6 +14,7 @@
 #include "grow/common/kamiya.hpp"
 #include "physics/hemodynamics.hpp"
 #include "test_support.hpp"
+#include "tree_checks.hpp"
 
 using namespace angiosynth;
 
@@ -43,47 +44,6 @@ DemandMap voxelMap(std::array<std::int32_t, 3> dims, double voxel_mm, F&& value)
     for (int j = 0; j < dims[1]; ++j)
       for (int i = 0; i < dims[0]; ++i) m.demand[m.flat(i, j, k)] = static_cast<float>(value(i, j, k));
   return m;
-}
-
-// Every pair of segments more than one segment apart, by brute force (independent of the grid
-// the grower and its final check use): their capsules must not overlap.
-std::int64_t bruteForceIntersections(const VascularTree& t) {
-  std::int64_t hits = 0;
-  for (std::int32_t x = 1; x < t.nodeCount(); ++x)
-    for (std::int32_t y = x + 1; y < t.nodeCount(); ++y) {
-      const Vec3 &a0 = t.position[t.parent[x]], &a1 = t.position[x], &b0 = t.position[t.parent[y]], &b1 = t.position[y];
-      // Bounding boxes first.
-      bool apart = false;
-      for (int ax = 0; ax < 3 && !apart; ++ax)
-        apart = std::min(a0[ax], a1[ax]) - t.radius[x] > std::max(b0[ax], b1[ax]) + t.radius[y] ||
-                std::min(b0[ax], b1[ax]) - t.radius[y] > std::max(a0[ax], a1[ax]) + t.radius[x];
-      if (apart) continue;
-      if (withinTwoSegments(t, x, y)) continue;
-      if (segmentSegmentDistance(a0, a1, b0, b1) < t.radius[x] + t.radius[y]) ++hits;
-    }
-  return hits;
-}
-
-// Geometry invariants of a final tree: length > 2r, inside the domain (checked by sampling the
-// capsule's centreline against the domain's depth), no intersecting pair.
-void expectGeometry(const VascularTree& t, const GrowthDomain& d) {
-  std::int64_t short_segments = 0, outside = 0;
-  for (std::int32_t s = 1; s < t.nodeCount(); ++s) {
-    if (!(t.length[s] > 2 * t.radius[s])) ++short_segments;
-    const Vec3 a = t.position[t.parent[s]], b = t.position[s];
-    for (int k = 0; k <= 64; ++k) {
-      const Vec3 p = a + (b - a) * (k / 64.0);
-      const double from_root = distance(p, t.position[0]);
-      const double need = t.parent[s] == 0 ? std::min(t.radius[s], from_root - t.radius[s]) : t.radius[s];
-      if (d.depth(p) < need - 1e-9) {
-        ++outside;
-        break;
-      }
-    }
-  }
-  EXPECT_EQ(short_segments, 0);
-  EXPECT_EQ(outside, 0);
-  EXPECT_EQ(bruteForceIntersections(t), 0);
 }
 
 }  // namespace
@@ -175,7 +135,7 @@ TEST(Cco, SphereTreeMeetsEveryConstraintAndHemodynamicInvariant) {
   const auto t = growCco(d, o, rep);
   PhysicsParameters p = o.physics;
   test::expectHemodynamicInvariants(t, p, 4000);
-  expectGeometry(t, d);
+  test::expectGeometry(t, d);
   EXPECT_EQ(rep.intersecting_pairs, 0);
   // Mean radius falls with the bifurcation level over the first levels (seed 000 Fig. 6–7),
   // from a root of about a millimetre (Karch 1999: 1.3–1.5 mm) to terminals under 0.15 mm.
@@ -196,7 +156,7 @@ TEST(Cco, DiscTreeIsPlanarAndMeetsEveryConstraint) {
   GrowthReport rep;
   const auto t = growCco(d, o, rep);
   test::expectHemodynamicInvariants(t, o.physics, 1500);
-  expectGeometry(t, d);
+  test::expectGeometry(t, d);
   for (const auto& p : t.position) ASSERT_EQ(p.z, d.planeZ());
 }
 
@@ -211,7 +171,7 @@ TEST(Cco, NonConvexMaskKeepsEveryVesselInsideTheMask) {
   GrowthReport rep;
   const auto t = growCco(d, o, rep);
   test::expectHemodynamicInvariants(t, o.physics, 600);
-  expectGeometry(t, d);
+  test::expectGeometry(t, d);
   // Independently of the depth map: every centreline sample lies in a mask voxel.
   std::int64_t outside = 0;
   for (std::int32_t s = 1; s < t.nodeCount(); ++s)
@@ -243,7 +203,7 @@ TEST(Cco, DemandWeightedSamplingPutsTerminalsWhereDemandIsHigh) {
     o.root_mm = Vec3(10, 0.6, 10);
     GrowthReport rep;
     const auto t = growCco(d, o, rep);
-    expectGeometry(t, d);
+    test::expectGeometry(t, d);
     double high = 0;
     for (std::int32_t i = 1; i < t.nodeCount(); ++i)
       if (t.isTerminal(i)) high += t.position[i].x > 10;

@@ -44,12 +44,15 @@ inline VascularTree grow(const Example& e, GrowthReport* report = nullptr) {
 }
 
 // Murray's law, flow conservation, equal terminal flows and pressures, and Poiseuille drops on
-// both sides of every bifurcation, each to 1e-9 relative; root flow Q_perf at P_perf.
-inline void expectHemodynamicInvariants(const VascularTree& t, const PhysicsParameters& p, std::int64_t terminals) {
+// both sides of every bifurcation, each to 1e-9 relative; root flow (terminals × q_term, by
+// default Q_perf) at P_perf. A draining tree (a vein) gains pressure towards its terminals.
+inline void expectHemodynamicInvariants(const VascularTree& t, const PhysicsParameters& p, std::int64_t terminals,
+                                        double q_term = 0) {
   ASSERT_EQ(t.terminalCount(), terminals);
   ASSERT_EQ(t.nodeCount(), 2 * terminals);
-  const double q_term = p.perfusion_flow / double(terminals);
-  const double drop = p.perfusion_pressure - p.terminal_pressure;
+  if (q_term == 0) q_term = p.perfusion_flow / double(terminals);
+  const double drop = std::abs(p.perfusion_pressure - p.terminal_pressure);
+  const double sign = p.terminal_pressure > p.perfusion_pressure ? -1 : 1;
   const double k = 8 * p.viscosity / std::numbers::pi;
   std::int64_t bifurcations = 0;
   for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
@@ -66,11 +69,11 @@ inline void expectHemodynamicInvariants(const VascularTree& t, const PhysicsPara
     EXPECT_NEAR(lhs, rhs, 1e-9 * lhs) << "segment " << i;
     for (auto c : {a, b}) {
       const double dp = t.flow[c] * k * t.length[c] / std::pow(t.radius[c], 4);
-      EXPECT_NEAR(t.pressure[c], t.pressure[i] - dp, 1e-9 * drop) << "segment " << c;
+      EXPECT_NEAR(t.pressure[c], t.pressure[i] - sign * dp, 1e-9 * drop) << "segment " << c;
     }
   }
   EXPECT_EQ(bifurcations, terminals - 1);
-  EXPECT_NEAR(t.flow[t.rootSegment()], p.perfusion_flow, 1e-9 * p.perfusion_flow);
+  EXPECT_NEAR(t.flow[t.rootSegment()], q_term * double(terminals), 1e-9 * q_term * double(terminals));
   EXPECT_EQ(t.pressure[0], p.perfusion_pressure);
 }
 

@@ -52,15 +52,21 @@ namespace angiosynth {
 // Multi-page TIFF (one page per z slice, zip-compressed, lossless) through OpenImageIO.
 void writeTiff(const std::filesystem::path& file, const VolumeView& v);
 
-// A 2D 8-bit image (row-major, width fastest).
+// A 2D 8-bit image (row-major, width fastest): grey, or RGB with `channels` = 3 interleaved.
 struct Image8 {
   int width = 0, height = 0;
   std::vector<std::uint8_t> pixels;
+  int channels = 1;
 };
 // Maximum-intensity projection along axis 0, 1 or 2, mapping [lo, hi] to [0, 255]. The image
 // shows the two remaining axes in increasing order (the lower one horizontal), index 0 at the
 // top left.
 Image8 maximumProjection(const Volume<float>& v, int axis, double lo, double hi);
+// The same projection in colour: each pixel takes the colour (0xRRGGBB, from `colour_of(label)`)
+// of the label of the voxel that gave its maximum (the first along the axis on ties), scaled by
+// its intensity; label 0 stays grey.
+Image8 maximumProjection(const Volume<float>& v, const Volume<std::uint8_t>& labels, std::uint32_t (*colour_of)(int),
+                         int axis, double lo, double hi);
 // Slice z of a volume, mapping [lo, hi] to [0, 255].
 Image8 sliceZ(const Volume<float>& v, std::int32_t z, double lo, double hi);
 // Lossless 8-bit PNG through OpenImageIO.

@@ -5,7 +5,7 @@
 namespace angiosynth {
 
 double rootRadius(const PhysicsParameters& p, double root_flow, double root_reduced_resistance) {
-  const double dp = p.perfusion_pressure - p.terminal_pressure;
+  const double dp = std::abs(p.perfusion_pressure - p.terminal_pressure);
   return std::sqrt(std::sqrt(root_flow * 8.0 * p.viscosity / std::numbers::pi * root_reduced_resistance / dp));
 }
 
@@ -37,7 +37,8 @@ void solveTree(VascularTree& t, const PhysicsParameters& p) {
   t.beta[root] = 1;
   t.pressure[0] = p.perfusion_pressure;
   t.depth[0] = 0;
-  const double resistance_factor = 8.0 * p.viscosity / std::numbers::pi;
+  // A draining tree (a vein) carries its flow from the terminals to the root: pressure rises downstream.
+  const double resistance_factor = (p.drains() ? -8.0 : 8.0) * p.viscosity / std::numbers::pi;
   for (auto i : order) {
     if (i == 0) continue;
     const auto par = t.parent[i];

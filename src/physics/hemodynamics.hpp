@@ -15,11 +15,13 @@ struct PhysicsParameters {
   double cost_radius_exponent = 2;  // λ
   double cost_length_exponent = 1;  // μ
   double viscosity = 3.6e-3;      // Pa*s
-  double perfusion_pressure = 13300;  // Pa
+  double perfusion_pressure = 13300;  // Pa, at the root (a vein's outlet)
   double terminal_pressure = 8300;    // Pa
   double perfusion_flow = 8330;       // mm^3/s, split equally among the final terminals
   std::int64_t total_terminals = 1;   // N: every terminal carries perfusion_flow / N
   double terminalFlow() const { return perfusion_flow / static_cast<double>(total_terminals); }
+  // Flow runs from the terminals to the root (a vein): the terminals are at the higher pressure.
+  bool drains() const { return terminal_pressure > perfusion_pressure; }
 };
 
 // x^(-1/3) for x >= 1 to full double precision: a first guess from the exponent bits, then
@@ -68,7 +70,7 @@ inline double combinedResistance(double l, const PowerKernel::Split& s, double R
   return l + 1.0 / (pow4(s.beta_a) / R_a + pow4(s.beta_b) / R_b);
 }
 
-// Root radius from r⁴ = Q_root·(8η/π)·R̃_root / (P_perf − P_term) (eq. 10).
+// Root radius from r⁴ = Q_root·(8η/π)·R̃_root / |P_root − P_term| (eq. 10).
 double rootRadius(const PhysicsParameters& p, double root_flow, double root_reduced_resistance);
 
 // Recomputes terminal counts, lengths, reduced resistances, β, cost ratios (bottom-up) and then

@@ -48,7 +48,7 @@ void writeDegradedImages(const Forest& forest, const std::vector<std::uint8_t>& 
         for (auto& c : labelChannels(*d.labels, suffix)) channels.push_back(c);
       }
       writeChannels(channels, ip.formats, dir, files);
-      if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end()) writeMips(d.image, lo, hi, suffix, dir, files);
+      if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end()) writeMips(d.image, previewClasses(forest.trees, d.labels ? *d.labels : gt), lo, hi, suffix, dir, files);
     }
     if (d.tree) {
       const std::string gxl = "tree" + suffix + ".gxl";

@@ -235,10 +235,18 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
     const auto& t = forest.trees[k];
     const auto root = roots.at(k);
     const auto seg = tree.child0[root];
+    // The pressure at its terminals: that of its first terminal (all are equal in flow-driven trees).
+    double terminal_pressure = tree.pressure[root];
+    for (std::int32_t i = seg; i >= 0; i = tree.child0[i]) terminal_pressure = tree.pressure[i];
+    const Vec3& at = tree.position[root];
     trees.push_back(Json{{"index", k}, {"id", t.id}, {"kind", t.kind}, {"class", t.class_label},
-                         {"root_node", root}, {"terminals", seg >= 0 ? tree.terminals[seg] : 0},
+                         {"root_node", root}, {"root_position", Json{{"value", {at.x, at.y, at.z}}, {"unit", "mm"}}},
+                         {"terminals", seg >= 0 ? tree.terminals[seg] : 0},
                          {"root_radius", quantityJson(seg >= 0 ? tree.radius[seg] : 0.0, "mm")},
-                         {"flow", quantityJson(seg >= 0 ? tree.flow[seg] : 0.0, "mm^3/s")}});
+                         {"flow", quantityJson(seg >= 0 ? tree.flow[seg] : 0.0, "mm^3/s")},
+                         {"root_pressure", quantityJson(tree.pressure[root], "Pa")},
+                         {"terminal_pressure", quantityJson(terminal_pressure, "Pa")},
+                         {"flow_direction", terminal_pressure > tree.pressure[root] ? "terminals to root (drains)" : "root to terminals"}});
   }
   j["trees"] = trees;
   Json legend = Json::object();

@@ -73,12 +73,12 @@ void writeChannels(const std::vector<Channel>& channels, const std::vector<std::
   }
 }
 
-void writeMips(const Volume<float>& v, double lo, double hi, const std::string& suffix, const std::filesystem::path& dir,
-               Json& files) {
+void writeMips(const Volume<float>& v, const Volume<std::uint8_t>* classes, double lo, double hi, const std::string& suffix,
+               const std::filesystem::path& dir, Json& files) {
   const char* axes[] = {"mip_x", "mip_y", "mip_z"};
   for (int ax = 0; ax < 3; ++ax) {
     const std::string role = std::string(axes[ax]) + suffix;
-    writePng(dir / (role + ".png"), maximumProjection(v, ax, lo, hi));
+    writePng(dir / (role + ".png"), classes ? maximumProjection(v, *classes, &classColour, ax, lo, hi) : maximumProjection(v, ax, lo, hi));
     files[role] = role + ".png";
   }
 }

@@ -1,6 +1,7 @@
 #pragma once
 // Writing a set of volumes (one sample's channels, clean or degraded) in every requested format,
 // recorded by role: the first volume format owns the plain role, later ones add _<format>.
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -38,9 +39,15 @@ std::vector<Channel> labelChannels(const GroundTruthVolumes& gt, const std::stri
 // Writes the channels in each volume format (nifti, nrrd, tiff; png and vdb are skipped).
 void writeChannels(const std::vector<Channel>& channels, const std::vector<std::string>& formats,
                    const std::filesystem::path& dir, nlohmann::ordered_json& files);
-// Maximum-intensity projections along x, y, z as mip_<axis><suffix>.png, [lo, hi] → [0, 255].
-void writeMips(const Volume<float>& v, double lo, double hi, const std::string& suffix, const std::filesystem::path& dir,
-               nlohmann::ordered_json& files);
+// Maximum-intensity projections along x, y, z as mip_<axis><suffix>.png, [lo, hi] → [0, 255]; in
+// colour by the kind of the brightest voxel (artery red, vein blue, ...) when `classes` is given.
+void writeMips(const Volume<float>& v, const Volume<std::uint8_t>* classes, double lo, double hi, const std::string& suffix,
+               const std::filesystem::path& dir, nlohmann::ordered_json& files);
+// The classes volume to colour previews with: unless every tree is an artery (grey, as before forests).
+inline const Volume<std::uint8_t>* previewClasses(const std::vector<TreeInfo>& trees, const GroundTruthVolumes& gt) {
+  const bool kinds = std::any_of(trees.begin(), trees.end(), [](const TreeInfo& t) { return t.class_label != 1; });
+  return kinds && !gt.classes.data.empty() ? &gt.classes : nullptr;
+}
 // VascuSynth's layout: <sub>/image.nii.gz and one lossless PNG per z slice, [lo, hi] → [0, 255].
 void writeSlices(const VolumeView& image, const Volume<float>& shown, double lo, double hi, const std::string& sub,
                  const std::string& role, const std::filesystem::path& dir, nlohmann::ordered_json& files);

@@ -22,6 +22,9 @@ constexpr std::int64_t kRefreshEvery = 64;
 constexpr double kMaxRepairShare = 0.05;
 // An ancestor is checked again for collisions once its radius has grown by this factor.
 constexpr double kRecheckGrowth = 1.02;
+// Connections refused in a row (for one terminal) because an ancestor hit another tree, after
+// which a forest's ancestors skip that check.
+constexpr std::int64_t kLenientAfter = 100;
 // Segments with ρ at least this are "thick": checked from a list rather than through the grid.
 constexpr double kThick = 0.25;
 
@@ -39,74 +42,200 @@ PhysicsParameters volumePhysics(const CcoOptions& o) {
   return p;
 }
 
+// One tree of the forest and what its growth keeps beside it.
+struct TreeGrowth {
+  TreeGrowth(const GrowthDomain& d, PhysicsParameters p, const Vec3& root, int system_id, std::int64_t reserve)
+      : params(p), kernel(params), index(d.lo(), d.hi(), d.dimension() == 2), system(system_id) {
+    tree.reserve(2 * reserve + 1);
+    tree.addNode(root, -1);
+  }
+  PhysicsParameters params;
+  PowerKernel kernel;
+  SegmentIndex index;
+  int system;
+  std::int64_t quota = 0;  // fixed number of terminals; 0: the territory it wins
+  VascularTree tree;
+  std::vector<double> rel{1.0};  // ρ: radius / root radius
+  std::vector<double> checked;         // radius (final units) at which each segment was last found clear
+  std::vector<std::int32_t> thick{1};  // segments with ρ >= kThick (the first is the root segment)
+  std::vector<std::pair<double, std::int32_t>> near;
+  std::size_t done = 0;                // near[0, done) evaluated in earlier rounds
+  std::int32_t terminalCount() const { return tree.terminalCount(); }
+};
+
+// Inlets competing for the same terminals (one kind).
+struct System {
+  std::int64_t target = 0;
+  std::int64_t territory = 0;  // terminals for the inlets without a fixed share
+  std::vector<int> trees;
+};
+
+// A trial connection of a drawn point to one tree, ranked by the volume it adds to the forest.
+struct Candidate {
+  int tree;
+  std::size_t trial;
+  double added;
+};
+
 class CcoGrower {
  public:
-  CcoGrower(const GrowthDomain& d, const CcoOptions& o, GrowthReport& r)
-      : dom_(d), opt_(o), report_(r), params_(volumePhysics(o)), kernel_(params_),
-        index_(d.lo(), d.hi(), d.dimension() == 2), rng_(o.seed, o.sample, Stage::Growth) {
-    tree_.reserve(2 * o.terminals + 1);
-    tree_.addNode(o.root_mm, -1);
+  CcoGrower(const GrowthDomain& d, const CcoOptions& o, const std::vector<CcoInlet>& inlets, GrowthReport& r)
+      : dom_(d), opt_(o), report_(r), rng_(o.seed, o.sample, Stage::Growth) {
+    int systems = 0;
+    for (const auto& in : inlets) systems = std::max(systems, in.system + 1);
+    systems_.resize(systems);
+    for (std::size_t k = 0; k < inlets.size(); ++k) {
+      const auto& in = inlets[k];
+      PhysicsParameters p = volumePhysics(o);
+      p.perfusion_pressure = in.root_pressure;
+      p.terminal_pressure = in.terminal_pressure;
+      trees_.emplace_back(d, p, in.root_mm, in.system, o.terminals);
+      systems_[in.system].trees.push_back(int(k));
+    }
+    for (auto& sys : systems_) {
+      sys.target = o.terminals;
+      std::vector<double> shares;
+      for (int k : sys.trees) shares.push_back(inlets[k].share);
+      const auto quotas = terminalQuotas(shares, sys.target);
+      sys.territory = sys.target;
+      for (std::size_t i = 0; i < sys.trees.size(); ++i) {
+        trees_[sys.trees[i]].quota = quotas[i];
+        sys.territory -= quotas[i];
+      }
+    }
   }
 
-  VascularTree run(const ProgressFn& progress) {
-    growUntil(opt_.terminals, progress);
+  std::vector<VascularTree> run(const ProgressFn& progress) {
+    growUntilTargets(progress);
     repair(progress);
-    report_.root_radius_mm = tree_.radius[tree_.rootSegment()];
-    return std::move(tree_);
+    report_.root_radius_mm = trees_[0].tree.radius[trees_[0].tree.rootSegment()];
+    std::vector<VascularTree> out;
+    for (auto& t : trees_) out.push_back(std::move(t.tree));
+    return out;
   }
 
  private:
-  double scale(std::int64_t n) const { return std::pow(double(n) / double(opt_.terminals), 1.0 / dom_.dimension()); }
+  std::int64_t systemTerminals(const System& s) const {
+    std::int64_t n = 0;
+    for (int k : s.trees) n += trees_[k].terminalCount();
+    return n;
+  }
+  // The domain grows with each system: s = (n/N)^(1/d) for the n terminals it has.
+  double scale(const System& s, std::int64_t n) const { return std::pow(double(n) / double(s.target), 1.0 / dom_.dimension()); }
   // Root radius in final-domain units for n terminals and root reduced resistance R (final units):
   // physically r⁴ ∝ n·(s·R), and lengths shrink by s.
-  double shrink(std::int64_t n) const { return std::pow(scale(n), -0.75); }
-  double rootRadiusFinal(std::int64_t n, double R, double shrink_n) const {
-    return rootRadius(params_, double(n) * params_.terminalFlow(), R) * shrink_n;
+  // Regrowth after the final repair fills holes in the final domain: in a forest it keeps the
+  // final scale, since the inflated radii of a domain that is "still growing" would make every
+  // trunk collide with the other tree's vessels beside it. (A single tree keeps the scaling.)
+  double shrink(const System& s, std::int64_t n) const {
+    return repairing_ && trees_.size() > 1 ? 1.0 : std::pow(scale(s, n), -0.75);
   }
-  double currentRootRadius() const {
-    const auto root = tree_.rootSegment();
-    const auto n = tree_.terminals[root];
-    return rootRadiusFinal(n, tree_.reduced_resistance[root], shrink(n));
+  static double rootRadiusFinal(const TreeGrowth& g, std::int64_t n, double R, double shrink_n) {
+    return rootRadius(g.params, double(n) * g.params.terminalFlow(), R) * shrink_n;
   }
-  bool startsAtRoot(std::int32_t seg) const { return tree_.parent[seg] == 0; }
+  double currentRootRadius(const TreeGrowth& g) const {
+    const auto root = g.tree.rootSegment();
+    if (root < 0) return 0;
+    const auto& sys = systems_[g.system];
+    return rootRadiusFinal(g, g.tree.terminals[root], g.tree.reduced_resistance[root], shrink(sys, systemTerminals(sys)));
+  }
+  static bool startsAtRoot(const TreeGrowth& g, std::int32_t seg) { return g.tree.parent[seg] == 0; }
+  // True if tree k may take one more terminal.
+  bool accepts(int k) const {
+    const auto& g = trees_[k];
+    if (g.quota > 0) return g.terminalCount() < g.quota;
+    std::int64_t n = 0;
+    for (int j : systems_[g.system].trees)
+      if (trees_[j].quota == 0) n += trees_[j].terminalCount();
+    return n < systems_[g.system].territory;
+  }
 
-  void plantFirst() {
-    const Vec3 root = tree_.position[0];
+  // True if the capsule a–e of radius r overlaps a vessel of a tree other than k: with the radii
+  // of growth (ρ × the current root radius), or, on the solved forest, the exact radii + 2 %.
+  bool hitsOtherTree(int k, const Vec3& a, const Vec3& e, double r, bool solved = false) {
+    for (std::size_t j = 0; j < trees_.size(); ++j) {
+      if (int(j) == k) continue;
+      auto& o = trees_[j];
+      if (o.tree.segmentCount() == 0) continue;
+      // During growth both sides carry the slack of kRecheckGrowth, and the other vessel counts
+      // with the radius it was last checked at if that is larger: a vessel is checked again only
+      // once it has thickened past that by kRecheckGrowth, so the pair stays clear until one of
+      // them is checked again. (Trunks of two trees that start side by side are too large for
+      // the final repair to regrow.)
+      const double rr = solved ? 1.02 * o.tree.radius[o.tree.rootSegment()] : kRecheckGrowth * currentRootRadius(o);
+      const auto radius_of = [&](std::int32_t y) {
+        if (solved) return 1.02 * o.tree.radius[y];
+        const double last = y < std::int32_t(o.checked.size()) ? o.checked[y] : 0.0;
+        return std::max(o.rel[y] * rr, kRecheckGrowth * last);
+      };
+      bool hit = false;
+      const auto test = [&](std::int32_t y) {
+        if (hit || y >= o.tree.nodeCount() || y < 1) return;
+        hit = capsulesOverlap(a, e, r, o.tree.position[o.tree.parent[y]], o.tree.position[y], radius_of(y));
+      };
+      if (solved) {  // the index holds the final geometry; the thickest vessel bounds the reach
+        o.index.forEachNearSegment(a, e, r + rr, test);
+        if (hit) return true;
+        continue;
+      }
+      // As within a tree: the grid as far as thin vessels reach, the few thick ones from their list.
+      o.index.forEachNearSegment(a, e, r + kThick * rr, test);
+      const Vec3 mid = (a + e) * 0.5;
+      const double half = 0.5 * distance(a, e);
+      for (auto y : o.thick) {
+        if (hit) break;
+        if (y >= o.tree.nodeCount()) continue;
+        const Vec3& b0 = o.tree.position[o.tree.parent[y]];
+        const Vec3& b1 = o.tree.position[y];
+        if (distance(mid, (b0 + b1) * 0.5) <= half + 0.5 * distance(b0, b1) + r + radius_of(y)) test(y);
+      }
+      if (hit) return true;
+    }
+    return false;
+  }
+
+  void plantFirst(int k) {
+    auto& g = trees_[k];
+    const auto& sys = systems_[g.system];
+    const Vec3 root = g.tree.position[0];
+    const double shrink_new = shrink(sys, systemTerminals(sys) + 1);
     for (std::int64_t draws = 0; draws < opt_.max_draws; ++draws) {
       ++report_.candidates;
       const Vec3 p = dom_.sample(rng_);
       const double l = distance(root, p);
-      const double r = rootRadiusFinal(1, l, shrink(1));
-      if (!(l > 2 * r) || !dom_.capsuleInside(root, p, r, true)) {
+      const double r = rootRadiusFinal(g, 1, l, shrink_new);
+      if (!(l > 2 * r) || !dom_.capsuleInside(root, p, r, true) || hitsOtherTree(k, root, p, kRecheckGrowth * r)) {
         ++report_.rejected_unreachable;
         continue;
       }
-      const auto t = tree_.addNode(p, 0);
-      tree_.length[t] = l;
-      tree_.terminals[t] = 1;
-      tree_.reduced_resistance[t] = l;
-      tree_.cost_ratio[t] = l;
-      tree_.beta[t] = 1;
-      rel_.assign(2, 1.0);
-      index_.refresh(tree_, true);
+      const auto t = g.tree.addNode(p, 0);
+      g.tree.length[t] = l;
+      g.tree.terminals[t] = 1;
+      g.tree.reduced_resistance[t] = l;
+      g.tree.cost_ratio[t] = l;
+      g.tree.beta[t] = 1;
+      g.rel.assign(2, 1.0);
+      g.index.refresh(g.tree, true);
       return;
     }
-    throw GrowthError("no first terminal could be connected to the root: every segment from it leaves the domain "
-                      "or is shorter than twice its radius; move the root inside the domain");
+    throw GrowthError("no first terminal could be connected to the root" + std::string(trees_.size() > 1 ? " of inlet " + std::to_string(k + 1) : "") +
+                      ": every segment from it leaves the domain, is shorter than twice its radius" +
+                      (trees_.size() > 1 ? " or crosses another tree" : "") + "; move the root inside the domain");
   }
 
   // Kamiya's bifurcation of segment s towards terminal p, with its volume and checks that need
   // no other vessel (run in parallel on a tree that does not change).
-  Trial evaluate(std::int32_t s, const Vec3& p, std::int64_t n_new, double shrink_new, const BifurcationOptimizer& opt) const {
+  Trial evaluate(const TreeGrowth& g, std::int32_t s, const Vec3& p, std::int64_t n_new, double shrink_new,
+                 const BifurcationOptimizer& opt) const {
     Trial t;
-    const auto& T = tree_;
+    const auto& T = g.tree;
     KamiyaProblem kp;
     kp.x0 = T.position[T.parent[s]];
     kp.x1 = T.position[s];
     kp.x2 = p;
     kp.f1 = T.terminals[s];
     kp.f2 = 1;
-    kp.murray_exponent = params_.murray_exponent;
+    kp.murray_exponent = g.params.murray_exponent;
     const auto k = kamiyaBifurcation(kp, opt_.kamiya_iterations, opt_.kamiya_tolerance);
     if (!k.converged) {
       t.kamiya_failed = true;
@@ -121,47 +250,48 @@ class CcoGrower {
     const double l[3] = {distance(kp.x0, k.x), distance(k.x, kp.x1), distance(k.x, p)};
     c.cost = opt.cost(s, l[0], l[1], l[2], &c.path);
     const auto& top = c.path.back();
-    c.root_radius = rootRadius(params_, top.terminals * params_.terminalFlow(), top.reduced_resistance);
+    c.root_radius = rootRadius(g.params, top.terminals * g.params.terminalFlow(), top.reduced_resistance);
     // ρ of the new bifurcation segment: the product of β from the root down the recorded path.
     double rho_b = 1;
     for (std::size_t lv = 1; lv < c.path.size(); ++lv) rho_b *= c.path[lv].beta_child;
-    const double rr = rootRadiusFinal(n_new, top.reduced_resistance, shrink_new);
+    const double rr = rootRadiusFinal(g, n_new, top.reduced_resistance, shrink_new);
     // Radii in final-domain units: new bifurcation segment, split part, terminal.
     const double r[3] = {rr * rho_b, rr * rho_b * c.path[0].beta_child, rr * rho_b * c.path[0].beta_other};
     for (int j = 0; j < 3; ++j)
       if (!(l[j] > 2 * r[j])) return t;  // §4.4: length / radius > 2
-    if (!dom_.capsuleInside(kp.x0, k.x, r[0], startsAtRoot(s)) || !dom_.capsuleInside(k.x, kp.x1, r[1], false) ||
+    if (!dom_.capsuleInside(kp.x0, k.x, r[0], startsAtRoot(g, s)) || !dom_.capsuleInside(k.x, kp.x1, r[1], false) ||
         !dom_.capsuleInside(k.x, p, r[2], false))
       return t;
     c.valid = true;
     return t;
   }
 
-  // True if a segment touched by the committed connection overlaps a vessel more than one
-  // segment away: the three new segments, and every ancestor (they all thicken) whose radius
-  // has grown by more than kRecheckGrowth since it was last checked; the exact final check
-  // covers that slack. Segments found clear are listed in cleared_.
-  bool collides(const Connection& c, double rr) {
-    const auto& T = tree_;
+  // True if a segment of tree k touched by the committed connection overlaps a vessel more than
+  // one segment away, or one of another tree: the three new segments, and every ancestor (they
+  // all thicken) whose radius has grown by more than kRecheckGrowth since it was last checked;
+  // the exact final check covers that slack. Segments found clear are listed in check_.
+  bool collides(int k, const Connection& c, double rr) {
+    auto& g = trees_[k];
+    const auto& T = g.tree;
     const auto b = T.nodeCount() - 2;
     check_.assign({b, c.segment, b + 1});
-    checked_.resize(T.nodeCount(), 0.0);
+    g.checked.resize(T.nodeCount(), 0.0);
     for (std::size_t lv = 1; lv < c.path.size(); ++lv) {
       const auto x = c.path[lv].segment;
-      if (rel_[x] * rr > kRecheckGrowth * checked_[x]) check_.push_back(x);
+      if (g.rel[x] * rr > kRecheckGrowth * g.checked[x]) check_.push_back(x);
     }
-    const auto radius_of = [&](std::int32_t y) { return rel_[y] * rr; };
-    for (auto x : check_) {
+    const auto radius_of = [&](std::int32_t y) { return g.rel[y] * rr; };
+    for (const auto& x : check_) {
       const Vec3& a0 = T.position[T.parent[x]];
       const Vec3& a1 = T.position[x];
-      const double rx = rel_[x] * rr;
+      const double rx = g.rel[x] * rr;
       // The grid is searched as far as thin vessels reach; the few thick ones are listed apart,
       // so the search does not widen with the root radius as the cells shrink.
       const auto candidates = [&](auto&& f) {
-        index_.forEachNearSegment(a0, a1, rx + kThick * rr, f);
+        g.index.forEachNearSegment(a0, a1, rx + kThick * rr, f);
         const Vec3 mid = (a0 + a1) * 0.5;
         const double half = 0.5 * distance(a0, a1);
-        for (auto y : thick_) {
+        for (auto y : g.thick) {
           if (y >= T.nodeCount()) continue;
           const Vec3& b0 = T.position[T.parent[y]];
           const Vec3& b1 = T.position[y];
@@ -169,99 +299,168 @@ class CcoGrower {
         }
       };
       if (overlapsOtherVessel(T, x, a0, a1, rx, candidates, radius_of)) return true;
+      const bool ancestor = &x - check_.data() >= 3;
+      if (trees_.size() > 1 && !(ancestor && lenient_) && hitsOtherTree(k, a0, a1, kRecheckGrowth * rx)) {
+        ancestor_blocks_ += ancestor;
+        return true;
+      }
     }
     return false;
   }
 
   // ρ of the whole tree, and the list of thick segments.
-  void refreshRelativeRadii() {
-    refreshRelative(tree_, rel_);
-    thick_.clear();
-    for (std::int32_t s = 1; s < tree_.nodeCount(); ++s)
-      if (rel_[s] >= kThick) thick_.push_back(s);
+  static void refreshRelativeRadii(TreeGrowth& g) {
+    refreshRelative(g.tree, g.rel);
+    g.thick.clear();
+    for (std::int32_t s = 1; s < g.tree.nodeCount(); ++s)
+      if (g.rel[s] >= kThick) g.thick.push_back(s);
   }
 
-  void markChecked(double rr) {
-    for (auto x : check_) checked_[x] = rel_[x] * rr;
+  // The whole-tree cost of tree k now, in the units of Connection::cost.
+  double treeCostNow(const TreeGrowth& g) const {
+    const auto root = g.tree.rootSegment();
+    const double r = rootRadius(g.params, g.tree.terminals[root] * g.params.terminalFlow(), g.tree.reduced_resistance[root]);
+    return g.kernel.radiusCost(r) * g.tree.cost_ratio[root];
   }
 
-  // Connects p through the cheapest valid bifurcation among its ν nearest segments, doubling ν
-  // while none is valid. False when p lies in a vessel or no segment can take it.
-  bool connect(const Vec3& p) {
-    const std::int64_t n_new = tree_.terminalCount() + 1;
-    const double rr_now = currentRootRadius(), shrink_new = shrink(n_new);
-    const BifurcationOptimizer opt(tree_, params_, dom_.frame(), 0.0);
+  // Connects p, drawn for system `sys`, through the cheapest valid bifurcation among the ν
+  // nearest segments of each of its trees that still takes terminals, doubling ν while none is
+  // valid. False when p lies in a vessel or no segment can take it.
+  bool connect(const Vec3& p, const System& sys) {
+    const std::int64_t n_sys_new = systemTerminals(sys) + 1;
+    const double shrink_new = shrink(sys, n_sys_new);
+    std::vector<int> open;
+    for (int k : sys.trees)
+      if (accepts(k) && trees_[k].tree.segmentCount() > 0) open.push_back(k);
+    // A tree's connection adds its new cost minus its cost now; alone, it ranks by its cost.
+    const bool competing = open.size() > 1;
+    std::vector<BifurcationOptimizer> opts;
+    std::vector<double> base, rr_now;
+    std::vector<std::int64_t> n_new;
+    for (int k : open) {
+      auto& g = trees_[k];
+      opts.emplace_back(g.tree, g.params, dom_.frame(), 0.0);
+      base.push_back(competing ? treeCostNow(g) : 0.0);
+      rr_now.push_back(currentRootRadius(g));
+      n_new.push_back(g.terminalCount() + 1);
+      g.done = 0;
+    }
+    if (trials_.size() < open.size()) trials_.resize(open.size());
     int nu = opt_.closest_neighbours;
-    std::size_t done = 0;
-    for (;;) {
-      index_.nearest(tree_, p, nu, near_);
-      if (done == 0)
-        for (const auto& [d, id] : near_)
-          if (d <= rel_[id] * rr_now) return false;  // inside a vessel (Algorithm 2)
-      trials_.resize(near_.size());
-      // Two halves: finer tasks cost more in scheduling than the few microseconds each takes.
-      const std::size_t grain = std::max<std::size_t>(1, (near_.size() - done + 1) / 2);
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(done, near_.size(), grain), [&](const auto& r) {
-        for (auto i = r.begin(); i != r.end(); ++i) trials_[i] = evaluate(near_[i].second, p, n_new, shrink_new, opt);
-      }, tbb::simple_partitioner());
-      order_.clear();
-      for (std::size_t i = done; i < near_.size(); ++i) {
-        if (trials_[i].kamiya_failed) ++report_.kamiya_failures;
-        if (trials_[i].c.valid) order_.push_back(i);
+    for (bool first = true;; first = false) {
+      for (std::size_t i = 0; i < open.size(); ++i) {
+        auto& g = trees_[open[i]];
+        g.index.nearest(g.tree, p, nu, g.near);
+        if (first)
+          for (const auto& [d, id] : g.near)
+            if (d <= g.rel[id] * rr_now[i]) return false;  // inside a vessel (Algorithm 2)
       }
-      std::sort(order_.begin(), order_.end(), [&](auto a, auto b) {
-        return std::tie(trials_[a].c.cost, trials_[a].c.segment) < std::tie(trials_[b].c.cost, trials_[b].c.segment);
+      ranked_.clear();
+      for (std::size_t i = 0; i < open.size(); ++i) {
+        auto& g = trees_[open[i]];
+        auto& trials = trials_[i];
+        trials.resize(g.near.size());
+        // Two halves: finer tasks cost more in scheduling than the few microseconds each takes.
+        const std::size_t grain = std::max<std::size_t>(1, (g.near.size() - g.done + 1) / 2);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(g.done, g.near.size(), grain), [&](const auto& r) {
+          for (auto j = r.begin(); j != r.end(); ++j) trials[j] = evaluate(g, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
+        }, tbb::simple_partitioner());
+        for (std::size_t j = g.done; j < g.near.size(); ++j) {
+          if (trials[j].kamiya_failed) ++report_.kamiya_failures;
+          if (trials[j].c.valid) ranked_.push_back({int(i), j, trials[j].c.cost - base[i]});
+        }
+      }
+      std::sort(ranked_.begin(), ranked_.end(), [&](const Candidate& a, const Candidate& b) {
+        return std::tie(a.added, a.tree, trials_[a.tree][a.trial].c.segment) <
+               std::tie(b.added, b.tree, trials_[b.tree][b.trial].c.segment);
       });
-      for (auto i : order_) {
-        const Connection& c = trials_[i].c;
-        const auto undo = commitConnection(tree_, c, opt, kernel_, rel_);
-        const double rr = rootRadiusFinal(n_new, c.path.back().reduced_resistance, shrink_new);
-        if (!collides(c, rr)) {
-          markChecked(rr);
-          const auto n = tree_.nodeCount();
-          index_.insert(tree_, n - 2);
-          index_.insert(tree_, n - 1);
-          index_.insert(tree_, c.segment);
-          index_.refresh(tree_);
-          if (rel_[n - 2] >= kThick) thick_.push_back(n - 2);
-          if (tree_.terminalCount() % kRefreshEvery == 0) refreshRelativeRadii();
+      for (const auto& cand : ranked_) {
+        const int k = open[cand.tree];
+        auto& g = trees_[k];
+        const Connection& c = trials_[cand.tree][cand.trial].c;
+        const auto undo = commitConnection(g.tree, c, opts[cand.tree], g.kernel, g.rel);
+        const double rr = rootRadiusFinal(g, n_new[cand.tree], c.path.back().reduced_resistance, shrink_new);
+        if (!collides(k, c, rr)) {
+          for (auto x : check_) g.checked[x] = g.rel[x] * rr;
+          const auto n = g.tree.nodeCount();
+          g.index.insert(g.tree, n - 2);
+          g.index.insert(g.tree, n - 1);
+          g.index.insert(g.tree, c.segment);
+          g.index.refresh(g.tree);
+          if (g.rel[n - 2] >= kThick) g.thick.push_back(n - 2);
+          if (g.terminalCount() % kRefreshEvery == 0) refreshRelativeRadii(g);
           return true;
         }
-        rollbackConnection(tree_, undo, rel_);
+        rollbackConnection(g.tree, undo, g.rel);
         ++report_.rejected_intersection;
       }
-      done = near_.size();
-      if (static_cast<std::int32_t>(done) >= tree_.segmentCount() || nu >= opt_.max_neighbours) return false;
+      bool more = false;
+      for (int k : open) {
+        auto& g = trees_[k];
+        g.done = g.near.size();
+        more |= static_cast<std::int32_t>(g.done) < g.tree.segmentCount();
+      }
+      if (!more || nu >= opt_.max_neighbours) return false;
       nu = std::min(2 * nu, opt_.max_neighbours);
       ++report_.neighbour_doublings;
     }
   }
 
-  void growUntil(std::int64_t target, const ProgressFn& progress) {
-    std::int64_t next_report = 0;
-    while (tree_.terminalCount() < target) {
-      if (progress && tree_.terminalCount() >= next_report) {
-        progress(tree_.terminalCount(), target);
-        next_report = tree_.terminalCount() + std::max<std::int64_t>(1, target / 200);
+  // The system furthest behind its target (systems grow in step), or -1 when all are complete.
+  int nextSystem() const {
+    int best = -1;
+    double best_fill = 1;
+    for (std::size_t s = 0; s < systems_.size(); ++s) {
+      const double fill = double(systemTerminals(systems_[s])) / double(systems_[s].target);
+      if (fill < best_fill) best = int(s), best_fill = fill;
+    }
+    return best;
+  }
+
+  void growUntilTargets(const ProgressFn& progress) {
+    std::int64_t total = 0, next_report = 0;
+    for (const auto& s : systems_) total += s.target;
+    const auto grown = [&] {
+      std::int64_t n = 0;
+      for (const auto& g : trees_) n += g.terminalCount();
+      return n;
+    };
+    for (int si; (si = nextSystem()) >= 0;) {
+      const System& sys = systems_[si];
+      if (progress && grown() >= next_report) {
+        progress(grown(), total);
+        next_report = grown() + std::max<std::int64_t>(1, total / 200);
       }
-      if (tree_.segmentCount() == 0) {
-        plantFirst();
+      if (const auto empty = std::find_if(sys.trees.begin(), sys.trees.end(), [&](int k) { return trees_[k].tree.segmentCount() == 0; });
+          empty != sys.trees.end()) {
+        plantFirst(*empty);
         continue;
       }
-      // δ_max (seed 000 eq. 15) for the current number of terminals, relaxed by runs of failures.
-      double delta = std::pow(dom_.measure() / double(tree_.terminalCount()), 1.0 / dom_.dimension());
+      const std::int64_t n = systemTerminals(sys);
+      // δ_max (seed 000 eq. 15) for the system's current number of terminals, relaxed by runs of failures.
+      double delta = std::pow(dom_.measure() / double(n), 1.0 / dom_.dimension());
       for (std::int64_t failures = 1;; ++failures) {
         if (failures > opt_.max_draws)
-          throw GrowthError("could place only " + std::to_string(tree_.terminalCount()) + " of " + std::to_string(target) +
-                            " terminals: " + std::to_string(opt_.max_draws) + " points in a row found no valid connection "
+          throw GrowthError("could place only " + std::to_string(n) + " of " + std::to_string(sys.target) +
+                            " terminals" + (systems_.size() > 1 ? " of system " + std::to_string(si + 1) : std::string()) + ": " +
+                            std::to_string(opt_.max_draws) + " points in a row found no valid connection "
                             "(too close " + std::to_string(report_.rejected_too_close) + ", unconnectable " +
                             std::to_string(report_.rejected_unreachable) + "); lower the number of terminals or enlarge the domain");
+        // An ancestor on every path (a trunk) that thickened against another tree's vessel would
+        // refuse every connection of its tree for ever: after a long run of failures, ancestors
+        // are no longer checked against other trees; the exact final check and repair see them.
+        if (failures == 1) ancestor_blocks_ = 0;
+        lenient_ = ancestor_blocks_ > kLenientAfter;
         const Vec3 p = dom_.sample(rng_);
-        if (index_.anyWithin(tree_, p, delta * dom_.spacingScale(p))) {
+        const double spacing = delta * dom_.spacingScale(p);
+        if (std::any_of(sys.trees.begin(), sys.trees.end(), [&](int k) { return trees_[k].index.anyWithin(trees_[k].tree, p, spacing); })) {
           ++report_.rejected_too_close;
         } else {
           ++report_.candidates;
-          if (connect(p)) break;
+          if (connect(p, sys)) {
+            report_.lenient_connections += lenient_;
+            break;
+          }
           ++report_.rejected_unreachable;
         }
         if (failures % opt_.draws_before_relaxing == 0) {
@@ -270,44 +469,49 @@ class CcoGrower {
         }
       }
     }
-    if (progress) progress(tree_.terminalCount(), target);
+    if (progress) progress(grown(), total);
   }
 
   // True if the solved tree's segment x, with ends a–e, stays in the domain, longer than twice
-  // its radius and clear of every vessel more than one segment away (radii with 2 % margin).
-  bool segmentFits(std::int32_t x, const Vec3& a, const Vec3& e) {
-    const auto& T = tree_;
+  // its radius and clear of every vessel more than one segment away and of the other trees
+  // (radii with 2 % margin).
+  bool segmentFits(int k, std::int32_t x, const Vec3& a, const Vec3& e) {
+    auto& g = trees_[k];
+    const auto& T = g.tree;
     const double rx = 1.02 * T.radius[x];
-    if (!(distance(a, e) > 2 * rx) || !dom_.capsuleInside(a, e, rx, startsAtRoot(x))) return false;
+    if (!(distance(a, e) > 2 * rx) || !dom_.capsuleInside(a, e, rx, startsAtRoot(g, x))) return false;
     const double reach = rx + 1.02 * T.radius[T.rootSegment()];
-    return !overlapsOtherVessel(
-        T, x, a, e, rx, [&](auto&& f) { index_.forEachNearSegment(a, e, reach, f); },
-        [&](std::int32_t y) { return 1.02 * T.radius[y]; });
+    if (overlapsOtherVessel(
+            T, x, a, e, rx, [&](auto&& f) { g.index.forEachNearSegment(a, e, reach, f); },
+            [&](std::int32_t y) { return 1.02 * T.radius[y]; }))
+      return false;
+    return trees_.size() == 1 || !hitsOtherTree(k, a, e, rx, true);
   }
 
-  // Moves node v to q if every segment meeting there still fits; restores it otherwise.
-  bool tryMove(std::int32_t v, const Vec3& q) {
-    auto& T = tree_;
+  // Moves node v of tree k to q if every segment meeting there still fits; restores it otherwise.
+  bool tryMove(int k, std::int32_t v, const Vec3& q) {
+    auto& g = trees_[k];
+    auto& T = g.tree;
     const Vec3 old = T.position[v];
     T.position[v] = q;
     const std::int32_t segs[3] = {v, T.child0[v], T.child1[v]};
     bool ok = true;
     for (auto x : segs)
-      if (x > 0 && ok) ok = segmentFits(x, T.position[T.parent[x]], T.position[x]);
+      if (x > 0 && ok) ok = segmentFits(k, x, T.position[T.parent[x]], T.position[x]);
     if (!ok) {
       T.position[v] = old;
       return false;
     }
     for (auto x : segs)
-      if (x > 0) index_.insert(T, x);
+      if (x > 0) g.index.insert(T, x);
     return true;
   }
 
   // A trunk that thickened past half its length since it was made: slide its distal
   // bifurcation outwards (along the trunk, or towards its children), or its proximal one back,
   // to 2.1–3 r, whichever first fits.
-  bool lengthen(std::int32_t s) {
-    auto& T = tree_;
+  bool lengthen(int k, std::int32_t s) {
+    const auto& T = trees_[k].tree;
     const auto P = T.parent[s];
     const Vec3 a = T.position[P], e = T.position[s];
     const Vec3 u = (e - a) / distance(a, e);
@@ -318,8 +522,8 @@ class CcoGrower {
     }
     for (double f : {2.1, 2.5, 3.0}) {
       const double L = f * T.radius[s], grow = L - distance(a, e);
-      if (!T.isTerminal(s) && (tryMove(s, a + u * L) || tryMove(s, e + w * grow))) return true;
-      if (P > 0 && tryMove(P, e - u * L)) return true;
+      if (!T.isTerminal(s) && (tryMove(k, s, a + u * L) || tryMove(k, s, e + w * grow))) return true;
+      if (P > 0 && tryMove(k, P, e - u * L)) return true;
     }
     return false;
   }
@@ -327,8 +531,8 @@ class CcoGrower {
   // A segment that the solved radii push out of the domain (its subtree too large to regrow):
   // move its distal node, else its proximal one, up the depth gradient by 0.5–3 r, whichever
   // first fits. Seen only where the final solve thickened a trunk next to a thin mask wall.
-  bool pushInside(std::int32_t s) {
-    auto& T = tree_;
+  bool pushInside(int k, std::int32_t s) {
+    const auto& T = trees_[k].tree;
     const double h = dom_.frame().voxel_mm;
     for (const std::int32_t v : {s, T.parent[s]}) {
       if (v <= 0) continue;
@@ -339,90 +543,179 @@ class CcoGrower {
       if (!(norm(g) > 0)) continue;
       g = g / norm(g);
       for (double f : {0.5, 1.0, 2.0, 3.0})
-        if (tryMove(v, p + g * (f * T.radius[s]))) return true;
+        if (tryMove(k, v, p + g * (f * T.radius[s]))) return true;
     }
     return false;
   }
 
-  // Segments of the solved tree that break a constraint: intersecting pairs, length <= 2r, or
-  // leaving the domain. Short trunks are lengthened in place; for the rest, the segment whose
-  // subtree removal costs fewest terminals is returned.
-  std::vector<std::int32_t> violations() {
-    const auto& T = tree_;
-    std::vector<std::int32_t> out;
-    const auto pairs = intersectingPairs(T, dom_.lo(), dom_.hi());
+  // Moves an end of segment x (tree k) away from segment y (tree j) that it overlaps, by the
+  // overlap and a margin, if every segment meeting there still fits.
+  bool separate(int k, std::int32_t x, int j, std::int32_t y) {
+    const auto& T = trees_[k].tree;
+    const auto& O = trees_[j].tree;
+    const Vec3 &b0 = O.position[O.parent[y]], &b1 = O.position[y];
+    for (const std::int32_t v : {x, T.parent[x]}) {
+      if (v <= 0) continue;
+      const Vec3 p = T.position[v];
+      const Vec3 ab = b1 - b0;
+      const double t = std::clamp(dot(p - b0, ab) / std::max(dot(ab, ab), 1e-300), 0.0, 1.0);
+      const Vec3 away = p - (b0 + ab * t);
+      if (!(norm(away) > 0)) continue;
+      const double gap = 1.05 * (T.radius[x] + O.radius[y]) - segmentSegmentDistance(T.position[T.parent[x]], T.position[x], b0, b1);
+      for (double f : {1.0, 1.5, 2.5})
+        if (tryMove(k, v, p + away / norm(away) * (f * std::max(gap, 0.0) + 0.1 * T.radius[x]))) return true;
+    }
+    return false;
+  }
+
+  bool tooLargeToRegrow(int k, std::int32_t s) const { return trees_[k].tree.terminals[s] > kMaxRepairShare * double(systems_[trees_[k].system].target); }
+
+  // Segments of the solved forest that break a constraint, per tree: intersecting pairs (within
+  // and across trees), length <= 2r, or leaving the domain. Short trunks are lengthened in
+  // place; for the rest, the segment whose subtree removal costs fewest terminals is listed.
+  std::vector<std::vector<std::int32_t>> violations() {
+    std::vector<std::vector<std::int32_t>> out(trees_.size());
+    // Every pair, within and across trees, on the forest of all trees (ids shifted per tree).
+    VascularTree forest;
+    std::vector<std::int32_t> offset;
+    for (std::size_t k = 0; k < trees_.size(); ++k) {
+      offset.push_back(forest.nodeCount());
+      forest.appendTree(trees_[k].tree, int(k));
+    }
+    const auto local = [&](std::int32_t x) { return std::pair<int, std::int32_t>(forest.tree[x], x - offset[forest.tree[x]]); };
+    const auto pairs = intersectingPairs(forest, dom_.lo(), dom_.hi());
     report_.intersecting_pairs = static_cast<std::int64_t>(pairs.size());
-    for (const auto& [x, y] : pairs) out.push_back(std::tie(T.terminals[x], y) < std::tie(T.terminals[y], x) ? x : y);
+    for (const auto& [fx, fy] : pairs) {
+      const auto [kx, x] = local(fx);
+      const auto [ky, y] = local(fy);
+      const auto nx = trees_[kx].tree.terminals[x], ny = trees_[ky].tree.terminals[y];
+      const bool x_goes = std::tie(nx, fy) < std::tie(ny, fx);
+      // Two trunks of different trees, both too large to regrow: push the thinner one aside.
+      if (kx != ky && tooLargeToRegrow(kx, x) && tooLargeToRegrow(ky, y) &&
+          (x_goes ? separate(kx, x, ky, y) : separate(ky, y, kx, x))) {
+        ++report_.moved_nodes;
+        continue;
+      }
+      if (x_goes) out[kx].push_back(x);
+      else out[ky].push_back(y);
+    }
     report_.short_segments = report_.outside_segments = 0;
-    index_.refresh(tree_, true);
-    for (std::int32_t s = 1; s < T.nodeCount(); ++s) {
-      if (!(T.length[s] > 2 * T.radius[s])) {
-        ++report_.short_segments;
-        if (lengthen(s)) {
-          ++report_.moved_nodes;
-        } else if (T.isTerminal(s)) {
-          out.push_back(s);
-        } else {  // the trunk merges with its larger child when the smaller child's subtree goes
-          out.push_back(T.terminals[T.child0[s]] <= T.terminals[T.child1[s]] ? T.child0[s] : T.child1[s]);
+    for (std::size_t k = 0; k < trees_.size(); ++k) trees_[k].index.refresh(trees_[k].tree, true);
+    for (std::size_t kk = 0; kk < trees_.size(); ++kk) {
+      const int k = int(kk);
+      const auto& T = trees_[k].tree;
+      for (std::int32_t s = 1; s < T.nodeCount(); ++s) {
+        if (!(T.length[s] > 2 * T.radius[s])) {
+          ++report_.short_segments;
+          if (lengthen(k, s)) {
+            ++report_.moved_nodes;
+          } else if (T.isTerminal(s)) {
+            out[k].push_back(s);
+          } else {  // the trunk merges with its larger child when the smaller child's subtree goes
+            out[k].push_back(T.terminals[T.child0[s]] <= T.terminals[T.child1[s]] ? T.child0[s] : T.child1[s]);
+          }
+        }
+        if (!dom_.capsuleInside(T.position[T.parent[s]], T.position[s], T.radius[s], startsAtRoot(trees_[k], s))) {
+          ++report_.outside_segments;
+          if (tooLargeToRegrow(k, s) && pushInside(k, s)) ++report_.moved_nodes;
+          else out[k].push_back(s);
         }
       }
-      if (!dom_.capsuleInside(T.position[T.parent[s]], T.position[s], T.radius[s], startsAtRoot(s))) {
-        ++report_.outside_segments;
-        if (T.terminals[s] > kMaxRepairShare * double(opt_.terminals) && pushInside(s)) ++report_.moved_nodes;
-        else out.push_back(s);
-      }
+      auto& o = out[k];
+      std::sort(o.begin(), o.end());
+      o.erase(std::unique(o.begin(), o.end()), o.end());
     }
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
   }
 
-  // Solves the exact final tree; removes and regrows the branches that break a constraint.
+  void solveAll() {
+    for (auto& g : trees_) solveTree(g.tree, g.params);
+  }
+
+  // Solves the exact final trees; removes and regrows the branches that break a constraint.
   void repair(const ProgressFn& progress) {
+    repairing_ = true;
     for (int round = 0;; ++round) {
-      solveTree(tree_, params_);
+      solveAll();
       const auto moved_before = report_.moved_nodes;
       auto bad = violations();
-      std::erase_if(bad, [&](std::int32_t s) { return tree_.terminals[s] > kMaxRepairShare * double(opt_.terminals); });
-      const bool moved = report_.moved_nodes > moved_before;
-      if ((bad.empty() && !moved) || round == opt_.max_repair_rounds) return;
-      ++report_.repair_rounds;
-      if (!bad.empty()) {
-        const auto before = tree_.terminalCount();
-        tree_.removeSubtrees(bad);
-        report_.repaired_terminals += before - tree_.terminalCount();
+      bool none = true;
+      for (std::size_t k = 0; k < trees_.size(); ++k) {
+        std::erase_if(bad[k], [&](std::int32_t s) { return tooLargeToRegrow(int(k), s); });
+        none &= bad[k].empty();
       }
-      solveTree(tree_, params_);
-      refreshRelativeRadii();
-      checked_ = tree_.radius;  // the exact check just passed every kept segment
-      index_.refresh(tree_, true);
-      growUntil(opt_.terminals, progress);
+      const bool moved = report_.moved_nodes > moved_before;
+      if ((none && !moved) || round == opt_.max_repair_rounds) return;
+      ++report_.repair_rounds;
+      for (std::size_t k = 0; k < trees_.size(); ++k) {
+        auto& g = trees_[k];
+        if (!bad[k].empty()) {
+          const auto before = g.terminalCount();
+          g.tree.removeSubtrees(bad[k]);
+          report_.repaired_terminals += before - g.terminalCount();
+        }
+      }
+      solveAll();
+      for (auto& g : trees_) {
+        refreshRelativeRadii(g);
+        g.checked = g.tree.radius;  // the exact check just passed every kept segment
+        g.index.refresh(g.tree, true);
+      }
+      growUntilTargets(progress);
     }
   }
 
   const GrowthDomain& dom_;
   const CcoOptions& opt_;
   GrowthReport& report_;
-  PhysicsParameters params_;
-  PowerKernel kernel_;
-  SegmentIndex index_;
   Rng rng_;
-  VascularTree tree_;
-  std::vector<double> rel_{1.0};  // ρ: radius / root radius
-  std::vector<std::pair<double, std::int32_t>> near_;
-  std::vector<Trial> trials_;
-  std::vector<std::size_t> order_;
+  std::vector<TreeGrowth> trees_;
+  std::vector<System> systems_;
+  std::vector<std::vector<Trial>> trials_;  // per open tree of the connection being made
+  std::vector<Candidate> ranked_;
   std::vector<std::int32_t> check_;
-  std::vector<double> checked_;         // radius (final units) at which each segment was last found clear
-  std::vector<std::int32_t> thick_{1};  // segments with ρ >= kThick (the first is the root segment)
+  bool repairing_ = false;
+  bool lenient_ = false;
+  std::int64_t ancestor_blocks_ = 0;
 };
 
 }  // namespace
 
+std::vector<VascularTree> growCcoForest(const GrowthDomain& domain, const CcoOptions& options,
+                                        const std::vector<CcoInlet>& inlets, GrowthReport& report,
+                                        const ProgressFn& progress) {
+  CcoGrower g(domain, options, inlets, report);
+  return g.run(progress);
+}
+
 VascularTree growCco(const GrowthDomain& domain, const CcoOptions& options, GrowthReport& report,
                      const ProgressFn& progress) {
-  CcoGrower g(domain, options, report);
-  return g.run(progress);
+  CcoInlet in;
+  in.root_mm = options.root_mm;
+  in.root_pressure = options.physics.perfusion_pressure;
+  in.terminal_pressure = options.physics.terminal_pressure;
+  return std::move(growCcoForest(domain, options, {in}, report, progress).front());
+}
+
+std::vector<std::int64_t> terminalQuotas(const std::vector<double>& shares, std::int64_t n) {
+  std::vector<std::int64_t> q(shares.size(), 0);
+  double fixed = 0;
+  bool all_fixed = true;
+  for (std::size_t i = 0; i < shares.size(); ++i) {
+    q[i] = std::int64_t(std::floor(shares[i] * double(n)));
+    fixed += shares[i];
+    all_fixed &= shares[i] > 0;
+  }
+  if (!all_fixed || std::abs(fixed - 1) > 1e-9) return q;
+  // Shares that sum to 1: the terminals left by rounding down go to the largest remainders.
+  std::vector<std::size_t> order(shares.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  const auto remainder = [&](std::size_t i) { return shares[i] * double(n) - double(q[i]); };
+  std::stable_sort(order.begin(), order.end(), [&](auto a, auto b) { return remainder(a) > remainder(b); });
+  std::int64_t left = n;
+  for (auto v : q) left -= v;
+  for (std::size_t i = 0; left > 0; i = (i + 1) % order.size(), --left) ++q[order[i]];
+  return q;
 }
 
 }  // namespace angiosynth

@@ -13,7 +13,15 @@
 // - R̃, β, ρ and terminal counts are updated along the path to the root only (§3.1.3).
 // The exact final tree is checked again for intersections, short and outside segments; the few
 // offending branches are removed and regrown until none is left.
+//
+// Forests: several inlets grow together in one domain. Inlets of one system (one kind, e.g. two
+// arteries) compete for that system's N terminals: each terminal joins the tree whose cheapest
+// connection adds the least volume, and a tree's share of the flow is either fixed (its quota of
+// terminals) or the territory it wins. Systems (arteries and veins) each perfuse, or drain, the
+// whole domain with their own N terminals, drawn in turn. No vessel of one tree overlaps a vessel
+// of another, checked as within a tree (during growth and on the exact final forest).
 #include <cstdint>
+#include <vector>
 
 #include "core/vascular_tree.hpp"
 #include "domain/growth_domain.hpp"
@@ -39,7 +47,25 @@ struct CcoOptions {
   std::int64_t max_draws = 2000000;   // consecutive failed draws before giving up
 };
 
-// Grows the tree; throws GrowthError when the domain cannot take N terminals.
+// One tree of a forest.
+struct CcoInlet {
+  Vec3 root_mm;                 // in the domain's frame
+  int system = 0;               // inlets of one system share its N terminals
+  double share = 0;             // fixed share of its system's terminals (and flow); 0: the territory it wins
+  double root_pressure = 0;     // Pa; below terminal_pressure the tree drains (a vein)
+  double terminal_pressure = 0; // Pa
+};
+
+// Grows one tree per inlet (each system with options.terminals terminals; the inlet's pressures
+// replace those of options.physics); the trees in inlet order.
+std::vector<VascularTree> growCcoForest(const GrowthDomain& domain, const CcoOptions& options,
+                                        const std::vector<CcoInlet>& inlets, GrowthReport& report,
+                                        const ProgressFn& progress = {});
+// Terminal quotas of a system's inlets from their fixed shares (largest remainder; shares that sum
+// to 1 give quotas that sum to n); 0 for inlets that win their territory.
+std::vector<std::int64_t> terminalQuotas(const std::vector<double>& shares, std::int64_t n);
+
+// Grows one tree from options.root_mm; throws GrowthError when the domain cannot take N terminals.
 VascularTree growCco(const GrowthDomain& domain, const CcoOptions& options, GrowthReport& report,
                      const ProgressFn& progress = {});
 

@@ -1,4 +1,8 @@
 // Method "cco": its parameters, TOML reader, description, domain and grow function.
+#include <cmath>
+#include <map>
+#include <set>
+
 #include "core/error.hpp"
 #include "core/quantity_json.hpp"
 #include "grow/cco/setup.hpp"
@@ -13,29 +17,84 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
+// Defaults of a vein's pressures (venules about 20 mmHg, a large vein about 5 mmHg).
+constexpr const char* kVeinRootPressure = "5 mmHg";
+constexpr const char* kVeinTerminalPressure = "20 mmHg";
+
+// The kinds of the inlets in order of first appearance: one system of competing trees each.
+std::vector<std::string> kindsOf(const std::vector<CcoInletSpec>& inlets) {
+  std::vector<std::string> kinds;
+  for (const auto& in : inlets)
+    if (std::find(kinds.begin(), kinds.end(), in.kind) == kinds.end()) kinds.push_back(in.kind);
+  return kinds;
+}
+
 class PreparedCco final : public PreparedGrowth {
  public:
   PreparedCco(const CcoSetup& s, GrowthDomain d) : setup_(s), domain_(std::move(d)) {}
   const DemandMap& frame() const override { return domain_.frame(); }
   void checkFeasibility() const override {
-    ccoRoot(setup_, domain_);
+    std::vector<Vec3> roots;
+    for (const auto& in : setup_.inlets) roots.push_back(ccoRoot(setup_, in.root, domain_));
     std::int64_t inside = 0;  // voxels of the domain
     for (float v : domain_.frame().demand) inside += v > 0;
     const auto& c = setup_.cco;
+    const auto kinds = kindsOf(setup_.inlets);
+    const std::int64_t total = c.terminals * std::int64_t(kinds.size());
     // A terminal per voxel of the domain at most: finer than its resolution the mask says nothing.
-    if (c.terminals > inside)
+    if (total > inside)
       throw InputError(setup_.parameter_file, setup_.terminals_line,
-                       std::to_string(c.terminals) + " terminals exceed the " + std::to_string(inside) +
-                           " voxels of the domain; use fewer terminals or a finer voxel_size (mask)");
-    checkVesselRoom(c.physics, c.terminals, domain_.measure(), domain_.dimension(), setup_.parameter_file, setup_.terminals_line);
+                       std::to_string(total) + " terminals" + (kinds.size() > 1 ? " (" + std::to_string(c.terminals) + " per kind)" : "") +
+                           " exceed the " + std::to_string(inside) + " voxels of the domain; use fewer terminals or a finer voxel_size (mask)");
+    // Every kind fills the domain beside the others: each has its share of the room, and its
+    // thickest vessels come from its smallest pressure drop.
+    std::vector<PhysicsParameters> per_inlet;
+    for (const auto& in : setup_.inlets) {
+      PhysicsParameters p = c.physics;
+      p.perfusion_pressure = in.root_pressure;
+      p.terminal_pressure = in.terminal_pressure;
+      per_inlet.push_back(p);
+    }
+    const double room = domain_.measure() / double(kinds.size());
+    for (std::size_t i = 0; i < per_inlet.size(); ++i)
+      checkVesselRoom(per_inlet[i], c.terminals, room, domain_.dimension(), setup_.parameter_file,
+                      setup_.inlet_tables ? setup_.inlets[i].line : setup_.terminals_line);
+    // Two roots closer than their root vessels are thick cannot both start a tree.
+    for (std::size_t i = 0; i < roots.size(); ++i)
+      for (std::size_t j = i + 1; j < roots.size(); ++j) {
+        const double ri = estimateRadii(per_inlet[i], c.terminals, room, domain_.dimension()).root;
+        const double rj = estimateRadii(per_inlet[j], c.terminals, room, domain_.dimension()).root;
+        if (!(distance(roots[i], roots[j]) > 2 * (ri + rj)))
+          throw InputError(setup_.parameter_file, setup_.inlets[j].root.root_line ? setup_.inlets[j].root.root_line : setup_.inlets[j].line,
+                           "the roots of inlets '" + setup_.inlets[i].id + "' and '" + setup_.inlets[j].id + "' lie " +
+                               show(distance(roots[i], roots[j])) + " mm apart; their root vessels (radius about " + show(ri) + " and " +
+                               show(rj) + " mm) need more than " + show(2 * (ri + rj)) + " mm; move them apart");
+      }
   }
   const GrowthDomain* domain() const override { return &domain_; }
   Forest grow(std::uint64_t seed, std::uint64_t sample, GrowthReport& report, const ProgressFn& progress) const override {
     CcoOptions co = setup_.cco;
-    co.root_mm = ccoRoot(setup_, domain_);
     co.seed = seed;
     co.sample = sample;
-    return singleTreeForest(growCco(domain_, co, report, progress));
+    const auto kinds = kindsOf(setup_.inlets);
+    std::vector<CcoInlet> inlets;
+    for (const auto& in : setup_.inlets) {
+      CcoInlet g;
+      g.root_mm = ccoRoot(setup_, in.root, domain_);
+      g.system = int(std::find(kinds.begin(), kinds.end(), in.kind) - kinds.begin());
+      g.share = in.share;
+      g.root_pressure = in.root_pressure;
+      g.terminal_pressure = in.terminal_pressure;
+      inlets.push_back(g);
+    }
+    auto trees = growCcoForest(domain_, co, inlets, report, progress);
+    Forest f;
+    for (std::size_t k = 0; k < trees.size(); ++k) {
+      f.vessels.appendTree(trees[k], int(k));
+      f.trees.push_back(TreeInfo{setup_.inlets[k].id, setup_.inlets[k].kind, 0});
+    }
+    assignClassLabels(f.trees);
+    return f;
   }
   void addStatistics(const GrowthReport& report, Json& stats) const override {
     stats["threshold_relaxations"] = report.threshold_relaxations;
@@ -44,6 +103,11 @@ class PreparedCco final : public PreparedGrowth {
     stats["short_segments"] = report.short_segments;
     stats["short_segments_definition"] = "segments not longer than twice their radius";
     stats["outside_segments"] = report.outside_segments;
+    if (setup_.inlets.size() > 1) {
+      stats["lenient_connections"] = report.lenient_connections;
+      stats["lenient_connections_definition"] =
+          "connections made after a long run of failures without re-checking their thickened ancestors against other trees (the final check covers them)";
+    }
     stats["domain_dimension"] = domain_.dimension();
     stats["domain_measure"] = quantityJson(domain_.measure(), domain_.dimension() == 2 ? "mm^2" : "mm^3");
   }
@@ -52,6 +116,146 @@ class PreparedCco final : public PreparedGrowth {
   const CcoSetup& setup_;
   GrowthDomain domain_;
 };
+
+// The root of one tree from its table (`name`: "tree" or "tree.inlet"): root_offset for analytic
+// shapes, root (mm) or root_voxel for masks.
+CcoRootSpec readRootOf(const TomlReader& r, const toml::table& t, const std::string& name, const CcoSetup& s, bool required) {
+  const auto& d = s.domain;
+  CcoRootSpec root;
+  if (d.shape == DomainShape::Mask) {
+    r.forbid(t, name, {"root_offset"}, "is for analytic shapes; give the root of a mask domain as root (mm) or root_voxel");
+    // A NIfTI mask's voxel size is known only once it is read: its root stays in mm until then.
+    if (const auto mm = readRoot(r, t, root.root_voxel, root.root_line, "mask voxels", ": a mask domain has no default root",
+                                   name == "tree" ? name : "[" + name + "]")) {
+      if (isNifti(d.mask)) {
+        root.root_mm = *mm;
+        root.root_in_mm = true;
+      } else {
+        root.root_voxel = *mm / d.voxel_mm;
+      }
+    }
+    return root;
+  }
+  r.forbid(t, name, {"root", "root_voxel"}, "is for mask domains; an analytic shape takes root_offset (mm from its centre)");
+  if (const auto* n = t.get("root_offset")) {
+    const bool flat = d.shape == DomainShape::Disc || d.shape == DomainShape::Square;
+    root.root_offset_mm = r.point(n, "root_offset (mm from the centre)", flat);
+    root.has_root_offset = true;
+    root.root_line = r.lineOf(n);
+  } else if (required) {
+    throw InputError(r.file(), r.lineOf(&t), "missing key 'root_offset' (mm from the centre) in [[" + name +
+                                                 "]]: with several inlets each needs its own root");
+  }
+  return root;
+}
+
+// Pressures of an inlet: [physics] for arteries and other kinds, 5 and 20 mmHg for veins; a vein
+// must drain (terminals above the root) and an artery supply.
+void readInletPressures(const TomlReader& r, const toml::table& t, const PhysicsParameters& ph, CcoInletSpec& in) {
+  const bool vein = in.kind == "vein";
+  in.root_pressure = t.get("root_pressure") ? r.quantity(t, "tree.inlet", "root_pressure", Dimension::Pressure)
+                                            : vein ? parseQuantity(kVeinRootPressure, Dimension::Pressure) : ph.perfusion_pressure;
+  in.terminal_pressure = t.get("terminal_pressure") ? r.quantity(t, "tree.inlet", "terminal_pressure", Dimension::Pressure)
+                                                    : vein ? parseQuantity(kVeinTerminalPressure, Dimension::Pressure) : ph.terminal_pressure;
+  checkRange(in.root_pressure, 0, false, Limits::kMaxPressure, false, r.at(t, "root_pressure"), "root_pressure (Pa)");
+  checkRange(in.terminal_pressure, 0, false, Limits::kMaxPressure, false, r.at(t, "terminal_pressure"), "terminal_pressure (Pa)");
+  const int line = r.lineOf(t.get("root_pressure") ? t.get("root_pressure") : t.get("terminal_pressure") ? t.get("terminal_pressure") : &t);
+  if (!(std::abs(in.root_pressure - in.terminal_pressure) >= Limits::kMinPressureDrop))
+    throw InputError(r.file(), line, "root_pressure and terminal_pressure of inlet '" + in.id + "' must differ by at least 0.001 Pa");
+  if (vein && in.root_pressure > in.terminal_pressure)
+    throw InputError(r.file(), line, "inlet '" + in.id + "' is a vein: it drains, so its terminal_pressure must exceed its root_pressure");
+  if (in.kind == "artery" && in.root_pressure < in.terminal_pressure)
+    throw InputError(r.file(), line, "inlet '" + in.id + "' is an artery: it supplies, so its root_pressure must exceed its terminal_pressure");
+}
+
+// [[tree.inlet]]: the trees of the forest, or the one tree of [tree].
+void readInlets(const TomlReader& r, const GrowthMethod& m, const toml::table& tree, CcoSetup& s) {
+  const auto* list = tree.get("inlet");
+  const auto& ph = s.cco.physics;
+  if (!list) {
+    CcoInletSpec in;
+    in.root = readRootOf(r, tree, "tree", s, false);
+    in.root_pressure = ph.perfusion_pressure;
+    in.terminal_pressure = ph.terminal_pressure;
+    in.line = r.lineOf(&tree);
+    s.inlets.push_back(in);
+    return;
+  }
+  const auto* arr = list->as_array();
+  if (!arr || arr->empty() || !arr->is_array_of_tables())
+    throw InputError(r.file(), r.lineOf(list), "inlet must be an array of tables: write each tree as [[tree.inlet]]");
+  for (const char* key : {"root_offset", "root", "root_voxel"})
+    if (tree.get(key))
+      throw InputError(r.file(), r.lineOf(tree.get(key)), std::string("'") + key + "' in [tree] with [[tree.inlet]] tables: give each inlet its root in its table");
+  s.inlet_tables = true;
+  std::map<std::string, int> per_kind;
+  for (const auto& node : *arr) {
+    const auto& t = *node.as_table();
+    checkMethodKeys(r, m, t, "tree.inlet");
+    CcoInletSpec in;
+    in.line = r.lineOf(&t);
+    in.kind = t.get("kind") ? r.string(t, "tree.inlet", "kind") : "artery";
+    if (in.kind.empty() || in.kind.size() > 40 || in.kind.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_-") != std::string::npos)
+      throw InputError(r.file(), r.lineOf(t.get("kind")), "kind '" + in.kind + "'; allowed: artery, vein, or a name of 1–40 lower-case letters, digits, '_' and '-'");
+    ++per_kind[in.kind];
+    in.root = readRootOf(r, t, "tree.inlet", s, arr->size() > 1);
+    if (const auto* sh = t.get("share")) {
+      if (sh->is_string()) {
+        const auto v = r.string(t, "tree.inlet", "share");
+        if (v != "territory") throw InputError(r.file(), r.lineOf(sh), "share '" + v + "'; allowed: \"territory\" or a number in (0, 1]");
+      } else {
+        in.share = r.number(t, "tree.inlet", "share");
+        checkRange(in.share, 0, false, 1, true, r.at(t, "share"), "share (of its kind's terminals and flow)");
+      }
+    }
+    s.inlets.push_back(in);
+  }
+  // Ids: the kind alone when it has one inlet, else kind_1, kind_2, ...; or as the file names them.
+  std::map<std::string, int> seen;
+  std::set<std::string> ids;
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    const auto& t = *(*arr)[i].as_table();
+    auto& in = s.inlets[i];
+    const int nth = ++seen[in.kind];
+    in.id = per_kind[in.kind] == 1 ? in.kind : in.kind + "_" + std::to_string(nth);
+    if (t.get("id")) {
+      in.id = r.string(t, "tree.inlet", "id");
+      if (in.id.empty() || in.id.size() > 60)
+        throw InputError(r.file(), r.lineOf(t.get("id")), "id must hold 1 to 60 characters");
+    }
+    if (!ids.insert(in.id).second)
+      throw InputError(r.file(), r.lineOf(t.get("id") ? t.get("id") : &t), "a second inlet with id '" + in.id + "'; ids must be unique");
+    readInletPressures(r, t, ph, in);
+  }
+  // Per kind: fixed shares sum to 1, or leave some of the terminals to inlets that win territory.
+  for (const auto& [kind, count] : per_kind) {
+    double sum = 0;
+    bool territory = false;
+    int last = 0;
+    for (const auto& in : s.inlets)
+      if (in.kind == kind) {
+        sum += in.share;
+        territory |= in.share == 0;
+        last = in.line;
+        if (in.share > 0 && in.share * double(s.cco.terminals) < 1)
+          throw InputError(r.file(), in.line, "inlet '" + in.id + "' has share " + show(in.share) + " of " + std::to_string(s.cco.terminals) +
+                                                   " terminals: less than one terminal; raise its share or the number of terminals");
+      }
+    if (!territory && std::abs(sum - 1) > 1e-9)
+      throw InputError(r.file(), last, "the shares of the " + kind + " inlets sum to " + show(sum) +
+                                           "; fixed shares of one kind must sum to 1 (or leave one inlet share = \"territory\")");
+    if (territory && sum >= 1 - 1e-9)
+      throw InputError(r.file(), last, "the fixed shares of the " + kind + " inlets already sum to " + show(sum) +
+                                           ", leaving nothing for the inlets that win territory");
+  }
+  // The capillary bed between arteries and veins needs a pressure drop.
+  for (const auto& a : s.inlets)
+    for (const auto& v : s.inlets)
+      if (a.kind == "artery" && v.kind == "vein" && !(v.terminal_pressure < a.terminal_pressure))
+        throw InputError(r.file(), v.line, "vein '" + v.id + "' has terminal_pressure " + show(v.terminal_pressure) +
+                                               " Pa, not below the " + show(a.terminal_pressure) + " Pa of artery '" + a.id +
+                                               "': blood would not cross the capillaries from artery to vein");
+}
 
 std::shared_ptr<const GrowthSetup> readCcoToml(const TomlReader& r, const GrowthMethod& m) {
   auto s = std::make_shared<CcoSetup>();
@@ -79,7 +283,6 @@ std::shared_ptr<const GrowthSetup> readCcoToml(const TomlReader& r, const Growth
   const bool round = d.shape == DomainShape::Sphere || d.shape == DomainShape::Disc;
   if (d.shape == DomainShape::Mask) {
     r.forbid(dom, "domain", {"radius", "side"}, "is for analytic shapes; a mask's extent comes from its file");
-    r.forbid(tree, "tree", {"root_offset"}, "is for analytic shapes; give the root of a mask domain as root (mm) or root_voxel");
     d.mask = resolveInputPath(r.string(dom, "domain", "mask"), path, r.lineOf(dom.get("mask")));
     const bool nifti = isNifti(d.mask);
     if (nifti) {
@@ -95,18 +298,8 @@ std::shared_ptr<const GrowthSetup> readCcoToml(const TomlReader& r, const Growth
         throw InputError(file, r.lineOf(dom.get("sampling")), "sampling '" + v + "'; allowed: uniform, demand (∝ mask value)");
       d.demand_weighted = v == "demand";
     }
-    // A NIfTI mask's voxel size is known only once it is read: its root stays in mm until then.
-    if (const auto mm = readRoot(r, tree, d.root_voxel, d.root_line, "mask voxels", ": a mask domain has no default root")) {
-      if (nifti) {
-        d.root_mm = *mm;
-        d.root_in_mm = true;
-      } else {
-        d.root_voxel = *mm / d.voxel_mm;
-      }
-    }
   } else {
     r.forbid(dom, "domain", {"mask", "sampling"}, "is for shape = \"mask\"");
-    r.forbid(tree, "tree", {"root", "root_voxel"}, "is for mask domains; an analytic shape takes root_offset (mm from its centre)");
     const char* size_key = round ? "radius" : "side";
     r.forbid(dom, "domain", {round ? "side" : "radius"}, std::string("does not size a ") + shape + "; give " + size_key);
     d.size_mm = r.quantity(dom, "domain", size_key, Dimension::Length);
@@ -114,12 +307,6 @@ std::shared_ptr<const GrowthSetup> readCcoToml(const TomlReader& r, const Growth
     d.voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
     checkRange(d.voxel_mm, std::max(Limits::kMinVoxel, d.size_mm / Limits::kMaxVoxelsPerAxis), false, d.size_mm, true,
                r.at(dom, "voxel_size"), "voxel_size (mm)");
-    if (const auto* n = tree.get("root_offset")) {
-      const bool flat = d.shape == DomainShape::Disc || d.shape == DomainShape::Square;
-      d.root_offset_mm = r.point(n, "root_offset (mm from the centre)", flat);
-      d.has_root_offset = true;
-      d.root_line = r.lineOf(n);
-    }
   }
 
   auto& c = s->cco;
@@ -128,6 +315,7 @@ std::shared_ptr<const GrowthSetup> readCcoToml(const TomlReader& r, const Growth
   whole("closest_neighbours", c.closest_neighbours, 1, Limits::kMaxNeighbours);
   c.physics = readPhysics(r, m, methodTable(r, m, "physics"));
   c.physics.total_terminals = c.terminals;
+  readInlets(r, m, tree, *s);
   whole("max_closest_neighbours", c.max_neighbours, c.closest_neighbours, Limits::kMaxNeighbours * 64);
   c.max_neighbours = std::max(c.max_neighbours, c.closest_neighbours);
   whole("kamiya_iterations", c.kamiya_iterations, 1, 100000);
@@ -158,8 +346,8 @@ GrowthDomain loadCcoDomain(const CcoSetup& s, std::uint64_t limit) {
     box.demand_map = spec.mask;
     box.supply_coefficients = {1, 0};
     box.voxel_mm = spec.voxel_mm;
-    box.root_voxel = spec.root_voxel;
-    box.root_line = spec.root_line;
+    box.root_voxel = s.inlets.front().root.root_voxel;  // the others are checked by ccoRoot
+    box.root_line = s.inlets.front().root.root_line;
     m = loadDomain(box, limit);
   }
   std::int64_t inside = 0;
@@ -168,10 +356,9 @@ GrowthDomain loadCcoDomain(const CcoSetup& s, std::uint64_t limit) {
   return GrowthDomain::mask(std::move(m), spec.demand_weighted);
 }
 
-Vec3 ccoRoot(const CcoSetup& s, const GrowthDomain& d) {
-  const auto& spec = s.domain;
+Vec3 ccoRoot(const CcoSetup& s, const CcoRootSpec& spec, const GrowthDomain& d) {
   Vec3 root;
-  if (spec.shape != DomainShape::Mask) {
+  if (d.shape() != DomainShape::Mask) {
     root = spec.has_root_offset ? d.center() + spec.root_offset_mm : d.defaultRoot();
   } else {
     root = spec.root_in_mm ? spec.root_mm : d.frame().toMm(spec.root_voxel);
@@ -192,16 +379,23 @@ Json CcoSetup::describe() const {
   Json j;
   j["method"] = "cco";
   j["shape"] = domainShapeName(d.shape);
+  const auto describeRoot = [&](const CcoRootSpec& root, Json& out) {
+    if (d.shape == DomainShape::Mask) {
+      if (root.root_in_mm) out["root"] = Json{{"value", {root.root_mm.x, root.root_mm.y, root.root_mm.z}}, {"unit", "mm"}};
+      else out["root_voxel"] = {root.root_voxel.x, root.root_voxel.y, root.root_voxel.z};
+    } else {
+      out["root_offset"] = root.has_root_offset
+                               ? Json{{"value", {root.root_offset_mm.x, root.root_offset_mm.y, root.root_offset_mm.z}}, {"unit", "mm"}}
+                               : Json("the top of the domain (+y)");
+    }
+  };
   if (d.shape == DomainShape::Mask) {
     j["mask"] = d.mask.string();
     j["sampling"] = d.demand_weighted ? "demand" : "uniform";
-    if (d.root_in_mm) j["root"] = Json{{"value", {d.root_mm.x, d.root_mm.y, d.root_mm.z}}, {"unit", "mm"}};
-    else j["root_voxel"] = {d.root_voxel.x, d.root_voxel.y, d.root_voxel.z};
   } else {
     j[d.shape == DomainShape::Sphere || d.shape == DomainShape::Disc ? "radius" : "side"] = quantityJson(d.size_mm, "mm");
-    j["root_offset"] = d.has_root_offset ? Json{{"value", {d.root_offset_mm.x, d.root_offset_mm.y, d.root_offset_mm.z}}, {"unit", "mm"}}
-                                         : Json("the top of the domain (+y)");
   }
+  if (!inlet_tables) describeRoot(inlets.front().root, j);
   if (d.voxel_mm > 0) j["voxel_size"] = quantityJson(d.voxel_mm, "mm");
   j["terminals"] = c.terminals;
   j["closest_neighbours"] = c.closest_neighbours;
@@ -212,6 +406,21 @@ Json CcoSetup::describe() const {
   j["relaxation"] = c.relaxation;
   j["murray_exponent"] = c.physics.murray_exponent;
   describePhysics(c.physics, c.terminals, j);
+  if (inlet_tables) {
+    j["terminals_per"] = "kind: each kind of inlet perfuses (or drains) the whole domain with this many terminals";
+    Json list = Json::array();
+    for (const auto& in : inlets) {
+      Json e;
+      e["id"] = in.id;
+      e["kind"] = in.kind;
+      describeRoot(in.root, e);
+      e["share"] = in.share > 0 ? Json(in.share) : Json("territory");
+      e["root_pressure"] = quantityJson(in.root_pressure, "Pa");
+      e["terminal_pressure"] = quantityJson(in.terminal_pressure, "Pa");
+      list.push_back(e);
+    }
+    j["inlets"] = list;
+  }
   return j;
 }
 
@@ -247,6 +456,14 @@ const GrowthMethod kCcoMethod{
         {"tree", "kamiya_tolerance", "", "1e-6", "its step, relative to the three lengths, at convergence"},
         {"tree", "draws_before_relaxing", "count", "100", "failed draws before the distance threshold shrinks"},
         {"tree", "relaxation", "", "0.9", "the factor on the distance threshold after such a run"},
+        {"tree.inlet", "id", "text", "its kind (kind_1, kind_2, ... when several)", "the tree's name in graphs and sample.json"},
+        {"tree.inlet", "kind", "text", "artery", "artery, vein or a free name; inlets of one kind compete for its `terminals`, each kind fills the domain"},
+        {"tree.inlet", "root_offset", "[x, y(, z)] mm", nullptr, "analytic shapes: the root relative to the centre"},
+        {"tree.inlet", "root", "[x, y, z] mm", nullptr, "masks: the root in mm in the frame (or root_voxel)"},
+        {"tree.inlet", "root_voxel", "[x, y, z] mask voxels", nullptr, "masks: the root in voxels (or root)"},
+        {"tree.inlet", "share", "", "territory", "its fixed share (0, 1] of its kind's terminals and flow, or \"territory\": what it wins"},
+        {"tree.inlet", "root_pressure", "Pa", "[physics] perfusion_pressure; vein 5 mmHg", "pressure at its root (a vein's outlet)"},
+        {"tree.inlet", "terminal_pressure", "Pa", "[physics] terminal_pressure; vein 20 mmHg", "pressure at its terminals (above the root: it drains)"},
     }, false, "0.0036 Pa*s", "100 mmHg", "60 mmHg", "500 mL/min"),
     &readCcoToml};
 

@@ -14,7 +14,7 @@ RadiusEstimate estimateRadii(const PhysicsParameters& p, std::int64_t terminals,
   double path = 0;  // Σ over levels of 2^-k · 2^(-k/d) · 2^(4k/γ)
   for (int k = 0; k <= int(levels); ++k)
     path += std::pow(2.0, -k - double(k) / dim + 4.0 * k / p.murray_exponent);
-  const double dp = p.perfusion_pressure - p.terminal_pressure;
+  const double dp = std::abs(p.perfusion_pressure - p.terminal_pressure);
   RadiusEstimate e;
   e.root = std::pow(8 * p.viscosity * p.perfusion_flow * root_length * path / (std::numbers::pi * dp), 0.25);
   e.terminal = e.root * std::pow(n, -1.0 / p.murray_exponent);

@@ -22,6 +22,7 @@ void checkMethodKeys(const TomlReader& r, const GrowthMethod& m, const toml::tab
   for (const auto& [k, v] : t) {
     const std::string key(k.str());
     if (findParam(m, name, key) || (name == "tree" && key == "method")) continue;
+    if (name == "tree" && key == "inlet" && !declaredKeys(m, "tree.inlet").empty()) continue;  // [[tree.inlet]]
     if (const GrowthMethod* other = methodDeclaring(name, key, &m))
       throw InputError(r.file(), r.lineOf(&v), "'" + key + "' in [" + name + "] is for method " + other->name +
                                                    "; this file grows with method " + m.name + " ([tree] method)");
@@ -111,7 +112,7 @@ PhysicsParameters readPhysics(const TomlReader& r, const GrowthMethod& m, const 
 }
 
 std::optional<Vec3> readRoot(const TomlReader& r, const toml::table& tree, Vec3& root_voxel, int& root_line,
-                             const std::string& voxels, const std::string& why_required) {
+                             const std::string& voxels, const std::string& why_required, const std::string& table) {
   if (tree.get("root_voxel") && tree.get("root"))
     throw InputError(r.file(), r.lineOf(tree.get("root")), "give root (mm) or root_voxel (" + voxels + "), not both");
   if (const auto* n = tree.get("root_voxel")) {
@@ -123,7 +124,7 @@ std::optional<Vec3> readRoot(const TomlReader& r, const toml::table& tree, Vec3&
     root_line = r.lineOf(n);
     return r.point(n, "root (mm)", false);
   }
-  throw InputError(r.file(), r.lineOf(&tree), "missing key 'root' (mm) or 'root_voxel' (" + voxels + ") in [tree]" + why_required);
+  throw InputError(r.file(), r.lineOf(&tree), "missing key 'root' (mm) or 'root_voxel' (" + voxels + ") in [" + table + "]" + why_required);
 }
 
 std::int64_t readTerminals(const TomlReader& r, const toml::table& tree, int& line) {

@@ -41,10 +41,10 @@ std::vector<MethodParam> withPhysicsParams(std::vector<MethodParam> rows, bool c
 // [physics] with m's defaults and the shared range checks; cost exponents only when m declares them.
 PhysicsParameters readPhysics(const TomlReader& r, const GrowthMethod& m, const toml::table& ph);
 
-// The root from [tree]: root_voxel (in `voxels`) is stored in root_voxel; root (mm) is returned.
+// The root from [tree] (or the named table): root_voxel (in `voxels`) is stored in root_voxel; root (mm) is returned.
 // Exactly one of them is required.
 std::optional<Vec3> readRoot(const TomlReader& r, const toml::table& tree, Vec3& root_voxel, int& root_line,
-                             const std::string& voxels, const std::string& why_required);
+                             const std::string& voxels, const std::string& why_required, const std::string& table = "tree");
 // [tree] terminals, checked; its line is stored for feasibility errors.
 std::int64_t readTerminals(const TomlReader& r, const toml::table& tree, int& line);
 // viscosity, pressures and flows with units, as sample.json records them.
