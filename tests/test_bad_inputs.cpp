@@ -45,6 +45,19 @@ const BadCase kCases[] = {
      "p.txt:7: PERF_FLOW (cm^3/s) = 1e+300 is out of range"},
     {"min_distance_huge", "p.txt", "vs", "MIN_DISTANCE: 1", "MIN_DISTANCE: 1e300", "generate p.txt --out out",
      "p.txt:12: MIN_DISTANCE (map voxels) = 1e+300 is out of range"},
+    // Forests of method cco: [[tree.inlet]] tables.
+#define CCO_FOREST "[domain]\nshape = \"sphere\"\nradius = \"10 mm\"\nvoxel_size = \"0.5 mm\"\n[tree]\nmethod = \"cco\"\nterminals = 100\n"
+    {"inlet_shares_sum", "p.toml", "", "", CCO_FOREST "[[tree.inlet]]\nroot_offset = [0, 10, 0]\nshare = 0.5\n[[tree.inlet]]\nroot_offset = [0, -10, 0]\nshare = 0.4\n",
+     "generate p.toml --out out", "p.toml:11: the shares of the artery inlets sum to 0.9; fixed shares of one kind must sum to 1"},
+    {"inlet_vein_supplies", "p.toml", "", "", CCO_FOREST "[[tree.inlet]]\nroot_offset = [0, 10, 0]\n[[tree.inlet]]\nkind = \"vein\"\nroot_offset = [0, -10, 0]\nroot_pressure = \"30 mmHg\"\nterminal_pressure = \"20 mmHg\"\n",
+     "generate p.toml --out out", "p.toml:13: inlet 'vein' is a vein: it drains, so its terminal_pressure must exceed its root_pressure"},
+    {"inlet_duplicate_id", "p.toml", "", "", CCO_FOREST "[[tree.inlet]]\nid = \"a\"\nroot_offset = [0, 10, 0]\n[[tree.inlet]]\nid = \"a\"\nroot_offset = [0, -10, 0]\n",
+     "generate p.toml --out out", "p.toml:12: a second inlet with id 'a'; ids must be unique"},
+    {"inlet_without_root", "p.toml", "", "", CCO_FOREST "[[tree.inlet]]\nroot_offset = [0, 10, 0]\n[[tree.inlet]]\nkind = \"vein\"\n",
+     "generate p.toml --out out", "p.toml:10: missing key 'root_offset' (mm from the centre) in [[tree.inlet]]"},
+    {"inlet_roots_touch", "p.toml", "", "", CCO_FOREST "[[tree.inlet]]\nroot_offset = [0, 10, 0]\n[[tree.inlet]]\nroot_offset = [0.1, 9.99, 0]\n",
+     "generate p.toml --out out", "p.toml:11: the roots of inlets 'artery_1' and 'artery_2' lie 0.100499 mm apart"},
+#undef CCO_FOREST
     {"profile_intensity_huge", "prof.toml", "", "", "background = 1e30\n[[effect]]\ntype = \"gaussian\"\nsigma = 1\n",
      "generate p.toml --out out --profile prof.toml", "prof.toml:1: background = 1e+30 is out of range"},
     {"bias_scale_tiny", "prof.toml", "", "", "[[effect]]\ntype = \"bias\"\namplitude = 0.2\nscale = \"1e-9 mm\"\n",
