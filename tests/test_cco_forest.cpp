@@ -39,14 +39,6 @@ CcoInlet inlet(const Vec3& root, int system, double share = 0, double p_root = 1
   return in;
 }
 
-// Each tree's physics: the options' with the inlet's pressures.
-PhysicsParameters physicsOf(const CcoOptions& o, const CcoInlet& in) {
-  PhysicsParameters p = o.physics;
-  p.perfusion_pressure = in.root_pressure;
-  p.terminal_pressure = in.terminal_pressure;
-  return p;
-}
-
 // Hemodynamics and geometry of every tree (terminal flow Q/N of its system), and no overlap
 // within or across trees on the assembled forest.
 void expectForestInvariants(const std::vector<VascularTree>& trees, const std::vector<CcoInlet>& inlets,
@@ -55,7 +47,7 @@ void expectForestInvariants(const std::vector<VascularTree>& trees, const std::v
   VascularTree forest;
   for (std::size_t k = 0; k < trees.size(); ++k) {
     SCOPED_TRACE("tree " + std::to_string(k));
-    test::expectHemodynamicInvariants(trees[k], physicsOf(o, inlets[k]), trees[k].terminalCount(),
+    test::expectHemodynamicInvariants(trees[k], inletPhysics(o.physics, inlets[k].root_pressure, inlets[k].terminal_pressure), trees[k].terminalCount(),
                                       o.physics.perfusion_flow / double(o.terminals));
     test::expectGeometry(trees[k], d);
     EXPECT_EQ(trees[k].position[0], inlets[k].root_mm);

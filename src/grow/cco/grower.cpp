@@ -86,10 +86,7 @@ class CcoGrower {
     systems_.resize(systems);
     for (std::size_t k = 0; k < inlets.size(); ++k) {
       const auto& in = inlets[k];
-      PhysicsParameters p = volumePhysics(o);
-      p.perfusion_pressure = in.root_pressure;
-      p.terminal_pressure = in.terminal_pressure;
-      trees_.emplace_back(d, p, in.root_mm, in.system, o.terminals);
+      trees_.emplace_back(d, inletPhysics(volumePhysics(o), in.root_pressure, in.terminal_pressure), in.root_mm, in.system, o.terminals);
       systems_[in.system].trees.push_back(int(k));
     }
     for (auto& sys : systems_) {
@@ -150,6 +147,23 @@ class CcoGrower {
     return n < systems_[g.system].territory;
   }
 
+  // Calls f(y) for the segments of g that may overlap the capsule a–e of radius r: the grid as
+  // far as thin vessels (ρ < kThick) reach, and the few thick ones from their list, so the search
+  // does not widen with the root radius rr as the cells shrink.
+  template <class Radius, class F>
+  static void forEachNearVessel(TreeGrowth& g, const Vec3& a, const Vec3& e, double r, double rr, Radius&& radius_of, F&& f) {
+    const auto& T = g.tree;
+    g.index.forEachNearSegment(a, e, r + kThick * rr, f);
+    const Vec3 mid = (a + e) * 0.5;
+    const double half = 0.5 * distance(a, e);
+    for (auto y : g.thick) {
+      if (y >= T.nodeCount()) continue;
+      const Vec3& b0 = T.position[T.parent[y]];
+      const Vec3& b1 = T.position[y];
+      if (distance(mid, (b0 + b1) * 0.5) <= half + 0.5 * distance(b0, b1) + r + radius_of(y)) f(y);
+    }
+  }
+
   // True if the capsule a–e of radius r overlaps a vessel of a tree other than k: with the radii
   // of growth (ρ × the current root radius), or, on the solved forest, the exact radii + 2 %.
   bool hitsOtherTree(int k, const Vec3& a, const Vec3& e, double r, bool solved = false) {
@@ -178,17 +192,7 @@ class CcoGrower {
         if (hit) return true;
         continue;
       }
-      // As within a tree: the grid as far as thin vessels reach, the few thick ones from their list.
-      o.index.forEachNearSegment(a, e, r + kThick * rr, test);
-      const Vec3 mid = (a + e) * 0.5;
-      const double half = 0.5 * distance(a, e);
-      for (auto y : o.thick) {
-        if (hit) break;
-        if (y >= o.tree.nodeCount()) continue;
-        const Vec3& b0 = o.tree.position[o.tree.parent[y]];
-        const Vec3& b1 = o.tree.position[y];
-        if (distance(mid, (b0 + b1) * 0.5) <= half + 0.5 * distance(b0, b1) + r + radius_of(y)) test(y);
-      }
+      forEachNearVessel(o, a, e, r, rr, radius_of, test);
       if (hit) return true;
     }
     return false;
@@ -285,19 +289,7 @@ class CcoGrower {
       const Vec3& a0 = T.position[T.parent[x]];
       const Vec3& a1 = T.position[x];
       const double rx = g.rel[x] * rr;
-      // The grid is searched as far as thin vessels reach; the few thick ones are listed apart,
-      // so the search does not widen with the root radius as the cells shrink.
-      const auto candidates = [&](auto&& f) {
-        g.index.forEachNearSegment(a0, a1, rx + kThick * rr, f);
-        const Vec3 mid = (a0 + a1) * 0.5;
-        const double half = 0.5 * distance(a0, a1);
-        for (auto y : g.thick) {
-          if (y >= T.nodeCount()) continue;
-          const Vec3& b0 = T.position[T.parent[y]];
-          const Vec3& b1 = T.position[y];
-          if (distance(mid, (b0 + b1) * 0.5) <= half + 0.5 * distance(b0, b1) + rx + radius_of(y)) f(y);
-        }
-      };
+      const auto candidates = [&](auto&& f) { forEachNearVessel(g, a0, a1, rx, rr, radius_of, f); };
       if (overlapsOtherVessel(T, x, a0, a1, rx, candidates, radius_of)) return true;
       const bool ancestor = &x - check_.data() >= 3;
       if (trees_.size() > 1 && !(ancestor && lenient_) && hitsOtherTree(k, a0, a1, kRecheckGrowth * rx)) {
@@ -695,6 +687,12 @@ VascularTree growCco(const GrowthDomain& domain, const CcoOptions& options, Grow
   in.root_pressure = options.physics.perfusion_pressure;
   in.terminal_pressure = options.physics.terminal_pressure;
   return std::move(growCcoForest(domain, options, {in}, report, progress).front());
+}
+
+PhysicsParameters inletPhysics(PhysicsParameters p, double root_pressure, double terminal_pressure) {
+  p.perfusion_pressure = root_pressure;
+  p.terminal_pressure = terminal_pressure;
+  return p;
 }
 
 std::vector<std::int64_t> terminalQuotas(const std::vector<double>& shares, std::int64_t n) {

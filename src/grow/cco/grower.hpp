@@ -61,6 +61,8 @@ struct CcoInlet {
 std::vector<VascularTree> growCcoForest(const GrowthDomain& domain, const CcoOptions& options,
                                         const std::vector<CcoInlet>& inlets, GrowthReport& report,
                                         const ProgressFn& progress = {});
+// The physics of one tree: `p` with the inlet's root and terminal pressures.
+PhysicsParameters inletPhysics(PhysicsParameters p, double root_pressure, double terminal_pressure);
 // Terminal quotas of a system's inlets from their fixed shares (largest remainder; shares that sum
 // to 1 give quotas that sum to n); 0 for inlets that win their territory.
 std::vector<std::int64_t> terminalQuotas(const std::vector<double>& shares, std::int64_t n);

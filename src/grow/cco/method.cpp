@@ -31,44 +31,50 @@ std::vector<std::string> kindsOf(const std::vector<CcoInletSpec>& inlets) {
 
 class PreparedCco final : public PreparedGrowth {
  public:
-  PreparedCco(const CcoSetup& s, GrowthDomain d) : setup_(s), domain_(std::move(d)) {}
+  // The inlets' roots are placed (and checked inside the domain) once, for every sample.
+  PreparedCco(const CcoSetup& s, GrowthDomain d) : setup_(s), domain_(std::move(d)) {
+    const auto kinds = kindsOf(s.inlets);
+    systems_ = kinds.size();
+    for (const auto& in : s.inlets) {
+      CcoInlet g;
+      g.root_mm = ccoRoot(s, in.root, domain_);
+      g.system = int(std::find(kinds.begin(), kinds.end(), in.kind) - kinds.begin());
+      g.share = in.share;
+      g.root_pressure = in.root_pressure;
+      g.terminal_pressure = in.terminal_pressure;
+      inlets_.push_back(g);
+    }
+  }
   const DemandMap& frame() const override { return domain_.frame(); }
   void checkFeasibility() const override {
-    std::vector<Vec3> roots;
-    for (const auto& in : setup_.inlets) roots.push_back(ccoRoot(setup_, in.root, domain_));
     std::int64_t inside = 0;  // voxels of the domain
     for (float v : domain_.frame().demand) inside += v > 0;
     const auto& c = setup_.cco;
-    const auto kinds = kindsOf(setup_.inlets);
-    const std::int64_t total = c.terminals * std::int64_t(kinds.size());
+    const std::int64_t total = c.terminals * std::int64_t(systems_);
     // A terminal per voxel of the domain at most: finer than its resolution the mask says nothing.
     if (total > inside)
       throw InputError(setup_.parameter_file, setup_.terminals_line,
-                       std::to_string(total) + " terminals" + (kinds.size() > 1 ? " (" + std::to_string(c.terminals) + " per kind)" : "") +
+                       std::to_string(total) + " terminals" + (systems_ > 1 ? " (" + std::to_string(c.terminals) + " per kind)" : "") +
                            " exceed the " + std::to_string(inside) + " voxels of the domain; use fewer terminals or a finer voxel_size (mask)");
     // Every kind fills the domain beside the others: each has its share of the room, and its
     // thickest vessels come from its smallest pressure drop.
-    std::vector<PhysicsParameters> per_inlet;
-    for (const auto& in : setup_.inlets) {
-      PhysicsParameters p = c.physics;
-      p.perfusion_pressure = in.root_pressure;
-      p.terminal_pressure = in.terminal_pressure;
-      per_inlet.push_back(p);
-    }
-    const double room = domain_.measure() / double(kinds.size());
-    for (std::size_t i = 0; i < per_inlet.size(); ++i)
-      checkVesselRoom(per_inlet[i], c.terminals, room, domain_.dimension(), setup_.parameter_file,
+    const double room = domain_.measure() / double(systems_);
+    std::vector<double> root_radius;
+    for (std::size_t i = 0; i < inlets_.size(); ++i) {
+      const auto p = inletPhysics(c.physics, inlets_[i].root_pressure, inlets_[i].terminal_pressure);
+      checkVesselRoom(p, c.terminals, room, domain_.dimension(), setup_.parameter_file,
                       setup_.inlet_tables ? setup_.inlets[i].line : setup_.terminals_line);
+      root_radius.push_back(estimateRadii(p, c.terminals, room, domain_.dimension()).root);
+    }
     // Two roots closer than their root vessels are thick cannot both start a tree.
-    for (std::size_t i = 0; i < roots.size(); ++i)
-      for (std::size_t j = i + 1; j < roots.size(); ++j) {
-        const double ri = estimateRadii(per_inlet[i], c.terminals, room, domain_.dimension()).root;
-        const double rj = estimateRadii(per_inlet[j], c.terminals, room, domain_.dimension()).root;
-        if (!(distance(roots[i], roots[j]) > 2 * (ri + rj)))
+    for (std::size_t i = 0; i < inlets_.size(); ++i)
+      for (std::size_t j = i + 1; j < inlets_.size(); ++j) {
+        const double ri = root_radius[i], rj = root_radius[j], apart = distance(inlets_[i].root_mm, inlets_[j].root_mm);
+        if (!(apart > 2 * (ri + rj)))
           throw InputError(setup_.parameter_file, setup_.inlets[j].root.root_line ? setup_.inlets[j].root.root_line : setup_.inlets[j].line,
-                           "the roots of inlets '" + setup_.inlets[i].id + "' and '" + setup_.inlets[j].id + "' lie " +
-                               show(distance(roots[i], roots[j])) + " mm apart; their root vessels (radius about " + show(ri) + " and " +
-                               show(rj) + " mm) need more than " + show(2 * (ri + rj)) + " mm; move them apart");
+                           "the roots of inlets '" + setup_.inlets[i].id + "' and '" + setup_.inlets[j].id + "' lie " + show(apart) +
+                               " mm apart; their root vessels (radius about " + show(ri) + " and " + show(rj) + " mm) need more than " +
+                               show(2 * (ri + rj)) + " mm; move them apart");
       }
   }
   const GrowthDomain* domain() const override { return &domain_; }
@@ -76,18 +82,7 @@ class PreparedCco final : public PreparedGrowth {
     CcoOptions co = setup_.cco;
     co.seed = seed;
     co.sample = sample;
-    const auto kinds = kindsOf(setup_.inlets);
-    std::vector<CcoInlet> inlets;
-    for (const auto& in : setup_.inlets) {
-      CcoInlet g;
-      g.root_mm = ccoRoot(setup_, in.root, domain_);
-      g.system = int(std::find(kinds.begin(), kinds.end(), in.kind) - kinds.begin());
-      g.share = in.share;
-      g.root_pressure = in.root_pressure;
-      g.terminal_pressure = in.terminal_pressure;
-      inlets.push_back(g);
-    }
-    auto trees = growCcoForest(domain_, co, inlets, report, progress);
+    auto trees = growCcoForest(domain_, co, inlets_, report, progress);
     Forest f;
     for (std::size_t k = 0; k < trees.size(); ++k) {
       f.vessels.appendTree(trees[k], int(k));
@@ -115,6 +110,8 @@ class PreparedCco final : public PreparedGrowth {
  private:
   const CcoSetup& setup_;
   GrowthDomain domain_;
+  std::vector<CcoInlet> inlets_;  // one per tree, roots in the domain's frame
+  std::size_t systems_ = 1;       // kinds of inlet
 };
 
 // The root of one tree from its table (`name`: "tree" or "tree.inlet"): root_offset for analytic
