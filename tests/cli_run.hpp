@@ -44,9 +44,11 @@ inline Run run(const std::string& args, const std::filesystem::path& cwd) {
 }
 
 // An empty directory for the running test, named after it.
+// A directory of its own per test and per process: two suites on one machine (a CI run beside
+// a local one) must not delete each other's files.
 inline std::filesystem::path freshTestDir(const std::string& prefix) {
   const auto dir = std::filesystem::temp_directory_path() /
-                   (prefix + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+                   (prefix + ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

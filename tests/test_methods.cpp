@@ -1,6 +1,7 @@
 // Growth methods as plug-ins: the registry, the declarations that drive reader, defaults and
 // reference, and the README generated from them.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <fstream>
 
@@ -45,7 +46,7 @@ TEST(Methods, EveryDeclaredDefaultIsReadableInItsUnitAndDeclaredOnce) {
 class MethodFiles : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / "angiosynth_methods";
+    dir_ = fs::temp_directory_path() / ("angiosynth_methods_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }

@@ -1,5 +1,6 @@
 // The sparse OpenVDB path agrees voxel for voxel with the dense rasterizer.
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
@@ -19,7 +20,7 @@ TEST(Vdb, SparseGridsMatchTheDenseRasterAndCarryTheGeometry) {
   g.spacing_mm = Vec3(0.45, 0.4, 0.37);
   g.origin_mm = Vec3(0.2, -0.3, 0.1);
   const auto dense = rasterizeGroundTruth(t, g, RasterOptions{3});
-  const auto file = std::filesystem::temp_directory_path() / "angiosynth_test.vdb";
+  const auto file = std::filesystem::temp_directory_path() / ("angiosynth_test_" + std::to_string(::getpid()) + ".vdb");
   const VdbReport rep = writeVdb(file, t, g, binSegments(t, g), RasterOptions{3});
   EXPECT_GT(rep.leaves, 0);
 

@@ -81,7 +81,7 @@ TEST_F(VolumeFiles, NrrdHeaderDescribesTheSameGeometryInLps) {
 TEST(GraphFiles, GraphmlLoadsInNetworkxAndMatchesTheTree) {
   auto ex = test::vascusynthExample(50, 3);
   const VascularTree t = test::grow(ex);
-  const fs::path file = fs::temp_directory_path() / "angiosynth_tree.graphml";
+  const fs::path file = fs::temp_directory_path() / ("angiosynth_tree_" + std::to_string(::getpid()) + ".graphml");
   std::ofstream(file) << [&] {
     std::ostringstream s;
     writeGraphml(s, t, singleTreeForest(VascularTree{}).trees);
