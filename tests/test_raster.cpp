@@ -66,9 +66,9 @@ TEST(Raster, WhollyInsideIsOneWhollyOutsideIsZero) {
     for (int j = 0; j < 40; ++j)
       for (int i = 0; i < 40; ++i) {
         const double d = pointSegmentDistance(g.centre(i, j, k), Vec3(5, 20, 20), Vec3(35, 20, 20));
-        if (d < 6.0 - half_diag) EXPECT_EQ(f.at(i, j, k), 1.0f);
-        if (d > 6.0 + half_diag) EXPECT_EQ(f.at(i, j, k), 0.0f);
-        if (f.at(i, j, k) > 0) EXPECT_EQ(id.at(i, j, k), 1u);
+        if (d < 6.0 - half_diag) { EXPECT_EQ(f.at(i, j, k), 1.0f); }
+        if (d > 6.0 + half_diag) { EXPECT_EQ(f.at(i, j, k), 0.0f); }
+        if (f.at(i, j, k) > 0) { EXPECT_EQ(id.at(i, j, k), 1u); }
       }
 }
 
@@ -135,8 +135,8 @@ TEST_F(GrownRaster, CentrelinesLieInTheMaskAndTheMaskIsOneComponent) {
   EXPECT_EQ(reached, total);
   // Labels agree: instances only on the mask, radius only on the centreline.
   for (std::size_t v = 0; v < gt.mask.data.size(); ++v) {
-    if (!gt.mask.data[v]) EXPECT_EQ(gt.instances.data[v], 0u);
-    if (gt.mask.data[v]) EXPECT_NE(gt.instances.data[v], 0u);
+    if (!gt.mask.data[v]) { EXPECT_EQ(gt.instances.data[v], 0u); }
+    if (gt.mask.data[v]) { EXPECT_NE(gt.instances.data[v], 0u); }
     EXPECT_EQ(gt.radius.data[v] > 0, gt.centerline.data[v] == 1);
   }
 }

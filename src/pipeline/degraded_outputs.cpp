@@ -44,7 +44,7 @@ void writeDegradedImages(const Forest& forest, const std::vector<std::uint8_t>& 
     } else {
       std::vector<Channel> channels{{"image" + suffix, image.view}};
       if (d.labels) {
-        fillClasses(*d.labels, segment_classes);  // warped instances keep the clean segment ids
+        fillClasses(*d.labels, *d.tree, segment_classes, &d.segment_origin);  // labels: clean segment ids
         for (auto& c : labelChannels(*d.labels, suffix)) channels.push_back(c);
       }
       writeChannels(channels, ip.formats, dir, files);

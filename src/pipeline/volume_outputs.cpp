@@ -110,7 +110,7 @@ void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::fil
   if (!needsDense(req)) return;
   GroundTruthVolumes gt = rasterizeGroundTruth(tree, g, RasterOptions{ip.supersampling});
   const std::vector<std::uint8_t> classes = segmentClasses(tree, forest.trees);
-  fillClasses(gt, classes);
+  fillClasses(gt, tree, classes);
   {
     TypedImage image;
     makeTypedImage(image, gt.fraction, ip.background, ip.vessel - ip.background, ip.dtype, "angiosynth image");

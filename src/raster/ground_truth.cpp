@@ -1,6 +1,10 @@
 #include "raster/ground_truth.hpp"
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <tuple>
 
 #include <atomic>
 #include <cmath>
@@ -15,7 +19,42 @@ std::uint64_t denseRasterBytes(const VolumeGrid& g) {
   return static_cast<std::uint64_t>(g.voxelCount()) * per_voxel;
 }
 
-void fillClasses(GroundTruthVolumes& gt, const std::vector<std::uint8_t>& class_of_segment) {
+namespace {
+
+// What visit(out, segment, voxel) emits for every voxel a centreline of t crosses (segments
+// with a kind), gathered per thread and sorted: the result does not depend on the thread count.
+template <class T, class Kind, class Visit>
+std::vector<T> gatherCrossings(const VascularTree& t, const VolumeGrid& g, const Kind& kind, const Visit& visit) {
+  tbb::enumerable_thread_specific<std::vector<T>> local;
+  tbb::parallel_for(tbb::blocked_range<std::int32_t>(1, t.nodeCount(), 256), [&](const tbb::blocked_range<std::int32_t>& r) {
+    auto& out = local.local();
+    for (std::int32_t s = r.begin(); s != r.end(); ++s) {
+      if (t.isRoot(s) || kind(s) == 0) continue;
+      forEachCrossedVoxel(g, t.position[t.parent[s]], t.position[s],
+                          [&](std::int64_t i, std::int64_t j, std::int64_t k) { visit(out, s, std::uint64_t(g.flat(i, j, k))); });
+    }
+  });
+  std::vector<T> all;
+  for (auto& h : local) all.insert(all.end(), h.begin(), h.end());
+  std::sort(all.begin(), all.end());
+  return all;
+}
+
+// Ordered so that the first crossing of a voxel is the one it keeps.
+struct Crossing {
+  std::uint64_t voxel;
+  std::uint32_t course;       // voxels the segment's centreline crosses
+  std::uint32_t radius_bits;  // radii are positive, so their bits order as the floats
+  std::int32_t label;
+  bool operator<(const Crossing& o) const {
+    return std::tie(voxel, course, radius_bits, label) < std::tie(o.voxel, o.course, o.radius_bits, o.label);
+  }
+};
+
+}  // namespace
+
+void fillClasses(GroundTruthVolumes& gt, const VascularTree& t, const std::vector<std::uint8_t>& class_of_segment,
+                 const std::vector<std::int32_t>* label_of_segment) {
   gt.classes = Volume<std::uint8_t>(gt.instances.grid);
   const std::int64_t n = static_cast<std::int64_t>(gt.instances.data.size());
   tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, n, 1 << 16), [&](const tbb::blocked_range<std::int64_t>& r) {
@@ -24,6 +63,31 @@ void fillClasses(GroundTruthVolumes& gt, const std::vector<std::uint8_t>& class_
       if (gt.mask.data[v] && s > 0 && s < class_of_segment.size()) gt.classes.data[v] = class_of_segment[s];
     }
   });
+  const auto label = [&](std::int32_t s) { return label_of_segment ? (*label_of_segment)[s] : s; };
+  const auto kind = [&](std::int32_t s) {
+    const auto l = static_cast<std::size_t>(label(s));
+    return l < class_of_segment.size() ? class_of_segment[l] : std::uint8_t(0);
+  };
+  // The voxels where a centreline disagrees with the class (none in a forest of one kind), and
+  // each segment's course in voxels; then every centreline crossing those voxels.
+  const VolumeGrid& g = gt.classes.grid;
+  std::vector<std::uint32_t> course(std::size_t(t.nodeCount()), 0);  // one thread per segment
+  auto conflicts = gatherCrossings<std::uint64_t>(t, g, kind, [&](std::vector<std::uint64_t>& out, std::int32_t s, std::uint64_t v) {
+    ++course[std::size_t(s)];
+    if (gt.classes.data[v] != kind(s)) out.push_back(v);
+  });
+  conflicts.erase(std::unique(conflicts.begin(), conflicts.end()), conflicts.end());
+  if (conflicts.empty()) return;
+  const auto crossings = gatherCrossings<Crossing>(t, g, kind, [&](std::vector<Crossing>& out, std::int32_t s, std::uint64_t v) {
+    if (!std::binary_search(conflicts.begin(), conflicts.end(), v)) return;
+    const float r = static_cast<float>(t.radius[s]);
+    std::uint32_t bits;
+    std::memcpy(&bits, &r, sizeof bits);
+    out.push_back({v, course[std::size_t(s)], bits, label(s)});
+  });
+  for (std::size_t i = 0; i < crossings.size(); ++i)
+    if (i == 0 || crossings[i].voxel != crossings[i - 1].voxel)
+      gt.classes.data[crossings[i].voxel] = class_of_segment[std::size_t(crossings[i].label)];
 }
 
 void centerlineVoxels(const VolumeGrid& g, const Vec3& a_mm, const Vec3& b_mm,

@@ -18,16 +18,24 @@ struct GroundTruthVolumes {
   Volume<float> radius;              // mm, on centreline voxels (the thicker vessel at joints)
   Volume<std::uint32_t> instances;   // segment id (= distal node id) on mask voxels, else 0
   // The kind of the vessel on mask voxels (1 artery, 2 vein, further kinds on), else 0: that of
-  // the voxel's instance, so a voxel two kinds share takes the kind whose vessel surface lies
-  // deepest around it (the partial-volume rule), and a centreline voxel the lower segment id.
+  // the voxel's instance, except on a voxel that a centreline of another kind crosses (see
+  // fillClasses).
   Volume<std::uint8_t> classes;
 };
 
 // Bytes of all dense channels plus a float image, for the size guard.
 std::uint64_t denseRasterBytes(const VolumeGrid& grid);
 
-// Fills gt.classes from gt.instances: class_of_segment[instance] on mask voxels.
-void fillClasses(GroundTruthVolumes& gt, const std::vector<std::uint8_t>& class_of_segment);
+// Fills gt.classes: class_of_segment[instance] on mask voxels; then every voxel that a
+// centreline of tree t crosses with another kind takes the kind of the crossing segment whose
+// centreline crosses the fewest voxels (for which the voxel is the largest share of its course),
+// then the thinner, then the lower label. Without it a thin vessel running through another
+// kind's partial volume loses its course there; two centrelines of different kinds in one voxel
+// (thin vessels, closer than a voxel) are the only losses left, shared evenly by the kinds
+// rather than always taken from the wider one. Instances keep the partial-volume rule. Segment
+// s of t carries label label_of_segment[s] (warped trees), or s.
+void fillClasses(GroundTruthVolumes& gt, const VascularTree& t, const std::vector<std::uint8_t>& class_of_segment,
+                 const std::vector<std::int32_t>* label_of_segment = nullptr);
 
 GroundTruthVolumes rasterizeGroundTruth(const VascularTree& tree, const VolumeGrid& grid, const RasterOptions& opt);
 
