@@ -167,6 +167,54 @@ TEST_F(Dataset, FailedSamplesAreRecordedAndMakeTheExitCodeNonZero) {
   EXPECT_NE(v.err.find("failed VesselTiny_"), std::string::npos) << v.err;
 }
 
+// labels = "kind": labelsTr holds one label per kind, numbered as [dataset] kinds lists them
+// (vein 1, artery 2 here) in every sample; each tree's root voxel carries its kind's label; the
+// label covers the mask of the image it belongs to (the warped one for the profile file that
+// warps), and imagesTr holds that profile's image, not the clean one.
+TEST_F(Dataset, KindLabelsNumberEachKindAsTheSpecListsItAndFollowTheWarpedImage) {
+  ASSERT_EQ(run("dataset " + quoted(src_ / "tests/data/dataset_av.toml") + " --out raw --quiet", dir_).code, 0);
+  const fs::path ds = dir_ / "raw" / "Dataset903_ArteryVeinTiny";
+  const std::string cmd = "/usr/bin/python3 '" + (src_ / "tests/check_nnunet.py").string() + "' '" + ds.string() + "' > '" +
+                          (dir_ / "check.txt").string() + "' 2>&1";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << slurp(dir_ / "check.txt");
+  const Json labels = Json::parse(slurp(ds / "dataset.json"))["labels"];
+  EXPECT_EQ(labels, (Json{{"background", 0}, {"vein", 1}, {"artery", 2}}));
+  const std::string out = debianPython(R"(
+import csv, glob, json, os
+import nibabel as nib, numpy as np
+warped = 0
+for lab in sorted(glob.glob('labelsTr/*.nii.gz')):
+    case = os.path.basename(lab)[:-7]
+    g = 'groundtruth/' + case
+    l = np.asarray(nib.load(lab).dataobj)
+    meta = json.load(open(g + '.json'))
+    sample = json.load(open(g + '/sample.json'))
+    warp = [f for f in os.listdir(g) if f.startswith('mask_')]
+    warped += len(warp)
+    mask = np.asarray(nib.load(g + '/' + (warp[0] if warp else 'mask.nii.gz')).dataobj)
+    image = np.asarray(nib.load('imagesTr/' + case + '_0000.nii.gz').dataobj)
+    clean = np.asarray(nib.load(g + '/image.nii.gz').dataobj)
+    roots = {r['kind']: tuple(int(np.floor(float(r[a + '_voxel']) + 0.5)) for a in 'xyz')
+             for r in csv.DictReader(open(g + '/keypoints.csv')) if r['type'] == 'root'}
+    print(case, 'values', sorted(int(v) for v in np.unique(l)), 'legend', sample['classes']['1'], sample['classes']['2'],
+          'meta', meta['label_values']['vein'], meta['label_values']['artery'],
+          'roots', *((int(l[roots['vein']]), int(l[roots['artery']])) if not warp else ('moved', 'by the warp')),
+          'on mask', bool(((l > 0) == (mask > 0)).all()), 'image', 'clean' if np.array_equal(image, clean) else 'degraded')
+print('warped', warped)
+)", ds);
+  for (const char* c : {"ArteryVeinTiny_0000", "ArteryVeinTiny_0001", "ArteryVeinTiny_0002"}) {
+    const auto at = out.find(c);
+    ASSERT_NE(at, std::string::npos) << out;
+    const std::string line = out.substr(at, out.find('\n', at) - at);
+    EXPECT_NE(line.find("values [0, 1, 2] legend vein artery meta 1 2"), std::string::npos) << line;
+    EXPECT_NE(line.find("on mask True image degraded"), std::string::npos) << line;
+    if (line.find("roots moved") == std::string::npos) {
+      EXPECT_NE(line.find("roots 1 2"), std::string::npos) << line;
+    }
+  }
+  EXPECT_EQ(out.find("warped 0"), std::string::npos) << out;  // the spec's profile file warps
+}
+
 TEST_F(Dataset, BadSpecsNameFileAndLine) {
   std::ofstream(dir_ / "bad.toml") << "[dataset]\nname = \"a.b\"\nid = 1\nsamples = 2\nseed = 1\n";
   auto r = run("dataset bad.toml --out raw", dir_);
@@ -178,6 +226,29 @@ TEST_F(Dataset, BadSpecsNameFileAndLine) {
   r = run("dataset bad2.toml --out raw", dir_);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("unknown key 'max' in a distribution"), std::string::npos) << r.err;
+  // Labels by kind: a mode that does not exist, kinds without that mode, and a sample growing a
+  // kind the list leaves out (line 10: kinds).
+  std::string av = slurp(src_ / "tests/data/dataset_av.toml");
+  fs::copy_file(src_ / "tests/data/profile_warp.toml", dir_ / "profile_warp.toml");
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = av;
+    t.replace(t.find(from), from.size(), to);
+    std::ofstream(dir_ / "bad3.toml") << t;
+    return run("dataset bad3.toml --out raw", dir_);
+  };
+  r = with("labels = \"kind\"", "labels = \"kinds\"");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("bad3.toml:9: labels must be \"binary\" (vessel 1) or \"kind\""), std::string::npos) << r.err;
+  r = with("labels = \"kind\"", "labels = \"binary\"");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("bad3.toml:10: kinds numbers the labels of labels = \"kind\""), std::string::npos) << r.err;
+  r = with("kinds = [\"vein\", \"artery\"]", "kinds = [\"artery\"]");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("bad3.toml:10: the sample grows a tree of kind 'vein', which has no label: kinds = [artery]"), std::string::npos)
+      << r.err;
+  r = with("kinds = [\"vein\", \"artery\"]", "kinds = [\"vein\", \"vein\"]");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("bad3.toml:10: kinds must be a list of distinct kind names"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "raw"));
 }
 

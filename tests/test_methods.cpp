@@ -36,8 +36,9 @@ TEST(Methods, EveryDeclaredDefaultIsReadableInItsUnitAndDeclaredOnce) {
       const std::string unit = p.unit;
       const auto dim = unit == "Pa" ? Dimension::Pressure : unit == "Pa*s" ? Dimension::Viscosity
                      : unit == "mm^3/s" ? Dimension::Flow : Dimension::Length;
-      if (unit == "Pa" || unit == "Pa*s" || unit == "mm^3/s" || (unit == "mm" && std::string(p.fallback) != "none"))
+      if (unit == "Pa" || unit == "Pa*s" || unit == "mm^3/s" || (unit == "mm" && std::string(p.fallback) != "none")) {
         EXPECT_NO_THROW(parseQuantity(p.fallback, dim, 1.0)) << m->name << " " << p.key << " = " << p.fallback;
+      }
     }
   }
   EXPECT_EQ(findGrowthMethod("lsystem-not-yet"), nullptr);

@@ -4,8 +4,7 @@
 
 namespace angiosynth {
 
-void assignClassLabels(std::vector<TreeInfo>& trees) {
-  std::vector<std::string> kinds{"artery", "vein"};
+void assignClassLabels(std::vector<TreeInfo>& trees, std::vector<std::string> kinds) {
   for (auto& t : trees) {
     auto it = std::find(kinds.begin(), kinds.end(), t.kind);
     if (it == kinds.end()) it = kinds.insert(kinds.end(), t.kind);

@@ -22,8 +22,9 @@ struct Forest {
   std::vector<TreeInfo> trees;
 };
 
-// Class labels of kinds: artery 1, vein 2, other kinds 3, 4, ... in order of first appearance.
-void assignClassLabels(std::vector<TreeInfo>& trees);
+// Class labels of kinds: those of `order` 1, 2, ... (by default artery 1, vein 2), then other
+// kinds in order of first appearance. A dataset passes its list so labels agree across samples.
+void assignClassLabels(std::vector<TreeInfo>& trees, std::vector<std::string> order = {"artery", "vein"});
 // The kinds in label order (index 0 is label 1).
 std::vector<std::string> kindsByLabel(const std::vector<TreeInfo>& trees);
 // The class label of every segment (by node id; 0 for roots), for the classes volume.

@@ -117,10 +117,18 @@ Json generateOne(const DatasetSpec& spec, const fs::path& dir, const fs::path& p
     req.graph_id = r.id;
     req.memory_limit = opt.memory_limit;
     req.record_timing = false;  // sample files depend on (spec, index) only
+    if (spec.labels == "kind") req.class_kinds = spec.kinds;
     const Json sample = generateSample(req, staging);
-    const std::string suffix = "_" + r.profile;
-    const fs::path label = fs::exists(staging / ("mask" + suffix + ".nii.gz")) ? staging / ("mask" + suffix + ".nii.gz")
-                                                                             : staging / "mask.nii.gz";
+    // The image of the profile, and as label the mask or the classes: of the warped image when the
+    // profile warps. Roles carry the profile's name (a profile file's stem), not its reference.
+    std::string suffix(1, '_');  // (appended: GCC 12 warns falsely, -Wrestrict, on "_" + string)
+    suffix += loadProfile(r.profile, spec.file, 0).name;
+    const auto written = [&](const std::string& role) {
+      const auto& files = sample.at("files");
+      const std::string own = role + suffix;
+      return staging / files.at(files.contains(own) ? own : role).get<std::string>();
+    };
+    const fs::path label = written(spec.labels == "kind" ? "classes" : "mask"), image = written("image");
     const std::string image_rel = "imagesTr/" + r.id + "_0000.nii.gz", label_rel = "labelsTr/" + r.id + ".nii.gz";
     const std::string gt_rel = "groundtruth/" + r.id, json_rel = "groundtruth/" + r.id + ".json";
     Json meta{{"id", r.id},
@@ -129,7 +137,7 @@ Json generateOne(const DatasetSpec& spec, const fs::path& dir, const fs::path& p
               {"profile", r.profile},
               {"image", image_rel},
               {"label", label_rel},
-              {"label_values", {{"background", 0}, {"vessel", 1}}},
+              {"label_values", labelValues(spec)},
               {"parameters_toml", r.toml},
               {"sample", sample}};
     writeTextFile(staging / "meta.json", [&](std::ostream& o) { o << meta.dump(2) << "\n"; });
@@ -137,8 +145,6 @@ Json generateOne(const DatasetSpec& spec, const fs::path& dir, const fs::path& p
     // earlier copy only once the new one is complete.
     fs::rename(staging / "meta.json", dir / json_rel);
     fs::rename(label, dir / label_rel);
-    fs::path image = staging / ("image" + suffix + ".nii.gz");
-    if (!fs::exists(image)) image = staging / "image.nii.gz";
     const fs::path image_tmp = dir / (image_rel + ".part");
     fs::rename(image, image_tmp);
     replaceDirectory(staging, dir / gt_rel, process_staging / (r.id + ".previous"));
@@ -253,6 +259,7 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
                                               {"samples", spec.samples},
                                               {"seed", spec.seed},
                                               {"channel_name", spec.channel_name},
+                                              {"labels", labelValues(spec)},
                                               {"spec_file", spec.file},
                                               {"spec_sha256", spec.sha256},
                                               {"spec", spec.text}});
@@ -367,11 +374,13 @@ DatasetCheck finalizeDataset(const fs::path& dir) {
     for (const auto& [i, e] : entries) profiles.insert(e.value("profile", ""));
     channel = profiles.size() == 1 && *profiles.begin() == "cta" ? "CT" : (profiles.size() == 1 ? *profiles.begin() : "image");
   }
+  // Datasets of older versions record no labels: they are binary.
+  const Json labels = info.contains("labels") && info["labels"].is_object() ? info["labels"] : Json{{"background", 0}, {"vessel", 1}};
   std::int64_t training = 0;
   for (const auto& [i, e] : entries) training += i < c.samples && e["status"] == "ok";
   writeJsonAtomically(dir / "dataset.json",
                       Json{{"channel_names", {{"0", channel}}},
-                           {"labels", {{"background", 0}, {"vessel", 1}}},
+                           {"labels", labels},
                            {"numTraining", training},
                            {"file_ending", ".nii.gz"},
                            {"name", info["name"]},

@@ -2,6 +2,7 @@
 
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -13,6 +14,7 @@
 #include "core/rng.hpp"
 #include "dataset/manifest.hpp"
 #include "degrade/profile.hpp"
+#include "grow/method.hpp"
 #include "io/scenario.hpp"
 
 namespace angiosynth {
@@ -173,7 +175,41 @@ bool validName(const std::string& s) {
   return true;
 }
 
+// [dataset] labels and kinds.
+void readLabels(const toml::table& d, DatasetSpec& s) {
+  if (const auto* l = d.get("labels")) {
+    const auto v = l->value<std::string>();
+    if (!v || (*v != "binary" && *v != "kind"))
+      throw InputError(s.file, lineOf(*l), "labels must be \"binary\" (vessel 1) or \"kind\" (one label per kind: artery, vein, ...)");
+    s.labels = *v;
+    s.labels_line = lineOf(*l);
+  }
+  const auto* k = d.get("kinds");
+  if (!k) {
+    if (s.labels == "kind") s.kinds = {"artery", "vein"};
+    return;
+  }
+  if (s.labels != "kind") throw InputError(s.file, lineOf(*k), "kinds numbers the labels of labels = \"kind\"; add that, or remove kinds");
+  const auto* a = k->as_array();
+  const auto allowed = "kinds must be a list of distinct kind names, e.g. [\"artery\", \"vein\"] (labels 1, 2, ...; at most 255)";
+  if (!a || a->empty() || a->size() > 255) throw InputError(s.file, lineOf(*k), allowed);
+  for (const auto& e : *a) {
+    const auto name = e.value<std::string>();
+    if (!name || name->empty() || std::find(s.kinds.begin(), s.kinds.end(), *name) != s.kinds.end())
+      throw InputError(s.file, lineOf(*k), allowed);
+    s.kinds.push_back(*name);
+  }
+  s.labels_line = lineOf(*k);
+}
+
 }  // namespace
+
+nlohmann::ordered_json labelValues(const DatasetSpec& spec) {
+  nlohmann::ordered_json j{{"background", 0}};
+  if (spec.labels != "kind") j["vessel"] = 1;
+  for (std::size_t i = 0; i < spec.kinds.size(); ++i) j[spec.kinds[i]] = i + 1;
+  return j;
+}
 
 DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
   DatasetSpec s;
@@ -196,9 +232,10 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
   if (!ds || !ds->is_table()) throw InputError(s.file, 0, "a dataset spec needs a [dataset] table (name, id, samples, seed)");
   const auto& d = *ds->as_table();
   for (const auto& [k, v] : d)
-    if (k != "name" && k != "id" && k != "samples" && k != "seed" && k != "profile" && k != "channel_name")
+    if (k != "name" && k != "id" && k != "samples" && k != "seed" && k != "profile" && k != "channel_name" && k != "labels" &&
+        k != "kinds")
       throw InputError(s.file, lineOf(v), "unknown key '" + std::string(k.str()) +
-                                              "' in [dataset]; allowed: name, id, samples, seed, profile, channel_name");
+                                              "' in [dataset]; allowed: name, id, samples, seed, profile, channel_name, labels, kinds");
   const auto need = [&](const char* key) -> const toml::node& {
     const auto* n = d.get(key);
     if (!n) throw InputError(s.file, lineOf(d), std::string("missing key '") + key + "' in [dataset]");
@@ -219,6 +256,7 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
     if (!c->is_string()) throw InputError(s.file, lineOf(*c), "channel_name must be a string (nnU-Net's channel name, e.g. \"CT\")");
     s.channel_name = *c->value<std::string>();
   }
+  readLabels(d, s);
   s.sha256 = canonicalSpecSha256(s.text, s.file);
   if (root->contains("seed")) throw InputError(s.file, lineOf(*root->get("seed")), "the seed of a dataset goes in [dataset]");
   // Resolve and read one sample now, so a bad spec fails before any work starts.
@@ -264,7 +302,12 @@ ResolvedSample resolveSample(const DatasetSpec& spec, std::int64_t index) {
   std::ostringstream o;
   o << *t << "\n";
   r.toml = o.str();
-  r.sha256 = sha256Text(r.toml + "\nimage profile: " + r.profile + "\n");
+  // The label numbering changes labelsTr: a kind-labelled sample depends on it (binary samples
+  // hash as they always did).
+  std::string labels;
+  if (spec.labels == "kind")
+    for (const auto& k : spec.kinds) labels += (labels.empty() ? "labels by kind: " : ", ") + k;
+  r.sha256 = sha256Text(r.toml + "\nimage profile: " + r.profile + "\n" + (labels.empty() ? "" : labels + "\n"));
   r.table = t;
   return r;
 }
@@ -324,7 +367,15 @@ void checkSampleDraws(const DatasetSpec& spec, const std::vector<std::int64_t>& 
   for (const auto i : indices) {
     const ResolvedSample r = resolveSample(spec, i);
     try {
-      readTomlParameters(*r.table, spec.file);
+      const Scenario sc = readTomlParameters(*r.table, spec.file);
+      for (const auto& kind : spec.labels == "kind" ? sc.growth->kinds() : std::vector<std::string>{})
+        if (std::find(spec.kinds.begin(), spec.kinds.end(), kind) == spec.kinds.end()) {
+          std::string list;
+          for (const auto& k : spec.kinds) list += (list.empty() ? "" : ", ") + k;
+          throw InputError(spec.file, spec.labels_line,
+                           "the sample grows a tree of kind '" + kind + "', which has no label: kinds = [" + list +
+                               "]; add it to [dataset] kinds");
+        }
       if (profiles.insert(r.profile).second) loadProfile(r.profile, spec.file, 0);
     } catch (const InputError& e) {
       throw InputError("", 0, std::string(e.what()) + " (sample " + std::to_string(i) + ", " + r.id +

@@ -31,7 +31,15 @@ struct DatasetSpec {
   std::int64_t samples = 0;
   std::uint64_t seed = 0;
   std::string channel_name;  // dataset.json channel 0 (default from the profile: "CT" for cta)
+  // labelsTr: "binary" (background 0, vessel 1: the mask) or "kind" (background 0, then one label
+  // per kind in the order of `kinds`: the classes volume, numbered alike in every sample).
+  std::string labels = "binary";
+  std::vector<std::string> kinds;  // labels = "kind": default artery, vein
+  int labels_line = 0;             // of `kinds`, else of `labels`, for errors about a sample's kinds
 };
+
+// The label values of labelsTr, as dataset.json and each sample's meta list them.
+nlohmann::ordered_json labelValues(const DatasetSpec& spec);
 
 DatasetSpec readDatasetSpec(const std::filesystem::path& file);
 

@@ -60,6 +60,9 @@ class GrowthSetup {
   // The physics of the (first) tree: cost exponents for the statistics.
   virtual const PhysicsParameters& physics() const = 0;
   virtual std::int64_t terminals() const = 0;
+  // The kinds of the trees it grows, each once ("artery", "vein", free names): known before
+  // growth, so a dataset can check its label list against every sample.
+  virtual std::vector<std::string> kinds() const = 0;
   // The voxel of the domain in mm, for lengths written in "voxel" (0 until a mask is read).
   virtual double voxelMm() const = 0;
 };

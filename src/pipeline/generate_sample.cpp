@@ -120,6 +120,7 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   Forest forest;
   try {
     forest = ps.growth->grow(req.seed, req.sample, report, req.progress);
+    if (!req.class_kinds.empty()) assignClassLabels(forest.trees, req.class_kinds);
   } catch (const GrowthError& e) {
     throw InputError(sc.parameter_file, 0, e.what());
   }

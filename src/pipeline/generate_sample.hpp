@@ -31,6 +31,8 @@ struct SampleRequest {
   std::optional<std::vector<Profile>> profiles;
   bool vascusynth_noise_layout = false;   // profiles write <name>/image.nii.gz + PNG slices
   bool record_timing = true;              // false: sample.json depends on seed and parameters only
+  // The kinds in class-label order (1, 2, ...), when a dataset fixes them; empty: artery 1, vein 2.
+  std::vector<std::string> class_kinds;
 };
 
 // Writes the sample's files into `dir` and returns the content of its sample.json.

@@ -370,6 +370,8 @@ Vec3 ccoRoot(const CcoSetup& s, const CcoRootSpec& spec, const GrowthDomain& d) 
   return root;
 }
 
+std::vector<std::string> CcoSetup::kinds() const { return kindsOf(inlets); }
+
 Json CcoSetup::describe() const {
   const auto& d = domain;
   const auto& c = cco;

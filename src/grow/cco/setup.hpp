@@ -55,6 +55,7 @@ struct CcoSetup final : GrowthSetup {
   std::unique_ptr<PreparedGrowth> prepare(std::uint64_t memory_limit) const override;
   const PhysicsParameters& physics() const override { return cco.physics; }
   std::int64_t terminals() const override { return cco.terminals; }
+  std::vector<std::string> kinds() const override;
   double voxelMm() const override { return domain.voxel_mm; }
 };
 

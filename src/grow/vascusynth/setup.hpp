@@ -20,6 +20,7 @@ struct VascuSynthSetup final : GrowthSetup {
   std::unique_ptr<PreparedGrowth> prepare(std::uint64_t memory_limit) const override;
   const PhysicsParameters& physics() const override { return growth.physics; }
   std::int64_t terminals() const override { return growth.terminals; }
+  std::vector<std::string> kinds() const override { return {"artery"}; }  // VascuSynth grows one arterial tree
   double voxelMm() const override { return domain.voxel_mm; }
 };
 
