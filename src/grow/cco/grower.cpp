@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <tuple>
 
 #include "grow/common/bifurcation_optimizer.hpp"
@@ -25,6 +26,9 @@ constexpr double kRecheckGrowth = 1.02;
 // Connections refused in a row (for one terminal) because an ancestor hit another tree, after
 // which a forest's ancestors skip that check.
 constexpr std::int64_t kLenientAfter = 100;
+// Refusals caused by one ancestor of a forest's tree hitting a vessel, after which only vessels
+// too large for the final repair to regrow still block it.
+constexpr std::uint8_t kDeferAfter = 8;
 // Segments with ρ at least this are "thick": checked from a list rather than through the grid.
 constexpr double kThick = 0.25;
 
@@ -57,6 +61,7 @@ struct TreeGrowth {
   VascularTree tree;
   std::vector<double> rel{1.0};  // ρ: radius / root radius
   std::vector<double> checked;         // radius (final units) at which each segment was last found clear
+  std::vector<std::uint8_t> blocks;    // connections each segment refused, as an ancestor, by hitting a vessel
   std::vector<std::int32_t> thick{1};  // segments with ρ >= kThick (the first is the root segment)
   std::vector<std::pair<double, std::int32_t>> near;
   std::size_t done = 0;                // near[0, done) evaluated in earlier rounds
@@ -166,7 +171,8 @@ class CcoGrower {
 
   // True if the capsule a–e of radius r overlaps a vessel of a tree other than k: with the radii
   // of growth (ρ × the current root radius), or, on the solved forest, the exact radii + 2 %.
-  bool hitsOtherTree(int k, const Vec3& a, const Vec3& e, double r, bool solved = false) {
+  // With big_only, only vessels too large for the final repair to regrow count.
+  bool hitsOtherTree(int k, const Vec3& a, const Vec3& e, double r, bool solved = false, bool big_only = false) {
     for (std::size_t j = 0; j < trees_.size(); ++j) {
       if (int(j) == k) continue;
       auto& o = trees_[j];
@@ -184,7 +190,7 @@ class CcoGrower {
       };
       bool hit = false;
       const auto test = [&](std::int32_t y) {
-        if (hit || y >= o.tree.nodeCount() || y < 1) return;
+        if (hit || y >= o.tree.nodeCount() || y < 1 || (big_only && !tooLargeToRegrow(int(j), y))) return;
         hit = capsulesOverlap(a, e, r, o.tree.position[o.tree.parent[y]], o.tree.position[y], radius_of(y));
       };
       if (solved) {  // the index holds the final geometry; the thickest vessel bounds the reach
@@ -280,20 +286,42 @@ class CcoGrower {
     const auto b = T.nodeCount() - 2;
     check_.assign({b, c.segment, b + 1});
     g.checked.resize(T.nodeCount(), 0.0);
+    g.blocks.resize(T.nodeCount(), 0);
+    skipped_ = false;
     for (std::size_t lv = 1; lv < c.path.size(); ++lv) {
       const auto x = c.path[lv].segment;
       if (g.rel[x] * rr > kRecheckGrowth * g.checked[x]) check_.push_back(x);
     }
     const auto radius_of = [&](std::int32_t y) { return g.rel[y] * rr; };
+    const bool forest = trees_.size() > 1;
     for (const auto& x : check_) {
       const Vec3& a0 = T.position[T.parent[x]];
       const Vec3& a1 = T.position[x];
       const double rx = g.rel[x] * rr;
-      const auto candidates = [&](auto&& f) { forEachNearVessel(g, a0, a1, rx, rr, radius_of, f); };
-      if (overlapsOtherVessel(T, x, a0, a1, rx, candidates, radius_of)) return true;
+      // In a forest, an ancestor that keeps hitting a vessel would freeze its whole subtree (every
+      // connection below it thickens it; seen for a vein's root segment beside a branch of its
+      // own): after kDeferAfter refusals only vessels too large to regrow still block it (the
+      // final check finds the others, and the repair regrows them), and after a long run of
+      // failures no other tree's vessel does.
       const bool ancestor = &x - check_.data() >= 3;
-      if (trees_.size() > 1 && !(ancestor && lenient_) && hitsOtherTree(k, a0, a1, kRecheckGrowth * rx)) {
-        ancestor_blocks_ += ancestor;
+      const bool big_only = forest && ancestor && g.blocks[x] >= kDeferAfter;
+      const auto candidates = [&](auto&& f) {
+        forEachNearVessel(g, a0, a1, rx, rr, radius_of, [&](std::int32_t y) {
+          if (!big_only || (y < T.nodeCount() && tooLargeToRegrow(k, y))) f(y);
+        });
+      };
+      bool hit = overlapsOtherVessel(T, x, a0, a1, rx, candidates, radius_of);
+      if (!hit && forest) {
+        if (ancestor && lenient_) {
+          skipped_ = true;
+          continue;
+        }
+        hit = hitsOtherTree(k, a0, a1, kRecheckGrowth * rx, false, big_only);
+        ancestor_blocks_ += hit && ancestor;
+      }
+      skipped_ |= big_only;
+      if (hit) {
+        if (forest && ancestor && g.blocks[x] < 255) ++g.blocks[x];
         return true;
       }
     }
@@ -450,7 +478,7 @@ class CcoGrower {
         } else {
           ++report_.candidates;
           if (connect(p, sys)) {
-            report_.lenient_connections += lenient_;
+            report_.lenient_connections += skipped_;
             break;
           }
           ++report_.rejected_unreachable;
@@ -517,6 +545,22 @@ class CcoGrower {
       if (!T.isTerminal(s) && (tryMove(k, s, a + u * L) || tryMove(k, s, e + w * grow))) return true;
       if (P > 0 && tryMove(k, P, e - u * L)) return true;
     }
+    if (T.isTerminal(s)) return false;
+    // Blocked straight ahead (a root segment beside another tree's trunk): the distal
+    // bifurcation on cones of 20° and 40° around the segment's direction (in the plane for 2D).
+    Vec3 p1 = std::abs(u.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
+    if (dom_.dimension() == 2) p1 = Vec3(0, 0, 1);
+    p1 = cross(u, p1);
+    p1 = p1 / norm(p1);
+    const Vec3 p2 = cross(u, p1);
+    const int turns = dom_.dimension() == 2 ? 2 : 8;
+    for (double f : {2.2, 2.6})
+      for (double theta : {20.0, 40.0})
+        for (int i = 0; i < turns; ++i) {
+          const double t = theta * std::numbers::pi / 180, phi = 2 * std::numbers::pi * i / turns;
+          const Vec3 d = u * std::cos(t) + (p1 * std::cos(phi) + p2 * std::sin(phi)) * std::sin(t);
+          if (tryMove(k, s, a + d * (f * T.radius[s]))) return true;
+        }
     return false;
   }
 
@@ -554,7 +598,7 @@ class CcoGrower {
       const Vec3 away = p - (b0 + ab * t);
       if (!(norm(away) > 0)) continue;
       const double gap = 1.05 * (T.radius[x] + O.radius[y]) - segmentSegmentDistance(T.position[T.parent[x]], T.position[x], b0, b1);
-      for (double f : {1.0, 1.5, 2.5})
+      for (double f : {1.0, 1.5, 2.5, 4.0})
         if (tryMove(k, v, p + away / norm(away) * (f * std::max(gap, 0.0) + 0.1 * T.radius[x]))) return true;
     }
     return false;
@@ -582,9 +626,9 @@ class CcoGrower {
       const auto [ky, y] = local(fy);
       const auto nx = trees_[kx].tree.terminals[x], ny = trees_[ky].tree.terminals[y];
       const bool x_goes = std::tie(nx, fy) < std::tie(ny, fx);
-      // Two trunks of different trees, both too large to regrow: push the thinner one aside.
-      if (kx != ky && tooLargeToRegrow(kx, x) && tooLargeToRegrow(ky, y) &&
-          (x_goes ? separate(kx, x, ky, y) : separate(ky, y, kx, x))) {
+      // Two trunks, both too large to regrow: push the thinner one aside.
+      if (tooLargeToRegrow(kx, x) && tooLargeToRegrow(ky, y) &&
+          (x_goes ? separate(kx, x, ky, y) || separate(ky, y, kx, x) : separate(ky, y, kx, x) || separate(kx, x, ky, y))) {
         ++report_.moved_nodes;
         continue;
       }
@@ -651,6 +695,7 @@ class CcoGrower {
       for (auto& g : trees_) {
         refreshRelativeRadii(g);
         g.checked = g.tree.radius;  // the exact check just passed every kept segment
+        g.blocks.assign(g.tree.nodeCount(), 0);  // ids change when subtrees go
         g.index.refresh(g.tree, true);
       }
       growUntilTargets(progress);
@@ -668,6 +713,7 @@ class CcoGrower {
   std::vector<std::int32_t> check_;
   bool repairing_ = false;
   bool lenient_ = false;
+  bool skipped_ = false;  // the last collision check skipped an ancestor's check against other trees
   std::int64_t ancestor_blocks_ = 0;
 };
 

@@ -101,7 +101,7 @@ class PreparedCco final : public PreparedGrowth {
     if (setup_.inlets.size() > 1) {
       stats["lenient_connections"] = report.lenient_connections;
       stats["lenient_connections_definition"] =
-          "connections made after a long run of failures without re-checking their thickened ancestors against other trees (the final check covers them)";
+          "connections whose thickened ancestors were checked only in part: an ancestor that refused 8 connections is then blocked only by vessels too large to regrow, and after a long run of failures ancestors skip other trees (the exact final check and repair cover both)";
     }
     stats["domain_dimension"] = domain_.dimension();
     stats["domain_measure"] = quantityJson(domain_.measure(), domain_.dimension() == 2 ? "mm^2" : "mm^3");

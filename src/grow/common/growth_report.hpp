@@ -24,7 +24,7 @@ struct GrowthReport {
   std::int64_t kamiya_failures = 0;        // Kamiya's iteration found no bifurcation
   std::int64_t short_segments = 0;         // final segments with length <= 2 r (target 0)
   std::int64_t outside_segments = 0;       // final segments leaving the domain (target 0)
-  std::int64_t lenient_connections = 0;    // forests: connections made without re-checking ancestors against other trees
+  std::int64_t lenient_connections = 0;    // forests: connections whose thickened ancestors were checked only in part
   double root_radius_mm = 0;
 };
 
