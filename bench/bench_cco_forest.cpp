@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "core/units.hpp"
 #include "core/memory.hpp"
 #include "grow/cco/grower.hpp"
 
@@ -20,7 +21,6 @@ using namespace angiosynth;
 
 namespace {
 
-constexpr double kMmHg = 133.322387415;
 
 CcoInlet inlet(const Vec3& root, int system, double p_root, double p_term) {
   CcoInlet in;
@@ -35,8 +35,8 @@ CcoOptions options(long n, std::uint64_t seed, double flow_ml_min) {
   CcoOptions o;
   o.terminals = n;
   o.physics.perfusion_flow = flow_ml_min * 1000.0 / 60.0;
-  o.physics.perfusion_pressure = 100 * kMmHg;
-  o.physics.terminal_pressure = 60 * kMmHg;
+  o.physics.perfusion_pressure = 100 * kPaPerMmHg;
+  o.physics.terminal_pressure = 60 * kPaPerMmHg;
   o.physics.total_terminals = n;
   o.seed = seed;
   return o;
@@ -54,8 +54,8 @@ int main(int argc, char** argv) {
     const int seeds = argc > 2 ? std::atoi(argv[2]) : 10;
     const auto d = GrowthDomain::analytic(DomainShape::Disc, 20, 0.05);  // examples/cco_two_inlets_2d.toml
     const Vec3 c = d.center();
-    const std::vector<CcoInlet> inlets{inlet(c + Vec3(-20, 0, 0), 0, 100 * kMmHg, 60 * kMmHg),
-                                       inlet(c + Vec3(20, 0, 0), 0, 100 * kMmHg, 60 * kMmHg)};
+    const std::vector<CcoInlet> inlets{inlet(c + Vec3(-20, 0, 0), 0, 100 * kPaPerMmHg, 60 * kPaPerMmHg),
+                                       inlet(c + Vec3(20, 0, 0), 0, 100 * kPaPerMmHg, 60 * kPaPerMmHg)};
     std::printf("%4s %10s %10s %12s %8s %6s\n", "seed", "left", "right", "larger share", "time s", "pairs");
     double sum = 0, sum2 = 0;
     for (int seed = 1; seed <= seeds; ++seed) {
@@ -77,8 +77,8 @@ int main(int argc, char** argv) {
   const auto d = GrowthDomain::analytic(DomainShape::Sphere, radius, 0.3);
   const Vec3 c = d.center();
   const double y = std::sqrt(radius * radius - 25);
-  const std::vector<CcoInlet> inlets{inlet(c + Vec3(-5, y, 0), 0, 100 * kMmHg, 60 * kMmHg),
-                                     inlet(c + Vec3(5, y, 0), 1, 5 * kMmHg, 20 * kMmHg)};
+  const std::vector<CcoInlet> inlets{inlet(c + Vec3(-5, y, 0), 0, 100 * kPaPerMmHg, 60 * kPaPerMmHg),
+                                     inlet(c + Vec3(5, y, 0), 1, 5 * kPaPerMmHg, 20 * kPaPerMmHg)};
   std::printf("%4s %9s %9s %10s %6s %6s %8s %9s\n", "seed", "terminals", "time (s)", "peak MiB", "pairs", "short", "repaired", "lenient");
   for (int seed = 1; seed <= seeds; ++seed) {
     GrowthReport rep;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/units.hpp"
 #include "domain/growth_domain.hpp"
 #include "grow/cco/grower.hpp"
 #include "grow/common/intersections.hpp"
@@ -26,8 +27,8 @@ CcoOptions karch(std::int64_t n, const GrowthDomain& d, std::uint64_t seed = 1) 
   o.terminals = n;
   if (d.shape() != DomainShape::Mask) o.root_mm = d.defaultRoot();
   o.physics.perfusion_flow = 500 * 1e3 / 60;
-  o.physics.perfusion_pressure = 100 * 133.322387415;
-  o.physics.terminal_pressure = 60 * 133.322387415;
+  o.physics.perfusion_pressure = 100 * kPaPerMmHg;
+  o.physics.terminal_pressure = 60 * kPaPerMmHg;
   o.physics.total_terminals = n;
   o.seed = seed;
   return o;

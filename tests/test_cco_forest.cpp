@@ -6,6 +6,7 @@
 
 #include <numbers>
 
+#include "core/units.hpp"
 #include "domain/growth_domain.hpp"
 #include "grow/cco/grower.hpp"
 #include "physics/hemodynamics.hpp"
@@ -16,20 +17,19 @@ using namespace angiosynth;
 
 namespace {
 
-constexpr double kMmHg = 133.322387415;
 
 CcoOptions options(std::int64_t n, std::uint64_t seed) {
   CcoOptions o;
   o.terminals = n;
   o.physics.perfusion_flow = 500 * 1e3 / 60;
-  o.physics.perfusion_pressure = 100 * kMmHg;
-  o.physics.terminal_pressure = 60 * kMmHg;
+  o.physics.perfusion_pressure = 100 * kPaPerMmHg;
+  o.physics.terminal_pressure = 60 * kPaPerMmHg;
   o.physics.total_terminals = n;
   o.seed = seed;
   return o;
 }
 
-CcoInlet inlet(const Vec3& root, int system, double share = 0, double p_root = 100 * kMmHg, double p_term = 60 * kMmHg) {
+CcoInlet inlet(const Vec3& root, int system, double share = 0, double p_root = 100 * kPaPerMmHg, double p_term = 60 * kPaPerMmHg) {
   CcoInlet in;
   in.root_mm = root;
   in.system = system;
@@ -98,7 +98,7 @@ TEST(CcoForest, ArteryAndVeinFillOneDomainWithoutTouchingAndTheVeinDrains) {
   const auto o = options(1200, 7);
   const Vec3 c = d.center();
   const double s = std::sqrt(19.0 * 19.0 - 4.0);
-  const std::vector<CcoInlet> inlets{inlet(c + Vec3(-2, s, 0), 0), inlet(c + Vec3(2, s, 0), 1, 0, 5 * kMmHg, 20 * kMmHg)};
+  const std::vector<CcoInlet> inlets{inlet(c + Vec3(-2, s, 0), 0), inlet(c + Vec3(2, s, 0), 1, 0, 5 * kPaPerMmHg, 20 * kPaPerMmHg)};
   GrowthReport rep;
   const auto trees = growCcoForest(d, o, inlets, rep);
   expectForestInvariants(trees, inlets, o, d);
@@ -129,7 +129,7 @@ TEST(CcoForest, SameSeedSameForestWhateverTheThreads) {
   const auto o = options(400, 11);
   const Vec3 c = d.center();
   const std::vector<CcoInlet> inlets{inlet(c + Vec3(-10, 0, 0), 0), inlet(c + Vec3(10, 0, 0), 0),
-                                     inlet(c + Vec3(0, 10, 0), 1, 0, 5 * kMmHg, 20 * kMmHg)};
+                                     inlet(c + Vec3(0, 10, 0), 1, 0, 5 * kPaPerMmHg, 20 * kPaPerMmHg)};
   const auto run = [&](int threads) {
     tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
     GrowthReport rep;

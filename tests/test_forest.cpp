@@ -12,6 +12,7 @@
 
 #include "cli_run.hpp"
 #include "core/forest.hpp"
+#include "core/units.hpp"
 #include "domain/growth_domain.hpp"
 #include "grow/cco/grower.hpp"
 #include "grow/common/intersections.hpp"
@@ -130,10 +131,9 @@ Forest interleavedForest(VolumeGrid& g) {
   o.seed = 3;
   const Vec3 c = d.center();
   const double s = std::sqrt(19.0 * 19.0 - 4.0);
-  constexpr double mmHg = 133.322387415;
   std::vector<CcoInlet> in(2);
-  in[0] = {c + Vec3(-2, s, 0), 0, 0, 100 * mmHg, 60 * mmHg};
-  in[1] = {c + Vec3(2, s, 0), 1, 0, 5 * mmHg, 20 * mmHg};
+  in[0] = {c + Vec3(-2, s, 0), 0, 0, 100 * kPaPerMmHg, 60 * kPaPerMmHg};
+  in[1] = {c + Vec3(2, s, 0), 1, 0, 5 * kPaPerMmHg, 20 * kPaPerMmHg};
   GrowthReport rep;
   const auto trees = growCcoForest(d, o, in, rep);
   Forest f;

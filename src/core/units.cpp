@@ -19,7 +19,7 @@ const Table& table(Dimension dim) {
                           {"cm3/s", 1e3},   {"cm^3/s", 1e3},   {"cm³/s", 1e3},
                           {"mL/s", 1e3},    {"ml/s", 1e3},     {"mL/min", 1e3 / 60},
                           {"ml/min", 1e3 / 60}, {"uL/min", 1.0 / 60}, {"m3/s", 1e9}};
-  static const Table pressure{{"Pa", 1},       {"kPa", 1e3},         {"mmHg", 133.322387415},
+  static const Table pressure{{"Pa", 1},       {"kPa", 1e3},         {"mmHg", kPaPerMmHg},
                               {"dyn/cm2", 0.1}, {"dyn/cm^2", 0.1},   {"Ba", 0.1},
                               {"cmH2O", 98.0665}};
   static const Table viscosity{{"Pa*s", 1}, {"Pa.s", 1},  {"Pa·s", 1},   {"mPa*s", 1e-3},

@@ -7,6 +7,9 @@ namespace angiosynth {
 
 enum class Dimension { Length, Flow, Pressure, Viscosity };
 
+// One mmHg in Pa (the conventional value, 13.5951 g/cm³ mercury at standard gravity).
+inline constexpr double kPaPerMmHg = 133.322387415;
+
 // Parses "<number> <unit>" (e.g. "0.4 mm", "100 mmHg", "3.6 mPa*s", "8.33 cm3/s") into the
 // internal unit of `dim`. The length unit "voxel" needs voxel_mm > 0. Throws
 // std::invalid_argument whose message says what is allowed.

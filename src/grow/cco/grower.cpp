@@ -626,9 +626,9 @@ class CcoGrower {
       const auto [ky, y] = local(fy);
       const auto nx = trees_[kx].tree.terminals[x], ny = trees_[ky].tree.terminals[y];
       const bool x_goes = std::tie(nx, fy) < std::tie(ny, fx);
-      // Two trunks, both too large to regrow: push the thinner one aside.
-      if (tooLargeToRegrow(kx, x) && tooLargeToRegrow(ky, y) &&
-          (x_goes ? separate(kx, x, ky, y) || separate(ky, y, kx, x) : separate(ky, y, kx, x) || separate(kx, x, ky, y))) {
+      // Two trunks, both too large to regrow: push the thinner one aside, else the thicker.
+      const auto [kt, t, kw, w] = x_goes ? std::tuple(kx, x, ky, y) : std::tuple(ky, y, kx, x);
+      if (tooLargeToRegrow(kx, x) && tooLargeToRegrow(ky, y) && (separate(kt, t, kw, w) || separate(kw, w, kt, t))) {
         ++report_.moved_nodes;
         continue;
       }
