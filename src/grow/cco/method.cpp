@@ -37,7 +37,7 @@ class PreparedCco final : public PreparedGrowth {
     systems_ = kinds.size();
     for (const auto& in : s.inlets) {
       CcoInlet g;
-      g.root_mm = ccoRoot(s, in.root, domain_);
+      g.root_mm = placeRoot(s.parameter_file, in.root, domain_);
       g.system = int(std::find(kinds.begin(), kinds.end(), in.kind) - kinds.begin());
       g.share = in.share;
       g.root_pressure = in.root_pressure;
@@ -114,38 +114,6 @@ class PreparedCco final : public PreparedGrowth {
   std::size_t systems_ = 1;       // kinds of inlet
 };
 
-// The root of one tree from its table (`name`: "tree" or "tree.inlet"): root_offset for analytic
-// shapes, root (mm) or root_voxel for masks.
-CcoRootSpec readRootOf(const TomlReader& r, const toml::table& t, const std::string& name, const CcoSetup& s, bool required) {
-  const auto& d = s.domain;
-  CcoRootSpec root;
-  if (d.shape == DomainShape::Mask) {
-    r.forbid(t, name, {"root_offset"}, "is for analytic shapes; give the root of a mask domain as root (mm) or root_voxel");
-    // A NIfTI mask's voxel size is known only once it is read: its root stays in mm until then.
-    if (const auto mm = readRoot(r, t, root.root_voxel, root.root_line, "mask voxels", ": a mask domain has no default root",
-                                   name == "tree" ? name : "[" + name + "]")) {
-      if (isNifti(d.mask)) {
-        root.root_mm = *mm;
-        root.root_in_mm = true;
-      } else {
-        root.root_voxel = *mm / d.voxel_mm;
-      }
-    }
-    return root;
-  }
-  r.forbid(t, name, {"root", "root_voxel"}, "is for mask domains; an analytic shape takes root_offset (mm from its centre)");
-  if (const auto* n = t.get("root_offset")) {
-    const bool flat = d.shape == DomainShape::Disc || d.shape == DomainShape::Square;
-    root.root_offset_mm = r.point(n, "root_offset (mm from the centre)", flat);
-    root.has_root_offset = true;
-    root.root_line = r.lineOf(n);
-  } else if (required) {
-    throw InputError(r.file(), r.lineOf(&t), "missing key 'root_offset' (mm from the centre) in [[" + name +
-                                                 "]]: with several inlets each needs its own root");
-  }
-  return root;
-}
-
 // Pressures of an inlet: [physics] for arteries and other kinds, 5 and 20 mmHg for veins; a vein
 // must drain (terminals above the root) and an artery supply.
 void readInletPressures(const TomlReader& r, const toml::table& t, const PhysicsParameters& ph, CcoInletSpec& in) {
@@ -171,7 +139,7 @@ void readInlets(const TomlReader& r, const GrowthMethod& m, const toml::table& t
   const auto& ph = s.cco.physics;
   if (!list) {
     CcoInletSpec in;
-    in.root = readRootOf(r, tree, "tree", s, false);
+    in.root = readRootOf(r, tree, "tree", s.domain, false);
     in.root_pressure = ph.perfusion_pressure;
     in.terminal_pressure = ph.terminal_pressure;
     in.line = r.lineOf(&tree);
@@ -195,7 +163,7 @@ void readInlets(const TomlReader& r, const GrowthMethod& m, const toml::table& t
     if (in.kind.empty() || in.kind.size() > 40 || in.kind.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_-") != std::string::npos)
       throw InputError(r.file(), r.lineOf(t.get("kind")), "kind '" + in.kind + "'; allowed: artery, vein, or a name of 1–40 lower-case letters, digits, '_' and '-'");
     ++per_kind[in.kind];
-    in.root = readRootOf(r, t, "tree.inlet", s, arr->size() > 1);
+    in.root = readRootOf(r, t, "tree.inlet", s.domain, arr->size() > 1);
     if (const auto* sh = t.get("share")) {
       if (sh->is_string()) {
         const auto v = r.string(t, "tree.inlet", "share");
@@ -264,47 +232,7 @@ std::shared_ptr<const GrowthSetup> readCcoToml(const TomlReader& r, const Growth
              "is for method vascusynth; cco minimises the total volume (radius exponent 2, length exponent 1)");
   const auto& dom = methodTable(r, m, "domain");
   const auto& tree = methodTable(r, m, "tree");
-  auto& d = s->domain;
-  d.line = r.lineOf(&dom);
-  const std::string shape = dom.get("shape") ? r.string(dom, "domain", "shape") : "sphere";
-  const std::pair<const char*, DomainShape> shapes[] = {{"sphere", DomainShape::Sphere}, {"cube", DomainShape::Cube},
-                                                        {"disc", DomainShape::Disc},     {"square", DomainShape::Square},
-                                                        {"mask", DomainShape::Mask}};
-  bool known = false;
-  for (const auto& [name, value] : shapes)
-    if (shape == name) {
-      d.shape = value;
-      known = true;
-    }
-  if (!known) throw InputError(file, r.lineOf(dom.get("shape")), "shape '" + shape + "'; allowed: sphere, cube, disc, square (2D), mask");
-  const bool round = d.shape == DomainShape::Sphere || d.shape == DomainShape::Disc;
-  if (d.shape == DomainShape::Mask) {
-    r.forbid(dom, "domain", {"radius", "side"}, "is for analytic shapes; a mask's extent comes from its file");
-    d.mask = resolveInputPath(r.string(dom, "domain", "mask"), path, r.lineOf(dom.get("mask")));
-    const bool nifti = isNifti(d.mask);
-    if (nifti) {
-      if (dom.get("voxel_size"))
-        throw InputError(file, r.lineOf(dom.get("voxel_size")), "a NIfTI mask carries its voxel size; remove voxel_size");
-    } else {
-      d.voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
-      checkRange(d.voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, r.at(dom, "voxel_size"), "voxel_size (mm)");
-    }
-    if (dom.get("sampling")) {
-      const auto v = r.string(dom, "domain", "sampling");
-      if (v != "uniform" && v != "demand")
-        throw InputError(file, r.lineOf(dom.get("sampling")), "sampling '" + v + "'; allowed: uniform, demand (∝ mask value)");
-      d.demand_weighted = v == "demand";
-    }
-  } else {
-    r.forbid(dom, "domain", {"mask", "sampling"}, "is for shape = \"mask\"");
-    const char* size_key = round ? "radius" : "side";
-    r.forbid(dom, "domain", {round ? "side" : "radius"}, std::string("does not size a ") + shape + "; give " + size_key);
-    d.size_mm = r.quantity(dom, "domain", size_key, Dimension::Length);
-    checkRange(d.size_mm, Limits::kMinVoxel, false, Limits::kMaxLength, false, r.at(dom, size_key), std::string(size_key) + " (mm)");
-    d.voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
-    checkRange(d.voxel_mm, std::max(Limits::kMinVoxel, d.size_mm / Limits::kMaxVoxelsPerAxis), false, d.size_mm, true,
-               r.at(dom, "voxel_size"), "voxel_size (mm)");
-  }
+  s->domain = readDomainSpec(r, dom, path);
 
   auto& c = s->cco;
   c.terminals = readTerminals(r, tree, s->terminals_line);
@@ -326,50 +254,6 @@ std::shared_ptr<const GrowthSetup> readCcoToml(const TomlReader& r, const Growth
 
 }  // namespace
 
-GrowthDomain loadCcoDomain(const CcoSetup& s, std::uint64_t limit) {
-  const auto& spec = s.domain;
-  if (spec.shape != DomainShape::Mask) {
-    const auto n = GrowthDomain::analyticDims(spec.shape, spec.size_mm, spec.voxel_mm);
-    checkDomainMemory(std::int64_t(n[0]) * n[1] * n[2], limit, s.parameter_file, spec.line,
-                      std::string("a ") + domainShapeName(spec.shape) + " frame");
-    return GrowthDomain::analytic(spec.shape, spec.size_mm, spec.voxel_mm);
-  }
-  DemandMap m;
-  if (isNifti(spec.mask)) {
-    m = readNiftiMask(spec.mask, limit);
-  } else {  // a VascuSynth box map; checks the root too
-    BoxMapSpec box;
-    box.parameter_file = s.parameter_file;
-    box.demand_map = spec.mask;
-    box.supply_coefficients = {1, 0};
-    box.voxel_mm = spec.voxel_mm;
-    box.root_voxel = s.inlets.front().root.root_voxel;  // the others are checked by ccoRoot
-    box.root_line = s.inlets.front().root.root_line;
-    m = loadDomain(box, limit);
-  }
-  std::int64_t inside = 0;
-  for (float v : m.demand) inside += v > 0;
-  if (inside == 0) throw InputError(spec.mask.string(), 0, "the mask has no voxel > 0; nothing to perfuse");
-  return GrowthDomain::mask(std::move(m), spec.demand_weighted);
-}
-
-Vec3 ccoRoot(const CcoSetup& s, const CcoRootSpec& spec, const GrowthDomain& d) {
-  Vec3 root;
-  if (d.shape() != DomainShape::Mask) {
-    root = spec.has_root_offset ? d.center() + spec.root_offset_mm : d.defaultRoot();
-  } else {
-    root = spec.root_in_mm ? spec.root_mm : d.frame().toMm(spec.root_voxel);
-  }
-  if (d.dimension() == 2) root.z = d.planeZ();
-  // The root may sit on the border (where the vessel enters), not outside it.
-  const double tolerance = d.frame().voxel_mm * 1e-6;
-  if (d.depth(root) < -tolerance)
-    throw InputError(s.parameter_file, spec.root_line,
-                     "the root (" + show3(root) + " mm in the frame) lies outside the " + domainShapeName(d.shape()) +
-                         " domain (" + show(-d.depth(root)) + " mm beyond its border); place it inside or on the border");
-  return root;
-}
-
 std::vector<std::string> CcoSetup::kinds() const { return kindsOf(inlets); }
 
 Json CcoSetup::describe() const {
@@ -378,7 +262,7 @@ Json CcoSetup::describe() const {
   Json j;
   j["method"] = "cco";
   j["shape"] = domainShapeName(d.shape);
-  const auto describeRoot = [&](const CcoRootSpec& root, Json& out) {
+  const auto describeRoot = [&](const RootSpec& root, Json& out) {
     if (d.shape == DomainShape::Mask) {
       if (root.root_in_mm) out["root"] = Json{{"value", {root.root_mm.x, root.root_mm.y, root.root_mm.z}}, {"unit", "mm"}};
       else out["root_voxel"] = {root.root_voxel.x, root.root_voxel.y, root.root_voxel.z};
@@ -423,13 +307,10 @@ Json CcoSetup::describe() const {
   return j;
 }
 
-std::vector<std::filesystem::path> CcoSetup::inputs() const {
-  if (domain.mask.empty()) return {};
-  return {domain.mask};
-}
+std::vector<std::filesystem::path> CcoSetup::inputs() const { return domainInputs(domain); }
 
 std::unique_ptr<PreparedGrowth> CcoSetup::prepare(std::uint64_t memory_limit) const {
-  return std::make_unique<PreparedCco>(*this, loadCcoDomain(*this, memory_limit));
+  return std::make_unique<PreparedCco>(*this, loadDomainSpec(domain, parameter_file, inlets.front().root, memory_limit));
 }
 
 const GrowthMethod kCcoMethod{
@@ -438,17 +319,9 @@ const GrowthMethod kCcoMethod{
     "domain grows with the tree, each terminal joins the one of its nearest segments whose Kamiya bifurcation gives the "
     "least total volume, no vessel leaves the domain or overlaps another",
     // Seed 000 §5 (Karch 1999): 3.6 cP, written in Pa*s, since "3.6 cP" parses one ulp off 3.6e-3.
-    withPhysicsParams({
-        {"domain", "shape", "text", "sphere", "sphere, cube, disc or square (2D), or mask"},
-        {"domain", "radius", "mm", nullptr, "sphere and disc: the radius"},
-        {"domain", "side", "mm", nullptr, "cube and square: the side"},
-        {"domain", "mask", "file", nullptr, "shape = \"mask\": a NIfTI volume (voxels > 0 inside) or a VascuSynth box map"},
-        {"domain", "sampling", "text", "uniform", "masks: terminals drawn uniformly, or ∝ the mask value (demand)"},
-        {"domain", "voxel_size", "mm", nullptr, "the voxel of the frame (analytic shapes, box maps; a NIfTI mask carries its own)"},
+    withPhysicsParams(withDomainParams("sphere, cube, disc or square (2D), or mask",
+                                       "masks: terminals drawn uniformly, or ∝ the mask value (demand)", {
         {"tree", "terminals", "count", nullptr, "N, the number of terminal segments"},
-        {"tree", "root_offset", "[x, y(, z)] mm", "the top (+y)", "analytic shapes: the root relative to the centre"},
-        {"tree", "root", "[x, y, z] mm", nullptr, "masks: the root in mm in the frame (or root_voxel)"},
-        {"tree", "root_voxel", "[x, y, z] mask voxels", nullptr, "masks: the root in voxels (or root)"},
         {"tree", "closest_neighbours", "count", "20", "ν, the nearest segments tried per terminal"},
         {"tree", "max_closest_neighbours", "count", "80", "ν doubles up to this when every candidate fails"},
         {"tree", "kamiya_iterations", "count", "100", "iterations of Kamiya's bifurcation solver"},
@@ -463,7 +336,7 @@ const GrowthMethod kCcoMethod{
         {"tree.inlet", "share", "", "territory", "its fixed share (0, 1] of its kind's terminals and flow, or \"territory\": what it wins"},
         {"tree.inlet", "root_pressure", "Pa", "[physics] perfusion_pressure; vein 5 mmHg", "pressure at its root (a vein's outlet)"},
         {"tree.inlet", "terminal_pressure", "Pa", "[physics] terminal_pressure; vein 20 mmHg", "pressure at its terminals (above the root: it drains)"},
-    }, false, "0.0036 Pa*s", "100 mmHg", "60 mmHg", "500 mL/min"),
+    }), false, "0.0036 Pa*s", "100 mmHg", "60 mmHg", "500 mL/min"),
     &readCcoToml};
 
 }  // namespace angiosynth
