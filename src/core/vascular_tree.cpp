@@ -18,12 +18,14 @@ void VascularTree::reserve(std::size_t n) {
   position.reserve(n); parent.reserve(n); child0.reserve(n); child1.reserve(n);
   terminals.reserve(n); length.reserve(n); reduced_resistance.reserve(n); beta.reserve(n);
   cost_ratio.reserve(n); radius.reserve(n); flow.reserve(n); pressure.reserve(n); depth.reserve(n); tree.reserve(n);
+  stage.reserve(n); role.reserve(n); branching.reserve(n);
 }
 
 void VascularTree::truncate(std::size_t n) {
   position.resize(n); parent.resize(n); child0.resize(n); child1.resize(n);
   terminals.resize(n); length.resize(n); reduced_resistance.resize(n); beta.resize(n);
   cost_ratio.resize(n); radius.resize(n); flow.resize(n); pressure.resize(n); depth.resize(n); tree.resize(n);
+  stage.resize(n); role.resize(n); branching.resize(n);
 }
 
 std::int32_t VascularTree::addNode(const Vec3& p, std::int32_t parent_node, std::int32_t tree_id) {
@@ -42,6 +44,9 @@ std::int32_t VascularTree::addNode(const Vec3& p, std::int32_t parent_node, std:
   pressure.push_back(0);
   depth.push_back(parent_node >= 0 ? depth[parent_node] + 1 : 0);
   tree.push_back(parent_node >= 0 ? tree[parent_node] : tree_id);
+  stage.push_back(-1);
+  role.push_back(0);
+  branching.push_back(0);
   if (parent_node >= 0) {
     if (child0[parent_node] < 0) child0[parent_node] = id;
     else if (child1[parent_node] < 0) child1[parent_node] = id;
@@ -54,6 +59,12 @@ void VascularTree::replaceChild(std::int32_t node, std::int32_t old_child, std::
   if (child0[node] == old_child) child0[node] = new_child;
   else if (child1[node] == old_child) child1[node] = new_child;
   else throw std::logic_error("replaceChild: not a child");
+}
+
+bool VascularTree::hasStages() const {
+  for (auto v : stage)
+    if (v >= 0) return true;
+  return false;
 }
 
 std::vector<std::int32_t> VascularTree::roots() const {
@@ -88,6 +99,9 @@ void VascularTree::appendTree(const VascularTree& t, std::int32_t tree_id) {
     pressure.push_back(t.pressure[i]);
     depth.push_back(t.depth[i]);
     tree.push_back(tree_id);
+    stage.push_back(t.stage[i]);
+    role.push_back(t.role[i]);
+    branching.push_back(t.branching[i]);
   }
 }
 
@@ -154,6 +168,9 @@ void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments, con
     out.child0.push_back(child0[i] >= 0 ? remap[child0[i]] : -1);
     out.child1.push_back(child1[i] >= 0 ? remap[child1[i]] : -1);
     out.tree.push_back(tree.empty() ? 0 : tree[i]);
+    out.stage.push_back(i < stage.size() ? stage[i] : -1);
+    out.role.push_back(i < role.size() ? role[i] : 0);
+    out.branching.push_back(i < branching.size() ? branching[i] : 0);
   }
   const auto m = out.position.size();
   out.terminals.assign(m, 1); out.length.assign(m, 0); out.reduced_resistance.assign(m, 0);

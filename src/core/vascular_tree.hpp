@@ -28,7 +28,13 @@ struct VascularTree {
   std::vector<double> pressure;             // Pa, at node i (distal end of segment i)
   std::vector<std::int32_t> depth;          // segments from the root to node i
   std::vector<std::int32_t> tree;           // index of the tree node i belongs to (0 in a single tree)
+  // Staged growth (DCCO): the stage that made segment i (-1: none, the method has no stages), its
+  // role (VesselRole) and how it may take new branches (Branching); graphs write them when set.
+  std::vector<std::int16_t> stage;
+  std::vector<std::uint8_t> role;
+  std::vector<std::uint8_t> branching;
 
+  bool hasStages() const;
   std::int32_t nodeCount() const { return static_cast<std::int32_t>(position.size()); }
   std::int32_t segmentCount() const { return nodeCount() > 0 ? nodeCount() - 1 : 0; }
   // Terminals of the tree rooted at node 0 (growth works on one tree).

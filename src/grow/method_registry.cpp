@@ -3,13 +3,14 @@
 #include <sstream>
 
 #include "grow/cco/setup.hpp"
+#include "grow/dcco/setup.hpp"
 #include "grow/method.hpp"
 #include "grow/vascusynth/setup.hpp"
 
 namespace angiosynth {
 
 const std::vector<const GrowthMethod*>& growthMethods() {
-  static const std::vector<const GrowthMethod*> all{&kVascuSynthMethod, &kCcoMethod};
+  static const std::vector<const GrowthMethod*> all{&kVascuSynthMethod, &kCcoMethod, &kDccoMethod};
   return all;
 }
 

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "core/format.hpp"
+#include "core/vessel_roles.hpp"
 
 namespace angiosynth {
 namespace {
@@ -24,6 +25,13 @@ std::string tupAttr(const char* name, const Vec3& p) {
 
 std::string stringAttr(const char* name, const std::string& v) {
   return std::string("      <attr name=\"") + name + "\"><string>" + v + "</string></attr>\n";
+}
+
+// Staged growth: the stage (from 0, in [[stage]] order), role and branching of segment i.
+std::string stageAttrs(const VascularTree& t, std::int32_t i) {
+  if (!t.hasStages()) return "";
+  return "      <attr name=\"stage\"><int>" + std::to_string(t.stage[i]) + "</int></attr>\n" +
+         stringAttr("role", roleName(t.role[i])) + stringAttr("branching", branchingName(t.branching[i]));
 }
 
 }  // namespace
@@ -50,7 +58,7 @@ void writeGxl(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
         << stringAttr("tree", treeOf(trees, t, i).id) << stringAttr("kind", treeOf(trees, t, i).kind)
         << floatAttr("radius", t.radius[i]) << floatAttr("length", t.length[i]) << floatAttr("flow", t.flow[i])
         << floatAttr("pressure_proximal", t.pressure[t.parent[i]]) << floatAttr("pressure_distal", t.pressure[i])
-        << "    </edge>\n";
+        << stageAttrs(t, i) << "    </edge>\n";
   }
   out << "  </graph>\n</gxl>\n";
 }
@@ -79,6 +87,7 @@ void writeVascuSynthGxl(std::ostream& out, const VascularTree& t, const GraphFra
 
 void writeDot(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees, const GraphFrame& f) {
   out << "digraph tree {\n  // positions in mm; radius and length in mm, flow in mm^3/s, pressure in Pa\n";
+  const bool staged = t.hasStages();
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
     const Vec3& p = t.position[i];
     out << "  n" << i << " [type=" << nodeTypeName(t.type(i)) << ", tree=\"" << treeOf(trees, t, i).id << "\", kind=\""
@@ -90,7 +99,9 @@ void writeDot(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
     out << "  n" << t.parent[i] << " -> n" << i << " [tree=\"" << treeOf(trees, t, i).id << "\", kind=\""
         << treeOf(trees, t, i).kind << "\", radius=" << exactNumber(t.radius[i])
         << ", length=" << exactNumber(t.length[i]) << ", flow=" << exactNumber(t.flow[i])
-        << ", pressure=" << exactNumber(t.pressure[i]) << "];\n";
+        << ", pressure=" << exactNumber(t.pressure[i]);
+    if (staged) out << ", stage=" << t.stage[i] << ", role=" << roleName(t.role[i]) << ", branching=" << branchingName(t.branching[i]);
+    out << "];\n";
   }
   out << "}\n";
 }

@@ -2,6 +2,7 @@
 #include <numbers>
 
 #include "core/format.hpp"
+#include "core/vessel_roles.hpp"
 #include "io/graph_writers.hpp"
 
 namespace angiosynth {
@@ -22,13 +23,16 @@ void writeNodesCsv(std::ostream& out, const VascularTree& t, const std::vector<T
 }
 
 void writeEdgesCsv(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees) {
-  out << "id,node1id,node2id,length,radius,flow,volume,tree,kind\n";
+  const bool staged = t.hasStages();
+  out << "id,node1id,node2id,length,radius,flow,volume,tree,kind" << (staged ? ",stage,role,branching" : "") << "\n";
   for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
     if (t.isRoot(i)) continue;
     const TreeInfo& tr = treeOf(trees, t, i);
     out << i << ',' << t.parent[i] << ',' << i << ',' << exactNumber(t.length[i]) << ',' << exactNumber(t.radius[i]) << ','
         << exactNumber(t.flow[i]) << ',' << exactNumber(std::numbers::pi * t.radius[i] * t.radius[i] * t.length[i]) << ','
-        << tr.id << ',' << tr.kind << '\n';
+        << tr.id << ',' << tr.kind;
+    if (staged) out << ',' << t.stage[i] << ',' << roleName(t.role[i]) << ',' << branchingName(t.branching[i]);
+    out << '\n';
   }
 }
 
@@ -58,6 +62,12 @@ void writeVtp(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
   for (auto i : segments) out << treeIndex(i) << '\n';
   out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"Class\" format=\"ascii\">\n";
   for (auto i : segments) out << treeOf(trees, t, i).class_label << '\n';
+  if (t.hasStages()) {  // staged growth: stage from 0, role 1 distribution, 2 transport, 3 perforator; branching 1 versatile, 2 fixed, 3 distal, 4 none
+    for (const auto& [name, value] : {std::pair<const char*, int>{"Stage", 0}, {"Role", 1}, {"Branching", 2}}) {
+      out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"" << name << "\" format=\"ascii\">\n";
+      for (auto i : segments) out << (value == 0 ? int(t.stage[i]) : value == 1 ? int(t.role[i]) : int(t.branching[i])) << '\n';
+    }
+  }
   out << "</DataArray>\n</CellData>\n<Lines>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
   for (auto i : segments) out << t.parent[i] << ' ' << i << '\n';
   out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
@@ -97,8 +107,13 @@ void writeGraphml(std::ostream& out, const VascularTree& t, const std::vector<Tr
          "  <key id=\"radius\" for=\"edge\" attr.name=\"radius\" attr.type=\"double\"/>\n"
          "  <key id=\"flow\" for=\"edge\" attr.name=\"flow\" attr.type=\"double\"/>\n"
          "  <key id=\"tree\" for=\"edge\" attr.name=\"tree\" attr.type=\"string\"/>\n"
-         "  <key id=\"kind\" for=\"edge\" attr.name=\"kind\" attr.type=\"string\"/>\n"
-         "  <graph id=\"tree\" edgedefault=\"directed\">\n";
+         "  <key id=\"kind\" for=\"edge\" attr.name=\"kind\" attr.type=\"string\"/>\n";
+  const bool staged = t.hasStages();
+  if (staged)
+    out << "  <key id=\"stage\" for=\"edge\" attr.name=\"stage\" attr.type=\"int\"/>\n"
+           "  <key id=\"role\" for=\"edge\" attr.name=\"role\" attr.type=\"string\"/>\n"
+           "  <key id=\"branching\" for=\"edge\" attr.name=\"branching\" attr.type=\"string\"/>\n";
+  out << "  <graph id=\"tree\" edgedefault=\"directed\">\n";
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
     const Vec3& p = t.position[i];
     const TreeInfo& tr = treeOf(trees, t, i);
@@ -112,8 +127,11 @@ void writeGraphml(std::ostream& out, const VascularTree& t, const std::vector<Tr
     const TreeInfo& tr = treeOf(trees, t, i);
     out << "    <edge id=\"e" << i << "\" source=\"n" << t.parent[i] << "\" target=\"n" << i << "\"><data key=\"length\">"
         << exactNumber(t.length[i]) << "</data><data key=\"radius\">" << exactNumber(t.radius[i]) << "</data><data key=\"flow\">"
-        << exactNumber(t.flow[i]) << "</data><data key=\"tree\">" << tr.id << "</data><data key=\"kind\">" << tr.kind
-        << "</data></edge>\n";
+        << exactNumber(t.flow[i]) << "</data><data key=\"tree\">" << tr.id << "</data><data key=\"kind\">" << tr.kind << "</data>";
+    if (staged)
+      out << "<data key=\"stage\">" << t.stage[i] << "</data><data key=\"role\">" << roleName(t.role[i])
+          << "</data><data key=\"branching\">" << branchingName(t.branching[i]) << "</data>";
+    out << "</edge>\n";
   }
   out << "  </graph>\n</graphml>\n";
 }

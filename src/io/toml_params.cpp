@@ -1,6 +1,7 @@
 // The native parameter format: TOML with units written out ("0.4 mm", "100 mmHg",
 // "3.6 mPa*s", "8330 mm3/s"). Every key is checked; unknown keys are errors.
 #include <algorithm>
+#include <set>
 
 #include "core/error.hpp"
 #include "grow/method.hpp"
@@ -15,7 +16,6 @@ Scenario readTomlParameters(const std::filesystem::path& path) {
 Scenario readTomlParameters(const toml::table& root, const std::filesystem::path& path) {
   const std::string file = path.string();
   TomlReader r(root, file);
-  r.checkKeys(root, {"seed", "domain", "tree", "physics", "image", "degrade", "output"}, "the top level");
   Scenario sc;
   sc.parameter_file = file;
   sc.format = "toml";
@@ -34,6 +34,18 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   }
   const GrowthMethod* m = findGrowthMethod(method);
   if (!m) throw InputError(file, r.lineOf(method_node), "method '" + method + "' is not available; allowed: " + growthMethodNames());
+  // The top-level tables: the common ones and those the method declares ([[stage]], [[region]]).
+  std::set<std::string> top{"seed", "domain", "tree", "physics", "image", "degrade", "output"};
+  const auto tableOf = [](const MethodParam& p) { return std::string(p.table).substr(0, std::string(p.table).find('.')); };
+  for (const auto& p : m->params) top.insert(tableOf(p));
+  for (const auto& [k, v] : root) {
+    if (top.count(std::string(k.str()))) continue;
+    for (const auto* other : growthMethods())
+      for (const auto& p : other->params)
+        if (tableOf(p) == k.str())
+          throw InputError(file, r.lineOf(&v), "[" + std::string(k.str()) + "] is for method " + other->name + ", not " + m->name);
+  }
+  r.checkKeys(root, top, "the top level");
   sc.growth = m->read(r, *m);
   const double voxel_mm = sc.growth->voxelMm();
 

@@ -22,7 +22,7 @@ void checkMethodKeys(const TomlReader& r, const GrowthMethod& m, const toml::tab
   for (const auto& [k, v] : t) {
     const std::string key(k.str());
     if (findParam(m, name, key) || (name == "tree" && key == "method")) continue;
-    if (name == "tree" && key == "inlet" && !declaredKeys(m, "tree.inlet").empty()) continue;  // [[tree.inlet]]
+    if (!declaredKeys(m, name + "." + key).empty()) continue;  // a sub-table the method declares: [[tree.inlet]], [[stage.gaussian]]
     if (const GrowthMethod* other = methodDeclaring(name, key, &m))
       throw InputError(r.file(), r.lineOf(&v), "'" + key + "' in [" + name + "] is for method " + other->name +
                                                    "; this file grows with method " + m.name + " ([tree] method)");

@@ -1,0 +1,832 @@
+#include "grow/dcco/grower.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <span>
+
+#include "core/rng.hpp"
+#include "grow/common/intersections.hpp"
+#include "grow/common/segment_index.hpp"
+#include "grow/dcco/lattice.hpp"
+#include "physics/hemodynamics.hpp"
+
+namespace angiosynth {
+namespace {
+
+constexpr double kEtaRef = 3.6e-3;  // Pa*s: reduced resistances are stored in units of 8·kEtaRef/π
+// An ancestor is checked again for collisions once its radius has grown by this factor.
+constexpr double kRecheckGrowth = 1.02;
+// Constraints are checked during growth with this margin on radii, so that the exact radii of
+// the stage's final fixed point rarely break them.
+constexpr double kMargin = 1.02;
+// Full fixed point (and exact relative radii) after the tree has grown by this share.
+constexpr double kRefreshShare = 0.02;
+// Vessels with ρ = r/r_1 above kThickReach are not found through the grid but from a list of
+// those above kThickList (rebuilt at every fixed point, while ρ drifts by a few percent).
+constexpr double kThickReach = 0.25, kThickList = 0.2;
+// The repair sheds at most this share of a stage's terminals from below one vessel.
+constexpr double kMaxShedShare = 0.05;
+
+// Characteristic length of a domain (eq. 13): the radius of the disc or ball of its measure.
+double characteristicLength(const GrowthDomain& d) {
+  return d.dimension() == 2 ? std::sqrt(d.measure() / std::numbers::pi) : std::cbrt(3 * d.measure() / (4 * std::numbers::pi));
+}
+
+// Murray kernels per stage (γ may differ between stages).
+std::vector<PowerKernel> kernelsOf(const std::vector<double>& gamma_of_stage) {
+  std::vector<PowerKernel> k;
+  for (double g : gamma_of_stage) {
+    PhysicsParameters p;
+    p.murray_exponent = g;
+    k.emplace_back(p);
+  }
+  return k;
+}
+
+// The kernel of the split at node i: that of the stage which made the bifurcation (its new branch).
+const PowerKernel& kernelAt(const VascularTree& t, std::int32_t i, const std::vector<PowerKernel>& kernels) {
+  const auto c = t.child1[i] >= 0 ? t.child1[i] : i;
+  const int st = t.stage[c] >= 0 ? t.stage[c] : 0;
+  return kernels[std::min<std::size_t>(std::size_t(st), kernels.size() - 1)];
+}
+
+// One level of the path from a new bifurcation to the root, as a trial point would leave it.
+struct Level {
+  std::int32_t seg, child, other;  // seg -1: the new bifurcation segment
+  double beta_child, beta_other, R, V;
+  std::int32_t n;
+};
+
+struct Trial {
+  std::int32_t s = -1;
+  Vec3 b;
+  double cost = 0;
+  double r[3] = {0, 0, 0};  // proximal part, distal part, new vessel
+  bool valid = false;
+};
+
+class DccoGrower {
+ public:
+  DccoGrower(const DccoOptions& o, GrowthReport& r, DccoReport& d)
+      : o_(o), report_(r), dr_(d), rng_(o.seed, o.sample, Stage::Growth), index_(o.world->lo(), o.world->hi(), o.world->dimension() == 2) {
+    for (const auto& st : o.stages) gamma_.push_back(st.gamma);
+    kernels_ = kernelsOf(gamma_);
+    std::int64_t total = 0;
+    for (const auto& st : o.stages) total += st.terminal_count;
+    t_.reserve(2 * total + 2);
+    t_.addNode(o.root_mm, -1);
+    eta_.assign(1, o.viscosity.at(o.root_radius));
+    rel_.assign(1, 1.0);
+    checked_.assign(1, 0.0);
+  }
+
+  VascularTree run(const ProgressFn& progress) {
+    std::int64_t total = 0, before = 0;
+    for (const auto& st : o_.stages) total += st.terminal_count;
+    for (std::size_t k = 0; k < o_.stages.size(); ++k) {
+      stage_ = int(k);
+      const auto& st = o_.stages[k];
+      target_ = terminalCount() + st.terminal_count;
+      lc_ = characteristicLength(*st.terminals);
+      growStage(progress, before, total);
+      repairStage(progress, before, total);
+      dr_.stage_terminals.push_back(terminalCount() - before);
+      before = terminalCount();
+    }
+    dr_.viscosity_iterations = solve();
+    finalCounts();
+    return std::move(t_);
+  }
+
+ private:
+  std::int64_t terminalCount() const { return t_.nodeCount() > 1 ? t_.terminals[t_.rootSegment()] : 0; }
+  const DccoStage& stage() const { return o_.stages[stage_]; }
+  double radiusOf(std::int32_t y) const { return o_.root_radius * rel_[y]; }
+  double e(std::int32_t y) const { return eta_[y] / kEtaRef; }
+
+  // Algorithm 1 on the whole tree; refreshes ρ, the clear-radius bookkeeping and the index.
+  int solve() {
+    const int it = solveDccoTree(t_, eta_, o_, gamma_);
+    rel_.assign(t_.nodeCount(), 1.0);
+    for (std::int32_t i = 1; i < t_.nodeCount(); ++i) rel_[i] = t_.radius[i] / o_.root_radius;
+    checked_.resize(t_.nodeCount(), 0.0);
+    solved_at_ = t_.nodeCount();
+    volume_ = std::numbers::pi * o_.root_radius * o_.root_radius * t_.cost_ratio[t_.rootSegment()];
+    listThick();
+    return it;
+  }
+
+  // A point from the stage's pdf in its terminal domain.
+  Vec3 draw() {
+    const auto& st = stage();
+    const auto& d = *st.terminals;
+    if (st.pdf != TerminalPdf::Gaussian) return d.sample(rng_);
+    double total = 0;
+    for (const auto& g : st.gaussians) total += g.weight;
+    for (;;) {
+      double u = rng_.uniform() * total;
+      const GaussianComponent* g = &st.gaussians.back();
+      for (const auto& c : st.gaussians)
+        if ((u -= c.weight) < 0) {
+          g = &c;
+          break;
+        }
+      Vec3 p = o_.world->center() + g->mean;
+      p.x += g->sigma.x * rng_.normal();
+      p.y += g->sigma.y * rng_.normal();
+      if (d.dimension() == 3) p.z += g->sigma.z * rng_.normal();
+      else p.z = d.planeZ();
+      if (d.depth(p) > 0) return p;
+    }
+  }
+
+  double limitLength() const {
+    const int D = stage().terminals->dimension();
+    return lc_ * std::pow(stage().nu / double(terminalCount() + 1), 1.0 / D);
+  }
+
+  // The root segment (Algorithm 2, line 1): a drawn point far enough from the root, with l > 2 r.
+  void plantRoot() {
+    double lim = limitLength();
+    const auto& st = stage();
+    for (std::int64_t draws = 1; draws <= o_.max_draws; ++draws) {
+      ++report_.candidates;
+      const Vec3 p = draw();
+      const double l = distance(o_.root_mm, p);
+      // The root vessel brings the blood into the stage's domain (the root may lie outside it):
+      // it stays in the world and ends in the stage's terminal region.
+      const bool inside = o_.world->capsuleInside(o_.root_mm, p, o_.root_radius, true);
+      if (l > lim && l > 2 * kMargin * o_.root_radius && inside) {
+        const auto n = t_.addNode(p, 0);
+        t_.stage[n] = std::int16_t(stage_);
+        t_.role[n] = std::uint8_t(st.role);
+        t_.branching[n] = std::uint8_t(Branching::Versatile);
+        t_.length[n] = l;
+        eta_.push_back(o_.viscosity.at(o_.root_radius));
+        t_.reduced_resistance[n] = e(n) * l;
+        t_.cost_ratio[n] = l;
+        rel_.push_back(1.0);
+        checked_.push_back(o_.root_radius);
+        solve();
+        index_.refresh(t_, true);
+        return;
+      }
+      ++report_.rejected_unreachable;
+      if (draws % st.draws_before_relaxing == 0) {
+        lim *= st.f_r;
+        ++dr_.threshold_relaxations;
+      }
+    }
+    throw GrowthError("stage '" + st.name + "': no root vessel could be placed: every point drawn lies too close to the root, "
+                      "makes a vessel shorter than twice the root radius or leaves the domain; move the root or enlarge the domain");
+  }
+
+  // Costs the trial point b on segment s for terminal x: fills t with the cost and the radii of the
+  // three new vessels, and `path` with the new values up to the root (O(depth)).
+  void cost(std::int32_t s, const Vec3& b, const Vec3& x, Trial& tr, std::vector<Level>& path) const {
+    const auto& T = t_;
+    const std::int32_t q = T.parent[s];
+    const double l_up = distance(T.position[q], b), l_down = distance(b, T.position[s]), l_new = distance(b, x);
+    const double es = e(s);
+    const double R_sd = es * l_down + (T.reduced_resistance[s] - es * T.length[s]);
+    const double V_sd = l_down + (T.cost_ratio[s] - T.length[s]);
+    const double R_t = es * l_new, V_t = l_new;
+    const auto sp = kernels_[stage_].split(T.terminals[s], R_sd, 1, R_t);
+    path.clear();
+    Level lv{-1, s, -1, sp.beta_a, sp.beta_b, es * l_up + 1.0 / (pow4(sp.beta_a) / R_sd + pow4(sp.beta_b) / R_t),
+             l_up + sp.beta_a * sp.beta_a * V_sd + sp.beta_b * sp.beta_b * V_t, T.terminals[s] + 1};
+    path.push_back(lv);
+    // Walk up: segment y = q ends at the node the bifurcation segment hangs from.
+    for (std::int32_t y = q; T.parent[y] >= 0; y = T.parent[y]) {
+      const auto& below = path.back();
+      const std::int32_t child = path.size() == 1 ? -1 : below.seg;  // -1: the new bifurcation segment
+      const std::int32_t other = T.child0[y] == (child < 0 ? s : child) ? T.child1[y] : T.child0[y];
+      const auto spl = kernelAt(T, y, kernels_).split(below.n, below.R, T.terminals[other], T.reduced_resistance[other]);
+      Level up{y, child, other, spl.beta_a, spl.beta_b,
+               e(y) * T.length[y] + 1.0 / (pow4(spl.beta_a) / below.R + pow4(spl.beta_b) / T.reduced_resistance[other]),
+               T.length[y] + spl.beta_a * spl.beta_a * below.V + spl.beta_b * spl.beta_b * T.cost_ratio[other], T.terminals[y] + 1};
+      path.push_back(up);
+    }
+    double rho = 1;
+    for (std::size_t k = path.size(); k-- > 1;) rho *= path[k].beta_child;
+    const double rb = o_.root_radius * rho;
+    tr.r[0] = rb;
+    tr.r[1] = rb * path[0].beta_child;
+    tr.r[2] = rb * path[0].beta_other;
+    const double volume_after = std::numbers::pi * o_.root_radius * o_.root_radius * path.back().V;
+    const double added = volume_after - volume_;
+    const auto& st = stage();
+    if (st.cost == StageCost::Volume) {
+      tr.cost = added;
+    } else {  // eq. 15: V_ref the stage's domain measure, l_ref its l_c, r_ref the root radius
+      const double l = l_new / lc_;
+      tr.cost = st.c_v * added / st.vessels->measure() + st.c_p * radiusOf(s) / o_.root_radius + st.c_d * l * l;
+    }
+  }
+
+  // The checks of a trial point that need no other vessel (run in parallel).
+  bool admissible(std::int32_t s, const Vec3& b, const Vec3& x, const Trial& tr, int level) const {
+    const auto& T = t_;
+    const auto& st = stage();
+    const Vec3 xp = T.position[T.parent[s]], xd = T.position[s];
+    const double l[3] = {distance(xp, b), distance(b, xd), distance(b, x)};
+    for (int k = 0; k < 3; ++k)
+      if (!(l[k] > 2 * kMargin * tr.r[k])) return false;
+    const double ratio = std::min(tr.r[1], tr.r[2]) / std::max(tr.r[1], tr.r[2]);
+    if (!(ratio > st.deltaAt(level))) return false;
+    const auto br = Branching(T.branching[s]);
+    if (br != Branching::Distal) {  // a distal branch continues the vessel's end: no angle to keep
+      const double th = bifurcationAngle(b, xd, x);
+      if (th < st.theta_min || th > st.theta_max) return false;
+      Vec3 fallback;
+      if (T.parent[T.parent[s]] >= 0) {  // the plane of the bifurcation s leaves
+        const auto q = T.parent[s];
+        const auto sib = T.sibling(s);
+        if (sib >= 0) fallback = cross(T.position[q] - T.position[T.parent[q]], T.position[sib] - T.position[q]);
+      }
+      const double ph = openingAngle(xp, b, xd, x, fallback);
+      if (ph < st.phi_min || ph > st.phi_max) return false;
+    }
+    // A perforator branches only inside Ω.
+    if (VesselRole(T.role[s]) == VesselRole::Perforator && !(st.vessels->depth(b) > 0)) return false;
+    // The bifurcation point where its vessels may lie (contained() checks their whole capsules).
+    if (st.role == VesselRole::Distribution && !(st.vessels->depth(b) >= kMargin * tr.r[2])) return false;
+    if (VesselRole(T.role[s]) == VesselRole::Distribution && T.stage[s] >= 0 &&
+        !(o_.stages[T.stage[s]].vessels->depth(b) >= kMargin * tr.r[1]))
+      return false;
+    return true;
+  }
+
+  // Where the roles let the vessels lie: the new vessel (the stage's role) inside the stage's
+  // domain if it distributes, else in the world; the two parts of the split vessel keep its role
+  // and stage, so a distribution vessel's parts stay in the domain of the stage that made it or
+  // of the current stage (the root vessel, which brings the blood in, and other roles only in
+  // the world). Every vessel stays in the world (a rasterised region may overhang it by half a
+  // voxel). Checked on the cheapest trials only (a mask domain samples every ¼ voxel).
+  bool contained(const Trial& tr, const Vec3& x) const {
+    const auto& T = t_;
+    const auto s = tr.s;
+    const Vec3 xp = T.position[T.parent[s]], xd = T.position[s];
+    const bool root_seg = T.parent[T.parent[s]] < 0;
+    const double r[3] = {kMargin * tr.r[0], kMargin * tr.r[1], kMargin * tr.r[2]};
+    if (!vesselFits(tr.b, x, r[2], false, stage().role, stage_)) return false;
+    const auto role = VesselRole(T.role[s]);
+    return vesselFits(xp, tr.b, r[0], root_seg, root_seg ? VesselRole::Transport : role, T.stage[s]) &&
+           vesselFits(tr.b, xd, r[1], false, role, T.stage[s]);
+  }
+
+  // True if the capsule a–e of radius r, of a vessel with this role made by stage `made`, lies
+  // where it may: in the world, and a distribution vessel also in its stage's or the current
+  // stage's domain.
+  bool vesselFits(const Vec3& a, const Vec3& e, double r, bool from_root, VesselRole role, int made) const {
+    if (!o_.world->capsuleInside(a, e, r, from_root)) return false;
+    if (role != VesselRole::Distribution || made < 0) return true;
+    const auto* own = o_.stages[made].vessels;
+    const auto* now = stage().vessels;
+    return (own != o_.world && own->capsuleInside(a, e, r, from_root)) || own == o_.world ||
+           (now != own && (now == o_.world || now->capsuleInside(a, e, r, from_root)));
+  }
+
+  // True if the capsule a–e (radius r) of segment x overlaps a vessel more than two segments
+  // away, or if its centreline runs through one of its near neighbours (one segment between
+  // them: their capsules may touch at the joint, their centrelines may not come within half
+  // the thinner radius; the lattice's bifurcation points can fold a branch over its sibling).
+  bool overlaps(std::int32_t x, const Vec3& a, const Vec3& e, double r) {
+    bool hit = false;
+    const auto test = [&](std::int32_t y) {
+      if (hit || y == x || y >= t_.nodeCount() || t_.parent[y] < 0 || sharesNode(x, y)) return;
+      const double d = segmentSegmentDistance(a, e, t_.position[t_.parent[y]], t_.position[y]);
+      const double ry = kMargin * radiusOf(y);
+      hit = withinTwoSegments(t_, x, y) ? d < 0.5 * std::min(r, ry) : d < r + ry;
+    };
+    // The grid as far as thin vessels reach; the few thick ones from their list, so the search
+    // does not widen with the root radius.
+    index_.forEachNearSegment(a, e, r + kMargin * kThickReach * o_.root_radius, test);
+    for (auto y : thick_)
+      if (!hit && y < t_.nodeCount() && radiusOf(y) > kThickReach * o_.root_radius) test(y);
+    return hit;
+  }
+  // Segments with ρ above kThickList, listed at each fixed point and when made.
+  void listThick() {
+    thick_.clear();
+    for (std::int32_t i = 1; i < t_.nodeCount(); ++i)
+      if (t_.parent[i] >= 0 && rel_[i] >= kThickList) thick_.push_back(i);
+  }
+  bool sharesNode(std::int32_t x, std::int32_t y) const {
+    return t_.parent[x] == t_.parent[y] || t_.parent[x] == y || t_.parent[y] == x;
+  }
+
+  // The three new vessels of a trial against the tree before it is committed, each with the
+  // neighbours it will have (sharing a node: exempt; one segment between: the rule for near
+  // neighbours; s itself is replaced). A cheap filter before the exact check after commit.
+  bool trialHits(const Trial& tr, const Vec3& x) {
+    const auto s = tr.s, q = t_.parent[s];
+    const auto& T = t_;
+    const std::int32_t sib = T.sibling(s), c0 = T.child0[s], c1 = T.child1[s];
+    const auto kids = [&](std::int32_t y, std::int32_t* out, int& n) {
+      if (y > 0 && T.child0[y] >= 0) out[n++] = T.child0[y];
+      if (y > 0 && T.child1[y] >= 0) out[n++] = T.child1[y];
+    };
+    // The new vessel b→x: next to s's parent and sibling (through the proximal part) and s's children.
+    {
+      const std::int32_t near[4] = {q, sib, c0, c1};
+      if (capsuleHits(tr.b, x, kMargin * tr.r[2], s, {}, {near, near + 4})) return true;
+    }
+    // The distal part b→xd: shares xd with s's children; next to s's parent, sibling, grandchildren.
+    {
+      const std::int32_t share[2] = {c0, c1};
+      std::int32_t near[6] = {q, sib};
+      int n = 2;
+      kids(c0, near, n);
+      kids(c1, near, n);
+      if (capsuleHits(tr.b, T.position[s], kMargin * tr.r[1], s, {share, share + 2}, {near, near + n})) return true;
+    }
+    // The proximal part q→b: shares q with s's parent and sibling; next to their neighbours and s's children.
+    {
+      const std::int32_t share[2] = {q, sib};
+      std::int32_t near[7] = {c0, c1};
+      int n = 2;
+      if (q > 0 && T.parent[q] >= 0) {
+        near[n++] = T.parent[q] > 0 && T.parent[T.parent[q]] >= 0 ? T.parent[q] : -1;
+        near[n++] = T.parent[T.parent[q]] >= 0 ? T.sibling(q) : -1;
+      }
+      kids(sib, near, n);
+      if (capsuleHits(T.position[q], tr.b, kMargin * tr.r[0], s, {share, share + 2}, {near, near + n})) return true;
+    }
+    return false;
+  }
+
+  // True if the capsule a–e of radius r overlaps a vessel other than `skip` and `share` (which
+  // meet it), with `near` (one segment away) held only to the rule for near neighbours.
+  bool capsuleHits(const Vec3& a, const Vec3& e, double r, std::int32_t skip, std::span<const std::int32_t> share,
+                   std::span<const std::int32_t> near) {
+    bool hit = false;
+    const auto test = [&](std::int32_t y) {
+      if (hit || y == skip || y >= t_.nodeCount() || t_.parent[y] < 0) return;
+      if (std::find(share.begin(), share.end(), y) != share.end()) return;
+      const double d = segmentSegmentDistance(a, e, t_.position[t_.parent[y]], t_.position[y]);
+      const double ry = kMargin * radiusOf(y);
+      hit = std::find(near.begin(), near.end(), y) != near.end() ? d < 0.5 * std::min(r, ry) : d < r + ry;
+    };
+    index_.forEachNearSegment(a, e, r + kMargin * kThickReach * o_.root_radius, test);
+    for (auto y : thick_)
+      if (!hit && y < t_.nodeCount() && radiusOf(y) > kThickReach * o_.root_radius) test(y);
+    return hit;
+  }
+
+  // The vessels of the last commit (proximal part, distal part s, new vessel) against the tree.
+  bool newVesselsCollide(std::int32_t s) {
+    const auto b = t_.nodeCount() - 2;
+    // s's children too: the new bifurcation puts a segment more between them and s's old
+    // neighbours, which may now touch them only where the rule for near neighbours allows.
+    for (const std::int32_t x : {std::int32_t(b + 1), b, s, t_.child0[s], t_.child1[s]})
+      if (x > 0 && overlaps(x, t_.position[t_.parent[x]], t_.position[x], kMargin * radiusOf(x))) return true;
+    return false;
+  }
+
+  struct Saved {
+    std::int32_t id, n;
+    double R, V, beta, rel;
+  };
+
+  // Applies a costed trial (path recorded by cost()).
+  void commit(const Trial& tr, const Vec3& x, const std::vector<Level>& path, std::vector<Saved>& undo) {
+    auto& T = t_;
+    const auto s = tr.s, q = T.parent[s];
+    undo.clear();
+    const auto save = [&](std::int32_t id) { undo.push_back({id, T.terminals[id], T.reduced_resistance[id], T.cost_ratio[id], T.beta[id], rel_[id]}); };
+    save(s);
+    for (std::size_t k = 1; k < path.size(); ++k) {
+      save(path[k].seg);
+      save(path[k].other);
+    }
+    const auto b = T.addNode(tr.b, -1);
+    T.parent[b] = q;
+    T.tree[b] = T.tree[q];
+    T.replaceChild(q, s, b);
+    T.parent[s] = b;
+    T.child0[b] = s;
+    T.stage[b] = T.stage[s];  // the proximal part of the split vessel
+    T.role[b] = T.role[s];
+    T.branching[b] = T.branching[s];
+    const double es = e(s);
+    T.length[b] = distance(T.position[q], tr.b);
+    const double l_down = distance(tr.b, T.position[s]);
+    T.reduced_resistance[s] = es * l_down + (T.reduced_resistance[s] - es * T.length[s]);
+    T.cost_ratio[s] = l_down + (T.cost_ratio[s] - T.length[s]);
+    T.length[s] = l_down;
+    const auto n = T.addNode(x, b);
+    T.stage[n] = std::int16_t(stage_);
+    T.role[n] = std::uint8_t(stage().role);
+    T.branching[n] = std::uint8_t(Branching::Versatile);
+    eta_.push_back(eta_[s]);
+    eta_.push_back(eta_[s]);
+    T.reduced_resistance[n] = es * T.length[n];
+    T.cost_ratio[n] = T.length[n];
+    T.terminals[n] = 1;
+    rel_.resize(T.nodeCount());
+    checked_.resize(T.nodeCount(), 0.0);
+    for (std::size_t k = 0; k < path.size(); ++k) {
+      const auto& L = path[k];
+      const auto seg = k == 0 ? b : L.seg;
+      const auto child = k == 0 ? s : (k == 1 ? b : L.child);
+      const auto other = k == 0 ? n : L.other;
+      T.terminals[seg] = L.n;
+      T.reduced_resistance[seg] = L.R;
+      T.cost_ratio[seg] = L.V;
+      T.beta[child] = L.beta_child;
+      T.beta[other] = L.beta_other;
+    }
+    const auto top = path.size() == 1 ? b : path.back().seg;
+    T.beta[top] = 1;
+    rel_[top] = 1;
+    for (std::size_t k = path.size(); k-- > 0;) {
+      const auto& L = path[k];
+      const auto seg = k == 0 ? b : L.seg;
+      const auto child = k == 0 ? s : (k == 1 ? b : L.child);
+      const auto other = k == 0 ? n : L.other;
+      rel_[child] = rel_[seg] * L.beta_child;
+      rel_[other] = rel_[seg] * L.beta_other;
+    }
+    volume_ = std::numbers::pi * o_.root_radius * o_.root_radius * T.cost_ratio[T.rootSegment()];
+    // In the index before the checks (entries left by a rollback are harmless: queries measure
+    // the current geometry); s's distal part leaves its old line.
+    index_.insert(T, b);
+    index_.insert(T, n);
+    index_.insert(T, s);
+    if (rel_[b] >= kThickList) thick_.push_back(b);
+  }
+
+  void rollback(const std::vector<Saved>& undo) {
+    auto& T = t_;
+    const auto b = T.nodeCount() - 2;
+    const auto s = T.child0[b], q = T.parent[b];
+    T.replaceChild(q, b, s);
+    T.parent[s] = q;
+    T.length[s] = distance(T.position[q], T.position[s]);
+    T.truncate(b);
+    eta_.resize(b);
+    rel_.resize(b);
+    checked_.resize(b);
+    for (auto it = undo.rbegin(); it != undo.rend(); ++it) {
+      T.terminals[it->id] = it->n;
+      T.reduced_resistance[it->id] = it->R;
+      T.cost_ratio[it->id] = it->V;
+      T.beta[it->id] = it->beta;
+      rel_[it->id] = it->rel;
+    }
+    volume_ = std::numbers::pi * o_.root_radius * o_.root_radius * T.cost_ratio[T.rootSegment()];
+  }
+
+  // After a commit: the ancestors that thickened past kRecheckGrowth since last found clear.
+  bool ancestorsCollide(const std::vector<Level>& path) {
+    for (std::size_t k = 1; k < path.size(); ++k) {
+      const auto x = path[k].seg;
+      const double r = radiusOf(x);
+      if (r <= kRecheckGrowth * checked_[x]) continue;
+      if (overlaps(x, t_.position[t_.parent[x]], t_.position[x], kMargin * r)) return true;
+      checked_[x] = r;
+    }
+    return false;
+  }
+
+  // Connects terminal x to the cheapest admissible point of its candidate vessels; false if none.
+  bool connect(const Vec3& x) {
+    const auto& st = stage();
+    // VItA's box: f_n times the unrelaxed l_lim, so that relaxing the spacing does not shrink it.
+    const double half = st.f_n * limitLength();
+    near_.clear();
+    const Vec3 h(half, half, st.terminals->dimension() == 2 ? 0.0 : half);
+    index_.forEachInBox(x - h, x + h, [&](std::int32_t y) {
+      if (y <= 0 || y >= t_.nodeCount() || t_.parent[y] < 0) return;
+      const Vec3 a = t_.position[t_.parent[y]], e = t_.position[y];
+      // The vessel's point nearest to x must lie in the box.
+      const Vec3 ab = e - a;
+      const double u = std::clamp(dot(x - a, ab) / std::max(dot(ab, ab), 1e-300), 0.0, 1.0);
+      const Vec3 c = a + ab * u - x;
+      if (std::abs(c.x) <= half && std::abs(c.y) <= half && std::abs(c.z) <= half) near_.push_back({norm(c), y});
+    });
+    std::sort(near_.begin(), near_.end());
+    if (near_.size() > std::size_t(st.max_candidates)) near_.resize(st.max_candidates);
+    if (near_.empty()) return false;
+    // Cost every lattice point of every candidate (in parallel; the tree is read only).
+    const std::size_t nc = near_.size();
+    trials_.assign(nc, {});
+    counts_.assign(nc, 0);
+    const auto evaluate = [&](std::size_t c) {
+      const auto s = near_[c].second;
+      const auto pts = bifurcationLattice(x, t_.position[t_.parent[s]], t_.position[s], st.delta_v, Branching(t_.branching[s]));
+      int level = -1;  // bifurcation level of the proximal part: bifurcations above it
+      for (std::int32_t y = t_.parent[s]; t_.parent[y] >= 0; y = t_.parent[y]) ++level;
+      std::vector<Level> path;
+      auto& out = trials_[c];
+      counts_[c] = pts.size();
+      out.reserve(pts.size());
+      for (const auto& b : pts) {
+        Trial tr;
+        tr.s = s;
+        tr.b = b;
+        cost(s, b, x, tr, path);
+        tr.valid = admissible(s, b, x, tr, level + 1);
+        if (tr.valid) out.push_back(tr);
+      }
+    };
+    if (nc >= 4) tbb::parallel_for(std::size_t(0), nc, evaluate);
+    else
+      for (std::size_t c = 0; c < nc; ++c) evaluate(c);
+    ranked_.clear();
+    for (std::size_t c = 0; c < nc; ++c) {
+      dr_.trial_points += std::int64_t(counts_[c]);
+      for (const auto& tr : trials_[c]) ranked_.push_back(tr);
+    }
+    // Cheapest first; ties by segment and point order (deterministic for any thread count).
+    std::stable_sort(ranked_.begin(), ranked_.end(), [](const Trial& a, const Trial& b) { return a.cost < b.cost; });
+    std::vector<Level> path;
+    for (const auto& tr : ranked_) {
+      if (!contained(tr, x)) continue;
+      if (trialHits(tr, x)) {
+        ++report_.rejected_intersection;
+        continue;
+      }
+      // Committed first, so that the overlap checks see the new vessels' true neighbours.
+      Trial exact = tr;
+      cost(tr.s, tr.b, x, exact, path);
+      commit(exact, x, path, undo_);
+      if (newVesselsCollide(tr.s)) {
+        rollback(undo_);
+        ++report_.rejected_intersection;
+        continue;
+      }
+      if (ancestorsCollide(path)) {
+        rollback(undo_);
+        ++report_.rejected_intersection;
+        continue;
+      }
+      const auto b = t_.nodeCount() - 2;
+      checked_[b] = radiusOf(b);
+      checked_[b + 1] = radiusOf(b + 1);
+      checked_[tr.s] = radiusOf(tr.s);
+      index_.refresh(t_);
+      if (double(t_.nodeCount()) > (1 + kRefreshShare) * double(solved_at_)) solve();
+      return true;
+    }
+    return false;
+  }
+
+  void growStage(const ProgressFn& progress, std::int64_t before, std::int64_t total) {
+    const auto& st = stage();
+    std::int64_t next_report = 0;
+    if (t_.nodeCount() < 2) plantRoot();
+    while (terminalCount() < target_) {
+      if (progress && terminalCount() >= next_report) {
+        progress(terminalCount(), total);
+        next_report = terminalCount() + std::max<std::int64_t>(1, total / 200);
+      }
+      double lim = limitLength();
+      for (std::int64_t failures = 1;; ++failures) {
+        if (failures > o_.max_draws)
+          throw GrowthError("stage '" + st.name + "' placed " + std::to_string(terminalCount() - before) + " of its " +
+                            std::to_string(st.terminal_count) + " terminals: " + std::to_string(o_.max_draws) +
+                            " points in a row found no admissible connection; lower its terminals, relax its angle or symmetry limits, "
+                            "or enlarge its domain");
+        const Vec3 x = draw();
+        if (index_.anyWithin(t_, x, lim)) {
+          ++report_.rejected_too_close;
+        } else {
+          ++report_.candidates;
+          if (connect(x)) break;
+          ++report_.rejected_unreachable;
+        }
+        if (failures % st.draws_before_relaxing == 0) {
+          lim *= st.f_r;
+          ++dr_.threshold_relaxations;
+        }
+      }
+    }
+  }
+
+  // Segments of the solved tree that break a constraint, each as the segment whose subtree goes:
+  // intersecting pairs, length <= 2r, leaving the world, terminal bifurcations below their δ.
+  std::vector<std::int32_t> violations() {
+    std::vector<std::int32_t> out;
+    const auto& T = t_;
+    const auto pick = [&](std::int32_t a, std::int32_t b) { return T.terminals[a] <= T.terminals[b] ? a : b; };
+    const auto pairs = intersectingPairs(T, o_.world->lo(), o_.world->hi());
+    report_.intersecting_pairs = std::int64_t(pairs.size());
+    for (const auto& [x, y] : pairs) {
+      // The vessel of this stage whose subtree holds fewer terminals goes.
+      const bool ox = ownSubtree(x), oy = ownSubtree(y);
+      out.push_back(ox && oy ? pick(x, y) : ox ? x : y);
+    }
+    dr_.short_segments = dr_.outside_segments = dr_.asymmetric_bifurcations = dr_.folded_pairs = 0;
+    index_.refresh(t_, true);
+    const double r_max = o_.root_radius;
+    for (std::int32_t x = 1; x < T.nodeCount(); ++x) {
+      if (T.parent[x] < 0) continue;
+      const Vec3 a = T.position[T.parent[x]], e = T.position[x];
+      index_.forEachNearSegment(a, e, T.radius[x] + r_max, [&](std::int32_t y) {
+        if (y <= x || y >= T.nodeCount() || T.parent[y] < 0 || sharesNode(x, y) || !withinTwoSegments(T, x, y)) return;
+        if (segmentSegmentDistance(a, e, T.position[T.parent[y]], T.position[y]) < 0.5 * std::min(T.radius[x], T.radius[y])) {
+          ++dr_.folded_pairs;
+          const bool ox = ownSubtree(x), oy = ownSubtree(y);
+          out.push_back(ox && oy ? pick(x, y) : ox ? x : y);
+        }
+      });
+    }
+    for (std::int32_t s = 1; s < T.nodeCount(); ++s) {
+      if (!(T.length[s] > 2 * T.radius[s])) {
+        ++dr_.short_segments;
+        const auto a = T.child0[s], b = T.child1[s];
+        out.push_back(T.isTerminal(s) || !(ownSubtree(a) || ownSubtree(b)) ? s : pick(a, b));
+      }
+      const bool root_seg = T.parent[T.parent[s]] < 0;
+      if (!vesselFits(T.position[T.parent[s]], T.position[s], T.radius[s], root_seg, root_seg ? VesselRole::Transport : VesselRole(T.role[s]),
+                      T.stage[s])) {
+        ++dr_.outside_segments;
+        out.push_back(s);
+      }
+      const auto a = T.child0[s], b = T.child1[s];
+      if (a >= 0 && b >= 0 && T.isTerminal(a) && T.isTerminal(b) && T.stage[b] >= 0) {
+        const auto& st = o_.stages[T.stage[b]];
+        const double ratio = std::min(T.radius[a], T.radius[b]) / std::max(T.radius[a], T.radius[b]);
+        if (!(ratio > st.deltaAt(T.depth[s] - 1))) {
+          ++dr_.asymmetric_bifurcations;
+          out.push_back(b);
+        }
+      }
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+
+  // True if every vessel of segment s's subtree was made by the current stage.
+  bool ownSubtree(std::int32_t s) const {
+    std::vector<std::int32_t> stack{s};
+    while (!stack.empty()) {
+      const auto i = stack.back();
+      stack.pop_back();
+      if (t_.stage[i] != stage_) return false;
+      if (t_.child0[i] >= 0) stack.push_back(t_.child0[i]);
+      if (t_.child1[i] >= 0) stack.push_back(t_.child1[i]);
+    }
+    return true;
+  }
+
+  // The top-most segments below s whose subtrees this stage made alone.
+  void ownBranchesBelow(std::int32_t s, std::vector<std::int32_t>& out) const {
+    std::vector<std::int32_t> stack;
+    for (auto c : {t_.child0[s], t_.child1[s]})
+      if (c >= 0) stack.push_back(c);
+    while (!stack.empty()) {
+      const auto i = stack.back();
+      stack.pop_back();
+      if (ownSubtree(i)) {
+        out.push_back(i);
+        continue;
+      }
+      if (t_.child0[i] >= 0) stack.push_back(t_.child0[i]);
+      if (t_.child1[i] >= 0) stack.push_back(t_.child1[i]);
+    }
+  }
+
+  // The stage's exact tree is checked; vessels of this stage that break a constraint are removed
+  // and regrown in the stage, until none is left (older vessels are never removed).
+  void repairStage(const ProgressFn& progress, std::int64_t before, std::int64_t total) {
+    for (int round = 0;; ++round) {
+      solve();
+      auto bad = violations();
+      // A vessel of an earlier stage that thickened into a neighbour (or below 2 r) sheds the
+      // branches this stage hung below it: they regrow elsewhere, and its radius falls back.
+      std::vector<std::int32_t> fix;
+      for (auto s : bad) {
+        if (ownSubtree(s)) {
+          fix.push_back(s);
+          continue;
+        }
+        // At most kMaxShedShare of the stage's terminals per vessel (a trunk of an earlier stage
+        // may carry the whole stage).
+        std::vector<std::int32_t> below;
+        ownBranchesBelow(s, below);
+        std::int64_t shed = 0;
+        for (auto b : below) shed += t_.terminals[b];
+        if (double(shed) <= std::max(1.0, kMaxShedShare * double(stage().terminal_count))) fix.insert(fix.end(), below.begin(), below.end());
+      }
+      std::sort(fix.begin(), fix.end());
+      fix.erase(std::unique(fix.begin(), fix.end()), fix.end());
+      bad = fix;
+      if (bad.empty() || round == o_.max_repair_rounds) break;
+      ++report_.repair_rounds;
+      const auto n = terminalCount();
+      t_.removeSubtrees(bad);
+      report_.repaired_terminals += n - terminalCount();
+      for (std::int32_t i = 1; i < t_.nodeCount(); ++i) t_.beta[i] = 1;
+      eta_.assign(t_.nodeCount(), o_.viscosity.at(o_.root_radius));
+      solve();
+      checked_ = t_.radius;
+      volume_ = std::numbers::pi * o_.root_radius * o_.root_radius * t_.cost_ratio[t_.rootSegment()];
+      index_.refresh(t_, true);
+      growStage(progress, before, total);
+    }
+    volume_ = std::numbers::pi * o_.root_radius * o_.root_radius * t_.cost_ratio[t_.rootSegment()];
+  }
+
+  void finalCounts() {
+    violations();
+    dr_.volume_mm3 = treeVolume(t_);
+    report_.root_radius_mm = o_.root_radius;
+  }
+
+  const DccoOptions& o_;
+  GrowthReport& report_;
+  DccoReport& dr_;
+  Rng rng_;
+  VascularTree t_;
+  SegmentIndex index_;
+  std::vector<double> eta_, rel_, checked_, gamma_;
+  std::vector<std::int32_t> thick_;
+  std::vector<PowerKernel> kernels_;
+  int stage_ = 0;
+  std::int64_t target_ = 0;
+  double lc_ = 1;
+  double volume_ = 0;
+  std::int32_t solved_at_ = 0;
+  std::vector<std::pair<double, std::int32_t>> near_;
+  std::vector<std::vector<Trial>> trials_;
+  std::vector<Trial> ranked_;
+  std::vector<std::size_t> counts_;
+  std::vector<Saved> undo_;
+};
+
+}  // namespace
+
+int solveDccoTree(VascularTree& t, std::vector<double>& eta, const DccoOptions& o, const std::vector<double>& gamma_of_stage,
+                  double tolerance) {
+  if (t.nodeCount() < 2) return 0;
+  const auto order = t.topDownOrder();
+  eta.resize(t.nodeCount(), o.viscosity.at(o.root_radius));
+  std::vector<double> next;
+  const auto kernels = kernelsOf(gamma_of_stage);
+  int it = 0;
+  for (;;) {
+    ++it;
+    for (auto k = order.rbegin(); k != order.rend(); ++k) {
+      const auto i = *k;
+      if (t.parent[i] < 0) continue;
+      t.length[i] = distance(t.position[t.parent[i]], t.position[i]);
+      const double ei = eta[i] / kEtaRef;
+      const auto a = t.child0[i], b = t.child1[i];
+      if (a < 0) {
+        t.terminals[i] = 1;
+        t.reduced_resistance[i] = ei * t.length[i];
+        t.cost_ratio[i] = t.length[i];
+        continue;
+      }
+      if (b < 0) {  // a continuation node (growth never makes one; existing networks may)
+        t.terminals[i] = t.terminals[a];
+        t.beta[a] = 1;
+        t.reduced_resistance[i] = ei * t.length[i] + t.reduced_resistance[a];
+        t.cost_ratio[i] = t.length[i] + t.cost_ratio[a];
+        continue;
+      }
+      const auto s = kernelAt(t, i, kernels).split(t.terminals[a], t.reduced_resistance[a], t.terminals[b], t.reduced_resistance[b]);
+      t.beta[a] = s.beta_a;
+      t.beta[b] = s.beta_b;
+      t.terminals[i] = t.terminals[a] + t.terminals[b];
+      t.reduced_resistance[i] = ei * t.length[i] + 1.0 / (pow4(s.beta_a) / t.reduced_resistance[a] + pow4(s.beta_b) / t.reduced_resistance[b]);
+      t.cost_ratio[i] = t.length[i] + s.beta_a * s.beta_a * t.cost_ratio[a] + s.beta_b * s.beta_b * t.cost_ratio[b];
+    }
+    const auto root = t.rootSegment();
+    const double q_term = o.flow / double(t.terminals[root]);
+    t.beta[root] = 1;
+    t.pressure[0] = o.root_pressure;
+    double change = 0;
+    next.resize(t.nodeCount());
+    for (auto i : order) {
+      if (t.parent[i] < 0) continue;
+      const auto par = t.parent[i];
+      t.depth[i] = t.depth[par] + 1;
+      t.flow[i] = q_term * t.terminals[i];
+      t.radius[i] = i == root ? o.root_radius : t.radius[par] * t.beta[i];
+      t.pressure[i] = t.pressure[par] - t.flow[i] * 8.0 * eta[i] * t.length[i] / (std::numbers::pi * pow4(t.radius[i]));
+      next[i] = o.viscosity.at(t.radius[i]);
+      change = std::max(change, std::abs(next[i] - eta[i]) / next[i]);
+    }
+    // The tree keeps the viscosities its radii and pressures were computed with (consistent to
+    // rounding); they differ from η(r) by less than the tolerance.
+    if (change < tolerance) return it;
+    if (it >= 200) throw GrowthError("the radius–viscosity fixed point (Algorithm 1) did not converge in 200 iterations");
+    for (auto i : order)
+      if (t.parent[i] >= 0) eta[i] = next[i];
+  }
+}
+
+VascularTree growDcco(const DccoOptions& o, GrowthReport& report, DccoReport& dcco, const ProgressFn& progress) {
+  DccoGrower g(o, report, dcco);
+  return g.run(progress);
+}
+
+}  // namespace angiosynth

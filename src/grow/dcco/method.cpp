@@ -1,0 +1,523 @@
+// Method "dcco": its parameters, TOML reader, description, domains and grow function.
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "core/error.hpp"
+#include "core/quantity_json.hpp"
+#include "grow/common/method_tables.hpp"
+#include "grow/dcco/setup.hpp"
+#include "io/growth_domain_files.hpp"
+
+namespace angiosynth {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+Json vectorJson(const Vec3& v) { return Json{{"value", {v.x, v.y, v.z}}, {"unit", "mm"}}; }
+
+const char* roleText(VesselRole r) { return roleName(std::uint8_t(r)); }
+
+// The domains of one stage on the world's frame; identical region sets share one domain.
+struct StageDomains {
+  const GrowthDomain* vessels;
+  const GrowthDomain* terminals;
+};
+
+class PreparedDcco final : public PreparedGrowth {
+ public:
+  PreparedDcco(const DccoSetup& s, GrowthDomain world) : setup_(s), world_(std::move(world)) {
+    root_ = placeRoot(s.parameter_file, s.root, world_);
+    std::map<std::string, const RegionSpec*> by_name;
+    for (const auto& r : s.regions) by_name[r.name] = &r;
+    const auto list = [&](const std::vector<std::string>& names) {
+      std::vector<const RegionSpec*> out;
+      for (const auto& n : names) out.push_back(by_name.at(n));
+      return out;
+    };
+    const auto key = [](const std::vector<std::string>& in, const std::vector<std::string>& out) {
+      std::string k;
+      for (const auto& n : in) k += n + ",";
+      k += "|";
+      for (const auto& n : out) k += n + ",";
+      return k;
+    };
+    for (const auto& st : s.stages) {
+      const auto domainOf = [&](const std::vector<std::string>& out, const std::string& what) -> const GrowthDomain* {
+        if (st.domain.empty() && out.empty()) return &world_;
+        const auto k = key(st.domain, out);
+        auto it = cache_.find(k);
+        if (it == cache_.end()) {
+          try {
+            it = cache_.emplace(k, std::make_unique<GrowthDomain>(regionDomain(world_, list(st.domain), list(out), what))).first;
+          } catch (const GrowthError& e) {
+            throw InputError(s.parameter_file, st.line, e.what());
+          }
+        }
+        return it->second.get();
+      };
+      auto excluded = st.avascular;
+      excluded.insert(excluded.end(), st.carriage.begin(), st.carriage.end());
+      StageDomains d{domainOf(st.avascular, "the domain of stage '" + st.stage.name + "'"),
+                     domainOf(excluded, "the terminal region of stage '" + st.stage.name + "'")};
+      if (st.stage.pdf == TerminalPdf::Demand) {
+        if (!demand_) demand_ = std::make_unique<GrowthDomain>(GrowthDomain::mask(world_.frame(), true));
+        d.terminals = demand_.get();
+      }
+      domains_.push_back(d);
+    }
+  }
+  const DemandMap& frame() const override { return world_.frame(); }
+  const GrowthDomain* domain() const override { return &world_; }
+  void checkFeasibility() const override {
+    std::int64_t total = 0;
+    for (std::size_t k = 0; k < setup_.stages.size(); ++k) {
+      const auto& st = setup_.stages[k];
+      total += st.stage.terminal_count;
+      std::int64_t inside = 0;
+      for (float v : domains_[k].terminals->frame().demand) inside += v > 0;
+      // A terminal per voxel at most: finer than its resolution the domain says nothing.
+      if (total > inside)
+        throw InputError(setup_.parameter_file, st.line,
+                         "stage '" + st.stage.name + "' brings the tree to " + std::to_string(total) + " terminals, more than the " +
+                             std::to_string(inside) + " voxels of its terminal region; use fewer terminals or a finer voxel_size");
+    }
+    const double r = setup_.options.root_radius;
+    if (!(world_.depth(root_) > -1e-6 * world_.frame().voxel_mm))
+      throw InputError(setup_.parameter_file, setup_.root.root_line, "the root lies outside the domain");
+    if (!(2 * r < 0.5 * std::min({world_.hi().x, world_.hi().y, world_.dimension() == 2 ? world_.hi().x : world_.hi().z})))
+      throw InputError(setup_.parameter_file, setup_.root.root_line,
+                       "root_radius " + show(r) + " mm is too large for the domain (its frame is " + show3(world_.hi()) + " mm)");
+  }
+  Forest grow(std::uint64_t seed, std::uint64_t sample, GrowthReport& report, const ProgressFn& progress) const override {
+    DccoOptions o = setup_.options;
+    o.seed = seed;
+    o.sample = sample;
+    o.root_mm = root_;
+    o.world = &world_;
+    o.stages.clear();
+    for (std::size_t k = 0; k < setup_.stages.size(); ++k) {
+      auto st = setup_.stages[k].stage;
+      st.vessels = domains_[k].vessels;
+      st.terminals = domains_[k].terminals;
+      o.stages.push_back(st);
+    }
+    dcco_ = {};
+    auto tree = growDcco(o, report, dcco_, progress);
+    Forest f = singleTreeForest(std::move(tree), setup_.kind);
+    return f;
+  }
+  void addStatistics(const GrowthReport& report, Json& stats) const override {
+    Json per = Json::array();
+    for (std::size_t k = 0; k < setup_.stages.size() && k < dcco_.stage_terminals.size(); ++k)
+      per.push_back(Json{{"name", setup_.stages[k].stage.name}, {"terminals", dcco_.stage_terminals[k]}});
+    stats["stages"] = per;
+    stats["threshold_relaxations"] = dcco_.threshold_relaxations;
+    stats["trial_points"] = dcco_.trial_points;
+    stats["trial_points_definition"] = "lattice points costed (Δv(Δv+1)/2 − 3 per versatile candidate vessel)";
+    stats["viscosity_iterations"] = dcco_.viscosity_iterations;
+    stats["short_segments"] = dcco_.short_segments;
+    stats["short_segments_definition"] = "segments not longer than twice their radius";
+    stats["outside_segments"] = dcco_.outside_segments;
+    stats["asymmetric_bifurcations"] = dcco_.asymmetric_bifurcations;
+    stats["asymmetric_bifurcations_definition"] = "bifurcations of two terminal vessels whose radius ratio is not above their stage's δ";
+    stats["domain_dimension"] = world_.dimension();
+    stats["domain_measure"] = quantityJson(world_.measure(), world_.dimension() == 2 ? "mm^2" : "mm^3");
+  }
+
+ private:
+  const DccoSetup& setup_;
+  GrowthDomain world_;
+  Vec3 root_;
+  std::map<std::string, std::unique_ptr<GrowthDomain>> cache_;
+  std::unique_ptr<GrowthDomain> demand_;
+  std::vector<StageDomains> domains_;
+  mutable DccoReport dcco_;  // of the last grow(), for addStatistics
+};
+
+template <class E>
+E choice(const TomlReader& r, const toml::table& t, const std::string& table, const std::string& key, E fallback,
+         const std::vector<std::pair<const char*, E>>& values) {
+  if (!t.get(key)) return fallback;
+  const auto v = r.string(t, table, key);
+  std::string allowed;
+  for (const auto& [name, value] : values) {
+    if (v == name) return value;
+    allowed += (allowed.empty() ? "" : ", ") + std::string(name);
+  }
+  throw InputError(r.file(), r.lineOf(t.get(key)), key + " '" + v + "'; allowed: " + allowed);
+}
+
+std::vector<std::string> names(const TomlReader& r, const toml::table& t, const std::string& key, const std::set<std::string>& known) {
+  std::vector<std::string> out;
+  const auto* n = t.get(key);
+  if (!n) return out;
+  const auto* arr = n->as_array();
+  if (!arr) {
+    if (!n->is_string()) throw InputError(r.file(), r.lineOf(n), key + " must be a region name or an array of region names");
+    out.push_back(*n->value<std::string>());
+  } else {
+    for (const auto& e : *arr) {
+      if (!e.is_string()) throw InputError(r.file(), r.lineOf(n), key + " must hold region names (strings)");
+      out.push_back(*e.value<std::string>());
+    }
+  }
+  for (const auto& name : out)
+    if (!known.count(name)) {
+      std::string list;
+      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+      throw InputError(r.file(), r.lineOf(n), "region '" + name + "' in " + key + " is not defined; [[region]] names: " +
+                                                  (list.empty() ? "none" : list));
+    }
+  return out;
+}
+
+std::vector<RegionSpec> readRegions(const TomlReader& r, const GrowthMethod& m, bool flat) {
+  std::vector<RegionSpec> out;
+  const auto* list = r.root().get("region");
+  if (!list) return out;
+  const auto* arr = list->as_array();
+  if (!arr || !arr->is_array_of_tables()) throw InputError(r.file(), r.lineOf(list), "region must be an array of tables: write each as [[region]]");
+  std::set<std::string> seen;
+  for (const auto& node : *arr) {
+    const auto& t = *node.as_table();
+    checkMethodKeys(r, m, t, "region");
+    RegionSpec g;
+    g.line = r.lineOf(&t);
+    g.name = r.string(t, "region", "name");
+    if (g.name.empty() || !seen.insert(g.name).second)
+      throw InputError(r.file(), r.lineOf(t.get("name")), "region name '" + g.name + "' is empty or defined twice; names must be unique");
+    g.shape = choice<RegionShape>(r, t, "region", "shape", flat ? RegionShape::Disc : RegionShape::Sphere,
+                                  {{"sphere", RegionShape::Sphere}, {"disc", RegionShape::Disc}, {"shell", RegionShape::Shell},
+                                   {"annulus", RegionShape::Annulus}, {"box", RegionShape::Box}});
+    const bool shape_flat = g.shape == RegionShape::Disc || g.shape == RegionShape::Annulus;
+    if (flat != shape_flat && g.shape != RegionShape::Box)
+      throw InputError(r.file(), r.lineOf(t.get("shape") ? t.get("shape") : &t),
+                       std::string("region '") + g.name + "' is a " + regionShapeName(g.shape) + " in a " + (flat ? "2D" : "3D") +
+                           " domain; allowed: " + (flat ? "disc, annulus, box" : "sphere, shell, box"));
+    if (const auto* c = t.get("centre")) g.centre = r.point(c, "centre (mm from the domain's centre)", flat);
+    const auto length = [&](const char* key) {
+      const double v = r.quantity(t, "region", key, Dimension::Length);
+      checkRange(v, 0, true, Limits::kMaxLength, false, r.at(t, key), std::string(key) + " (mm)");
+      return v;
+    };
+    const auto only = [&](std::set<std::string> keys) {
+      for (const char* k : {"radius", "inner_radius", "outer_radius", "size"})
+        if (!keys.count(k) && t.get(k))
+          throw InputError(r.file(), r.lineOf(t.get(k)), std::string("'") + k + "' does not size a " + regionShapeName(g.shape));
+    };
+    switch (g.shape) {
+      case RegionShape::Sphere:
+      case RegionShape::Disc:
+        only({"radius"});
+        g.radius = length("radius");
+        break;
+      case RegionShape::Shell:
+      case RegionShape::Annulus:
+        only({"inner_radius", "outer_radius"});
+        g.inner = length("inner_radius");
+        g.outer = length("outer_radius");
+        if (!(g.outer > g.inner))
+          throw InputError(r.file(), r.lineOf(t.get("outer_radius")), "outer_radius must exceed inner_radius");
+        break;
+      case RegionShape::Box: {
+        only({"size"});
+        const auto* n = r.need(t, "region", "size");
+        const auto v = r.point(n, "size ([x, y(, z)] mm)", flat);
+        g.size = Vec3(v.x, v.y, flat ? 0.0 : v.z);
+        if (!(g.size.x > 0 && g.size.y > 0 && (flat || g.size.z > 0)))
+          throw InputError(r.file(), r.lineOf(n), "size must be positive on every axis");
+        break;
+      }
+    }
+    out.push_back(g);
+  }
+  return out;
+}
+
+// δ: one number for every level, or a list by bifurcation level (the last repeats).
+std::vector<double> readSymmetry(const TomlReader& r, const toml::table& t) {
+  const auto* n = t.get("symmetry");
+  std::vector<double> v = !n ? std::vector<double>{0.0} : n->is_array() ? r.numbers(n, "symmetry", 0) : std::vector<double>{r.number(t, "stage", "symmetry")};
+  for (double d : v)
+    if (!(d >= 0 && d < 1)) throw InputError(r.file(), r.lineOf(n), "symmetry (δ) values must lie in [0, 1)");
+  return v;
+}
+
+std::vector<GaussianComponent> readGaussians(const TomlReader& r, const GrowthMethod& m, const toml::table& t, bool flat) {
+  std::vector<GaussianComponent> out;
+  const auto* list = t.get("gaussian");
+  const auto* arr = list ? list->as_array() : nullptr;
+  if (!arr || arr->empty() || !arr->is_array_of_tables())
+    throw InputError(r.file(), r.lineOf(list ? list : &t), "pdf = \"gaussian\" needs [[stage.gaussian]] tables (mean, sigma, weight)");
+  for (const auto& node : *arr) {
+    const auto& g = *node.as_table();
+    checkMethodKeys(r, m, g, "stage.gaussian");
+    GaussianComponent c;
+    c.mean = g.get("mean") ? r.point(g.get("mean"), "mean (mm from the domain's centre)", flat) : Vec3();
+    c.sigma = r.point(r.need(g, "stage.gaussian", "sigma"), "sigma (mm per axis)", flat);
+    if (flat) c.sigma.z = 1;
+    if (!(c.sigma.x > 0 && c.sigma.y > 0 && c.sigma.z > 0)) throw InputError(r.file(), r.lineOf(g.get("sigma")), "sigma must be positive on every axis");
+    c.weight = declaredNumber(r, m, g, "stage.gaussian", "weight");
+    checkRange(c.weight, 0, true, 1e12, false, r.at(g, "weight"), "weight");
+    out.push_back(c);
+  }
+  return out;
+}
+
+DccoStageSpec readStage(const TomlReader& r, const GrowthMethod& m, const toml::table& t, int index, bool flat,
+                        const std::set<std::string>& regions) {
+  checkMethodKeys(r, m, t, "stage");
+  DccoStageSpec s;
+  s.line = r.lineOf(&t);
+  auto& st = s.stage;
+  st.name = t.get("name") ? r.string(t, "stage", "name") : "stage_" + std::to_string(index + 1);
+  st.terminal_count = r.integer(t, "stage", "terminals");
+  checkRange(double(st.terminal_count), 1, false, Limits::kMaxTerminals, false, r.at(t, "terminals"), "terminals");
+  s.domain = names(r, t, "domain", regions);
+  s.avascular = names(r, t, "avascular", regions);
+  s.carriage = names(r, t, "carriage", regions);
+  st.pdf = choice<TerminalPdf>(r, t, "stage", "pdf", TerminalPdf::Uniform,
+                               {{"uniform", TerminalPdf::Uniform}, {"demand", TerminalPdf::Demand}, {"gaussian", TerminalPdf::Gaussian}});
+  if (st.pdf == TerminalPdf::Gaussian) st.gaussians = readGaussians(r, m, t, flat);
+  else if (t.get("gaussian")) throw InputError(r.file(), r.lineOf(t.get("gaussian")), "[[stage.gaussian]] needs pdf = \"gaussian\"");
+  st.gamma = declaredNumber(r, m, t, "stage", "murray_exponent");
+  checkRange(st.gamma, Limits::kMinMurray, true, Limits::kMaxMurray, false, r.at(t, "murray_exponent"), "murray_exponent (γ)");
+  st.delta = readSymmetry(r, t);
+  st.nu = declaredNumber(r, m, t, "stage", "nu");
+  checkRange(st.nu, 0, true, 1e6, false, r.at(t, "nu"), "nu (ν)");
+  st.f_r = declaredNumber(r, m, t, "stage", "relaxation");
+  checkRange(st.f_r, 0, true, 1, true, r.at(t, "relaxation"), "relaxation (f_r)");
+  st.f_n = declaredNumber(r, m, t, "stage", "neighbourhood");
+  checkRange(st.f_n, 0, true, 1e6, false, r.at(t, "neighbourhood"), "neighbourhood (f_n)");
+  st.delta_v = declaredCount(r, m, t, "stage", "lattice", 3, 50);
+  st.cost = choice<StageCost>(r, t, "stage", "cost", StageCost::Volume, {{"volume", StageCost::Volume}, {"sprout", StageCost::Sprout}});
+  if (st.cost == StageCost::Volume) {
+    r.forbid(t, "stage", {"c_v", "c_p", "c_d"}, "weighs the sprouting cost; set cost = \"sprout\" or remove it");
+  } else {
+    // Seed 001 Fig. 3: c_v 0.5e2 in 2D, 1e4 in 3D; c_p 0.5; c_d 1.
+    st.c_v = t.get("c_v") ? r.number(t, "stage", "c_v") : flat ? 50.0 : 1e4;
+    st.c_p = declaredNumber(r, m, t, "stage", "c_p");
+    st.c_d = declaredNumber(r, m, t, "stage", "c_d");
+    for (const char* k : {"c_v", "c_p", "c_d"}) {
+      const double v = std::string(k) == "c_v" ? st.c_v : std::string(k) == "c_p" ? st.c_p : st.c_d;
+      checkRange(v, 0, false, 1e12, false, r.at(t, k), k);
+    }
+  }
+  const auto degrees = [&](const char* key, double fallback, double hi) {
+    const double v = t.get(key) ? r.number(t, "stage", key) : fallback;
+    checkRange(v, 0, false, hi, false, r.at(t, key), std::string(key) + " (degrees)");
+    return v;
+  };
+  st.theta_min = degrees("theta_min", 0, 180);
+  st.theta_max = degrees("theta_max", 180 - st.theta_min, 180);  // Table 1: the supplement
+  st.phi_min = degrees("phi_min", 0, 90);
+  st.phi_max = degrees("phi_max", 90, 90);
+  if (!(st.theta_max > st.theta_min)) throw InputError(r.file(), r.lineOf(t.get("theta_max") ? t.get("theta_max") : t.get("theta_min")), "theta_max must exceed theta_min");
+  if (!(st.phi_max >= st.phi_min)) throw InputError(r.file(), r.lineOf(t.get("phi_max") ? t.get("phi_max") : t.get("phi_min")), "phi_max must not be below phi_min");
+  st.role = choice<VesselRole>(r, t, "stage", "role", VesselRole::Distribution,
+                               {{"distribution", VesselRole::Distribution}, {"transport", VesselRole::Transport}, {"perforator", VesselRole::Perforator}});
+  st.draws_before_relaxing = declaredCount(r, m, t, "stage", "draws_before_relaxing", 1, 1000000);
+  st.max_candidates = declaredCount(r, m, t, "stage", "max_candidates", 1, 100000);
+  return s;
+}
+
+std::shared_ptr<const GrowthSetup> readDccoToml(const TomlReader& r, const GrowthMethod& m) {
+  auto s = std::make_shared<DccoSetup>();
+  s->parameter_file = r.file();
+  const auto& dom = methodTable(r, m, "domain");
+  const auto& tree = methodTable(r, m, "tree");
+  const auto& ph = methodTable(r, m, "physics");
+  s->domain = readDomainSpec(r, dom, r.file());
+  const bool flat = s->domain.shape == DomainShape::Disc || s->domain.shape == DomainShape::Square;
+  s->root = readRootOf(r, tree, "tree", s->domain, false);
+  auto& o = s->options;
+  o.root_radius = r.quantity(tree, "tree", "root_radius", Dimension::Length);
+  checkRange(o.root_radius, 0, true, Limits::kMaxLength, false, r.at(tree, "root_radius"), "root_radius (mm)");
+  if (tree.get("kind")) s->kind = r.string(tree, "tree", "kind");
+  // [physics]: viscosity "pries" or a quantity.
+  if (const auto* v = ph.get("viscosity"); v && v->is_string() && *v->value<std::string>() == "pries") {
+    o.viscosity.model = ViscosityModel::Pries;
+  } else {
+    o.viscosity.constant = declaredQuantity(r, m, ph, "physics", "viscosity", Dimension::Viscosity);
+    checkRange(o.viscosity.constant, Limits::kMinViscosity, false, Limits::kMaxViscosity, false, r.at(ph, "viscosity"), "viscosity (Pa*s)");
+    r.forbid(ph, "physics", {"pries_exponent"}, "is for viscosity = \"pries\"");
+  }
+  o.viscosity.exponent = declaredNumber(r, m, ph, "physics", "pries_exponent");
+  checkRange(o.viscosity.exponent, 0.1, false, 2, false, r.at(ph, "pries_exponent"), "pries_exponent");
+  if (o.viscosity.model == ViscosityModel::Pries && !(o.root_radius > 0.01))
+    throw InputError(r.file(), r.lineOf(tree.get("root_radius")), "root_radius below 10 µm: Pries' law holds for diameters of about 10 µm and more");
+  o.flow = declaredQuantity(r, m, ph, "physics", "perfusion_flow", Dimension::Flow);
+  checkRange(o.flow, Limits::kMinFlow, false, Limits::kMaxFlow, false, r.at(ph, "perfusion_flow"), "perfusion_flow (mm^3/s)");
+  o.root_pressure = declaredQuantity(r, m, ph, "physics", "perfusion_pressure", Dimension::Pressure);
+  checkRange(o.root_pressure, 0, false, Limits::kMaxPressure, false, r.at(ph, "perfusion_pressure"), "perfusion_pressure (Pa)");
+  s->regions = readRegions(r, m, flat);
+  std::set<std::string> region_names;
+  for (const auto& g : s->regions) region_names.insert(g.name);
+  const auto* list = r.root().get("stage");
+  const auto* arr = list ? list->as_array() : nullptr;
+  if (!arr || arr->empty() || !arr->is_array_of_tables())
+    throw InputError(r.file(), r.lineOf(list ? list : &tree), "method dcco needs at least one [[stage]] table (terminals, domain, parameters)");
+  std::set<std::string> stage_names;
+  for (const auto& node : *arr) {
+    s->stages.push_back(readStage(r, m, *node.as_table(), int(s->stages.size()), flat, region_names));
+    const auto& st = s->stages.back();
+    if (!stage_names.insert(st.stage.name).second) throw InputError(r.file(), st.line, "a second stage named '" + st.stage.name + "'");
+    if (st.stage.pdf == TerminalPdf::Demand && (s->domain.shape != DomainShape::Mask || !st.domain.empty() || !st.avascular.empty() || !st.carriage.empty()))
+      throw InputError(r.file(), st.line, "pdf = \"demand\" draws terminals ∝ the mask value of the whole domain: it needs shape = \"mask\" and a stage without domain, avascular or carriage regions");
+  }
+  if (s->stages.size() > 30000) throw InputError(r.file(), s->stages.back().line, "more than 30000 stages");
+  auto& p = s->physics_summary;
+  p.murray_exponent = s->stages.front().stage.gamma;
+  p.viscosity = o.viscosity.constant;
+  p.perfusion_flow = o.flow;
+  p.perfusion_pressure = o.root_pressure;
+  p.total_terminals = s->terminals();
+  return s;
+}
+
+}  // namespace
+
+std::int64_t DccoSetup::terminals() const {
+  std::int64_t n = 0;
+  for (const auto& st : stages) n += st.stage.terminal_count;
+  return n;
+}
+
+Json DccoSetup::describe() const {
+  const auto& d = domain;
+  const auto& o = options;
+  Json j;
+  j["method"] = "dcco";
+  j["shape"] = domainShapeName(d.shape);
+  if (d.shape == DomainShape::Mask) {
+    j["mask"] = d.mask.string();
+    if (root.root_in_mm) j["root"] = Json{{"value", {root.root_mm.x, root.root_mm.y, root.root_mm.z}}, {"unit", "mm"}};
+    else j["root_voxel"] = {root.root_voxel.x, root.root_voxel.y, root.root_voxel.z};
+  } else {
+    j[d.shape == DomainShape::Sphere || d.shape == DomainShape::Disc ? "radius" : "side"] = quantityJson(d.size_mm, "mm");
+    j["root_offset"] = root.has_root_offset ? Json{{"value", {root.root_offset_mm.x, root.root_offset_mm.y, root.root_offset_mm.z}}, {"unit", "mm"}}
+                                            : Json("the top of the domain (+y)");
+  }
+  if (d.voxel_mm > 0) j["voxel_size"] = quantityJson(d.voxel_mm, "mm");
+  j["kind"] = kind;
+  j["root_radius"] = quantityJson(o.root_radius, "mm");
+  j["perfusion_flow"] = quantityJson(o.flow, "mm^3/s");
+  j["perfusion_pressure"] = quantityJson(o.root_pressure, "Pa");
+  if (o.viscosity.model == ViscosityModel::Pries) {
+    j["viscosity"] = "pries";
+    j["pries_exponent"] = o.viscosity.exponent;
+  } else {
+    j["viscosity"] = quantityJson(o.viscosity.constant, "Pa*s");
+  }
+  j["terminals"] = terminals();
+  Json regs = Json::array();
+  for (const auto& g : regions) {
+    Json e{{"name", g.name}, {"shape", regionShapeName(g.shape)}, {"centre", vectorJson(g.centre)}};
+    if (g.radius > 0) e["radius"] = quantityJson(g.radius, "mm");
+    if (g.outer > 0) {
+      e["inner_radius"] = quantityJson(g.inner, "mm");
+      e["outer_radius"] = quantityJson(g.outer, "mm");
+    }
+    if (g.size.x > 0) e["size"] = vectorJson(g.size);
+    regs.push_back(e);
+  }
+  if (!regions.empty()) j["regions"] = regs;
+  Json stages_json = Json::array();
+  for (const auto& sp : stages) {
+    const auto& st = sp.stage;
+    Json e;
+    e["name"] = st.name;
+    e["terminals"] = st.terminal_count;
+    e["domain"] = sp.domain.empty() ? Json("the whole domain") : Json(sp.domain);
+    if (!sp.avascular.empty()) e["avascular"] = sp.avascular;
+    if (!sp.carriage.empty()) e["carriage"] = sp.carriage;
+    e["pdf"] = st.pdf == TerminalPdf::Uniform ? "uniform" : st.pdf == TerminalPdf::Demand ? "demand" : "gaussian";
+    if (st.pdf == TerminalPdf::Gaussian) {
+      Json gs = Json::array();
+      for (const auto& g : st.gaussians)
+        gs.push_back(Json{{"mean", vectorJson(g.mean)},
+                          {"sigma", vectorJson(g.sigma)}, {"weight", g.weight}});
+      e["gaussians"] = gs;
+    }
+    e["murray_exponent"] = st.gamma;
+    e["symmetry"] = st.delta;
+    e["nu"] = st.nu;
+    e["relaxation"] = st.f_r;
+    e["neighbourhood"] = st.f_n;
+    e["lattice"] = st.delta_v;
+    e["cost"] = st.cost == StageCost::Volume ? "volume" : "sprout";
+    if (st.cost == StageCost::Sprout) {
+      e["c_v"] = st.c_v;
+      e["c_p"] = st.c_p;
+      e["c_d"] = st.c_d;
+    }
+    e["theta_min"] = quantityJson(st.theta_min, "degree");
+    e["theta_max"] = quantityJson(st.theta_max, "degree");
+    e["phi_min"] = quantityJson(st.phi_min, "degree");
+    e["phi_max"] = quantityJson(st.phi_max, "degree");
+    e["role"] = roleText(st.role);
+    e["draws_before_relaxing"] = st.draws_before_relaxing;
+    e["max_candidates"] = st.max_candidates;
+    stages_json.push_back(e);
+  }
+  j["stages"] = stages_json;
+  return j;
+}
+
+std::vector<std::filesystem::path> DccoSetup::inputs() const { return domainInputs(domain); }
+
+std::unique_ptr<PreparedGrowth> DccoSetup::prepare(std::uint64_t memory_limit) const {
+  return std::make_unique<PreparedDcco>(*this, loadDomainSpec(domain, parameter_file, root, memory_limit));
+}
+
+const GrowthMethod kDccoMethod{
+    "dcco",
+    "domain-constrained CCO in stages (Maso Talou et al. 2021, seed 001): each [[stage]] adds its terminals in its own "
+    "region with its own parameters, cost (volume or sprouting) and vessel role; bifurcations on DCCO's triangle lattice, "
+    "a fixed root radius and inflow, constant or Pries viscosity, angle and symmetry limits, no overlapping vessels",
+    withDomainParams("sphere, cube, disc or square (2D), or mask: the region every vessel stays in",
+                     "masks: terminals of stages over the whole domain drawn uniformly, or ∝ the mask value (demand; as [[stage]] pdf = \"demand\")", {
+        {"tree", "root_radius", "mm", nullptr, "r_1, the fixed radius of the root vessel"},
+        {"tree", "kind", "text", "artery", "the tree's kind in labels and graphs"},
+        {"physics", "viscosity", "Pa*s or \"pries\"", "0.0036 Pa*s", "constant blood viscosity, or \"pries\": Pries' in-vivo law η(D) at haematocrit 0.45 (eqs. 8–9), solved with the radii to |Δη/η| < 1e-6"},
+        {"physics", "pries_exponent", "", "0.645", "the exponent of D in Pries' law (the paper prints 0.64)"},
+        {"physics", "perfusion_flow", "mm^3/s", "500 mL/min", "Q, the inflow, split equally among the terminals"},
+        {"physics", "perfusion_pressure", "Pa", "100 mmHg", "pressure at the root (the pressures downstream follow from the radii)"},
+        {"region", "name", "text", nullptr, "the region's name, used by [[stage]] domain, avascular and carriage"},
+        {"region", "shape", "text", "sphere (3D), disc (2D)", "sphere, shell, box (3D); disc, annulus, box (2D)"},
+        {"region", "centre", "[x, y(, z)] mm", "[0, 0, 0]", "relative to the domain's centre"},
+        {"region", "radius", "mm", nullptr, "sphere, disc"},
+        {"region", "inner_radius", "mm", nullptr, "shell, annulus"},
+        {"region", "outer_radius", "mm", nullptr, "shell, annulus"},
+        {"region", "size", "[x, y(, z)] mm", nullptr, "box: its sides"},
+        {"stage", "name", "text", "stage_1, stage_2, ...", "the stage's name in sample.json"},
+        {"stage", "terminals", "count", nullptr, "N^t, the terminals this stage adds"},
+        {"stage", "domain", "region names", "the whole [domain]", "Ω_t, the union of these regions"},
+        {"stage", "avascular", "region names", "none", "regions no vessel of the stage enters and no terminal lies in"},
+        {"stage", "carriage", "region names", "none", "regions vessels may cross but no terminal lies in"},
+        {"stage", "pdf", "text", "uniform", "terminal positions: uniform, demand (∝ the mask value), or gaussian ([[stage.gaussian]])"},
+        {"stage", "murray_exponent", "", "3", "γ of the bifurcations the stage makes"},
+        {"stage", "symmetry", "number or list", "0", "δ: min/max radius of a new bifurcation's branches must exceed it; a list gives δ per bifurcation level (the last repeats)"},
+        {"stage", "nu", "", "1", "ν in l_lim = l_c (ν / (N_T + 1))^(1/D)"},
+        {"stage", "relaxation", "", "0.9", "f_r: l_lim × f_r after draws_before_relaxing rejected points"},
+        {"stage", "neighbourhood", "", "8", "f_n: candidate vessels lie within the box of half-side f_n·l_lim around the terminal"},
+        {"stage", "lattice", "count", "7", "Δv: points per edge of the bifurcation lattice (Δv(Δv+1)/2 − 3 points)"},
+        {"stage", "cost", "text", "volume", "volume (eq. 10) or sprout (eq. 15)"},
+        {"stage", "c_v", "", "50 (2D), 1e4 (3D)", "sprout: weight of the added volume / the stage domain's measure"},
+        {"stage", "c_p", "", "0.5", "sprout: weight of the parent's radius / r_1"},
+        {"stage", "c_d", "", "1", "sprout: weight of (new vessel length / l_c)²"},
+        {"stage", "theta_min", "degrees", "0", "θ_min, bifurcation angle between the split vessel's distal part and the new vessel"},
+        {"stage", "theta_max", "degrees", "180 − theta_min", "θ_max"},
+        {"stage", "phi_min", "degrees", "0", "φ_min, angle between the new vessel and the plane of the split vessel's parts (that of the bifurcation it leaves when they are collinear)"},
+        {"stage", "phi_max", "degrees", "90", "φ_max"},
+        {"stage", "role", "text", "distribution", "role of the vessels the stage makes: distribution (inside Ω_t), transport (anywhere), perforator (anywhere, branching only inside Ω_t)"},
+        {"stage", "draws_before_relaxing", "count", "100", "N_fail: rejected points before l_lim shrinks"},
+        {"stage", "max_candidates", "count", "64", "candidate vessels tried per terminal, nearest first"},
+        {"stage.gaussian", "mean", "[x, y(, z)] mm", "[0, 0, 0]", "centre of the Gaussian, relative to the domain's centre"},
+        {"stage.gaussian", "sigma", "[x, y(, z)] mm", nullptr, "standard deviation per axis"},
+        {"stage.gaussian", "weight", "", "1", "its weight in the mixture"},
+    }),
+    &readDccoToml};
+
+}  // namespace angiosynth

@@ -1,0 +1,287 @@
+// DCCO (seed 001): the bifurcation lattice, Pries' viscosity, the angle formulas, and the
+// invariants of every shipped dcco example's tree (Murray, flow, pressure, stages, δ, θ, roles,
+// no overlapping vessels), terminal density against the pdf, and determinism across threads.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <numbers>
+#include <sstream>
+
+#include "core/rng.hpp"
+#include "grow/dcco/lattice.hpp"
+#include "grow/dcco/setup.hpp"
+#include "io/scenario.hpp"
+#include "physics/viscosity.hpp"
+#include "test_support.hpp"
+#include "tree_checks.hpp"
+
+using namespace angiosynth;
+
+namespace {
+
+constexpr std::uint64_t kNoLimit = std::uint64_t(1) << 40;
+
+struct Grown {
+  std::shared_ptr<const GrowthSetup> growth;
+  std::unique_ptr<PreparedGrowth> prepared;
+  Forest forest;
+  const DccoSetup* setup = nullptr;
+};
+
+Grown growFile(const std::filesystem::path& file, std::uint64_t seed = 1) {
+  Grown g;
+  g.growth = readTomlParameters(file).growth;
+  g.setup = dynamic_cast<const DccoSetup*>(g.growth.get());
+  EXPECT_NE(g.setup, nullptr);
+  g.prepared = g.growth->prepare(kNoLimit);
+  g.prepared->checkFeasibility();
+  GrowthReport report;
+  g.forest = g.prepared->grow(seed, 0, report, {});
+  return g;
+}
+
+// Writes `text` to a scratch file and returns its path.
+std::filesystem::path scratchToml(const std::string& name, const std::string& text) {
+  const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_dcco_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / name) << text;
+  return dir / name;
+}
+
+std::string readText(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+TEST(DccoLattice, HasTheSeedsPointCountsAndStaysInItsTriangle) {
+  const Vec3 xt(0, 3, 0), xp(0, 0, 0), xd(4, 0, 0);
+  EXPECT_EQ(bifurcationLattice(xt, xp, xd, 7, Branching::Versatile).size(), 25u);  // Σ_{i≤7} i − 3
+  EXPECT_EQ(bifurcationLattice(xt, xp, xd, 6, Branching::Versatile).size(), 18u);
+  EXPECT_EQ(bifurcationLattice(xt, xp, xd, 7, Branching::Fixed).size(), 5u);
+  EXPECT_EQ(bifurcationLattice(xt, xp, xd, 7, Branching::Distal).size(), 1u);
+  EXPECT_TRUE(bifurcationLattice(xt, xp, xd, 7, Branching::None).empty());
+  const auto pts = bifurcationLattice(xt, xp, xd, 7, Branching::Versatile);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const auto& p = pts[i];
+    // Inside the triangle x >= 0, y >= 0, x/4 + y/3 <= 1; never a corner.
+    EXPECT_GE(p.x, -1e-12);
+    EXPECT_GE(p.y, -1e-12);
+    EXPECT_LE(p.x / 4 + p.y / 3, 1 + 1e-12);
+    for (const auto& c : {xt, xp, xd}) EXPECT_GT(distance(p, c), 0.1);
+    for (std::size_t j = 0; j < i; ++j) EXPECT_GT(distance(p, pts[j]), 0.1);
+  }
+  for (const auto& p : bifurcationLattice(xt, xp, xd, 7, Branching::Fixed)) EXPECT_DOUBLE_EQ(p.y, 0.0);  // on the vessel
+  EXPECT_EQ(bifurcationLattice(xt, xp, xd, 7, Branching::Distal)[0], xd);
+}
+
+TEST(DccoViscosity, PriesLawMatchesVItAsValues) {
+  // VItA's values (cP) for D = 10, 50 and 1000 µm; η in Pa*s, r in mm.
+  EXPECT_NEAR(priesViscosity(0.005) * 1e3 / 6.604, 1, 1e-3);
+  EXPECT_NEAR(priesViscosity(0.025) * 1e3 / 2.566, 1, 1e-3);
+  EXPECT_NEAR(priesViscosity(0.5) * 1e3 / 3.596, 1, 1e-3);
+  // The printed exponent 0.64 is a different law (2.546 cP at 50 µm).
+  EXPECT_NEAR(priesViscosity(0.025, 0.64) * 1e3, 2.546, 1e-3);
+  Viscosity v;
+  EXPECT_DOUBLE_EQ(v.at(0.005), 3.6e-3);
+  v.model = ViscosityModel::Pries;
+  EXPECT_DOUBLE_EQ(v.at(0.005), priesViscosity(0.005));
+}
+
+TEST(DccoAngles, BifurcationAndOpeningAnglesOnHandMadeGeometries) {
+  const Vec3 b(0, 0, 0);
+  EXPECT_NEAR(bifurcationAngle(b, Vec3(1, 0, 0), Vec3(0, 2, 0)), 90, 1e-12);
+  EXPECT_NEAR(bifurcationAngle(b, Vec3(1, 0, 0), Vec3(1, 1, 0)), 45, 1e-12);
+  EXPECT_NEAR(bifurcationAngle(b, Vec3(1, 0, 0), Vec3(-1, 0, 0)), 180, 1e-12);
+  // The split vessel bends at b: its parts span the plane z = 0 (normal (b − xp) × (xd − b)).
+  const Vec3 xp(-1, 0, 0), xd(1, 1, 0);
+  EXPECT_NEAR(openingAngle(xp, b, xd, Vec3(0, 0, 1), {}), 90, 1e-12);   // straight out of the plane
+  EXPECT_NEAR(openingAngle(xp, b, xd, Vec3(1, -1, 0), {}), 0, 1e-12);   // in the plane
+  EXPECT_NEAR(openingAngle(xp, b, xd, Vec3(0, 1, 1), {}), 45, 1e-12);
+  EXPECT_NEAR(openingAngle(xp, b, xd, Vec3(0, 1, -std::sqrt(3.0)), {}), 60, 1e-12);  // either side
+  // The printed normal (xd − b) × (xt − b) would make φ ≡ 0: the corrected one does not.
+  // Collinear parts: the fallback plane (that of the bifurcation the vessel leaves), else 90°.
+  const Vec3 straight(1, 0, 0);
+  EXPECT_NEAR(openingAngle(xp, b, straight, Vec3(0, 1, 1), Vec3(0, 0, 1)), 45, 1e-12);
+  EXPECT_NEAR(openingAngle(xp, b, straight, Vec3(0, 1, 0), Vec3(0, 0, 1)), 0, 1e-12);
+  EXPECT_NEAR(openingAngle(xp, b, straight, Vec3(0, 1, 0), Vec3()), 90, 1e-12);
+}
+
+TEST(DccoDomains, OneSliceMaskDepthIsTheDiscsDistanceNotCappedNearTheBorder) {
+  // A one-slice mask of a disc of radius 10 mm on 0.1 mm voxels: its depth map must reach the
+  // disc's depth everywhere (it was once capped at 1.5 voxels by a slab too thin in z).
+  const auto disc = GrowthDomain::analytic(DomainShape::Disc, 10, 0.1);
+  const auto mask = GrowthDomain::mask(disc.frame(), false);
+  double worst = 0, deepest = 0;
+  for (double x = -9.5; x <= 9.5; x += 0.37)
+    for (double y = -9.5; y <= 9.5; y += 0.41) {
+      const Vec3 p = disc.center() + Vec3(x, y, 0);
+      if (disc.depth(p) < 0.2) continue;
+      worst = std::max(worst, std::abs(mask.depth(p) - disc.depth(p)));
+      deepest = std::max(deepest, mask.depth(p));
+    }
+  EXPECT_LT(worst, 0.1);  // a voxel
+  EXPECT_GT(deepest, 9.5);
+}
+
+// Every shipped dcco example: the invariants of seed 001 §1.4 on its grown tree.
+class DccoExample : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(DccoExample, TreeMeetsEveryConstraintOfItsStages) {
+  const auto g = growFile(test::sourceDir() / "examples" / GetParam());
+  const auto& s = *g.setup;
+  const auto& t = g.forest.vessels;
+  const auto& o = s.options;
+  const auto& world = *g.prepared->domain();
+  ASSERT_GT(t.nodeCount(), 2);
+  // Terminal counts per stage, exact; every vessel knows its stage, role and branching.
+  std::vector<std::int64_t> per_stage(s.stages.size(), 0);
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    ASSERT_GE(t.stage[i], 0);
+    ASSERT_LT(std::size_t(t.stage[i]), s.stages.size());
+    EXPECT_NE(t.role[i], 0);
+    EXPECT_EQ(Branching(t.branching[i]), Branching::Versatile);
+    if (t.isTerminal(i)) ++per_stage[t.stage[i]];
+  }
+  for (std::size_t k = 0; k < s.stages.size(); ++k) EXPECT_EQ(per_stage[k], s.stages[k].stage.terminal_count) << s.stages[k].stage.name;
+  // Radius fixed at the root; Murray at every bifurcation; flow conserved; equal terminal flow.
+  const auto root = t.rootSegment();
+  EXPECT_DOUBLE_EQ(t.radius[root], o.root_radius);
+  EXPECT_NEAR(t.flow[root] / o.flow, 1, 1e-12);
+  const double q_term = o.flow / double(t.terminals[root]);
+  double worst_murray = 0, worst_flow = 0;
+  double p_min = 1e300, p_max = -1e300;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    const auto a = t.child0[i], b = t.child1[i];
+    if (a < 0) {
+      EXPECT_NEAR(t.flow[i] / q_term, 1, 1e-12);
+      p_min = std::min(p_min, t.pressure[i]);
+      p_max = std::max(p_max, t.pressure[i]);
+      continue;
+    }
+    ASSERT_GE(b, 0);
+    const double g3 = s.stages[t.stage[b]].stage.gamma;
+    worst_murray = std::max(worst_murray, std::abs(std::pow(t.radius[i], g3) - std::pow(t.radius[a], g3) - std::pow(t.radius[b], g3)) /
+                                              std::pow(t.radius[i], g3));
+    worst_flow = std::max(worst_flow, std::abs(t.flow[i] - t.flow[a] - t.flow[b]) / t.flow[i]);
+  }
+  EXPECT_LE(worst_murray, 1e-9);
+  EXPECT_LE(worst_flow, 1e-12);
+  // Karch's radii with the viscosities of the fixed point give every terminal one pressure.
+  EXPECT_LT((p_max - p_min) / (o.root_pressure - p_min), 1e-9);
+  // δ and θ at every bifurcation of two terminal vessels (its geometry is that of its making).
+  std::int64_t terminal_pairs = 0;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    const auto a = t.child0[i], b = t.child1[i];
+    if (a < 0 || b < 0 || !t.isTerminal(a) || !t.isTerminal(b)) continue;
+    ++terminal_pairs;
+    const auto& st = s.stages[t.stage[b]].stage;
+    EXPECT_GT(std::min(t.radius[a], t.radius[b]) / std::max(t.radius[a], t.radius[b]), st.deltaAt(t.depth[i] - 1) - 1e-9);
+    const double theta = bifurcationAngle(t.position[i], t.position[a], t.position[b]);
+    EXPECT_GE(theta, st.theta_min - 1e-9);
+    EXPECT_LE(theta, st.theta_max + 1e-9);
+  }
+  EXPECT_GT(terminal_pairs, 10);
+  // Containment: every vessel in the domain; distribution vessels (but the root vessel) in their
+  // stage's regions, within a voxel (regions are rasterised on the frame).
+  test::expectGeometry(t, world);
+  const double voxel = world.frame().voxel_mm;
+  std::int64_t outside_stage = 0;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    const auto& sp = s.stages[t.stage[i]];
+    if (VesselRole(t.role[i]) != VesselRole::Distribution || sp.domain.empty() || t.parent[i] == 0) continue;
+    // The capsule's surface, sampled (centreline points offset by r across it), must lie in the
+    // union of the allowed regions: each sample in some region, within a voxel.
+    const Vec3 a = t.position[t.parent[i]], e = t.position[i];
+    const Vec3 u = (e - a) / distance(a, e);
+    Vec3 n1 = cross(u, std::abs(u.z) < 0.9 ? Vec3(0, 0, 1) : Vec3(1, 0, 0));
+    n1 = n1 / norm(n1);
+    const Vec3 n2 = cross(u, n1);
+    const bool flat = world.dimension() == 2;
+    bool out = false;
+    for (int k = 0; k <= 16 && !out; ++k)
+      for (int j = 0; j < (flat ? 2 : 8) && !out; ++j) {
+        const double ang = 2 * std::numbers::pi * j / (flat ? 2 : 8);
+        const Vec3 off = flat ? n1 * (j == 0 ? 1.0 : -1.0) : n1 * std::cos(ang) + n2 * std::sin(ang);
+        const Vec3 p = a + (e - a) * (k / 16.0) + off * t.radius[i];
+        // Its own stage's regions or a later stage's (later stages may thicken it into theirs).
+        double depth = -1e300;
+        for (std::size_t st = std::size_t(t.stage[i]); st < s.stages.size(); ++st) {
+          if (s.stages[st].domain.empty()) depth = 1e300;
+          for (const auto& name : s.stages[st].domain)
+            for (const auto& r : s.regions)
+              if (r.name == name) depth = std::max(depth, regionDepth(r, p, world.center()));
+        }
+        out = depth < -voxel;
+      }
+    outside_stage += out;
+  }
+  EXPECT_EQ(outside_stage, 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Shipped, DccoExample,
+                         ::testing::Values("dcco_scale_specific_2d.toml", "dcco_hierarchical_2d.toml", "dcco_pdf_mixture_2d.toml",
+                                           "dcco_sphere_pries_3d.toml"),
+                         [](const auto& info) {
+                           std::string n = info.param;
+                           return n.substr(5, n.size() - 10);  // dcco_<name>.toml
+                         });
+
+TEST(Dcco, TerminalsFollowTheMixturePdfOfFig4) {
+  // Fig. 4 (right) at N = 2000: the terminals' y against 2000 draws from the pdf restricted to
+  // the disc, two-sample Kolmogorov–Smirnov at α = 0.01.
+  auto text = readText(test::sourceDir() / "examples/dcco_pdf_mixture_2d.toml");
+  text.replace(text.find("terminals = 1000"), 16, "terminals = 2000");
+  text.replace(text.find("[image]"), 7, "[image]\nenabled = false");
+  const auto g = growFile(scratchToml("mixture.toml", text));
+  const auto& t = g.forest.vessels;
+  const Vec3 c = g.prepared->domain()->center();
+  std::vector<double> grown, drawn;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i)
+    if (t.isTerminal(i)) grown.push_back(t.position[i].y - c.y);
+  Rng rng(7, 0, Stage::Growth);
+  while (drawn.size() < 2000) {
+    const bool first = rng.uniform() < 0.5;
+    const double x = (first ? 5.0 : 2.0) * rng.normal(), y = (first ? 10.0 : -10.0) + (first ? 5.0 : 2.0) * rng.normal();
+    if (std::hypot(x, y) < 20) drawn.push_back(y);
+  }
+  std::sort(grown.begin(), grown.end());
+  std::sort(drawn.begin(), drawn.end());
+  double d = 0;
+  std::size_t i = 0, j = 0;
+  while (i < grown.size() && j < drawn.size()) {
+    const double v = std::min(grown[i], drawn[j]);
+    while (i < grown.size() && grown[i] <= v) ++i;
+    while (j < drawn.size() && drawn[j] <= v) ++j;
+    d = std::max(d, std::abs(double(i) / grown.size() - double(j) / drawn.size()));
+  }
+  const double n = grown.size(), m = drawn.size();
+  const double critical = 1.628 * std::sqrt((n + m) / (n * m));  // α = 0.01
+  std::cout << "KS statistic " << d << ", critical " << critical << " (alpha 0.01)\n";
+  EXPECT_EQ(grown.size(), 2000u);
+  EXPECT_LT(d, critical) << "KS statistic " << d << " (critical " << critical << ")";
+}
+
+TEST(Dcco, SameSeedSameTreeWhateverTheThreads) {
+  const auto file = test::sourceDir() / "examples/dcco_pdf_mixture_2d.toml";
+  const auto many = growFile(file, 3);
+  Forest one;
+  {
+    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    one = growFile(file, 3).forest;
+  }
+  ASSERT_EQ(one.vessels.nodeCount(), many.forest.vessels.nodeCount());
+  for (std::int32_t i = 0; i < one.vessels.nodeCount(); ++i) {
+    ASSERT_EQ(one.vessels.position[i], many.forest.vessels.position[i]) << i;
+    ASSERT_EQ(one.vessels.radius[i], many.forest.vessels.radius[i]) << i;
+  }
+  const auto other = growFile(file, 4);
+  EXPECT_NE(other.forest.vessels.position[5], many.forest.vessels.position[5]);
+}
