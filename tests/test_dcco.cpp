@@ -14,6 +14,7 @@
 #include "core/rng.hpp"
 #include "grow/dcco/lattice.hpp"
 #include "grow/dcco/setup.hpp"
+#include "io/graph_writers.hpp"
 #include "io/scenario.hpp"
 #include "physics/viscosity.hpp"
 #include "test_support.hpp"
@@ -224,6 +225,28 @@ TEST_P(DccoExample, TreeMeetsEveryConstraintOfItsStages) {
     outside_stage += out;
   }
   EXPECT_EQ(outside_stage, 0);
+  // The VTP carries VItA's cell arrays with VItA's codes (distribution 0, versatile = deformable 2).
+  std::ostringstream vtp;
+  writeVtp(vtp, t, g.forest.trees);
+  const std::string text = vtp.str();
+  for (const char* name : {"radius", "flow", "pressure", "length", "beta", "level", "ID_Vessel", "stage", "vesselFunction", "branchingType"})
+    EXPECT_NE(text.find(std::string("Name=\"") + name + "\""), std::string::npos) << name;
+  const auto values = [&](const char* name) {
+    std::istringstream in(text.substr(text.find(std::string("Name=\"") + name + "\"")));
+    std::string line;
+    std::getline(in, line);
+    std::vector<double> v;
+    while (std::getline(in, line) && line.rfind("</DataArray>", 0) != 0) v.push_back(std::stod(line));
+    return v;
+  };
+  const auto stages = values("stage"), functions = values("vesselFunction"), branching = values("branchingType");
+  ASSERT_EQ(stages.size(), std::size_t(t.segmentCount()));
+  std::size_t k = 0;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i, ++k) {
+    EXPECT_EQ(stages[k], t.stage[i]);
+    EXPECT_EQ(functions[k], VesselRole(t.role[i]) == VesselRole::Distribution ? 0 : VesselRole(t.role[i]) == VesselRole::Perforator ? 1 : 2);
+    EXPECT_EQ(branching[k], 2);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Shipped, DccoExample,
@@ -284,4 +307,18 @@ TEST(Dcco, SameSeedSameTreeWhateverTheThreads) {
   }
   const auto other = growFile(file, 4);
   EXPECT_NE(other.forest.vessels.position[5], many.forest.vessels.position[5]);
+}
+
+TEST(Dcco, ARootTooThinForItsFlowIsRefusedNamingTheFix) {
+  // r_1 and Q both fixed: 100 times the example's flow needs a drop beyond the root pressure.
+  auto text = readText(test::sourceDir() / "examples/dcco_scale_specific_2d.toml");
+  text.replace(text.find("\"4 mL/min\""), 10, "\"400 mL/min\"");
+  text.replace(text.find("terminals = 1500"), 16, "terminals = 150");
+  try {
+    growFile(scratchToml("thin_root.toml", text));
+    FAIL() << "no error";
+  } catch (const GrowthError& e) {
+    EXPECT_NE(std::string(e.what()).find("more than perfusion_pressure"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("lower perfusion_flow"), std::string::npos) << e.what();
+  }
 }

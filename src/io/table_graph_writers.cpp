@@ -36,6 +36,45 @@ void writeEdgesCsv(std::ostream& out, const VascularTree& t, const std::vector<T
   }
 }
 
+namespace {
+
+// The cell arrays VItA's VTK writer names (seed 001's public code), with its codes, so scripts
+// written for VItA's trees read ours: vesselFunction 0 distribution, 1 perforator, 2 transport;
+// branchingType 0 none, 1 rigid (fixed), 2 deformable (versatile), 3 distal; pressure at the
+// proximal end (Pa here), level from 0 at the root vessel, ID_Vessel our segment id.
+void writeVitaCellArrays(std::ostream& out, const VascularTree& t, const std::vector<std::int32_t>& segments) {
+  const auto array = [&](const char* name, auto&& value) {
+    out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
+    for (auto i : segments) out << exactNumber(double(value(i))) << '\n';
+  };
+  array("radius", [&](std::int32_t i) { return t.radius[i]; });
+  array("flow", [&](std::int32_t i) { return t.flow[i]; });
+  array("pressure", [&](std::int32_t i) { return t.pressure[t.parent[i]]; });
+  array("length", [&](std::int32_t i) { return t.length[i]; });
+  array("beta", [&](std::int32_t i) { return t.beta[i]; });
+  array("geomConst", [&](std::int32_t i) { return t.length[i] - 2 * t.radius[i]; });
+  array("level", [&](std::int32_t i) { return t.depth[i] - 1; });
+  array("ID_Vessel", [&](std::int32_t i) { return i; });
+  array("stage", [&](std::int32_t i) { return t.stage[i]; });
+  array("vesselFunction", [&](std::int32_t i) {
+    switch (VesselRole(t.role[i])) {
+      case VesselRole::Perforator: return 1;
+      case VesselRole::Transport: return 2;
+      default: return 0;
+    }
+  });
+  array("branchingType", [&](std::int32_t i) {
+    switch (Branching(t.branching[i])) {
+      case Branching::None: return 0;
+      case Branching::Fixed: return 1;
+      case Branching::Distal: return 3;
+      default: return 2;
+    }
+  });
+}
+
+}  // namespace
+
 void writeVtp(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees) {
   const auto n = t.nodeCount();
   std::vector<std::int32_t> segments;
@@ -67,6 +106,7 @@ void writeVtp(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
       out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"" << name << "\" format=\"ascii\">\n";
       for (auto i : segments) out << (value == 0 ? int(t.stage[i]) : value == 1 ? int(t.role[i]) : int(t.branching[i])) << '\n';
     }
+    writeVitaCellArrays(out, t, segments);
   }
   out << "</DataArray>\n</CellData>\n<Lines>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
   for (auto i : segments) out << t.parent[i] << ' ' << i << '\n';

@@ -98,6 +98,15 @@ class DccoGrower {
     }
     dr_.viscosity_iterations = solve();
     finalCounts();
+    // r_1 and Q are both given, so the pressures follow: a root too thin for its flow would need
+    // a drop larger than the root pressure (radii and geometry do not depend on Q).
+    double lowest = o_.root_pressure;
+    for (std::int32_t i = 1; i < t_.nodeCount(); ++i) lowest = std::min(lowest, t_.pressure[i]);
+    if (!(lowest > 0))
+      throw GrowthError("the tree carries perfusion_flow " + std::to_string(o_.flow) + " mm^3/s with a pressure drop of " +
+                        std::to_string(o_.root_pressure - lowest) + " Pa, more than perfusion_pressure (" +
+                        std::to_string(o_.root_pressure) + " Pa): lower perfusion_flow (pressures scale with it; the tree does not change) "
+                        "or raise root_radius");
     return std::move(t_);
   }
 
