@@ -225,6 +225,19 @@ TEST_P(DccoExample, TreeMeetsEveryConstraintOfItsStages) {
     outside_stage += out;
   }
   EXPECT_EQ(outside_stage, 0);
+  // A perforator branches only inside the domain of the stage that hung the branch on it.
+  std::int64_t perforator_branches = 0, outside_branches = 0;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    if (VesselRole(t.role[i]) != VesselRole::Perforator || t.child1[i] < 0) continue;
+    ++perforator_branches;
+    const auto& sp = s.stages[t.stage[t.child1[i]]];
+    double depth = sp.domain.empty() ? 1e300 : -1e300;
+    for (const auto& name : sp.domain)
+      for (const auto& r : s.regions)
+        if (r.name == name) depth = std::max(depth, regionDepth(r, t.position[i], world.center()));
+    outside_branches += depth < -voxel;
+  }
+  EXPECT_EQ(outside_branches, 0) << "of " << perforator_branches << " bifurcations on perforators";
   // The VTP carries VItA's cell arrays with VItA's codes (distribution 0, versatile = deformable 2).
   std::ostringstream vtp;
   writeVtp(vtp, t, g.forest.trees);

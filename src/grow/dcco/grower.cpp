@@ -165,9 +165,13 @@ class DccoGrower {
       ++report_.candidates;
       const Vec3 p = draw();
       const double l = distance(o_.root_mm, p);
-      // The root vessel brings the blood into the stage's domain (the root may lie outside it):
-      // it stays in the world and ends in the stage's terminal region.
-      const bool inside = o_.world->capsuleInside(o_.root_mm, p, o_.root_radius, true);
+      // The root vessel brings the blood into the stage's domain: it stays in the world and,
+      // when the stage distributes, inside the stage's domain from 2 r_1 past the root on (the
+      // root may sit on the domain's border, where a rasterised region is inset by half a voxel).
+      const double r = kMargin * o_.root_radius;
+      const Vec3 from = o_.root_mm + (p - o_.root_mm) * (std::min(2 * r, l) / l);
+      const bool inside = o_.world->capsuleInside(o_.root_mm, p, r, true) &&
+                          (st.role != VesselRole::Distribution || st.vessels->capsuleInside(from, p, r, false));
       if (l > lim && l > 2 * kMargin * o_.root_radius && inside) {
         const auto n = t_.addNode(p, 0);
         t_.stage[n] = std::int16_t(stage_);
@@ -619,7 +623,7 @@ class DccoGrower {
 
   // Segments of the solved tree that break a constraint, each as the segment whose subtree goes:
   // intersecting pairs, length <= 2r, leaving the world, terminal bifurcations below their δ.
-  std::vector<std::int32_t> violations() {
+  std::vector<std::int32_t> violations(bool fix) {
     std::vector<std::int32_t> out;
     const auto& T = t_;
     const auto pick = [&](std::int32_t a, std::int32_t b) { return T.terminals[a] <= T.terminals[b] ? a : b; };
@@ -646,7 +650,7 @@ class DccoGrower {
       });
     }
     for (std::int32_t s = 1; s < T.nodeCount(); ++s) {
-      if (!(T.length[s] > 2 * T.radius[s])) {
+      if (!(T.length[s] > 2 * T.radius[s]) && !(fix && lengthen(s))) {
         ++dr_.short_segments;
         const auto a = T.child0[s], b = T.child1[s];
         out.push_back(T.isTerminal(s) || !(ownSubtree(a) || ownSubtree(b)) ? s : pick(a, b));
@@ -670,6 +674,53 @@ class DccoGrower {
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
+  }
+
+  // A vessel that later stages thickened past half its length: its distal bifurcation slides
+  // along it (or its proximal one back) to 2.1–3 r, if every vessel meeting there still fits
+  // (in place, with the solved radii).
+  bool lengthen(std::int32_t s) {
+    auto& T = t_;
+    if (T.isTerminal(s)) return false;
+    const auto P = T.parent[s];
+    const Vec3 a = T.position[P], e = T.position[s];
+    const Vec3 u = (e - a) / distance(a, e);
+    for (double f : {2.1, 2.5, 3.0}) {
+      const double L = f * T.radius[s];
+      if (tryMove(s, a + u * L)) return true;
+      if (T.parent[P] >= 0 && T.parent[T.parent[P]] >= 0 && tryMove(P, e - u * L)) return true;
+    }
+    return false;
+  }
+
+  // Moves node v to q if the vessels meeting there stay longer than 2 r, where their roles allow
+  // and clear of every other vessel; restores it otherwise.
+  bool tryMove(std::int32_t v, const Vec3& q) {
+    auto& T = t_;
+    const Vec3 old = T.position[v];
+    T.position[v] = q;
+    const std::int32_t segs[3] = {v, T.child0[v], T.child1[v]};
+    bool ok = true;
+    for (auto x : segs) {
+      if (x <= 0 || !ok) continue;
+      const Vec3 a = T.position[T.parent[x]], e = T.position[x];
+      const bool root_seg = T.parent[T.parent[x]] < 0;
+      ok = distance(a, e) > 2 * kMargin * T.radius[x] &&
+           vesselFits(a, e, T.radius[x], root_seg, root_seg ? VesselRole::Transport : VesselRole(T.role[x]), T.stage[x]) &&
+           !overlaps(x, a, e, kMargin * T.radius[x]);
+    }
+    if (!ok) {
+      T.position[v] = old;
+      return false;
+    }
+    for (auto x : segs)
+      if (x > 0) {
+        T.length[x] = distance(T.position[T.parent[x]], T.position[x]);
+        index_.insert(T, x);
+      }
+    ++moved_;
+    ++report_.moved_nodes;
+    return true;
   }
 
   // True if every vessel of segment s's subtree was made by the current stage.
@@ -707,7 +758,8 @@ class DccoGrower {
   void repairStage(const ProgressFn& progress, std::int64_t before, std::int64_t total) {
     for (int round = 0;; ++round) {
       solve();
-      auto bad = violations();
+      const auto moved = moved_;
+      auto bad = violations(true);
       // A vessel of an earlier stage that thickened into a neighbour (or below 2 r) sheds the
       // branches this stage hung below it: they regrow elsewhere, and its radius falls back.
       std::vector<std::int32_t> fix;
@@ -727,6 +779,7 @@ class DccoGrower {
       std::sort(fix.begin(), fix.end());
       fix.erase(std::unique(fix.begin(), fix.end()), fix.end());
       bad = fix;
+      if (bad.empty() && moved_ > moved && round < o_.max_repair_rounds) continue;  // nodes moved: solve and check again
       if (bad.empty() || round == o_.max_repair_rounds) break;
       ++report_.repair_rounds;
       const auto n = terminalCount();
@@ -744,7 +797,7 @@ class DccoGrower {
   }
 
   void finalCounts() {
-    violations();
+    violations(false);
     dr_.volume_mm3 = treeVolume(t_);
     report_.root_radius_mm = o_.root_radius;
   }
@@ -757,6 +810,7 @@ class DccoGrower {
   SegmentIndex index_;
   std::vector<double> eta_, rel_, checked_, gamma_;
   std::vector<std::int32_t> thick_;
+  std::int64_t moved_ = 0;
   std::vector<PowerKernel> kernels_;
   int stage_ = 0;
   std::int64_t target_ = 0;
