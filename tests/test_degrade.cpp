@@ -23,8 +23,12 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path writeTemp(const std::string& name, const std::string& text) {
-  // The pid keeps tests that ctest runs in parallel processes off each other's files.
-  const fs::path p = fs::temp_directory_path() / ("angiosynth_degrade_" + std::to_string(::getpid()) + "_" + name);
+  // A directory per process keeps tests that ctest runs in parallel off each other's files; the
+  // file keeps its name, which names the profile and so keys its random draws (a pid in the name
+  // made every process draw another warp).
+  const fs::path dir = fs::temp_directory_path() / ("angiosynth_degrade_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path p = dir / name;
   std::ofstream(p, std::ios::binary) << text;
   return p;
 }
