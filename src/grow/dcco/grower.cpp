@@ -283,12 +283,15 @@ class DccoGrower {
     const auto& T = t_;
     const auto s = tr.s;
     const Vec3 xp = T.position[T.parent[s]], xd = T.position[s];
-    const bool root_seg = T.parent[T.parent[s]] < 0;
     const double r[3] = {kMargin * tr.r[0], kMargin * tr.r[1], kMargin * tr.r[2]};
-    if (!vesselFits(tr.b, x, r[2], false, stage().role, stage_)) return false;
-    const auto role = VesselRole(T.role[s]);
-    return vesselFits(xp, tr.b, r[0], root_seg, root_seg ? VesselRole::Transport : role, T.stage[s]) &&
-           vesselFits(tr.b, xd, r[1], false, role, T.stage[s]);
+    return vesselFits(tr.b, x, r[2], false, stage().role, stage_) && segmentFits(s, xp, tr.b, r[0]) &&
+           vesselFits(tr.b, xd, r[1], false, VesselRole(T.role[s]), T.stage[s]);
+  }
+
+  // vesselFits for (a new course of) existing segment x: the root vessel only in the world.
+  bool segmentFits(std::int32_t x, const Vec3& a, const Vec3& e, double r) const {
+    const bool root_seg = t_.parent[t_.parent[x]] < 0;
+    return vesselFits(a, e, r, root_seg, root_seg ? VesselRole::Transport : VesselRole(t_.role[x]), t_.stage[x]);
   }
 
   // True if the capsule a–e of radius r, of a vessel with this role made by stage `made`, lies
@@ -308,15 +311,27 @@ class DccoGrower {
   // them: their capsules may touch at the joint, their centrelines may not come within half
   // the thinner radius; the lattice's bifurcation points can fold a branch over its sibling).
   bool overlaps(std::int32_t x, const Vec3& a, const Vec3& e, double r) {
+    return hitsVessel(a, e, r, [&](std::int32_t y) {
+      return y == x || sharesNode(x, y) ? Neighbour::Meets : withinTwoSegments(t_, x, y) ? Neighbour::Near : Neighbour::Apart;
+    });
+  }
+
+  enum class Neighbour { Meets, Near, Apart };
+  // True if the capsule a–e of radius r overlaps a vessel y that `kind(y)` calls Apart, or runs
+  // its centreline within half the thinner radius of one it calls Near (Meets: exempt). The grid
+  // as far as thin vessels reach; the few thick ones from their list, so the search does not
+  // widen with the root radius.
+  template <class Kind>
+  bool hitsVessel(const Vec3& a, const Vec3& e, double r, Kind&& kind) {
     bool hit = false;
     const auto test = [&](std::int32_t y) {
-      if (hit || y == x || y >= t_.nodeCount() || t_.parent[y] < 0 || sharesNode(x, y)) return;
+      if (hit || y >= t_.nodeCount() || t_.parent[y] < 0) return;
+      const auto k = kind(y);
+      if (k == Neighbour::Meets) return;
       const double d = segmentSegmentDistance(a, e, t_.position[t_.parent[y]], t_.position[y]);
       const double ry = kMargin * radiusOf(y);
-      hit = withinTwoSegments(t_, x, y) ? d < 0.5 * std::min(r, ry) : d < r + ry;
+      hit = k == Neighbour::Near ? d < 0.5 * std::min(r, ry) : d < r + ry;
     };
-    // The grid as far as thin vessels reach; the few thick ones from their list, so the search
-    // does not widen with the root radius.
     index_.forEachNearSegment(a, e, r + kMargin * kThickReach * o_.root_radius, test);
     for (auto y : thick_)
       if (!hit && y < t_.nodeCount() && radiusOf(y) > kThickReach * o_.root_radius) test(y);
@@ -376,18 +391,10 @@ class DccoGrower {
   // meet it), with `near` (one segment away) held only to the rule for near neighbours.
   bool capsuleHits(const Vec3& a, const Vec3& e, double r, std::int32_t skip, std::span<const std::int32_t> share,
                    std::span<const std::int32_t> near) {
-    bool hit = false;
-    const auto test = [&](std::int32_t y) {
-      if (hit || y == skip || y >= t_.nodeCount() || t_.parent[y] < 0) return;
-      if (std::find(share.begin(), share.end(), y) != share.end()) return;
-      const double d = segmentSegmentDistance(a, e, t_.position[t_.parent[y]], t_.position[y]);
-      const double ry = kMargin * radiusOf(y);
-      hit = std::find(near.begin(), near.end(), y) != near.end() ? d < 0.5 * std::min(r, ry) : d < r + ry;
-    };
-    index_.forEachNearSegment(a, e, r + kMargin * kThickReach * o_.root_radius, test);
-    for (auto y : thick_)
-      if (!hit && y < t_.nodeCount() && radiusOf(y) > kThickReach * o_.root_radius) test(y);
-    return hit;
+    const auto in = [](std::span<const std::int32_t> list, std::int32_t y) { return std::find(list.begin(), list.end(), y) != list.end(); };
+    return hitsVessel(a, e, r, [&](std::int32_t y) {
+      return y == skip || in(share, y) ? Neighbour::Meets : in(near, y) ? Neighbour::Near : Neighbour::Apart;
+    });
   }
 
   // The vessels of the last commit (proximal part, distal part s, new vessel) against the tree.
@@ -655,9 +662,7 @@ class DccoGrower {
         const auto a = T.child0[s], b = T.child1[s];
         out.push_back(T.isTerminal(s) || !(ownSubtree(a) || ownSubtree(b)) ? s : pick(a, b));
       }
-      const bool root_seg = T.parent[T.parent[s]] < 0;
-      if (!vesselFits(T.position[T.parent[s]], T.position[s], T.radius[s], root_seg, root_seg ? VesselRole::Transport : VesselRole(T.role[s]),
-                      T.stage[s])) {
+      if (!segmentFits(s, T.position[T.parent[s]], T.position[s], T.radius[s])) {
         ++dr_.outside_segments;
         out.push_back(s);
       }
@@ -704,10 +709,7 @@ class DccoGrower {
     for (auto x : segs) {
       if (x <= 0 || !ok) continue;
       const Vec3 a = T.position[T.parent[x]], e = T.position[x];
-      const bool root_seg = T.parent[T.parent[x]] < 0;
-      ok = distance(a, e) > 2 * kMargin * T.radius[x] &&
-           vesselFits(a, e, T.radius[x], root_seg, root_seg ? VesselRole::Transport : VesselRole(T.role[x]), T.stage[x]) &&
-           !overlaps(x, a, e, kMargin * T.radius[x]);
+      ok = distance(a, e) > 2 * kMargin * T.radius[x] && segmentFits(x, a, e, T.radius[x]) && !overlaps(x, a, e, kMargin * T.radius[x]);
     }
     if (!ok) {
       T.position[v] = old;
@@ -785,15 +787,12 @@ class DccoGrower {
       const auto n = terminalCount();
       t_.removeSubtrees(bad);
       report_.repaired_terminals += n - terminalCount();
-      for (std::int32_t i = 1; i < t_.nodeCount(); ++i) t_.beta[i] = 1;
       eta_.assign(t_.nodeCount(), o_.viscosity.at(o_.root_radius));
       solve();
       checked_ = t_.radius;
-      volume_ = std::numbers::pi * o_.root_radius * o_.root_radius * t_.cost_ratio[t_.rootSegment()];
       index_.refresh(t_, true);
       growStage(progress, before, total);
     }
-    volume_ = std::numbers::pi * o_.root_radius * o_.root_radius * t_.cost_ratio[t_.rootSegment()];
   }
 
   void finalCounts() {

@@ -299,10 +299,8 @@ DccoStageSpec readStage(const TomlReader& r, const GrowthMethod& m, const toml::
     st.c_v = t.get("c_v") ? r.number(t, "stage", "c_v") : flat ? 50.0 : 1e4;
     st.c_p = declaredNumber(r, m, t, "stage", "c_p");
     st.c_d = declaredNumber(r, m, t, "stage", "c_d");
-    for (const char* k : {"c_v", "c_p", "c_d"}) {
-      const double v = std::string(k) == "c_v" ? st.c_v : std::string(k) == "c_p" ? st.c_p : st.c_d;
+    for (const auto& [k, v] : {std::pair<const char*, double>{"c_v", st.c_v}, {"c_p", st.c_p}, {"c_d", st.c_d}})
       checkRange(v, 0, false, 1e12, false, r.at(t, k), k);
-    }
   }
   const auto degrees = [&](const char* key, double fallback, double hi) {
     const double v = t.get(key) ? r.number(t, "stage", key) : fallback;
