@@ -15,6 +15,7 @@
 #include "grow/dcco/lattice.hpp"
 #include "grow/dcco/setup.hpp"
 #include "io/graph_writers.hpp"
+#include "io/network_files.hpp"
 #include "io/scenario.hpp"
 #include "physics/viscosity.hpp"
 #include "test_support.hpp"
@@ -334,4 +335,188 @@ TEST(Dcco, ARootTooThinForItsFlowIsRefusedNamingTheFix) {
     EXPECT_NE(std::string(e.what()).find("more than perfusion_pressure"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("lower perfusion_flow"), std::string::npos) << e.what();
   }
+}
+
+namespace {
+
+// Segments of the subtree below segment s (s included).
+std::vector<std::int32_t> subtreeOf(const VascularTree& t, std::int32_t s) {
+  std::vector<std::int32_t> out{s};
+  for (std::size_t k = 0; k < out.size(); ++k)
+    for (auto c : {t.child0[out[k]], t.child1[out[k]]})
+      if (c >= 0) out.push_back(c);
+  return out;
+}
+
+// The pressure at the terminals (one for all: Karch's radii).
+double p_min_of(const VascularTree& v) {
+  double p = 1e300;
+  for (std::int32_t i = 1; i < v.nodeCount(); ++i)
+    if (v.isTerminal(i)) p = std::min(p, v.pressure[i]);
+  return p;
+}
+
+}  // namespace
+
+// Growth from an existing network with a prescribed outflow (seed 001 Fig. 5): the given vessels
+// keep their geometry, the outlet carries f·Q and the domain's terminals share the rest, Murray,
+// flow and pressure hold everywhere, and re-solving the same tree for another outflow scales
+// every radius of the domain's tree by (R_old/R_new)^(1/4), R the domain tree's resistance.
+TEST(DccoInitial, OutletCarriesItsShareAndTheDomainTreeScalesAsFig5Says) {
+  std::vector<double> mean_radius;
+  for (const char* name : {"dcco_outlet_half_2d.toml", "dcco_outlet_most_2d.toml"}) {
+    SCOPED_TRACE(name);
+    const auto g = growFile(test::sourceDir() / "examples" / name);
+    const auto& s = *g.setup;
+    const auto& t = g.forest.vessels;
+    const auto& o = s.options;
+    const auto& world = *g.prepared->domain();
+    // The given network: the same nodes where the file puts them, stage -1.
+    const auto& given = s.initial.tree;
+    for (std::int32_t i = 0; i < given.nodeCount(); ++i) {
+      EXPECT_EQ(t.position[i].x, given.position[i].x + world.center().x);
+      EXPECT_EQ(t.position[i].y, given.position[i].y + world.center().y);
+      if (!t.isRoot(i)) {
+        EXPECT_EQ(t.stage[i], -1);
+      }
+    }
+    std::int32_t outlet = -1;
+    double f = 0;
+    std::int64_t stage_terminals = 0, common = 0;
+    for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+      if (t.outflow[i] > 0) {
+        outlet = i;
+        f = t.outflow[i];
+      }
+      if (t.isTerminal(i)) {
+        stage_terminals += t.stage[i] == 0;
+        common += !(t.outflow[i] > 0);
+      }
+    }
+    ASSERT_GE(outlet, 0);
+    EXPECT_EQ(stage_terminals, s.stages[0].stage.terminal_count);
+    const double q_f = o.flow * (1 - f) / double(common);
+    EXPECT_NEAR(t.flow[outlet] / (f * o.flow), 1, 1e-12);
+    EXPECT_NEAR(t.flow[t.rootSegment()] / o.flow, 1, 1e-12);
+    double worst_murray = 0, worst_flow = 0, p_min = 1e300, p_max = -1e300;
+    for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+      const auto a = t.child0[i], b = t.child1[i];
+      if (a < 0) {
+        if (i != outlet) EXPECT_NEAR(t.flow[i] / q_f, 1, 1e-12);
+        p_min = std::min(p_min, t.pressure[i]);
+        p_max = std::max(p_max, t.pressure[i]);
+        continue;
+      }
+      const double sum = b < 0 ? t.flow[a] : t.flow[a] + t.flow[b];
+      worst_flow = std::max(worst_flow, std::abs(t.flow[i] - sum) / t.flow[i]);
+      if (b < 0) continue;
+      worst_murray = std::max(worst_murray, std::abs(std::pow(t.radius[i], 3) - std::pow(t.radius[a], 3) - std::pow(t.radius[b], 3)) /
+                                                std::pow(t.radius[i], 3));
+    }
+    EXPECT_LE(worst_murray, 1e-9);
+    EXPECT_LE(worst_flow, 1e-12);
+    EXPECT_LT((p_max - p_min) / (o.root_pressure - p_min), 1e-9);  // the outlet's end too
+    // Grown vessels: longer than 2 r, inside the disc; no two vessels overlap.
+    std::int64_t short_segments = 0, outside = 0;
+    for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+      if (t.stage[i] < 0) continue;
+      short_segments += !(t.length[i] > 2 * t.radius[i]);
+      for (int k = 0; k <= 32; ++k)
+        if (world.depth(t.position[t.parent[i]] + (t.position[i] - t.position[t.parent[i]]) * (k / 32.0)) < t.radius[i] - 1e-9) {
+          ++outside;
+          break;
+        }
+    }
+    EXPECT_EQ(short_segments, 0);
+    EXPECT_EQ(outside, 0);
+    EXPECT_EQ(test::bruteForceIntersections(t), 0);
+    // Fig. 5: the same tree solved for 0.99 Q through the outlet.
+    const auto root_seg = t.rootSegment();
+    const auto domain = t.child0[root_seg] == outlet ? t.child1[root_seg] : t.child0[root_seg];
+    VascularTree u = t;
+    u.outflow[outlet] = 0.99;
+    std::vector<double> eta;
+    std::vector<double> gammas{3.0};
+    solveDccoTree(u, eta, o, gammas, s.root_radii);
+    const auto below = subtreeOf(t, domain);
+    const double k = u.radius[domain] / t.radius[domain];
+    double worst = 0, sum = 0;
+    for (auto i : below) {
+      worst = std::max(worst, std::abs(u.radius[i] / t.radius[i] / k - 1));
+      sum += t.radius[i];
+    }
+    mean_radius.push_back(sum / double(below.size()));
+    EXPECT_LE(worst, 1e-9) << "every radius of the domain's tree scales alike";
+    const auto resistance = [&](const VascularTree& v) { return (v.pressure[v.parent[domain]] - p_min_of(v)) / v.flow[domain]; };
+    EXPECT_NEAR(k, std::pow(resistance(t) / resistance(u), 0.25), 1e-6 * k);
+    if (f < 0.99) EXPECT_LT(k, 1);
+  }
+  EXPECT_LT(mean_radius[1], mean_radius[0]) << "the more flow leaves, the thinner the domain's vessels";
+}
+
+// VItA's .cco: a grown tree written, read, written and read again keeps every position, radius,
+// outflow, role, branching, stage and link (to 1e-12; the writer prints round-trip digits).
+TEST(DccoInitial, CcoReadWriteReadRoundTripIsExact) {
+  const auto g = growFile(test::sourceDir() / "examples/dcco_outlet_half_2d.toml");
+  const auto dir = scratchToml("x.toml", "").parent_path();
+  const auto write = [&](const VascularTree& t, const std::string& name) {
+    std::ofstream out(dir / name);
+    writeCco(out, t, g.forest.trees);
+    return dir / name;
+  };
+  const auto first = readNetwork(write(g.forest.vessels, "a.cco"));
+  const auto second = readNetwork(write(first.tree, "b.cco"));
+  const auto& a = first.tree;
+  const auto& b = second.tree;
+  const auto& t = g.forest.vessels;
+  ASSERT_EQ(a.nodeCount(), t.nodeCount());
+  ASSERT_EQ(b.nodeCount(), a.nodeCount());
+  std::int64_t outlets = 0;
+  for (std::int32_t i = 0; i < a.nodeCount(); ++i) {
+    EXPECT_LE(distance(a.position[i], b.position[i]), 1e-12);
+    EXPECT_EQ(a.parent[i], b.parent[i]);
+    if (a.isRoot(i)) continue;
+    EXPECT_NEAR(a.radius[i], b.radius[i], 1e-12);
+    EXPECT_NEAR(a.outflow[i], b.outflow[i], 1e-12);
+    EXPECT_EQ(a.role[i], b.role[i]);
+    EXPECT_EQ(a.branching[i], b.branching[i]);
+    EXPECT_EQ(a.stage[i], b.stage[i]);
+    outlets += a.outflow[i] > 0;
+  }
+  EXPECT_EQ(outlets, 1);
+  // And the first read is the grown tree (ids are its segment ids; breadth-first order).
+  std::map<std::string, std::int32_t> by_id;
+  for (std::int32_t i = 0; i < a.nodeCount(); ++i)
+    if (!a.isRoot(i)) by_id[first.ids[std::size_t(i)]] = i;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    const auto j = by_id.at(std::to_string(i));
+    EXPECT_LE(distance(a.position[j], t.position[i]), 1e-12);
+    EXPECT_NEAR(a.radius[j], t.radius[i], 1e-12);
+    EXPECT_EQ(a.stage[j], t.stage[i]);
+    EXPECT_EQ(a.branching[j], t.branching[i]);
+  }
+  EXPECT_NEAR(first.flow, g.setup->options.flow, 1e-9 * first.flow);
+  EXPECT_DOUBLE_EQ(first.root_radius, 0.15);
+}
+
+// Malformed networks are refused with the file's line and what is allowed.
+TEST(DccoInitial, BadNetworkFilesNameTheLine) {
+  const auto dir = scratchToml("y.toml", "").parent_path();
+  const auto expectError = [&](const std::string& name, const std::string& text, const std::string& fragment) {
+    std::ofstream(dir / name) << text;
+    try {
+      readNetwork(dir / name);
+      ADD_FAILURE() << name << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  };
+  expectError("three.swc", "1 1 0 0 0 1 -1\n2 2 1 0 0 1 1\n3 2 2 0 0 1 2\n4 2 2 1 0 1 2\n5 2 2 2 0 1 2\n", "three.swc:2: 2 has more than two children: N-ary junctions are not supported yet");
+  expectError("orphan.swc", "1 1 0 0 0 1 -1\n2 2 1 0 0 1 7\n", "orphan.swc:2: parent 7 of 2 is not defined");
+  expectError("cycle.swc", "1 1 0 0 0 1 -1\n2 2 1 0 0 1 3\n3 2 2 0 0 1 2\n", "is not connected to a root");
+  expectError("bad.swc", "1 1 0 0 zero 1 -1\n", "bad.swc:1: z 'zero' is not a finite number");
+  expectError("x.vtk", "", "unknown network format '.vtk'; allowed: .cco (VItA), .swc");
+  expectError("gap.cco", "*Vessels\n2\n0 0 0 0 1 0 0 0 0 0 0 2 1 0 0 0 0 0 0 0 -1\n1 1 0.5 0 2 0 0 0 0 0 0 2 1 0 0 0 0 0 0 0 -1\n*Connectivity\n0 -1 1\n1 0\n",
+              "gap.cco:4: vessel 1 starts at 1 0.5 0, not where its parent 0 ends (1 0 0)");
+  expectError("mode.cco", "*Vessels\n1\n0 0 0 0 1 0 0 0 0 0 0 4 1 0 0 0 0 0 0 0 -1\n*Connectivity\n0 -1\n", "mode.cco:3: branching mode 4; allowed: 0 (none)");
 }

@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "core/vessel_roles.hpp"
+
 namespace angiosynth {
 
 const char* nodeTypeName(NodeType t) {
@@ -18,14 +20,14 @@ void VascularTree::reserve(std::size_t n) {
   position.reserve(n); parent.reserve(n); child0.reserve(n); child1.reserve(n);
   terminals.reserve(n); length.reserve(n); reduced_resistance.reserve(n); beta.reserve(n);
   cost_ratio.reserve(n); radius.reserve(n); flow.reserve(n); pressure.reserve(n); depth.reserve(n); tree.reserve(n);
-  stage.reserve(n); role.reserve(n); branching.reserve(n);
+  stage.reserve(n); role.reserve(n); branching.reserve(n); outflow.reserve(n);
 }
 
 void VascularTree::truncate(std::size_t n) {
   position.resize(n); parent.resize(n); child0.resize(n); child1.resize(n);
   terminals.resize(n); length.resize(n); reduced_resistance.resize(n); beta.resize(n);
   cost_ratio.resize(n); radius.resize(n); flow.resize(n); pressure.resize(n); depth.resize(n); tree.resize(n);
-  stage.resize(n); role.resize(n); branching.resize(n);
+  stage.resize(n); role.resize(n); branching.resize(n); outflow.resize(n);
 }
 
 std::int32_t VascularTree::addNode(const Vec3& p, std::int32_t parent_node, std::int32_t tree_id) {
@@ -47,6 +49,7 @@ std::int32_t VascularTree::addNode(const Vec3& p, std::int32_t parent_node, std:
   stage.push_back(-1);
   role.push_back(0);
   branching.push_back(0);
+  outflow.push_back(0);
   if (parent_node >= 0) {
     if (child0[parent_node] < 0) child0[parent_node] = id;
     else if (child1[parent_node] < 0) child1[parent_node] = id;
@@ -102,6 +105,7 @@ void VascularTree::appendTree(const VascularTree& t, std::int32_t tree_id) {
     stage.push_back(t.stage[i]);
     role.push_back(t.role[i]);
     branching.push_back(t.branching[i]);
+    outflow.push_back(i < std::int32_t(t.outflow.size()) ? t.outflow[i] : 0.0);
   }
 }
 
@@ -146,7 +150,7 @@ void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments, con
     drop(s);
     replaceChild(p, s, -1);
     if (child0[p] < 0) std::swap(child0[p], child1[p]);
-    if (parent[p] >= 0 && sib >= 0) {
+    if (parent[p] >= 0 && sib >= 0 && !(p < std::int32_t(branching.size()) && Branching(branching[p]) == Branching::Distal)) {
       // Bifurcation p now has one child: splice it out, sib hangs from p's parent.
       const auto pp = parent[p];
       replaceChild(pp, p, sib);
@@ -171,6 +175,7 @@ void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments, con
     out.stage.push_back(i < stage.size() ? stage[i] : -1);
     out.role.push_back(i < role.size() ? role[i] : 0);
     out.branching.push_back(i < branching.size() ? branching[i] : 0);
+    out.outflow.push_back(i < outflow.size() ? outflow[i] : 0.0);
   }
   const auto m = out.position.size();
   out.terminals.assign(m, 1); out.length.assign(m, 0); out.reduced_resistance.assign(m, 0);

@@ -33,6 +33,9 @@ struct VascularTree {
   std::vector<std::int16_t> stage;
   std::vector<std::uint8_t> role;
   std::vector<std::uint8_t> branching;
+  // Prescribed outflow of terminal segment i as a fraction of its tree's inflow (seed 001's
+  // outlets to adjacent territories; 0: an ordinary terminal sharing the rest equally).
+  std::vector<double> outflow;
 
   bool hasStages() const;
   std::int32_t nodeCount() const { return static_cast<std::int32_t>(position.size()); }
@@ -70,7 +73,8 @@ struct VascularTree {
   // Nodes ordered so that every parent precedes its children (breadth-first from each root in turn).
   std::vector<std::int32_t> topDownOrder() const;
   // Removes the given segments together with their subtrees and merges each orphaned
-  // bifurcation into one straight segment; node ids are compacted, order is preserved.
+  // bifurcation into one straight segment (not a distal-branching node: it is a given vessel's
+  // end, not a split point); node ids are compacted, order is preserved.
   // Nodes in `prune` lose both child subtrees and become terminals (no splice). Pruning comes
   // first; segments inside pruned subtrees are skipped.
   void removeSubtrees(const std::vector<std::int32_t>& segments, const std::vector<std::int32_t>& prune = {});

@@ -102,7 +102,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     return out;
   };
   if (im.get("formats")) ip.formats = strings("formats", {"nifti", "nrrd", "tiff", "png", "vdb"});
-  if (im.get("graph_formats")) ip.graph_formats = strings("graph_formats", {"csv", "vtp", "swc", "graphml"});
+  if (im.get("graph_formats")) ip.graph_formats = strings("graph_formats", {"csv", "vtp", "swc", "graphml", "cco"});
 
   const auto& deg = r.table("degrade", {"profiles"});
   if (const auto* n = deg.get("profiles")) {

@@ -7,6 +7,7 @@
 #include "core/format.hpp"
 #include "degrade/effect.hpp"
 #include "io/graph_writers.hpp"
+#include "io/network_files.hpp"
 #include "io/text_file.hpp"
 
 namespace angiosynth {
@@ -112,6 +113,8 @@ void writeGraphFiles(const VascularTree& tree, const std::vector<TreeInfo>& tree
       file("centerlines", ".vtp", "vtp", [&](std::ostream& o) { writeVtp(o, tree, trees); });
     } else if (fmt == "swc") {
       file("tree", ".swc", "swc", [&](std::ostream& o) { writeSwc(o, tree, trees); });
+    } else if (fmt == "cco") {
+      file("tree", ".cco", "cco", [&](std::ostream& o) { writeCco(o, tree, trees); });
     } else if (fmt == "graphml") {
       file("tree", ".graphml", "graphml", [&](std::ostream& o) { writeGraphml(o, tree, trees); });
     }

@@ -55,17 +55,19 @@ const PowerKernel& kernelAt(const VascularTree& t, std::int32_t i, const std::ve
 
 // One level of the path from a new bifurcation to the root, as a trial point would leave it.
 struct Level {
-  std::int32_t seg, child, other;  // seg -1: the new bifurcation segment
+  std::int32_t seg, child, other;  // child -1: the level-0 segment; other -1: none (a continuation)
   double beta_child, beta_other, R, V;
-  std::int32_t n;
+  std::int32_t n;  // terminals below
+  double w;        // load: flow below in units of the common terminal flow
 };
 
 struct Trial {
   std::int32_t s = -1;
   Vec3 b;
   double cost = 0;
-  double r[3] = {0, 0, 0};  // proximal part, distal part, new vessel
+  double r[3] = {0, 0, 0};  // proximal part, distal part, new vessel (distal: s, its child, new vessel)
   bool valid = false;
+  bool distal = false;      // the new vessel leaves s's distal end (s is not split)
 };
 
 class DccoGrower {
@@ -76,11 +78,26 @@ class DccoGrower {
     kernels_ = kernelsOf(gamma_);
     std::int64_t total = 0;
     for (const auto& st : o.stages) total += st.terminal_count;
-    t_.reserve(2 * total + 2);
-    t_.addNode(o.root_mm, -1);
-    eta_.assign(1, o.viscosity.at(o.root_radius));
-    rel_.assign(1, 1.0);
-    checked_.assign(1, 0.0);
+    t_.reserve(2 * total + 2 + (o.initial ? std::size_t(o.initial->nodeCount()) : 0));
+    if (o.initial) {
+      t_ = *o.initial;
+      for (std::int32_t i = 0; i < t_.nodeCount(); ++i) t_.stage[i] = -1;
+      given_ = t_.nodeCount();
+    } else {
+      t_.addNode(o.root_mm, -1);
+    }
+    trees_ = std::int32_t(t_.roots().size());
+    r1_ = o.root_radii.empty() ? std::vector<double>(std::size_t(trees_), o.root_radius) : o.root_radii;
+    vol_.assign(std::size_t(trees_), 0.0);
+    eta_.assign(std::size_t(t_.nodeCount()), o.viscosity.at(o.root_radius));
+    rel_.assign(std::size_t(t_.nodeCount()), 1.0);
+    checked_.assign(std::size_t(t_.nodeCount()), 0.0);
+    load_.assign(std::size_t(t_.nodeCount()), 0.0);
+    if (o.initial) {
+      solve();
+      checked_ = t_.radius;
+      index_.refresh(t_, true);
+    }
   }
 
   VascularTree run(const ProgressFn& progress) {
@@ -89,12 +106,12 @@ class DccoGrower {
     for (std::size_t k = 0; k < o_.stages.size(); ++k) {
       stage_ = int(k);
       const auto& st = o_.stages[k];
-      target_ = terminalCount() + st.terminal_count;
+      made_ = 0;
       lc_ = characteristicLength(*st.terminals);
       growStage(progress, before, total);
       repairStage(progress, before, total);
-      dr_.stage_terminals.push_back(terminalCount() - before);
-      before = terminalCount();
+      dr_.stage_terminals.push_back(made_);
+      before += made_;
     }
     dr_.viscosity_iterations = solve();
     finalCounts();
@@ -111,19 +128,35 @@ class DccoGrower {
   }
 
  private:
-  std::int64_t terminalCount() const { return t_.nodeCount() > 1 ? t_.terminals[t_.rootSegment()] : 0; }
+  std::int64_t terminalCount() const { return t_.nodeCount() > 1 ? t_.totalTerminals() : 0; }
   const DccoStage& stage() const { return o_.stages[stage_]; }
-  double radiusOf(std::int32_t y) const { return o_.root_radius * rel_[y]; }
+  double rootRadiusOf(std::int32_t y) const { return r1_[std::size_t(t_.tree[y])]; }
+  double radiusOf(std::int32_t y) const { return rootRadiusOf(y) * rel_[y]; }
+  // A node of the initial network (never removed; ids below given_ survive every compaction).
+  bool givenNode(std::int32_t i) const { return i < given_; }
+  // Terminals the current stage made (its vessels that end free).
+  std::int64_t stageTerminals() const {
+    std::int64_t n = 0;
+    for (std::int32_t i = 0; i < t_.nodeCount(); ++i) n += t_.isTerminal(i) && t_.stage[i] == stage_;
+    return n;
+  }
+  double treeVolumeOf(std::int32_t tr) const {
+    const double r = r1_[std::size_t(tr)];
+    return std::numbers::pi * r * r * t_.cost_ratio[t_.child0[rootOf_[std::size_t(tr)]]];
+  }
   double e(std::int32_t y) const { return eta_[y] / kEtaRef; }
 
   // Algorithm 1 on the whole tree; refreshes ρ, the clear-radius bookkeeping and the index.
   int solve() {
-    const int it = solveDccoTree(t_, eta_, o_, gamma_);
+    const int it = solveDccoTree(t_, eta_, o_, gamma_, r1_, &load_);
     rel_.assign(t_.nodeCount(), 1.0);
-    for (std::int32_t i = 1; i < t_.nodeCount(); ++i) rel_[i] = t_.radius[i] / o_.root_radius;
+    for (std::int32_t i = 1; i < t_.nodeCount(); ++i)
+      if (!t_.isRoot(i)) rel_[i] = t_.radius[i] / rootRadiusOf(i);
     checked_.resize(t_.nodeCount(), 0.0);
     solved_at_ = t_.nodeCount();
-    volume_ = std::numbers::pi * o_.root_radius * o_.root_radius * t_.cost_ratio[t_.rootSegment()];
+    rootOf_.assign(std::size_t(trees_), -1);
+    for (auto r : t_.roots()) rootOf_[std::size_t(t_.tree[r])] = r;
+    for (std::int32_t k = 0; k < trees_; ++k) vol_[std::size_t(k)] = treeVolumeOf(k);
     listThick();
     return it;
   }
@@ -183,6 +216,8 @@ class DccoGrower {
         t_.cost_ratio[n] = l;
         rel_.push_back(1.0);
         checked_.push_back(o_.root_radius);
+        load_.push_back(1.0);
+        ++made_;
         solve();
         index_.refresh(t_, true);
         return;
@@ -198,39 +233,63 @@ class DccoGrower {
   }
 
   // Costs the trial point b on segment s for terminal x: fills t with the cost and the radii of the
-  // three new vessels, and `path` with the new values up to the root (O(depth)).
+  // three vessels that meet at the new junction, and `path` with the new values up to the root
+  // (O(depth)). A distal trial hangs the new vessel from s's distal end (b = x_d) instead of
+  // splitting s.
   void cost(std::int32_t s, const Vec3& b, const Vec3& x, Trial& tr, std::vector<Level>& path) const {
     const auto& T = t_;
     const std::int32_t q = T.parent[s];
-    const double l_up = distance(T.position[q], b), l_down = distance(b, T.position[s]), l_new = distance(b, x);
+    const double l_new = distance(b, x);
     const double es = e(s);
-    const double R_sd = es * l_down + (T.reduced_resistance[s] - es * T.length[s]);
-    const double V_sd = l_down + (T.cost_ratio[s] - T.length[s]);
     const double R_t = es * l_new, V_t = l_new;
-    const auto sp = kernels_[stage_].split(T.terminals[s], R_sd, 1, R_t);
     path.clear();
-    Level lv{-1, s, -1, sp.beta_a, sp.beta_b, es * l_up + 1.0 / (pow4(sp.beta_a) / R_sd + pow4(sp.beta_b) / R_t),
-             l_up + sp.beta_a * sp.beta_a * V_sd + sp.beta_b * sp.beta_b * V_t, T.terminals[s] + 1};
-    path.push_back(lv);
-    // Walk up: segment y = q ends at the node the bifurcation segment hangs from.
+    if (!tr.distal) {
+      const double l_up = distance(T.position[q], b), l_down = distance(b, T.position[s]);
+      const double R_sd = es * l_down + (T.reduced_resistance[s] - es * T.length[s]);
+      const double V_sd = l_down + (T.cost_ratio[s] - T.length[s]);
+      const auto sp = kernels_[stage_].split(load_[s], R_sd, 1, R_t);
+      path.push_back(Level{-1, s, -1, sp.beta_a, sp.beta_b, es * l_up + 1.0 / (pow4(sp.beta_a) / R_sd + pow4(sp.beta_b) / R_t),
+                           l_up + sp.beta_a * sp.beta_a * V_sd + sp.beta_b * sp.beta_b * V_t, T.terminals[s] + 1, load_[s] + 1});
+    } else if (T.child0[s] < 0) {  // s ends free: the new vessel continues it, s stops being a terminal
+      path.push_back(Level{s, -1, -1, 1, 1, es * T.length[s] + R_t, T.length[s] + V_t, T.terminals[s], load_[s]});
+    } else {  // s's end becomes a bifurcation of its child and the new vessel
+      const auto c = T.child0[s];
+      const auto sp = kernels_[stage_].split(load_[c], T.reduced_resistance[c], 1, R_t);
+      path.push_back(Level{s, c, -1, sp.beta_a, sp.beta_b, es * T.length[s] + 1.0 / (pow4(sp.beta_a) / T.reduced_resistance[c] + pow4(sp.beta_b) / R_t),
+                           T.length[s] + sp.beta_a * sp.beta_a * T.cost_ratio[c] + sp.beta_b * sp.beta_b * V_t, T.terminals[s] + 1, load_[s] + 1});
+    }
+    const std::int32_t dn = path[0].n - T.terminals[s];
+    const double dw = path[0].w - load_[s];
+    // Walk up: segment y = q ends at the node the level-0 segment hangs from.
     for (std::int32_t y = q; T.parent[y] >= 0; y = T.parent[y]) {
       const auto& below = path.back();
-      const std::int32_t child = path.size() == 1 ? -1 : below.seg;  // -1: the new bifurcation segment
-      const std::int32_t other = T.child0[y] == (child < 0 ? s : child) ? T.child1[y] : T.child0[y];
-      const auto spl = kernelAt(T, y, kernels_).split(below.n, below.R, T.terminals[other], T.reduced_resistance[other]);
-      Level up{y, child, other, spl.beta_a, spl.beta_b,
-               e(y) * T.length[y] + 1.0 / (pow4(spl.beta_a) / below.R + pow4(spl.beta_b) / T.reduced_resistance[other]),
-               T.length[y] + spl.beta_a * spl.beta_a * below.V + spl.beta_b * spl.beta_b * T.cost_ratio[other], T.terminals[y] + 1};
-      path.push_back(up);
+      const std::int32_t child = path.size() == 1 ? -1 : below.seg;  // -1: the level-0 segment
+      const std::int32_t from = child < 0 ? s : child;
+      const std::int32_t other = T.child0[y] == from ? T.child1[y] : T.child0[y];
+      if (other < 0) {  // a continuation: the flow passes on
+        path.push_back(Level{y, child, -1, 1, 0, e(y) * T.length[y] + below.R, T.length[y] + below.V, T.terminals[y] + dn, load_[y] + dw});
+        continue;
+      }
+      const auto spl = kernelAt(T, y, kernels_).split(below.w, below.R, load_[other], T.reduced_resistance[other]);
+      path.push_back(Level{y, child, other, spl.beta_a, spl.beta_b,
+                           e(y) * T.length[y] + 1.0 / (pow4(spl.beta_a) / below.R + pow4(spl.beta_b) / T.reduced_resistance[other]),
+                           T.length[y] + spl.beta_a * spl.beta_a * below.V + spl.beta_b * spl.beta_b * T.cost_ratio[other],
+                           T.terminals[y] + dn, load_[y] + dw});
     }
     double rho = 1;
     for (std::size_t k = path.size(); k-- > 1;) rho *= path[k].beta_child;
-    const double rb = o_.root_radius * rho;
+    const double r1 = rootRadiusOf(s);
+    const double rb = r1 * rho;
     tr.r[0] = rb;
-    tr.r[1] = rb * path[0].beta_child;
-    tr.r[2] = rb * path[0].beta_other;
-    const double volume_after = std::numbers::pi * o_.root_radius * o_.root_radius * path.back().V;
-    const double added = volume_after - volume_;
+    if (!tr.distal) {
+      tr.r[1] = rb * path[0].beta_child;
+      tr.r[2] = rb * path[0].beta_other;
+    } else {
+      tr.r[1] = T.child0[s] < 0 ? 0.0 : rb * path[0].beta_child;
+      tr.r[2] = rb * path[0].beta_other;
+    }
+    const double volume_after = std::numbers::pi * r1 * r1 * path.back().V;
+    const double added = volume_after - vol_[std::size_t(T.tree[s])];
     const auto& st = stage();
     if (st.cost == StageCost::Volume) {
       tr.cost = added;
@@ -244,6 +303,13 @@ class DccoGrower {
   bool admissible(std::int32_t s, const Vec3& b, const Vec3& x, const Trial& tr, int level) const {
     const auto& T = t_;
     const auto& st = stage();
+    if (tr.distal) {
+      // Only the new vessel is made; a bifurcation it forms with s's child must be symmetric enough.
+      if (!(distance(b, x) > 2 * kMargin * tr.r[2])) return false;
+      if (tr.r[1] > 0 && !(std::min(tr.r[1], tr.r[2]) / std::max(tr.r[1], tr.r[2]) > st.deltaAt(level))) return false;
+      if (VesselRole(T.role[s]) == VesselRole::Perforator && !(st.vessels->depth(b) > 0)) return false;
+      return st.role != VesselRole::Distribution || st.vessels->depth(b) >= kMargin * tr.r[2];
+    }
     const Vec3 xp = T.position[T.parent[s]], xd = T.position[s];
     const double l[3] = {distance(xp, b), distance(b, xd), distance(b, x)};
     for (int k = 0; k < 3; ++k)
@@ -270,6 +336,8 @@ class DccoGrower {
     if (VesselRole(T.role[s]) == VesselRole::Distribution && T.stage[s] >= 0 &&
         !(o_.stages[T.stage[s]].vessels->depth(b) >= kMargin * tr.r[1]))
       return false;
+    // A vessel of the initial network is split only inside the world.
+    if (T.stage[s] < 0 && !(o_.world->depth(b) >= 0)) return false;
     return true;
   }
 
@@ -284,12 +352,15 @@ class DccoGrower {
     const auto s = tr.s;
     const Vec3 xp = T.position[T.parent[s]], xd = T.position[s];
     const double r[3] = {kMargin * tr.r[0], kMargin * tr.r[1], kMargin * tr.r[2]};
+    if (tr.distal) return vesselFits(tr.b, x, r[2], false, stage().role, stage_);
     return vesselFits(tr.b, x, r[2], false, stage().role, stage_) && segmentFits(s, xp, tr.b, r[0]) &&
            vesselFits(tr.b, xd, r[1], false, VesselRole(T.role[s]), T.stage[s]);
   }
 
-  // vesselFits for (a new course of) existing segment x: the root vessel only in the world.
+  // vesselFits for (a new course of) existing segment x: the root vessel only in the world; the
+  // initial network's vessels (and their parts) where they are.
   bool segmentFits(std::int32_t x, const Vec3& a, const Vec3& e, double r) const {
+    if (t_.stage[x] < 0 && given_ > 0) return true;
     const bool root_seg = t_.parent[t_.parent[x]] < 0;
     return vesselFits(a, e, r, root_seg, root_seg ? VesselRole::Transport : VesselRole(t_.role[x]), t_.stage[x]);
   }
@@ -298,6 +369,7 @@ class DccoGrower {
   // where it may: in the world, and a distribution vessel also in its stage's or the current
   // stage's domain.
   bool vesselFits(const Vec3& a, const Vec3& e, double r, bool from_root, VesselRole role, int made) const {
+    if (made < 0 && given_ > 0) return true;
     if (!o_.world->capsuleInside(a, e, r, from_root)) return false;
     if (role != VesselRole::Distribution || made < 0) return true;
     const auto* own = o_.stages[made].vessels;
@@ -358,6 +430,13 @@ class DccoGrower {
       if (y > 0 && T.child0[y] >= 0) out[n++] = T.child0[y];
       if (y > 0 && T.child1[y] >= 0) out[n++] = T.child1[y];
     };
+    if (tr.distal) {  // the new vessel x_d→x: shares x_d with s and its child; next to s's parent and sibling, its grandchildren
+      const std::int32_t share[2] = {c0, c1};
+      std::int32_t near[6] = {T.parent[q] >= 0 ? q : -1, sib};
+      int n = 2;
+      kids(c0, near, n);
+      return capsuleHits(tr.b, x, kMargin * tr.r[2], s, {share, share + 2}, {near, near + n});
+    }
     // The new vessel b→x: next to s's parent and sibling (through the proximal part) and s's children.
     {
       const std::int32_t near[4] = {q, sib, c0, c1};
@@ -398,7 +477,14 @@ class DccoGrower {
   }
 
   // The vessels of the last commit (proximal part, distal part s, new vessel) against the tree.
-  bool newVesselsCollide(std::int32_t s) {
+  bool newVesselsCollide(const Trial& tr) {
+    const auto s = tr.s;
+    if (tr.distal) {  // the new vessel, s and its other child (both thickened)
+      const auto n = t_.nodeCount() - 1;
+      for (const std::int32_t x : {n, s, t_.child0[s] == n ? -1 : t_.child0[s]})
+        if (x > 0 && overlaps(x, t_.position[t_.parent[x]], t_.position[x], kMargin * radiusOf(x))) return true;
+      return false;
+    }
     const auto b = t_.nodeCount() - 2;
     // s's children too: the new bifurcation puts a segment more between them and s's old
     // neighbours, which may now touch them only where the rule for near neighbours allows.
@@ -409,7 +495,7 @@ class DccoGrower {
 
   struct Saved {
     std::int32_t id, n;
-    double R, V, beta, rel;
+    double R, V, beta, rel, w;
   };
 
   // Applies a costed trial (path recorded by cost()).
@@ -417,48 +503,58 @@ class DccoGrower {
     auto& T = t_;
     const auto s = tr.s, q = T.parent[s];
     undo.clear();
-    const auto save = [&](std::int32_t id) { undo.push_back({id, T.terminals[id], T.reduced_resistance[id], T.cost_ratio[id], T.beta[id], rel_[id]}); };
+    const auto save = [&](std::int32_t id) {
+      if (id >= 0) undo.push_back({id, T.terminals[id], T.reduced_resistance[id], T.cost_ratio[id], T.beta[id], rel_[id], load_[id]});
+    };
     save(s);
+    if (tr.distal) save(T.child0[s]);
     for (std::size_t k = 1; k < path.size(); ++k) {
       save(path[k].seg);
       save(path[k].other);
     }
-    const auto b = T.addNode(tr.b, -1);
-    T.parent[b] = q;
-    T.tree[b] = T.tree[q];
-    T.replaceChild(q, s, b);
-    T.parent[s] = b;
-    T.child0[b] = s;
-    T.stage[b] = T.stage[s];  // the proximal part of the split vessel
-    T.role[b] = T.role[s];
-    T.branching[b] = T.branching[s];
     const double es = e(s);
-    T.length[b] = distance(T.position[q], tr.b);
-    const double l_down = distance(tr.b, T.position[s]);
-    T.reduced_resistance[s] = es * l_down + (T.reduced_resistance[s] - es * T.length[s]);
-    T.cost_ratio[s] = l_down + (T.cost_ratio[s] - T.length[s]);
-    T.length[s] = l_down;
+    std::int32_t b = s;  // the level-0 segment
+    if (!tr.distal) {
+      b = T.addNode(tr.b, -1);
+      T.parent[b] = q;
+      T.tree[b] = T.tree[q];
+      T.replaceChild(q, s, b);
+      T.parent[s] = b;
+      T.child0[b] = s;
+      T.stage[b] = T.stage[s];  // the proximal part of the split vessel
+      T.role[b] = T.role[s];
+      T.branching[b] = T.branching[s];
+      T.length[b] = distance(T.position[q], tr.b);
+      const double l_down = distance(tr.b, T.position[s]);
+      T.reduced_resistance[s] = es * l_down + (T.reduced_resistance[s] - es * T.length[s]);
+      T.cost_ratio[s] = l_down + (T.cost_ratio[s] - T.length[s]);
+      T.length[s] = l_down;
+      eta_.push_back(eta_[s]);
+    }
     const auto n = T.addNode(x, b);
     T.stage[n] = std::int16_t(stage_);
     T.role[n] = std::uint8_t(stage().role);
     T.branching[n] = std::uint8_t(Branching::Versatile);
     eta_.push_back(eta_[s]);
-    eta_.push_back(eta_[s]);
     T.reduced_resistance[n] = es * T.length[n];
     T.cost_ratio[n] = T.length[n];
     T.terminals[n] = 1;
+    ++made_;
     rel_.resize(T.nodeCount());
     checked_.resize(T.nodeCount(), 0.0);
+    load_.resize(T.nodeCount(), 0.0);
+    load_[n] = 1;
     for (std::size_t k = 0; k < path.size(); ++k) {
       const auto& L = path[k];
       const auto seg = k == 0 ? b : L.seg;
-      const auto child = k == 0 ? s : (k == 1 ? b : L.child);
+      const auto child = k == 0 ? (tr.distal ? L.child : s) : (k == 1 ? b : L.child);
       const auto other = k == 0 ? n : L.other;
       T.terminals[seg] = L.n;
+      load_[seg] = L.w;
       T.reduced_resistance[seg] = L.R;
       T.cost_ratio[seg] = L.V;
-      T.beta[child] = L.beta_child;
-      T.beta[other] = L.beta_other;
+      if (child >= 0) T.beta[child] = L.beta_child;
+      if (other >= 0) T.beta[other] = L.beta_other;
     }
     const auto top = path.size() == 1 ? b : path.back().seg;
     T.beta[top] = 1;
@@ -466,39 +562,51 @@ class DccoGrower {
     for (std::size_t k = path.size(); k-- > 0;) {
       const auto& L = path[k];
       const auto seg = k == 0 ? b : L.seg;
-      const auto child = k == 0 ? s : (k == 1 ? b : L.child);
+      const auto child = k == 0 ? (tr.distal ? L.child : s) : (k == 1 ? b : L.child);
       const auto other = k == 0 ? n : L.other;
-      rel_[child] = rel_[seg] * L.beta_child;
-      rel_[other] = rel_[seg] * L.beta_other;
+      if (child >= 0) rel_[child] = rel_[seg] * L.beta_child;
+      if (other >= 0) rel_[other] = rel_[seg] * L.beta_other;
     }
-    volume_ = std::numbers::pi * o_.root_radius * o_.root_radius * T.cost_ratio[T.rootSegment()];
+    vol_[std::size_t(T.tree[s])] = treeVolumeOf(T.tree[s]);
     // In the index before the checks (entries left by a rollback are harmless: queries measure
     // the current geometry); s's distal part leaves its old line.
-    index_.insert(T, b);
+    if (!tr.distal) index_.insert(T, b);
     index_.insert(T, n);
     index_.insert(T, s);
-    if (rel_[b] >= kThickList) thick_.push_back(b);
+    if (!tr.distal && rel_[b] >= kThickList) thick_.push_back(b);
   }
 
-  void rollback(const std::vector<Saved>& undo) {
+  void rollback(const Trial& tr, const std::vector<Saved>& undo) {
     auto& T = t_;
-    const auto b = T.nodeCount() - 2;
-    const auto s = T.child0[b], q = T.parent[b];
-    T.replaceChild(q, b, s);
-    T.parent[s] = q;
-    T.length[s] = distance(T.position[q], T.position[s]);
-    T.truncate(b);
-    eta_.resize(b);
-    rel_.resize(b);
-    checked_.resize(b);
+    const auto n = T.nodeCount() - 1;
+    std::int32_t cut = n;
+    if (tr.distal) {
+      const auto s = T.parent[n];
+      if (T.child1[s] == n) T.child1[s] = -1;
+      else T.child0[s] = -1;
+    } else {
+      const auto b = n - 1;
+      const auto s = T.child0[b], q = T.parent[b];
+      T.replaceChild(q, b, s);
+      T.parent[s] = q;
+      T.length[s] = distance(T.position[q], T.position[s]);
+      cut = b;
+    }
+    T.truncate(cut);
+    eta_.resize(cut);
+    rel_.resize(cut);
+    checked_.resize(cut);
+    load_.resize(cut);
+    --made_;
     for (auto it = undo.rbegin(); it != undo.rend(); ++it) {
       T.terminals[it->id] = it->n;
       T.reduced_resistance[it->id] = it->R;
       T.cost_ratio[it->id] = it->V;
       T.beta[it->id] = it->beta;
       rel_[it->id] = it->rel;
+      load_[it->id] = it->w;
     }
-    volume_ = std::numbers::pi * o_.root_radius * o_.root_radius * T.cost_ratio[T.rootSegment()];
+    vol_[std::size_t(T.tree[tr.s])] = treeVolumeOf(T.tree[tr.s]);
   }
 
   // After a commit: the ancestors that thickened past kRecheckGrowth since last found clear.
@@ -513,6 +621,14 @@ class DccoGrower {
     return false;
   }
 
+  // True if vessel y may take a new branch: not a non-branching vessel or an outlet (its flow
+  // is prescribed), and a distal one only while its end has fewer than two children.
+  bool mayBranch(std::int32_t y) const {
+    const auto b = Branching(t_.branching[y]);
+    if (b == Branching::None || b == Branching::Unset || t_.outflow[y] > 0) return false;
+    return b != Branching::Distal || t_.child1[y] < 0;
+  }
+
   // Connects terminal x to the cheapest admissible point of its candidate vessels; false if none.
   bool connect(const Vec3& x) {
     const auto& st = stage();
@@ -521,7 +637,7 @@ class DccoGrower {
     near_.clear();
     const Vec3 h(half, half, st.terminals->dimension() == 2 ? 0.0 : half);
     index_.forEachInBox(x - h, x + h, [&](std::int32_t y) {
-      if (y <= 0 || y >= t_.nodeCount() || t_.parent[y] < 0) return;
+      if (y <= 0 || y >= t_.nodeCount() || t_.parent[y] < 0 || !mayBranch(y)) return;
       const Vec3 a = t_.position[t_.parent[y]], e = t_.position[y];
       // The vessel's point nearest to x must lie in the box.
       const Vec3 ab = e - a;
@@ -549,6 +665,7 @@ class DccoGrower {
         Trial tr;
         tr.s = s;
         tr.b = b;
+        tr.distal = Branching(t_.branching[s]) == Branching::Distal;
         cost(s, b, x, tr, path);
         tr.valid = admissible(s, b, x, tr, level + 1);
         if (tr.valid) out.push_back(tr);
@@ -575,19 +692,19 @@ class DccoGrower {
       Trial exact = tr;
       cost(tr.s, tr.b, x, exact, path);
       commit(exact, x, path, undo_);
-      if (newVesselsCollide(tr.s)) {
-        rollback(undo_);
+      if (newVesselsCollide(tr)) {
+        rollback(tr, undo_);
         ++report_.rejected_intersection;
         continue;
       }
       if (ancestorsCollide(path)) {
-        rollback(undo_);
+        rollback(tr, undo_);
         ++report_.rejected_intersection;
         continue;
       }
-      const auto b = t_.nodeCount() - 2;
-      checked_[b] = radiusOf(b);
-      checked_[b + 1] = radiusOf(b + 1);
+      const auto n = t_.nodeCount() - 1;
+      if (!tr.distal) checked_[n - 1] = radiusOf(n - 1);
+      checked_[n] = radiusOf(n);
       checked_[tr.s] = radiusOf(tr.s);
       index_.refresh(t_);
       if (double(t_.nodeCount()) > (1 + kRefreshShare) * double(solved_at_)) solve();
@@ -600,7 +717,7 @@ class DccoGrower {
     const auto& st = stage();
     std::int64_t next_report = 0;
     if (t_.nodeCount() < 2) plantRoot();
-    while (terminalCount() < target_) {
+    while (made_ < st.terminal_count) {
       if (progress && terminalCount() >= next_report) {
         progress(terminalCount(), total);
         next_report = terminalCount() + std::max<std::int64_t>(1, total / 200);
@@ -637,18 +754,23 @@ class DccoGrower {
     const auto pairs = intersectingPairs(T, o_.world->lo(), o_.world->hi());
     report_.intersecting_pairs = std::int64_t(pairs.size());
     for (const auto& [x, y] : pairs) {
+      if (T.stage[x] < 0 && T.stage[y] < 0 && given_ > 0) {  // the initial network as it was given
+        --report_.intersecting_pairs;
+        continue;
+      }
       // The vessel of this stage whose subtree holds fewer terminals goes.
       const bool ox = ownSubtree(x), oy = ownSubtree(y);
       out.push_back(ox && oy ? pick(x, y) : ox ? x : y);
     }
     dr_.short_segments = dr_.outside_segments = dr_.asymmetric_bifurcations = dr_.folded_pairs = 0;
     index_.refresh(t_, true);
-    const double r_max = o_.root_radius;
+    const double r_max = *std::max_element(r1_.begin(), r1_.end());
     for (std::int32_t x = 1; x < T.nodeCount(); ++x) {
       if (T.parent[x] < 0) continue;
       const Vec3 a = T.position[T.parent[x]], e = T.position[x];
       index_.forEachNearSegment(a, e, T.radius[x] + r_max, [&](std::int32_t y) {
         if (y <= x || y >= T.nodeCount() || T.parent[y] < 0 || sharesNode(x, y) || !withinTwoSegments(T, x, y)) return;
+        if (T.stage[x] < 0 && T.stage[y] < 0 && given_ > 0) return;
         if (segmentSegmentDistance(a, e, T.position[T.parent[y]], T.position[y]) < 0.5 * std::min(T.radius[x], T.radius[y])) {
           ++dr_.folded_pairs;
           const bool ox = ownSubtree(x), oy = ownSubtree(y);
@@ -657,10 +779,12 @@ class DccoGrower {
       });
     }
     for (std::int32_t s = 1; s < T.nodeCount(); ++s) {
+      if (T.isRoot(s)) continue;
       if (!(T.length[s] > 2 * T.radius[s]) && !(fix && lengthen(s))) {
         ++dr_.short_segments;
         const auto a = T.child0[s], b = T.child1[s];
-        out.push_back(T.isTerminal(s) || !(ownSubtree(a) || ownSubtree(b)) ? s : pick(a, b));
+        if (b < 0) out.push_back(a >= 0 && ownSubtree(a) ? a : s);
+        else out.push_back(T.isTerminal(s) || !(ownSubtree(a) || ownSubtree(b)) ? s : pick(a, b));
       }
       if (!segmentFits(s, T.position[T.parent[s]], T.position[s], T.radius[s])) {
         ++dr_.outside_segments;
@@ -702,6 +826,7 @@ class DccoGrower {
   // and clear of every other vessel; restores it otherwise.
   bool tryMove(std::int32_t v, const Vec3& q) {
     auto& T = t_;
+    if (givenNode(v)) return false;  // the initial network keeps its geometry
     const Vec3 old = T.position[v];
     T.position[v] = q;
     const std::int32_t segs[3] = {v, T.child0[v], T.child1[v]};
@@ -789,6 +914,7 @@ class DccoGrower {
       report_.repaired_terminals += n - terminalCount();
       eta_.assign(t_.nodeCount(), o_.viscosity.at(o_.root_radius));
       solve();
+      made_ = stageTerminals();
       checked_ = t_.radius;
       index_.refresh(t_, true);
       growStage(progress, before, total);
@@ -812,9 +938,11 @@ class DccoGrower {
   std::int64_t moved_ = 0;
   std::vector<PowerKernel> kernels_;
   int stage_ = 0;
-  std::int64_t target_ = 0;
   double lc_ = 1;
-  double volume_ = 0;
+  std::vector<double> vol_, r1_, load_;  // per tree: volume, root radius; per segment: load (Level::w)
+  std::vector<std::int32_t> rootOf_;     // per tree: its root node
+  std::int32_t trees_ = 1, given_ = 0;   // trees; nodes of the initial network
+  std::int64_t made_ = 0;                // terminals the current stage made
   std::int32_t solved_at_ = 0;
   std::vector<std::pair<double, std::int32_t>> near_;
   std::vector<std::vector<Trial>> trials_;
@@ -826,12 +954,26 @@ class DccoGrower {
 }  // namespace
 
 int solveDccoTree(VascularTree& t, std::vector<double>& eta, const DccoOptions& o, const std::vector<double>& gamma_of_stage,
-                  double tolerance) {
+                  const std::vector<double>& root_radius, std::vector<double>* load_out, double tolerance) {
   if (t.nodeCount() < 2) return 0;
   const auto order = t.topDownOrder();
   eta.resize(t.nodeCount(), o.viscosity.at(o.root_radius));
   std::vector<double> next;
+  std::vector<double> own_load;
+  auto& load = load_out ? *load_out : own_load;
+  load.assign(t.nodeCount(), 0.0);
   const auto kernels = kernelsOf(gamma_of_stage);
+  // Outlets carry f_i·Q; the common terminals share (1 − Σf)·Q: in units of their flow q_f an
+  // outlet weighs f_i·N_common / (1 − Σf).
+  std::int64_t common = 0;
+  double reserved = 0;
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i)
+    if (t.isTerminal(i)) {
+      if (t.outflow[i] > 0) reserved += t.outflow[i];
+      else ++common;
+    }
+  if (common == 0) throw GrowthError("every terminal of the tree has a prescribed outflow: none is left to perfuse the domain");
+  const auto outletLoad = [&](std::int32_t i) { return t.outflow[i] * double(common) / (1 - reserved); };
   int it = 0;
   for (;;) {
     ++it;
@@ -843,36 +985,40 @@ int solveDccoTree(VascularTree& t, std::vector<double>& eta, const DccoOptions& 
       const auto a = t.child0[i], b = t.child1[i];
       if (a < 0) {
         t.terminals[i] = 1;
+        load[i] = t.outflow[i] > 0 ? outletLoad(i) : 1.0;
         t.reduced_resistance[i] = ei * t.length[i];
         t.cost_ratio[i] = t.length[i];
         continue;
       }
-      if (b < 0) {  // a continuation node (growth never makes one; existing networks may)
+      if (b < 0) {  // a continuation node (of an existing network, or a distal branch's first child)
         t.terminals[i] = t.terminals[a];
+        load[i] = load[a];
         t.beta[a] = 1;
         t.reduced_resistance[i] = ei * t.length[i] + t.reduced_resistance[a];
         t.cost_ratio[i] = t.length[i] + t.cost_ratio[a];
         continue;
       }
-      const auto s = kernelAt(t, i, kernels).split(t.terminals[a], t.reduced_resistance[a], t.terminals[b], t.reduced_resistance[b]);
+      const auto s = kernelAt(t, i, kernels).split(load[a], t.reduced_resistance[a], load[b], t.reduced_resistance[b]);
       t.beta[a] = s.beta_a;
       t.beta[b] = s.beta_b;
       t.terminals[i] = t.terminals[a] + t.terminals[b];
+      load[i] = load[a] + load[b];
       t.reduced_resistance[i] = ei * t.length[i] + 1.0 / (pow4(s.beta_a) / t.reduced_resistance[a] + pow4(s.beta_b) / t.reduced_resistance[b]);
       t.cost_ratio[i] = t.length[i] + s.beta_a * s.beta_a * t.cost_ratio[a] + s.beta_b * s.beta_b * t.cost_ratio[b];
     }
-    const auto root = t.rootSegment();
-    const double q_term = o.flow / double(t.terminals[root]);
-    t.beta[root] = 1;
-    t.pressure[0] = o.root_pressure;
+    const double q_term = o.flow * (1 - reserved) / double(common);
     double change = 0;
     next.resize(t.nodeCount());
     for (auto i : order) {
-      if (t.parent[i] < 0) continue;
       const auto par = t.parent[i];
+      if (par < 0) {
+        t.pressure[i] = o.root_pressure;
+        if (t.child0[i] >= 0) t.beta[t.child0[i]] = 1;
+        continue;
+      }
       t.depth[i] = t.depth[par] + 1;
-      t.flow[i] = q_term * t.terminals[i];
-      t.radius[i] = i == root ? o.root_radius : t.radius[par] * t.beta[i];
+      t.flow[i] = q_term * load[i];
+      t.radius[i] = t.isRoot(par) ? root_radius[std::size_t(t.tree[i])] : t.radius[par] * t.beta[i];
       t.pressure[i] = t.pressure[par] - t.flow[i] * 8.0 * eta[i] * t.length[i] / (std::numbers::pi * pow4(t.radius[i]));
       next[i] = o.viscosity.at(t.radius[i]);
       change = std::max(change, std::abs(next[i] - eta[i]) / next[i]);

@@ -71,6 +71,12 @@ struct DccoOptions {
   double root_pressure = 13300;       // Pa at the root (pressures downstream follow)
   Viscosity viscosity;
   const GrowthDomain* world = nullptr;  // every vessel stays inside (minus the avascular regions of its stage)
+  // The network growth continues (seed 001's vascular completion; null: the first stage plants a
+  // root vessel at root_mm). Its vessels keep their geometry, role, branching and outflow and
+  // take stage -1; each of its roots is an inlet with the fixed radius root_radii[tree] (empty:
+  // root_radius), all inlets share Q by the terminals they feed.
+  const VascularTree* initial = nullptr;
+  std::vector<double> root_radii;
   std::vector<DccoStage> stages;
   std::uint64_t seed = 1, sample = 0;
   int max_repair_rounds = 30;
@@ -91,11 +97,13 @@ struct DccoReport {
 // Grows the staged tree; throws GrowthError when a stage cannot place its terminals.
 VascularTree growDcco(const DccoOptions& o, GrowthReport& report, DccoReport& dcco, const ProgressFn& progress = {});
 
-// Algorithm 1 on a grown tree: radii from r_1 and Karch's update with per-vessel viscosities,
-// viscosities from the radii, until the largest relative change is below `tolerance`; fills
-// terminals, β, radii, flows (Q equally over the terminals), pressures. `gamma_of_node(i)` is the
-// Murray exponent of the split at node i. Returns the iterations.
+// Algorithm 1 on a grown tree: radii from each root's fixed radius (`root_radius` by tree) and
+// Karch's update with per-vessel viscosities, viscosities from the radii, until the largest
+// relative change is below `tolerance`; fills terminals, β, radii, flows, pressures. Terminals
+// with an outflow fraction f_i carry f_i·Q, the others share the rest equally. `gamma_of_stage`
+// gives the Murray exponent of the splits each stage made. `load` (if given) receives every
+// segment's flow in units of the common terminal flow. Returns the iterations.
 int solveDccoTree(VascularTree& t, std::vector<double>& eta, const DccoOptions& o, const std::vector<double>& gamma_of_stage,
-                  double tolerance = 1e-6);
+                  const std::vector<double>& root_radius, std::vector<double>* load = nullptr, double tolerance = 1e-6);
 
 }  // namespace angiosynth

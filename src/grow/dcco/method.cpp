@@ -8,6 +8,8 @@
 #include "grow/common/method_tables.hpp"
 #include "grow/dcco/setup.hpp"
 #include "io/growth_domain_files.hpp"
+#include "io/param_checks.hpp"
+#include "io/scenario.hpp"
 
 namespace angiosynth {
 namespace {
@@ -27,7 +29,15 @@ struct StageDomains {
 class PreparedDcco final : public PreparedGrowth {
  public:
   PreparedDcco(const DccoSetup& s, GrowthDomain world) : setup_(s), world_(std::move(world)) {
-    root_ = placeRoot(s.parameter_file, s.root, world_);
+    if (s.initial_file.empty()) {
+      root_ = placeRoot(s.parameter_file, s.root, world_);
+    } else {  // the file's positions are relative to the domain's centre
+      initial_ = s.initial.tree;
+      for (auto& p : initial_.position) {
+        p = p + world_.center();
+        if (world_.dimension() == 2) p.z = world_.planeZ();
+      }
+    }
     std::map<std::string, const RegionSpec*> by_name;
     for (const auto& r : s.regions) by_name[r.name] = &r;
     const auto list = [&](const std::vector<std::string>& names) {
@@ -83,6 +93,7 @@ class PreparedDcco final : public PreparedGrowth {
                              std::to_string(inside) + " voxels of its terminal region; use fewer terminals or a finer voxel_size");
     }
     const double r = setup_.options.root_radius;
+    if (!setup_.initial_file.empty()) return;
     if (!(world_.depth(root_) > -1e-6 * world_.frame().voxel_mm))
       throw InputError(setup_.parameter_file, setup_.root.root_line, "the root lies outside the domain");
     if (!(2 * r < 0.5 * std::min({world_.hi().x, world_.hi().y, world_.dimension() == 2 ? world_.hi().x : world_.hi().z})))
@@ -95,6 +106,10 @@ class PreparedDcco final : public PreparedGrowth {
     o.sample = sample;
     o.root_mm = root_;
     o.world = &world_;
+    if (!setup_.initial_file.empty()) {
+      o.initial = &initial_;
+      o.root_radii = setup_.root_radii;
+    }
     o.stages.clear();
     for (std::size_t k = 0; k < setup_.stages.size(); ++k) {
       auto st = setup_.stages[k].stage;
@@ -104,7 +119,13 @@ class PreparedDcco final : public PreparedGrowth {
     }
     dcco_ = {};
     auto tree = growDcco(o, report, dcco_, progress);
+    const auto roots = tree.roots().size();
     Forest f = singleTreeForest(std::move(tree), setup_.kind);
+    if (roots > 1) {  // one inlet per root of the initial network
+      f.trees.clear();
+      for (std::size_t k = 0; k < roots; ++k) f.trees.push_back(TreeInfo{"inlet_" + std::to_string(k + 1), setup_.kind, 0});
+      assignClassLabels(f.trees);
+    }
     return f;
   }
   void addStatistics(const GrowthReport& report, Json& stats) const override {
@@ -129,6 +150,7 @@ class PreparedDcco final : public PreparedGrowth {
   const DccoSetup& setup_;
   GrowthDomain world_;
   Vec3 root_;
+  VascularTree initial_;  // in the frame
   std::map<std::string, std::unique_ptr<GrowthDomain>> cache_;
   std::unique_ptr<GrowthDomain> demand_;
   std::vector<StageDomains> domains_;
@@ -320,6 +342,89 @@ DccoStageSpec readStage(const TomlReader& r, const GrowthMethod& m, const toml::
   return s;
 }
 
+// [initial] and [[initial.vessel]]: the network growth continues from.
+void readInitial(const TomlReader& r, const GrowthMethod& m, DccoSetup& s, bool flat, const toml::table* root_radius) {
+  const auto* node = r.root().get("initial");
+  if (!node) {
+    if (!root_radius) throw InputError(r.file(), 0, "[tree] root_radius is required (the fixed radius of the root vessel)");
+    return;
+  }
+  const auto* t = node->as_table();
+  if (!t) throw InputError(r.file(), r.lineOf(node), "initial must be a table: [initial] file = \"tree.cco\"");
+  checkMethodKeys(r, m, *t, "initial");
+  s.initial_file = resolveInputPath(r.string(*t, "initial", "file"), r.file(), r.lineOf(t->get("file")));
+  const auto unit = t->get("unit") ? r.string(*t, "initial", "unit") : "mm";
+  const std::map<std::string, double> units{{"mm", 1.0}, {"cm", 10.0}, {"m", 1000.0}, {"um", 1e-3}};
+  if (!units.count(unit)) throw InputError(r.file(), r.lineOf(t->get("unit")), "unit '" + unit + "'; allowed: mm, cm, m, um");
+  s.initial = readNetwork(s.initial_file, units.at(unit));
+  auto& tree = s.initial.tree;
+  const auto branchingOf = [&](const toml::table& tab, const std::string& table, Branching fallback) {
+    return choice<Branching>(r, tab, table, "branching", fallback,
+                             {{"none", Branching::None}, {"distal", Branching::Distal}, {"fixed", Branching::Fixed}, {"versatile", Branching::Versatile}});
+  };
+  const auto roleOf = [&](const toml::table& tab, const std::string& table, VesselRole fallback) {
+    return choice<VesselRole>(r, tab, table, "role", fallback,
+                              {{"distribution", VesselRole::Distribution}, {"transport", VesselRole::Transport}, {"perforator", VesselRole::Perforator}});
+  };
+  const auto default_branching = branchingOf(*t, "initial", Branching::None);
+  const auto default_role = roleOf(*t, "initial", VesselRole::Transport);
+  for (std::int32_t i = 0; i < tree.nodeCount(); ++i) {
+    if (tree.isRoot(i)) continue;
+    if (tree.branching[i] == 0) tree.branching[i] = std::uint8_t(default_branching);
+    if (tree.role[i] == 0) tree.role[i] = std::uint8_t(default_role);
+  }
+  std::map<std::string, std::int32_t> by_id;
+  for (std::int32_t i = 0; i < tree.nodeCount(); ++i)
+    if (!tree.isRoot(i)) by_id[s.initial.ids[std::size_t(i)]] = i;
+  if (const auto* list = t->get("vessel")) {
+    const auto* arr = list->as_array();
+    if (!arr || !arr->is_array_of_tables()) throw InputError(r.file(), r.lineOf(list), "vessel must be an array of tables: write each as [[initial.vessel]]");
+    for (const auto& v : *arr) {
+      const auto& vt = *v.as_table();
+      checkMethodKeys(r, m, vt, "initial.vessel");
+      const auto* idn = r.need(vt, "initial.vessel", "id");
+      const std::string id = idn->is_integer() ? std::to_string(*idn->value<std::int64_t>()) : r.string(vt, "initial.vessel", "id");
+      const auto it = by_id.find(id);
+      if (it == by_id.end())
+        throw InputError(r.file(), r.lineOf(idn), "vessel id " + id + " is not a vessel of " + s.initial_file.string() +
+                                                      " (ids: a .cco vessel's, an SWC sample's that ends the segment)");
+      const auto i = it->second;
+      tree.branching[i] = std::uint8_t(branchingOf(vt, "initial.vessel", Branching(tree.branching[i])));
+      tree.role[i] = std::uint8_t(roleOf(vt, "initial.vessel", VesselRole(tree.role[i])));
+      if (vt.get("outflow")) {
+        const double f = r.number(vt, "initial.vessel", "outflow");
+        checkRange(f, 0, false, 1, true, r.at(vt, "outflow"), "outflow (fraction of the inflow Q)");
+        tree.outflow[i] = f;
+      }
+    }
+  }
+  double reserved = 0;
+  std::int64_t common = 0;
+  for (std::int32_t i = 0; i < tree.nodeCount(); ++i) {
+    if (tree.outflow[i] > 0 && !tree.isTerminal(i))
+      throw InputError(s.initial_file.string(), s.initial.lines[std::size_t(i)], "vessel " + s.initial.ids[std::size_t(i)] +
+                                                                                     " has an outflow but branches; outflows are for terminal vessels");
+    if (tree.outflow[i] > 0) reserved += tree.outflow[i];
+    else common += tree.isTerminal(i);
+  }
+  if (!(reserved < 1) || common == 0)
+    throw InputError(r.file(), r.lineOf(node), "the outflows add up to " + show(reserved) +
+                                                   " of Q with " + std::to_string(common) + " terminals left to perfuse the domain; they must add up to less than 1 and leave a terminal without outflow");
+  // Each root's fixed radius: [tree] root_radius for all, else the file's root vessel radius.
+  for (auto root : tree.roots()) {
+    const auto seg = tree.child0[root];
+    if (seg < 0) throw InputError(s.initial_file.string(), s.initial.lines[std::size_t(root)], "a root without a vessel");
+    double radius = root_radius ? s.options.root_radius : tree.radius[seg];
+    if (!root_radius && !(radius > 0))
+      throw InputError(s.initial_file.string(), s.initial.lines[std::size_t(seg)],
+                       "root vessel " + s.initial.ids[std::size_t(seg)] + " has no radius; give [tree] root_radius");
+    s.root_radii.push_back(radius);
+  }
+  s.options.root_radius = *std::max_element(s.root_radii.begin(), s.root_radii.end());
+  if (flat)
+    for (auto& p : tree.position) p.z = 0;
+}
+
 std::shared_ptr<const GrowthSetup> readDccoToml(const TomlReader& r, const GrowthMethod& m) {
   auto s = std::make_shared<DccoSetup>();
   s->parameter_file = r.file();
@@ -330,8 +435,11 @@ std::shared_ptr<const GrowthSetup> readDccoToml(const TomlReader& r, const Growt
   const bool flat = s->domain.shape == DomainShape::Disc || s->domain.shape == DomainShape::Square;
   s->root = readRootOf(r, tree, "tree", s->domain, false);
   auto& o = s->options;
-  o.root_radius = r.quantity(tree, "tree", "root_radius", Dimension::Length);
-  checkRange(o.root_radius, 0, true, Limits::kMaxLength, false, r.at(tree, "root_radius"), "root_radius (mm)");
+  if (tree.get("root_radius")) {
+    o.root_radius = r.quantity(tree, "tree", "root_radius", Dimension::Length);
+    checkRange(o.root_radius, 0, true, Limits::kMaxLength, false, r.at(tree, "root_radius"), "root_radius (mm)");
+  }
+  readInitial(r, m, *s, flat, tree.get("root_radius") ? &tree : nullptr);
   if (tree.get("kind")) s->kind = r.string(tree, "tree", "kind");
   // [physics]: viscosity "pries" or a quantity.
   if (const auto* v = ph.get("viscosity"); v && v->is_string() && *v->value<std::string>() == "pries") {
@@ -399,6 +507,16 @@ Json DccoSetup::describe() const {
   }
   if (d.voxel_mm > 0) j["voxel_size"] = quantityJson(d.voxel_mm, "mm");
   j["kind"] = kind;
+  if (!initial_file.empty()) {
+    Json init{{"file", initial_file.string()}, {"vessels", initial.tree.segmentCount()}, {"roots", root_radii.size()}};
+    Json radii = Json::array(), outlets = Json::array();
+    for (double v : root_radii) radii.push_back(v);
+    init["root_radii_mm"] = radii;
+    for (std::int32_t i = 0; i < initial.tree.nodeCount(); ++i)
+      if (initial.tree.outflow[i] > 0) outlets.push_back(Json{{"vessel", initial.ids[std::size_t(i)]}, {"outflow", initial.tree.outflow[i]}});
+    init["outlets"] = outlets;
+    j["initial"] = init;
+  }
   j["root_radius"] = quantityJson(o.root_radius, "mm");
   j["perfusion_flow"] = quantityJson(o.flow, "mm^3/s");
   j["perfusion_pressure"] = quantityJson(o.root_pressure, "Pa");
@@ -463,7 +581,11 @@ Json DccoSetup::describe() const {
   return j;
 }
 
-std::vector<std::filesystem::path> DccoSetup::inputs() const { return domainInputs(domain); }
+std::vector<std::filesystem::path> DccoSetup::inputs() const {
+  auto in = domainInputs(domain);
+  if (!initial_file.empty()) in.push_back(initial_file);
+  return in;
+}
 
 std::unique_ptr<PreparedGrowth> DccoSetup::prepare(std::uint64_t memory_limit) const {
   return std::make_unique<PreparedDcco>(*this, loadDomainSpec(domain, parameter_file, root, memory_limit));
@@ -476,7 +598,15 @@ const GrowthMethod kDccoMethod{
     "a fixed root radius and inflow, constant or Pries viscosity, angle and symmetry limits, no overlapping vessels",
     withDomainParams("sphere, cube, disc or square (2D), or mask: the region every vessel stays in",
                      "masks: terminals of stages over the whole domain drawn uniformly, or ∝ the mask value (demand; as [[stage]] pdf = \"demand\")", {
-        {"tree", "root_radius", "mm", nullptr, "r_1, the fixed radius of the root vessel"},
+        {"tree", "root_radius", "mm", "with [initial]: each root vessel's radius in its file", "r_1, the fixed radius of the root vessel (of every root of [initial])"},
+        {"initial", "file", "path", "none", "an existing network the growth continues (.cco of VItA, .swc); positions relative to the domain's centre; each root is an inlet"},
+        {"initial", "unit", "text", "mm", "length unit of the file: mm, cm, m, um"},
+        {"initial", "branching", "text", "none", "branching of its vessels where the file gives none: none, distal, fixed, versatile"},
+        {"initial", "role", "text", "transport", "role of its vessels where the file gives none: distribution, transport, perforator"},
+        {"initial.vessel", "id", "id", nullptr, "a vessel of the file (.cco vessel id, SWC id of the sample ending it)"},
+        {"initial.vessel", "branching", "text", "the file's", "its branching: none, distal, fixed, versatile"},
+        {"initial.vessel", "role", "text", "the file's", "its role"},
+        {"initial.vessel", "outflow", "", "0", "a terminal's prescribed outflow as a fraction of Q (the other terminals share the rest)"},
         {"tree", "kind", "text", "artery", "the tree's kind in labels and graphs"},
         {"physics", "viscosity", "Pa*s or \"pries\"", "0.0036 Pa*s", "constant blood viscosity, or \"pries\": Pries' in-vivo law η(D) at haematocrit 0.45 (eqs. 8–9), solved with the radii to |Δη/η| < 1e-6"},
         {"physics", "pries_exponent", "", "0.645", "the exponent of D in Pries' law (the paper prints 0.64)"},

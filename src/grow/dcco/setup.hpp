@@ -8,6 +8,7 @@
 #include "grow/dcco/grower.hpp"
 #include "grow/dcco/regions.hpp"
 #include "grow/method.hpp"
+#include "io/network_files.hpp"
 
 namespace angiosynth {
 
@@ -29,6 +30,11 @@ struct DccoSetup final : GrowthSetup {
   std::vector<RegionSpec> regions;
   std::vector<DccoStageSpec> stages;
   PhysicsParameters physics_summary;    // γ of the first stage, η, Q: for the statistics
+  // [initial]: the network growth continues (empty path: none); positions relative to the
+  // domain's centre, branching, role and outflow as the file and [[initial.vessel]] set them.
+  std::filesystem::path initial_file;
+  ExistingNetwork initial;
+  std::vector<double> root_radii;       // per root of the initial network
 
   const char* method() const override { return "dcco"; }
   nlohmann::ordered_json describe() const override;
