@@ -520,3 +520,27 @@ TEST(DccoInitial, BadNetworkFilesNameTheLine) {
               "gap.cco:4: vessel 1 starts at 1 0.5 0, not where its parent 0 ends (1 0 0)");
   expectError("mode.cco", "*Vessels\n1\n0 0 0 0 1 0 0 0 0 0 0 4 1 0 0 0 0 0 0 0 -1\n*Connectivity\n0 -1\n", "mode.cco:3: branching mode 4; allowed: 0 (none)");
 }
+
+// Two inlets from one feeding vessel (seed 001 Fig. 3, 2D): 25 sprouting terminals then 975 by
+// volume keep the equiradial inlets balanced; the volume cost alone lets one inlet take most.
+TEST(DccoInitial, SproutingKeepsTwoInletsBalancedAndVolumeAloneDoesNot) {
+  const auto share = [](const Forest& f) {
+    const auto& t = f.vessels;
+    const auto junction = t.child0[t.rootSegment()] >= 0 ? t.rootSegment() : -1;
+    EXPECT_GE(junction, 0);
+    const double a = t.flow[t.child0[junction]], b = t.flow[t.child1[junction]];
+    return std::min(a, b) / (a + b);
+  };
+  const auto file = test::sourceDir() / "examples/dcco_two_inlets_2d.toml";
+  const auto g = growFile(file);
+  EXPECT_EQ(g.forest.vessels.totalTerminals(), 2 + 25 + 975);
+  const double balanced = share(g.forest);
+  auto text = readText(file);
+  text.replace(text.find("cost = \"sprout\""), 15, "cost = \"volume\"");
+  text.replace(text.find("dcco_two_inlets_t0_2d.swc"), 25, (test::sourceDir() / "examples/dcco_two_inlets_t0_2d.swc").string());
+  const auto volume = growFile(scratchToml("volume_only.toml", text));
+  const double skewed = share(volume.forest);
+  std::cout << "smaller inlet's share of Q: sprout then volume " << balanced << ", volume only " << skewed << "\n";
+  EXPECT_GT(balanced, 0.4);
+  EXPECT_LT(skewed, 0.3);
+}

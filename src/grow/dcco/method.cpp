@@ -598,7 +598,7 @@ const GrowthMethod kDccoMethod{
     "a fixed root radius and inflow, constant or Pries viscosity, angle and symmetry limits, no overlapping vessels",
     withDomainParams("sphere, cube, disc or square (2D), or mask: the region every vessel stays in",
                      "masks: terminals of stages over the whole domain drawn uniformly, or ∝ the mask value (demand; as [[stage]] pdf = \"demand\")", {
-        {"tree", "root_radius", "mm", "with [initial]: each root vessel's radius in its file", "r_1, the fixed radius of the root vessel (of every root of [initial])"},
+        {"tree", "root_radius", "mm", "[initial]: each root vessel's radius in its file; required without it", "r_1, the fixed radius of the root vessel (of every root of [initial])"},
         {"initial", "file", "path", "none", "an existing network the growth continues (.cco of VItA, .swc); positions relative to the domain's centre; each root is an inlet"},
         {"initial", "unit", "text", "mm", "length unit of the file: mm, cm, m, um"},
         {"initial", "branching", "text", "none", "branching of its vessels where the file gives none: none, distal, fixed, versatile"},
