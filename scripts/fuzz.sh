@@ -15,12 +15,13 @@ root=$(pwd)
 corpus=build-san/fuzz-corpus
 findings=build-san/fuzz-findings
 mkdir -p "$findings"
-for t in toml_params vascusynth_params box_map noise_file profile dataset_spec manifest nifti_mask; do mkdir -p "$corpus/fuzz_$t"; done
+for t in toml_params vascusynth_params box_map noise_file profile dataset_spec manifest nifti_mask network_file; do mkdir -p "$corpus/fuzz_$t"; done
 cp examples/*.toml "$corpus/fuzz_toml_params/" 2>/dev/null || true
 for f in examples/vascusynth/param*.txt; do cp "$f" "$corpus/fuzz_vascusynth_params/"; done
 for f in demand_maps/vascusynth_rods_100.txt demand_maps/supply_100.txt tests/data/*.txt; do [ -f "$f" ] && cp "$f" "$corpus/fuzz_box_map/" || true; done
 for f in noise_profiles/*.txt tests/data/*noise*; do [ -f "$f" ] && cp "$f" "$corpus/fuzz_noise_file/" || true; done
 cp noise_profiles/*.toml "$corpus/fuzz_profile/"
+cp examples/*.swc examples/*.cco "$corpus/fuzz_network_file/" 2>/dev/null || true
 for f in examples/dataset_*.toml tests/data/dataset_*.toml; do cp "$f" "$corpus/fuzz_dataset_spec/"; done
 printf '%s\n' '{"index":0,"status":"ok","files":[{"path":"imagesTr/F_0000_0000.nii.gz","size":5,"sha256":"6105d6cc76af400325e94d588ce511be5bfdbb73b437dc51eca43917d7a43e3d"}]}' \
   '{"index":1,"status":"failed","error":"x"}' > "$corpus/fuzz_manifest/two_lines.jsonl"
@@ -35,7 +36,7 @@ fi
 # Inputs that once failed, kept so every run tries them first.
 for d in fuzz/regressions/*/; do cp "$d"* "$corpus/$(basename "$d")/" 2>/dev/null || true; done
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_toml_params fuzz_vascusynth_params fuzz_box_map fuzz_noise_file fuzz_profile fuzz_dataset_spec fuzz_manifest fuzz_nifti_mask)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_toml_params fuzz_vascusynth_params fuzz_box_map fuzz_noise_file fuzz_profile fuzz_dataset_spec fuzz_manifest fuzz_nifti_mask fuzz_network_file)
 export ASAN_OPTIONS="detect_leaks=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/sanitizer/ubsan.supp"
 status=0

@@ -137,55 +137,81 @@ TEST(DccoDomains, OneSliceMaskDepthIsTheDiscsDistanceNotCappedNearTheBorder) {
 class DccoExample : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(DccoExample, TreeMeetsEveryConstraintOfItsStages) {
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+  // 7320 terminals take minutes under the sanitizers; the release run checks this tree.
+  if (std::string(GetParam()) == "dcco_brain_shell_3d.toml") GTEST_SKIP() << "too slow under AddressSanitizer";
+#endif
+#endif
   const auto g = growFile(test::sourceDir() / "examples" / GetParam());
   const auto& s = *g.setup;
   const auto& t = g.forest.vessels;
   const auto& o = s.options;
   const auto& world = *g.prepared->domain();
   ASSERT_GT(t.nodeCount(), 2);
-  // Terminal counts per stage, exact; every vessel knows its stage, role and branching.
+  // Terminal counts per stage, exact; every vessel knows its stage, role and branching (the
+  // initial network's vessels: stage -1, as the file and [[initial.vessel]] set them).
+  const bool initial = !s.initial_file.empty();
   std::vector<std::int64_t> per_stage(s.stages.size(), 0);
   for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    if (t.isRoot(i)) continue;
+    EXPECT_NE(t.role[i], 0);
+    if (initial && t.stage[i] < 0) continue;
     ASSERT_GE(t.stage[i], 0);
     ASSERT_LT(std::size_t(t.stage[i]), s.stages.size());
-    EXPECT_NE(t.role[i], 0);
     EXPECT_EQ(Branching(t.branching[i]), Branching::Versatile);
     if (t.isTerminal(i)) ++per_stage[t.stage[i]];
   }
   for (std::size_t k = 0; k < s.stages.size(); ++k) EXPECT_EQ(per_stage[k], s.stages[k].stage.terminal_count) << s.stages[k].stage.name;
-  // Radius fixed at the root; Murray at every bifurcation; flow conserved; equal terminal flow.
-  const auto root = t.rootSegment();
-  EXPECT_DOUBLE_EQ(t.radius[root], o.root_radius);
-  EXPECT_NEAR(t.flow[root] / o.flow, 1, 1e-12);
-  const double q_term = o.flow / double(t.terminals[root]);
+  // Radii fixed at the roots; Murray at every bifurcation; flow conserved; outlets carry their
+  // share, the other terminals one flow; Q in.
+  double inflow = 0, reserved = 0;
+  std::int64_t common = 0;
+  for (auto r : t.roots()) {
+    const auto seg = t.child0[r];
+    EXPECT_DOUBLE_EQ(t.radius[seg], initial ? s.root_radii[std::size_t(t.tree[r])] : o.root_radius);
+    inflow += t.flow[seg];
+  }
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i)
+    if (t.isTerminal(i)) (t.outflow[i] > 0 ? reserved += t.outflow[i] : ++common);
+  EXPECT_NEAR(inflow / o.flow, 1, 1e-12);
+  const double q_term = o.flow * (1 - reserved) / double(common);
   double worst_murray = 0, worst_flow = 0;
-  double p_min = 1e300, p_max = -1e300;
+  std::vector<double> p_min(t.roots().size(), 1e300), p_max(t.roots().size(), -1e300);
   for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    if (t.isRoot(i)) continue;
     const auto a = t.child0[i], b = t.child1[i];
     if (a < 0) {
-      EXPECT_NEAR(t.flow[i] / q_term, 1, 1e-12);
-      p_min = std::min(p_min, t.pressure[i]);
-      p_max = std::max(p_max, t.pressure[i]);
+      EXPECT_NEAR(t.flow[i] / (t.outflow[i] > 0 ? t.outflow[i] * o.flow : q_term), 1, 1e-12);
+      auto& lo = p_min[std::size_t(t.tree[i])];
+      auto& hi = p_max[std::size_t(t.tree[i])];
+      lo = std::min(lo, t.pressure[i]);
+      hi = std::max(hi, t.pressure[i]);
       continue;
     }
-    ASSERT_GE(b, 0);
-    const double g3 = s.stages[t.stage[b]].stage.gamma;
+    if (b < 0) {  // a continuation: the flow and the radius pass on
+      worst_flow = std::max(worst_flow, std::abs(t.flow[i] - t.flow[a]) / t.flow[i]);
+      EXPECT_DOUBLE_EQ(t.radius[a], t.radius[i]);
+      continue;
+    }
+    const double g3 = s.stages[std::size_t(std::max<int>(t.stage[b], 0))].stage.gamma;
     worst_murray = std::max(worst_murray, std::abs(std::pow(t.radius[i], g3) - std::pow(t.radius[a], g3) - std::pow(t.radius[b], g3)) /
                                               std::pow(t.radius[i], g3));
     worst_flow = std::max(worst_flow, std::abs(t.flow[i] - t.flow[a] - t.flow[b]) / t.flow[i]);
   }
   EXPECT_LE(worst_murray, 1e-9);
   EXPECT_LE(worst_flow, 1e-12);
-  // Karch's radii with the viscosities of the fixed point give every terminal one pressure.
-  EXPECT_LT((p_max - p_min) / (o.root_pressure - p_min), 1e-9);
+  // Karch's radii with the viscosities of the fixed point give the terminals of a tree one pressure.
+  for (std::size_t k = 0; k < p_min.size(); ++k) EXPECT_LT((p_max[k] - p_min[k]) / (o.root_pressure - p_min[k]), 1e-9);
   // δ and θ at every bifurcation of two terminal vessels (its geometry is that of its making).
   std::int64_t terminal_pairs = 0;
   for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
     const auto a = t.child0[i], b = t.child1[i];
-    if (a < 0 || b < 0 || !t.isTerminal(a) || !t.isTerminal(b)) continue;
+    if (a < 0 || b < 0 || !t.isTerminal(a) || !t.isTerminal(b) || t.stage[b] < 0) continue;
     ++terminal_pairs;
     const auto& st = s.stages[t.stage[b]].stage;
     EXPECT_GT(std::min(t.radius[a], t.radius[b]) / std::max(t.radius[a], t.radius[b]), st.deltaAt(t.depth[i] - 1) - 1e-9);
+    if (Branching(t.branching[i]) == Branching::Distal) continue;  // a distal junction has no angle to keep
     const double theta = bifurcationAngle(t.position[i], t.position[a], t.position[b]);
     EXPECT_GE(theta, st.theta_min - 1e-9);
     EXPECT_LE(theta, st.theta_max + 1e-9);
@@ -193,10 +219,29 @@ TEST_P(DccoExample, TreeMeetsEveryConstraintOfItsStages) {
   EXPECT_GT(terminal_pairs, 10);
   // Containment: every vessel in the domain; distribution vessels (but the root vessel) in their
   // stage's regions, within a voxel (regions are rasterised on the frame).
-  test::expectGeometry(t, world);
+  // The initial network may leave the domain (a feeding artery, outlets): the grown vessels may not.
+  if (!initial) {
+    test::expectGeometry(t, world);
+  } else {
+    std::int64_t short_segments = 0, outside = 0;
+    for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+      if (t.isRoot(i)) continue;
+      short_segments += !(t.length[i] > 2 * t.radius[i]);
+      if (t.stage[i] < 0) continue;
+      for (int k = 0; k <= 64; ++k)
+        if (world.depth(t.position[t.parent[i]] + (t.position[i] - t.position[t.parent[i]]) * (k / 64.0)) < t.radius[i] - 1e-9) {
+          ++outside;
+          break;
+        }
+    }
+    EXPECT_EQ(short_segments, 0);
+    EXPECT_EQ(outside, 0);
+    EXPECT_EQ(test::bruteForceIntersections(t), 0);
+  }
   const double voxel = world.frame().voxel_mm;
   std::int64_t outside_stage = 0;
   for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    if (t.isRoot(i) || t.stage[i] < 0) continue;
     const auto& sp = s.stages[t.stage[i]];
     if (VesselRole(t.role[i]) != VesselRole::Distribution || sp.domain.empty() || t.parent[i] == 0) continue;
     // The capsule's surface, sampled (centreline points offset by r across it), must lie in the
@@ -229,7 +274,7 @@ TEST_P(DccoExample, TreeMeetsEveryConstraintOfItsStages) {
   // A perforator branches only inside the domain of the stage that hung the branch on it.
   std::int64_t perforator_branches = 0, outside_branches = 0;
   for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
-    if (VesselRole(t.role[i]) != VesselRole::Perforator || t.child1[i] < 0) continue;
+    if (t.isRoot(i) || VesselRole(t.role[i]) != VesselRole::Perforator || t.child1[i] < 0) continue;
     ++perforator_branches;
     const auto& sp = s.stages[t.stage[t.child1[i]]];
     double depth = sp.domain.empty() ? 1e300 : -1e300;
@@ -254,18 +299,24 @@ TEST_P(DccoExample, TreeMeetsEveryConstraintOfItsStages) {
     return v;
   };
   const auto stages = values("stage"), functions = values("vesselFunction"), branching = values("branchingType");
-  ASSERT_EQ(stages.size(), std::size_t(t.segmentCount()));
+  ASSERT_EQ(stages.size(), std::size_t(t.nodeCount()) - t.roots().size());
   std::size_t k = 0;
-  for (std::int32_t i = 1; i < t.nodeCount(); ++i, ++k) {
+  const auto vitaBranching = [](std::uint8_t b) {
+    return Branching(b) == Branching::None ? 0 : Branching(b) == Branching::Fixed ? 1 : Branching(b) == Branching::Distal ? 3 : 2;
+  };
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    if (t.isRoot(i)) continue;
     EXPECT_EQ(stages[k], t.stage[i]);
     EXPECT_EQ(functions[k], VesselRole(t.role[i]) == VesselRole::Distribution ? 0 : VesselRole(t.role[i]) == VesselRole::Perforator ? 1 : 2);
-    EXPECT_EQ(branching[k], 2);
+    EXPECT_EQ(branching[k], vitaBranching(t.branching[i]));
+    ++k;
   }
 }
 
 INSTANTIATE_TEST_SUITE_P(Shipped, DccoExample,
                          ::testing::Values("dcco_scale_specific_2d.toml", "dcco_hierarchical_2d.toml", "dcco_pdf_mixture_2d.toml",
-                                           "dcco_sphere_pries_3d.toml"),
+                                           "dcco_sphere_pries_3d.toml", "dcco_outlet_half_2d.toml", "dcco_outlet_most_2d.toml",
+                                           "dcco_two_inlets_2d.toml", "dcco_brain_shell_3d.toml"),
                          [](const auto& info) {
                            std::string n = info.param;
                            return n.substr(5, n.size() - 10);  // dcco_<name>.toml

@@ -27,7 +27,8 @@ constexpr double kRefreshShare = 0.02;
 // Vessels with ρ = r/r_1 above kThickReach are not found through the grid but from a list of
 // those above kThickList (rebuilt at every fixed point, while ρ drifts by a few percent).
 constexpr double kThickReach = 0.25, kThickList = 0.2;
-// The repair sheds at most this share of a stage's terminals from below one vessel.
+// The repair sheds at most this share of a stage's terminals from below one vessel while that
+// fixes something (more only when a violation would otherwise stay).
 constexpr double kMaxShedShare = 0.05;
 
 // Characteristic length of a domain (eq. 13): the radius of the disc or ball of its measure.
@@ -890,18 +891,24 @@ class DccoGrower {
       // A vessel of an earlier stage that thickened into a neighbour (or below 2 r) sheds the
       // branches this stage hung below it: they regrow elsewhere, and its radius falls back.
       std::vector<std::int32_t> fix;
-      for (auto s : bad) {
-        if (ownSubtree(s)) {
-          fix.push_back(s);
-          continue;
+      // At most kMaxShedShare of the stage's terminals per vessel (a trunk of an earlier stage may
+      // carry the whole stage), doubled while that leaves a violation with nothing to shed.
+      for (double cap = kMaxShedShare;; cap = std::min(1.0, 2 * cap)) {
+        fix.clear();
+        bool held = false;
+        for (auto s : bad) {
+          if (ownSubtree(s)) {
+            fix.push_back(s);
+            continue;
+          }
+          std::vector<std::int32_t> below;
+          ownBranchesBelow(s, below);
+          std::int64_t shed = 0;
+          for (auto b : below) shed += t_.terminals[b];
+          if (double(shed) <= std::max(1.0, cap * double(stage().terminal_count))) fix.insert(fix.end(), below.begin(), below.end());
+          else held = true;
         }
-        // At most kMaxShedShare of the stage's terminals per vessel (a trunk of an earlier stage
-        // may carry the whole stage).
-        std::vector<std::int32_t> below;
-        ownBranchesBelow(s, below);
-        std::int64_t shed = 0;
-        for (auto b : below) shed += t_.terminals[b];
-        if (double(shed) <= std::max(1.0, kMaxShedShare * double(stage().terminal_count))) fix.insert(fix.end(), below.begin(), below.end());
+        if (!fix.empty() || !held || cap >= 1) break;
       }
       std::sort(fix.begin(), fix.end());
       fix.erase(std::unique(fix.begin(), fix.end()), fix.end());
