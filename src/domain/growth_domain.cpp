@@ -76,7 +76,15 @@ GrowthDomain GrowthDomain::mask(DemandMap map, bool demand_weighted) {
   d.center_ = m.extentMm() * 0.5;
   d.size_ = 0;
   d.depth_ = maskDepthMap(m);
-  d.sampler_ = std::make_shared<DemandSampler>(weights);
+  if (demand_weighted) {
+    d.sampler_ = std::make_shared<DemandSampler>(weights);
+  } else {  // equal weights: the k-th inside voxel, k = ⌊u·N⌋, as the sum tree would pick it, in O(N) memory
+    auto in = std::make_shared<std::vector<std::int64_t>>();
+    in->reserve(std::size_t(inside));
+    for (std::size_t v = 0; v < weights.size(); ++v)
+      if (weights[v] > 0) in->push_back(std::int64_t(v));
+    d.inside_ = std::move(in);
+  }
   return d;
 }
 
@@ -103,7 +111,12 @@ double GrowthDomain::maskDepth(const Vec3& p) const {
     const double w = (di ? f[0] : 1 - f[0]) * (dj ? f[1] : 1 - f[1]) * (dk ? f[2] : 1 - f[2]);
     if (w != 0) v += w * depth_[m.flat(i, j, k)];
   }
-  return v;
+  // Interpolation overestimates the depth near a concave edge of the mask (the distance there is
+  // a cone): a point in a voxel outside the mask is never inside.
+  const int vi = std::min(static_cast<int>(std::floor(c[0] + 0.5)), m.dims[0] - 1),
+            vj = std::min(static_cast<int>(std::floor(c[1] + 0.5)), m.dims[1] - 1),
+            vk = dimension_ == 2 ? 0 : std::min(static_cast<int>(std::floor(c[2] + 0.5)), m.dims[2] - 1);
+  return depth_[m.flat(vi, vj, vk)] < 0 ? std::min(v, 0.0) : v;
 }
 
 double GrowthDomain::depth(const Vec3& p) const {
@@ -146,7 +159,14 @@ Vec3 GrowthDomain::sample(Rng& rng) const {
   }
   const auto& m = map_;
   for (;;) {
-    const auto v = sampler_->sample(rng.uniform());
+    const double u = rng.uniform();
+    std::int64_t v = -1;
+    if (sampler_) {
+      v = sampler_->sample(u);
+    } else {
+      const double rank = u * double(inside_->size());  // u·N may round up to N: no voxel, draw again
+      if (rank < double(inside_->size())) v = (*inside_)[std::size_t(rank)];
+    }
     const Vec3 jitter(rng.uniform(), rng.uniform(), dimension_ == 2 ? 0.5 : rng.uniform());
     if (v < 0) continue;
     const std::int64_t nx = m.dims[0], ny = m.dims[1];

@@ -68,11 +68,12 @@ class GrowthDomain {
   bool demand_weighted_ = false;
   double mean_weight_ = 1;
   std::vector<float> depth_;  // masks: depth at voxel centres, mm
-  std::shared_ptr<const DemandSampler> sampler_;
+  std::shared_ptr<const DemandSampler> sampler_;               // demand-weighted masks
+  std::shared_ptr<const std::vector<std::int64_t>> inside_;    // uniform masks: their voxels in order
 };
 
 // Depth (mm, positive inside) at every voxel centre of a mask with weight > 0 inside; voxels
-// outside the map count as outside. One-slice maps get 2D distances. OpenVDB fast sweeping.
+// outside the map count as outside. One-slice maps get 2D distances. Exact Euclidean distance transform.
 std::vector<float> maskDepthMap(const DemandMap& map);
 
 }  // namespace angiosynth

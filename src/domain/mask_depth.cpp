@@ -1,9 +1,8 @@
-// The only translation unit of the domain module that includes OpenVDB.
-#include <openvdb/openvdb.h>
-#include <openvdb/tools/FastSweeping.h>
+// Depth maps of mask domains: exact Euclidean distances (Felzenszwalb & Huttenlocher), in parallel.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <cmath>
-#include <mutex>
 
 #include "domain/growth_domain.hpp"
 
@@ -40,65 +39,56 @@ void edt1d(const std::vector<double>& f, std::vector<double>& d, std::vector<int
   }
 }
 
-// Depth of a one-slice map, exact in 2D: the distance from each voxel centre to the nearest
-// centre of the other side, minus half a voxel (the border lies halfway), signed.
-std::vector<float> flatDepth(const DemandMap& m) {
-  const int nx = m.dims[0] + 2, ny = m.dims[1] + 2;  // with one layer of outside voxels around
-  const auto inside = [&](int i, int j) {
-    return i >= 1 && j >= 1 && i <= m.dims[0] && j <= m.dims[1] && m.demand[m.flat(i - 1, j - 1, 0)] > 0;
-  };
+// Depth of a map, exact: the distance from each voxel centre to the nearest centre of the other
+// side, minus half a voxel (the border lies halfway), signed; separable squared distances
+// (x, y, then z lines), each line independent. One-slice maps are 2D (no z pass: a slab of
+// slices would bound the depth by its thickness).
+std::vector<float> exactDepth(const DemandMap& m) {
+  const bool flat = m.dims[2] == 1;
+  // One layer of outside voxels around the map (none along z for one-slice maps).
+  const int n[3] = {m.dims[0] + 2, m.dims[1] + 2, flat ? 1 : m.dims[2] + 2};
+  const int off = flat ? 0 : 1;
+  const auto at = [&](int i, int j, int k) { return (std::size_t(k) * n[1] + j) * n[0] + i; };
+  std::vector<char> inside(std::size_t(n[0]) * n[1] * n[2], 0);
+  for (int k = 0; k < m.dims[2]; ++k)
+    for (int j = 0; j < m.dims[1]; ++j)
+      for (int i = 0; i < m.dims[0]; ++i) inside[at(i + 1, j + 1, k + off)] = m.demand[m.flat(i, j, k)] > 0;
   std::vector<float> depth(m.voxelCount());
-  std::vector<double> f, d, z, col(std::size_t(nx) * ny);
-  std::vector<int> v;
+  std::vector<double> g(inside.size());
   for (const bool to_outside : {true, false}) {
-    // Squared distance (voxels²) to the nearest voxel of the other side: columns, then rows.
-    for (int i = 0; i < nx; ++i) {
-      f.assign(ny, kFar);
-      for (int j = 0; j < ny; ++j)
-        if (inside(i, j) != to_outside) f[j] = 0;
-      edt1d(f, d, v, z);
-      for (int j = 0; j < ny; ++j) col[std::size_t(j) * nx + i] = d[j];
+    for (std::size_t v = 0; v < g.size(); ++v) g[v] = (inside[v] != 0) != to_outside ? 0.0 : kFar;
+    for (int axis = 0; axis < (flat ? 2 : 3); ++axis) {
+      // The lines along `axis`, indexed by their two other coordinates.
+      const int a = axis == 0 ? 1 : 0, b = axis == 2 ? 1 : 2;
+      const int len = n[axis], na = n[a];
+      const std::size_t lines = std::size_t(n[a]) * n[b];
+      const std::size_t stride[3] = {1, std::size_t(n[0]), std::size_t(n[0]) * n[1]};
+      const std::size_t step = stride[axis], sa = stride[a], sb = stride[b];
+      double* data = g.data();
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lines), [data, len, na, step, sa, sb](const tbb::blocked_range<std::size_t>& r) {
+        std::vector<double> f(static_cast<std::size_t>(len)), d, z;
+        std::vector<int> v;
+        for (std::size_t line = r.begin(); line != r.end(); ++line) {
+          double* p = data + (line % std::size_t(na)) * sa + (line / std::size_t(na)) * sb;
+          for (int q = 0; q < len; ++q) f[std::size_t(q)] = p[std::size_t(q) * step];
+          edt1d(f, d, v, z);
+          for (int q = 0; q < len; ++q) p[std::size_t(q) * step] = d[std::size_t(q)];
+        }
+      });
     }
-    for (int j = 0; j < ny; ++j) {
-      f.assign(col.begin() + std::ptrdiff_t(j) * nx, col.begin() + std::ptrdiff_t(j + 1) * nx);
-      edt1d(f, d, v, z);
-      for (int i = 1; i <= m.dims[0]; ++i)
-        if (j >= 1 && j <= m.dims[1] && inside(i, j) == to_outside)
-          depth[m.flat(i - 1, j - 1, 0)] = float((to_outside ? 1.0 : -1.0) * (std::sqrt(d[i]) - 0.5) * m.voxel_mm);
-    }
+    for (int k = 0; k < m.dims[2]; ++k)
+      for (int j = 0; j < m.dims[1]; ++j)
+        for (int i = 0; i < m.dims[0]; ++i) {
+          const auto v = at(i + 1, j + 1, k + off);
+          if ((inside[v] != 0) == to_outside)
+            depth[m.flat(i, j, k)] = float((to_outside ? 1.0 : -1.0) * (std::sqrt(g[v]) - 0.5) * m.voxel_mm);
+        }
   }
   return depth;
 }
 
 }  // namespace
 
-std::vector<float> maskDepthMap(const DemandMap& m) {
-  // One-slice maps: exact 2D distances (a slab of slices would bound the depth by its thickness).
-  if (m.dims[2] == 1) return flatDepth(m);
-  static std::once_flag init;
-  std::call_once(init, [] { openvdb::initialize(); });
-  const bool flat = m.dims[2] == 1;
-  // Fog: 1 inside, 0 outside, every voxel active, with one layer of outside voxels around the
-  // map (none along z for one-slice maps, whose slice is repeated so that z has no border).
-  auto fog = openvdb::FloatGrid::create(0.0f);
-  fog->setTransform(openvdb::math::Transform::createLinearTransform(m.voxel_mm));
-  auto acc = fog->getAccessor();
-  const int kz0 = -1, kz1 = flat ? 1 : m.dims[2];
-  for (int k = kz0; k <= kz1; ++k)
-    for (int j = -1; j <= m.dims[1]; ++j)
-      for (int i = -1; i <= m.dims[0]; ++i) {
-        const int kk = flat ? 0 : k;
-        const bool in = i >= 0 && j >= 0 && kk >= 0 && i < m.dims[0] && j < m.dims[1] && kk < m.dims[2] &&
-                        m.demand[m.flat(i, j, kk)] > 0;
-        acc.setValueOn(openvdb::Coord(i, j, k), in ? 1.0f : 0.0f);
-      }
-  auto sdf = openvdb::tools::fogToSdf(*fog, 0.5f, 1);
-  auto sacc = sdf->getConstAccessor();
-  std::vector<float> depth(m.voxelCount());
-  for (int k = 0; k < m.dims[2]; ++k)
-    for (int j = 0; j < m.dims[1]; ++j)
-      for (int i = 0; i < m.dims[0]; ++i) depth[m.flat(i, j, k)] = -sacc.getValue(openvdb::Coord(i, j, k));
-  return depth;
-}
+std::vector<float> maskDepthMap(const DemandMap& m) { return exactDepth(m); }
 
 }  // namespace angiosynth
