@@ -316,7 +316,8 @@ TEST_P(DccoExample, TreeMeetsEveryConstraintOfItsStages) {
 INSTANTIATE_TEST_SUITE_P(Shipped, DccoExample,
                          ::testing::Values("dcco_scale_specific_2d.toml", "dcco_hierarchical_2d.toml", "dcco_pdf_mixture_2d.toml",
                                            "dcco_sphere_pries_3d.toml", "dcco_outlet_half_2d.toml", "dcco_outlet_most_2d.toml",
-                                           "dcco_two_inlets_2d.toml", "dcco_brain_shell_3d.toml"),
+                                           "dcco_two_inlets_2d.toml", "dcco_two_inlets_3d.toml", "dcco_sequential_2d.toml",
+                                           "dcco_brain_shell_3d.toml"),
                          [](const auto& info) {
                            std::string n = info.param;
                            return n.substr(5, n.size() - 10);  // dcco_<name>.toml
@@ -453,7 +454,9 @@ TEST(DccoInitial, OutletCarriesItsShareAndTheDomainTreeScalesAsFig5Says) {
     for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
       const auto a = t.child0[i], b = t.child1[i];
       if (a < 0) {
-        if (i != outlet) EXPECT_NEAR(t.flow[i] / q_f, 1, 1e-12);
+        if (i != outlet) {
+          EXPECT_NEAR(t.flow[i] / q_f, 1, 1e-12);
+        }
         p_min = std::min(p_min, t.pressure[i]);
         p_max = std::max(p_max, t.pressure[i]);
         continue;
@@ -500,7 +503,9 @@ TEST(DccoInitial, OutletCarriesItsShareAndTheDomainTreeScalesAsFig5Says) {
     EXPECT_LE(worst, 1e-9) << "every radius of the domain's tree scales alike";
     const auto resistance = [&](const VascularTree& v) { return (v.pressure[v.parent[domain]] - p_min_of(v)) / v.flow[domain]; };
     EXPECT_NEAR(k, std::pow(resistance(t) / resistance(u), 0.25), 1e-6 * k);
-    if (f < 0.99) EXPECT_LT(k, 1);
+    if (f < 0.99) {
+      EXPECT_LT(k, 1);
+    }
   }
   EXPECT_LT(mean_radius[1], mean_radius[0]) << "the more flow leaves, the thinner the domain's vessels";
 }
