@@ -21,7 +21,7 @@ for f in examples/vascusynth/param*.txt; do cp "$f" "$corpus/fuzz_vascusynth_par
 for f in demand_maps/vascusynth_rods_100.txt demand_maps/supply_100.txt tests/data/*.txt; do [ -f "$f" ] && cp "$f" "$corpus/fuzz_box_map/" || true; done
 for f in noise_profiles/*.txt tests/data/*noise*; do [ -f "$f" ] && cp "$f" "$corpus/fuzz_noise_file/" || true; done
 cp noise_profiles/*.toml "$corpus/fuzz_profile/"
-cp examples/*.swc examples/*.cco "$corpus/fuzz_network_file/" 2>/dev/null || true
+cp examples/*.swc examples/*.cco tests/data/network/*.vtp "$corpus/fuzz_network_file/" 2>/dev/null || true
 for f in examples/dataset_*.toml tests/data/dataset_*.toml; do cp "$f" "$corpus/fuzz_dataset_spec/"; done
 printf '%s\n' '{"index":0,"status":"ok","files":[{"path":"imagesTr/F_0000_0000.nii.gz","size":5,"sha256":"6105d6cc76af400325e94d588ce511be5bfdbb73b437dc51eca43917d7a43e3d"}]}' \
   '{"index":1,"status":"failed","error":"x"}' > "$corpus/fuzz_manifest/two_lines.jsonl"

@@ -58,6 +58,15 @@ const BadCase kCases[] = {
     {"inlet_roots_touch", "p.toml", "", "", CCO_FOREST "[[tree.inlet]]\nroot_offset = [0, 10, 0]\n[[tree.inlet]]\nroot_offset = [0.1, 9.99, 0]\n",
      "generate p.toml --out out", "p.toml:11: the roots of inlets 'artery_1' and 'artery_2' lie 0.100499 mm apart"},
 #undef CCO_FOREST
+    // dcco growing from an existing network ([initial]).
+#define DCCO_INITIAL "[domain]\nshape = \"disc\"\nradius = \"20 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"dcco\"\n[[stage]]\nterminals = 10\n[initial]\n"
+    {"initial_origin_unknown", "p.toml", "", "", DCCO_INITIAL "file = \"" ANGIOSYNTH_SOURCE_DIR "/examples/dcco_outlet_t0_2d.swc\"\norigin = \"middle\"\n",
+     "generate p.toml --out out", "p.toml:11: origin 'middle'; allowed: centre, corner"},
+    {"initial_format_unknown", "p.toml", "", "", DCCO_INITIAL "file = \"p.toml\"\n",
+     "generate p.toml --out out", "p.toml: unknown network format '.toml'; allowed: .cco (VItA), .swc, .gxl, .csv (nodes and edges), .vtp"},
+    {"initial_unit_unknown", "p.toml", "", "", DCCO_INITIAL "file = \"" ANGIOSYNTH_SOURCE_DIR "/tests/data/network/tree_ascii.vtp\"\nunit = \"inch\"\n",
+     "generate p.toml --out out", "p.toml:11: unit 'inch'; allowed: mm, cm, m, um"},
+#undef DCCO_INITIAL
     {"profile_intensity_huge", "prof.toml", "", "", "background = 1e30\n[[effect]]\ntype = \"gaussian\"\nsigma = 1\n",
      "generate p.toml --out out --profile prof.toml", "prof.toml:1: background = 1e+30 is out of range"},
     {"bias_scale_tiny", "prof.toml", "", "", "[[effect]]\ntype = \"bias\"\namplitude = 0.2\nscale = \"1e-9 mm\"\n",

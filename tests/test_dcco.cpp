@@ -18,6 +18,7 @@
 #include "io/network_files.hpp"
 #include "io/scenario.hpp"
 #include "physics/viscosity.hpp"
+#include "grow_file.hpp"
 #include "test_support.hpp"
 #include "tree_checks.hpp"
 
@@ -25,26 +26,8 @@ using namespace angiosynth;
 
 namespace {
 
-constexpr std::uint64_t kNoLimit = std::uint64_t(1) << 40;
-
-struct Grown {
-  std::shared_ptr<const GrowthSetup> growth;
-  std::unique_ptr<PreparedGrowth> prepared;
-  Forest forest;
-  const DccoSetup* setup = nullptr;
-};
-
-Grown growFile(const std::filesystem::path& file, std::uint64_t seed = 1) {
-  Grown g;
-  g.growth = readTomlParameters(file).growth;
-  g.setup = dynamic_cast<const DccoSetup*>(g.growth.get());
-  EXPECT_NE(g.setup, nullptr);
-  g.prepared = g.growth->prepare(kNoLimit);
-  g.prepared->checkFeasibility();
-  GrowthReport report;
-  g.forest = g.prepared->grow(seed, 0, report, {});
-  return g;
-}
+using test::Grown;
+using test::growFile;
 
 // Writes `text` to a scratch file and returns its path.
 std::filesystem::path scratchToml(const std::string& name, const std::string& text) {

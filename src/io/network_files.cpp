@@ -9,9 +9,11 @@
 #include "core/error.hpp"
 #include "core/format.hpp"
 #include "core/vessel_roles.hpp"
+#include "io/network_rows.hpp"
 #include "io/param_checks.hpp"
 
 namespace angiosynth {
+namespace network_detail {
 namespace {
 
 struct Line {
@@ -51,19 +53,9 @@ long long whole(const std::string& file, const Line& l, std::size_t k, const cha
   return static_cast<long long>(v);
 }
 
-// One segment of the file before the tree is assembled.
-struct Row {
-  std::string id;
-  std::string parent;  // empty: a root vessel (.cco) or root sample (SWC)
-  Vec3 prox, dist;     // .cco: both ends; SWC: dist only
-  double radius = 0, outflow = 0;
-  std::int16_t stage = -1;
-  std::uint8_t role = 0, branching = 0;
-  int line = 0;
-};
 
-// Builds the tree breadth-first from the roots in file order. `swc`: a root row is a root node
-// (no segment); else a root row is a root vessel whose proximal point is the root node.
+}  // namespace
+
 ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, bool swc, double unit_mm) {
   std::map<std::string, std::size_t> at;
   for (std::size_t k = 0; k < rows.size(); ++k)
@@ -156,6 +148,51 @@ std::uint8_t roleFromVita(const std::string& file, int line, long long code) {
     default: throw InputError(file, line, "vessel function " + std::to_string(code) + "; allowed: 0 (distribution), 1 (perforator), 2 (transport)");
   }
 }
+
+std::uint8_t roleNamed(const std::string& file, int line, const std::string& name) {
+  for (auto r : {VesselRole::Distribution, VesselRole::Transport, VesselRole::Perforator})
+    if (name == roleName(std::uint8_t(r))) return std::uint8_t(r);
+  if (name.empty()) return 0;
+  throw InputError(file, line, "role '" + name + "'; allowed: distribution, transport, perforator");
+}
+
+std::uint8_t branchingNamed(const std::string& file, int line, const std::string& name) {
+  for (auto b : {Branching::Versatile, Branching::Fixed, Branching::Distal, Branching::None})
+    if (name == branchingName(std::uint8_t(b))) return std::uint8_t(b);
+  if (name.empty()) return 0;
+  throw InputError(file, line, "branching '" + name + "'; allowed: versatile, fixed, distal, none");
+}
+
+std::vector<Row> rowsFromPoints(const std::string& file, const std::vector<Vec3>& points, std::vector<PointSegment> segments) {
+  constexpr auto kNone = std::size_t(-1);
+  std::vector<std::size_t> ending(points.size(), kNone), root_starts(points.size(), 0);
+  for (std::size_t k = 0; k < segments.size(); ++k) {
+    auto& s = segments[k];
+    if (s.from >= points.size() || s.to >= points.size())
+      throw InputError(file, s.row.line, "vessel " + s.row.id + " refers to a point that is not defined");
+    if (s.from == s.to) throw InputError(file, s.row.line, "vessel " + s.row.id + " starts and ends at the same point");
+    if (ending[s.to] != kNone)
+      throw InputError(file, s.row.line, "vessels " + segments[ending[s.to]].row.id + " and " + s.row.id + " both end at " + show3(points[s.to]) +
+                                             ": a node of a tree has one parent vessel (a cycle, or vessels that merge)");
+    ending[s.to] = k;
+  }
+  std::vector<Row> rows;
+  rows.reserve(segments.size());
+  for (auto& s : segments) {
+    s.row.prox = points[s.from];
+    s.row.dist = points[s.to];
+    if (ending[s.from] != kNone) {
+      s.row.parent = segments[ending[s.from]].row.id;
+    } else if (++root_starts[s.from] > 1) {
+      throw InputError(file, s.row.line, "vessel " + s.row.id + " starts at the root point " + show3(points[s.from]) +
+                                             ", which starts another vessel: a tree's root has one vessel");
+    }
+    rows.push_back(s.row);
+  }
+  return rows;
+}
+
+namespace {
 
 ExistingNetwork readCco(const std::string& file, double unit_mm) {
   const auto lines = tokenLines(file);
@@ -274,16 +311,22 @@ int vitaFunction(std::uint8_t r) {
 }
 
 }  // namespace
+}  // namespace network_detail
 
 ExistingNetwork readNetwork(const std::filesystem::path& file, double unit_mm) {
   auto ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  using namespace network_detail;
   if (ext == ".cco") return readCco(file.string(), unit_mm);
   if (ext == ".swc") return readSwc(file.string(), unit_mm);
-  throw InputError(file.string(), 0, "unknown network format '" + ext + "'; allowed: .cco (VItA), .swc");
+  if (ext == ".gxl") return readGxl(file.string(), unit_mm);
+  if (ext == ".csv") return readCsv(file.string(), unit_mm);
+  if (ext == ".vtp") return readVtp(file.string(), unit_mm);
+  throw InputError(file.string(), 0, "unknown network format '" + ext + "'; allowed: .cco (VItA), .swc, .gxl, .csv (nodes and edges), .vtp");
 }
 
 void writeCco(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees) {
+  using namespace network_detail;
   (void)trees;
   const auto roots = t.roots();
   double terminal_pressure = 0;

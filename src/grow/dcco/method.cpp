@@ -31,10 +31,10 @@ class PreparedDcco final : public PreparedGrowth {
   PreparedDcco(const DccoSetup& s, GrowthDomain world) : setup_(s), world_(std::move(world)) {
     if (s.initial_file.empty()) {
       root_ = placeRoot(s.parameter_file, s.root, world_);
-    } else {  // the file's positions are relative to the domain's centre
+    } else {  // the file's positions are relative to the domain's centre, or its grid's corner
       initial_ = s.initial.tree;
       for (auto& p : initial_.position) {
-        p = p + world_.center();
+        if (!s.initial_from_corner) p = p + world_.center();
         if (world_.dimension() == 2) p.z = world_.planeZ();
       }
     }
@@ -357,6 +357,7 @@ void readInitial(const TomlReader& r, const GrowthMethod& m, DccoSetup& s, bool 
   const std::map<std::string, double> units{{"mm", 1.0}, {"cm", 10.0}, {"m", 1000.0}, {"um", 1e-3}};
   if (!units.count(unit)) throw InputError(r.file(), r.lineOf(t->get("unit")), "unit '" + unit + "'; allowed: mm, cm, m, um");
   s.initial = readNetwork(s.initial_file, units.at(unit));
+  s.initial_from_corner = choice<bool>(r, *t, "initial", "origin", false, {{"centre", false}, {"corner", true}});
   auto& tree = s.initial.tree;
   const auto branchingOf = [&](const toml::table& tab, const std::string& table, Branching fallback) {
     return choice<Branching>(r, tab, table, "branching", fallback,
@@ -508,7 +509,8 @@ Json DccoSetup::describe() const {
   if (d.voxel_mm > 0) j["voxel_size"] = quantityJson(d.voxel_mm, "mm");
   j["kind"] = kind;
   if (!initial_file.empty()) {
-    Json init{{"file", initial_file.string()}, {"vessels", initial.tree.segmentCount()}, {"roots", root_radii.size()}};
+    Json init{{"file", initial_file.string()}, {"origin", initial_from_corner ? "corner" : "centre"}, {"vessels", initial.tree.segmentCount()},
+              {"roots", root_radii.size()}};
     Json radii = Json::array(), outlets = Json::array();
     for (double v : root_radii) radii.push_back(v);
     init["root_radii_mm"] = radii;
@@ -599,7 +601,8 @@ const GrowthMethod kDccoMethod{
     withDomainParams("sphere, cube, disc or square (2D), or mask: the region every vessel stays in",
                      "masks: terminals of stages over the whole domain drawn uniformly, or ∝ the mask value (demand; as [[stage]] pdf = \"demand\")", {
         {"tree", "root_radius", "mm", "[initial]: each root vessel's radius in its file; required without it", "r_1, the fixed radius of the root vessel (of every root of [initial])"},
-        {"initial", "file", "path", "none", "an existing network the growth continues (.cco of VItA, .swc); positions relative to the domain's centre; each root is an inlet"},
+        {"initial", "file", "path", "none", "an existing network the growth continues (.cco of VItA, .swc, .vtp of VItA or VTK, angiosynth's .gxl or nodes/edges .csv); each root is an inlet"},
+        {"initial", "origin", "text", "centre", "where the file's positions start: centre (of the domain) or corner (of its grid, as angiosynth's graphs write them)"},
         {"initial", "unit", "text", "mm", "length unit of the file: mm, cm, m, um"},
         {"initial", "branching", "text", "none", "branching of its vessels where the file gives none: none, distal, fixed, versatile"},
         {"initial", "role", "text", "transport", "role of its vessels where the file gives none: distribution, transport, perforator"},

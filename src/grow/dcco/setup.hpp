@@ -31,9 +31,10 @@ struct DccoSetup final : GrowthSetup {
   std::vector<DccoStageSpec> stages;
   PhysicsParameters physics_summary;    // γ of the first stage, η, Q: for the statistics
   // [initial]: the network growth continues (empty path: none); positions relative to the
-  // domain's centre, branching, role and outflow as the file and [[initial.vessel]] set them.
+  // domain's centre or its grid's corner, branching, role and outflow as the file and [[initial.vessel]] set them.
   std::filesystem::path initial_file;
   ExistingNetwork initial;
+  bool initial_from_corner = false;     // [initial] origin = "corner": positions as angiosynth's graphs give them
   std::vector<double> root_radii;       // per root of the initial network
 
   const char* method() const override { return "dcco"; }
