@@ -25,10 +25,10 @@ class GrowthDomain {
   static GrowthDomain analytic(DomainShape shape, double size_mm, double voxel_mm, int margin_voxels = 2);
   // The voxel frame `analytic` builds, known before anything is allocated.
   static std::array<std::int32_t, 3> analyticDims(DomainShape shape, double size_mm, double voxel_mm, int margin_voxels = 2);
-  // A mask: voxels with weight > 0 are inside. Depth comes from a distance map of the mask
-  // border (OpenVDB fast sweeping): within a few voxels of the border (where it is compared with
-  // vessel radii) it is exact to a tenth of a voxel; deeper, its first-order error only makes
-  // it smaller, which keeps vessels further in. `demand_weighted`: terminals are drawn ∝ weight, else uniformly.
+  // A mask: voxels with weight > 0 are inside. Depth comes from the exact Euclidean distance
+  // between voxel centres of the two sides (less half a voxel), interpolated trilinearly and
+  // never positive in a voxel outside the mask. `demand_weighted`: terminals are drawn ∝
+  // weight, else uniformly.
   static GrowthDomain mask(DemandMap map, bool demand_weighted);
 
   DomainShape shape() const { return shape_; }

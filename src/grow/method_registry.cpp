@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "grow/cco/setup.hpp"
+#include "grow/colonisation/setup.hpp"
 #include "grow/dcco/setup.hpp"
 #include "grow/method.hpp"
 #include "grow/vascusynth/setup.hpp"
@@ -10,7 +11,7 @@
 namespace angiosynth {
 
 const std::vector<const GrowthMethod*>& growthMethods() {
-  static const std::vector<const GrowthMethod*> all{&kVascuSynthMethod, &kCcoMethod, &kDccoMethod};
+  static const std::vector<const GrowthMethod*> all{&kVascuSynthMethod, &kCcoMethod, &kDccoMethod, &kColonisationMethod};
   return all;
 }
 

@@ -6,6 +6,7 @@
 #include "core/error.hpp"
 #include "core/quantity_json.hpp"
 #include "grow/common/method_tables.hpp"
+#include "grow/common/region_tables.hpp"
 #include "grow/dcco/setup.hpp"
 #include "io/growth_domain_files.hpp"
 #include "io/param_checks.hpp"
@@ -157,106 +158,6 @@ class PreparedDcco final : public PreparedGrowth {
   mutable DccoReport dcco_;  // of the last grow(), for addStatistics
 };
 
-template <class E>
-E choice(const TomlReader& r, const toml::table& t, const std::string& table, const std::string& key, E fallback,
-         const std::vector<std::pair<const char*, E>>& values) {
-  if (!t.get(key)) return fallback;
-  const auto v = r.string(t, table, key);
-  std::string allowed;
-  for (const auto& [name, value] : values) {
-    if (v == name) return value;
-    allowed += (allowed.empty() ? "" : ", ") + std::string(name);
-  }
-  throw InputError(r.file(), r.lineOf(t.get(key)), key + " '" + v + "'; allowed: " + allowed);
-}
-
-std::vector<std::string> names(const TomlReader& r, const toml::table& t, const std::string& key, const std::set<std::string>& known) {
-  std::vector<std::string> out;
-  const auto* n = t.get(key);
-  if (!n) return out;
-  const auto* arr = n->as_array();
-  if (!arr) {
-    if (!n->is_string()) throw InputError(r.file(), r.lineOf(n), key + " must be a region name or an array of region names");
-    out.push_back(*n->value<std::string>());
-  } else {
-    for (const auto& e : *arr) {
-      if (!e.is_string()) throw InputError(r.file(), r.lineOf(n), key + " must hold region names (strings)");
-      out.push_back(*e.value<std::string>());
-    }
-  }
-  for (const auto& name : out)
-    if (!known.count(name)) {
-      std::string list;
-      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-      throw InputError(r.file(), r.lineOf(n), "region '" + name + "' in " + key + " is not defined; [[region]] names: " +
-                                                  (list.empty() ? "none" : list));
-    }
-  return out;
-}
-
-std::vector<RegionSpec> readRegions(const TomlReader& r, const GrowthMethod& m, bool flat) {
-  std::vector<RegionSpec> out;
-  const auto* list = r.root().get("region");
-  if (!list) return out;
-  const auto* arr = list->as_array();
-  if (!arr || !arr->is_array_of_tables()) throw InputError(r.file(), r.lineOf(list), "region must be an array of tables: write each as [[region]]");
-  std::set<std::string> seen;
-  for (const auto& node : *arr) {
-    const auto& t = *node.as_table();
-    checkMethodKeys(r, m, t, "region");
-    RegionSpec g;
-    g.line = r.lineOf(&t);
-    g.name = r.string(t, "region", "name");
-    if (g.name.empty() || !seen.insert(g.name).second)
-      throw InputError(r.file(), r.lineOf(t.get("name")), "region name '" + g.name + "' is empty or defined twice; names must be unique");
-    g.shape = choice<RegionShape>(r, t, "region", "shape", flat ? RegionShape::Disc : RegionShape::Sphere,
-                                  {{"sphere", RegionShape::Sphere}, {"disc", RegionShape::Disc}, {"shell", RegionShape::Shell},
-                                   {"annulus", RegionShape::Annulus}, {"box", RegionShape::Box}});
-    const bool shape_flat = g.shape == RegionShape::Disc || g.shape == RegionShape::Annulus;
-    if (flat != shape_flat && g.shape != RegionShape::Box)
-      throw InputError(r.file(), r.lineOf(t.get("shape") ? t.get("shape") : &t),
-                       std::string("region '") + g.name + "' is a " + regionShapeName(g.shape) + " in a " + (flat ? "2D" : "3D") +
-                           " domain; allowed: " + (flat ? "disc, annulus, box" : "sphere, shell, box"));
-    if (const auto* c = t.get("centre")) g.centre = r.point(c, "centre (mm from the domain's centre)", flat);
-    const auto length = [&](const char* key) {
-      const double v = r.quantity(t, "region", key, Dimension::Length);
-      checkRange(v, 0, true, Limits::kMaxLength, false, r.at(t, key), std::string(key) + " (mm)");
-      return v;
-    };
-    const auto only = [&](std::set<std::string> keys) {
-      for (const char* k : {"radius", "inner_radius", "outer_radius", "size"})
-        if (!keys.count(k) && t.get(k))
-          throw InputError(r.file(), r.lineOf(t.get(k)), std::string("'") + k + "' does not size a " + regionShapeName(g.shape));
-    };
-    switch (g.shape) {
-      case RegionShape::Sphere:
-      case RegionShape::Disc:
-        only({"radius"});
-        g.radius = length("radius");
-        break;
-      case RegionShape::Shell:
-      case RegionShape::Annulus:
-        only({"inner_radius", "outer_radius"});
-        g.inner = length("inner_radius");
-        g.outer = length("outer_radius");
-        if (!(g.outer > g.inner))
-          throw InputError(r.file(), r.lineOf(t.get("outer_radius")), "outer_radius must exceed inner_radius");
-        break;
-      case RegionShape::Box: {
-        only({"size"});
-        const auto* n = r.need(t, "region", "size");
-        const auto v = r.point(n, "size ([x, y(, z)] mm)", flat);
-        g.size = Vec3(v.x, v.y, flat ? 0.0 : v.z);
-        if (!(g.size.x > 0 && g.size.y > 0 && (flat || g.size.z > 0)))
-          throw InputError(r.file(), r.lineOf(n), "size must be positive on every axis");
-        break;
-      }
-    }
-    out.push_back(g);
-  }
-  return out;
-}
-
 // δ: one number for every level, or a list by bifurcation level (the last repeats).
 std::vector<double> readSymmetry(const TomlReader& r, const toml::table& t) {
   const auto* n = t.get("symmetry");
@@ -296,9 +197,9 @@ DccoStageSpec readStage(const TomlReader& r, const GrowthMethod& m, const toml::
   st.name = t.get("name") ? r.string(t, "stage", "name") : "stage_" + std::to_string(index + 1);
   st.terminal_count = r.integer(t, "stage", "terminals");
   checkRange(double(st.terminal_count), 1, false, Limits::kMaxTerminals, false, r.at(t, "terminals"), "terminals");
-  s.domain = names(r, t, "domain", regions);
-  s.avascular = names(r, t, "avascular", regions);
-  s.carriage = names(r, t, "carriage", regions);
+  s.domain = regionNames(r, t, "domain", regions);
+  s.avascular = regionNames(r, t, "avascular", regions);
+  s.carriage = regionNames(r, t, "carriage", regions);
   st.pdf = choice<TerminalPdf>(r, t, "stage", "pdf", TerminalPdf::Uniform,
                                {{"uniform", TerminalPdf::Uniform}, {"demand", TerminalPdf::Demand}, {"gaussian", TerminalPdf::Gaussian}});
   if (st.pdf == TerminalPdf::Gaussian) st.gaussians = readGaussians(r, m, t, flat);
@@ -598,7 +499,7 @@ const GrowthMethod kDccoMethod{
     "domain-constrained CCO in stages (Maso Talou et al. 2021, seed 001): each [[stage]] adds its terminals in its own "
     "region with its own parameters, cost (volume or sprouting) and vessel role; bifurcations on DCCO's triangle lattice, "
     "a fixed root radius and inflow, constant or Pries viscosity, angle and symmetry limits, no overlapping vessels",
-    withDomainParams("sphere, cube, disc or square (2D), or mask: the region every vessel stays in",
+    withRegionParams(withDomainParams("sphere, cube, disc or square (2D), or mask: the region every vessel stays in",
                      "masks: terminals of stages over the whole domain drawn uniformly, or ∝ the mask value (demand; as [[stage]] pdf = \"demand\")", {
         {"tree", "root_radius", "mm", "[initial]: each root vessel's radius in its file; required without it", "r_1, the fixed radius of the root vessel (of every root of [initial])"},
         {"initial", "file", "path", "none", "an existing network the growth continues (.cco of VItA, .swc, .vtp of VItA or VTK, angiosynth's .gxl or nodes/edges .csv); each root is an inlet"},
@@ -615,13 +516,6 @@ const GrowthMethod kDccoMethod{
         {"physics", "pries_exponent", "", "0.645", "the exponent of D in Pries' law (the paper prints 0.64)"},
         {"physics", "perfusion_flow", "mm^3/s", "500 mL/min", "Q, the inflow, split equally among the terminals"},
         {"physics", "perfusion_pressure", "Pa", "100 mmHg", "pressure at the root (the pressures downstream follow from the radii)"},
-        {"region", "name", "text", nullptr, "the region's name, used by [[stage]] domain, avascular and carriage"},
-        {"region", "shape", "text", "sphere (3D), disc (2D)", "sphere, shell, box (3D); disc, annulus, box (2D)"},
-        {"region", "centre", "[x, y(, z)] mm", "[0, 0, 0]", "relative to the domain's centre"},
-        {"region", "radius", "mm", nullptr, "sphere, disc"},
-        {"region", "inner_radius", "mm", nullptr, "shell, annulus"},
-        {"region", "outer_radius", "mm", nullptr, "shell, annulus"},
-        {"region", "size", "[x, y(, z)] mm", nullptr, "box: its sides"},
         {"stage", "name", "text", "stage_1, stage_2, ...", "the stage's name in sample.json"},
         {"stage", "terminals", "count", nullptr, "N^t, the terminals this stage adds"},
         {"stage", "domain", "region names", "the whole [domain]", "Ω_t, the union of these regions"},
@@ -648,7 +542,7 @@ const GrowthMethod kDccoMethod{
         {"stage.gaussian", "mean", "[x, y(, z)] mm", "[0, 0, 0]", "centre of the Gaussian, relative to the domain's centre"},
         {"stage.gaussian", "sigma", "[x, y(, z)] mm", nullptr, "standard deviation per axis"},
         {"stage.gaussian", "weight", "", "1", "its weight in the mixture"},
-    }),
+    }), "the region's name, used by [[stage]] domain, avascular and carriage"),
     &readDccoToml};
 
 }  // namespace angiosynth

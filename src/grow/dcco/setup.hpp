@@ -6,7 +6,7 @@
 
 #include "grow/common/domain_spec.hpp"
 #include "grow/dcco/grower.hpp"
-#include "grow/dcco/regions.hpp"
+#include "grow/common/regions.hpp"
 #include "grow/method.hpp"
 #include "io/network_files.hpp"
 

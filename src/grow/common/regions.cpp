@@ -1,4 +1,4 @@
-#include "grow/dcco/regions.hpp"
+#include "grow/common/regions.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,0 +1,496 @@
+// Method "colonisation": its parameters, TOML reader, description, domains and grow function.
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "core/error.hpp"
+#include "core/quantity_json.hpp"
+#include "grow/colonisation/point_hash.hpp"
+#include "grow/colonisation/setup.hpp"
+#include "grow/common/intersections.hpp"
+#include "grow/common/method_tables.hpp"
+#include "grow/common/region_tables.hpp"
+#include "io/growth_domain_files.hpp"
+#include "io/param_checks.hpp"
+#include "io/scenario.hpp"
+
+namespace angiosynth {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+// The domain's diameter: lengths not given in mm are fractions of it.
+double diameterOf(const GrowthDomain& d) {
+  switch (d.shape()) {
+    case DomainShape::Sphere:
+    case DomainShape::Disc: return 2 * d.size();
+    case DomainShape::Cube:
+    case DomainShape::Square: return d.size();
+    case DomainShape::Mask: break;
+  }
+  const Vec3 e = d.hi() - d.lo();
+  return std::max({e.x, e.y, d.dimension() == 2 ? 0.0 : e.z});
+}
+
+// Flows (each leaf an equal share of Q) and pressures (Poiseuille from the root pressure) of a
+// tree whose radii are set; lengths, depth, β and terminal counts too.
+void flowsAndPressures(VascularTree& t, const PhysicsParameters& p, double leaf_flow) {
+  const auto order = t.topDownOrder();
+  for (auto it = order.rbegin(); it != order.rend(); ++it) {
+    const auto i = *it;
+    const auto a = t.child0[i], b = t.child1[i];
+    t.terminals[i] = a < 0 ? 1 : t.terminals[a] + (b < 0 ? 0 : t.terminals[b]);
+    t.flow[i] = a < 0 ? leaf_flow : t.flow[a] + (b < 0 ? 0 : t.flow[b]);
+  }
+  for (auto i : order) {
+    if (t.isRoot(i)) {
+      t.pressure[i] = p.perfusion_pressure;
+      t.radius[i] = 0;
+      continue;
+    }
+    const auto up = t.parent[i];
+    const double r = t.radius[i];
+    t.beta[i] = t.isRoot(up) ? 1.0 : r / t.radius[up];
+    const double drop = 8 * p.viscosity * t.length[i] * t.flow[i] / (std::numbers::pi * r * r * r * r);
+    t.pressure[i] = t.pressure[up] - (p.drains() ? -drop : drop);
+  }
+}
+
+class PreparedColonisation final : public PreparedGrowth {
+ public:
+  PreparedColonisation(const ColonisationSetup& s, GrowthDomain loaded) : setup_(s), loaded_(std::move(loaded)) {
+    std::map<std::string, const RegionSpec*> by_name;
+    for (const auto& r : s.regions) by_name[r.name] = &r;
+    const auto list = [&](const std::vector<std::string>& names) {
+      std::vector<const RegionSpec*> out;
+      for (const auto& n : names) out.push_back(by_name.at(n));
+      return out;
+    };
+    const auto fail = [&](int line, const GrowthError& e) { return InputError(s.parameter_file, line, e.what()); };
+    try {  // the world: the domain without its avascular regions
+      if (!s.avascular.empty()) world_ = std::make_unique<GrowthDomain>(regionDomain(loaded_, {}, list(s.avascular), "the domain without its avascular regions"));
+    } catch (const GrowthError& e) {
+      throw fail(0, e);
+    }
+    const GrowthDomain& world = *(world_ ? world_.get() : &loaded_);
+    options_ = s.options;
+    options_.world = &world;
+    const double diameter = diameterOf(loaded_);
+    for (const auto& spec : s.stages) {
+      auto st = spec.stage;
+      st.step = spec.step.resolve(diameter);
+      st.perception_distance = spec.perception_distance.resolve(diameter);
+      st.satisfaction_distance = spec.satisfaction_distance.resolve(diameter);
+      st.co2_distance = spec.co2_distance.resolve(diameter);
+      st.drain_spacing = spec.drain_spacing.resolve(diameter);
+      st.terminal_radius = spec.terminal_radius.resolve(diameter);
+      st.surface_depth = spec.surface_depth.resolve(diameter);
+      if (spec.domain.empty()) {
+        st.drains = &world;
+      } else {
+        try {
+          drains_.push_back(std::make_unique<GrowthDomain>(regionDomain(world, list(spec.domain), {}, "the drain region of stage '" + st.name + "'")));
+        } catch (const GrowthError& e) {
+          throw fail(spec.line, e);
+        }
+        st.drains = drains_.back().get();
+      }
+      if (!(st.perception_distance > st.satisfaction_distance))
+        throw InputError(s.parameter_file, spec.line, "stage '" + st.name + "': perception_distance (" + show(st.perception_distance) +
+                                                          " mm) must exceed satisfaction_distance (" + show(st.satisfaction_distance) +
+                                                          " mm), or no drain is ever perceived before it is satisfied");
+      options_.stages.push_back(st);
+    }
+    // Roots: placed in the domain, heading to its centre unless given a direction.
+    for (const auto& r : s.roots) {
+      ColonisationRoot root;
+      if (r.beside_artery) {
+        // Beside the artery's root, as vessels enter an organ together: 0.05 D along x, then
+        // toward the centre until inside.
+        const Vec3 a = options_.roots.front().position, c = world.center();
+        Vec3 p = a + Vec3(0.05 * diameter, 0, 0);
+        for (int it = 0; it < 1000 && world.depth(p) < 0; ++it) p = p + (c - p) * 0.01;
+        if (world.depth(p) < 0)
+          throw InputError(s.parameter_file, r.line, "no default vein root beside the artery's fits the domain; give the roots as [[tree.inlet]] tables");
+        root.position = p;
+      } else {
+        root.position = placeRoot(s.parameter_file, r.root, world);
+      }
+      root.vein = r.kind == "vein";
+      Vec3 d = r.has_direction ? r.direction : world.center() - root.position;
+      if (world.dimension() == 2) d.z = 0;
+      if (!(norm(d) > 0)) d = Vec3(0, -1, 0);
+      root.direction = d / norm(d);
+      options_.roots.push_back(root);
+    }
+  }
+  const DemandMap& frame() const override { return loaded_.frame(); }
+  void checkFeasibility() const override {}
+  const GrowthDomain* domain() const override { return options_.world; }
+  Forest grow(std::uint64_t seed, std::uint64_t sample, GrowthReport& report, const ProgressFn& progress) const override {
+    auto o = options_;
+    o.seed = seed;
+    o.sample = sample;
+    cr_ = ColonisationReport{};
+    auto trees = growColonisation(o, report, cr_, progress);
+    Forest f;
+    for (std::size_t k = 0; k < trees.size(); ++k) {
+      // Each system's leaves share Q equally: an artery supplies what a vein drains.
+      std::int64_t same = 0;
+      for (std::size_t q = 0; q < trees.size(); ++q)
+        if (o.roots[q].vein == o.roots[k].vein)
+          for (std::int32_t i = 0; i < trees[q].nodeCount(); ++i) same += !trees[q].isRoot(i) && trees[q].child0[i] < 0;
+      auto p = setup_.physics_summary;
+      if (o.roots[k].vein) std::swap(p.perfusion_pressure, p.terminal_pressure);
+      flowsAndPressures(trees[k], p, same > 0 ? p.perfusion_flow / double(same) : 0.0);
+      f.vessels.appendTree(trees[k], int(k));
+      f.trees.push_back(TreeInfo{setup_.roots[k].id, setup_.roots[k].kind, 0});
+    }
+    assignClassLabels(f.trees);
+    const auto t0 = std::chrono::steady_clock::now();
+    report.intersecting_pairs = crossingPairs(f.vessels);
+    cr_.check_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    report.root_radius_mm = 0;
+    for (std::int32_t i = 0; i < f.vessels.nodeCount(); ++i)
+      if (f.vessels.isRoot(i) && f.vessels.child0[i] >= 0) report.root_radius_mm = std::max(report.root_radius_mm, f.vessels.radius[f.vessels.child0[i]]);
+    return f;
+  }
+  void addStatistics(const GrowthReport&, Json& stats) const override {
+    stats["arterial_drains"] = cr_.arterial_drains;
+    stats["venous_drains"] = cr_.venous_drains;
+    stats["venous_drains_definition"] = "arterial drains satisfied and turned into CO2 sources";
+    stats["bifurcations"] = cr_.bifurcations;
+    stats["lateral_branches"] = cr_.lateral_branches;
+    stats["elongations"] = cr_.elongations;
+    stats["outside_rejected"] = cr_.outside_rejected;
+    stats["crossing_rejected"] = cr_.crossing_rejected;
+    stats["crossing_check_seconds"] = cr_.check_seconds;
+    stats["intersecting_pairs_note"] =
+        "colonisation: segments whose capsules overlap, unless the path between them along the tree is shorter than their radii";
+  }
+
+  // Overlapping capsules, except segments of one tree joined by a path shorter than their radii
+  // (chains of short segments in a thick vessel touch by construction). Candidates from a grid
+  // of segment midpoints; the path is walked up from both segments within that budget.
+  static std::int64_t crossingPairs(const VascularTree& t) {
+    Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
+    double reach = 0;  // the largest half length + radius
+    for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+      const auto& p = t.position[i];
+      lo = Vec3(std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z));
+      hi = Vec3(std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z));
+      if (!t.isRoot(i)) reach = std::max(reach, t.length[i] / 2 + t.radius[i]);
+    }
+    if (!(reach > 0)) return 0;
+    PointHash grid(lo, hi, 2 * reach, false);
+    const auto mid = [&](std::int32_t i) { return (t.position[i] + t.position[t.parent[i]]) * 0.5; };
+    for (std::int32_t i = 0; i < t.nodeCount(); ++i)
+      if (!t.isRoot(i)) grid.insert(mid(i), i);
+    // True if x and y are joined along their tree by a path shorter than `budget`.
+    const auto joined = [&](std::int32_t x, std::int32_t y, double budget) {
+      std::vector<std::pair<std::int32_t, double>> up;  // x's proximal node and its ancestors, with the path to them
+      double s = 0;
+      for (std::int32_t v = t.parent[x]; v >= 0 && s <= budget; v = t.parent[v]) {
+        up.emplace_back(v, s);
+        if (v == t.parent[y] || v == y) return true;
+        if (t.parent[v] >= 0) s += t.length[v];
+      }
+      s = 0;
+      for (std::int32_t v = t.parent[y]; v >= 0 && s <= budget; v = t.parent[v]) {
+        if (v == x) return true;
+        for (const auto& [a, sa] : up)
+          if (a == v && sa + s <= budget) return true;
+        if (t.parent[v] >= 0) s += t.length[v];
+      }
+      return false;
+    };
+    std::int64_t n = 0;
+    for (std::int32_t x = 0; x < t.nodeCount(); ++x) {
+      if (t.isRoot(x)) continue;
+      const Vec3 mx = mid(x);
+      const double bx = t.length[x] / 2 + t.radius[x];
+      grid.forEachNear(mx, bx + reach, [&](std::int32_t y) {
+        if (y <= x) return;
+        const double by = t.length[y] / 2 + t.radius[y];
+        if (distance(mx, mid(y)) >= bx + by) return;
+        if (!capsulesOverlap(t.position[t.parent[x]], t.position[x], t.radius[x], t.position[t.parent[y]], t.position[y], t.radius[y])) return;
+        const double budget = t.radius[x] + t.radius[y];
+        if ((t.tree.empty() || t.tree[x] == t.tree[y]) && joined(x, y, budget)) return;
+        ++n;
+      });
+    }
+    return n;
+  }
+
+ private:
+  const ColonisationSetup& setup_;
+  GrowthDomain loaded_;
+  std::unique_ptr<GrowthDomain> world_;
+  std::vector<std::unique_ptr<GrowthDomain>> drains_;
+  ColonisationOptions options_;
+  mutable ColonisationReport cr_;
+};
+
+DomainLength readLength(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const char* key) {
+  DomainLength l;
+  if (t.get(key)) {
+    l.value = r.quantity(t, "stage", key, Dimension::Length);
+    l.of_diameter = false;
+    checkRange(l.value, 0, false, Limits::kMaxLength, false, r.at(t, key), std::string(key) + " (mm)");
+    return l;
+  }
+  // The declared default: "[domain] diameter × f".
+  const std::string fallback = findParam(m, "stage", key)->fallback;
+  l.value = std::stod(fallback.substr(fallback.find("× ") + 3));
+  return l;
+}
+
+ColonisationStageSpec readStage(const TomlReader& r, const GrowthMethod& m, const toml::table& t, int index,
+                                const std::set<std::string>& regions) {
+  checkMethodKeys(r, m, t, "stage");
+  ColonisationStageSpec spec;
+  spec.line = r.lineOf(&t);
+  auto& st = spec.stage;
+  st.name = t.get("name") ? r.string(t, "stage", "name") : "stage_" + std::to_string(index + 1);
+  st.steps = declaredCount(r, m, t, "stage", "steps", 1, 100000);
+  st.drains_per_step = declaredCount(r, m, t, "stage", "drains_per_step", 1, 10000000);
+  st.drain_lifetime = declaredCount(r, m, t, "stage", "drain_lifetime", 0, 1000000);
+  const auto number = [&](const char* key, double lo, bool lo_open, double hi, bool hi_open) {
+    const double v = declaredNumber(r, m, t, "stage", key);
+    checkRange(v, lo, lo_open, hi, hi_open, r.at(t, key), key);
+    return v;
+  };
+  st.delta_sigma = number("delta_sigma", 0, false, 100, false);
+  st.perception_angle = number("perception_angle", 0, true, 360, false);
+  st.bias = number("bias", 0, false, 1, false);
+  st.bifurcation_spread = number("bifurcation_spread", 0, false, 180, false);
+  st.spread = choice<SpreadStatistic>(r, t, "stage", "spread_statistic", SpreadStatistic::StandardDeviation,
+                                      {{"sd", SpreadStatistic::StandardDeviation}, {"rms", SpreadStatistic::RootMeanSquare}});
+  st.lateral = r.boolean(t, "lateral", true);
+  st.source = choice<DrainSource>(r, t, "stage", "source", DrainSource::Volume, {{"volume", DrainSource::Volume}, {"surface", DrainSource::Surface}});
+  spec.step = readLength(r, m, t, "step");
+  spec.perception_distance = readLength(r, m, t, "perception_distance");
+  spec.satisfaction_distance = readLength(r, m, t, "satisfaction_distance");
+  spec.co2_distance = readLength(r, m, t, "co2_distance");
+  spec.drain_spacing = readLength(r, m, t, "drain_spacing");
+  spec.terminal_radius = readLength(r, m, t, "terminal_radius");
+  spec.surface_depth = readLength(r, m, t, "surface_depth");
+  spec.domain = regionNames(r, t, "domain", regions);
+  return spec;
+}
+
+void readRoots(const TomlReader& r, const GrowthMethod& m, const toml::table& tree, ColonisationSetup& s, bool flat) {
+  const auto* list = tree.get("inlet");
+  if (!list || !list->is_array()) {
+    // One artery at [tree]'s root (the top by default) and, with veins, one vein beside it.
+    ColonisationRootSpec a;
+    a.id = "artery";
+    a.root = readRootOf(r, tree, "tree", s.domain, false);
+    a.line = r.lineOf(&tree);
+    s.roots.push_back(a);
+    if (s.options.veins) {
+      if (s.domain.shape == DomainShape::Mask)
+        throw InputError(r.file(), r.lineOf(&tree), "a mask domain has no default vein root: give the roots as [[tree.inlet]] tables (kind = \"vein\")");
+      ColonisationRootSpec v = a;
+      v.id = "vein";
+      v.kind = "vein";
+      v.beside_artery = true;
+      s.roots.push_back(v);
+    }
+    return;
+  }
+  for (const char* key : {"root_offset", "root", "root_voxel"})
+    if (tree.get(key)) throw InputError(r.file(), r.lineOf(tree.get(key)), std::string("'") + key + "' in [tree] with [[tree.inlet]] tables: give each root in its table");
+  const auto* arr = list->as_array();
+  if (!arr->is_array_of_tables() || arr->empty()) throw InputError(r.file(), r.lineOf(list), "inlet must be an array of tables: write each as [[tree.inlet]]");
+  std::map<std::string, int> per_kind, seen;
+  for (const auto& node : *arr) {
+    const auto& t = *node.as_table();
+    checkMethodKeys(r, m, t, "tree.inlet");
+    ColonisationRootSpec rs;
+    rs.line = r.lineOf(&t);
+    rs.kind = choice<std::string>(r, t, "tree.inlet", "kind", "artery", {{"artery", "artery"}, {"vein", "vein"}});
+    rs.root = readRootOf(r, t, "tree.inlet", s.domain, true);
+    if (const auto* d = t.get("direction")) {
+      rs.direction = r.point(d, "direction", flat);
+      if (!(norm(rs.direction) > 0)) throw InputError(r.file(), r.lineOf(d), "direction must not be zero");
+      rs.has_direction = true;
+    }
+    ++per_kind[rs.kind];
+    s.roots.push_back(rs);
+  }
+  std::set<std::string> ids;
+  for (std::size_t i = 0; i < arr->size(); ++i) {
+    const auto& t = *(*arr)[i].as_table();
+    auto& rs = s.roots[i];
+    const int nth = ++seen[rs.kind];
+    rs.id = per_kind[rs.kind] == 1 ? rs.kind : rs.kind + "_" + std::to_string(nth);
+    if (t.get("id")) rs.id = r.string(t, "tree.inlet", "id");
+    if (rs.id.empty() || rs.id.size() > 60 || !ids.insert(rs.id).second)
+      throw InputError(r.file(), rs.line, "root id '" + rs.id + "' is empty, longer than 60 characters or used twice");
+  }
+  if (!per_kind.count("artery")) throw InputError(r.file(), r.lineOf(list), "no artery root: the veins grow to the drains arteries satisfy");
+  if (s.options.veins && !per_kind.count("vein"))
+    throw InputError(r.file(), r.lineOf(list), "no vein root: add a [[tree.inlet]] with kind = \"vein\", or set [tree] veins = false");
+}
+
+std::shared_ptr<const GrowthSetup> readColonisationToml(const TomlReader& r, const GrowthMethod& m) {
+  auto s = std::make_shared<ColonisationSetup>();
+  s->parameter_file = r.file();
+  const auto& dom = methodTable(r, m, "domain");
+  const auto& tree = methodTable(r, m, "tree");
+  const auto& ph = methodTable(r, m, "physics");
+  s->domain = readDomainSpec(r, dom, r.file());
+  const bool flat = s->domain.shape == DomainShape::Disc || s->domain.shape == DomainShape::Square;
+  auto& o = s->options;
+  o.veins = r.boolean(tree, "veins", true);
+  o.avoid_crossing = r.boolean(tree, "avoid_crossing", false);
+  o.sigma0 = declaredNumber(r, m, tree, "tree", "sigma0");
+  checkRange(o.sigma0, 0, true, 1e6, false, r.at(tree, "sigma0"), "sigma0");
+  readRoots(r, m, tree, *s, flat);
+  auto& p = s->physics_summary;
+  p.murray_exponent = declaredNumber(r, m, ph, "physics", "murray_exponent");
+  checkRange(p.murray_exponent, 2, true, 4, true, r.at(ph, "murray_exponent"), "murray_exponent (κ of seed 003)");
+  o.murray_exponent = p.murray_exponent;
+  p.viscosity = declaredQuantity(r, m, ph, "physics", "viscosity", Dimension::Viscosity);
+  checkRange(p.viscosity, Limits::kMinViscosity, false, Limits::kMaxViscosity, false, r.at(ph, "viscosity"), "viscosity (Pa*s)");
+  p.perfusion_pressure = declaredQuantity(r, m, ph, "physics", "perfusion_pressure", Dimension::Pressure);
+  checkRange(p.perfusion_pressure, 0, false, Limits::kMaxPressure, false, r.at(ph, "perfusion_pressure"), "perfusion_pressure (Pa)");
+  p.terminal_pressure = declaredQuantity(r, m, ph, "physics", "venous_pressure", Dimension::Pressure);
+  checkRange(p.terminal_pressure, 0, false, Limits::kMaxPressure, false, r.at(ph, "venous_pressure"), "venous_pressure (Pa)");
+  p.perfusion_flow = declaredQuantity(r, m, ph, "physics", "perfusion_flow", Dimension::Flow);
+  checkRange(p.perfusion_flow, Limits::kMinFlow, false, Limits::kMaxFlow, false, r.at(ph, "perfusion_flow"), "perfusion_flow (mm^3/s)");
+  s->regions = readRegions(r, m, flat);
+  std::set<std::string> names;
+  for (const auto& g : s->regions) names.insert(g.name);
+  s->avascular = regionNames(r, tree, "avascular", names);
+  if (const auto* list = r.root().get("stage")) {
+    const auto* arr = list->as_array();
+    if (!arr || arr->empty() || !arr->is_array_of_tables()) throw InputError(r.file(), r.lineOf(list), "stage must be an array of tables: write each as [[stage]]");
+    std::set<std::string> stage_names;
+    for (const auto& node : *arr) {
+      s->stages.push_back(readStage(r, m, *node.as_table(), int(s->stages.size()), names));
+      if (!stage_names.insert(s->stages.back().stage.name).second)
+        throw InputError(r.file(), s->stages.back().line, "a second stage named '" + s->stages.back().stage.name + "'");
+    }
+  } else {
+    s->stages.push_back(readStage(r, m, toml::table{}, 0, names));  // one stage with every default
+  }
+  return s;
+}
+
+}  // namespace
+
+std::vector<std::string> ColonisationSetup::kinds() const {
+  std::vector<std::string> k;
+  for (const auto& r : roots)
+    if (std::find(k.begin(), k.end(), r.kind) == k.end()) k.push_back(r.kind);
+  return k;
+}
+
+Json ColonisationSetup::describe() const {
+  Json j;
+  j["method"] = "colonisation";
+  j["shape"] = domainShapeName(domain.shape);
+  if (domain.shape == DomainShape::Mask) {
+    j["mask"] = domain.mask.string();
+  } else {
+    j[domain.shape == DomainShape::Sphere || domain.shape == DomainShape::Disc ? "radius" : "side"] = quantityJson(domain.size_mm, "mm");
+  }
+  if (domain.voxel_mm > 0) j["voxel_size"] = quantityJson(domain.voxel_mm, "mm");
+  j["murray_exponent"] = options.murray_exponent;
+  j["sigma0"] = options.sigma0;
+  j["veins"] = options.veins;
+  j["avoid_crossing"] = options.avoid_crossing;
+  j["frame"] = "lengths are their values at the last step; at step t they are scaled by sigma_T / sigma_t";
+  Json roots_json = Json::array();
+  for (const auto& r : roots) {
+    Json e{{"id", r.id}, {"kind", r.kind}};
+    if (r.beside_artery) e["root_offset"] = "beside the artery's root (0.05 of the diameter along x, moved in until inside)";
+    else if (r.root.has_root_offset)
+      e["root_offset"] = Json{{"value", {r.root.root_offset_mm.x, r.root.root_offset_mm.y, r.root.root_offset_mm.z}}, {"unit", "mm"}};
+    else if (r.root.root_in_mm) e["root"] = Json{{"value", {r.root.root_mm.x, r.root.root_mm.y, r.root.root_mm.z}}, {"unit", "mm"}};
+    else if (domain.shape == DomainShape::Mask) e["root_voxel"] = {r.root.root_voxel.x, r.root.root_voxel.y, r.root.root_voxel.z};
+    else e["root_offset"] = "the top of the domain (+y)";
+    if (r.has_direction) e["direction"] = {r.direction.x, r.direction.y, r.direction.z};
+    roots_json.push_back(e);
+  }
+  j["roots"] = roots_json;
+  Json st = Json::array();
+  const auto length = [](const DomainLength& l) {
+    return l.of_diameter ? Json{{"value", l.value}, {"unit", "domain diameter"}} : quantityJson(l.value, "mm");
+  };
+  for (const auto& spec : stages) {
+    const auto& s = spec.stage;
+    Json e{{"name", s.name}, {"steps", s.steps}, {"drains_per_step", s.drains_per_step}, {"drain_lifetime", s.drain_lifetime}, {"delta_sigma", s.delta_sigma},
+           {"step", length(spec.step)}, {"perception_distance", length(spec.perception_distance)},
+           {"perception_angle", quantityJson(s.perception_angle, "deg")}, {"satisfaction_distance", length(spec.satisfaction_distance)}, {"co2_distance", length(spec.co2_distance)},
+           {"drain_spacing", length(spec.drain_spacing)}, {"terminal_radius", length(spec.terminal_radius)}, {"bias", s.bias},
+           {"bifurcation_spread", quantityJson(s.bifurcation_spread, "deg")},
+           {"spread_statistic", s.spread == SpreadStatistic::StandardDeviation ? "sd" : "rms"}, {"lateral", s.lateral},
+           {"source", s.source == DrainSource::Volume ? "volume" : "surface"}};
+    if (s.source == DrainSource::Surface) e["surface_depth"] = length(spec.surface_depth);
+    if (!spec.domain.empty()) e["domain"] = spec.domain;
+    st.push_back(e);
+  }
+  j["stages"] = st;
+  if (!avascular.empty()) j["avascular"] = avascular;
+  j["viscosity"] = quantityJson(physics_summary.viscosity, "Pa*s");
+  j["perfusion_pressure"] = quantityJson(physics_summary.perfusion_pressure, "Pa");
+  j["venous_pressure"] = quantityJson(physics_summary.terminal_pressure, "Pa");
+  j["perfusion_flow"] = quantityJson(physics_summary.perfusion_flow, "mm^3/s");
+  return j;
+}
+
+std::unique_ptr<PreparedGrowth> ColonisationSetup::prepare(std::uint64_t memory_limit) const {
+  auto loaded = loadDomainSpec(domain, parameter_file, roots.front().root, memory_limit);
+  return std::make_unique<PreparedColonisation>(*this, std::move(loaded));
+}
+
+const GrowthMethod kColonisationMethod{
+    "colonisation",
+    "space colonisation with physiological constraints (Rauch & Harders 2021; seed 003): arterial and venous trees grow "
+    "together toward oxygen drains sampled in the tissue (oxygenated tissue near the arteries and the drains they satisfy become the veins' CO2 sources), leaves "
+    "inside a perception cone, inter-nodes in the Murray-angle shell of a lateral branch, symmetric bifurcations at Murray's "
+    "angles when the drains spread wider than φ, radii by Murray's law with κ, tissue growth Δσ per step, in stages with "
+    "their own parameters and regions; no node or centreline leaves the domain",
+    withRegionParams(withDomainParams("sphere, cube, disc or square (2D), or mask", "masks: drains drawn uniformly, or ∝ the mask value (demand)", {
+        {"tree", "veins", "true/false", "true", "grow the venous system (needs a vein root)"},
+        {"tree", "sigma0", "", "1", "σ_0, the tissue's initial size (σ_t = σ_0 + Σ Δσ)"},
+        {"tree", "avoid_crossing", "true/false", "false", "no new vessel comes closer to another than their radii"},
+        {"tree", "avascular", "region names", "none", "regions no vessel enters (a foveal avascular zone)"},
+        {"tree.inlet", "id", "text", "its kind (kind_1, kind_2, ... when several)", "the tree's name in graphs and sample.json"},
+        {"tree.inlet", "kind", "text", "artery", "artery or vein"},
+        {"tree.inlet", "root_offset", "[x, y(, z)] mm", nullptr, "analytic shapes: the root relative to the centre"},
+        {"tree.inlet", "root", "[x, y, z] mm", nullptr, "masks: the root in mm in the frame (or root_voxel)"},
+        {"tree.inlet", "root_voxel", "[x, y, z] mask voxels", nullptr, "masks: the root in voxels (or root)"},
+        {"tree.inlet", "direction", "[x, y(, z)]", "toward the domain's centre", "where the root vessel heads"},
+        {"physics", "murray_exponent", "", "2.55", "κ in (2, 4]: r_p^κ = r_a^κ + r_b^κ"},
+        {"physics", "viscosity", "Pa*s", "0.0036 Pa*s", "blood viscosity η (flows and pressures of the outputs)"},
+        {"physics", "perfusion_pressure", "Pa", "100 mmHg", "pressure at the arterial roots"},
+        {"physics", "venous_pressure", "Pa", "5 mmHg", "pressure at the venous roots"},
+        {"physics", "perfusion_flow", "mm^3/s", "1 mL/min", "Q, split equally among the leaves of each system"},
+        {"stage", "name", "text", "stage_1, stage_2, ...", "the stage's name in sample.json"},
+        {"stage", "steps", "count", "100", "iterations of the stage"},
+        {"stage", "drains_per_step", "count", "1000", "oxygen drains sampled per step"},
+        {"stage", "drain_lifetime", "count", "1", "steps an unsatisfied drain (or CO2 source) lives (0: until satisfied); satisfied drains go at once"},
+        {"stage", "delta_sigma", "", "0.02", "Δσ, tissue growth per step"},
+        {"stage", "step", "mm", "[domain] diameter × 0.008", "d, the growth step (at the last step; × σ_T/σ_t at step t)"},
+        {"stage", "perception_distance", "mm", "[domain] diameter × 0.04", "δ, how far a node perceives drains"},
+        {"stage", "perception_angle", "deg", "90", "γ, the full angle of the perception cone"},
+        {"stage", "satisfaction_distance", "mm", "[domain] diameter × 0.01", "a drain this close to a node of its system is supplied"},
+        {"stage", "co2_distance", "mm", "[domain] diameter × 0.03", "tissue this close to an artery makes CO2: a drain for the veins (unless a vein is within satisfaction_distance)"},
+        {"stage", "drain_spacing", "mm", "[domain] diameter × 0.005", "minimum distance between drains"},
+        {"stage", "terminal_radius", "mm", "[domain] diameter × 0.0004", "r, the radius of every leaf"},
+        {"stage", "bias", "", "0.5", "ω in [0, 1]: weight of the current (or Murray-branch) direction against the drains' mean"},
+        {"stage", "bifurcation_spread", "deg", "10", "φ: a leaf splits when its drains' angular spread exceeds it"},
+        {"stage", "spread_statistic", "text", "sd", "sd (the standard deviation of the angles to their mean direction, as the paper) or rms (their root mean square)"},
+        {"stage", "lateral", "true/false", "true", "inter-nodes may take lateral branches"},
+        {"stage", "source", "text", "volume", "volume: drains anywhere in the stage's region; surface: within surface_depth of the border"},
+        {"stage", "surface_depth", "mm", "[domain] diameter × 0.01", "source = surface: the shell drains and new nodes lie in"},
+        {"stage", "domain", "region names", "the whole domain", "the regions its drains are sampled in (a plexus)"},
+    }), "the region's name, used by [tree] avascular and [[stage]] domain"),
+    &readColonisationToml};
+
+}  // namespace angiosynth

@@ -1,0 +1,87 @@
+#pragma once
+// Points in the cubic cells of a dense grid over a box (linked lists: 4 bytes per cell and per
+// point), for radius and nearest queries while points are added: space colonisation's node and
+// drain searches. Points outside the box fall into its border cells (queries measure anyway).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "core/vec3.hpp"
+
+namespace angiosynth {
+
+class PointHash {
+ public:
+  // `flat`: a 2D domain, one layer of cells.
+  PointHash(const Vec3& lo, const Vec3& hi, double cell, bool flat) : lo_(lo), cell_(cell), inv_(1.0 / cell) {
+    const auto count = [&](double extent) { return std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(extent * inv_)) + 1); };
+    n_[0] = count(hi.x - lo.x);
+    n_[1] = count(hi.y - lo.y);
+    n_[2] = flat ? 1 : count(hi.z - lo.z);
+    // Keep the grid within 2M cells (8 MB): coarser cells for large boxes.
+    while (n_[0] * n_[1] * n_[2] > (std::int64_t(1) << 21)) {
+      cell_ *= 2;
+      inv_ = 1.0 / cell_;
+      n_[0] = count(hi.x - lo.x);
+      n_[1] = count(hi.y - lo.y);
+      n_[2] = flat ? 1 : count(hi.z - lo.z);
+    }
+    head_.assign(std::size_t(n_[0] * n_[1] * n_[2]), -1);
+  }
+
+  void insert(const Vec3& p, std::int32_t id) {
+    if (std::size_t(id) >= next_.size()) next_.resize(std::size_t(id) + 1, -1);
+    const auto c = index(axis(p.x, 0), axis(p.y, 1), axis(p.z, 2));
+    if (head_[c] < 0) touched_.push_back(c);
+    next_[std::size_t(id)] = head_[c];
+    head_[c] = id;
+  }
+  // Empties the grid in the time of the cells it used.
+  void clear() {
+    for (auto c : touched_) head_[c] = -1;
+    touched_.clear();
+  }
+  // Calls f(id) for every point in the cells a ball of radius r around p touches.
+  template <class F>
+  void forEachNear(const Vec3& p, double r, F&& f) const {
+    const std::int64_t x0 = axis(p.x - r, 0), x1 = axis(p.x + r, 0), y0 = axis(p.y - r, 1), y1 = axis(p.y + r, 1), z0 = axis(p.z - r, 2),
+                       z1 = axis(p.z + r, 2);
+    for (std::int64_t z = z0; z <= z1; ++z)
+      for (std::int64_t y = y0; y <= y1; ++y)
+        for (std::int64_t x = x0; x <= x1; ++x)
+          for (auto id = head_[index(x, y, z)]; id >= 0; id = next_[std::size_t(id)]) f(id);
+  }
+  // The id minimising dist2(id) among points within r (ties: the smaller id), or -1.
+  template <class Dist2>
+  std::int32_t nearest(const Vec3& p, double r, Dist2&& dist2) const {
+    std::int32_t best = -1;
+    double bd = r * r;
+    forEachNear(p, r, [&](std::int32_t id) {
+      const double d2 = dist2(id);
+      if (d2 < bd || (d2 == bd && best >= 0 && id < best)) {
+        bd = d2;
+        best = id;
+      }
+    });
+    return best;
+  }
+
+  double cell() const { return cell_; }
+
+ private:
+  std::int64_t axis(double v, int a) const {
+    const double o = a == 0 ? lo_.x : a == 1 ? lo_.y : lo_.z;
+    const double c = std::floor((v - o) * inv_);
+    return static_cast<std::int64_t>(std::clamp(c, 0.0, double(n_[a] - 1)));
+  }
+  std::size_t index(std::int64_t x, std::int64_t y, std::int64_t z) const { return std::size_t((z * n_[1] + y) * n_[0] + x); }
+
+  Vec3 lo_;
+  double cell_, inv_;
+  std::int64_t n_[3];
+  std::vector<std::int32_t> head_, next_;
+  std::vector<std::size_t> touched_;
+};
+
+}  // namespace angiosynth

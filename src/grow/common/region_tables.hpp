@@ -1,0 +1,37 @@
+#pragma once
+// [[region]] tables (named analytic shapes, relative to the domain's centre) and the helpers
+// their readers share: a stage names regions, a key takes one of a list of words.
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/error.hpp"
+#include "grow/common/method_tables.hpp"
+#include "grow/common/regions.hpp"
+
+namespace angiosynth {
+
+// table.key as one of `values` (by name), or `fallback` when absent; an unknown word is an
+// error listing the allowed ones.
+template <class E>
+E choice(const TomlReader& r, const toml::table& t, const std::string& table, const std::string& key, E fallback,
+         const std::vector<std::pair<const char*, E>>& values) {
+  if (!t.get(key)) return fallback;
+  const auto v = r.string(t, table, key);
+  std::string allowed;
+  for (const auto& [name, value] : values) {
+    if (v == name) return value;
+    allowed += (allowed.empty() ? "" : ", ") + std::string(name);
+  }
+  throw InputError(r.file(), r.lineOf(t.get(key)), key + " '" + v + "'; allowed: " + allowed);
+}
+
+// The region names of t.key (one name or an array), each defined in `known`.
+std::vector<std::string> regionNames(const TomlReader& r, const toml::table& t, const std::string& key, const std::set<std::string>& known);
+// Every [[region]] of the file, keys checked against m's declarations.
+std::vector<RegionSpec> readRegions(const TomlReader& r, const GrowthMethod& m, bool flat);
+// The [[region]] declarations (`used_by` says which keys name regions), appended to `rows`.
+std::vector<MethodParam> withRegionParams(std::vector<MethodParam> rows, const char* used_by);
+
+}  // namespace angiosynth
