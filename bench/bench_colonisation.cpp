@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
       // The final crossing count is a check of the result, not growth: reported apart.
       nlohmann::ordered_json stats;
       prepared->addStatistics(report, stats);
-      const double c = stats.value("crossing_check_seconds", 0.0) * 1e3;
+      const double c = stats["timing_seconds"].value("crossing_check", 0.0) * 1e3;
       const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() - c;
       if (ms < best) {
         best = ms;

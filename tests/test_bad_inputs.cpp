@@ -67,6 +67,13 @@ const BadCase kCases[] = {
     {"initial_unit_unknown", "p.toml", "", "", DCCO_INITIAL "file = \"" ANGIOSYNTH_SOURCE_DIR "/tests/data/network/tree_ascii.vtp\"\nunit = \"inch\"\n",
      "generate p.toml --out out", "p.toml:11: unit 'inch'; allowed: mm, cm, m, um"},
 #undef DCCO_INITIAL
+    // Space colonisation.
+#define COLONISATION "[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"colonisation\"\n"
+    {"colonisation_kappa_4_5", "p.toml", "", "", COLONISATION "[physics]\nmurray_exponent = 4.5\n",
+     "generate p.toml --out out", "p.toml:8: murray_exponent (κ of seed 003) = 4.5 is out of range; allowed: (2, 4)"},
+    {"colonisation_no_vein_root", "p.toml", "", "", COLONISATION "[[tree.inlet]]\nkind = \"artery\"\nroot_offset = [0, 9]\n",
+     "generate p.toml --out out", "p.toml:7: no vein root: add a [[tree.inlet]] with kind = \"vein\", or set [tree] veins = false"},
+#undef COLONISATION
     {"profile_intensity_huge", "prof.toml", "", "", "background = 1e30\n[[effect]]\ntype = \"gaussian\"\nsigma = 1\n",
      "generate p.toml --out out --profile prof.toml", "prof.toml:1: background = 1e+30 is out of range"},
     {"bias_scale_tiny", "prof.toml", "", "", "[[effect]]\ntype = \"bias\"\namplitude = 0.2\nscale = \"1e-9 mm\"\n",

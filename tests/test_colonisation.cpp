@@ -213,3 +213,69 @@ TEST(Colonisation, BadParametersNameTheirLine) {
   expectError("lateral = 3\n", "bad.toml:20: lateral must be true or false");
   expectError("drain_lifetime = -1\n", "bad.toml:20: drain_lifetime = -1 is out of range");
 }
+
+// avoid_crossing: no new vessel comes closer to another than their radii, and branches that
+// Murray's law later thickens into another vessel are pruned: no overlapping pair is left.
+TEST(Colonisation, AvoidCrossingLeavesNoOverlappingVessels) {
+  std::ifstream in(example("colonisation_organ_3d.toml"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("method = \"colonisation\""), 23, "method = \"colonisation\"\navoid_crossing = true");
+  text.replace(text.find("drains_per_step = 2000"), 22, "drains_per_step = 1000");
+  const auto file = variant("colonisation_organ_3d.toml", "", "avoid");
+  std::ofstream(file) << text;
+  GrowthReport with, without;
+  const auto g = test::growFile(file, 3, &with);
+  text.replace(text.find("avoid_crossing = true"), 21, "avoid_crossing = false");
+  std::ofstream(file) << text;
+  test::growFile(file, 3, &without);
+  EXPECT_GT(without.intersecting_pairs, 0) << "the check can fail";
+  EXPECT_EQ(with.intersecting_pairs, 0);
+  EXPECT_GT(nodesOfKind(g.forest, "vein"), 100);
+}
+
+// Surface growth: drains within surface_depth of the border, and every node kept in that shell.
+TEST(Colonisation, SurfaceGrowthKeepsNodesInTheShell) {
+  std::ifstream in(example("colonisation_organ_3d.toml"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto file = variant("colonisation_organ_3d.toml", "", "surface");
+  text.replace(text.find("drains_per_step = 2000"), 22, "drains_per_step = 1000\nsource = \"surface\"\nsurface_depth = \"0.5 mm\"");
+  std::ofstream(file) << text;
+  const auto g = test::growFile(file, 3);
+  const auto& t = g.forest.vessels;
+  const Vec3 centre = g.prepared->domain()->center();
+  std::int64_t deep = 0, outside = 0;
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    const double depth = 10 - distance(t.position[i], centre);
+    outside += depth < -1e-9;
+    deep += depth > 0.5 + 1e-6;
+  }
+  EXPECT_GT(t.nodeCount(), 1000);
+  EXPECT_EQ(outside, 0);
+  EXPECT_EQ(deep, 0);
+}
+
+// Growth on from stumps of an existing tree ([initial]): the stump's nodes keep their places
+// (positions relative to the disc's centre), it is one arterial tree that grew, and Murray's
+// law holds through it.
+TEST(Colonisation, StumpsOfAnExistingTreeGrowOn) {
+  const auto g = test::growFile(example("colonisation_stump_2d.toml"));
+  const auto& t = g.forest.vessels;
+  const Vec3 c = g.prepared->domain()->center();
+  const Vec3 stump[] = {{0, 10, 0}, {0, 8, 0}, {0, 6, 0}, {-1.5, 4.5, 0}, {1.5, 4.5, 0}};
+  std::int64_t kept = 0;
+  for (const auto& s : stump)
+    for (std::int32_t i = 0; i < t.nodeCount(); ++i)
+      kept += std::abs(t.position[i].x - (c.x + s.x)) < 1e-12 && std::abs(t.position[i].y - (c.y + s.y)) < 1e-12 &&
+              g.forest.trees[std::size_t(t.tree[i])].id == "artery_initial_1";
+  EXPECT_EQ(kept, 5);
+  ASSERT_EQ(g.forest.trees.size(), 2u);
+  EXPECT_GT(nodesOfKind(g.forest, "artery"), 1000);
+  EXPECT_GE(nodesOfKind(g.forest, "vein"), nodesOfKind(g.forest, "artery") / 2);
+  double murray = 0;
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i)
+    if (!t.isRoot(i) && t.child1[i] >= 0) {
+      const double rk = std::pow(t.radius[i], 2.55);
+      murray = std::max(murray, std::abs(rk - std::pow(t.radius[t.child0[i]], 2.55) - std::pow(t.radius[t.child1[i]], 2.55)) / rk);
+    }
+  EXPECT_LE(murray, 1e-12);
+}

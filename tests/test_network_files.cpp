@@ -126,7 +126,8 @@ TEST(NetworkFiles, VitaLayoutWithPolylinesKeepsChainsOfUnarySegments) {
   EXPECT_EQ(vita.ids[1].substr(0, 3), "100") << "ids come from VItA's ID_Vessel";
 }
 
-TEST(NetworkFiles, BadGraphFilesNameTheLineAndWhatIsAllowed) {
+// Malformed networks are refused with the file's line and what is allowed.
+TEST(NetworkFiles, BadNetworkFilesNameTheLineAndWhatIsAllowed) {
   const auto dir = scratch();
   const auto expectError = [&](const std::string& name, const std::string& text, const std::string& fragment) {
     std::ofstream(dir / name) << text;
@@ -137,6 +138,16 @@ TEST(NetworkFiles, BadGraphFilesNameTheLineAndWhatIsAllowed) {
       EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
     }
   };
+  // SWC and VItA's .cco.
+  expectError("three.swc", "1 1 0 0 0 1 -1\n2 2 1 0 0 1 1\n3 2 2 0 0 1 2\n4 2 2 1 0 1 2\n5 2 2 2 0 1 2\n", "three.swc:2: 2 has more than two children: N-ary junctions are not supported yet");
+  expectError("orphan.swc", "1 1 0 0 0 1 -1\n2 2 1 0 0 1 7\n", "orphan.swc:2: parent 7 of 2 is not defined");
+  expectError("cycle.swc", "1 1 0 0 0 1 -1\n2 2 1 0 0 1 3\n3 2 2 0 0 1 2\n", "is not connected to a root");
+  expectError("bad.swc", "1 1 0 0 zero 1 -1\n", "bad.swc:1: z 'zero' is not a finite number");
+  expectError("x.vtk", "", "unknown network format '.vtk'; allowed: .cco (VItA), .swc");
+  expectError("gap.cco", "*Vessels\n2\n0 0 0 0 1 0 0 0 0 0 0 2 1 0 0 0 0 0 0 0 -1\n1 1 0.5 0 2 0 0 0 0 0 0 2 1 0 0 0 0 0 0 0 -1\n*Connectivity\n0 -1 1\n1 0\n",
+              "gap.cco:4: vessel 1 starts at 1 0.5 0, not where its parent 0 ends (1 0 0)");
+  expectError("mode.cco", "*Vessels\n1\n0 0 0 0 1 0 0 0 0 0 0 4 1 0 0 0 0 0 0 0 -1\n*Connectivity\n0 -1\n", "mode.cco:3: branching mode 4; allowed: 0 (none)");
+  // GXL, CSV and VTP.
   const std::string node0 = "<node id=\"a\"><attr name=\"position\"><tup><float>0</float><float>0</float><float>0</float></tup></attr></node>\n";
   const std::string node1 = "<node id=\"b\"><attr name=\"position\"><tup><float>1</float><float>0</float><float>0</float></tup></attr></node>\n";
   const std::string node2 = "<node id=\"c\"><attr name=\"position\"><tup><float>2</float><float>0</float><float>0</float></tup></attr></node>\n";

@@ -186,7 +186,19 @@ class Grower {
     for (std::size_t k = 0; k < o.roots.size(); ++k) {
       const auto& r = o.roots[k];
       auto& s = r.vein ? ven_ : art_;
-      s.add(r.position, -1, unit(r.direction), o.stages.front().terminal_radius, std::int32_t(k));
+      const double leaf = o.stages.front().terminal_radius;
+      if (!r.stump) {
+        s.add(r.position, -1, unit(r.direction), leaf, std::int32_t(k));
+        continue;
+      }
+      const auto& t = *r.stump;
+      std::vector<std::int32_t> id(std::size_t(t.nodeCount()), -1);
+      for (auto i : t.topDownOrder()) {
+        const bool root = t.isRoot(i);
+        const Vec3 d = root ? (t.child0[i] >= 0 ? t.position[t.child0[i]] - t.position[i] : r.direction) : t.position[i] - t.position[t.parent[i]];
+        const double radius = !root && t.child0[i] < 0 && t.radius[i] > 0 ? t.radius[i] : leaf;
+        id[std::size_t(i)] = s.add(t.position[i], root ? -1 : id[std::size_t(t.parent[i])], unit(d), radius, std::int32_t(k));
+      }
     }
   }
 

@@ -55,6 +55,9 @@ struct ColonisationRoot {
   Vec3 position;   // mm in the frame
   Vec3 direction;  // unit: where the root vessel heads
   bool vein = false;
+  // A stump of an existing tree (in the frame, node 0 its root at `position`): its vessels keep
+  // their geometry and grow on; leaves keep their radius.
+  const VascularTree* stump = nullptr;
 };
 
 struct ColonisationOptions {
@@ -73,6 +76,7 @@ struct ColonisationReport {
   std::int64_t satisfied = 0;                          // arterial drains satisfied
   std::int64_t bifurcations = 0, lateral_branches = 0, elongations = 0;
   std::int64_t outside_rejected = 0, crossing_rejected = 0;
+  std::int64_t pruned = 0;                              // avoid_crossing: branches removed after growth
   std::vector<std::int64_t> nodes_per_step;             // nodes of both systems after each step
   double check_seconds = 0;                             // the final crossing count (not growth)
 };

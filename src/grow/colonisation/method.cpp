@@ -12,6 +12,7 @@
 #include "grow/common/method_tables.hpp"
 #include "grow/common/region_tables.hpp"
 #include "io/growth_domain_files.hpp"
+#include "io/network_files.hpp"
 #include "io/param_checks.hpp"
 #include "io/scenario.hpp"
 
@@ -60,13 +61,7 @@ void flowsAndPressures(VascularTree& t, const PhysicsParameters& p, double leaf_
 class PreparedColonisation final : public PreparedGrowth {
  public:
   PreparedColonisation(const ColonisationSetup& s, GrowthDomain loaded) : setup_(s), loaded_(std::move(loaded)) {
-    std::map<std::string, const RegionSpec*> by_name;
-    for (const auto& r : s.regions) by_name[r.name] = &r;
-    const auto list = [&](const std::vector<std::string>& names) {
-      std::vector<const RegionSpec*> out;
-      for (const auto& n : names) out.push_back(by_name.at(n));
-      return out;
-    };
+    const auto list = [&](const std::vector<std::string>& names) { return regionsNamed(s.regions, names); };
     const auto fail = [&](int line, const GrowthError& e) { return InputError(s.parameter_file, line, e.what()); };
     try {  // the world: the domain without its avascular regions
       if (!s.avascular.empty()) world_ = std::make_unique<GrowthDomain>(regionDomain(loaded_, {}, list(s.avascular), "the domain without its avascular regions"));
@@ -119,10 +114,50 @@ class PreparedColonisation final : public PreparedGrowth {
       }
       root.vein = r.kind == "vein";
       Vec3 d = r.has_direction ? r.direction : world.center() - root.position;
+      if (!r.has_direction && options_.stages.front().source == DrainSource::Surface) {
+        // Surface growth: along the border, not into the domain.
+        const Vec3 n = d / norm(d);
+        d = cross(n, std::abs(n.z) < 0.9 ? Vec3(0, 0, 1) : Vec3(1, 0, 0));
+      }
       if (world.dimension() == 2) d.z = 0;
       if (!(norm(d) > 0)) d = Vec3(0, -1, 0);
       root.direction = d / norm(d);
       options_.roots.push_back(root);
+      ids_.push_back(r.id);
+      kinds_.push_back(r.kind);
+    }
+    // [initial]: each root of the network is a stump of its own tree.
+    if (!s.initial_file.empty()) {
+      const auto& net = s.initial.tree;
+      int nth = 0;
+      for (auto root : net.roots()) {
+        VascularTree t;
+        std::vector<std::int32_t> id(std::size_t(net.nodeCount()), -1), queue{root};
+        for (std::size_t q = 0; q < queue.size(); ++q) {
+          const auto i = queue[q];
+          Vec3 p = net.position[i] + (s.initial_from_corner ? Vec3() : world.center());
+          if (world.dimension() == 2) p.z = world.planeZ();
+          id[std::size_t(i)] = t.addNode(p, net.isRoot(i) ? -1 : id[std::size_t(net.parent[i])]);
+          t.radius[id[std::size_t(i)]] = net.radius[i];
+          if (!(world.depth(p) > -1e-9 * diameter))
+            throw InputError(s.initial_file.string(), s.initial.lines[std::size_t(i)],
+                             "node " + s.initial.ids[std::size_t(i)] + " lies outside the domain (" + show(-world.depth(p)) +
+                                 " mm beyond its border); space colonisation keeps every node inside");
+          for (auto c : {net.child0[i], net.child1[i]})
+            if (c >= 0) queue.push_back(c);
+        }
+        if (net.child1[root] >= 0)
+          throw InputError(s.initial_file.string(), s.initial.lines[std::size_t(root)], "a root of the network starts two vessels; a tree's root has one");
+        stumps_.push_back(std::make_unique<VascularTree>(std::move(t)));
+        ColonisationRoot r;
+        r.position = stumps_.back()->position[0];
+        r.vein = s.initial_kind == "vein";
+        r.direction = Vec3(0, -1, 0);
+        r.stump = stumps_.back().get();
+        options_.roots.push_back(r);
+        ids_.push_back(s.initial_kind + "_initial_" + std::to_string(++nth));
+        kinds_.push_back(s.initial_kind);
+      }
     }
   }
   const DemandMap& frame() const override { return loaded_.frame(); }
@@ -134,6 +169,7 @@ class PreparedColonisation final : public PreparedGrowth {
     o.sample = sample;
     cr_ = ColonisationReport{};
     auto trees = growColonisation(o, report, cr_, progress);
+    if (o.avoid_crossing) cr_.pruned = pruneCrossings(trees, o.murray_exponent);
     Forest f;
     for (std::size_t k = 0; k < trees.size(); ++k) {
       // Each system's leaves share Q equally: an artery supplies what a vein drains.
@@ -145,11 +181,11 @@ class PreparedColonisation final : public PreparedGrowth {
       if (o.roots[k].vein) std::swap(p.perfusion_pressure, p.terminal_pressure);
       flowsAndPressures(trees[k], p, same > 0 ? p.perfusion_flow / double(same) : 0.0);
       f.vessels.appendTree(trees[k], int(k));
-      f.trees.push_back(TreeInfo{setup_.roots[k].id, setup_.roots[k].kind, 0});
+      f.trees.push_back(TreeInfo{ids_[k], kinds_[k], 0});
     }
     assignClassLabels(f.trees);
     const auto t0 = std::chrono::steady_clock::now();
-    report.intersecting_pairs = crossingPairs(f.vessels);
+    report.intersecting_pairs = std::int64_t(crossingPairs(f.vessels).size());
     cr_.check_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     report.root_radius_mm = 0;
     for (std::int32_t i = 0; i < f.vessels.nodeCount(); ++i)
@@ -159,13 +195,17 @@ class PreparedColonisation final : public PreparedGrowth {
   void addStatistics(const GrowthReport&, Json& stats) const override {
     stats["arterial_drains"] = cr_.arterial_drains;
     stats["venous_drains"] = cr_.venous_drains;
-    stats["venous_drains_definition"] = "arterial drains satisfied and turned into CO2 sources";
+    stats["venous_drains_definition"] = "CO2 sources: oxygenated tissue within co2_distance of an artery, and arterial drains the arteries satisfied";
     stats["bifurcations"] = cr_.bifurcations;
     stats["lateral_branches"] = cr_.lateral_branches;
     stats["elongations"] = cr_.elongations;
     stats["outside_rejected"] = cr_.outside_rejected;
     stats["crossing_rejected"] = cr_.crossing_rejected;
-    stats["crossing_check_seconds"] = cr_.check_seconds;
+    if (setup_.options.avoid_crossing) {
+      stats["crossing_pruned"] = cr_.pruned;
+      stats["crossing_pruned_definition"] = "branches removed after growth because Murray's law had thickened vessels into each other";
+    }
+    stats["timing_seconds"] = Json{{"crossing_check", cr_.check_seconds}};  // a time: not sample data
     stats["intersecting_pairs_note"] =
         "colonisation: segments whose capsules overlap, unless the path between them along the tree is shorter than their radii";
   }
@@ -173,7 +213,7 @@ class PreparedColonisation final : public PreparedGrowth {
   // Overlapping capsules, except segments of one tree joined by a path shorter than their radii
   // (chains of short segments in a thick vessel touch by construction). Candidates from a grid
   // of segment midpoints; the path is walked up from both segments within that budget.
-  static std::int64_t crossingPairs(const VascularTree& t) {
+  static std::vector<std::pair<std::int32_t, std::int32_t>> crossingPairs(const VascularTree& t) {
     Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
     double reach = 0;  // the largest half length + radius
     for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
@@ -182,7 +222,8 @@ class PreparedColonisation final : public PreparedGrowth {
       hi = Vec3(std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z));
       if (!t.isRoot(i)) reach = std::max(reach, t.length[i] / 2 + t.radius[i]);
     }
-    if (!(reach > 0)) return 0;
+    std::vector<std::pair<std::int32_t, std::int32_t>> out;
+    if (!(reach > 0)) return out;
     PointHash grid(lo, hi, 2 * reach, false);
     const auto mid = [&](std::int32_t i) { return (t.position[i] + t.position[t.parent[i]]) * 0.5; };
     for (std::int32_t i = 0; i < t.nodeCount(); ++i)
@@ -205,7 +246,6 @@ class PreparedColonisation final : public PreparedGrowth {
       }
       return false;
     };
-    std::int64_t n = 0;
     for (std::int32_t x = 0; x < t.nodeCount(); ++x) {
       if (t.isRoot(x)) continue;
       const Vec3 mx = mid(x);
@@ -217,10 +257,65 @@ class PreparedColonisation final : public PreparedGrowth {
         if (!capsulesOverlap(t.position[t.parent[x]], t.position[x], t.radius[x], t.position[t.parent[y]], t.position[y], t.radius[y])) return;
         const double budget = t.radius[x] + t.radius[y];
         if ((t.tree.empty() || t.tree[x] == t.tree[y]) && joined(x, y, budget)) return;
-        ++n;
+        out.emplace_back(x, y);
       });
     }
-    return n;
+    return out;
+  }
+
+  // avoid_crossing: vessels that overlap once Murray's law has thickened them lose the branch
+  // with fewer leaves below it (and the chain left dangling), until none overlaps.
+  static std::int64_t pruneCrossings(std::vector<VascularTree>& trees, double kappa) {
+    std::int64_t pruned = 0;
+    for (int round = 0; round < 200; ++round) {
+      Forest tmp;
+      std::vector<std::int32_t> offset;
+      for (std::size_t k = 0; k < trees.size(); ++k) {
+        offset.push_back(tmp.vessels.nodeCount());
+        tmp.vessels.appendTree(trees[k], int(k));
+      }
+      auto& t = tmp.vessels;
+      const auto pairs = crossingPairs(t);
+      if (pairs.empty()) break;
+      std::vector<std::int64_t> leaves(std::size_t(t.nodeCount()), 0);
+      const auto order = t.topDownOrder();
+      for (auto it = order.rbegin(); it != order.rend(); ++it) {
+        const auto i = *it;
+        leaves[std::size_t(i)] = t.child0[i] < 0 ? 1 : leaves[std::size_t(t.child0[i])] + (t.child1[i] < 0 ? 0 : leaves[std::size_t(t.child1[i])]);
+      }
+      std::vector<char> removed(std::size_t(t.nodeCount()), 0);
+      for (const auto& [x, y] : pairs) {
+        const auto victim = leaves[std::size_t(x)] < leaves[std::size_t(y)] || (leaves[std::size_t(x)] == leaves[std::size_t(y)] && x > y) ? x : y;
+        if (!removed[std::size_t(victim)]) ++pruned;
+        removed[std::size_t(victim)] = 1;
+      }
+      for (auto i : order)  // subtrees go with their segment
+        if (!t.isRoot(i) && removed[std::size_t(t.parent[i])] && !t.isRoot(t.parent[i])) removed[std::size_t(i)] = 1;
+      for (auto it = order.rbegin(); it != order.rend(); ++it) {  // and chains left without leaves
+        const auto i = *it;
+        if (t.isRoot(i) || removed[std::size_t(i)] || t.child0[i] < 0) continue;
+        const bool a = removed[std::size_t(t.child0[i])], b = t.child1[i] < 0 || removed[std::size_t(t.child1[i])];
+        if (a && b) removed[std::size_t(i)] = 1;
+      }
+      for (std::size_t k = 0; k < trees.size(); ++k) {
+        const auto& old = trees[k];
+        VascularTree fresh;
+        std::vector<std::int32_t> id(std::size_t(old.nodeCount()), -1);
+        for (auto i : old.topDownOrder()) {
+          if (removed[std::size_t(offset[k] + i)]) continue;
+          id[std::size_t(i)] = fresh.addNode(old.position[i], old.isRoot(i) ? -1 : id[std::size_t(old.parent[i])]);
+          fresh.radius[id[std::size_t(i)]] = old.radius[i];
+        }
+        const auto fo = fresh.topDownOrder();
+        for (auto it = fo.rbegin(); it != fo.rend(); ++it) {  // Murray from the leaves, which keep their radius
+          const auto i = *it, a = fresh.child0[i], b = fresh.child1[i];
+          if (a < 0) continue;
+          fresh.radius[i] = b < 0 ? fresh.radius[a] : std::pow(std::pow(fresh.radius[a], kappa) + std::pow(fresh.radius[b], kappa), 1.0 / kappa);
+        }
+        trees[k] = std::move(fresh);
+      }
+    }
+    return pruned;
   }
 
  private:
@@ -229,6 +324,8 @@ class PreparedColonisation final : public PreparedGrowth {
   std::unique_ptr<GrowthDomain> world_;
   std::vector<std::unique_ptr<GrowthDomain>> drains_;
   ColonisationOptions options_;
+  std::vector<std::string> ids_, kinds_;  // per root of options_
+  std::vector<std::unique_ptr<VascularTree>> stumps_;
   mutable ColonisationReport cr_;
 };
 
@@ -282,6 +379,14 @@ ColonisationStageSpec readStage(const TomlReader& r, const GrowthMethod& m, cons
 
 void readRoots(const TomlReader& r, const GrowthMethod& m, const toml::table& tree, ColonisationSetup& s, bool flat) {
   const auto* list = tree.get("inlet");
+  const bool initial = r.root().get("initial") != nullptr;
+  if (initial && (!list || !list->is_array())) {
+    if (s.initial_kind == "vein")
+      throw InputError(r.file(), r.lineOf(&tree), "no artery root: with [initial] kind = \"vein\" give the arteries' roots as [[tree.inlet]] tables");
+    if (s.options.veins)
+      throw InputError(r.file(), r.lineOf(&tree), "no vein root: with [initial] give the veins' roots as [[tree.inlet]] tables (kind = \"vein\"), or set [tree] veins = false");
+    return;
+  }
   if (!list || !list->is_array()) {
     // One artery at [tree]'s root (the top by default) and, with veins, one vein beside it.
     ColonisationRootSpec a;
@@ -330,6 +435,7 @@ void readRoots(const TomlReader& r, const GrowthMethod& m, const toml::table& tr
     if (rs.id.empty() || rs.id.size() > 60 || !ids.insert(rs.id).second)
       throw InputError(r.file(), rs.line, "root id '" + rs.id + "' is empty, longer than 60 characters or used twice");
   }
+  if (initial) ++per_kind[s.initial_kind];
   if (!per_kind.count("artery")) throw InputError(r.file(), r.lineOf(list), "no artery root: the veins grow to the drains arteries satisfy");
   if (s.options.veins && !per_kind.count("vein"))
     throw InputError(r.file(), r.lineOf(list), "no vein root: add a [[tree.inlet]] with kind = \"vein\", or set [tree] veins = false");
@@ -338,16 +444,20 @@ void readRoots(const TomlReader& r, const GrowthMethod& m, const toml::table& tr
 std::shared_ptr<const GrowthSetup> readColonisationToml(const TomlReader& r, const GrowthMethod& m) {
   auto s = std::make_shared<ColonisationSetup>();
   s->parameter_file = r.file();
-  const auto& dom = methodTable(r, m, "domain");
-  const auto& tree = methodTable(r, m, "tree");
-  const auto& ph = methodTable(r, m, "physics");
-  s->domain = readDomainSpec(r, dom, r.file());
-  const bool flat = s->domain.shape == DomainShape::Disc || s->domain.shape == DomainShape::Square;
+  const auto [dom, tree, ph, domain, flat] = readMethodFileTables(r, m);
+  s->domain = domain;
   auto& o = s->options;
   o.veins = r.boolean(tree, "veins", true);
   o.avoid_crossing = r.boolean(tree, "avoid_crossing", false);
   o.sigma0 = declaredNumber(r, m, tree, "tree", "sigma0");
   checkRange(o.sigma0, 0, true, 1e6, false, r.at(tree, "sigma0"), "sigma0");
+  if (const auto* node = r.root().get("initial")) {
+    auto in = readInitialNetwork(r, m, *node);
+    s->initial_file = in.file;
+    s->initial = std::move(in.network);
+    s->initial_from_corner = in.from_corner;
+    s->initial_kind = choice<std::string>(r, *node->as_table(), "initial", "kind", "artery", {{"artery", "artery"}, {"vein", "vein"}});
+  }
   readRoots(r, m, tree, *s, flat);
   auto& p = s->physics_summary;
   p.murray_exponent = declaredNumber(r, m, ph, "physics", "murray_exponent");
@@ -386,6 +496,7 @@ std::vector<std::string> ColonisationSetup::kinds() const {
   std::vector<std::string> k;
   for (const auto& r : roots)
     if (std::find(k.begin(), k.end(), r.kind) == k.end()) k.push_back(r.kind);
+  if (!initial_file.empty() && std::find(k.begin(), k.end(), initial_kind) == k.end()) k.push_back(initial_kind);
   return k;
 }
 
@@ -417,6 +528,9 @@ Json ColonisationSetup::describe() const {
     roots_json.push_back(e);
   }
   j["roots"] = roots_json;
+  if (!initial_file.empty())
+    j["initial"] = Json{{"file", initial_file.string()}, {"kind", initial_kind}, {"origin", initial_from_corner ? "corner" : "centre"},
+                        {"vessels", initial.tree.segmentCount()}, {"roots", initial.tree.roots().size()}};
   Json st = Json::array();
   const auto length = [](const DomainLength& l) {
     return l.of_diameter ? Json{{"value", l.value}, {"unit", "domain diameter"}} : quantityJson(l.value, "mm");
@@ -444,7 +558,7 @@ Json ColonisationSetup::describe() const {
 }
 
 std::unique_ptr<PreparedGrowth> ColonisationSetup::prepare(std::uint64_t memory_limit) const {
-  auto loaded = loadDomainSpec(domain, parameter_file, roots.front().root, memory_limit);
+  auto loaded = loadDomainSpec(domain, parameter_file, roots.empty() ? RootSpec{} : roots.front().root, memory_limit);
   return std::make_unique<PreparedColonisation>(*this, std::move(loaded));
 }
 
@@ -460,13 +574,17 @@ const GrowthMethod kColonisationMethod{
         {"tree", "sigma0", "", "1", "σ_0, the tissue's initial size (σ_t = σ_0 + Σ Δσ)"},
         {"tree", "avoid_crossing", "true/false", "false", "no new vessel comes closer to another than their radii"},
         {"tree", "avascular", "region names", "none", "regions no vessel enters (a foveal avascular zone)"},
+        {"initial", "file", "path", "none", "an existing network whose trees grow on (stumps; .swc, .vtp, .gxl, .csv, VItA's .cco); every node must lie in the domain"},
+        {"initial", "kind", "text", "artery", "the kind of its trees: artery or vein"},
+        {"initial", "origin", "text", "centre", "where the file's positions start: centre (of the domain) or corner (of its grid, as angiosynth's graphs write them)"},
+        {"initial", "unit", "text", "mm", "length unit of the file: mm, cm, m, um"},
         {"tree.inlet", "id", "text", "its kind (kind_1, kind_2, ... when several)", "the tree's name in graphs and sample.json"},
         {"tree.inlet", "kind", "text", "artery", "artery or vein"},
         {"tree.inlet", "root_offset", "[x, y(, z)] mm", nullptr, "analytic shapes: the root relative to the centre"},
         {"tree.inlet", "root", "[x, y, z] mm", nullptr, "masks: the root in mm in the frame (or root_voxel)"},
         {"tree.inlet", "root_voxel", "[x, y, z] mask voxels", nullptr, "masks: the root in voxels (or root)"},
         {"tree.inlet", "direction", "[x, y(, z)]", "toward the domain's centre", "where the root vessel heads"},
-        {"physics", "murray_exponent", "", "2.55", "κ in (2, 4]: r_p^κ = r_a^κ + r_b^κ"},
+        {"physics", "murray_exponent", "", "2.55", "κ in (2, 4): r_p^κ = r_a^κ + r_b^κ"},
         {"physics", "viscosity", "Pa*s", "0.0036 Pa*s", "blood viscosity η (flows and pressures of the outputs)"},
         {"physics", "perfusion_pressure", "Pa", "100 mmHg", "pressure at the arterial roots"},
         {"physics", "venous_pressure", "Pa", "5 mmHg", "pressure at the venous roots"},

@@ -8,6 +8,7 @@
 #include "grow/common/domain_spec.hpp"
 #include "grow/common/regions.hpp"
 #include "grow/method.hpp"
+#include "io/network_files.hpp"
 
 namespace angiosynth {
 
@@ -42,6 +43,11 @@ struct ColonisationSetup final : GrowthSetup {
   std::vector<ColonisationRootSpec> roots;
   std::vector<RegionSpec> regions;
   std::vector<std::string> avascular;          // regions no vessel enters
+  // [initial]: stumps of an existing network (each root a tree of `initial_kind`) that grow on.
+  std::filesystem::path initial_file;
+  ExistingNetwork initial;
+  bool initial_from_corner = false;
+  std::string initial_kind = "artery";
   PhysicsParameters physics_summary;           // κ, η, pressures and flow: flows and pressures of the trees
 
   const char* method() const override { return "colonisation"; }

@@ -39,6 +39,15 @@ RootSpec readRootOf(const TomlReader& r, const toml::table& t, const std::string
   return root;
 }
 
+MethodFileTables readMethodFileTables(const TomlReader& r, const GrowthMethod& m) {
+  const auto& dom = methodTable(r, m, "domain");
+  const auto& tree = methodTable(r, m, "tree");
+  const auto& ph = methodTable(r, m, "physics");
+  auto spec = readDomainSpec(r, dom, r.file());
+  const bool flat = spec.shape == DomainShape::Disc || spec.shape == DomainShape::Square;
+  return {dom, tree, ph, std::move(spec), flat};
+}
+
 std::vector<MethodParam> withDomainParams(const char* shape_meaning, const char* sampling_meaning, std::vector<MethodParam> rows) {
   std::vector<MethodParam> out{
       {"domain", "shape", "text", "sphere", shape_meaning},

@@ -40,6 +40,17 @@ std::vector<MethodParam> withDomainParams(const char* shape_meaning, const char*
 // The mask file of a domain, if any: growth reads it, so outputs must not hold it.
 std::vector<std::filesystem::path> domainInputs(const DomainSpec& spec);
 
+// The [domain], [tree] and [physics] tables of a method's file (keys checked against its
+// declarations), its domain read, and whether the domain is flat (disc, square).
+struct MethodFileTables {
+  const toml::table& domain;
+  const toml::table& tree;
+  const toml::table& physics;
+  DomainSpec spec;
+  bool flat;
+};
+MethodFileTables readMethodFileTables(const TomlReader& r, const GrowthMethod& m);
+
 // [domain] of a parameter file (keys checked by the method's declarations beforehand).
 DomainSpec readDomainSpec(const TomlReader& r, const toml::table& dom, const std::filesystem::path& parameter_file);
 // The root of one tree from its table (`name`: "tree" or "tree.inlet"): root_offset for analytic

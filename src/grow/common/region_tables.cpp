@@ -1,6 +1,7 @@
 #include "grow/common/region_tables.hpp"
 
 #include "io/param_checks.hpp"
+#include "io/scenario.hpp"
 
 namespace angiosynth {
 
@@ -89,6 +90,18 @@ std::vector<RegionSpec> readRegions(const TomlReader& r, const GrowthMethod& m, 
     out.push_back(g);
   }
   return out;
+}
+
+InitialNetwork readInitialNetwork(const TomlReader& r, const GrowthMethod& m, const toml::node& node) {
+  const auto* t = node.as_table();
+  if (!t) throw InputError(r.file(), r.lineOf(&node), "initial must be a table: [initial] file = \"tree.swc\"");
+  checkMethodKeys(r, m, *t, "initial");
+  InitialNetwork in;
+  in.file = resolveInputPath(r.string(*t, "initial", "file"), r.file(), r.lineOf(t->get("file")));
+  const auto unit = choice<double>(r, *t, "initial", "unit", 1.0, {{"mm", 1.0}, {"cm", 10.0}, {"m", 1000.0}, {"um", 1e-3}});
+  in.from_corner = choice<bool>(r, *t, "initial", "origin", false, {{"centre", false}, {"corner", true}});
+  in.network = readNetwork(in.file, unit);
+  return in;
 }
 
 std::vector<MethodParam> withRegionParams(std::vector<MethodParam> rows, const char* used_by) {

@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "grow/common/method_tables.hpp"
 #include "grow/common/regions.hpp"
+#include "io/network_files.hpp"
 
 namespace angiosynth {
 
@@ -31,6 +32,16 @@ E choice(const TomlReader& r, const toml::table& t, const std::string& table, co
 std::vector<std::string> regionNames(const TomlReader& r, const toml::table& t, const std::string& key, const std::set<std::string>& known);
 // Every [[region]] of the file, keys checked against m's declarations.
 std::vector<RegionSpec> readRegions(const TomlReader& r, const GrowthMethod& m, bool flat);
+// [initial] (checked against m's declarations): the network file (beside the parameter file),
+// read in its `unit` (mm, cm, m, um), and whether its positions start at the grid's corner
+// (`origin = "corner"`) rather than the domain's centre.
+struct InitialNetwork {
+  std::filesystem::path file;
+  ExistingNetwork network;
+  bool from_corner = false;
+};
+InitialNetwork readInitialNetwork(const TomlReader& r, const GrowthMethod& m, const toml::node& node);
+
 // The [[region]] declarations (`used_by` says which keys name regions), appended to `rows`.
 std::vector<MethodParam> withRegionParams(std::vector<MethodParam> rows, const char* used_by);
 

@@ -71,4 +71,12 @@ GrowthDomain regionDomain(const GrowthDomain& world, const std::vector<const Reg
   return GrowthDomain::mask(std::move(m), false);
 }
 
+std::vector<const RegionSpec*> regionsNamed(const std::vector<RegionSpec>& all, const std::vector<std::string>& names) {
+  std::vector<const RegionSpec*> out;
+  for (const auto& n : names)
+    for (const auto& r : all)
+      if (r.name == n) out.push_back(&r);
+  return out;
+}
+
 }  // namespace angiosynth

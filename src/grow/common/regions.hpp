@@ -27,6 +27,8 @@ struct RegionSpec {
 // Signed distance from p (mm in the frame) to the region's border, positive inside; disc and
 // annulus ignore z.
 double regionDepth(const RegionSpec& r, const Vec3& p, const Vec3& domain_centre);
+// The regions of `all` with the given names, in their order (every name must be defined).
+std::vector<const RegionSpec*> regionsNamed(const std::vector<RegionSpec>& all, const std::vector<std::string>& names);
 // Area (2D) or volume of the region, mm² or mm³.
 double regionMeasure(const RegionSpec& r);
 

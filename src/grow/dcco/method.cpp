@@ -39,13 +39,7 @@ class PreparedDcco final : public PreparedGrowth {
         if (world_.dimension() == 2) p.z = world_.planeZ();
       }
     }
-    std::map<std::string, const RegionSpec*> by_name;
-    for (const auto& r : s.regions) by_name[r.name] = &r;
-    const auto list = [&](const std::vector<std::string>& names) {
-      std::vector<const RegionSpec*> out;
-      for (const auto& n : names) out.push_back(by_name.at(n));
-      return out;
-    };
+    const auto list = [&](const std::vector<std::string>& names) { return regionsNamed(s.regions, names); };
     const auto key = [](const std::vector<std::string>& in, const std::vector<std::string>& out) {
       std::string k;
       for (const auto& n : in) k += n + ",";
@@ -250,15 +244,11 @@ void readInitial(const TomlReader& r, const GrowthMethod& m, DccoSetup& s, bool 
     if (!root_radius) throw InputError(r.file(), 0, "[tree] root_radius is required (the fixed radius of the root vessel)");
     return;
   }
+  auto in = readInitialNetwork(r, m, *node);
   const auto* t = node->as_table();
-  if (!t) throw InputError(r.file(), r.lineOf(node), "initial must be a table: [initial] file = \"tree.cco\"");
-  checkMethodKeys(r, m, *t, "initial");
-  s.initial_file = resolveInputPath(r.string(*t, "initial", "file"), r.file(), r.lineOf(t->get("file")));
-  const auto unit = t->get("unit") ? r.string(*t, "initial", "unit") : "mm";
-  const std::map<std::string, double> units{{"mm", 1.0}, {"cm", 10.0}, {"m", 1000.0}, {"um", 1e-3}};
-  if (!units.count(unit)) throw InputError(r.file(), r.lineOf(t->get("unit")), "unit '" + unit + "'; allowed: mm, cm, m, um");
-  s.initial = readNetwork(s.initial_file, units.at(unit));
-  s.initial_from_corner = choice<bool>(r, *t, "initial", "origin", false, {{"centre", false}, {"corner", true}});
+  s.initial_file = in.file;
+  s.initial = std::move(in.network);
+  s.initial_from_corner = in.from_corner;
   auto& tree = s.initial.tree;
   const auto branchingOf = [&](const toml::table& tab, const std::string& table, Branching fallback) {
     return choice<Branching>(r, tab, table, "branching", fallback,
@@ -330,11 +320,8 @@ void readInitial(const TomlReader& r, const GrowthMethod& m, DccoSetup& s, bool 
 std::shared_ptr<const GrowthSetup> readDccoToml(const TomlReader& r, const GrowthMethod& m) {
   auto s = std::make_shared<DccoSetup>();
   s->parameter_file = r.file();
-  const auto& dom = methodTable(r, m, "domain");
-  const auto& tree = methodTable(r, m, "tree");
-  const auto& ph = methodTable(r, m, "physics");
-  s->domain = readDomainSpec(r, dom, r.file());
-  const bool flat = s->domain.shape == DomainShape::Disc || s->domain.shape == DomainShape::Square;
+  const auto [dom, tree, ph, domain, flat] = readMethodFileTables(r, m);
+  s->domain = domain;
   s->root = readRootOf(r, tree, "tree", s->domain, false);
   auto& o = s->options;
   if (tree.get("root_radius")) {
