@@ -73,6 +73,7 @@ struct System {
   std::vector<double> leaf_radius;           // the radius a leaf carries
   std::vector<double> rk;                    // Σ leaf_radius^κ over the leaves below: the edge's radius^κ (Murray)
   std::vector<double> radius;                // exact Murray radii, set by finishRadii()
+  std::vector<std::int32_t> roots;           // the root nodes
   double kappa = 2.55;
   PointHash nodes;   // cells of the perception distance
   PointHash close;   // cells of the satisfaction distance: "is a node this close?"
@@ -100,6 +101,7 @@ struct System {
     leaf_radius.push_back(leaf_r);
     const double own = std::pow(leaf_r, kappa);
     rk.push_back(own);
+    if (par < 0) roots.push_back(id);
     if (par >= 0) {
       // Murray's law in r^κ is additive: the new leaf adds its share to every ancestor, and a
       // leaf that becomes a parent no longer counts its own.
@@ -495,8 +497,7 @@ class Grower {
     // 2. Arteries grow; the drains they reach turn into CO₂ sources too; 3. veins grow to those.
     grow(art_, st, k);
     for (const System* s : {&art_, &ven_})
-      for (std::size_t r = 0; r < s->pos.size() && r < o_.roots.size(); ++r)
-        if (s->parent[r] < 0) max_radius_ = std::max(max_radius_, s->radiusOf(std::int32_t(r)));
+      for (auto r : s->roots) max_radius_ = std::max(max_radius_, s->radiusOf(r));
     satisfy(art_, sat, veins ? &ven_ : nullptr, st.drain_lifetime);
     if (veins) {
       grow(ven_, st, k);
