@@ -82,9 +82,12 @@ TEST(Colonisation, SymmetricDaughtersLeaveAtMurraysAngle) {
       const Vec3 e = t.position[i] - t.position[t.parent[i]];
       const double a = angleBetween(e, t.position[t.child0[i]] - t.position[i]);
       const double b = angleBetween(e, t.position[t.child1[i]] - t.position[i]);
-      if (std::abs(a - b) < 0.01 / kDeg && std::abs(a - want) < 0.5 / kDeg) {
+      // A split's daughters are made in one step, so they are equally long; a lateral branch is
+      // shorter than the continuation made steps before it.
+      const double la = t.length[t.child0[i]], lb = t.length[t.child1[i]];
+      if (std::abs(la - lb) <= 1e-9 * la) {
         ++symmetric;
-        worst = std::max(worst, std::abs(a - want) * kDeg);
+        worst = std::max({worst, std::abs(a - want) * kDeg, std::abs(b - want) * kDeg});
       } else {
         worst_other += std::abs(a - want) < 1e-9 && std::abs(b - want) < 1e-9;
       }

@@ -249,14 +249,11 @@ class Grower {
     return std::max(c, 1e-6);
   }
 
-  // The centreline a–b inside the world: convex shapes by its ends, masks at quarter voxels.
+  // The centreline a–b inside the world: convex shapes by its end, masks voxel by voxel (every
+  // voxel the segment crosses is inside; sampling at fractions of a voxel can cut a corner).
   bool inside(const Vec3& a, const Vec3& b) const {
     if (world_.shape() != DomainShape::Mask) return world_.depth(b) > 0;  // a is a node (or a root on the border)
-    const double len = distance(a, b), h = world_.frame().voxel_mm / 4;
-    const int n = std::max(1, static_cast<int>(std::ceil(len / h)));
-    for (int i = 1; i <= n; ++i)
-      if (!(world_.depth(a + (b - a) * (double(i) / n)) > 0)) return false;
-    return true;
+    return world_.depth(b) > 0 && world_.frame().segmentClear(a, b);
   }
 
   Vec3 sampleDrain(const ColonisationStage& st) {
