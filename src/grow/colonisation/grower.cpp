@@ -77,6 +77,7 @@ struct System {
   double kappa = 2.55;
   PointHash nodes;   // cells of the perception distance
   PointHash close;   // cells of the satisfaction distance: "is a node this close?"
+  PointHash drains;  // cells of the drain spacing
   std::vector<Vec3> drain;
   std::vector<char> alive;
   std::vector<std::int32_t> born;           // the step a drain appeared
@@ -84,7 +85,7 @@ struct System {
   bool flat = false;
   std::vector<std::int32_t> cone_stamp;      // per node: the step its perception bounds were computed
   std::vector<double> cos_lo, cos_hi;
-  PointHash drains;
+
   System(const Vec3& lo, const Vec3& hi, double node_cell, double close_cell, double drain_cell, bool is_flat)
       : nodes(lo, hi, node_cell, is_flat), close(lo, hi, close_cell, is_flat), drains(lo, hi, drain_cell, is_flat), flat(is_flat) {}
 
