@@ -123,7 +123,7 @@ double GrowthDomain::depth(const Vec3& p) const {
   const Vec3 d = p - center_;
   switch (shape_) {
     case DomainShape::Sphere: return size_ - norm(d);
-    case DomainShape::Disc: return size_ - std::hypot(d.x, d.y);
+    case DomainShape::Disc: return size_ - std::sqrt(d.x * d.x + d.y * d.y);
     case DomainShape::Cube: return size_ - std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
     case DomainShape::Square: return size_ - std::max(std::abs(d.x), std::abs(d.y));
     case DomainShape::Mask: return maskDepth(p);

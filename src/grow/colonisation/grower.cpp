@@ -78,16 +78,19 @@ struct System {
   PointHash nodes;   // cells of the perception distance
   PointHash close;   // cells of the satisfaction distance: "is a node this close?"
   PointHash drains;  // cells of the drain spacing
+  PointHash fresh;   // the drains added in this step's sampling, same cells
   std::vector<Vec3> drain;
-  std::vector<char> alive;
   std::vector<std::int32_t> born;           // the step a drain appeared
-  std::vector<std::int32_t> live;           // alive drains, ascending
+  // A drain's nearest node within the perception distance (−1: none), found when it was made,
+  // and the node count then: still exact while the step and the nodes are the same.
+  std::vector<std::int32_t> near, near_count;
   bool flat = false;
   std::vector<std::int32_t> cone_stamp;      // per node: the step its perception bounds were computed
   std::vector<double> cos_lo, cos_hi;
 
   System(const Vec3& lo, const Vec3& hi, double node_cell, double close_cell, double drain_cell, bool is_flat)
-      : nodes(lo, hi, node_cell, is_flat), close(lo, hi, close_cell, is_flat), drains(lo, hi, drain_cell, is_flat), flat(is_flat) {}
+      : nodes(lo, hi, node_cell, is_flat), close(lo, hi, close_cell, is_flat), drains(lo, hi, drain_cell, is_flat),
+        fresh(lo, hi, drain_cell, is_flat), flat(is_flat) {}
 
   double radiusOf(std::int32_t i) const { return std::pow(rk[std::size_t(i)], 1.0 / kappa); }
 
@@ -114,37 +117,23 @@ struct System {
     close.insert(p, id);
     return id;
   }
-  void addDrain(const Vec3& p, std::int32_t step) {
+  // `nearest`: its nearest node within this step's perception distance, or −2 (not known).
+  void addDrain(const Vec3& p, std::int32_t step, std::int32_t nearest = -2) {
     const auto id = static_cast<std::int32_t>(drain.size());
     drain.push_back(p);
-    alive.push_back(1);
     born.push_back(step);
-    live.push_back(id);
+    near.push_back(nearest);
+    near_count.push_back(std::int32_t(pos.size()));
     drains.insert(p, id);
+    fresh.insert(p, id);
   }
   // True if a node lies within r (r at most a few cells of `close`).
   bool nodeWithin(const Vec3& p, double r) const {
-    bool hit = false;
     const double r2 = r * r;
-    (r > 2 * close.cell() ? nodes : close).forEachNear(p, r, [&](std::int32_t id) {
-      if (!hit) {
-        const Vec3 v = pos[id] - p;
-        hit = dot(v, v) < r2;
-      }
-    });
-    return hit;
-  }
-  // Squared distance to the nearest node within r (r² if none), stopping at the first node
-  // closer than `enough`.
-  double nearestDistance2(const Vec3& p, double r, double enough) const {
-    double bd = r * r;
-    const double e2 = enough * enough;
-    (r > 2 * close.cell() ? nodes : close).forEachNear(p, r, [&](std::int32_t id) {
-      if (bd < e2) return;
+    return (r > 2 * close.cell() ? nodes : close).anyNear(p, r, [&](std::int32_t id) {
       const Vec3 v = pos[id] - p;
-      bd = std::min(bd, dot(v, v));
+      return dot(v, v) < r2;
     });
-    return bd;
   }
   // Nearest node within r (ties: the smaller id), or -1.
   std::int32_t nearestNode(const Vec3& p, double r) const {
@@ -153,12 +142,19 @@ struct System {
       return dot(v, v);
     });
   }
-  bool anyDrainWithin(const Vec3& p, double r) const {
-    bool hit = false;
-    drains.forEachNear(p, r, [&](std::int32_t id) {
-      if (!hit && alive[id] && distance(drain[id], p) < r) hit = true;
+  // The cached nearest node of drain k, if still exact at `step`.
+  bool knowsNearest(std::size_t k, std::int32_t step) const {
+    return near[k] != -2 && born[k] == step && near_count[k] == std::int32_t(pos.size());
+  }
+  bool anyDrainWithin(const Vec3& p, double r) const { return drainWithin(drains, p, r); }
+  // Only the drains added since the step began (the others were checked in parallel).
+  bool freshDrainWithin(const Vec3& p, double r) const { return drainWithin(fresh, p, r); }
+  bool drainWithin(const PointHash& grid, const Vec3& p, double r) const {
+    const double r2 = r * r;
+    return grid.anyNear(p, r, [&](std::int32_t id) {
+      const Vec3 v = drain[id] - p;
+      return dot(v, v) < r2;
     });
-    return hit;
   }
   // Exact Murray radii from the leaves up (children come after their parent), once at the end.
   void finishRadii() {
@@ -170,17 +166,28 @@ struct System {
       else radius[k] = std::pow(std::pow(radius[a], kappa) + std::pow(radius[b], kappa), 1.0 / kappa);
     }
   }
-  // Drains' grid holds the live drains only.
-  void reindexDrains() {
+  // Keeps the drains listed (ascending), renumbered from 0: ids stay small and storage warm.
+  void keepDrains(const std::vector<std::int32_t>& keep) {
+    std::size_t n = 0;
+    for (auto d : keep) {
+      drain[n] = drain[std::size_t(d)];
+      near[n] = near[std::size_t(d)];
+      near_count[n] = near_count[std::size_t(d)];
+      born[n++] = born[std::size_t(d)];
+    }
+    drain.resize(n);
+    born.resize(n);
+    near.resize(n);
+    near_count.resize(n);
     drains.clear();
-    for (auto d : live) drains.insert(drain[d], d);
+    for (std::size_t d = 0; d < n; ++d) drains.insert(drain[d], std::int32_t(d));
   }
 };
 
 class Grower {
  public:
   Grower(const ColonisationOptions& o, GrowthReport& report, ColonisationReport& cr)
-      : o_(o), report_(report), cr_(cr), world_(*o.world), rng_(o.seed, o.sample, Stage::Growth),
+      : o_(o), report_(report), cr_(cr), world_(*o.world),
         art_(world_.lo(), world_.hi(), cell(o, 0), cell(o, 1), cell(o, 2), world_.dimension() == 2),
         ven_(world_.lo(), world_.hi(), cell(o, 0), cell(o, 1), cell(o, 2), world_.dimension() == 2) {
     art_.vein = false;
@@ -242,11 +249,13 @@ class Grower {
 
  private:
   // Cells (0) of the node grid: the smallest perception distance; (1) of the near-node grid:
-  // the smallest satisfaction distance; (2) of the drain grid: the smallest spacing.
+  // the smallest satisfaction distance; (2) of the drain grid: half the perception distance, or
+  // the spacing if larger (live drains are sparse: a few fuller cells scan faster than many
+  // empty ones).
   static double cell(const ColonisationOptions& o, int which) {
     double c = INFINITY;
     for (const auto& st : o.stages)
-      c = std::min(c, which == 0 ? st.perception_distance : which == 1 ? st.satisfaction_distance : std::max(st.drain_spacing, st.perception_distance / 8));
+      c = std::min(c, which == 0 ? st.perception_distance : which == 1 ? st.satisfaction_distance : std::max(st.drain_spacing, st.perception_distance / 2));
     return std::max(c, 1e-6);
   }
 
@@ -257,11 +266,11 @@ class Grower {
     return world_.depth(b) > 0 && world_.frame().segmentClear(a, b);
   }
 
-  Vec3 sampleDrain(const ColonisationStage& st) {
+  Vec3 sampleDrain(const ColonisationStage& st, Rng& rng) const {
     const GrowthDomain& d = *st.drains;
-    if (st.source == DrainSource::Volume) return d.sample(rng_);
+    if (st.source == DrainSource::Volume) return d.sample(rng);
     for (int tries = 0;; ++tries) {  // surface: rejection to the shell of depth ≤ surface_depth
-      const Vec3 p = d.sample(rng_);
+      const Vec3 p = d.sample(rng);
       if (d.depth(p) <= st.surface_depth || tries >= 1000) return p;
     }
   }
@@ -303,16 +312,16 @@ class Grower {
   // perception volume), grouped by node.
   std::vector<std::pair<std::int32_t, std::int32_t>> assign(System& s, const ColonisationStage& st, double delta) {
     const double half = st.perception_angle * kDeg / 2, cos_half = std::cos(half);
-    std::vector<std::int32_t> owner(s.live.size(), -1);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.live.size(), 128), [&](const tbb::blocked_range<std::size_t>& b) {
-      for (std::size_t k = b.begin(); k != b.end(); ++k) owner[k] = s.nearestNode(s.drain[s.live[k]], delta);
+    std::vector<std::int32_t> owner(s.drain.size(), -1);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.drain.size(), 128), [&](const tbb::blocked_range<std::size_t>& b) {
+      for (std::size_t k = b.begin(); k != b.end(); ++k) owner[k] = s.knowsNearest(k, step_) ? s.near[k] : s.nearestNode(s.drain[k], delta);
     });
     // Perception bounds of the nodes that are nearest to some drain, computed once per step.
     s.cone_stamp.resize(s.pos.size(), -1);
     s.cos_lo.resize(s.pos.size());
     s.cos_hi.resize(s.pos.size());
     std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
-    for (std::size_t k = 0; k < s.live.size(); ++k) {
+    for (std::size_t k = 0; k < s.drain.size(); ++k) {
       const auto j = owner[k];
       if (j < 0) continue;
       if (s.cone_stamp[j] != step_) {
@@ -327,10 +336,10 @@ class Grower {
           s.cos_hi[j] = std::cos(std::max(0.0, alpha - half));
         }
       }
-      const Vec3 v = s.drain[s.live[k]] - s.pos[j];
+      const Vec3 v = s.drain[k] - s.pos[j];
       const double d = norm(v);
       const double c = d > 0 ? dot(v, s.dir[j]) / d : -2.0;
-      if (c >= s.cos_lo[j] && c <= s.cos_hi[j]) pairs.emplace_back(j, s.live[k]);
+      if (c >= s.cos_lo[j] && c <= s.cos_hi[j]) pairs.emplace_back(j, std::int32_t(k));
     }
     std::sort(pairs.begin(), pairs.end());
     return pairs;
@@ -429,77 +438,97 @@ class Grower {
 
   // Drains of s within `sat` of one of its nodes are satisfied: removed (an artery's become the
   // veins' CO₂ sources).
-  void satisfy(System& s, double sat, System* co2, int lifetime) {
-    std::vector<char> done(s.live.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.live.size(), 128), [&](const tbb::blocked_range<std::size_t>& b) {
-      for (std::size_t k = b.begin(); k != b.end(); ++k) done[k] = s.nodeWithin(s.drain[s.live[k]], sat);
+  // `delta`: the perception distance, for the nearest vein of each new CO₂ source.
+  void satisfy(System& s, double sat, System* co2, int lifetime, double delta) {
+    std::vector<char> done(s.drain.size(), 0);
+    std::vector<std::int32_t> vein_near(co2 ? s.drain.size() : 0, -2);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.drain.size(), 128), [&](const tbb::blocked_range<std::size_t>& b) {
+      for (std::size_t k = b.begin(); k != b.end(); ++k) {
+        done[k] = s.nodeWithin(s.drain[k], sat);
+        if (done[k] && co2) vein_near[k] = co2->nearestNode(s.drain[k], delta);
+      }
     });
     std::vector<std::int32_t> keep;
-    for (std::size_t k = 0; k < s.live.size(); ++k) {
-      const auto d = s.live[k];
+    for (std::size_t k = 0; k < s.drain.size(); ++k) {
       if (!done[k]) {
-        if (lifetime > 0 && step_ - s.born[d] + 1 >= lifetime) {  // expired unsatisfied
-          s.alive[d] = 0;
-        } else {
-          keep.push_back(d);
-        }
+        if (lifetime <= 0 || step_ - s.born[k] + 1 < lifetime) keep.push_back(std::int32_t(k));  // else expired unsatisfied
         continue;
       }
-      s.alive[d] = 0;
       if (!s.vein) ++cr_.satisfied;
       if (co2) {
-        co2->addDrain(s.drain[d], step_);
+        co2->addDrain(s.drain[k], step_, vein_near[k]);
         ++cr_.venous_drains;
       }
     }
-    s.live = std::move(keep);
-    s.reindexDrains();
-    if (co2) co2->reindexDrains();
+    s.keepDrains(keep);
   }
 
   void step(const ColonisationStage& st, double k) {
     terminal_radius_ = st.terminal_radius * k;
     const double sat = st.satisfaction_distance * k, spacing = st.drain_spacing * k;
-    // 1. Oxygen drains where the tissue is not yet supplied, apart from each other.
-    // Drawn in order (the draws are the seed's), tested for supply in parallel, spaced in order.
-    candidates_.resize(std::size_t(st.drains_per_step));
-    for (auto& p : candidates_) p = sampleDrain(st);
-    // 1: supplied (an artery within the satisfaction distance), 2: oxygenated (within the CO₂
-    // distance): such tissue makes CO₂, a source for the veins unless a vein already drains it.
-    const double co2 = st.co2_distance * k;
+    const double co2 = st.co2_distance * k, delta = st.perception_distance * k;
     const bool veins = o_.veins && !ven_.pos.empty();
-    supplied_.assign(candidates_.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates_.size(), 128), [&](const tbb::blocked_range<std::size_t>& b) {
+    // 1. Oxygen drains where the tissue is not yet supplied, apart from each other. Candidate q
+    // of step t is drawn from its own stream and tested against the trees and the drains the
+    // step began with in parallel; the spacing among this step's drains is kept in draw order.
+    enum : char { Supplied = 1, Oxygenated = 2, Drained = 4, NearVeinDrain = 8, NearArteryDrain = 16 };
+    candidates_.resize(std::size_t(st.drains_per_step));
+    flags_.assign(candidates_.size(), 0);
+    art_near_.assign(candidates_.size(), -2);
+    ven_near_.assign(candidates_.size(), -2);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates_.size(), 64), [&](const tbb::blocked_range<std::size_t>& b) {
       for (std::size_t q = b.begin(); q != b.end(); ++q) {
-        const Vec3& p = candidates_[q];
-        const double d2 = art_.nearestDistance2(p, veins ? std::max(co2, sat) : sat, sat);
-        supplied_[q] = d2 < sat * sat ? 1 : veins && d2 < co2 * co2 ? 2 : 0;
-        if (supplied_[q] && veins && ven_.nodeWithin(p, sat)) supplied_[q] |= 4;  // drained already
+        Rng rng(o_.seed, o_.sample, Stage::Growth, 1 + (std::uint64_t(step_) << 32) + q);
+        const Vec3 p = candidates_[q] = sampleDrain(st, rng);
+        // Supplied: an artery within the satisfaction distance; oxygenated: within the CO₂
+        // distance. Such tissue makes CO₂, a source for the veins unless a vein drains it.
+        // A candidate that may become a drain also finds the node that will perceive it.
+        char f = 0;
+        if (art_.nodeWithin(p, sat)) {
+          f = Supplied;
+        } else if (art_.anyDrainWithin(p, spacing)) {
+          f = NearArteryDrain | (veins && art_.nodeWithin(p, co2) ? Oxygenated : 0);
+        } else {
+          const auto j = art_.nearestNode(p, std::max(delta, co2));
+          const Vec3 v = j >= 0 ? art_.pos[std::size_t(j)] - p : Vec3(0, 0, 0);
+          const double d2 = j >= 0 ? dot(v, v) : INFINITY;
+          if (veins && d2 < co2 * co2) f = Oxygenated;
+          art_near_[q] = d2 < delta * delta ? j : -1;
+        }
+        if (veins && (f & (Supplied | Oxygenated))) {
+          if (ven_.nodeWithin(p, sat)) f |= Drained;
+          else if (ven_.anyDrainWithin(p, spacing)) f |= NearVeinDrain;
+          else ven_near_[q] = ven_.nearestNode(p, delta);
+        }
+        flags_[q] = f;
       }
     });
+    art_.fresh.clear();
+    ven_.fresh.clear();
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
       const Vec3 p = candidates_[i];
+      const char f = flags_[i];
       ++report_.candidates;
-      if (supplied_[i] && !(supplied_[i] & 4) && !ven_.anyDrainWithin(p, spacing)) {
-        ven_.addDrain(p, step_);
+      if ((f & (Supplied | Oxygenated)) && !(f & (Drained | NearVeinDrain)) && !ven_.freshDrainWithin(p, spacing)) {
+        ven_.addDrain(p, step_, ven_near_[i]);
         ++cr_.venous_drains;
       }
-      if (supplied_[i] & 1) {
+      if (f & Supplied) {
         ++report_.rejected_too_close;
         continue;
       }
-      if (art_.anyDrainWithin(p, spacing)) continue;
-      art_.addDrain(p, step_);
+      if ((f & NearArteryDrain) || art_.freshDrainWithin(p, spacing)) continue;
+      art_.addDrain(p, step_, art_near_[i]);
       ++cr_.arterial_drains;
     }
     // 2. Arteries grow; the drains they reach turn into CO₂ sources too; 3. veins grow to those.
     grow(art_, st, k);
     for (const System* s : {&art_, &ven_})
       for (auto r : s->roots) max_radius_ = std::max(max_radius_, s->radiusOf(r));
-    satisfy(art_, sat, veins ? &ven_ : nullptr, st.drain_lifetime);
+    satisfy(art_, sat, veins ? &ven_ : nullptr, st.drain_lifetime, delta);
     if (veins) {
       grow(ven_, st, k);
-      satisfy(ven_, sat, nullptr, st.drain_lifetime);
+      satisfy(ven_, sat, nullptr, st.drain_lifetime, delta);
     }
     ++step_;
   }
@@ -513,11 +542,11 @@ class Grower {
   GrowthReport& report_;
   ColonisationReport& cr_;
   const GrowthDomain& world_;
-  Rng rng_;
   System art_, ven_;
   std::vector<Pending> pending_;
   std::vector<Vec3> candidates_;
-  std::vector<char> supplied_;
+  std::vector<char> flags_;
+  std::vector<std::int32_t> art_near_, ven_near_;
   double terminal_radius_ = 0, max_edge_ = 0, max_radius_ = 0;
   std::int32_t step_ = 0;
 };

@@ -598,7 +598,7 @@ const GrowthMethod kColonisationMethod{
         {"stage", "perception_distance", "mm", "[domain] diameter × 0.04", "δ, how far a node perceives drains"},
         {"stage", "perception_angle", "deg", "90", "γ, the full angle of the perception cone"},
         {"stage", "satisfaction_distance", "mm", "[domain] diameter × 0.01", "a drain this close to a node of its system is supplied"},
-        {"stage", "co2_distance", "mm", "[domain] diameter × 0.03", "tissue this close to an artery makes CO2: a drain for the veins (unless a vein is within satisfaction_distance)"},
+        {"stage", "co2_distance", "mm", "[domain] diameter × 0.04", "tissue this close to an artery makes CO2: a drain for the veins (unless a vein is within satisfaction_distance)"},
         {"stage", "drain_spacing", "mm", "[domain] diameter × 0.005", "minimum distance between drains"},
         {"stage", "terminal_radius", "mm", "[domain] diameter × 0.0004", "r, the radius of every leaf"},
         {"stage", "bias", "", "0.5", "ω in [0, 1]: weight of the current (or Murray-branch) direction against the drains' mean"},

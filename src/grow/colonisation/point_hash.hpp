@@ -52,6 +52,18 @@ class PointHash {
         for (std::int64_t x = x0; x <= x1; ++x)
           for (auto id = head_[index(x, y, z)]; id >= 0; id = next_[std::size_t(id)]) f(id);
   }
+  // True as soon as pred(id) holds for a point in the cells a ball of radius r around p touches.
+  template <class Pred>
+  bool anyNear(const Vec3& p, double r, Pred&& pred) const {
+    const std::int64_t x0 = axis(p.x - r, 0), x1 = axis(p.x + r, 0), y0 = axis(p.y - r, 1), y1 = axis(p.y + r, 1), z0 = axis(p.z - r, 2),
+                       z1 = axis(p.z + r, 2);
+    for (std::int64_t z = z0; z <= z1; ++z)
+      for (std::int64_t y = y0; y <= y1; ++y)
+        for (std::int64_t x = x0; x <= x1; ++x)
+          for (auto id = head_[index(x, y, z)]; id >= 0; id = next_[std::size_t(id)])
+            if (pred(id)) return true;
+    return false;
+  }
   // The id minimising dist2(id) among points within r (ties: the smaller id), or -1.
   template <class Dist2>
   std::int32_t nearest(const Vec3& p, double r, Dist2&& dist2) const {
