@@ -74,6 +74,16 @@ const BadCase kCases[] = {
     {"colonisation_no_vein_root", "p.toml", "", "", COLONISATION "[[tree.inlet]]\nkind = \"artery\"\nroot_offset = [0, 9]\n",
      "generate p.toml --out out", "p.toml:7: no vein root: add a [[tree.inlet]] with kind = \"vein\", or set [tree] veins = false"},
 #undef COLONISATION
+    // L-system (seed 004): blocks the inverse problem cannot fill.
+#define LZH "[domain]\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"lsystem\"\nblock_width = \"10 mm\"\nstart_length = \"3 mm\"\n" \
+            "capillary_length = \"2 mm\"\nstart_diameter = \"1 mm\"\ncapillary_diameter = \"0.2 mm\"\ncapillary_spacing = \"1.2 mm\"\n"
+    {"lzh_block_too_low", "p.toml", "", "", LZH "block_height = \"7 mm\"\n", "generate p.toml --out out",
+     "p.toml:11: block_height 7 mm leaves no room for the trees: it must exceed 2·start_length + capillary_length = 8 mm"},
+    {"lzh_capillary_walls_overlap", "p.toml", "", "", LZH "block_height = \"20 mm\"\ncapillary_wall = \"0.3 mm\"\n", "generate p.toml --out out",
+     "p.toml:10: neighbouring capillaries lie 0.586667 mm apart, less than their outer diameter 0.8 mm"},
+    {"lzh_unknown_mode", "p.toml", "", "", LZH "block_height = \"20 mm\"\nmode = \"grammar\"\n", "generate p.toml --out out",
+     "p.toml:12: mode 'grammar'; allowed: lzh"},
+#undef LZH
     {"profile_intensity_huge", "prof.toml", "", "", "background = 1e30\n[[effect]]\ntype = \"gaussian\"\nsigma = 1\n",
      "generate p.toml --out out --profile prof.toml", "prof.toml:1: background = 1e+30 is out of range"},
     {"bias_scale_tiny", "prof.toml", "", "", "[[effect]]\ntype = \"bias\"\namplitude = 0.2\nscale = \"1e-9 mm\"\n",

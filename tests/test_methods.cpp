@@ -94,8 +94,8 @@ TEST_F(MethodFiles, KeysAreCheckedAgainstTheDeclarations) {
   EXPECT_NE(m.find("p.toml:8: unknown key 'branching' in [tree] of method cco; allowed: closest_neighbours,"), std::string::npos) << m;
   m = message(head + "[tree]\nmethod = \"cco\"\nterminals = 100\nmin_distance = \"1 mm\"\n");
   EXPECT_NE(m.find("p.toml:8: 'min_distance' in [tree] is for method vascusynth"), std::string::npos) << m;
-  m = message(head + "[tree]\nmethod = \"lsystem\"\nterminals = 100\n");
-  EXPECT_NE(m.find("p.toml:6: method 'lsystem' is not available; allowed: vascusynth, cco, dcco"), std::string::npos) << m;
+  m = message(head + "[tree]\nmethod = \"diffusion\"\nterminals = 100\n");
+  EXPECT_NE(m.find("p.toml:6: method 'diffusion' is not available; allowed: vascusynth, cco, dcco, colonisation, lsystem"), std::string::npos) << m;
   // dcco's terminals come per [[stage]]; a [[stage]] table in a cco file is for method dcco.
   m = message(head + "[tree]\nmethod = \"dcco\"\nterminals = 100\n");
   EXPECT_NE(m.find("p.toml:7: 'terminals' in [tree] is for method"), std::string::npos) << m;

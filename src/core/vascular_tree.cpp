@@ -16,11 +16,24 @@ const char* nodeTypeName(NodeType t) {
   return "";
 }
 
+bool VascularTree::hasTapers() const {
+  for (std::size_t i = 0; i < radius_start.size(); ++i)
+    if (radius_start[i] >= 0 && radius_start[i] != radius[i]) return true;
+  return false;
+}
+
+bool VascularTree::hasWalls() const {
+  for (std::size_t i = 0; i < wall.size(); ++i)
+    if (wall[i] > 0 || wall_start[i] > 0) return true;
+  return false;
+}
+
 void VascularTree::reserve(std::size_t n) {
   position.reserve(n); parent.reserve(n); child0.reserve(n); child1.reserve(n);
   terminals.reserve(n); length.reserve(n); reduced_resistance.reserve(n); beta.reserve(n);
   cost_ratio.reserve(n); radius.reserve(n); flow.reserve(n); pressure.reserve(n); depth.reserve(n); tree.reserve(n);
   stage.reserve(n); role.reserve(n); branching.reserve(n); outflow.reserve(n);
+  radius_start.reserve(n); wall_start.reserve(n); wall.reserve(n);
 }
 
 void VascularTree::truncate(std::size_t n) {
@@ -28,6 +41,7 @@ void VascularTree::truncate(std::size_t n) {
   terminals.resize(n); length.resize(n); reduced_resistance.resize(n); beta.resize(n);
   cost_ratio.resize(n); radius.resize(n); flow.resize(n); pressure.resize(n); depth.resize(n); tree.resize(n);
   stage.resize(n); role.resize(n); branching.resize(n); outflow.resize(n);
+  radius_start.resize(n); wall_start.resize(n); wall.resize(n);
 }
 
 std::int32_t VascularTree::addNode(const Vec3& p, std::int32_t parent_node, std::int32_t tree_id) {
@@ -50,6 +64,9 @@ std::int32_t VascularTree::addNode(const Vec3& p, std::int32_t parent_node, std:
   role.push_back(0);
   branching.push_back(0);
   outflow.push_back(0);
+  radius_start.push_back(-1);
+  wall_start.push_back(0);
+  wall.push_back(0);
   if (parent_node >= 0) {
     if (child0[parent_node] < 0) child0[parent_node] = id;
     else if (child1[parent_node] < 0) child1[parent_node] = id;
@@ -106,6 +123,9 @@ void VascularTree::appendTree(const VascularTree& t, std::int32_t tree_id) {
     role.push_back(t.role[i]);
     branching.push_back(t.branching[i]);
     outflow.push_back(i < std::int32_t(t.outflow.size()) ? t.outflow[i] : 0.0);
+    radius_start.push_back(i < std::int32_t(t.radius_start.size()) ? t.radius_start[i] : -1.0);
+    wall_start.push_back(i < std::int32_t(t.wall_start.size()) ? t.wall_start[i] : 0.0);
+    wall.push_back(i < std::int32_t(t.wall.size()) ? t.wall[i] : 0.0);
   }
 }
 
@@ -177,6 +197,10 @@ void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments, con
     out.branching.push_back(i < branching.size() ? branching[i] : 0);
     out.outflow.push_back(i < outflow.size() ? outflow[i] : 0.0);
   }
+  // Merged segments are re-sized by the method: cylinders again, walls as given.
+  out.radius_start.assign(out.position.size(), -1.0);
+  out.wall_start.assign(out.position.size(), 0.0);
+  out.wall.assign(out.position.size(), 0.0);
   const auto m = out.position.size();
   out.terminals.assign(m, 1); out.length.assign(m, 0); out.reduced_resistance.assign(m, 0);
   out.beta.assign(m, 1); out.cost_ratio.assign(m, 0); out.radius.assign(m, 0);

@@ -4,6 +4,7 @@
 // parent[i] to node i. The root node has one child segment; bifurcations have two.
 // A forest stores several trees in one such structure: each tree has its own root (parent -1),
 // `tree[i]` says which tree node i belongs to, and node and segment ids stay unique.
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -36,8 +37,20 @@ struct VascularTree {
   // Prescribed outflow of terminal segment i as a fraction of its tree's inflow (seed 001's
   // outlets to adjacent territories; 0: an ordinary terminal sharing the rest equally).
   std::vector<double> outflow;
+  // Tapered vessels (seed 004: diameter and wall linear along the path): segment i runs from
+  // radius_start[i] at its proximal node to radius[i] at its distal node, a cone with spherical
+  // caps; −1 (the default) is a cylinder of radius[i]. wall_start/wall: the wall thickness at its
+  // two ends (0: none given).
+  std::vector<double> radius_start, wall_start, wall;
 
   bool hasStages() const;
+  // True if some segment tapers (radius_start set) or carries a wall thickness.
+  bool hasTapers() const;
+  bool hasWalls() const;
+  // Radius of segment i at its proximal end.
+  double startRadius(std::int32_t i) const { return radius_start[i] >= 0 ? radius_start[i] : radius[i]; }
+  // The larger of its two radii.
+  double maxRadius(std::int32_t i) const { return std::max(radius[i], radius_start[i]); }
   std::int32_t nodeCount() const { return static_cast<std::int32_t>(position.size()); }
   std::int32_t segmentCount() const { return nodeCount() > 0 ? nodeCount() - 1 : 0; }
   // Terminals of the tree rooted at node 0 (growth works on one tree).

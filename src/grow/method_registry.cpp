@@ -5,13 +5,14 @@
 #include "grow/cco/setup.hpp"
 #include "grow/colonisation/setup.hpp"
 #include "grow/dcco/setup.hpp"
+#include "grow/lsystem/setup.hpp"
 #include "grow/method.hpp"
 #include "grow/vascusynth/setup.hpp"
 
 namespace angiosynth {
 
 const std::vector<const GrowthMethod*>& growthMethods() {
-  static const std::vector<const GrowthMethod*> all{&kVascuSynthMethod, &kCcoMethod, &kDccoMethod, &kColonisationMethod};
+  static const std::vector<const GrowthMethod*> all{&kVascuSynthMethod, &kCcoMethod, &kDccoMethod, &kColonisationMethod, &kLsystemMethod};
   return all;
 }
 

@@ -34,6 +34,12 @@ std::string stageAttrs(const VascularTree& t, std::int32_t i) {
          stringAttr("role", roleName(t.role[i])) + stringAttr("branching", branchingName(t.branching[i]));
 }
 
+// Tapered vessels (seed 004): the radius at the proximal end and the wall at both ends.
+std::string taperAttrs(const VascularTree& t, std::int32_t i, bool tapered) {
+  if (!tapered) return "";
+  return floatAttr("radius_start", t.startRadius(i)) + floatAttr("wall_start", t.wall_start[i]) + floatAttr("wall", t.wall[i]);
+}
+
 }  // namespace
 
 const TreeInfo& treeOf(const std::vector<TreeInfo>& trees, const VascularTree& t, std::int32_t node) {
@@ -52,13 +58,14 @@ void writeGxl(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
         << stringAttr("tree", treeOf(trees, t, i).id) << stringAttr("kind", treeOf(trees, t, i).kind)
         << tupAttr("position", t.position[i]) << tupAttr("position_voxel", t.position[i] / f.voxel_mm) << "    </node>\n";
   }
+  const bool tapered = t.hasTapers() || t.hasWalls();
   for (auto i : t.topDownOrder()) {
     if (t.isRoot(i)) continue;
     out << "    <edge id=\"e" << i << "\" from=\"n" << t.parent[i] << "\" to=\"n" << i << "\">\n"
         << stringAttr("tree", treeOf(trees, t, i).id) << stringAttr("kind", treeOf(trees, t, i).kind)
         << floatAttr("radius", t.radius[i]) << floatAttr("length", t.length[i]) << floatAttr("flow", t.flow[i])
         << floatAttr("pressure_proximal", t.pressure[t.parent[i]]) << floatAttr("pressure_distal", t.pressure[i])
-        << stageAttrs(t, i) << "    </edge>\n";
+        << stageAttrs(t, i) << taperAttrs(t, i, tapered) << "    </edge>\n";
   }
   out << "  </graph>\n</gxl>\n";
 }
@@ -87,7 +94,7 @@ void writeVascuSynthGxl(std::ostream& out, const VascularTree& t, const GraphFra
 
 void writeDot(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees, const GraphFrame& f) {
   out << "digraph tree {\n  // positions in mm; radius and length in mm, flow in mm^3/s, pressure in Pa\n";
-  const bool staged = t.hasStages();
+  const bool staged = t.hasStages(), tapered = t.hasTapers() || t.hasWalls();
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
     const Vec3& p = t.position[i];
     out << "  n" << i << " [type=" << nodeTypeName(t.type(i)) << ", tree=\"" << treeOf(trees, t, i).id << "\", kind=\""
@@ -101,6 +108,9 @@ void writeDot(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
         << ", length=" << exactNumber(t.length[i]) << ", flow=" << exactNumber(t.flow[i])
         << ", pressure=" << exactNumber(t.pressure[i]);
     if (staged) out << ", stage=" << t.stage[i] << ", role=" << roleName(t.role[i]) << ", branching=" << branchingName(t.branching[i]);
+    if (tapered)
+      out << ", radius_start=" << exactNumber(t.startRadius(i)) << ", wall_start=" << exactNumber(t.wall_start[i])
+          << ", wall=" << exactNumber(t.wall[i]);
     out << "];\n";
   }
   out << "}\n";

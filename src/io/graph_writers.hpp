@@ -32,6 +32,8 @@ void writeDot(std::ostream& out, const VascularTree& tree, const std::vector<Tre
 
 // Radius at a node: that of its incoming segment (a root takes its root segment's).
 double nodeRadius(const VascularTree& tree, std::int32_t node);
+// The lumen volume of segment i (a cylinder, or a truncated cone when it tapers), mm³.
+double segmentVolume(const VascularTree& tree, std::int32_t segment);
 
 // VesselGraph-style tables. nodes.csv: id,pos_x,pos_y,pos_z (mm),type,pressure (Pa),tree,kind;
 // edges.csv: id,node1id,node2id (proximal, distal),length,radius (mm),flow (mm^3/s),volume (mm^3),tree,kind.

@@ -9,7 +9,14 @@ namespace angiosynth {
 
 double nodeRadius(const VascularTree& t, std::int32_t i) {
   if (!t.isRoot(i)) return t.radius[i];
-  return t.child0[i] > 0 ? t.radius[t.child0[i]] : 0.0;
+  return t.child0[i] > 0 ? t.startRadius(t.child0[i]) : 0.0;
+}
+
+double segmentVolume(const VascularTree& t, std::int32_t i) {
+  const double r = t.radius[i], l = t.length[i];
+  if (t.radius_start[i] < 0) return std::numbers::pi * r * r * l;
+  const double a = t.radius_start[i];
+  return std::numbers::pi * l * (a * a + a * r + r * r) / 3;  // a truncated cone
 }
 
 void writeNodesCsv(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees) {
@@ -23,15 +30,16 @@ void writeNodesCsv(std::ostream& out, const VascularTree& t, const std::vector<T
 }
 
 void writeEdgesCsv(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees) {
-  const bool staged = t.hasStages();
-  out << "id,node1id,node2id,length,radius,flow,volume,tree,kind" << (staged ? ",stage,role,branching" : "") << "\n";
+  const bool staged = t.hasStages(), tapered = t.hasTapers() || t.hasWalls();
+  out << "id,node1id,node2id,length,radius,flow,volume,tree,kind" << (staged ? ",stage,role,branching" : "")
+      << (tapered ? ",radius_start,wall_start,wall" : "") << "\n";
   for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
     if (t.isRoot(i)) continue;
     const TreeInfo& tr = treeOf(trees, t, i);
     out << i << ',' << t.parent[i] << ',' << i << ',' << exactNumber(t.length[i]) << ',' << exactNumber(t.radius[i]) << ','
-        << exactNumber(t.flow[i]) << ',' << exactNumber(std::numbers::pi * t.radius[i] * t.radius[i] * t.length[i]) << ','
-        << tr.id << ',' << tr.kind;
+        << exactNumber(t.flow[i]) << ',' << exactNumber(segmentVolume(t, i)) << ',' << tr.id << ',' << tr.kind;
     if (staged) out << ',' << t.stage[i] << ',' << roleName(t.role[i]) << ',' << branchingName(t.branching[i]);
+    if (tapered) out << ',' << exactNumber(t.startRadius(i)) << ',' << exactNumber(t.wall_start[i]) << ',' << exactNumber(t.wall[i]);
     out << '\n';
   }
 }
@@ -108,6 +116,15 @@ void writeVtp(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
     }
     writeVitaCellArrays(out, t, segments);
   }
+  if (t.hasTapers() || t.hasWalls()) {  // tapered vessels (seed 004): the proximal radius, the wall at both ends
+    const auto array = [&](const char* name, auto&& value) {
+      out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
+      for (auto i : segments) out << exactNumber(value(i)) << '\n';
+    };
+    array("RadiusStart", [&](std::int32_t i) { return t.startRadius(i); });
+    array("WallStart", [&](std::int32_t i) { return t.wall_start[i]; });
+    array("Wall", [&](std::int32_t i) { return t.wall[i]; });
+  }
   out << "</DataArray>\n</CellData>\n<Lines>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
   for (auto i : segments) out << t.parent[i] << ' ' << i << '\n';
   out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
@@ -148,7 +165,11 @@ void writeGraphml(std::ostream& out, const VascularTree& t, const std::vector<Tr
          "  <key id=\"flow\" for=\"edge\" attr.name=\"flow\" attr.type=\"double\"/>\n"
          "  <key id=\"tree\" for=\"edge\" attr.name=\"tree\" attr.type=\"string\"/>\n"
          "  <key id=\"kind\" for=\"edge\" attr.name=\"kind\" attr.type=\"string\"/>\n";
-  const bool staged = t.hasStages();
+  const bool staged = t.hasStages(), tapered = t.hasTapers() || t.hasWalls();
+  if (tapered)
+    out << "  <key id=\"radius_start\" for=\"edge\" attr.name=\"radius_start\" attr.type=\"double\"/>\n"
+           "  <key id=\"wall_start\" for=\"edge\" attr.name=\"wall_start\" attr.type=\"double\"/>\n"
+           "  <key id=\"wall\" for=\"edge\" attr.name=\"wall\" attr.type=\"double\"/>\n";
   if (staged)
     out << "  <key id=\"stage\" for=\"edge\" attr.name=\"stage\" attr.type=\"int\"/>\n"
            "  <key id=\"role\" for=\"edge\" attr.name=\"role\" attr.type=\"string\"/>\n"
@@ -171,6 +192,9 @@ void writeGraphml(std::ostream& out, const VascularTree& t, const std::vector<Tr
     if (staged)
       out << "<data key=\"stage\">" << t.stage[i] << "</data><data key=\"role\">" << roleName(t.role[i])
           << "</data><data key=\"branching\">" << branchingName(t.branching[i]) << "</data>";
+    if (tapered)
+      out << "<data key=\"radius_start\">" << exactNumber(t.startRadius(i)) << "</data><data key=\"wall_start\">"
+          << exactNumber(t.wall_start[i]) << "</data><data key=\"wall\">" << exactNumber(t.wall[i]) << "</data>";
     out << "</edge>\n";
   }
   out << "  </graph>\n</graphml>\n";

@@ -243,7 +243,7 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
     trees.push_back(Json{{"index", k}, {"id", t.id}, {"kind", t.kind}, {"class", t.class_label},
                          {"root_node", root}, {"root_position", Json{{"value", {at.x, at.y, at.z}}, {"unit", "mm"}}},
                          {"terminals", seg >= 0 ? tree.terminals[seg] : 0},
-                         {"root_radius", quantityJson(seg >= 0 ? tree.radius[seg] : 0.0, "mm")},
+                         {"root_radius", quantityJson(seg >= 0 ? tree.startRadius(seg) : 0.0, "mm")},
                          {"flow", quantityJson(seg >= 0 ? tree.flow[seg] : 0.0, "mm^3/s")},
                          {"root_pressure", quantityJson(tree.pressure[root], "Pa")},
                          {"terminal_pressure", quantityJson(terminal_pressure, "Pa")},

@@ -8,14 +8,21 @@
 namespace angiosynth {
 namespace {
 
-// A capsule in continuous voxel-index coordinates scaled to mm (so distances are in mm).
+// A capsule in continuous voxel-index coordinates scaled to mm (so distances are in mm); a
+// tapered vessel is a round cone: the convex hull of a sphere of radius ra at a and one of rb at b.
 struct Capsule {
-  Vec3 a, d;        // start and axis (mm)
-  double inv_len2;  // 1/|d|²
-  double r, r2;
-  std::uint32_t id;
-  // Signed distance to the surface, moved inwards by half_var·κ.
+  Vec3 a, d;            // start and axis (mm)
+  double inv_len2 = 0;  // 1/|d|²
+  double r = 0, r2 = 0; // the cylinder's radius; a cone's larger one
+  std::uint32_t id = 0;
+  bool cone = false;
+  Vec3 e;                   // unit axis
+  double ra = 0, rb = 0, len = 0, sin_a = 0, cos_a = 1;  // sin α = (ra − rb)/len: the side's slope
+  bool nested = false;      // |ra − rb| ≥ len: one sphere holds the other, no side
+  // Signed distance to the surface, moved inwards by half_var·κ (κ: the mean curvature ×2 of
+  // the nearest surface part: 1/r on a cylinder, cos α/ρ on a cone's side, 2/r on the caps).
   double signedDistance(const Vec3& p, double half_var) const {
+    if (cone) return coneDistance(p, half_var);
     const Vec3 ap = p - a;
     const double u = inv_len2 > 0 ? dot(ap, d) * inv_len2 : 0.0;
     const double t = u < 0 ? 0 : (u > 1 ? 1 : u);
@@ -23,6 +30,8 @@ struct Capsule {
     const double kappa = (t == u && inv_len2 > 0) ? 1.0 / r : 2.0 / r;
     return std::sqrt(dot(q, q)) - r + half_var * kappa;
   }
+  // Unshifted signed distance (< 0 inside).
+  double depth(const Vec3& p) const { return cone ? coneDistance(p, 0) : std::sqrt(dist2(p)) - r; }
   double dist2(const Vec3& p) const {
     const Vec3 ap = p - a;
     double t = inv_len2 > 0 ? dot(ap, d) * inv_len2 : 0.0;
@@ -30,13 +39,47 @@ struct Capsule {
     const Vec3 q = ap - d * t;
     return dot(q, q);
   }
+  double coneDistance(const Vec3& p, double half_var) const {
+    const Vec3 ap = p - a, bp = ap - d;
+    const double da = std::sqrt(dot(ap, ap)) - ra, db = std::sqrt(dot(bp, bp)) - rb;
+    if (nested) return da < db ? da + half_var * 2 / ra : db + half_var * 2 / rb;
+    // In the plane of the axis and p: y along the axis, x from it. The side is the line tangent
+    // to both circles; s is the position along it from the tangent point on sphere a.
+    const double y = dot(ap, e), x = std::sqrt(std::max(0.0, dot(ap, ap) - y * y));
+    const double s = y * cos_a - x * sin_a;
+    if (s <= 0) return da + half_var * 2 / ra;
+    if (s >= len * cos_a) return db + half_var * 2 / rb;
+    const double rho = ra * cos_a - s * sin_a;  // the side's distance from the axis there
+    return y * sin_a + x * cos_a - ra + half_var * cos_a / rho;
+  }
 };
 
 Capsule capsuleOf(const VascularTree& t, std::int32_t s) {
   const Vec3 a = t.position[t.parent[s]], b = t.position[s];
   const Vec3 d = b - a;
   const double l2 = dot(d, d);
-  return {a, d, l2 > 0 ? 1.0 / l2 : 0.0, t.radius[s], t.radius[s] * t.radius[s], static_cast<std::uint32_t>(s)};
+  const double r = t.maxRadius(s);
+  Capsule c;
+  c.a = a;
+  c.d = d;
+  c.inv_len2 = l2 > 0 ? 1.0 / l2 : 0.0;
+  c.r = r;
+  c.r2 = r * r;
+  c.id = static_cast<std::uint32_t>(s);
+  const double ra = t.startRadius(s), rb = t.radius[s];
+  if (ra != rb) {
+    c.cone = true;
+    c.ra = ra;
+    c.rb = rb;
+    c.len = std::sqrt(l2);
+    c.nested = std::abs(ra - rb) >= c.len;
+    if (!c.nested) {
+      c.e = d / c.len;
+      c.sin_a = (ra - rb) / c.len;
+      c.cos_a = std::sqrt(1 - c.sin_a * c.sin_a);
+    }
+  }
+  return c;
 }
 
 }  // namespace
@@ -48,7 +91,7 @@ double brickPairBound(const VascularTree& tree, const VolumeGrid& g) {
     const Vec3 a = tree.position[tree.parent[s]], b = tree.position[s];
     double n = 1;
     for (int ax = 0; ax < 3; ++ax) {
-      const double extent = (std::abs(a[ax] - b[ax]) + 2 * tree.radius[s]) / g.spacing_mm[ax] + 2;
+      const double extent = (std::abs(a[ax] - b[ax]) + 2 * tree.maxRadius(s)) / g.spacing_mm[ax] + 2;
       n *= std::min(extent / kBrick + 1, (g.dims[ax] + kBrick - 1.0) / kBrick);
     }
     total += n;
@@ -65,7 +108,7 @@ BrickBins binSegments(const VascularTree& tree, const VolumeGrid& g) {
   for (std::int32_t s = 1; s < tree.nodeCount(); ++s) {
     if (tree.isRoot(s)) continue;
     const Vec3 a = tree.position[tree.parent[s]], b = tree.position[s];
-    const double r = tree.radius[s];
+    const double r = tree.maxRadius(s);
     // Voxel x (cube [x−½, x+½] in index units) can touch the capsule's box if
     // x ∈ [⌈min − r/s − ½⌉, ⌊max + r/s + ½⌋]; bricks hold voxels 8b … 8b+7.
     int lo[3], hi[3];
@@ -142,7 +185,7 @@ void rasterizeBricks(const VascularTree& tree, const VolumeGrid& g, const BrickB
             double best = 1e300;
             bool full = false;
             for (const auto& cap : caps) {
-              const double depth = std::sqrt(cap.dist2(c)) - cap.r;  // < 0 inside
+              const double depth = cap.depth(c);  // < 0 inside
               if (depth >= half_diag) continue;
               if (depth < best) best = depth, instance[v] = cap.id;
               if (depth <= -half_diag) full = true;

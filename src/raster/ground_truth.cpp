@@ -139,11 +139,20 @@ void addCenterlines(const VascularTree& t, GroundTruthVolumes& gt, const std::ve
       forEachCrossedVoxel(g, a, b, [&](std::int64_t i, std::int64_t j, std::int64_t k) { claim(g.flat(i, j, k), s); });
       centerlineVoxels(g, a, b, curve);
       // Radii are positive, so their bit patterns order like the floats: a maximum on integers.
-      const float rs = static_cast<float>(t.radius[s]);
+      // A tapered vessel's radius is the one across from the voxel's centre.
+      const double r0 = t.startRadius(s), r1 = t.radius[s];
+      const Vec3 ab = b - a;
+      const double inv_len2 = dot(ab, ab) > 0 ? 1.0 / dot(ab, ab) : 0.0;
+      const float rs = static_cast<float>(r1);
       std::uint32_t rbits;
       std::memcpy(&rbits, &rs, sizeof rbits);
       for (const auto& c : curve) {
         const auto v = g.flat(c[0], c[1], c[2]);
+        if (r0 != r1) {
+          const double f = std::clamp(dot(g.centre(c[0], c[1], c[2]) - a, ab) * inv_len2, 0.0, 1.0);
+          const float rl = static_cast<float>(r0 + f * (r1 - r0));
+          std::memcpy(&rbits, &rl, sizeof rbits);
+        }
         std::atomic_ref<std::uint8_t>(gt.centerline.data[v]).store(1, std::memory_order_relaxed);
         std::atomic_ref<std::uint32_t> rad(*reinterpret_cast<std::uint32_t*>(&gt.radius.data[v]));
         std::uint32_t cur = rad.load(std::memory_order_relaxed);
