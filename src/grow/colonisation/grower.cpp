@@ -8,7 +8,7 @@
 #include <numbers>
 
 #include "core/rng.hpp"
-#include "grow/colonisation/point_hash.hpp"
+#include "grow/common/point_hash.hpp"
 
 namespace angiosynth {
 

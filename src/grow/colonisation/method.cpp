@@ -6,8 +6,9 @@
 
 #include "core/error.hpp"
 #include "core/quantity_json.hpp"
-#include "grow/colonisation/point_hash.hpp"
+#include "grow/common/point_hash.hpp"
 #include "grow/colonisation/setup.hpp"
+#include "grow/common/chain_trees.hpp"
 #include "grow/common/intersections.hpp"
 #include "grow/common/method_tables.hpp"
 #include "grow/common/region_tables.hpp"
@@ -20,43 +21,6 @@ namespace angiosynth {
 namespace {
 
 using Json = nlohmann::ordered_json;
-
-// The domain's diameter: lengths not given in mm are fractions of it.
-double diameterOf(const GrowthDomain& d) {
-  switch (d.shape()) {
-    case DomainShape::Sphere:
-    case DomainShape::Disc: return 2 * d.size();
-    case DomainShape::Cube:
-    case DomainShape::Square: return d.size();
-    case DomainShape::Mask: break;
-  }
-  const Vec3 e = d.hi() - d.lo();
-  return std::max({e.x, e.y, d.dimension() == 2 ? 0.0 : e.z});
-}
-
-// Flows (each leaf an equal share of Q) and pressures (Poiseuille from the root pressure) of a
-// tree whose radii are set; lengths, depth, β and terminal counts too.
-void flowsAndPressures(VascularTree& t, const PhysicsParameters& p, double leaf_flow) {
-  const auto order = t.topDownOrder();
-  for (auto it = order.rbegin(); it != order.rend(); ++it) {
-    const auto i = *it;
-    const auto a = t.child0[i], b = t.child1[i];
-    t.terminals[i] = a < 0 ? 1 : t.terminals[a] + (b < 0 ? 0 : t.terminals[b]);
-    t.flow[i] = a < 0 ? leaf_flow : t.flow[a] + (b < 0 ? 0 : t.flow[b]);
-  }
-  for (auto i : order) {
-    if (t.isRoot(i)) {
-      t.pressure[i] = p.perfusion_pressure;
-      t.radius[i] = 0;
-      continue;
-    }
-    const auto up = t.parent[i];
-    const double r = t.radius[i];
-    t.beta[i] = t.isRoot(up) ? 1.0 : r / t.radius[up];
-    const double drop = 8 * p.viscosity * t.length[i] * t.flow[i] / (std::numbers::pi * r * r * r * r);
-    t.pressure[i] = t.pressure[up] - (p.drains() ? -drop : drop);
-  }
-}
 
 class PreparedColonisation final : public PreparedGrowth {
  public:
@@ -208,59 +172,6 @@ class PreparedColonisation final : public PreparedGrowth {
     stats["timing_seconds"] = Json{{"crossing_check", cr_.check_seconds}};  // a time: not sample data
     stats["intersecting_pairs_note"] =
         "colonisation: segments whose capsules overlap, unless the path between them along the tree is shorter than their radii";
-  }
-
-  // Overlapping capsules, except segments of one tree joined by a path shorter than their radii
-  // (chains of short segments in a thick vessel touch by construction). Candidates from a grid
-  // of segment midpoints; the path is walked up from both segments within that budget.
-  static std::vector<std::pair<std::int32_t, std::int32_t>> crossingPairs(const VascularTree& t) {
-    Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
-    double reach = 0;  // the largest half length + radius
-    for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
-      const auto& p = t.position[i];
-      lo = Vec3(std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z));
-      hi = Vec3(std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z));
-      if (!t.isRoot(i)) reach = std::max(reach, t.length[i] / 2 + t.radius[i]);
-    }
-    std::vector<std::pair<std::int32_t, std::int32_t>> out;
-    if (!(reach > 0)) return out;
-    PointHash grid(lo, hi, 2 * reach, false);
-    const auto mid = [&](std::int32_t i) { return (t.position[i] + t.position[t.parent[i]]) * 0.5; };
-    for (std::int32_t i = 0; i < t.nodeCount(); ++i)
-      if (!t.isRoot(i)) grid.insert(mid(i), i);
-    // True if x and y are joined along their tree by a path shorter than `budget`.
-    const auto joined = [&](std::int32_t x, std::int32_t y, double budget) {
-      std::vector<std::pair<std::int32_t, double>> up;  // x's proximal node and its ancestors, with the path to them
-      double s = 0;
-      for (std::int32_t v = t.parent[x]; v >= 0 && s <= budget; v = t.parent[v]) {
-        up.emplace_back(v, s);
-        if (v == t.parent[y] || v == y) return true;
-        if (t.parent[v] >= 0) s += t.length[v];
-      }
-      s = 0;
-      for (std::int32_t v = t.parent[y]; v >= 0 && s <= budget; v = t.parent[v]) {
-        if (v == x) return true;
-        for (const auto& [a, sa] : up)
-          if (a == v && sa + s <= budget) return true;
-        if (t.parent[v] >= 0) s += t.length[v];
-      }
-      return false;
-    };
-    for (std::int32_t x = 0; x < t.nodeCount(); ++x) {
-      if (t.isRoot(x)) continue;
-      const Vec3 mx = mid(x);
-      const double bx = t.length[x] / 2 + t.radius[x];
-      grid.forEachNear(mx, bx + reach, [&](std::int32_t y) {
-        if (y <= x) return;
-        const double by = t.length[y] / 2 + t.radius[y];
-        if (distance(mx, mid(y)) >= bx + by) return;
-        if (!capsulesOverlap(t.position[t.parent[x]], t.position[x], t.radius[x], t.position[t.parent[y]], t.position[y], t.radius[y])) return;
-        const double budget = t.radius[x] + t.radius[y];
-        if ((t.tree.empty() || t.tree[x] == t.tree[y]) && joined(x, y, budget)) return;
-        out.emplace_back(x, y);
-      });
-    }
-    return out;
   }
 
   // avoid_crossing: vessels that overlap once Murray's law has thickened them lose the branch

@@ -1,5 +1,7 @@
 #include "grow/common/domain_spec.hpp"
 
+#include "core/quantity_json.hpp"
+
 #include "core/error.hpp"
 #include "grow/common/method_tables.hpp"
 #include "io/growth_domain_files.hpp"
@@ -162,6 +164,21 @@ Vec3 placeRoot(const std::string& parameter_file, const RootSpec& spec, const Gr
                      "the root (" + show3(root) + " mm in the frame) lies outside the " + domainShapeName(d.shape()) +
                          " domain (" + show(-d.depth(root)) + " mm beyond its border); place it inside or on the border");
   return root;
+}
+
+void describeDomainAndRoot(const DomainSpec& d, const RootSpec& root, nlohmann::ordered_json& j) {
+  using Json = nlohmann::ordered_json;
+  j["shape"] = domainShapeName(d.shape);
+  if (d.shape == DomainShape::Mask) {
+    j["mask"] = d.mask.string();
+    if (root.root_in_mm) j["root"] = Json{{"value", {root.root_mm.x, root.root_mm.y, root.root_mm.z}}, {"unit", "mm"}};
+    else j["root_voxel"] = {root.root_voxel.x, root.root_voxel.y, root.root_voxel.z};
+  } else {
+    j[d.shape == DomainShape::Sphere || d.shape == DomainShape::Disc ? "radius" : "side"] = quantityJson(d.size_mm, "mm");
+    j["root_offset"] = root.has_root_offset ? Json{{"value", {root.root_offset_mm.x, root.root_offset_mm.y, root.root_offset_mm.z}}, {"unit", "mm"}}
+                                            : Json("the top of the domain (+y)");
+  }
+  if (d.voxel_mm > 0) j["voxel_size"] = quantityJson(d.voxel_mm, "mm");
 }
 
 }  // namespace angiosynth

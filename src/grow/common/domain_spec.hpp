@@ -4,6 +4,8 @@
 // relative to an analytic shape's centre, or in mm or voxels for masks.
 #include <cstdint>
 #include <filesystem>
+
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "domain/growth_domain.hpp"
@@ -63,5 +65,8 @@ GrowthDomain loadDomainSpec(const DomainSpec& spec, const std::string& parameter
 // A root in the domain's frame (mm): the offset from the centre for analytic shapes; must lie
 // inside or on the border.
 Vec3 placeRoot(const std::string& parameter_file, const RootSpec& root, const GrowthDomain& d);
+// The domain and the root as sample.json records them: shape, mask or radius/side, the root,
+// voxel_size.
+void describeDomainAndRoot(const DomainSpec& d, const RootSpec& root, nlohmann::ordered_json& j);
 
 }  // namespace angiosynth

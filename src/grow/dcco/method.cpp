@@ -384,17 +384,7 @@ Json DccoSetup::describe() const {
   const auto& o = options;
   Json j;
   j["method"] = "dcco";
-  j["shape"] = domainShapeName(d.shape);
-  if (d.shape == DomainShape::Mask) {
-    j["mask"] = d.mask.string();
-    if (root.root_in_mm) j["root"] = Json{{"value", {root.root_mm.x, root.root_mm.y, root.root_mm.z}}, {"unit", "mm"}};
-    else j["root_voxel"] = {root.root_voxel.x, root.root_voxel.y, root.root_voxel.z};
-  } else {
-    j[d.shape == DomainShape::Sphere || d.shape == DomainShape::Disc ? "radius" : "side"] = quantityJson(d.size_mm, "mm");
-    j["root_offset"] = root.has_root_offset ? Json{{"value", {root.root_offset_mm.x, root.root_offset_mm.y, root.root_offset_mm.z}}, {"unit", "mm"}}
-                                            : Json("the top of the domain (+y)");
-  }
-  if (d.voxel_mm > 0) j["voxel_size"] = quantityJson(d.voxel_mm, "mm");
+  describeDomainAndRoot(d, root, j);
   j["kind"] = kind;
   if (!initial_file.empty()) {
     Json init{{"file", initial_file.string()}, {"origin", initial_from_corner ? "corner" : "centre"}, {"vessels", initial.tree.segmentCount()},

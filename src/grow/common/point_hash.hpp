@@ -45,12 +45,10 @@ class PointHash {
   // Calls f(id) for every point in the cells a ball of radius r around p touches.
   template <class F>
   void forEachNear(const Vec3& p, double r, F&& f) const {
-    const std::int64_t x0 = axis(p.x - r, 0), x1 = axis(p.x + r, 0), y0 = axis(p.y - r, 1), y1 = axis(p.y + r, 1), z0 = axis(p.z - r, 2),
-                       z1 = axis(p.z + r, 2);
-    for (std::int64_t z = z0; z <= z1; ++z)
-      for (std::int64_t y = y0; y <= y1; ++y)
-        for (std::int64_t x = x0; x <= x1; ++x)
-          for (auto id = head_[index(x, y, z)]; id >= 0; id = next_[std::size_t(id)]) f(id);
+    anyNear(p, r, [&](std::int32_t id) {
+      f(id);
+      return false;
+    });
   }
   // True as soon as pred(id) holds for a point in the cells a ball of radius r around p touches.
   template <class Pred>
