@@ -81,8 +81,10 @@ const BadCase kCases[] = {
      "p.toml:11: block_height 7 mm leaves no room for the trees: it must exceed 2·start_length + capillary_length = 8 mm"},
     {"lzh_capillary_walls_overlap", "p.toml", "", "", LZH "block_height = \"20 mm\"\ncapillary_wall = \"0.3 mm\"\n", "generate p.toml --out out",
      "p.toml:10: neighbouring capillaries lie 0.586667 mm apart, less than their outer diameter 0.8 mm"},
-    {"lzh_unknown_mode", "p.toml", "", "", LZH "block_height = \"20 mm\"\nmode = \"grammar\"\n", "generate p.toml --out out",
-     "p.toml:12: mode 'grammar'; allowed: lzh"},
+    {"lzh_unknown_mode", "p.toml", "", "", LZH "block_height = \"20 mm\"\nmode = \"vsystem\"\n", "generate p.toml --out out",
+     "p.toml:12: mode 'vsystem'; allowed: lzh, grammar"},
+    {"grammar_with_lzh_key", "p.toml", "", "", LZH "mode = \"grammar\"\n", "generate p.toml --out out",
+     "p.toml:5: 'block_width' in [tree] is for mode lzh; this file's mode is grammar ([tree] mode)"},
 #undef LZH
     {"profile_intensity_huge", "prof.toml", "", "", "background = 1e30\n[[effect]]\ntype = \"gaussian\"\nsigma = 1\n",
      "generate p.toml --out out --profile prof.toml", "prof.toml:1: background = 1e+30 is out of range"},

@@ -1,6 +1,7 @@
 // Method lsystem, mode lzh (seed 004): the inverse problem's geometry on random high-level
 // parameters, the closed network's flows, tapered vessels in the rasteriser, connectivity.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <set>
 
 #include "core/rng.hpp"
+#include "grow/lsystem/grammar.hpp"
 #include "grow/lsystem/lzh.hpp"
 #include "grow_file.hpp"
 #include "pipeline/volume_outputs.hpp"
@@ -41,6 +43,33 @@ LzhParameters randomParameters(Rng& rng, int dimension) {
   p.perfusion_flow = rng.uniform(0.01, 10);
   p.perfusion_pressure = 13332;
   return p;
+}
+
+// 6-connected components of the non-zero voxels.
+int sixConnectedComponents(const Volume<std::uint8_t>& v) {
+  const VolumeGrid& g = v.grid;
+  std::vector<char> seen(v.data.size(), 0);
+  int count = 0;
+  for (std::size_t s = 0; s < v.data.size(); ++s) {
+    if (!v.data[s] || seen[s]) continue;
+    ++count;
+    std::queue<std::int64_t> q;
+    q.push(std::int64_t(s));
+    seen[s] = 1;
+    while (!q.empty()) {
+      const auto c = q.front();
+      q.pop();
+      const std::int64_t x = c % g.dims[0], y = (c / g.dims[0]) % g.dims[1], z = c / (std::int64_t(g.dims[0]) * g.dims[1]);
+      const std::int64_t d[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+      for (const auto& o : d) {
+        const std::int64_t X = x + o[0], Y = y + o[1], Z = z + o[2];
+        if (!g.contains(X, Y, Z)) continue;
+        const auto n = g.flat(X, Y, Z);
+        if (v.data[n] && !seen[n]) seen[n] = 1, q.push(n);
+      }
+    }
+  }
+  return count;
 }
 
 // A block by its numbers: dimension, w_b, h, d, L_s, L_c, d_s, d_c (mm).
@@ -256,8 +285,9 @@ TEST(Lzh, TaperedVesselsRasteriseToTheirVolume) {
   EXPECT_GT(checked, 30);
 }
 
-// Rasterised unclipped, the closed network is one 6-connected component in the mask, also when
-// its capillaries are thinner than a voxel.
+// Rasterised unclipped, the closed network is one 6-connected component in the mask and (with
+// centerline_connectivity = 6) in the centreline volume, also when its capillaries are thinner
+// than a voxel.
 TEST(Lzh, TheNetworkIsOneSixConnectedComponent) {
   for (double capillary : {0.2, 0.03}) {
     const LzhParameters p = block(3, 6, 12, 1.1, 2, 1, 0.8, capillary);
@@ -269,31 +299,89 @@ TEST(Lzh, TheNetworkIsOneSixConnectedComponent) {
               std::int32_t(std::ceil((p.height + 2 * m) / voxel))};
     g.spacing_mm = Vec3(voxel, voxel, voxel);
     g.origin_mm = Vec3(voxel / 2, voxel / 2, voxel / 2);
-    const auto gt = rasterizeGroundTruth(f.vessels, g, RasterOptions{});
-    const auto components = [&](const Volume<std::uint8_t>& v) {
-      std::vector<char> seen(v.data.size(), 0);
-      int count = 0;
-      for (std::size_t s = 0; s < v.data.size(); ++s) {
-        if (!v.data[s] || seen[s]) continue;
-        ++count;
-        std::queue<std::int64_t> q;
-        q.push(std::int64_t(s));
-        seen[s] = 1;
-        while (!q.empty()) {
-          const auto c = q.front();
-          q.pop();
-          const std::int64_t x = c % g.dims[0], y = (c / g.dims[0]) % g.dims[1], z = c / (std::int64_t(g.dims[0]) * g.dims[1]);
-          const std::int64_t d[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-          for (const auto& o : d) {
-            const std::int64_t X = x + o[0], Y = y + o[1], Z = z + o[2];
-            if (!g.contains(X, Y, Z)) continue;
-            const auto n = g.flat(X, Y, Z);
-            if (v.data[n] && !seen[n]) seen[n] = 1, q.push(n);
-          }
-        }
-      }
-      return count;
-    };
-    EXPECT_EQ(components(gt.mask), 1) << "capillary diameter " << capillary << " mm";
+    const auto gt = rasterizeGroundTruth(f.vessels, g, RasterOptions{4, 6});
+    EXPECT_EQ(sixConnectedComponents(gt.mask), 1) << "capillary diameter " << capillary << " mm";
+    EXPECT_EQ(sixConnectedComponents(gt.centerline), 1) << "capillary diameter " << capillary << " mm";
+    // The default thin curve (26-connected) is not face-connected: the option is what makes it so.
+    EXPECT_GT(sixConnectedComponents(rasterizeGroundTruth(f.vessels, g, RasterOptions{}).centerline), 1);
   }
+}
+
+// Zamir's optimal angles: equal daughters leave at arccos(2^(-1/3)) = 37.47° each (Murray's
+// symmetric angle for k = 3); a thinner daughter turns more than its sibling.
+TEST(Grammar, ZamirAnglesMatchMurrayForEqualDaughters) {
+  double a, b;
+  zamirAngles(1, 1, a, b);
+  EXPECT_NEAR(a, std::acos(std::pow(2.0, -1.0 / 3)), 1e-12);  // 37.467°
+  EXPECT_NEAR(a, b, 1e-15);
+  zamirAngles(1, 0.5, a, b);
+  EXPECT_LT(a, b);
+}
+
+// The grammar example: Murray's law at every bifurcation, tips where the grammar asks, no
+// overlapping vessels, every vessel inside the sphere, the same tree for the same seed on any
+// thread count, and one 6-connected component once rasterised.
+TEST(Grammar, TreeKeepsMurrayStaysInsideAndDoesNotOverlap) {
+  const auto g = test::growFile(example("lsystem_grammar_3d.toml"));
+  const VascularTree& t = g.forest.vessels;
+  const GrowthDomain& d = *g.prepared->domain();
+  int bifurcations = 0;
+  double murray = 0;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    EXPECT_GE(d.depth(t.position[i]), t.radius[i] - 1e-12) << "node " << i;
+    if (t.child1[i] < 0) continue;
+    ++bifurcations;
+    const double p = std::pow(2 * t.radius[i], 3), c = std::pow(2 * t.radius[t.child0[i]], 3) + std::pow(2 * t.radius[t.child1[i]], 3);
+    murray = std::max(murray, std::abs(p - c) / p);
+  }
+  EXPECT_GT(bifurcations, 400);
+  EXPECT_LE(murray, 1e-12);
+  GrowthReport report;
+  {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    const auto again = test::growFile(example("lsystem_grammar_3d.toml"), 1, &report);
+    EXPECT_EQ(again.forest.vessels.position, t.position);
+    EXPECT_EQ(again.forest.vessels.radius, t.radius);
+  }
+  EXPECT_EQ(report.intersecting_pairs, 0);
+  const auto other = test::growFile(example("lsystem_grammar_3d.toml"), 2);
+  EXPECT_NE(other.forest.vessels.position, t.position);
+}
+
+// Without a wall in reach every one of the 2^n tips grows (1 + 5·(2^(n+1) − 1) nodes); in a
+// domain too small the run fails with a message instead of returning a near-empty tree.
+TEST(Grammar, AskedTipsGrowOrTheRunFails) {
+  GrowthDomain big = GrowthDomain::analytic(DomainShape::Sphere, 100, 4, 2);
+  GrammarOptions o;
+  o.domain = &big;
+  o.iterations = 6;
+  o.root_diameter = 0.5;
+  o.root = big.center() + Vec3(0, 60, 0);
+  o.direction = Vec3(0, -1, 0);
+  GrammarReport r;
+  const VascularTree t = growGrammar(o, r, {});
+  EXPECT_EQ(r.tips, 64);
+  EXPECT_EQ(t.nodeCount(), 1 + 5 * 127);
+  GrowthDomain small = GrowthDomain::analytic(DomainShape::Sphere, 5, 0.1, 2);
+  o.domain = &small;
+  o.root = small.defaultRoot();
+  o.direction = Vec3(0, -1, 0);
+  try {
+    GrammarReport r2;
+    growGrammar(o, r2, {});
+    FAIL() << "a tree that cannot fit was returned";
+  } catch (const GrowthError& e) {
+    EXPECT_NE(std::string(e.what()).find("tips its 6 iterations ask for"), std::string::npos) << e.what();
+  }
+}
+
+// V-System's grammar trees fall apart into hundreds of pieces once voxelised; ours rasterises as
+// one 6-connected component in the mask and the (6-connected) centreline, its thinnest vessels
+// (0.004 mm, 1/25 voxel) included.
+TEST(Grammar, RasterisedTreeIsOneSixConnectedComponent) {
+  const auto g = test::growFile(example("lsystem_grammar_3d.toml"));
+  const auto grid = imageGrid(g.prepared->frame(), ImageParameters{});
+  const auto gt = rasterizeGroundTruth(g.forest.vessels, grid, RasterOptions{4, 6});
+  EXPECT_EQ(sixConnectedComponents(gt.mask), 1);
+  EXPECT_EQ(sixConnectedComponents(gt.centerline), 1);
 }

@@ -98,7 +98,8 @@ DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
   out.vessel = s.vessel;
   if (s.warp) {
     const auto t0 = std::chrono::steady_clock::now();
-    out.labels = warpedLabels(*s.warped_fraction, *s.warped_tree, s.segment_origin, in.truth->instances, *s.warp);
+    out.labels = warpedLabels(*s.warped_fraction, *s.warped_tree, s.segment_origin, in.truth->instances, *s.warp,
+                              in.truth->centerline_connectivity);
     out.tree = s.warped_tree;
     out.segment_origin = s.segment_origin;
     out.warp = s.warp;

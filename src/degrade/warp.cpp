@@ -191,7 +191,7 @@ Volume<float> warpVolume(const Volume<float>& v, const BSplineWarp& warp) {
 }
 
 GroundTruthVolumes warpedLabels(const Volume<float>& wf, const VascularTree& wt, const std::vector<std::int32_t>& origin,
-                                const Volume<std::uint32_t>& clean, const BSplineWarp& warp) {
+                                const Volume<std::uint32_t>& clean, const BSplineWarp& warp, int centerline_connectivity) {
   const VolumeGrid& g = wf.grid;
   GroundTruthVolumes gt;
   gt.fraction = wf;
@@ -199,6 +199,7 @@ GroundTruthVolumes warpedLabels(const Volume<float>& wf, const VascularTree& wt,
   gt.centerline = Volume<std::uint8_t>(g);
   gt.radius = Volume<float>(g);
   gt.instances = Volume<std::uint32_t>(g);
+  gt.centerline_connectivity = centerline_connectivity;
   forEachVoxelIjk(g, [&](std::int64_t q, std::int64_t i, std::int64_t j, std::int64_t k) {
     if (wf.data[q] < 0.5f) return;
     gt.mask.data[q] = 1;

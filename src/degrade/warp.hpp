@@ -61,6 +61,6 @@ Volume<float> warpVolume(const Volume<float>& v, const BSplineWarp& warp);
 // largest weight among labelled corners), so no label value is invented.
 GroundTruthVolumes warpedLabels(const Volume<float>& warped_fraction, const VascularTree& warped_tree,
                                 const std::vector<std::int32_t>& origin, const Volume<std::uint32_t>& clean_instances,
-                                const BSplineWarp& warp);
+                                const BSplineWarp& warp, int centerline_connectivity = 26);
 
 }  // namespace angiosynth

@@ -27,6 +27,7 @@ struct ImageParameters {
   double voxel_mm = 0;                 // 0: the demand map's voxel size
   Vec3 field_of_view_mm;               // 0: the demand map's extent
   int supersampling = 4;               // S: S³ samples per partially covered voxel
+  int centerline_connectivity = 26;    // of the centreline channel: 26 or 6
   double background = 0, vessel = 255; // image = background + (vessel − background) × fraction
   std::string dtype = "uint8";         // uint8, uint16, int16, float32
   std::vector<std::string> formats{"nifti", "png"};                        // nifti, nrrd, tiff, png, vdb

@@ -49,7 +49,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   sc.growth = m->read(r, *m);
   const double voxel_mm = sc.growth->voxelMm();
 
-  const auto& im = r.table("image", {"enabled", "voxel_size", "field_of_view", "supersampling", "background", "vessel",
+  const auto& im = r.table("image", {"enabled", "voxel_size", "field_of_view", "supersampling", "centerline_connectivity", "background", "vessel",
                                      "dtype", "formats", "graph_formats"});
   auto& ip = sc.image;
   sc.image_line = r.lineOf(root.get("image"));
@@ -73,6 +73,11 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
       checkRange(f[ax], 0, true, Limits::kMaxLength, false, r.at(im, "field_of_view"), "field_of_view (mm)");
     }
     ip.field_of_view_mm = Vec3(f[0], f[1], f[2]);
+  }
+  if (const auto* c = im.get("centerline_connectivity")) {
+    ip.centerline_connectivity = int(r.smallInteger(im, "image", "centerline_connectivity", 6, 26));
+    if (ip.centerline_connectivity != 6 && ip.centerline_connectivity != 26)
+      throw InputError(file, r.lineOf(c), "centerline_connectivity = " + std::to_string(ip.centerline_connectivity) + "; allowed: 26 (a thin curve), 6 (face-connected)");
   }
   if (im.get("supersampling")) {
     ip.supersampling = r.smallInteger(im, "image", "supersampling", 1, 16);

@@ -32,6 +32,7 @@ Json describeParameters(const Scenario& sc) {
                     {"field_of_view", im.field_of_view_mm.x > 0 ? Json{{"value", {im.field_of_view_mm.x, im.field_of_view_mm.y, im.field_of_view_mm.z}}, {"unit", "mm"}}
                                                                : Json("the demand map's extent")},
                     {"supersampling", im.supersampling},
+                    {"centerline_connectivity", im.centerline_connectivity},
                     {"background", im.background},
                     {"vessel", im.vessel},
                     {"dtype", im.dtype},

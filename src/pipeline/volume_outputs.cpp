@@ -96,7 +96,7 @@ void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::fil
       throw InputError(req.parameter_file, req.image_line,
                        "the sparse volume needs about " + formatBytes(need) + ", more than the limit of " +
                            formatBytes(req.memory_limit) + "; raise [image] voxel_size or --memory-limit");
-    const VdbReport r = writeVdb(dir / "volume.vdb", tree, g, bins, RasterOptions{ip.supersampling});
+    const VdbReport r = writeVdb(dir / "volume.vdb", tree, g, bins, RasterOptions{ip.supersampling, ip.centerline_connectivity});
     files["vdb"] = "volume.vdb";
     stats["vdb_leaves"] = r.leaves;
     stats["vdb_active_voxels"] = r.active_voxels;
@@ -108,7 +108,7 @@ void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::fil
                                {"definition", "centre of voxel (0,0,0); world frame RAS+ (NIfTI, VDB), LPS in NRRD"}};
   writeGraphFiles(tree, forest.trees, g, ip.graph_formats, "", dir, files);
   if (!needsDense(req)) return;
-  GroundTruthVolumes gt = rasterizeGroundTruth(tree, g, RasterOptions{ip.supersampling});
+  GroundTruthVolumes gt = rasterizeGroundTruth(tree, g, RasterOptions{ip.supersampling, ip.centerline_connectivity});
   const std::vector<std::uint8_t> classes = segmentClasses(tree, forest.trees);
   fillClasses(gt, tree, classes);
   {

@@ -16,6 +16,9 @@ namespace angiosynth {
 
 struct RasterOptions {
   int supersampling = 4;  // S: S³ samples per voxel in partially covered voxels
+  // The centreline channel: 26 (a thin digital curve per segment, 3D Bresenham) or 6 (every
+  // voxel the segment passes through, face-connected, so a tree is one 6-connected component).
+  int centerline_connectivity = 26;
 };
 
 constexpr int kBrick = 8;  // brick edge in voxels (an OpenVDB leaf node)

@@ -137,7 +137,12 @@ void addCenterlines(const VascularTree& t, GroundTruthVolumes& gt, const std::ve
       const Vec3& a = t.position[t.parent[s]];
       const Vec3& b = t.position[s];
       forEachCrossedVoxel(g, a, b, [&](std::int64_t i, std::int64_t j, std::int64_t k) { claim(g.flat(i, j, k), s); });
-      centerlineVoxels(g, a, b, curve);
+      if (gt.centerline_connectivity == 6) {
+        curve.clear();
+        forEachCrossedVoxel(g, a, b, [&](std::int64_t i, std::int64_t j, std::int64_t k) { curve.push_back({i, j, k}); });
+      } else {
+        centerlineVoxels(g, a, b, curve);
+      }
       // Radii are positive, so their bit patterns order like the floats: a maximum on integers.
       // A tapered vessel's radius is the one across from the voxel's centre.
       const double r0 = t.startRadius(s), r1 = t.radius[s];
@@ -171,6 +176,7 @@ GroundTruthVolumes rasterizeGroundTruth(const VascularTree& t, const VolumeGrid&
   gt.mask = Volume<std::uint8_t>(g);
   gt.centerline = Volume<std::uint8_t>(g);
   gt.radius = Volume<float>(g);
+  gt.centerline_connectivity = opt.centerline_connectivity;
   // Bricks are disjoint, so the visitor writes from several threads without conflict; only
   // non-zero voxels are written.
   const BrickBins bins = binSegments(t, g);

@@ -14,7 +14,8 @@ namespace angiosynth {
 struct GroundTruthVolumes {
   Volume<float> fraction;            // fraction of each voxel inside the vessels, [0, 1]
   Volume<std::uint8_t> mask;         // fraction >= 0.5, plus every voxel a centreline crosses
-  Volume<std::uint8_t> centerline;   // 26-connected voxel curve of every segment
+  Volume<std::uint8_t> centerline;   // voxel curve of every segment, 26- or 6-connected
+  int centerline_connectivity = 26;  // see RasterOptions
   Volume<float> radius;              // mm, on centreline voxels (the thicker vessel at joints)
   Volume<std::uint32_t> instances;   // segment id (= distal node id) on mask voxels, else 0
   // The kind of the vessel on mask voxels (1 artery, 2 vein, further kinds on), else 0: that of
@@ -39,8 +40,9 @@ void fillClasses(GroundTruthVolumes& gt, const VascularTree& t, const std::vecto
 
 GroundTruthVolumes rasterizeGroundTruth(const VascularTree& tree, const VolumeGrid& grid, const RasterOptions& opt);
 
-// The centreline pass: marks centreline and radius, and adds to the mask (and, where the
-// partial volume left no label, to the instances) every voxel a segment's centreline crosses.
+// The centreline pass: marks centreline (as gt.centerline_connectivity says) and radius, and adds
+// to the mask (and, where the partial volume left no label, to the instances) every voxel a
+// segment's centreline crosses.
 // Instances are segment ids, or label_of_segment[segment] when given.
 void addCenterlines(const VascularTree& tree, GroundTruthVolumes& gt, const std::vector<std::int32_t>* label_of_segment);
 
