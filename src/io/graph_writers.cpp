@@ -28,8 +28,8 @@ std::string stringAttr(const char* name, const std::string& v) {
 }
 
 // Staged growth: the stage (from 0, in [[stage]] order), role and branching of segment i.
-std::string stageAttrs(const VascularTree& t, std::int32_t i) {
-  if (!t.hasStages()) return "";
+std::string stageAttrs(const VascularTree& t, std::int32_t i, bool staged) {
+  if (!staged) return "";
   return "      <attr name=\"stage\"><int>" + std::to_string(t.stage[i]) + "</int></attr>\n" +
          stringAttr("role", roleName(t.role[i])) + stringAttr("branching", branchingName(t.branching[i]));
 }
@@ -58,14 +58,14 @@ void writeGxl(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
         << stringAttr("tree", treeOf(trees, t, i).id) << stringAttr("kind", treeOf(trees, t, i).kind)
         << tupAttr("position", t.position[i]) << tupAttr("position_voxel", t.position[i] / f.voxel_mm) << "    </node>\n";
   }
-  const bool tapered = t.hasTapers() || t.hasWalls();
+  const bool tapered = t.hasTapers() || t.hasWalls(), staged = t.hasStages();
   for (auto i : t.topDownOrder()) {
     if (t.isRoot(i)) continue;
     out << "    <edge id=\"e" << i << "\" from=\"n" << t.parent[i] << "\" to=\"n" << i << "\">\n"
         << stringAttr("tree", treeOf(trees, t, i).id) << stringAttr("kind", treeOf(trees, t, i).kind)
         << floatAttr("radius", t.radius[i]) << floatAttr("length", t.length[i]) << floatAttr("flow", t.flow[i])
         << floatAttr("pressure_proximal", t.pressure[t.parent[i]]) << floatAttr("pressure_distal", t.pressure[i])
-        << stageAttrs(t, i) << taperAttrs(t, i, tapered) << "    </edge>\n";
+        << stageAttrs(t, i, staged) << taperAttrs(t, i, tapered) << "    </edge>\n";
   }
   out << "  </graph>\n</gxl>\n";
 }
