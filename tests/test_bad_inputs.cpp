@@ -85,6 +85,13 @@ const BadCase kCases[] = {
      "p.toml:12: mode 'vsystem'; allowed: lzh, grammar"},
     {"grammar_with_lzh_key", "p.toml", "", "", LZH "mode = \"grammar\"\n", "generate p.toml --out out",
      "p.toml:5: 'block_width' in [tree] is for mode lzh; this file's mode is grammar ([tree] mode)"},
+    // Curved vessels: an unbounded target, two wavelengths, an unknown key.
+    {"curves_tortuosity_below_one", "p.toml", "", "", LZH "block_height = \"20 mm\"\n[curves]\ntortuosity = 0.9\n", "generate p.toml --out out",
+     "p.toml:13: tortuosity (arc length over chord) = 0.9 is out of range; allowed: [1, 3]"},
+    {"curves_two_wavelengths", "p.toml", "", "", LZH "block_height = \"20 mm\"\n[curves]\nwavelength = \"2 mm\"\nwavelength_radii = 30\n",
+     "generate p.toml --out out", "p.toml:14: give wavelength (a length) or wavelength_radii (multiples of each vessel's radius), not both"},
+    {"curves_unknown_key", "p.toml", "", "", LZH "block_height = \"20 mm\"\n[curves]\namplitude = 2\n", "generate p.toml --out out",
+     "p.toml:13: unknown key 'amplitude'"},
 #undef LZH
     {"profile_intensity_huge", "prof.toml", "", "", "background = 1e30\n[[effect]]\ntype = \"gaussian\"\nsigma = 1\n",
      "generate p.toml --out out --profile prof.toml", "prof.toml:1: background = 1e+30 is out of range"},

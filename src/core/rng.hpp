@@ -17,7 +17,7 @@ constexpr std::uint64_t mix64(std::uint64_t z) {
 }
 
 // Stage ids: keep stable, they are part of every output's identity.
-enum class Stage : std::uint64_t { Growth = 1, Repair = 2, Raster = 3, Degrade = 4, Dataset = 5 };
+enum class Stage : std::uint64_t { Growth = 1, Repair = 2, Raster = 3, Degrade = 4, Dataset = 5, Curves = 6 };
 
 class Rng {
  public:

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/units.hpp"
+#include "grow/common/curved_vessels.hpp"
 #include "grow/method.hpp"
 
 namespace toml {
@@ -39,6 +40,8 @@ struct Scenario {
   std::string format;  // "vascusynth" or "toml"
   std::shared_ptr<const GrowthSetup> growth;   // the growth method and its options
   std::optional<std::uint64_t> seed;
+  CurveOptions curves;                         // [curves]: vessels made curves after growth
+  int curves_line = 0;
   ImageParameters image;
   int image_line = 0;                          // line of [image], for errors about its size
   std::string gxl_dialect = "gxl";             // "gxl" (GXL 1.0) or "vascusynth"

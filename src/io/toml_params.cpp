@@ -35,7 +35,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   const GrowthMethod* m = findGrowthMethod(method);
   if (!m) throw InputError(file, r.lineOf(method_node), "method '" + method + "' is not available; allowed: " + growthMethodNames());
   // The top-level tables: the common ones and those the method declares ([[stage]], [[region]]).
-  std::set<std::string> top{"seed", "domain", "tree", "physics", "image", "degrade", "output"};
+  std::set<std::string> top{"seed", "domain", "tree", "physics", "curves", "image", "degrade", "output"};
   const auto tableOf = [](const MethodParam& p) { return std::string(p.table).substr(0, std::string(p.table).find('.')); };
   for (const auto& p : m->params) top.insert(tableOf(p));
   for (const auto& [k, v] : root) {
@@ -108,6 +108,35 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   };
   if (im.get("formats")) ip.formats = strings("formats", {"nifti", "nrrd", "tiff", "png", "vdb"});
   if (im.get("graph_formats")) ip.graph_formats = strings("graph_formats", {"csv", "vtp", "swc", "graphml", "cco"});
+
+  if (root.get("curves")) {
+    const auto& cv = r.table("curves", {"tortuosity", "tortuosity_sd", "wavelength", "wavelength_radii", "piece_length", "wall_clearance",
+                                        "avoid_overlaps"});
+    auto& co = sc.curves;
+    co.enabled = true;
+    sc.curves_line = r.lineOf(root.get("curves"));
+    if (cv.get("tortuosity")) co.tortuosity = r.number(cv, "curves", "tortuosity");
+    checkRange(co.tortuosity, 1, false, 3, false, r.at(cv, "tortuosity"), "tortuosity (arc length over chord)");
+    if (cv.get("tortuosity_sd")) co.tortuosity_sd = r.number(cv, "curves", "tortuosity_sd");
+    checkRange(co.tortuosity_sd, 0, false, 1, false, r.at(cv, "tortuosity_sd"), "tortuosity_sd");
+    if (cv.get("wavelength") && cv.get("wavelength_radii"))
+      throw InputError(file, r.lineOf(cv.get("wavelength_radii")), "give wavelength (a length) or wavelength_radii (multiples of each vessel's radius), not both");
+    if (cv.get("wavelength")) {
+      co.wavelength_mm = r.quantity(cv, "curves", "wavelength", Dimension::Length, voxel_mm);
+      checkRange(co.wavelength_mm, 0, true, Limits::kMaxLength, false, r.at(cv, "wavelength"), "wavelength (mm)");
+    }
+    if (cv.get("wavelength_radii")) co.wavelength_radii = r.number(cv, "curves", "wavelength_radii");
+    checkRange(co.wavelength_radii, 2, false, 1e4, false, r.at(cv, "wavelength_radii"), "wavelength_radii");
+    if (cv.get("piece_length")) {
+      co.piece_mm = r.quantity(cv, "curves", "piece_length", Dimension::Length, voxel_mm);
+      checkRange(co.piece_mm, Limits::kMinVoxel, false, Limits::kMaxLength, false, r.at(cv, "piece_length"), "piece_length (mm)");
+    }
+    if (cv.get("wall_clearance")) {
+      co.wall_clearance_mm = r.quantity(cv, "curves", "wall_clearance", Dimension::Length, voxel_mm);
+      checkRange(co.wall_clearance_mm, 0, false, Limits::kMaxLength, false, r.at(cv, "wall_clearance"), "wall_clearance (mm)");
+    }
+    co.avoid_overlaps = r.boolean(cv, "avoid_overlaps", co.avoid_overlaps);
+  }
 
   const auto& deg = r.table("degrade", {"profiles"});
   if (const auto* n = deg.get("profiles")) {

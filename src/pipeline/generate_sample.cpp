@@ -38,6 +38,16 @@ Json describeParameters(const Scenario& sc) {
                     {"dtype", im.dtype},
                     {"formats", im.formats},
                     {"graph_formats", im.graph_formats}};
+  if (sc.curves.enabled) {
+    const auto& c = sc.curves;
+    Json cj{{"tortuosity", c.tortuosity}, {"tortuosity_sd", c.tortuosity_sd}};
+    if (c.wavelength_mm > 0) cj["wavelength"] = quantityJson(c.wavelength_mm, "mm");
+    else cj["wavelength_radii"] = c.wavelength_radii;
+    cj["piece_length"] = quantityJson(c.piece_mm > 0 ? c.piece_mm : sc.growth->voxelMm(), "mm");
+    cj["wall_clearance"] = quantityJson(c.wall_clearance_mm, "mm");
+    cj["avoid_overlaps"] = c.avoid_overlaps;
+    j["curves"] = cj;
+  }
   j["profiles"] = sc.profiles;
   return j;
 }
@@ -125,8 +135,14 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   } catch (const GrowthError& e) {
     throw InputError(sc.parameter_file, 0, e.what());
   }
-  const VascularTree& tree = forest.vessels;
   timing["grow"] = seconds(t0);
+  CurveReport curves;
+  if (sc.curves.enabled) {
+    t0 = Clock::now();
+    forest.vessels = curveVessels(forest.vessels, sc.curves, domain, map, req.seed, req.sample, curves);
+    timing["curves"] = seconds(t0);
+  }
+  const VascularTree& tree = forest.vessels;
 
   t0 = Clock::now();
   GraphFrame frame{map.voxel_mm, sc.input_units};
@@ -201,6 +217,23 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   stats["moved_nodes"] = report.moved_nodes;
   stats["repaired_terminals"] = report.repaired_terminals;
   ps.growth->addStatistics(report, stats);
+  if (sc.curves.enabled)
+    stats["curves"] = Json{{"vessels", curves.vessels},
+                           {"curved", curves.curved},
+                           {"already_tortuous", curves.already_tortuous},
+                           {"flattened_by_domain", curves.flattened_by_domain},
+                           {"flattened_by_overlap", curves.flattened_by_overlap},
+                           {"left_straight", curves.straightened},
+                           {"overlap_rounds", curves.overlap_rounds},
+                           {"overlapping_vessel_pairs", curves.overlapping_vessel_pairs},
+                           {"nodes_before", curves.nodes_before},
+                           {"nodes_after", curves.nodes_after},
+                           {"tortuosity_mean", curves.tortuosity_mean},
+                           {"tortuosity_min", curves.tortuosity_min},
+                           {"tortuosity_max", curves.tortuosity_max},
+                           {"tortuosity_target_error_max", curves.target_error_max},
+                           {"tortuosity_definition", "distance metric of each vessel (root, bifurcation or terminal to the next): arc length over chord"},
+                           {"pressures", "radii and flows as grown; pressures along the longer paths (Poiseuille)"}};
   // Mean radius per bifurcation level (the root segment is level 0), as in seed 000 Fig. 6–7.
   {
     std::vector<double> sum;
