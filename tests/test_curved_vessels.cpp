@@ -16,6 +16,7 @@
 #include "grow_file.hpp"
 #include "raster/ground_truth.hpp"
 #include "test_support.hpp"
+#include "voxel_components.hpp"
 
 using namespace angiosynth;
 
@@ -166,6 +167,7 @@ TEST(CurvedVessels, SameSeedSameCurvesOnAnyThreadCount) {
 
 // The mask's partial volumes add up to the curved vessels' volume (Σ π r² l over the pieces,
 // less what overlaps at joints): the rasteriser follows the curves, not the straight vessels.
+// With the face-connected centreline, mask and centreline are each one 6-connected piece.
 TEST(CurvedVessels, RasterisedVolumeIsTheCurvesVolume) {
   CurveReport rep;
   auto o = options(1.4);
@@ -176,11 +178,13 @@ TEST(CurvedVessels, RasterisedVolumeIsTheCurvesVolume) {
   grid.dims = f.dims;
   grid.spacing_mm = Vec3(f.voxel_mm, f.voxel_mm, f.voxel_mm);
   grid.origin_mm = grid.spacing_mm * 0.5;
-  const auto gt = rasterizeGroundTruth(w, grid, RasterOptions{4, 26});
+  const auto gt = rasterizeGroundTruth(w, grid, RasterOptions{4, 6});
   double fraction = 0;
   for (float f : gt.fraction.data) fraction += f;
   const double voxel = std::pow(grid.spacing_mm.x, 3), measured = fraction * voxel;
   const double curves = treeVolume(w), straight = treeVolume(t);
   EXPECT_GT(curves, 1.2 * straight);  // the curves are longer
   EXPECT_NEAR(measured, curves, 0.05 * curves) << "straight " << straight;
+  EXPECT_EQ(test::sixConnectedComponents(gt.mask), 1);
+  EXPECT_EQ(test::sixConnectedComponents(gt.centerline), 1);
 }

@@ -16,6 +16,7 @@
 #include "pipeline/volume_outputs.hpp"
 #include "raster/ground_truth.hpp"
 #include "test_support.hpp"
+#include "voxel_components.hpp"
 
 using namespace angiosynth;
 
@@ -43,33 +44,6 @@ LzhParameters randomParameters(Rng& rng, int dimension) {
   p.perfusion_flow = rng.uniform(0.01, 10);
   p.perfusion_pressure = 13332;
   return p;
-}
-
-// 6-connected components of the non-zero voxels.
-int sixConnectedComponents(const Volume<std::uint8_t>& v) {
-  const VolumeGrid& g = v.grid;
-  std::vector<char> seen(v.data.size(), 0);
-  int count = 0;
-  for (std::size_t s = 0; s < v.data.size(); ++s) {
-    if (!v.data[s] || seen[s]) continue;
-    ++count;
-    std::queue<std::int64_t> q;
-    q.push(std::int64_t(s));
-    seen[s] = 1;
-    while (!q.empty()) {
-      const auto c = q.front();
-      q.pop();
-      const std::int64_t x = c % g.dims[0], y = (c / g.dims[0]) % g.dims[1], z = c / (std::int64_t(g.dims[0]) * g.dims[1]);
-      const std::int64_t d[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-      for (const auto& o : d) {
-        const std::int64_t X = x + o[0], Y = y + o[1], Z = z + o[2];
-        if (!g.contains(X, Y, Z)) continue;
-        const auto n = g.flat(X, Y, Z);
-        if (v.data[n] && !seen[n]) seen[n] = 1, q.push(n);
-      }
-    }
-  }
-  return count;
 }
 
 // A block by its numbers: dimension, w_b, h, d, L_s, L_c, d_s, d_c (mm).
@@ -300,10 +274,10 @@ TEST(Lzh, TheNetworkIsOneSixConnectedComponent) {
     g.spacing_mm = Vec3(voxel, voxel, voxel);
     g.origin_mm = Vec3(voxel / 2, voxel / 2, voxel / 2);
     const auto gt = rasterizeGroundTruth(f.vessels, g, RasterOptions{4, 6});
-    EXPECT_EQ(sixConnectedComponents(gt.mask), 1) << "capillary diameter " << capillary << " mm";
-    EXPECT_EQ(sixConnectedComponents(gt.centerline), 1) << "capillary diameter " << capillary << " mm";
+    EXPECT_EQ(test::sixConnectedComponents(gt.mask), 1) << "capillary diameter " << capillary << " mm";
+    EXPECT_EQ(test::sixConnectedComponents(gt.centerline), 1) << "capillary diameter " << capillary << " mm";
     // The default thin curve (26-connected) is not face-connected: the option is what makes it so.
-    EXPECT_GT(sixConnectedComponents(rasterizeGroundTruth(f.vessels, g, RasterOptions{}).centerline), 1);
+    EXPECT_GT(test::sixConnectedComponents(rasterizeGroundTruth(f.vessels, g, RasterOptions{}).centerline), 1);
   }
 }
 
@@ -382,6 +356,6 @@ TEST(Grammar, RasterisedTreeIsOneSixConnectedComponent) {
   const auto g = test::growFile(example("lsystem_grammar_3d.toml"));
   const auto grid = imageGrid(g.prepared->frame(), ImageParameters{});
   const auto gt = rasterizeGroundTruth(g.forest.vessels, grid, RasterOptions{4, 6});
-  EXPECT_EQ(sixConnectedComponents(gt.mask), 1);
-  EXPECT_EQ(sixConnectedComponents(gt.centerline), 1);
+  EXPECT_EQ(test::sixConnectedComponents(gt.mask), 1);
+  EXPECT_EQ(test::sixConnectedComponents(gt.centerline), 1);
 }
