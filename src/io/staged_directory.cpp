@@ -82,7 +82,10 @@ StagedDirectory::StagedDirectory(fs::path target, ExistingOutput existing, const
   }
   const fs::path parent = target_.has_parent_path() ? target_.parent_path() : fs::path(".");
   fs::create_directories(parent, ec);
-  const std::string prefix = "." + target_.filename().string() + ".tmp-";
+  // Built by appending: GCC 12 misreads `"." + std::string` as an overlapping copy (-Wrestrict).
+  std::string prefix(1, '.');
+  prefix += target_.filename().string();
+  prefix += ".tmp-";
   removeStaleStaging(parent, prefix);
   staging_ = parent / (prefix + stagingSuffix());
   fs::remove_all(staging_, ec);  // our own pid's: a leftover of a process that had this pid
