@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Configures (Release unless BUILD_TYPE says otherwise) and builds into build/.
+# Configures (Release unless BUILD_TYPE says otherwise) and builds into build/: the targets
+# named as arguments (e.g. the program alone: angiosynth), else everything (tests, benchmarks).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -7,5 +8,6 @@ bash scripts/install-deps.sh
 export CCACHE_BASEDIR="$(pwd)" CCACHE_NOHASHDIR=1
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-cmake -S . -B build -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" "${launcher[@]}" >/dev/null
-cmake --build build -j "$(nproc)"
+cmake -S . -B build -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" -DANGIOSYNTH_WERROR="${WERROR:-OFF}" "${launcher[@]}" >/dev/null
+echo "building ${*:-everything} in build/ ..." >&2
+cmake --build build -j "$(nproc)" ${1:+--target "$@"}

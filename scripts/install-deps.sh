@@ -3,7 +3,8 @@
 set -euo pipefail
 pkgs=(build-essential cmake pkg-config ccache
       libtbb-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libtinyxml2-dev
-      libgtest-dev libbenchmark-dev zlib1g-dev libnifti2-dev libopenimageio-dev python3-nibabel python3-networkx
+      libgtest-dev libbenchmark-dev zlib1g-dev libnifti2-dev libtiff-dev libpng-dev libjpeg-dev
+      libopenimageio-dev python3-nibabel python3-networkx  # OpenImageIO: the tests' independent reader
       libopenvdb-dev libboost-iostreams-dev libssl-dev libceres-dev
       clang libclang-rt-14-dev)  # the sanitizer build and libFuzzer (scripts/sanitize.sh)
 missing=()
@@ -11,8 +12,12 @@ for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 [ ${#missing[@]} -eq 0 ] && exit 0
-echo "installing: ${missing[*]}" >&2
+echo "installing ${#missing[@]} Debian packages (and what they need): ${missing[*]}" >&2
 sudo=""; [ "$(id -u)" -ne 0 ] && sudo="sudo"
 export DEBIAN_FRONTEND=noninteractive
 $sudo apt-get update -qq
-$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+# apt's own progress (one line per package), so a long first install is visibly moving.
+$sudo apt-get install -y --no-install-recommends -o Dpkg::Use-Pty=0 "${missing[@]}" | grep -E '^(Get|Setting up)' >&2 || true
+for p in "${missing[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || { echo "could not install $p" >&2; exit 1; }
+done

@@ -43,6 +43,18 @@ inline Run run(const std::string& args, const std::filesystem::path& cwd) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
 }
 
+// Runs angiosynth in `cwd` and returns its exit code and everything it printed (stdout and stderr).
+inline Run runPrinted(const std::string& args, const std::filesystem::path& cwd) {
+  std::string out;
+  int status = -1;
+  if (FILE* p = popen(("cd '" + cwd.string() + "' && '" + ANGIOSYNTH_EXE + "' " + args + " 2>&1").c_str(), "r")) {
+    char buf[4096];
+    while (fgets(buf, sizeof buf, p)) out += buf;
+    status = pclose(p);
+  }
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
 // An empty directory for the running test, named after it.
 // A directory of its own per test and per process: two suites on one machine (a CI run beside
 // a local one) must not delete each other's files.

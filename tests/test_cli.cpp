@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "cli_run.hpp"
+#include "grow/method.hpp"
+#include "io/scenario.hpp"
 
 using Json = nlohmann::json;
 namespace fs = std::filesystem;
@@ -79,6 +81,19 @@ TEST_F(Cli, GenerateWritesValidRoundTrippingGxlAndSidecar) {
   EXPECT_NEAR(volume, j["statistics"]["total_volume"]["value"].get<double>(), 1e-12 * volume);
 }
 
+// --no-image drops the volumes, not the graph formats the file asks for (issue 18).
+TEST_F(Cli, NoImageStillWritesEveryGraphFormat) {
+  const auto r = run("generate " + (src_ / "examples/cco_disc_2d.toml").string() + " --out g --no-image --quiet", dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* f : {"tree.gxl", "tree.dot", "nodes.csv", "edges.csv", "centerlines.vtp", "tree.swc", "tree.graphml", "keypoints.csv"})
+    EXPECT_TRUE(fs::exists(dir_ / "g" / f)) << f;
+  EXPECT_FALSE(fs::exists(dir_ / "g" / "image.nii.gz"));
+  EXPECT_FALSE(fs::exists(dir_ / "g" / "mask.nii.gz"));
+  const auto again = runPrinted("generate " + (src_ / "examples/cco_disc_2d.toml").string() + " --out g2 --no-image --quiet", dir_);
+  EXPECT_EQ(again.code, 0);
+  EXPECT_EQ(again.err, "");  // --quiet prints nothing
+}
+
 TEST_F(Cli, SameSeedSameBytesWhateverTheThreads) {
   const std::string params = "'" + (src_ / "examples/vascusynth/param_rods_1000.txt").string() + "'";
   ASSERT_EQ(run("generate " + params + " --out one --threads 1 --quiet", dir_).code, 0);
@@ -135,12 +150,14 @@ TEST_F(Cli, VascuSynthSubcommandWritesItsLayoutAndDialect) {
   EXPECT_NE(xml.find(" bifurication "), std::string::npos);
   EXPECT_NE(xml.find("<attr name=\" flow\"><float>8.33</float></attr>"), std::string::npos);
   EXPECT_TRUE(fs::exists(dir_ / "image1/tree_structure.xml"));
-  // The lossless image VascuSynth users expect: 101³ for a 100³ map at 0.04/0.04, as NIfTI and
-  // one PNG per slice (never JPEG).
+  // VascuSynth's layout, file for file: 101³ for a 100³ map at 0.04/0.04, one JPEG per slice
+  // as VascuSynth writes them (the exact image as NIfTI beside them), and the DOT graph.
   EXPECT_TRUE(fs::exists(dir_ / "image1/original_image/image.nii.gz"));
-  EXPECT_TRUE(fs::exists(dir_ / "image1/original_image/image000.png"));
-  EXPECT_TRUE(fs::exists(dir_ / "image1/original_image/image100.png"));
-  EXPECT_FALSE(fs::exists(dir_ / "image1/original_image/image101.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "image1/original_image/image000.jpg"));
+  EXPECT_TRUE(fs::exists(dir_ / "image1/original_image/image100.jpg"));
+  EXPECT_FALSE(fs::exists(dir_ / "image1/original_image/image101.jpg"));
+  EXPECT_EQ(slurp(dir_ / "image1/original_image/image000.jpg").substr(0, 3), std::string("\xff\xd8\xff"));  // a JPEG
+  EXPECT_TRUE(fs::exists(dir_ / "image1/tree.dot"));
   const Json j = Json::parse(slurp(dir_ / "image1/sample.json"));
   EXPECT_EQ(j["statistics"]["image_size"], Json::parse("[101,101,101]"));
   EXPECT_TRUE(fs::exists(dir_ / "image1/sample.json"));
@@ -209,17 +226,48 @@ TEST_F(Cli, VascuSynthNoiseFilesGiveNoiseImagesAndMisspellingsStopEverything) {
   EXPECT_EQ(bad.code, 2);
   EXPECT_EQ(bad.err.rfind("typo.txt:2: unknown noise directive 'SALTPEPER'", 0), 0u) << bad.err;
   EXPECT_FALSE(fs::exists(dir_ / "img"));
-  const auto ok = run("vascusynth params.txt names.txt 0.04 noise.txt noise.txt --quiet", dir_);
+  // Noise folders counted from 0 in argument order, as VascuSynth's; --slices png: lossless slices.
+  const auto ok = run("vascusynth params.txt names.txt 0.04 noise.txt noise.txt --slices png --quiet", dir_);
   ASSERT_EQ(ok.code, 0) << ok.err;
-  for (const char* sub : {"noise_image_1", "noise_image_2"}) {
+  for (const char* sub : {"noise_image_0", "noise_image_1"}) {
     EXPECT_TRUE(fs::exists(dir_ / "img" / sub / "image.nii.gz")) << sub;
     EXPECT_TRUE(fs::exists(dir_ / "img" / sub / "image000.png")) << sub;
     EXPECT_TRUE(fs::exists(dir_ / "img" / sub / "image100.png")) << sub;
   }
+  EXPECT_FALSE(fs::exists(dir_ / "img" / "noise_image_2"));
   // Two copies of one noise file are two independent draws.
-  EXPECT_NE(slurp(dir_ / "img/noise_image_1/image.nii.gz"), slurp(dir_ / "img/noise_image_2/image.nii.gz"));
+  EXPECT_NE(slurp(dir_ / "img/noise_image_0/image.nii.gz"), slurp(dir_ / "img/noise_image_1/image.nii.gz"));
   const Json j = Json::parse(slurp(dir_ / "img/sample.json"));
-  EXPECT_EQ(j["degradation"]["noise_image_1"]["effects"][1]["shadows"].size(), 2u);
+  EXPECT_EQ(j["degradation"]["noise_image_0"]["effects"][1]["shadows"].size(), 2u);
+}
+
+// `init METHOD FILE` writes a template of every method that the reader takes and that grows;
+// every key it lists commented out is a key the reader knows; it never replaces a file.
+TEST_F(Cli, InitTemplatesRunAsTheyAreAndParamsListEveryKey) {
+  for (const auto* m : angiosynth::growthMethods()) {
+    const std::string name = m->name, file = name + ".toml";
+    const auto r = run("init " + name + " " + file, dir_);
+    ASSERT_EQ(r.code, 0) << name << ": " << r.err;
+    const angiosynth::Scenario sc = angiosynth::readTomlParameters(dir_ / file);
+    EXPECT_EQ(std::string(sc.growth->method()), name);
+    // Every key of the method is listed (commented out, at its default).
+    const std::string text = slurp(dir_ / file);
+    std::size_t listed = 0;
+    for (const auto& p : m->params) listed += text.find("# " + std::string(p.key) + " = ") != std::string::npos;
+    EXPECT_EQ(listed, m->params.size()) << name;
+    const auto again = run("init " + name + " " + file, dir_);
+    EXPECT_EQ(again.code, 2);
+    EXPECT_NE(again.err.find("exists"), std::string::npos) << again.err;
+    EXPECT_EQ(slurp(dir_ / file), text);
+  }
+  // The cco template grows: a run of the file as written.
+  ASSERT_EQ(run("generate cco.toml --out grown --no-image --quiet", dir_).code, 0);
+  EXPECT_TRUE(fs::exists(dir_ / "grown/tree.gxl"));
+  const auto p = runPrinted("params colonisation", dir_);
+  ASSERT_EQ(p.code, 0);
+  for (const char* key : {"[image] supersampling", "[curves] tortuosity", "[stage] co2_distance", "seed"})
+    EXPECT_NE(p.err.find(key), std::string::npos) << key;
+  EXPECT_EQ(runPrinted("params nosuch", dir_).code, 2);
 }
 
 TEST_F(Cli, HelpAndVersion) {

@@ -100,13 +100,13 @@ TEST_F(Safety, VascuSynthRerunsOverwriteTheirFilesAndLeaveTheUsersAndRefuseDotNa
   std::ofstream(work_ / "names.txt") << "img\n";
   std::ofstream(work_ / "noise.txt") << "GAUSSIAN: 0 10\n";
   ASSERT_EQ(run("vascusynth params.txt names.txt 0.04 noise.txt --quiet", work_).code, 0);
-  ASSERT_TRUE(fs::exists(work_ / "img" / "noise_image_1"));
+  ASSERT_TRUE(fs::exists(work_ / "img" / "noise_image_0"));
   std::ofstream(work_ / "img" / "mynotes.txt") << "mine\n";
   // Again without the noise file: our noise image goes, the user's notes stay.
   ASSERT_EQ(run("vascusynth params.txt names.txt 0.04 --quiet", work_).code, 0);
   EXPECT_EQ(slurp(work_ / "img" / "mynotes.txt"), "mine\n");
   EXPECT_TRUE(fs::exists(work_ / "img" / "tree_structure.xml"));
-  EXPECT_FALSE(fs::exists(work_ / "img" / "noise_image_1"));
+  EXPECT_FALSE(fs::exists(work_ / "img" / "noise_image_0"));
   // A name that is the working directory (or its parent) is refused before anything is grown.
   const auto before = snapshot(dir_);
   for (const std::string name : std::vector<std::string>{".", "..", "img/.."}) {

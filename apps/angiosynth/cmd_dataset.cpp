@@ -137,6 +137,7 @@ int runDatasetCommand(const DatasetArgs& a, const std::string& command_line) {
   std::int64_t failures = 0;
   opt.on_sample = [&](const nlohmann::json& e, std::int64_t done, std::int64_t total) {
     failures += e["status"] != "ok";
+    if (a.common.quiet) return;
     if (!terminal) {  // one JSON line per sample for logs
       nlohmann::json line{{"id", e["id"]}, {"index", e["index"]}, {"status", e["status"]}, {"seconds", e["seconds"]},
                           {"done", done}, {"total", total}};
@@ -157,7 +158,7 @@ int runDatasetCommand(const DatasetArgs& a, const std::string& command_line) {
   const DatasetRunReport r = runDataset(spec, a.out, sel, opt);
   if (!a.common.quiet)
     std::cerr << r.dir.string() << ": " << r.generated << " generated, " << r.skipped << " skipped (verified), " << r.failed
-              << " failed, " << r.in_flight << " in flight, "
+              << " failed (" << r.in_flight << " at a time), "
               << duration(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()) << "\n";
   int code = r.failed ? 1 : 0;
   if (sel.part == "all") {

@@ -20,7 +20,10 @@ CLI::App* addVascuSynth(CLI::App& app, VascuSynthArgs& a) {
   c->add_option("VOXEL_WIDTH", a.output_voxel_width, "output image voxel width, in VOXEL_WIDTH's unit")
       ->required()
       ->check(finiteIn(1e-12, 1e12));
-  c->add_option("NOISE_FILE", a.noise_files, "VascuSynth noise files (GAUSSIAN:, UNIFORM:, SALTPEPPER:, SHADOW: lines); file i gives NAME/noise_image_<i>/");
+  c->add_option("NOISE_FILE", a.noise_files, "VascuSynth noise files (GAUSSIAN:, UNIFORM:, SALTPEPPER:, SHADOW: lines); the i-th (from 0) gives NAME/noise_image_<i>/");
+  c->add_option("--slices", a.slices, "slice images: jpg (8-bit JPEG, what VascuSynth writes; lossy) or png (lossless); "
+                                      "the exact image is image.nii.gz beside them")
+      ->check(CLI::IsMember({"jpg", "png"}));
   addCommonOptions(*c, a.common);
   return c;
 }
@@ -39,7 +42,7 @@ int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line) {
   for (std::size_t i = 0; i < a.noise_files.size(); ++i) {
     if (!std::filesystem::exists(a.noise_files[i])) throw InputError(a.noise_files[i], 0, "no such noise file");
     noise.push_back(readVascuSynthNoiseFile(a.noise_files[i]));
-    noise.back().name = "noise_image_" + std::to_string(i + 1);
+    noise.back().name = "noise_image_" + std::to_string(i);  // VascuSynth counts from 0
   }
   ReadOptions ro;
   ro.vascusynth_length_unit = a.common.vascusynth_unit;
@@ -69,6 +72,7 @@ int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line) {
     req.progress = progressPrinter(a.common, names[i].text);
     req.profiles = noise;
     req.vascusynth_noise_layout = true;
+    req.slice_format = a.slices;
     req.output_voxel_mm = a.output_voxel_width * sc.input_units.mm_per_length;
     checkRange(req.output_voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, Where{"VOXEL_WIDTH", 0},
                "VOXEL_WIDTH (mm)");

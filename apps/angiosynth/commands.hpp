@@ -29,10 +29,23 @@ struct VascuSynthArgs {
   std::string param_list, name_list;
   double output_voxel_width = 0;
   std::vector<std::string> noise_files;
+  std::string slices = "jpg";
   CommonOptions common;
 };
 CLI::App* addVascuSynth(CLI::App& app, VascuSynthArgs& a);
 int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line);
+
+struct ParamsArgs {
+  std::string method;
+};
+CLI::App* addParams(CLI::App& app, ParamsArgs& a);
+int runParams(const ParamsArgs& a);
+
+struct InitArgs {
+  std::vector<std::string> args;  // [METHOD] FILE
+};
+CLI::App* addInit(CLI::App& app, InitArgs& a);
+int runInit(const InitArgs& a);
 
 struct DatasetArgs {
   std::string spec, out, dir;

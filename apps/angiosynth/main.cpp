@@ -25,6 +25,10 @@ int main(int argc, char** argv) {
   auto* d = cli::addDataset(app, ds);
   auto* fx = app.add_subcommand("effects", "list the degradation effects and their parameters (Markdown)");
   auto* gm = app.add_subcommand("methods", "list the growth methods and their parameters (Markdown)");
+  cli::ParamsArgs pa;
+  auto* pm = cli::addParams(app, pa);
+  cli::InitArgs ia;
+  auto* in = cli::addInit(app, ia);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -36,6 +40,8 @@ int main(int argc, char** argv) {
     if (g->parsed()) return cli::runGenerate(gen, cmdline);
     if (v->parsed()) return cli::runVascuSynth(vs, cmdline);
     if (d->parsed()) return cli::runDatasetCommand(ds, cmdline);
+    if (pm->parsed()) return cli::runParams(pa);
+    if (in->parsed()) return cli::runInit(ia);
     if (fx->parsed()) {
       std::cout << effectReference();
       return 0;

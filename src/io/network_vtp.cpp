@@ -312,7 +312,8 @@ ExistingNetwork readVtp(const std::string& file, double unit_mm) {
   const auto [radius, radius_name] = cellArray({"Radius", "radius"});
   std::vector<double> point_radius;
   if (!radius_name) {
-    const auto* a = vtp.array("PointData", "Radius");
+    const auto* a = vtp.array("PointData", "NodeRadius");
+    if (!a) a = vtp.array("PointData", "Radius");
     if (!a) a = vtp.array("PointData", "radius");
     if (!a) throw InputError(file, piece->GetLineNum(), "no radius: a cell or point array named Radius or radius is required");
     point_radius = vtp.values(a, points_n);

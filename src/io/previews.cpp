@@ -1,58 +1,16 @@
-// PNG and TIFF through OpenImageIO; kept in one file so only it includes OIIO's headers.
-#include <OpenImageIO/imageio.h>
-
+// Previews: maximum-intensity projections (grey or coloured by label) and slices, as 8-bit images.
 #include <algorithm>
 #include <cmath>
 
-#include "core/error.hpp"
 #include "io/volume_writers.hpp"
 
 namespace angiosynth {
 namespace {
 
-OIIO::TypeDesc oiioType(VoxelType t) {
-  switch (t) {
-    case VoxelType::UInt8: return OIIO::TypeDesc::UINT8;
-    case VoxelType::Int16: return OIIO::TypeDesc::INT16;
-    case VoxelType::UInt16: return OIIO::TypeDesc::UINT16;
-    case VoxelType::UInt32: return OIIO::TypeDesc::UINT32;
-    case VoxelType::Float32: return OIIO::TypeDesc::FLOAT;
-  }
-  return OIIO::TypeDesc::FLOAT;
-}
-
 std::uint8_t to8(float v, double lo, double scale) {
   const double x = (v - lo) * scale;
   return std::isnan(x) ? 0 : static_cast<std::uint8_t>(std::clamp(std::round(x), 0.0, 255.0));
 }
-
-[[noreturn]] void fail(const std::filesystem::path& file, const std::string& why) {
-  throw InputError(file.string(), 0, "cannot write: " + why);
-}
-
-}  // namespace
-
-void writeTiff(const std::filesystem::path& file, const VolumeView& v) {
-  const VolumeGrid& g = *v.grid;
-  auto out = OIIO::ImageOutput::create(file.string());
-  if (!out) fail(file, OIIO::geterror());
-  OIIO::ImageSpec spec(g.dims[0], g.dims[1], 1, oiioType(v.type));
-  spec.attribute("compression", "zip");
-  spec.attribute("ImageDescription", v.description);
-  spec.attribute("XResolution", float(10.0 / g.spacing_mm.x));  // pixels per cm
-  spec.attribute("YResolution", float(10.0 / g.spacing_mm.y));
-  spec.attribute("ResolutionUnit", "cm");
-  const std::vector<OIIO::ImageSpec> specs(static_cast<std::size_t>(g.dims[2]), spec);
-  if (!out->open(file.string(), g.dims[2], specs.data())) fail(file, out->geterror());
-  const std::size_t slice = std::size_t(g.dims[0]) * g.dims[1] * voxelBytes(v.type);
-  for (std::int32_t z = 0; z < g.dims[2]; ++z) {
-    if (z > 0 && !out->open(file.string(), spec, OIIO::ImageOutput::AppendSubimage)) fail(file, out->geterror());
-    if (!out->write_image(oiioType(v.type), static_cast<const char*>(v.data) + z * slice)) fail(file, out->geterror());
-  }
-  if (!out->close()) fail(file, out->geterror());
-}
-
-namespace {
 
 // The largest value along `axis` for every pixel (-inf for none) and its voxel (the first on
 // ties; -1 for none).
@@ -113,14 +71,6 @@ Image8 sliceZ(const Volume<float>& v, std::int32_t z, double lo, double hi) {
   const float* s = v.data.data() + std::size_t(z) * img.pixels.size();
   for (std::size_t p = 0; p < img.pixels.size(); ++p) img.pixels[p] = to8(s[p], lo, scale);
   return img;
-}
-
-void writePng(const std::filesystem::path& file, const Image8& image) {
-  auto out = OIIO::ImageOutput::create(file.string());
-  if (!out) fail(file, OIIO::geterror());
-  OIIO::ImageSpec spec(image.width, image.height, image.channels, OIIO::TypeDesc::UINT8);
-  if (!out->open(file.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, image.pixels.data()) || !out->close())
-    fail(file, out->geterror());
 }
 
 }  // namespace angiosynth

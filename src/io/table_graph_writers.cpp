@@ -95,7 +95,10 @@ void writeVtp(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
       << "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
   for (std::int32_t i = 0; i < n; ++i)
     out << exactNumber(t.position[i].x) << ' ' << exactNumber(t.position[i].y) << ' ' << exactNumber(t.position[i].z) << '\n';
-  out << "</DataArray>\n</Points>\n<PointData Scalars=\"Radius\">\n<DataArray type=\"Float64\" Name=\"Radius\" format=\"ascii\">\n";
+  // A segment is a cylinder: its radius is the cell's (active scalars). Per point, for viewers
+  // that need point radii, the radius of the segment ending there, named so it is not mistaken
+  // for the vessel's (interpolated between points it tapers every vessel).
+  out << "</DataArray>\n</Points>\n<PointData>\n<DataArray type=\"Float64\" Name=\"NodeRadius\" format=\"ascii\">\n";
   for (std::int32_t i = 0; i < n; ++i) out << exactNumber(nodeRadius(t, i)) << '\n';
   out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"Tree\" format=\"ascii\">\n";
   for (std::int32_t i = 0; i < n; ++i) out << treeIndex(i) << '\n';

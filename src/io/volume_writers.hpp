@@ -49,7 +49,7 @@ void writeNrrd(const std::filesystem::path& file, const VolumeView& v);
 
 namespace angiosynth {
 
-// Multi-page TIFF (one page per z slice, zip-compressed, lossless) through OpenImageIO.
+// Multi-page TIFF (one page per z slice, deflate-compressed, lossless) through libtiff.
 void writeTiff(const std::filesystem::path& file, const VolumeView& v);
 
 // A 2D 8-bit image (row-major, width fastest): grey, or RGB with `channels` = 3 interleaved.
@@ -69,7 +69,9 @@ Image8 maximumProjection(const Volume<float>& v, const Volume<std::uint8_t>& lab
                          int axis, double lo, double hi);
 // Slice z of a volume, mapping [lo, hi] to [0, 255].
 Image8 sliceZ(const Volume<float>& v, std::int32_t z, double lo, double hi);
-// Lossless 8-bit PNG through OpenImageIO.
+// Lossless 8-bit PNG through libpng.
 void writePng(const std::filesystem::path& file, const Image8& image);
+// Baseline JPEG through libjpeg (lossy: VascuSynth's slice format, kept for its users' scripts).
+void writeJpeg(const std::filesystem::path& file, const Image8& image, int quality = 95);
 
 }  // namespace angiosynth

@@ -40,7 +40,7 @@ void writeDegradedImages(const Forest& forest, const std::vector<std::uint8_t>& 
     // Previews span the profile's background to vessel intensities.
     const double lo = std::min(d.background, d.vessel), hi = std::max(d.background, d.vessel);
     if (req.vascusynth_noise_layout) {
-      writeSlices(image.view, d.image, lo, hi, profile.name, profile.name, dir, files);
+      writeSlices(image.view, d.image, lo, hi, profile.name, profile.name, req.slice_format, dir, files);
     } else {
       std::vector<Channel> channels{{"image" + suffix, image.view}};
       if (d.labels) {

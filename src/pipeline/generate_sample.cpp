@@ -11,6 +11,7 @@
 #include "io/graph_writers.hpp"
 #include "io/svg_writer.hpp"
 #include "io/text_file.hpp"
+#include "pipeline/volume_files.hpp"
 #include "pipeline/volume_outputs.hpp"
 #include "physics/hemodynamics.hpp"
 
@@ -73,7 +74,7 @@ PreparedSample prepareSample(const SampleRequest& req) {
   // The volume request is settled, and its size checked, before the (possibly long) growth.
   ImageParameters ip = sc.image;
   if (!req.formats.empty()) ip.formats = req.formats;
-  if (req.vascusynth_layout) ip.formats = {"nifti"};  // beside the PNG slices of original_image
+  if (req.vascusynth_layout) ip.formats = {"nifti"};  // beside the slices of original_image
   ps.volumes = ip.enabled && !req.no_image;
   VolumeRequest& vr = ps.vr;
   std::vector<Profile>& profiles = ps.profiles;
@@ -93,6 +94,7 @@ PreparedSample prepareSample(const SampleRequest& req) {
     vr.parameter_file = sc.parameter_file;
     vr.image_line = sc.image_line;
     vr.slices = req.vascusynth_layout;
+    vr.slice_format = req.slice_format;
     vr.profiles = profiles;
     vr.seed = req.seed;
     vr.sample = req.sample;
@@ -150,6 +152,8 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   if (req.vascusynth_layout) {
     writeTextFile(dir / "tree_structure.xml", [&](std::ostream& o) { writeVascuSynthGxl(o, tree, frame, req.graph_id); });
     files["gxl"] = "tree_structure.xml";
+    writeTextFile(dir / "tree.dot", [&](std::ostream& o) { writeDot(o, tree, forest.trees, frame); });
+    files["dot"] = "tree.dot";
   } else {
     writeTextFile(dir / "tree.gxl", [&](std::ostream& o) {
       if (req.gxl_dialect == "vascusynth") writeVascuSynthGxl(o, tree, frame, req.graph_id);
@@ -172,6 +176,12 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
     writeVolumes(forest, vr, dir, files, stats, degradation, &degrade_seconds);
     if (!degrade_seconds.empty()) timing["degrade_effects"] = degrade_seconds;
     timing["rasterize_and_write_volumes"] = seconds(t0);
+  } else if (!req.vascusynth_layout) {
+    // Without volumes the graphs asked for are written all the same; voxel coordinates in the
+    // key points refer to the grid the image would have had.
+    t0 = Clock::now();
+    writeGraphFiles(tree, forest.trees, imageGrid(map, sc.image, sc.parameter_file, sc.image_line), sc.image.graph_formats, "", dir, files);
+    timing["write_graphs"] = timing["write_graphs"].get<double>() + seconds(t0);
   }
 
   // Statistics of the final tree.

@@ -29,7 +29,8 @@ struct SampleRequest {
   std::uint64_t sample = 0;               // index within a dataset (part of every random stream)
   // Degradation profiles overriding the parameter file's [degrade] profiles when set.
   std::optional<std::vector<Profile>> profiles;
-  bool vascusynth_noise_layout = false;   // profiles write <name>/image.nii.gz + PNG slices
+  bool vascusynth_noise_layout = false;   // profiles write <name>/image.nii.gz + slices
+  std::string slice_format = "jpg";       // VascuSynth layout: jpg (VascuSynth's) or png
   bool record_timing = true;              // false: sample.json depends on seed and parameters only
   // The kinds in class-label order (1, 2, ...), when a dataset fixes them; empty: artery 1, vein 2.
   std::vector<std::string> class_kinds;

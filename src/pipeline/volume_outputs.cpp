@@ -118,7 +118,7 @@ void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::fil
     for (auto& c : labelChannels(gt, "")) channels.push_back(c);
     writeChannels(channels, ip.formats, dir, files);
     if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end()) writeMips(gt.fraction, previewClasses(forest.trees, gt), 0, 1, "", dir, files);
-    if (req.slices) writeSlices(image.view, gt.fraction, 0, 1, req.slice_dir, "original_image", dir, files);
+    if (req.slices) writeSlices(image.view, gt.fraction, 0, 1, req.slice_dir, "original_image", req.slice_format, dir, files);
   }
   std::int64_t mask_voxels = 0;
   for (auto m : gt.mask.data) mask_voxels += m;

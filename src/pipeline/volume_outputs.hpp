@@ -28,7 +28,8 @@ struct VolumeRequest {
   std::uint64_t memory_limit = 0;
   std::string parameter_file;     // for size errors
   int image_line = 0;
-  bool slices = false;            // also one lossless PNG per z slice (VascuSynth's layout)
+  bool slices = false;            // also one 8-bit image per z slice (VascuSynth's layout)
+  std::string slice_format = "jpg";  // jpg (VascuSynth's) or png (lossless)
   std::string slice_dir = "original_image";
   // Degradation: one image per profile (role image_<profile>), drawn from (seed, sample).
   std::vector<Profile> profiles;

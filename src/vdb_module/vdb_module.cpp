@@ -1,86 +1,86 @@
-// The only translation unit that includes OpenVDB (heavy headers).
-#include "io/vdb_writer.hpp"
-
+// libangiosynth_vdb.so: the only code that includes or links OpenVDB (heavy headers, and a
+// library whose symbols slow every program start); the main program loads it when asked for .vdb.
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
-#include <algorithm>
+#include <cstring>
+#include <memory>
 #include <mutex>
+#include <string>
+#include <vector>
 
-#include "core/error.hpp"
+#include "io/vdb_module_api.hpp"
 
-namespace angiosynth {
+namespace {
 
-std::uint64_t sparseRasterBytes(const BrickBins& bins) {
-  // A float leaf and an int leaf (2 KiB each plus masks), and the bins themselves.
-  std::uint64_t seg_refs = 0;
-  for (const auto& s : bins.segments) seg_refs += s.size();
-  return bins.brick_ids.size() * (2 * (512 * 4 + 128) + 64) + seg_refs * 4 + bins.brick_ids.size() * 32;
-}
+constexpr int kBrick = 8;
 
-VdbReport writeVdb(const std::filesystem::path& file, const VascularTree& tree, const VolumeGrid& g, const BrickBins& bins,
-                   const RasterOptions& opt) {
+struct Writer {
+  openvdb::FloatGrid::Ptr fraction = openvdb::FloatGrid::create(0.0f);
+  openvdb::Int32Grid::Ptr instances = openvdb::Int32Grid::create(0);
+  std::int64_t leaves = 0, active = 0;
+};
+
+void* create() {
   static std::once_flag init;
   std::call_once(init, [] { openvdb::initialize(); });
+  return new Writer;
+}
+
+void addLeaf(void* p, std::int32_t x, std::int32_t y, std::int32_t z, const float* f, const std::uint32_t* id) {
+  auto& w = *static_cast<Writer*>(p);
   using FloatLeaf = openvdb::FloatTree::LeafNodeType;
   using IntLeaf = openvdb::Int32Tree::LeafNodeType;
-  std::vector<std::unique_ptr<FloatLeaf>> fleaves(bins.brick_ids.size());
-  std::vector<std::unique_ptr<IntLeaf>> ileaves(bins.brick_ids.size());
-  const auto nb = bins.bricks;
-  rasterizeBricks(tree, g, bins, opt, [&](std::int64_t brick, const float* f, const std::uint32_t* id) {
-    if (std::all_of(f, f + kBrick * kBrick * kBrick, [](float v) { return v == 0; })) return;
-    const std::size_t bi = std::lower_bound(bins.brick_ids.begin(), bins.brick_ids.end(), brick) - bins.brick_ids.begin();
-    const std::int64_t bx = brick % nb[0], by = (brick / nb[0]) % nb[1], bz = brick / (std::int64_t(nb[0]) * nb[1]);
-    const openvdb::Coord origin(int(bx * kBrick), int(by * kBrick), int(bz * kBrick));
-    auto fl = std::make_unique<FloatLeaf>(origin, 0.0f, false);
-    auto il = std::make_unique<IntLeaf>(origin, 0, false);
-    for (int k = 0; k < kBrick; ++k)
-      for (int j = 0; j < kBrick; ++j)
-        for (int i = 0; i < kBrick; ++i) {
-          const int v = i + kBrick * (j + kBrick * k);
-          if (f[v] == 0) continue;
-          const openvdb::Coord c = origin.offsetBy(i, j, k);
-          fl->setValueOn(c, f[v]);
-          if (f[v] >= 0.5f) il->setValueOn(c, static_cast<std::int32_t>(id[v]));
-        }
-    fleaves[bi] = std::move(fl);
-    ileaves[bi] = std::move(il);
-  });
-  auto fgrid = openvdb::FloatGrid::create(0.0f);
-  auto igrid = openvdb::Int32Grid::create(0);
-  // Attach leaves in brick order: the tree, and so the file, does not depend on threads.
-  VdbReport report;
-  for (std::size_t bi = 0; bi < fleaves.size(); ++bi) {
-    if (!fleaves[bi]) continue;
-    ++report.leaves;
-    report.active_voxels += fleaves[bi]->onVoxelCount();
-    fgrid->tree().addLeaf(fleaves[bi].release());
-    if (ileaves[bi]->onVoxelCount() > 0) igrid->tree().addLeaf(ileaves[bi].release());
-  }
+  const openvdb::Coord origin(x, y, z);
+  auto fl = std::make_unique<FloatLeaf>(origin, 0.0f, false);
+  auto il = std::make_unique<IntLeaf>(origin, 0, false);
+  for (int k = 0; k < kBrick; ++k)
+    for (int j = 0; j < kBrick; ++j)
+      for (int i = 0; i < kBrick; ++i) {
+        const int v = i + kBrick * (j + kBrick * k);
+        if (f[v] == 0) continue;
+        const openvdb::Coord c = origin.offsetBy(i, j, k);
+        fl->setValueOn(c, f[v]);
+        if (f[v] >= 0.5f) il->setValueOn(c, static_cast<std::int32_t>(id[v]));
+      }
+  ++w.leaves;
+  w.active += fl->onVoxelCount();
+  w.fraction->tree().addLeaf(fl.release());
+  if (il->onVoxelCount() > 0) w.instances->tree().addLeaf(il.release());
+}
+
+int write(void* p, const char* file, const double spacing[3], const double origin[3], std::int64_t* leaves, std::int64_t* active,
+          char* error, std::size_t error_size) {
+  auto& w = *static_cast<Writer*>(p);
   // OpenVDB matrices act on row vectors: scale on the diagonal, translation in the last row.
   openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();
-  m(0, 0) = g.spacing_mm.x;
-  m(1, 1) = g.spacing_mm.y;
-  m(2, 2) = g.spacing_mm.z;
-  m(3, 0) = g.origin_mm.x;
-  m(3, 1) = g.origin_mm.y;
-  m(3, 2) = g.origin_mm.z;
+  for (int a = 0; a < 3; ++a) m(a, a) = spacing[a], m(3, a) = origin[a];
   auto transform = openvdb::math::Transform::createLinearTransform(m);
-  for (openvdb::GridBase::Ptr grid : {openvdb::GridBase::Ptr(fgrid), openvdb::GridBase::Ptr(igrid)}) {
+  for (openvdb::GridBase::Ptr grid : {openvdb::GridBase::Ptr(w.fraction), openvdb::GridBase::Ptr(w.instances)}) {
     grid->setTransform(transform->copy());
     grid->insertMeta("units", openvdb::StringMetadata("mm, RAS"));
   }
-  fgrid->setName("fraction");
-  fgrid->setGridClass(openvdb::GRID_FOG_VOLUME);
-  igrid->setName("instances");
+  w.fraction->setName("fraction");
+  w.fraction->setGridClass(openvdb::GRID_FOG_VOLUME);
+  w.instances->setName("instances");
+  *leaves = w.leaves;
+  *active = w.active;
   try {
-    openvdb::io::File out(file.string());
-    out.write({fgrid, igrid});
+    openvdb::io::File out(file);
+    out.write({w.fraction, w.instances});
     out.close();
   } catch (const std::exception& e) {
-    throw InputError(file.string(), 0, std::string("cannot write: ") + e.what());
+    std::snprintf(error, error_size, "%s", e.what());
+    return 1;
   }
-  return report;
+  return 0;
 }
 
-}  // namespace angiosynth
+void destroy(void* p) { delete static_cast<Writer*>(p); }
+
+}  // namespace
+
+extern "C" const AngiosynthVdbApi* angiosynth_vdb_api() {
+  static const AngiosynthVdbApi api{kAngiosynthVdbApiVersion, &create, &addLeaf, &write, &destroy};
+  return &api;
+}
