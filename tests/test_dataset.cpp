@@ -110,6 +110,22 @@ TEST_F(Dataset, LayoutObeysTheRulesNnUNetChecks) {
   EXPECT_EQ(lines, 6);
 }
 
+// previews = true: MIPs of the clean and the degraded image beside each sample's ground truth,
+// none in nnU-Net's folders.
+TEST_F(Dataset, PreviewsPutMipsInTheGroundTruthOnly) {
+  std::string text = slurp(src_ / "tests/data/dataset_tiny.toml");
+  text.replace(text.find("../../demand_maps"), 17, (src_ / "demand_maps").string());
+  text.replace(text.find("channel_name"), 0, "previews = true\n");
+  std::ofstream(dir_ / "tiny_previews.toml") << text;
+  ASSERT_EQ(run("dataset tiny_previews.toml --out p --index 2 --quiet", dir_).code, 0);
+  const fs::path gt = dir_ / "p" / name_ / "groundtruth/VesselTiny_0002";
+  const Json meta = Json::parse(slurp(dir_ / "p" / name_ / "groundtruth/VesselTiny_0002.json"));
+  const std::string profile = meta["profile"];
+  for (const std::string& f : std::vector<std::string>{"mip_x.png", "mip_y.png", "mip_z.png", "mip_z_" + profile + ".png"}) EXPECT_TRUE(fs::exists(gt / f)) << f;
+  for (const char* sub : {"imagesTr", "labelsTr"})
+    for (const auto& e : fs::directory_iterator(dir_ / "p" / name_ / sub)) EXPECT_NE(e.path().extension(), ".png") << e.path();
+}
+
 TEST_F(Dataset, DescribeShowsTheParametersTheSampleIsMadeFrom) {
   ASSERT_EQ(run("dataset " + spec_ + " --out raw --index 3 --quiet", dir_).code, 0);
   const std::string cmd = quoted(ANGIOSYNTH_EXE) + " dataset describe " + spec_ + " --index 3 > " + quoted(dir_ / "d.txt");

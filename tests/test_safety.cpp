@@ -49,7 +49,7 @@ class Safety : public ::testing::Test {
 
 TEST_F(Safety, OutputThatIsOrContainsTheWorkingDirectoryOrAnInputIsRefusedAndNothingIsDeleted) {
   const auto before = snapshot(dir_);
-  for (const std::string out : std::vector<std::string>{".", "./", "..", work_.string(), dir_.string(), "/"}) {
+  for (const std::string& out : std::vector<std::string>{".", "./", "..", work_.string(), dir_.string(), "/"}) {
     const auto r = run("generate params.toml --out '" + out + "' --force --no-image --quiet", work_);
     EXPECT_EQ(r.code, 2) << out << ": " << r.err;
     EXPECT_NE(r.err.find("refuses to write there"), std::string::npos) << r.err;
@@ -109,7 +109,7 @@ TEST_F(Safety, VascuSynthRerunsOverwriteTheirFilesAndLeaveTheUsersAndRefuseDotNa
   EXPECT_FALSE(fs::exists(work_ / "img" / "noise_image_0"));
   // A name that is the working directory (or its parent) is refused before anything is grown.
   const auto before = snapshot(dir_);
-  for (const std::string name : std::vector<std::string>{".", "..", "img/.."}) {
+  for (const std::string& name : std::vector<std::string>{".", "..", "img/.."}) {
     std::ofstream(work_ / "names.txt") << name << "\n";
     const auto before_names = snapshot(dir_);
     const auto r = run("vascusynth params.txt names.txt 0.04 --quiet", work_);

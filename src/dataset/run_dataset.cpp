@@ -65,7 +65,7 @@ void writeJsonAtomically(const fs::path& p, const Json& j) {
 Scenario scenarioOf(const DatasetSpec& spec, const ResolvedSample& r) {
   Scenario sc = readTomlParameters(*r.table, spec.file);
   sc.image.enabled = true;
-  sc.image.formats = {"nifti"};
+  sc.image.formats = spec.previews ? std::vector<std::string>{"nifti", "png"} : std::vector<std::string>{"nifti"};
   sc.profiles = {r.profile};
   return sc;
 }

@@ -233,9 +233,9 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
   const auto& d = *ds->as_table();
   for (const auto& [k, v] : d)
     if (k != "name" && k != "id" && k != "samples" && k != "seed" && k != "profile" && k != "channel_name" && k != "labels" &&
-        k != "kinds")
+        k != "kinds" && k != "previews")
       throw InputError(s.file, lineOf(v), "unknown key '" + std::string(k.str()) +
-                                              "' in [dataset]; allowed: name, id, samples, seed, profile, channel_name, labels, kinds");
+                                              "' in [dataset]; allowed: name, id, samples, seed, profile, channel_name, labels, kinds, previews");
   const auto need = [&](const char* key) -> const toml::node& {
     const auto* n = d.get(key);
     if (!n) throw InputError(s.file, lineOf(d), std::string("missing key '") + key + "' in [dataset]");
@@ -257,6 +257,10 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
     s.channel_name = *c->value<std::string>();
   }
   readLabels(d, s);
+  if (const auto* p = d.get("previews")) {
+    if (!p->is_boolean()) throw InputError(s.file, lineOf(*p), "previews must be true or false (MIPs of each sample in groundtruth/)");
+    s.previews = *p->value<bool>();
+  }
   s.sha256 = canonicalSpecSha256(s.text, s.file);
   if (root->contains("seed")) throw InputError(s.file, lineOf(*root->get("seed")), "the seed of a dataset goes in [dataset]");
   // Resolve and read one sample now, so a bad spec fails before any work starts.

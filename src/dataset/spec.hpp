@@ -36,6 +36,7 @@ struct DatasetSpec {
   std::string labels = "binary";
   std::vector<std::string> kinds;  // labels = "kind": default artery, vein
   int labels_line = 0;             // of `kinds`, else of `labels`, for errors about a sample's kinds
+  bool previews = false;           // MIPs (PNG) of each sample's clean and degraded image in groundtruth/
 };
 
 // The label values of labelsTr, as dataset.json and each sample's meta list them.

@@ -35,9 +35,13 @@ const std::vector<MethodParam>& commonParams() {
 namespace {
 
 void line(std::ostream& o, const MethodParam& p) {
-  o << "  " << (*p.table ? "[" + std::string(p.table) + "] " : std::string()) << p.key;
+  o << "  ";
+  if (*p.table) o << '[' << p.table << "] ";
+  o << p.key;
   if (*p.unit) o << " (" << p.unit << ")";
-  o << ": " << p.meaning << "; " << (p.fallback ? "default " + std::string(p.fallback) : std::string("required")) << "\n";
+  o << ": " << p.meaning << "; ";
+  if (p.fallback) o << "default " << p.fallback << '\n';
+  else o << "required\n";
 }
 
 }  // namespace
@@ -74,9 +78,11 @@ std::string parameterTemplate(const GrowthMethod& method, const std::string& ste
       if (!*p.table) continue;  // top-level keys (seed) stand at the top of the example itself
       if (table != p.table) {
         table = p.table;
-        o << "#\n" << (*p.table ? "# [" + table + "]\n" : std::string());
+        o << "#\n# [" << table << "]\n";
       }
-      o << "# " << p.key << " = " << (p.fallback ? p.fallback : "(required)") << "   # " << p.meaning << (*p.unit ? " (" + std::string(p.unit) + ")" : "") << "\n";
+      o << "# " << p.key << " = " << (p.fallback ? p.fallback : "(required)") << "   # " << p.meaning;
+      if (*p.unit) o << " (" << p.unit << ')';
+      o << '\n';
     }
   };
   block(method.params);
