@@ -29,8 +29,8 @@ int main(int argc, char** argv) {
     double rmax = 0;
     for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
       const Vec3& p = t.position[i];
-      lo = Vec3(std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z));
-      hi = Vec3(std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z));
+      lo = componentMin(lo, p);
+      hi = componentMax(hi, p);
       rmax = std::max(rmax, t.radius[i]);
     }
     VolumeGrid g;

@@ -44,6 +44,18 @@ void VascularTree::truncate(std::size_t n) {
   radius_start.resize(n); wall_start.resize(n); wall.resize(n);
 }
 
+void VascularTree::setPieceOf(const VascularTree& t, std::int32_t n, int q, int k, std::int32_t id) {
+  const double f = double(q) / k, f0 = double(q - 1) / k;
+  const double r0 = t.startRadius(n), r1 = t.radius[n];
+  radius[id] = r0 + f * (r1 - r0);
+  if (t.radius_start[n] >= 0) radius_start[id] = r0 + f0 * (r1 - r0);
+  wall_start[id] = t.wall_start[n] + f0 * (t.wall[n] - t.wall_start[n]);
+  wall[id] = t.wall_start[n] + f * (t.wall[n] - t.wall_start[n]);
+  flow[id] = t.flow[n];
+  terminals[id] = t.terminals[n];
+  depth[id] = t.depth[n];
+}
+
 std::int32_t VascularTree::addNode(const Vec3& p, std::int32_t parent_node, std::int32_t tree_id) {
   const auto id = nodeCount();
   position.push_back(p);

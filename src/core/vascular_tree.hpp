@@ -77,6 +77,10 @@ struct VascularTree {
   // Appends a node with its incoming segment from `parent_node` (-1 for a root, which starts
   // tree `tree_id`); returns its id.
   std::int32_t addNode(const Vec3& p, std::int32_t parent_node, std::int32_t tree_id = 0);
+  // Node `id` ends piece q (1 … k) of segment `seg` of `from`, cut into k equal pieces (warped or
+  // curved trees): radius and wall interpolated along it (a tapered vessel's pieces taper), flow,
+  // terminal count and depth as the segment's. Pressure, β and the staged attributes are the caller's.
+  void setPieceOf(const VascularTree& from, std::int32_t seg, int q, int k, std::int32_t id);
   // Appends every node of `t` (a single tree) as tree `tree_id`, ids shifted by nodeCount().
   void appendTree(const VascularTree& t, std::int32_t tree_id);
   void replaceChild(std::int32_t node, std::int32_t old_child, std::int32_t new_child);

@@ -21,6 +21,14 @@ constexpr double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.
 constexpr Vec3 cross(const Vec3& a, const Vec3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 inline double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
 inline double distance(const Vec3& a, const Vec3& b) { return norm(a - b); }
+// The direction of v (the zero vector stays zero).
+inline Vec3 unit(const Vec3& v) {
+  const double n = norm(v);
+  return n > 0 ? v / n : v;
+}
+// Corners of the box of two points: componentwise minimum and maximum.
+inline Vec3 componentMin(const Vec3& a, const Vec3& b) { return {std::fmin(a.x, b.x), std::fmin(a.y, b.y), std::fmin(a.z, b.z)}; }
+inline Vec3 componentMax(const Vec3& a, const Vec3& b) { return {std::fmax(a.x, b.x), std::fmax(a.y, b.y), std::fmax(a.z, b.z)}; }
 
 // Distance from point p to the segment [a, b].
 inline double pointSegmentDistance(const Vec3& p, const Vec3& a, const Vec3& b) {

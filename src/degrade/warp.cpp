@@ -143,17 +143,13 @@ VascularTree warpTree(const VascularTree& t, const BSplineWarp& warp, double pie
       const std::int64_t at = first_point[n] + q - 1;
       const std::int32_t id = w.addNode(moved[at], prev);
       const double f = double(q) / pieces[n];
-      // A tapered vessel's pieces taper along it (radius and wall linear in its length).
-      const double f0 = double(q - 1) / pieces[n];
-      const double r0 = t.startRadius(n), r1 = t.radius[n];
-      w.radius[id] = (r0 + f * (r1 - r0)) * scale[at];
-      if (t.radius_start[n] >= 0) w.radius_start[id] = (r0 + f0 * (r1 - r0)) * scale[at];
-      w.wall_start[id] = (t.wall_start[n] + f0 * (t.wall[n] - t.wall_start[n])) * scale[at];
-      w.wall[id] = (t.wall_start[n] + f * (t.wall[n] - t.wall_start[n])) * scale[at];
-      w.flow[id] = t.flow[n];
-      w.terminals[id] = t.terminals[n];
+      w.setPieceOf(t, n, q, pieces[n], id);
+      // The cross-section stretches with the warp.
+      w.radius[id] *= scale[at];
+      if (t.radius_start[n] >= 0) w.radius_start[id] *= scale[at];
+      w.wall_start[id] *= scale[at];
+      w.wall[id] *= scale[at];
       w.pressure[id] = t.pressure[t.parent[n]] + f * (t.pressure[n] - t.pressure[t.parent[n]]);  // linear along a Poiseuille tube
-      w.depth[id] = t.depth[n];
       w.beta[id] = t.beta[n];
       origin.push_back(n);
       prev = id;

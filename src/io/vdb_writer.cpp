@@ -61,6 +61,8 @@ std::uint64_t sparseRasterBytes(const BrickBins& bins) {
   return bins.brick_ids.size() * (2 * (512 * 4 + 128) + 64 + 512 * 8) + seg_refs * 4 + bins.brick_ids.size() * 32;
 }
 
+static_assert(kBrick == 8, "the module's leaves are 8³ bricks (OpenVDB's leaf size)");
+
 VdbReport writeVdb(const std::filesystem::path& file, const VascularTree& tree, const VolumeGrid& g, const BrickBins& bins,
                    const RasterOptions& opt) {
   const AngiosynthVdbApi* api = loadModule(file);

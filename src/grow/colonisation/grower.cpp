@@ -41,11 +41,6 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180;
 
-Vec3 unit(const Vec3& v) {
-  const double n = norm(v);
-  return n > 0 ? v / n : v;
-}
-
 // A unit vector perpendicular to e (in the plane z = const when e is).
 Vec3 perpendicular(const Vec3& e) {
   const Vec3 a = std::abs(e.z) < 0.9 && (std::abs(e.x) > 1e-12 || std::abs(e.y) > 1e-12) ? Vec3(-e.y, e.x, 0) : cross(e, Vec3(1, 0, 0));

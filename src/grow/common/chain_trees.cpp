@@ -51,8 +51,8 @@ std::vector<std::pair<std::int32_t, std::int32_t>> crossingPairs(const VascularT
   std::int64_t segments = 0;
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
     const auto& p = t.position[i];
-    lo = Vec3(std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z));
-    hi = Vec3(std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z));
+    lo = componentMin(lo, p);
+    hi = componentMax(hi, p);
     if (!t.isRoot(i)) total += t.length[i] + 2 * t.maxRadius(i), ++segments;
   }
   std::vector<std::pair<std::int32_t, std::int32_t>> out;

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
-#include <unordered_map>
 
 #include "core/rng.hpp"
 #include "domain/growth_domain.hpp"
@@ -99,8 +98,6 @@ struct VesselCurve {
   }
 };
 
-Vec3 unit(const Vec3& v) { return v / norm(v); }
-
 Vec3 perpendicular(const Vec3& d) {
   const Vec3 a = std::fabs(d.x) < 0.6 ? Vec3(1, 0, 0) : std::fabs(d.y) < 0.6 ? Vec3(0, 1, 0) : Vec3(0, 0, 1);
   return unit(cross(d, a));
@@ -110,7 +107,6 @@ struct Bounds {
   const GrowthDomain* domain;
   const DemandMap& frame;
   double clearance;
-  bool flat;
   // Each curve point is held to what the path point it replaces met: as deep inside the domain
   // as the radius and clearance ask (or as the path point was, if less), and on perfusable voxels
   // where the path was.
@@ -140,12 +136,12 @@ struct Bounds {
 // near each other along one vessel) touch by construction and are not counted.
 struct PieceOverlaps {
   std::vector<Vec3> a, b;
-  std::vector<double> r, u, ulen;
+  std::vector<double> r, u;
   std::vector<std::int32_t> vessel;
   double mean_extent = 1;
 
   void collect(const std::vector<VesselCurve>& curves) {
-    a.clear(), b.clear(), r.clear(), u.clear(), ulen.clear(), vessel.clear();
+    a.clear(), b.clear(), r.clear(), u.clear(), vessel.clear();
     double extent = 0;
     for (std::size_t v = 0; v < curves.size(); ++v) {
       const auto& c = curves[v];
@@ -155,7 +151,6 @@ struct PieceOverlaps {
         a.push_back(prev), b.push_back(c.points[i]);
         r.push_back(c.radiusOfPiece(i, seg));
         u.push_back(c.piece_u[i]);
-        ulen.push_back(c.length());
         vessel.push_back(std::int32_t(v));
         extent += distance(prev, c.points[i]) + 2 * r.back();
         prev = c.points[i];
@@ -169,8 +164,10 @@ struct PieceOverlaps {
     std::set<std::pair<std::int32_t, std::int32_t>> out;
     if (a.empty()) return out;
     Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
-    for (const auto& p : b) lo = Vec3(std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)), hi = Vec3(std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z));
-    for (const auto& p : a) lo = Vec3(std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)), hi = Vec3(std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z));
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      lo = componentMin(componentMin(lo, a[i]), b[i]);
+      hi = componentMax(componentMax(hi, a[i]), b[i]);
+    }
     SegmentGrid grid(lo, hi, 2 * mean_extent, flat);
     for (std::size_t i = 0; i < a.size(); ++i) grid.insert(std::int32_t(i), a[i], b[i], r[i]);
     for (std::size_t x = 0; x < a.size(); ++x)
@@ -198,7 +195,7 @@ struct PieceOverlaps {
     for (int i = 0; i < 2; ++i)
       for (int j = 0; j < 2; ++j)
         if (ends_x[i] == ends_y[j]) {
-          const double dx = i == 0 ? u[x] : ulen[x] - u[x], dy = j == 0 ? u[y] : ulen[y] - u[y];
+          const double dx = i == 0 ? u[x] : cx.length() - u[x], dy = j == 0 ? u[y] : cy.length() - u[y];
           const double d = std::max(dx, dy);
           if (best < 0 || d < best) best = d;
         }
@@ -216,13 +213,11 @@ VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const Gr
   rep.vessels = std::int64_t(paths.size());
   const bool flat = frame.dims[2] == 1;
   const double piece = o.piece_mm > 0 ? o.piece_mm : frame.voxel_mm;
-  const Bounds bounds{domain, frame, o.wall_clearance_mm, flat};
+  const Bounds bounds{domain, frame, o.wall_clearance_mm};
 
   std::vector<VesselCurve> curves(paths.size());
   const auto build = [&](VesselCurve& c) {
-    double a = c.amplitude;
-    for (int l = 0; l < c.level; ++l) a *= 0.5;
-    if (c.level >= kLevels) a = 0;
+    const double a = c.level >= kLevels ? 0.0 : std::ldexp(c.amplitude, -c.level);  // halved `level` times
     c.draw(a);
     c.moved = a > 0;
   };
@@ -287,12 +282,8 @@ VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const Gr
 
   if (o.avoid_overlaps) {
     // Pairs that overlap in growth's own shapes are not the curves' doing: drawn straight once.
-    std::vector<VesselCurve> straight(curves.size());
-    tbb::parallel_for(std::size_t(0), curves.size(), [&](std::size_t v) {
-      straight[v].t = curves[v].t, straight[v].path = curves[v].path, straight[v].base = curves[v].base, straight[v].arc = curves[v].arc;
-      straight[v].pieces = curves[v].pieces, straight[v].knot = curves[v].knot, straight[v].chord = curves[v].chord;
-      straight[v].draw(0);
-    });
+    std::vector<VesselCurve> straight = curves;
+    tbb::parallel_for(std::size_t(0), straight.size(), [&](std::size_t v) { straight[v].draw(0); });
     PieceOverlaps finder;
     const auto grown = finder.pairs(straight, flat);
     for (;;) {
@@ -319,11 +310,14 @@ VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const Gr
   }
 
   // The tree: pieces in place of segments, attributes from the segment each piece replaces.
-  std::vector<std::pair<std::int32_t, std::int32_t>> where(t.nodeCount(), {-1, -1});  // segment → (vessel, first piece)
+  struct Place {
+    std::int32_t vessel = -1, index = -1, first_piece = -1;  // the segment's vessel, its place in it, its first piece
+  };
+  std::vector<Place> where(t.nodeCount());
   for (std::size_t v = 0; v < curves.size(); ++v) {
     std::int32_t first = 0;
     for (std::size_t j = 0; j < curves[v].path.segments.size(); ++j) {
-      where[curves[v].path.segments[j]] = {std::int32_t(v), first};
+      where[curves[v].path.segments[j]] = {std::int32_t(v), std::int32_t(j), first};
       first += curves[v].pieces[j];
     }
   }
@@ -337,27 +331,17 @@ VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const Gr
       w.depth[node_of[n]] = t.depth[n];
       continue;
     }
-    const auto [v, first] = where[n];
-    const auto& c = curves[std::size_t(v)];
-    std::size_t j = 0;
-    while (c.path.segments[j] != n) ++j;
-    const int k = c.pieces[j];
+    const Place& at = where[n];
+    const auto& c = curves[std::size_t(at.vessel)];
+    const int k = c.pieces[std::size_t(at.index)];
     // Poiseuille: the pressure falls (or rises, in a vein) linearly with the length along a vessel.
     const double gradient = t.length[n] > 0 ? (t.pressure[t.parent[n]] - t.pressure[n]) / t.length[n] : 0.0;
     std::int32_t prev = node_of[t.parent[n]];
     for (int q = 1; q <= k; ++q) {
-      const Vec3& p = c.points[std::size_t(first + q - 1)];
+      const Vec3& p = c.points[std::size_t(at.first_piece + q - 1)];
       const std::int32_t id = w.addNode(p, prev);
-      const double f = double(q) / k, f0 = double(q - 1) / k;
-      const double r0 = t.startRadius(n), r1 = t.radius[n];
-      w.radius[id] = r0 + f * (r1 - r0);
-      if (t.radius_start[n] >= 0) w.radius_start[id] = r0 + f0 * (r1 - r0);
-      w.wall_start[id] = t.wall_start[n] + f0 * (t.wall[n] - t.wall_start[n]);
-      w.wall[id] = t.wall_start[n] + f * (t.wall[n] - t.wall_start[n]);
-      w.flow[id] = t.flow[n];
-      w.terminals[id] = t.terminals[n];
+      w.setPieceOf(t, n, q, k, id);
       w.pressure[id] = w.pressure[prev] - gradient * w.length[id];
-      w.depth[id] = t.depth[n];
       w.beta[id] = q == 1 ? t.beta[n] : 1.0;
       w.stage[id] = t.stage[n];
       w.role[id] = t.role[n];

@@ -17,8 +17,6 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180;
 
-Vec3 unit(const Vec3& v) { return v / norm(v); }
-
 // Rodrigues: v rotated by angle a about the unit axis k.
 Vec3 rotate(const Vec3& v, const Vec3& k, double a) {
   const double c = std::cos(a), s = std::sin(a);
