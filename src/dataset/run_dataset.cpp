@@ -128,7 +128,8 @@ Json generateOne(const DatasetSpec& spec, const fs::path& dir, const fs::path& p
       const std::string own = role + suffix;
       return staging / files.at(files.contains(own) ? own : role).get<std::string>();
     };
-    const fs::path label = written(spec.labels == "kind" ? "classes" : "mask"), image = written("image");
+    const fs::path label = written(spec.label_policy != "binary" ? "label" : spec.labels == "kind" ? "classes" : "mask"),
+                   image = written("image");
     const std::string image_rel = "imagesTr/" + r.id + "_0000.nii.gz", label_rel = "labelsTr/" + r.id + ".nii.gz";
     const std::string gt_rel = "groundtruth/" + r.id, json_rel = "groundtruth/" + r.id + ".json";
     Json meta{{"id", r.id},
@@ -254,15 +255,17 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
   for (const char* sub : {"imagesTr", "labelsTr", "groundtruth", "manifest"}) fs::create_directories(dir / sub);
   const fs::path staging = processStaging(dir);
   // The same content from every process, so concurrent shards may all write it.
-  writeJsonAtomically(dir / "spec.json", Json{{"name", spec.name},
-                                              {"id", spec.id},
-                                              {"samples", spec.samples},
-                                              {"seed", spec.seed},
-                                              {"channel_name", spec.channel_name},
-                                              {"labels", labelValues(spec)},
-                                              {"spec_file", spec.file},
-                                              {"spec_sha256", spec.sha256},
-                                              {"spec", spec.text}});
+  Json spec_record{{"name", spec.name},
+                   {"id", spec.id},
+                   {"samples", spec.samples},
+                   {"seed", spec.seed},
+                   {"channel_name", spec.channel_name},
+                   {"labels", labelValues(spec)}};
+  if (spec.label_policy != "binary") spec_record["label_policy"] = spec.label_policy;  // binary datasets as before
+  spec_record["spec_file"] = spec.file;
+  spec_record["spec_sha256"] = spec.sha256;
+  spec_record["spec"] = spec.text;
+  writeJsonAtomically(dir / "spec.json", spec_record);
   writeJsonAtomically(dir / "manifest" / (sel.part + ".run.json"),
                       Json{{"tool", {{"name", "angiosynth"}, {"version", kVersion}}},
                            {"command_line", opt.command_line},
@@ -378,15 +381,18 @@ DatasetCheck finalizeDataset(const fs::path& dir) {
   const Json labels = info.contains("labels") && info["labels"].is_object() ? info["labels"] : Json{{"background", 0}, {"vessel", 1}};
   std::int64_t training = 0;
   for (const auto& [i, e] : entries) training += i < c.samples && e["status"] == "ok";
-  writeJsonAtomically(dir / "dataset.json",
-                      Json{{"channel_names", {{"0", channel}}},
-                           {"labels", labels},
-                           {"numTraining", training},
-                           {"file_ending", ".nii.gz"},
-                           {"name", info["name"]},
-                           {"description", "synthetic vascular trees with exact ground truth (angiosynth)"},
-                           {"licence", "generated data; see provenance.json"},
-                           {"release", kVersion}});
+  Json dataset_json{{"channel_names", {{"0", channel}}},
+                    {"labels", labels},
+                    {"numTraining", training},
+                    {"file_ending", ".nii.gz"},
+                    {"name", info["name"]},
+                    {"description", "synthetic vascular trees with exact ground truth (angiosynth)"},
+                    {"licence", "generated data; see provenance.json"},
+                    {"release", kVersion}};
+  // A non-binary label policy is named (nnU-Net reads the ignore label from "labels"; "soft"
+  // labelsTr hold the partial volume as float, for trainers with soft targets).
+  if (info.contains("label_policy")) dataset_json["label_policy"] = info["label_policy"];
+  writeJsonAtomically(dir / "dataset.json", dataset_json);
   Json runs = Json::array();
   std::vector<fs::path> run_files;
   std::error_code ec;

@@ -202,12 +202,30 @@ void readLabels(const toml::table& d, DatasetSpec& s) {
   s.labels_line = lineOf(*k);
 }
 
+// [image] label_policy as the dataset sees it: one plain policy for every sample.
+void readLabelPolicy(const toml::table& root, DatasetSpec& s) {
+  const auto* im = root.get("image");
+  const auto* n = im && im->is_table() ? im->as_table()->get("label_policy") : nullptr;
+  if (!n) return;
+  const auto v = n->value<std::string>();
+  if (!v) throw InputError(s.file, lineOf(*n), "label_policy must be one policy for the whole dataset (a string, not a distribution): "
+                                              "binary, threshold, visible, soft or ignore");
+  s.label_policy = *v;  // the parameter reader checks the name
+  if (s.label_policy == "soft" && s.labels == "kind")
+    throw InputError(s.file, lineOf(*n), "label_policy = \"soft\" gives one float label (the partial volume); it cannot number kinds: "
+                                         "use labels = \"binary\" or another policy");
+  if (s.label_policy == "ignore" && s.kinds.size() >= 255)
+    throw InputError(s.file, lineOf(*n), "label_policy = \"ignore\" needs a label after the last kind; allowed: at most 254 kinds");
+}
+
 }  // namespace
 
 nlohmann::ordered_json labelValues(const DatasetSpec& spec) {
   nlohmann::ordered_json j{{"background", 0}};
   if (spec.labels != "kind") j["vessel"] = 1;
   for (std::size_t i = 0; i < spec.kinds.size(); ++i) j[spec.kinds[i]] = i + 1;
+  // nnU-Net v2: the ignore label is the highest, named "ignore".
+  if (spec.label_policy == "ignore") j["ignore"] = spec.kinds.empty() ? 2 : spec.kinds.size() + 1;
   return j;
 }
 
@@ -257,6 +275,7 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
     s.channel_name = *c->value<std::string>();
   }
   readLabels(d, s);
+  readLabelPolicy(*root, s);
   if (const auto* p = d.get("previews")) {
     if (!p->is_boolean()) throw InputError(s.file, lineOf(*p), "previews must be true or false (MIPs of each sample in groundtruth/)");
     s.previews = *p->value<bool>();

@@ -36,6 +36,9 @@ struct DatasetSpec {
   std::string labels = "binary";
   std::vector<std::string> kinds;  // labels = "kind": default artery, vein
   int labels_line = 0;             // of `kinds`, else of `labels`, for errors about a sample's kinds
+  // [image] label_policy of every sample (one for the whole dataset): labelsTr holds the policy's
+  // label (a float partial volume for "soft"); "ignore" adds nnU-Net's ignore label.
+  std::string label_policy = "binary";
   bool previews = false;           // MIPs (PNG) of each sample's clean and degraded image in groundtruth/
 };
 

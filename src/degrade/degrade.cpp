@@ -48,11 +48,11 @@ DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
   s.vessel = drawIntensity(profile.vessel, in.vessel, "vessel", prng, rec);
   out.dtype = profile.dtype.empty() ? in.dtype : profile.dtype;
   rec["dtype"] = out.dtype;
-  s.fraction = &in.truth->fraction;
+  s.fraction = in.fraction ? in.fraction : &in.truth->fraction;
   s.tree = in.tree;
   s.image = Volume<float>(s.grid);
   const float bg = static_cast<float>(s.background), c = static_cast<float>(s.vessel - s.background);
-  forEachVoxel(s.grid.voxelCount(), [&](std::int64_t v) { s.image.data[v] = bg + c * in.truth->fraction.data[v]; });
+  forEachVoxel(s.grid.voxelCount(), [&](std::int64_t v) { s.image.data[v] = bg + c * s.fraction->data[v]; });
 
   double lo, hi;
   dtypeRange(out.dtype, lo, hi);
@@ -77,7 +77,7 @@ DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
     Json params;
     const Drawn drawn = drawParams(spec.type->params, spec.params, scale, rng, params, profile.file, spec.line);
     er["parameters"] = params;
-    if (applied) {
+    if (applied && !(in.noise_free && spec.type->noise)) {
       const auto t0 = std::chrono::steady_clock::now();
       EffectContext ctx{s, rng, er, profile.file, spec.line};
       try {
@@ -96,7 +96,7 @@ DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
   rec["effects"] = effects;
   out.background = s.background;
   out.vessel = s.vessel;
-  if (s.warp) {
+  if (s.warp && !in.noise_free) {
     const auto t0 = std::chrono::steady_clock::now();
     out.labels = warpedLabels(*s.warped_fraction, *s.warped_tree, s.segment_origin, in.truth->instances, *s.warp,
                               in.truth->centerline_connectivity);

@@ -20,6 +20,11 @@ struct DegradeInput {
   std::uint64_t seed = 1, sample = 0;
   double background = 0, vessel = 255;        // defaults for profiles that do not set them
   std::string dtype = "uint8";
+  // For the visible label's evidence: skip the noise effects (every draw stays as it is, so the
+  // other effects do exactly what they do in the noisy run), and optionally image another
+  // partial volume (all zero: the same scene without vessels).
+  bool noise_free = false;
+  const Volume<float>* fraction = nullptr;  // instead of truth->fraction
 };
 
 struct DegradedImage {

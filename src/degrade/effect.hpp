@@ -48,6 +48,7 @@ struct EffectType {
   std::vector<ParamDecl> params;
   void (*apply)(const Drawn& p, EffectContext& ctx);
   bool moves_geometry = false;      // a warp: at most one per profile
+  bool noise = false;               // random noise (left out of the visible label's noise-free runs)
 };
 
 // Every effect, in the order the README lists them.

@@ -35,13 +35,17 @@ extern const EffectType kGaussianNoise{
     "additive white Gaussian noise N(mean, sigma²) (VascuSynth's GAUSSIAN)",
     {{"mean", ParamKind::Intensity, -1e9, 1e9, "0", "mean of the added noise"},
      {"sigma", ParamKind::Intensity, 0, 1e9, nullptr, "standard deviation of the added noise"}},
-    applyGaussian};
+    applyGaussian,
+    /*moves_geometry=*/false,
+    /*noise=*/true};
 
 extern const EffectType kUniformNoise{
     "uniform",
     "additive uniform noise U(low, high) (VascuSynth's UNIFORM)",
     {{"low", ParamKind::Intensity, -1e9, 1e9, nullptr, "lower bound of the added noise"},
      {"high", ParamKind::Intensity, -1e9, 1e9, nullptr, "upper bound of the added noise"}},
-    applyUniform};
+    applyUniform,
+    /*moves_geometry=*/false,
+    /*noise=*/true};
 
 }  // namespace angiosynth

@@ -28,6 +28,8 @@ extern const EffectType kImpulseNoise{
      {"salt_probability", ParamKind::Probability, 0, 1, nullptr, "probability that a voxel becomes salt"},
      {"pepper_value", ParamKind::Intensity, -1e9, 1e9, "background", "intensity of pepper voxels"},
      {"pepper_probability", ParamKind::Probability, 0, 1, nullptr, "probability that a voxel becomes pepper"}},
-    applyImpulse};
+    applyImpulse,
+    /*moves_geometry=*/false,
+    /*noise=*/true};
 
 }  // namespace angiosynth

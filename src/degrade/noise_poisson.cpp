@@ -28,6 +28,8 @@ extern const EffectType kPoissonNoise{
     "Poisson–Gaussian noise: Poisson(signal × photons_per_unit) / photons_per_unit + N(0, read_sigma²)",
     {{"photons_per_unit", ParamKind::Number, 1e-9, 1e9, "1", "detected photons per unit of intensity (the inverse gain)"},
      {"read_sigma", ParamKind::Intensity, 0, 1e9, "0", "standard deviation of the Gaussian read-out noise"}},
-    applyPoisson};
+    applyPoisson,
+    /*moves_geometry=*/false,
+    /*noise=*/true};
 
 }  // namespace angiosynth

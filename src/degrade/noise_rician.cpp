@@ -26,6 +26,8 @@ extern const EffectType kRicianNoise{
     "rician",
     "Rician noise: |signal + N(0, sigma²) + i·N(0, sigma²)|, the noise of magnitude MR images",
     {{"sigma", ParamKind::Intensity, 0, 1e9, nullptr, "standard deviation of the noise on each of the real and imaginary channels"}},
-    applyRician};
+    applyRician,
+    /*moves_geometry=*/false,
+    /*noise=*/true};
 
 }  // namespace angiosynth

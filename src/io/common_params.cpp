@@ -26,6 +26,12 @@ const std::vector<MethodParam>& commonParams() {
       {"image", "dtype", "text", "uint8", "uint8, uint16, int16 or float32"},
       {"image", "formats", "[text]", "[\"nifti\", \"png\"]", "any of nifti, nrrd, tiff, png (MIPs), vdb"},
       {"image", "graph_formats", "[text]", "[\"csv\", \"vtp\", \"swc\", \"graphml\"]", "any of csv, vtp, swc, graphml, cco (GXL and DOT are always written)"},
+      {"image", "label_policy", "text", "binary",
+       "the training label (label.nii.gz; the mask stays as it is): binary (the mask), threshold, visible, soft or ignore"},
+      {"image", "label_threshold", "", "0.5", "label_policy = threshold: vessel where the partial volume is at least this (0 … 1]"},
+      {"image", "visible_snr", "", "2", "label_policy = visible: vessel where the noise-free contrast is at least this many noise sigmas of the image"},
+      {"image", "ignore_band", "[low, high]", "[0.25, 0.75]",
+       "label_policy = ignore: vessel at partial volume >= high; nnU-Net's ignore label on (low, high) and on centreline voxels below high"},
       {"degrade", "profiles", "[text]", "[]", "degraded images to write, one image_<name> each: shipped profile names, .toml profiles or VascuSynth noise files"},
       {"output", "gxl_dialect", "text", "gxl", "gxl (GXL 1.0) or vascusynth"},
   };

@@ -13,6 +13,7 @@
 #include "core/units.hpp"
 #include "grow/common/curved_vessels.hpp"
 #include "grow/method.hpp"
+#include "raster/label_policy.hpp"
 
 namespace toml {
 inline namespace v3 {
@@ -33,6 +34,8 @@ struct ImageParameters {
   std::string dtype = "uint8";         // uint8, uint16, int16, float32
   std::vector<std::string> formats{"nifti", "png"};                        // nifti, nrrd, tiff, png, vdb
   std::vector<std::string> graph_formats{"csv", "vtp", "swc", "graphml"};  // besides GXL and DOT
+  LabelPolicy labels;                  // the training label (label.nii.gz) beside the mask
+  int labels_line = 0;
 };
 
 struct Scenario {

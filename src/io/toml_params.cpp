@@ -4,11 +4,46 @@
 #include <set>
 
 #include "core/error.hpp"
+#include "core/format.hpp"
+#include "io/param_checks.hpp"
 #include "grow/method.hpp"
 #include "io/scenario.hpp"
 #include "io/toml_reader.hpp"
 
 namespace angiosynth {
+namespace {
+
+// [image] label_policy and its one parameter; a parameter of another policy is an error.
+void readLabelPolicy(const TomlReader& r, const toml::table& im, ImageParameters& ip) {
+  LabelPolicy& p = ip.labels;
+  if (const auto* n = im.get("label_policy")) {
+    p.name = r.string(im, "image", "label_policy");
+    ip.labels_line = r.lineOf(n);
+    const auto& names = labelPolicyNames();
+    if (std::find(names.begin(), names.end(), p.name) == names.end())
+      throw InputError(r.file(), r.lineOf(n), "label_policy '" + p.name + "'; allowed: binary, threshold, visible, soft, ignore");
+  }
+  const auto only = [&](const char* key, const char* policy) {
+    if (im.get(key) && p.name != policy)
+      throw InputError(r.file(), r.lineOf(im.get(key)), std::string(key) + " is a parameter of label_policy = \"" + policy +
+                                                            "\", not of \"" + p.name + "\"; set that policy or remove the key");
+    return im.get(key) != nullptr;
+  };
+  if (only("label_threshold", "threshold")) p.threshold = r.number(im, "image", "label_threshold");
+  checkRange(p.threshold, 0, true, 1, false, r.at(im, "label_threshold"), "label_threshold (partial volume)");
+  if (only("visible_snr", "visible")) p.visible_snr = r.number(im, "image", "visible_snr");
+  checkRange(p.visible_snr, 0, false, 1000, false, r.at(im, "visible_snr"), "visible_snr (multiples of the noise sigma)");
+  if (only("ignore_band", "ignore")) {
+    const auto band = r.numbers(im.get("ignore_band"), "ignore_band", 2);
+    if (!(band[0] >= 0 && band[0] < band[1] && band[1] <= 1))
+      throw InputError(r.file(), r.lineOf(im.get("ignore_band")),
+                       "ignore_band = [" + show(band[0]) + ", " + show(band[1]) + "]; allowed: [low, high] partial volumes with 0 <= low < high <= 1");
+    p.ignore_low = band[0], p.ignore_high = band[1];
+  }
+}
+
+}  // namespace
+
 Scenario readTomlParameters(const std::filesystem::path& path) {
   return readTomlParameters(parseTomlFile(path, "parameter file"), path);
 }
@@ -50,7 +85,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   const double voxel_mm = sc.growth->voxelMm();
 
   const auto& im = r.table("image", {"enabled", "voxel_size", "field_of_view", "supersampling", "centerline_connectivity", "background", "vessel",
-                                     "dtype", "formats", "graph_formats"});
+                                     "dtype", "formats", "graph_formats", "label_policy", "label_threshold", "visible_snr", "ignore_band"});
   auto& ip = sc.image;
   sc.image_line = r.lineOf(root.get("image"));
   ip.enabled = r.boolean(im, "enabled", ip.enabled);
@@ -106,6 +141,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     }
     return out;
   };
+  readLabelPolicy(r, im, ip);
   if (im.get("formats")) ip.formats = strings("formats", {"nifti", "nrrd", "tiff", "png", "vdb"});
   if (im.get("graph_formats")) ip.graph_formats = strings("graph_formats", {"csv", "vtp", "swc", "graphml", "cco"});
 

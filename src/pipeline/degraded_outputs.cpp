@@ -3,9 +3,12 @@
 #include "degrade/degrade.hpp"
 #include "io/graph_writers.hpp"
 #include "io/text_file.hpp"
+#include "pipeline/label_outputs.hpp"
 #include "pipeline/volume_files.hpp"
 
 namespace angiosynth {
+
+using Json = nlohmann::ordered_json;
 
 std::uint64_t degradedImageBytes(const Profile& p, const VolumeGrid& g) {
   bool warps = false, fields = false;
@@ -46,6 +49,23 @@ void writeDegradedImages(const Forest& forest, const std::vector<std::uint8_t>& 
       if (d.labels) {
         fillClasses(*d.labels, *d.tree, segment_classes, &d.segment_origin);  // labels: clean segment ids
         for (auto& c : labelChannels(*d.labels, suffix)) channels.push_back(c);
+      }
+      // The policy's label of this image, where it is not the clean one.
+      Label label;
+      if (ip.labels.perProfile() || (ip.labels.writesLabel() && d.labels)) {
+        const GroundTruthVolumes& truth = d.labels ? *d.labels : gt;
+        Json& rec = d.record["label"];
+        if (ip.labels.perProfile()) {
+          const ProfileVisibility vis = profileVisibility(profile, in, d.image, truth.fraction);
+          const VisibilityEvidence evidence{&vis.contrast, vis.noise_sigma};
+          label = makeLabel(ip.labels, truth, req.label_numbering, &evidence);
+          rec["noise_sigma"] = vis.noise_sigma;
+        } else {
+          label = makeLabel(ip.labels, truth, req.label_numbering);
+        }
+        const Json kept = labelLengthKept(label, ip.labels, req.label_numbering, d.tree ? *d.tree : forest.vessels);
+        for (const auto& [k, v] : kept.items()) rec[k] = v;
+        channels.push_back(labelChannel(label, ip.labels, "label" + suffix));
       }
       writeChannels(channels, ip.formats, dir, files);
       if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end()) writeMips(d.image, previewClasses(forest.trees, d.labels ? *d.labels : gt), lo, hi, suffix, dir, files);

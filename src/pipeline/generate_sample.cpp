@@ -38,7 +38,8 @@ Json describeParameters(const Scenario& sc) {
                     {"vessel", im.vessel},
                     {"dtype", im.dtype},
                     {"formats", im.formats},
-                    {"graph_formats", im.graph_formats}};
+                    {"graph_formats", im.graph_formats},
+                    {"label", im.labels.describe()}};
   if (sc.curves.enabled) {
     const auto& c = sc.curves;
     Json cj{{"tortuosity", c.tortuosity}, {"tortuosity_sd", c.tortuosity_sd}};
@@ -100,6 +101,10 @@ PreparedSample prepareSample(const SampleRequest& req) {
     vr.sample = req.sample;
     vr.frame = GraphFrame{map.voxel_mm, sc.input_units};
     vr.vascusynth_noise_layout = req.vascusynth_noise_layout;
+    // Labelled by kind (a dataset's `labels = "kind"`): vessels carry their kind's number and the
+    // ignore label comes after the last kind.
+    vr.label_numbering.by_kind = !req.class_kinds.empty();
+    vr.label_numbering.ignore_value = static_cast<std::uint8_t>(req.class_kinds.empty() ? 2 : req.class_kinds.size() + 1);
     checkVolumeMemory(vr);
   }
   ps.growth->checkFeasibility();

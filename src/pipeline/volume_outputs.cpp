@@ -11,6 +11,7 @@
 #include "io/vdb_writer.hpp"
 #include "io/volume_writers.hpp"
 #include "pipeline/degraded_outputs.hpp"
+#include "pipeline/label_outputs.hpp"
 #include "pipeline/volume_files.hpp"
 #include "io/param_checks.hpp"
 #include "raster/ground_truth.hpp"
@@ -70,6 +71,8 @@ void checkVolumeMemory(const VolumeRequest& req) {
   std::uint64_t profile_bytes = 0;
   for (const auto& p : req.profiles) profile_bytes = std::max(profile_bytes, degradedImageBytes(p, g));
   need += profile_bytes;
+  if (!req.profiles.empty() || req.image.labels.writesLabel())
+    need += labelBytesPerVoxel(req.image.labels) * static_cast<std::uint64_t>(g.voxelCount());
   if (need > req.memory_limit)
     throw InputError(req.parameter_file, req.image_line,
                      "an image of " + size + " voxels needs " + formatBytes(need) + " of memory, more than the limit of " +
@@ -116,6 +119,9 @@ void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::fil
     makeTypedImage(image, gt.fraction, ip.background, ip.vessel - ip.background, ip.dtype, "angiosynth image");
     std::vector<Channel> channels{{"image", image.view}};
     for (auto& c : labelChannels(gt, "")) channels.push_back(c);
+    const Label label = makeLabel(ip.labels, gt, req.label_numbering);
+    if (ip.labels.writesLabel()) channels.push_back(labelChannel(label, ip.labels, "label"));
+    stats["label"] = labelLengthKept(label, ip.labels, req.label_numbering, tree);
     writeChannels(channels, ip.formats, dir, files);
     if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end()) writeMips(gt.fraction, previewClasses(forest.trees, gt), 0, 1, "", dir, files);
     if (req.slices) writeSlices(image.view, gt.fraction, 0, 1, req.slice_dir, "original_image", req.slice_format, dir, files);

@@ -11,6 +11,7 @@
 #include "core/forest.hpp"
 #include "io/graph_writers.hpp"
 #include "io/scenario.hpp"
+#include "raster/label_policy.hpp"
 #include "raster/volume.hpp"
 
 namespace angiosynth {
@@ -35,6 +36,7 @@ struct VolumeRequest {
   std::vector<Profile> profiles;
   std::uint64_t seed = 1, sample = 0;
   GraphFrame frame;               // for the GXL of warped trees
+  LabelNumbering label_numbering;  // vessel 1 (or each kind's class), ignore value
   bool vascusynth_noise_layout = false;  // <profile>/image.nii.gz + slices, as VascuSynth's noise_image_<i>
 };
 
