@@ -162,55 +162,92 @@ void rasterizeBricks(const VascularTree& tree, const VolumeGrid& g, const BrickB
   const double sub_width = std::cbrt(sp.x * sp.y * sp.z) / S;  // subvoxel edge
   const double inv_sub_width = 1.0 / sub_width;
   const double half_var = sub_width * sub_width / 24.0;      // σ²/2 with σ² = w²/12
+  constexpr int kVoxels = kBrick * kBrick * kBrick;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bins.brick_ids.size(), 16), [&](const tbb::blocked_range<std::size_t>& range) {
     std::vector<Capsule> caps, near;
-    float fraction[kBrick * kBrick * kBrick];
-    std::uint32_t instance[kBrick * kBrick * kBrick];
+    float fraction[kVoxels];
+    std::uint32_t instance[kVoxels];
+    double best[kVoxels];
+    bool full[kVoxels];
+    int count[kVoxels + 1];
+    // (voxel, capsule) pairs of capsules whose surface may cross the voxel, in capsule order,
+    // then grouped by voxel (counting sort: each voxel's capsules stay in capsule order).
+    std::vector<std::pair<std::uint16_t, std::int32_t>> pairs;
+    std::vector<std::int32_t> grouped;
     for (std::size_t bi = range.begin(); bi != range.end(); ++bi) {
       const std::int64_t brick = bins.brick_ids[bi];
       const std::int64_t bx = brick % bins.bricks[0], by = (brick / bins.bricks[0]) % bins.bricks[1],
                          bz = brick / (std::int64_t(bins.bricks[0]) * bins.bricks[1]);
+      const std::int64_t base[3] = {bx * kBrick, by * kBrick, bz * kBrick};
       caps.clear();
       for (auto s : bins.segments[bi]) caps.push_back(capsuleOf(tree, s));
-      for (int k = 0; k < kBrick; ++k)
-        for (int j = 0; j < kBrick; ++j)
-          for (int i = 0; i < kBrick; ++i) {
-            const int v = i + kBrick * (j + kBrick * k);
-            fraction[v] = 0;
-            instance[v] = 0;
-            const std::int64_t x = bx * kBrick + i, y = by * kBrick + j, z = bz * kBrick + k;
-            if (!g.contains(x, y, z)) continue;
-            const Vec3 c = g.centre(x, y, z);
-            near.clear();
-            double best = 1e300;
-            bool full = false;
-            for (const auto& cap : caps) {
-              const double depth = cap.depth(c);  // < 0 inside
+      std::fill(fraction, fraction + kVoxels, 0.0f);
+      std::fill(instance, instance + kVoxels, 0u);
+      std::fill(best, best + kVoxels, 1e300);
+      std::fill(full, full + kVoxels, false);
+      pairs.clear();
+      // A capsule can reach only the voxels whose centres lie in its box grown by its radius and
+      // the half diagonal (a hair more, so rounding never drops one): visit those alone. Each
+      // voxel sees its capsules in the same order as a scan of all of them would.
+      for (std::size_t ci = 0; ci < caps.size(); ++ci) {
+        const Capsule& cap = caps[ci];
+        const double reach = (cap.r + half_diag) * (1 + 1e-9) + 1e-12;
+        std::int64_t lo[3], hi[3];
+        bool empty = false;
+        for (int ax = 0; ax < 3; ++ax) {
+          const double a = cap.a[ax], b = a + cap.d[ax];
+          const double i0 = std::ceil((std::min(a, b) - reach - g.origin_mm[ax]) / sp[ax]);
+          const double i1 = std::floor((std::max(a, b) + reach - g.origin_mm[ax]) / sp[ax]);
+          lo[ax] = static_cast<std::int64_t>(std::max(i0, double(std::max<std::int64_t>(base[ax], 0))));
+          hi[ax] = static_cast<std::int64_t>(std::min(i1, double(std::min<std::int64_t>(base[ax] + kBrick, g.dims[ax]) - 1)));
+          empty |= hi[ax] < lo[ax];
+        }
+        if (empty) continue;
+        for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+          for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+            for (std::int64_t x = lo[0]; x <= hi[0]; ++x) {
+              const int v = int((x - base[0]) + kBrick * ((y - base[1]) + kBrick * (z - base[2])));
+              const double depth = cap.depth(g.centre(x, y, z));  // < 0 inside
               if (depth >= half_diag) continue;
-              if (depth < best) best = depth, instance[v] = cap.id;
-              if (depth <= -half_diag) full = true;
-              near.push_back(cap);
+              if (depth < best[v]) best[v] = depth, instance[v] = cap.id;
+              if (depth <= -half_diag) full[v] = true;
+              pairs.emplace_back(std::uint16_t(v), std::int32_t(ci));
             }
-            if (full) {
-              fraction[v] = 1;
-              continue;
-            }
-            if (near.empty()) continue;
-            // Each subvoxel counts by its signed distance to the vessel surface through a linear
-            // ramp of its width w (the same second moment, w²/12, as the exact cube coverage in
-            // any orientation), with the surface moved in by σ²κ/2 (κ = 1/r on the cylinder,
-            // 2/r on the caps): the level shift that smoothing causes on a curved surface.
-            // Second-order accurate; 0/1 samples alias on thin vessels (1.5 % at r = 0.5 voxel).
-            double inside = 0;
-            for (const Vec3& o : offsets) {
-              const Vec3 p = c + o;
-              double sd = 1e300;
-              for (const auto& cap : near) sd = std::min(sd, cap.signedDistance(p, half_var));
-              inside += std::clamp(0.5 - sd * inv_sub_width, 0.0, 1.0);
-            }
-            fraction[v] = static_cast<float>(std::min(1.0, inside * inv_samples));
-            if (inside == 0) instance[v] = 0;
-          }
+      }
+      std::fill(count, count + kVoxels + 1, 0);
+      for (const auto& pr : pairs) ++count[pr.first + 1];
+      for (int v = 0; v < kVoxels; ++v) count[v + 1] += count[v];
+      grouped.resize(pairs.size());
+      {
+        int fill[kVoxels];
+        std::copy(count, count + kVoxels, fill);
+        for (const auto& pr : pairs) grouped[std::size_t(fill[pr.first]++)] = pr.second;
+      }
+      for (int v = 0; v < kVoxels; ++v) {
+        if (full[v]) {
+          fraction[v] = 1;
+          continue;
+        }
+        if (count[v] == count[v + 1]) continue;
+        const int i = v % kBrick, j = (v / kBrick) % kBrick, k = v / (kBrick * kBrick);
+        const Vec3 c = g.centre(base[0] + i, base[1] + j, base[2] + k);
+        near.clear();
+        for (int q = count[v]; q < count[v + 1]; ++q) near.push_back(caps[std::size_t(grouped[std::size_t(q)])]);
+        // Each subvoxel counts by its signed distance to the vessel surface through a linear
+        // ramp of its width w (the same second moment, w²/12, as the exact cube coverage in
+        // any orientation), with the surface moved in by σ²κ/2 (κ = 1/r on the cylinder,
+        // 2/r on the caps): the level shift that smoothing causes on a curved surface.
+        // Second-order accurate; 0/1 samples alias on thin vessels (1.5 % at r = 0.5 voxel).
+        double inside = 0;
+        for (const Vec3& o : offsets) {
+          const Vec3 p = c + o;
+          double sd = 1e300;
+          for (const auto& cap : near) sd = std::min(sd, cap.signedDistance(p, half_var));
+          inside += std::clamp(0.5 - sd * inv_sub_width, 0.0, 1.0);
+        }
+        fraction[v] = static_cast<float>(std::min(1.0, inside * inv_samples));
+        if (inside == 0) instance[v] = 0;
+      }
       visit(brick, fraction, instance);
     }
   });
