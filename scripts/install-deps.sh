@@ -1,12 +1,17 @@
 #!/usr/bin/env bash
 # Installs the Debian packages angiosynth builds and tests with, only those missing.
 set -euo pipefail
+# `install-deps.sh program`: what the program needs to build (scripts/example.sh); with no
+# argument also what the tests, benchmarks and sanitizer build need (scripts/test.sh).
 pkgs=(build-essential cmake pkg-config ccache
       libtbb-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libtinyxml2-dev
-      libgtest-dev libbenchmark-dev zlib1g-dev libnifti2-dev libtiff-dev libpng-dev libjpeg-dev
-      libopenimageio-dev python3-nibabel python3-networkx  # OpenImageIO: the tests' independent reader
-      libopenvdb-dev libboost-iostreams-dev libssl-dev libceres-dev
-      clang libclang-rt-14-dev)  # the sanitizer build and libFuzzer (scripts/sanitize.sh)
+      zlib1g-dev libnifti2-dev libtiff-dev libpng-dev libjpeg-dev
+      libopenvdb-dev libboost-iostreams-dev libssl-dev libceres-dev)
+if [ "${1:-all}" != program ]; then
+  pkgs+=(libgtest-dev libbenchmark-dev
+         libopenimageio-dev python3-nibabel python3-networkx  # OpenImageIO: the tests' independent reader
+         clang libclang-rt-14-dev)  # the sanitizer build and libFuzzer (scripts/sanitize.sh)
+fi
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
