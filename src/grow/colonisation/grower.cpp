@@ -85,7 +85,22 @@ struct System {
 
   System(const Vec3& lo, const Vec3& hi, double node_cell, double close_cell, double drain_cell, bool is_flat)
       : nodes(lo, hi, node_cell, is_flat), close(lo, hi, close_cell, is_flat), drains(lo, hi, drain_cell, is_flat),
-        fresh(lo, hi, drain_cell, is_flat), flat(is_flat) {}
+        fresh(lo, hi, drain_cell, is_flat), flat(is_flat), lo_(lo), hi_(hi), scale_(1) {}
+
+  // The grids' cells follow the step's lengths (× σ_T/σ_t, up to 3× the last step's early in a
+  // run): a query then scans a few cells, not dozens. Queries answer the same on any cells.
+  void rescale(double node_cell, double close_cell, double drain_cell, double k) {
+    if (std::abs(std::log(k / scale_)) < std::log(1.25)) return;
+    scale_ = k;
+    nodes = PointHash(lo_, hi_, node_cell * k, flat);
+    close = PointHash(lo_, hi_, close_cell * k, flat);
+    drains = PointHash(lo_, hi_, drain_cell * k, flat);
+    fresh = PointHash(lo_, hi_, drain_cell * k, flat);  // emptied before every use
+    for (std::size_t i = 0; i < pos.size(); ++i) nodes.insert(pos[i], std::int32_t(i)), close.insert(pos[i], std::int32_t(i));
+    for (std::size_t d = 0; d < drain.size(); ++d) drains.insert(drain[d], std::int32_t(d));
+  }
+  Vec3 lo_, hi_;
+  double scale_;
 
   double radiusOf(std::int32_t i) const { return std::pow(rk[std::size_t(i)], 1.0 / kappa); }
 
@@ -459,6 +474,7 @@ class Grower {
   }
 
   void step(const ColonisationStage& st, double k) {
+    for (System* s : {&art_, &ven_}) s->rescale(cell(o_, 0), cell(o_, 1), cell(o_, 2), k);
     terminal_radius_ = st.terminal_radius * k;
     const double sat = st.satisfaction_distance * k, spacing = st.drain_spacing * k;
     const double co2 = st.co2_distance * k, delta = st.perception_distance * k;
