@@ -323,7 +323,7 @@ class Grower {
   std::vector<std::pair<std::int32_t, std::int32_t>> assign(System& s, const ColonisationStage& st, double delta) {
     const double half = st.perception_angle * kDeg / 2, cos_half = std::cos(half);
     std::vector<std::int32_t> owner(s.drain.size(), -1);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.drain.size(), 128), [&](const tbb::blocked_range<std::size_t>& b) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.drain.size(), 512), [&](const tbb::blocked_range<std::size_t>& b) {
       for (std::size_t k = b.begin(); k != b.end(); ++k) owner[k] = s.knowsNearest(k, step_) ? s.near[k] : s.nearestNode(s.drain[k], delta);
     });
     // Perception bounds of the nodes that are nearest to some drain, computed once per step.
@@ -452,7 +452,7 @@ class Grower {
   void satisfy(System& s, double sat, System* co2, int lifetime, double delta) {
     std::vector<char> done(s.drain.size(), 0);
     std::vector<std::int32_t> vein_near(co2 ? s.drain.size() : 0, -2);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.drain.size(), 128), [&](const tbb::blocked_range<std::size_t>& b) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.drain.size(), 512), [&](const tbb::blocked_range<std::size_t>& b) {
       for (std::size_t k = b.begin(); k != b.end(); ++k) {
         done[k] = s.nodeWithin(s.drain[k], sat);
         if (done[k] && co2) vein_near[k] = co2->nearestNode(s.drain[k], delta);
@@ -487,7 +487,7 @@ class Grower {
     flags_.assign(candidates_.size(), 0);
     art_near_.assign(candidates_.size(), -2);
     ven_near_.assign(candidates_.size(), -2);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates_.size(), 64), [&](const tbb::blocked_range<std::size_t>& b) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates_.size(), 256), [&](const tbb::blocked_range<std::size_t>& b) {
       for (std::size_t q = b.begin(); q != b.end(); ++q) {
         Rng rng(o_.seed, o_.sample, Stage::Growth, 1 + (std::uint64_t(step_) << 32) + q);
         const Vec3 p = candidates_[q] = sampleDrain(st, rng);
