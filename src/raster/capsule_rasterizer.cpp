@@ -56,6 +56,9 @@ struct Capsule {
 
 // sd[q] = min(sd[q], the capsule's signedDistance at c + (ox, oy, oz)[q]) for a cylinder: the
 // same arithmetic in the same order, written over arrays so that it vectorises.
+// Wider vectors where the processor has them (chosen at run time); no FMA contraction (not
+// enabled by "avx2"), so every lane computes the same IEEE value as the baseline build.
+__attribute__((target_clones("avx2", "default")))
 void cylinderDistances(const Capsule& cap, const Vec3& c, const double* ox, const double* oy, const double* oz, int n,
                        double half_var, double* sd) {
   const double ax = cap.a.x, ay = cap.a.y, az = cap.a.z, dx = cap.d.x, dy = cap.d.y, dz = cap.d.z, inv = cap.inv_len2, r = cap.r;
