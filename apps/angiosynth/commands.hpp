@@ -61,4 +61,14 @@ struct DatasetArgs {
 CLI::App* addDataset(CLI::App& app, DatasetArgs& a);
 int runDatasetCommand(const DatasetArgs& a, const std::string& command_line);
 
+struct ScoreArgs {
+  std::string prediction, sample, out, csv;
+  double tolerance_mm = 0;
+  bool topcow = false, force = false;
+  std::vector<double> bins_voxels, bins_mm;
+  CommonOptions common;
+};
+CLI::App* addScore(CLI::App& app, ScoreArgs& a);
+int runScore(const ScoreArgs& a);
+
 }  // namespace angiosynth::cli

@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
   auto* pm = cli::addParams(app, pa);
   cli::InitArgs ia;
   auto* in = cli::addInit(app, ia);
+  cli::ScoreArgs sa;
+  auto* sc = cli::addScore(app, sa);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -42,6 +44,7 @@ int main(int argc, char** argv) {
     if (d->parsed()) return cli::runDatasetCommand(ds, cmdline);
     if (pm->parsed()) return cli::runParams(pa);
     if (in->parsed()) return cli::runInit(ia);
+    if (sc->parsed()) return cli::runScore(sa);
     if (fx->parsed()) {
       std::cout << effectReference();
       return 0;

@@ -1,0 +1,48 @@
+#pragma once
+// Scoring a segmentation against a generated sample's exact truth: overlap, surface distances
+// in mm, recall by vessel calibre from the exact centreline and radius, and vessels detected
+// from the generating graph. Every metric's definition, connectivity and empty-mask convention
+// is written into the result.
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "raster/volume.hpp"
+
+namespace angiosynth {
+
+struct ScoreOptions {
+  double tolerance_mm = 0;                           // NSD's τ; 0: the smallest voxel edge
+  bool topcow = false;                               // TopCoW's conventions (see surfaceScores)
+  std::vector<double> bins_voxels{0, 0.5, 1, 2, 4};  // calibre bins: lower edges, radius in voxels
+  std::vector<double> bins_mm;                       // calibre bins in mm (none unless given)
+  std::uint64_t memory_limit = 0;
+};
+
+// Overlap of two binary volumes on one grid: tp, fp, fn, Dice, Jaccard, precision, recall.
+nlohmann::ordered_json overlapScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, bool topcow);
+
+// Border voxels: foreground voxels with a background neighbour (6 face neighbours; 26 with
+// `all_neighbours`), voxels beyond the grid counting as background.
+Volume<std::uint8_t> borderVoxels(const Volume<std::uint8_t>& v, bool all_neighbours);
+
+// The distance (mm, between voxel centres, the grid's spacing per axis) from each border voxel
+// of `from` to the nearest border voxel of `to`, in voxel order.
+std::vector<double> directedBorderDistances(const Volume<std::uint8_t>& from_border, const Volume<std::uint8_t>& to_border);
+
+// HD, HD95 (the larger of the two directed 95th percentiles, linear interpolation between order
+// statistics as NumPy's default), ASSD, MASD and NSD at tolerance τ between the borders of two
+// volumes. Empty masks: both empty give 0 mm and NSD 1; one empty gives null (TopCoW: 90 mm).
+nlohmann::ordered_json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, double tolerance_mm,
+                                     bool topcow);
+
+// 95th percentile, linear interpolation between order statistics (NumPy's default).
+double percentile95(std::vector<double> values);
+
+// Scores PRED (a NIfTI; voxels > 0 are vessel) against the sample in `sample_dir` (mask,
+// centerline and radius NIfTI volumes, nodes.csv and edges.csv); the grids must agree.
+nlohmann::ordered_json scoreCase(const std::filesystem::path& pred, const std::filesystem::path& sample_dir, const ScoreOptions& opt);
+
+}  // namespace angiosynth

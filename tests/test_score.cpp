@@ -1,0 +1,207 @@
+// Scoring (issue 16, first part): overlap and surface distances against a brute-force
+// computation on hand-made volumes (shifted spheres, anisotropic voxels), the empty-mask
+// conventions, the NumPy percentile, and `angiosynth score` on a generated sample with a
+// prediction that misses every vessel thinner than one voxel.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <map>
+
+#include "cli_run.hpp"
+#include "io/nifti_reader.hpp"
+#include "io/volume_writers.hpp"
+#include "score/case_scores.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using namespace angiosynth;
+
+VolumeGrid grid(int n, const Vec3& spacing) {
+  VolumeGrid g;
+  g.dims = {n, n, n};
+  g.spacing_mm = spacing;
+  return g;
+}
+
+// A ball of radius r (mm) around c (mm).
+Volume<std::uint8_t> ball(const VolumeGrid& g, const Vec3& c, double r) {
+  Volume<std::uint8_t> v(g);
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i) v.at(i, j, k) = distance(g.centre(i, j, k), c) <= r;
+  return v;
+}
+
+// Border voxels listed by brute force: a voxel of v whose 6 face neighbours are not all in v.
+std::vector<Vec3> border(const Volume<std::uint8_t>& v) {
+  std::vector<Vec3> out;
+  const auto& g = v.grid;
+  const auto in = [&](int i, int j, int k) { return i >= 0 && j >= 0 && k >= 0 && i < g.dims[0] && j < g.dims[1] && k < g.dims[2] && v.at(i, j, k); };
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i)
+        if (in(i, j, k) && !(in(i - 1, j, k) && in(i + 1, j, k) && in(i, j - 1, k) && in(i, j + 1, k) && in(i, j, k - 1) && in(i, j, k + 1)))
+          out.push_back(g.centre(i, j, k));
+  return out;
+}
+
+std::vector<double> directed(const std::vector<Vec3>& from, const std::vector<Vec3>& to) {
+  std::vector<double> d;
+  for (const auto& p : from) {
+    double best = INFINITY;
+    for (const auto& q : to) best = std::min(best, distance(p, q));
+    d.push_back(best);
+  }
+  return d;
+}
+
+TEST(Score, PercentileIsNumpysLinearInterpolation) {
+  std::vector<double> v;
+  for (int i = 101; i >= 1; --i) v.push_back(i);
+  EXPECT_DOUBLE_EQ(percentile95(v), 96.0);        // np.percentile(range(1, 102), 95)
+  EXPECT_DOUBLE_EQ(percentile95({0, 10}), 9.5);    // np.percentile([0, 10], 95)
+  EXPECT_DOUBLE_EQ(percentile95({3}), 3.0);
+}
+
+// Two balls of radius 6 mm, the prediction shifted by k voxels along x; isotropic and
+// anisotropic voxels. Overlap by counting, distances against all pairs of border voxels.
+TEST(Score, ShiftedSpheresMatchBruteForceOverlapAndSurfaceDistances) {
+  for (const Vec3 spacing : {Vec3(1, 1, 1), Vec3(0.8, 1.0, 1.7)}) {
+    for (int k : {0, 1, 3}) {
+      const VolumeGrid g = grid(24, spacing);
+      const Vec3 c = g.centre(11, 11, 11) + Vec3(0.3, 0.1, 0.2);
+      const auto truth = ball(g, c, 6), pred = ball(g, c + Vec3(k * spacing.x, 0, 0), 6);
+      std::int64_t tp = 0, fp = 0, fn = 0;
+      for (std::size_t i = 0; i < truth.data.size(); ++i) tp += pred.data[i] && truth.data[i], fp += pred.data[i] && !truth.data[i],
+                                                            fn += !pred.data[i] && truth.data[i];
+      const Json o = Json::parse(overlapScores(pred, truth, false).dump());
+      EXPECT_DOUBLE_EQ(o["dice"].get<double>(), 2.0 * tp / (2.0 * tp + fp + fn));
+      EXPECT_DOUBLE_EQ(o["jaccard"].get<double>(), double(tp) / double(tp + fp + fn));
+      EXPECT_DOUBLE_EQ(o["precision"].get<double>(), double(tp) / double(tp + fp));
+      EXPECT_DOUBLE_EQ(o["recall"].get<double>(), double(tp) / double(tp + fn));
+      const auto bp = border(pred), bt = border(truth);
+      const auto pt = directed(bp, bt), tp_ = directed(bt, bp);
+      double hd = 0, sum = 0, sp = 0, st = 0, within = 0;
+      const double tau = 1.0;
+      for (double x : pt) hd = std::max(hd, x), sum += x, sp += x, within += x <= tau;
+      for (double x : tp_) hd = std::max(hd, x), sum += x, st += x, within += x <= tau;
+      const Json s = Json::parse(surfaceScores(pred, truth, tau, false).dump());
+      ASSERT_EQ(s["border_voxels_prediction"].get<std::size_t>(), bp.size());
+      EXPECT_NEAR(s["hd_mm"].get<double>(), hd, 1e-9) << k;
+      EXPECT_NEAR(s["hd95_mm"].get<double>(), std::max(percentile95(pt), percentile95(tp_)), 1e-9);
+      EXPECT_NEAR(s["assd_mm"].get<double>(), sum / double(bp.size() + bt.size()), 1e-9);
+      EXPECT_NEAR(s["masd_mm"].get<double>(), 0.5 * (sp / double(bp.size()) + st / double(bt.size())), 1e-9);
+      EXPECT_NEAR(s["nsd"].get<double>(), within / double(bp.size() + bt.size()), 1e-12);
+      // A ball shifted along x: the farthest border voxel lies exactly the shift away.
+      if (spacing.x == 1) {
+        EXPECT_NEAR(s["hd_mm"].get<double>(), k, 1e-9);
+      }
+    }
+  }
+}
+
+TEST(Score, EmptyMasksFollowTheWrittenConventions) {
+  const VolumeGrid g = grid(10, Vec3(1, 1, 1));
+  const Volume<std::uint8_t> none(g), some = ball(g, g.centre(5, 5, 5), 2);
+  Json o = Json::parse(overlapScores(none, none, false).dump());
+  EXPECT_EQ(o["dice"], 1.0);
+  EXPECT_TRUE(o["precision"].is_null());
+  EXPECT_EQ(Json::parse(overlapScores(none, none, true).dump())["dice"], 0.0);  // TopCoW
+  o = Json::parse(overlapScores(none, some, false).dump());
+  EXPECT_EQ(o["dice"], 0.0);
+  EXPECT_EQ(o["recall"], 0.0);
+  EXPECT_TRUE(o["precision"].is_null());
+  Json s = Json::parse(surfaceScores(none, some, 1, false).dump());
+  EXPECT_TRUE(s["hd95_mm"].is_null());
+  EXPECT_EQ(s["nsd"], 0.0);
+  s = Json::parse(surfaceScores(none, some, 1, true).dump());
+  EXPECT_EQ(s["hd95_mm"], 90.0);
+  s = Json::parse(surfaceScores(none, none, 1, false).dump());
+  EXPECT_EQ(s["hd_mm"], 0.0);
+  EXPECT_EQ(s["nsd"], 1.0);
+}
+
+class ScoreRun : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = freshTestDir("angiosynth_score_"); }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+  const fs::path src_ = ANGIOSYNTH_SOURCE_DIR;
+};
+
+// A prediction that is the truth mask less every voxel of a vessel thinner than one voxel: its
+// calibre curve must drop below one voxel and stay at 1 above, and the thick vessels are all
+// detected; a prediction on another grid is refused with a clear message and writes nothing.
+TEST_F(ScoreRun, APredictionMissingTheThinVesselsShowsItInTheCalibreCurve) {
+  std::ofstream(dir_ / "p.toml") << "seed = 3\n[domain]\ndemand_map = '" << (src_ / "demand_maps/vascusynth_rods_100.txt").string()
+                                 << "'\nsupply_coefficients = [0.65, 0.34, 0.01, 7]\nvoxel_size = \"0.4 mm\"\n"
+                                    "[tree]\nterminals = 300\nroot_voxel = [0, 50, 50]\n"
+                                    "[physics]\nviscosity = \"3.6 mPa*s\"\nperfusion_pressure = \"13300 Pa\"\n"
+                                    "terminal_pressure = \"8300 Pa\"\nperfusion_flow = \"8330 mm3/s\"\n"
+                                    "[image]\nformats = [\"nifti\"]\n";
+  ASSERT_EQ(run("generate p.toml --out s --quiet", dir_).code, 0);
+  // Radius of each segment from edges.csv (id = segment id = instance label).
+  std::map<long, double> radius;
+  {
+    std::ifstream in(dir_ / "s/edges.csv");
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      std::stringstream ss(line);
+      std::string cell[5];
+      for (auto& c : cell) std::getline(ss, c, ',');
+      radius[std::stol(cell[0])] = std::stod(cell[4]);
+    }
+  }
+  const NiftiVolume inst = readNiftiVolume(dir_ / "s/instances.nii.gz", 1ULL << 32, 4, "instances");
+  const NiftiVolume mask = readNiftiVolume(dir_ / "s/mask.nii.gz", 1ULL << 32, 4, "mask");
+  const double voxel = inst.values.grid.spacing_mm.x;
+  Volume<std::uint8_t> pred(inst.values.grid);
+  std::int64_t kept = 0, dropped = 0;
+  for (std::size_t i = 0; i < pred.data.size(); ++i) {
+    if (!(mask.values.data[i] > 0)) continue;
+    const bool thick = radius[long(inst.values.data[i])] >= voxel;
+    pred.data[i] = thick;
+    kept += thick, dropped += !thick;
+  }
+  ASSERT_GT(kept, 500);
+  ASSERT_GT(dropped, 500);
+  writeNifti(dir_ / "pred.nii.gz", viewOf(pred, true, "test prediction"));
+  const auto r = run("score pred.nii.gz s --out scores.json --csv scores.csv --quiet", dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Json j = Json::parse(slurp(dir_ / "scores.json"));
+  std::printf("[ measure  ] calibre recall %s\n", j["calibre"].dump().c_str());
+  const Json& bins = j["calibre"];
+  ASSERT_EQ(bins.size(), 5u);
+  EXPECT_LT(bins[0]["recall"].get<double>(), 0.3) << bins.dump();   // radius < ½ voxel
+  EXPECT_LT(bins[1]["recall"].get<double>(), 0.5) << bins.dump();   // ½ … 1 voxel
+  EXPECT_GT(bins[2]["recall"].get<double>(), 0.95) << bins.dump();  // 1 … 2 voxels
+  for (const auto& b : bins) {
+    if (!b["truth_coverage"].is_null()) {
+      EXPECT_EQ(b["truth_coverage"], 1.0);  // the mask holds every centreline voxel
+    }
+  }
+  EXPECT_EQ(j["overlap"]["precision"], 1.0);
+  EXPECT_NEAR(j["overlap"]["recall"].get<double>(), double(kept) / double(kept + dropped), 1e-12);
+  const Json& lv = j["vessels"]["by_level"];
+  ASSERT_GT(lv.size(), 3u);
+  EXPECT_EQ(lv[0]["detected_rate"], 1.0);  // the root vessel is thick
+  EXPECT_LT(j["vessels"]["detected_rate"].get<double>(), 0.5);  // most vessels are thin
+  const std::string csv = slurp(dir_ / "scores.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 2) << csv;
+  // Another grid: refused, nothing written.
+  Volume<std::uint8_t> small(grid(10, Vec3(0.4, 0.4, 0.4)));
+  writeNifti(dir_ / "small.nii.gz", viewOf(small, true, "wrong grid"));
+  const auto bad = run("score small.nii.gz s --out bad.json", dir_);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("small.nii.gz: the prediction has 10 x 10 x 10 voxels"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ / "bad.json"));
+  const auto again = run("score pred.nii.gz s --out scores.json", dir_);  // never replaces a file without --force
+  EXPECT_EQ(again.code, 2);
+  EXPECT_NE(again.err.find("exists; give --force"), std::string::npos) << again.err;
+}
+
+}  // namespace
