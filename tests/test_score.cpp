@@ -238,3 +238,40 @@ print('max_difference', max(abs(x - y) for x, y in zip(ref, ours)), 'fp', int(fp
 }
 
 }  // namespace
+
+namespace {
+
+// `score --dataset`: every case of a dataset against its own image's truth (the warped labels
+// and graph for the profile that warps, the mask where labelsTr holds the classes); labelsTr as
+// predictions score Dice 1 everywhere; a missing prediction names its case.
+TEST_F(ScoreRun, DatasetModeScoresEveryCaseAgainstItsImagesTruth) {
+  fs::copy_file(src_ / "tests/data/profile_warp.toml", dir_ / "profile_warp.toml");
+  fs::copy_file(src_ / "tests/data/dataset_av.toml", dir_ / "spec.toml");
+  ASSERT_EQ(run("dataset spec.toml --out raw --quiet", dir_).code, 0);
+  const fs::path ds = dir_ / "raw/Dataset903_ArteryVeinTiny";
+  fs::create_directories(dir_ / "pred");
+  for (const auto& e : fs::directory_iterator(ds / "labelsTr")) fs::copy_file(e.path(), dir_ / "pred" / e.path().filename());
+  const auto r = run("score --dataset raw/Dataset903_ArteryVeinTiny --predictions pred --out all.json --csv all.csv --quiet", dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Json j = Json::parse(slurp(dir_ / "all.json"));
+  ASSERT_EQ(j["cases"], 3);
+  EXPECT_EQ(j["summary"]["dice"]["mean"], 1.0);
+  EXPECT_EQ(j["summary"]["hd_mm"]["max"], 0.0);
+  int warped = 0;
+  for (const auto& c : j["per_case"]) {
+    EXPECT_EQ(c["centreline"]["recall"], 1.0) << c["case"];
+    EXPECT_EQ(c["vessels"]["detected_rate"], 1.0) << c["case"];
+    warped += c["truth"].get<std::string>().find("groundtruth") != std::string::npos &&
+              fs::exists(ds / "groundtruth" / c["case"].get<std::string>() / "centerline_profile_warp.nii.gz");
+  }
+  EXPECT_GT(warped, 0);  // the spec's profile file warps: some case was scored against warped labels
+  const std::string csv = slurp(dir_ / "all.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 3 + 3) << csv;  // header, cases, mean/median/sd
+  fs::remove(dir_ / "pred/ArteryVeinTiny_0001.nii.gz");
+  const auto bad = run("score --dataset raw/Dataset903_ArteryVeinTiny --predictions pred --out bad.json", dir_);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("ArteryVeinTiny_0001.nii.gz: missing: no prediction for case ArteryVeinTiny_0001"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ / "bad.json"));
+}
+
+}  // namespace

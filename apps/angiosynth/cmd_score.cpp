@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "io/text_file.hpp"
 #include "score/case_scores.hpp"
+#include "score/dataset_scores.hpp"
 
 namespace angiosynth::cli {
 
@@ -15,36 +16,17 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
-std::string number(const Json& v) {
-  if (v.is_null()) return "";
-  std::ostringstream o;
-  o.precision(17);
-  o << v.get<double>();
-  return o.str();
-}
-
-// One CSV row of the headline numbers (the JSON holds everything).
-void writeCsv(std::ostream& o, const Json& j) {
-  o << "prediction,dice,jaccard,precision,recall,hd_mm,hd95_mm,assd_mm,masd_mm,nsd,centreline_recall,vessels_detected_rate,"
-       "tree_length_detected\n";
-  const Json& ov = j["overlap"];
-  const Json& s = j["surface"];
-  const Json none;
-  const Json& v = j.contains("vessels") ? j["vessels"] : none;
-  o << '"' << j["prediction"].get<std::string>() << '"';
-  for (const Json* x : {&ov["dice"], &ov["jaccard"], &ov["precision"], &ov["recall"], &s["hd_mm"], &s["hd95_mm"], &s["assd_mm"],
-                        &s["masd_mm"], &s["nsd"], &j["centreline"]["recall"]})
-    o << ',' << number(*x);
-  o << ',' << (v.is_null() ? "" : number(v["detected_rate"])) << ',' << (v.is_null() ? "" : number(v["tree_length_detected"])) << '\n';
-}
-
 // Output files are new files, or --force; never an input.
 void checkOutput(const std::string& out, const ScoreArgs& a) {
   if (out.empty()) return;
   const fs::path o = fs::weakly_canonical(out);
-  if (o == fs::weakly_canonical(a.prediction) || o.parent_path() == fs::weakly_canonical(a.sample) ||
-      o == fs::weakly_canonical(a.sample))
-    throw InputError(out, 0, "is the prediction or lies in the truth sample; allowed: a file elsewhere");
+  for (const std::string& in : {a.prediction, a.sample, a.dataset, a.predictions}) {
+    if (in.empty()) continue;
+    const fs::path i = fs::weakly_canonical(in);
+    const auto rel = o.lexically_relative(i);
+    if (o == i || (!rel.empty() && *rel.begin() != ".."))
+      throw InputError(out, 0, "is an input or lies inside one (" + in + "); allowed: a file elsewhere");
+  }
   if (fs::exists(o) && !a.force) throw InputError(out, 0, "exists; give --force to replace it");
 }
 
@@ -53,8 +35,10 @@ void checkOutput(const std::string& out, const ScoreArgs& a) {
 CLI::App* addScore(CLI::App& app, ScoreArgs& a) {
   auto* c = app.add_subcommand("score", "score a segmentation (NIfTI, voxels > 0 = vessel) against a generated sample's exact truth: "
                                         "overlap, surface distances, recall by calibre, vessels detected");
-  c->add_option("PRED", a.prediction, "the prediction (.nii or .nii.gz on the sample's grid)")->required();
-  c->add_option("SAMPLE_DIR", a.sample, "the sample directory angiosynth generate wrote")->required();
+  c->add_option("PRED", a.prediction, "the prediction (.nii or .nii.gz on the sample's grid)");
+  c->add_option("SAMPLE_DIR", a.sample, "the sample directory angiosynth generate wrote");
+  c->add_option("--dataset", a.dataset, "a dataset angiosynth made (DatasetNNN_Name): score every case, with --predictions");
+  c->add_option("--predictions", a.predictions, "with --dataset: the directory of predictions, <case>.nii.gz (nnU-Net naming)");
   c->add_option("--out", a.out, "write the scores as JSON here (default: print them)");
   c->add_option("--csv", a.csv, "also write the headline numbers as one CSV row here");
   c->add_option("--tolerance", a.tolerance_mm, "NSD tolerance in mm (default: the smallest voxel edge)")->check(finiteIn(0, 1e6));
@@ -81,14 +65,32 @@ int runScore(const ScoreArgs& a) {
         throw InputError("", 0, "calibre bins must be finite, non-negative and increasing (lower edges)");
   if (!a.bins_voxels.empty()) opt.bins_voxels = a.bins_voxels;
   opt.bins_mm = a.bins_mm;
-  const Json j = scoreCase(a.prediction, a.sample, opt);
+  const bool dataset = !a.dataset.empty() || !a.predictions.empty();
+  if (dataset ? (a.dataset.empty() || a.predictions.empty() || !a.prediction.empty()) : (a.prediction.empty() || a.sample.empty()))
+    throw InputError("", 0, "give PRED SAMPLE_DIR (one case) or --dataset DIR --predictions DIR (every case of a dataset)");
+  Json j;
+  std::string csv;
+  if (dataset) {
+    j = scoreDataset(a.dataset, a.predictions, opt, progressPrinter(a.common, "scoring"), csv);
+  } else {
+    j = scoreCase(a.prediction, sampleTruth(a.sample), opt);
+    csv = scoreCsvHeader() + scoreCsvRow(a.prediction, j);
+  }
   if (a.out.empty()) std::cout << j.dump(2) << "\n";
   else writeTextFile(a.out, [&](std::ostream& o) { o << j.dump(2) << "\n"; });
-  if (!a.csv.empty()) writeTextFile(a.csv, [&](std::ostream& o) { writeCsv(o, j); });
+  if (!a.csv.empty()) writeTextFile(a.csv, [&](std::ostream& o) { o << csv; });
   if (!a.common.quiet) {
-    const Json& ov = j["overlap"];
-    std::cerr << "Dice " << number(ov["dice"]) << ", HD95 " << number(j["surface"]["hd95_mm"]) << " mm, centreline recall "
-              << number(j["centreline"]["recall"]) << "\n";
+    const Json& s = dataset ? j["summary"] : j;
+    const auto show = [&](const char* pointer) {
+      const Json::json_pointer p(pointer);
+      return s.contains(p) && s.at(p).is_number() ? std::to_string(s.at(p).get<double>()) : std::string("-");
+    };
+    if (dataset)
+      std::cerr << j["cases"] << " cases: mean Dice " << show("/dice/mean") << ", mean HD95 " << show("/hd95_mm/mean")
+                << " mm, mean centreline recall " << show("/centreline_recall/mean") << "\n";
+    else
+      std::cerr << "Dice " << show("/overlap/dice") << ", HD95 " << show("/surface/hd95_mm") << " mm, centreline recall "
+                << show("/centreline/recall") << "\n";
   }
   return 0;
 }

@@ -63,6 +63,7 @@ int runDatasetCommand(const DatasetArgs& a, const std::string& command_line);
 
 struct ScoreArgs {
   std::string prediction, sample, out, csv;
+  std::string dataset, predictions;  // --dataset mode
   double tolerance_mm = 0;
   bool topcow = false, force = false;
   std::vector<double> bins_voxels, bins_mm;

@@ -246,14 +246,21 @@ Json vesselDetection(const Volume<std::uint8_t>& pred, const VascularTree& t) {
 
 }  // namespace
 
-Json scoreCase(const std::filesystem::path& pred_file, const std::filesystem::path& dir, const ScoreOptions& opt) {
+TruthFiles sampleTruth(const std::filesystem::path& dir) {
+  if (!std::filesystem::is_directory(dir)) throw InputError(dir.string(), 0, "is not a directory; allowed: a sample directory angiosynth generate wrote");
   const auto need = [&](const char* name) {
     const auto f = dir / name;
     if (!std::filesystem::is_regular_file(f))
       throw InputError(dir.string(), 0, std::string("no ") + name + " in the sample directory; allowed: a directory angiosynth generate wrote (with volumes)");
     return f;
   };
-  const auto mask_file = need("mask.nii.gz"), centre_file = need("centerline.nii.gz"), radius_file = need("radius.nii.gz");
+  TruthFiles t{need("mask.nii.gz"), need("centerline.nii.gz"), need("radius.nii.gz"), {}, dir.string()};
+  if (std::filesystem::is_regular_file(dir / "edges.csv") && std::filesystem::is_regular_file(dir / "nodes.csv")) t.edges = dir / "edges.csv";
+  return t;
+}
+
+Json scoreCase(const std::filesystem::path& pred_file, const TruthFiles& files, const ScoreOptions& opt) {
+  const auto &mask_file = files.mask, &centre_file = files.centerline, &radius_file = files.radius;
   // Per voxel while scoring: five volumes of floats and bytes, two distance maps, the borders.
   constexpr std::uint64_t kBytesPerVoxel = 4 * 4 + 2 * 8 + 4;
   const NiftiVolume truth = readNiftiVolume(mask_file, opt.memory_limit, kBytesPerVoxel, "the truth mask");
@@ -270,7 +277,7 @@ Json scoreCase(const std::filesystem::path& pred_file, const std::filesystem::pa
 
   Json j;
   j["prediction"] = pred_file.string();
-  j["truth"] = dir.string();
+  j["truth"] = files.name;
   j["conventions"] = opt.topcow ? "TopCoW: 26-neighbour borders, 90 mm for a surface distance when one mask is empty, Dice and Jaccard 0 when both are"
                                 : "default: 6-neighbour borders, null for a surface distance when one mask is empty, Dice and Jaccard 1 when both are";
   j["overlap"] = overlapScores(p, t, opt.topcow);
@@ -282,9 +289,7 @@ Json scoreCase(const std::filesystem::path& pred_file, const std::filesystem::pa
   j["centreline"] = Json{{"voxels", cl}, {"recall", ratio(double(cl_hit), double(cl))}};
   j["calibre"] = calibreRecall(p, t, centre.values, radius.values, opt.bins_voxels, voxel, "voxels");
   if (!opt.bins_mm.empty()) j["calibre_mm"] = calibreRecall(p, t, centre.values, radius.values, opt.bins_mm, 1.0, "mm");
-  const auto edges = dir / "edges.csv";
-  if (std::filesystem::is_regular_file(edges) && std::filesystem::is_regular_file(dir / "nodes.csv"))
-    j["vessels"] = vesselDetection(p, readNetwork(edges).tree);
+  if (!files.edges.empty()) j["vessels"] = vesselDetection(p, readNetwork(files.edges).tree);
   j["definitions"] = Json{
       {"prediction", "voxels > 0 are vessel"},
       {"truth", "the sample's mask.nii.gz (partial volume >= 0.5 or crossed by a centreline)"},

@@ -41,8 +41,16 @@ nlohmann::ordered_json surfaceScores(const Volume<std::uint8_t>& pred, const Vol
 // 95th percentile, linear interpolation between order statistics (NumPy's default).
 double percentile95(std::vector<double> values);
 
-// Scores PRED (a NIfTI; voxels > 0 are vessel) against the sample in `sample_dir` (mask,
-// centerline and radius NIfTI volumes, nodes.csv and edges.csv); the grids must agree.
-nlohmann::ordered_json scoreCase(const std::filesystem::path& pred, const std::filesystem::path& sample_dir, const ScoreOptions& opt);
+// The truth of one case: its mask, exact centreline and radius volumes, and its graph's edges
+// file (with nodes beside it; empty: no vessel scores).
+struct TruthFiles {
+  std::filesystem::path mask, centerline, radius, edges;
+  std::string name;  // how the output names the truth
+};
+// The files of a sample directory `generate` wrote (mask.nii.gz, centerline.nii.gz, …).
+TruthFiles sampleTruth(const std::filesystem::path& sample_dir);
+
+// Scores PRED (a NIfTI; voxels > 0 are vessel) against the truth; the grids must agree.
+nlohmann::ordered_json scoreCase(const std::filesystem::path& pred, const TruthFiles& truth, const ScoreOptions& opt);
 
 }  // namespace angiosynth
