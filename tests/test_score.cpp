@@ -11,6 +11,7 @@
 #include "cli_run.hpp"
 #include "io/nifti_reader.hpp"
 #include "io/volume_writers.hpp"
+#include "score/betti.hpp"
 #include "score/case_scores.hpp"
 
 namespace {
@@ -272,6 +273,48 @@ TEST_F(ScoreRun, DatasetModeScoresEveryCaseAgainstItsImagesTruth) {
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("ArteryVeinTiny_0001.nii.gz: missing: no prediction for case ArteryVeinTiny_0001"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(dir_ / "bad.json"));
+}
+
+}  // namespace
+
+namespace {
+
+// Betti numbers of shapes whose topology is known: a ball (1, 0, 0), two balls (2, 0, 0), a
+// hollow ball (1, 0, 1), a solid torus (1, 1, 0), a ring of two tori linked by a bar (1, 2, 0),
+// diagonal neighbours (26-connected: one piece), an empty volume (0, 0, 0).
+TEST(Score, BettiNumbersOfShapesWithKnownTopology) {
+  const VolumeGrid g = grid(40, Vec3(1, 1, 1));
+  const auto make = [&](auto&& inside) {
+    Volume<std::uint8_t> v(g);
+    for (int k = 0; k < 40; ++k)
+      for (int j = 0; j < 40; ++j)
+        for (int i = 0; i < 40; ++i) v.at(i, j, k) = inside(Vec3(i, j, k));
+    return v;
+  };
+  const auto torus = [](const Vec3& p, const Vec3& c, double R, double r) {
+    const Vec3 d = p - c;
+    const double q = std::sqrt(d.x * d.x + d.y * d.y) - R;
+    return q * q + d.z * d.z <= r * r;
+  };
+  const auto expect = [](const Volume<std::uint8_t>& v, std::int64_t b0, std::int64_t b1, std::int64_t b2, const char* what) {
+    const Betti b = bettiNumbers(v);
+    EXPECT_EQ(b.b0, b0) << what;
+    EXPECT_EQ(b.b1, b1) << what;
+    EXPECT_EQ(b.b2, b2) << what;
+  };
+  const Vec3 c(20, 20, 20);
+  expect(make([&](const Vec3& p) { return distance(p, c) <= 8; }), 1, 0, 0, "ball");
+  expect(make([&](const Vec3& p) { return distance(p, Vec3(10, 10, 10)) <= 5 || distance(p, Vec3(28, 28, 28)) <= 6; }), 2, 0, 0, "two balls");
+  expect(make([&](const Vec3& p) { return distance(p, c) <= 12 && distance(p, c) >= 8; }), 1, 0, 1, "hollow ball");
+  expect(make([&](const Vec3& p) { return torus(p, c, 10, 3); }), 1, 1, 0, "torus");
+  expect(make([&](const Vec3& p) {
+           return torus(p, Vec3(12, 20, 20), 6, 2.5) || torus(p, Vec3(28, 20, 20), 6, 2.5) || (std::abs(p.y - 20) <= 1 && std::abs(p.z - 20) <= 1 && p.x >= 16 && p.x <= 24);
+         }),
+         1, 2, 0, "two tori joined by a bar");
+  Volume<std::uint8_t> diagonal(g);
+  diagonal.at(5, 5, 5) = diagonal.at(6, 6, 6) = diagonal.at(7, 7, 7) = 1;
+  expect(diagonal, 1, 0, 0, "voxels touching at corners");
+  expect(Volume<std::uint8_t>(g), 0, 0, 0, "empty");
 }
 
 }  // namespace

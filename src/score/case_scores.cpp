@@ -11,6 +11,7 @@
 #include "io/network_files.hpp"
 #include "io/nifti_reader.hpp"
 #include "io/param_checks.hpp"
+#include "score/betti.hpp"
 
 namespace angiosynth {
 namespace {
@@ -287,6 +288,15 @@ Json scoreCase(const std::filesystem::path& pred_file, const TruthFiles& files, 
   for (std::size_t i = 0; i < centre.values.data.size(); ++i)
     if (centre.values.data[i] > 0) ++cl, cl_hit += p.data[i] != 0;
   j["centreline"] = Json{{"voxels", cl}, {"recall", ratio(double(cl_hit), double(cl))}};
+  {
+    const Betti bp = bettiNumbers(p), bt = bettiNumbers(t);
+    const auto json = [](const Betti& b) { return Json{{"b0", b.b0}, {"b1", b.b1}, {"b2", b.b2}, {"euler_characteristic", b.euler}}; };
+    j["topology"] = Json{{"prediction", json(bp)},
+                         {"truth", json(bt)},
+                         {"b0_error", std::abs(bp.b0 - bt.b0)},
+                         {"b1_error", std::abs(bp.b1 - bt.b1)},
+                         {"b2_error", std::abs(bp.b2 - bt.b2)}};
+  }
   j["calibre"] = calibreRecall(p, t, centre.values, radius.values, opt.bins_voxels, voxel, "voxels");
   if (!opt.bins_mm.empty()) j["calibre_mm"] = calibreRecall(p, t, centre.values, radius.values, opt.bins_mm, 1.0, "mm");
   if (!files.edges.empty()) j["vessels"] = vesselDetection(p, readNetwork(files.edges).tree);
@@ -297,6 +307,9 @@ Json scoreCase(const std::filesystem::path& pred_file, const TruthFiles& files, 
       {"surface", "distances in mm between border voxel centres (spacing per axis); HD the largest directed distance; HD95 the larger of the "
                   "two directed 95th percentiles (linear interpolation, NumPy's default); ASSD the mean over both borders' distances; MASD "
                   "the mean of the two directed means; NSD the share of both borders within tolerance_mm of the other"},
+      {"topology", "Betti numbers: b0 pieces of the foreground (26-connected), b2 cavities (6-connected background pieces not reaching the "
+                   "outside; the volume padded with background), b1 tunnels = b0 + b2 - the Euler characteristic of the union of closed voxel "
+                   "cubes; errors |prediction - truth|"},
       {"centreline", "share of the exact centreline's voxels (centerline.nii.gz) in the prediction: clDice's topology sensitivity with the exact skeleton"},
       {"calibre", "centreline voxels binned by the exact radius there (radius.nii.gz; in voxels of the smallest edge, or mm): recall = share in "
                   "the prediction, truth_coverage = share in the truth mask"},
