@@ -13,6 +13,7 @@
 #include "io/volume_writers.hpp"
 #include "score/betti.hpp"
 #include "score/case_scores.hpp"
+#include "score/skeleton.hpp"
 
 namespace {
 
@@ -315,6 +316,53 @@ TEST(Score, BettiNumbersOfShapesWithKnownTopology) {
   diagonal.at(5, 5, 5) = diagonal.at(6, 6, 6) = diagonal.at(7, 7, 7) = 1;
   expect(diagonal, 1, 0, 0, "voxels touching at corners");
   expect(Volume<std::uint8_t>(g), 0, 0, 0, "empty");
+}
+
+}  // namespace
+
+namespace {
+
+// The skeleton is scikit-image's skeletonize_3d voxel for voxel (Debian's python3-skimage) on
+// the masks of generated trees (3D CCO, VascuSynth's rods, a 2D disc) and on a thick shape, so
+// clDice matches the public implementations.
+TEST_F(ScoreRun, SkeletonIsScikitImagesVoxelForVoxel) {
+  const std::map<std::string, std::string> params{
+      {"cco3d", "seed = 2\n[domain]\nshape = \"sphere\"\nradius = \"6 mm\"\nvoxel_size = \"0.2 mm\"\n[tree]\nmethod = \"cco\"\nterminals = 300\n"},
+      {"disc2d", "seed = 2\n[domain]\nshape = \"disc\"\nradius = \"20 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"cco\"\nterminals = 300\n[physics]\nperfusion_flow = \"2 mL/min\"\n"},
+      {"vs", "seed = 3\n[domain]\ndemand_map = '" + (src_ / "demand_maps/vascusynth_rods_100.txt").string() +
+                 "'\nsupply_coefficients = [0.65, 0.34, 0.01, 7]\nvoxel_size = \"0.4 mm\"\n[tree]\nterminals = 300\nroot_voxel = [0, 50, 50]\n"
+                 "[physics]\nviscosity = \"3.6 mPa*s\"\nperfusion_pressure = \"13300 Pa\"\nterminal_pressure = \"8300 Pa\"\nperfusion_flow = \"8330 mm3/s\"\n"}};
+  for (const auto& [name, text] : params) {
+    std::ofstream(dir_ / (name + ".toml")) << text << "[image]\nformats = [\"nifti\"]\n";
+    ASSERT_EQ(run("generate " + name + ".toml --out " + name + " --quiet", dir_).code, 0) << name;
+  }
+  // A thick tube bent into an L (medial thinning of a solid, not only thin vessels).
+  Volume<std::uint8_t> tube(grid(30, Vec3(1, 1, 1)));
+  for (int k = 0; k < 30; ++k)
+    for (int j = 0; j < 30; ++j)
+      for (int i = 0; i < 30; ++i)
+        tube.at(i, j, k) = (std::hypot(j - 8.3, k - 14.6) <= 4.5 && i >= 4 && i <= 24) || (std::hypot(i - 20.2, k - 14.6) <= 4.5 && j >= 8 && j <= 27);
+  writeNifti(dir_ / "tube.nii.gz", viewOf(tube, true, "tube"));
+  for (const std::string mask : {"cco3d/mask.nii.gz", "disc2d/mask.nii.gz", "vs/mask.nii.gz", "tube.nii.gz"}) {
+    const NiftiVolume m = readNiftiVolume(dir_ / mask, 1ULL << 32, 4, "mask");
+    Volume<std::uint8_t> b(m.values.grid);
+    for (std::size_t i = 0; i < b.data.size(); ++i) b.data[i] = m.values.data[i] > 0;
+    const Volume<std::uint8_t> s = skeletonize(b);
+    writeNifti(dir_ / "ours.nii.gz", viewOf(s, true, "skeleton"));
+    const std::string out = debianPython(R"(
+import numpy as np, nibabel as nib
+from skimage.morphology import skeletonize_3d
+m = np.asarray(nib.load(')" + mask + R"(').dataobj) > 0
+ref = skeletonize_3d(m.astype(np.uint8)) > 0
+ours = np.asarray(nib.load('ours.nii.gz').dataobj) > 0
+print('mask', int(m.sum()), 'skeleton', int(ref.sum()), 'different', int((ref != ours).sum()))
+)", dir_);
+    long mask_voxels = 0, skeleton = 0, different = -1;
+    ASSERT_EQ(std::sscanf(out.c_str(), "mask %ld skeleton %ld different %ld", &mask_voxels, &skeleton, &different), 3) << out;
+    EXPECT_EQ(different, 0) << mask << ": " << out;
+    EXPECT_GT(skeleton, 10) << mask;
+    EXPECT_LT(skeleton, mask_voxels) << mask;  // not vacuous: thinning removed voxels
+  }
 }
 
 }  // namespace

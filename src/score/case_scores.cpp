@@ -12,6 +12,7 @@
 #include "io/nifti_reader.hpp"
 #include "io/param_checks.hpp"
 #include "score/betti.hpp"
+#include "score/skeleton.hpp"
 
 namespace angiosynth {
 namespace {
@@ -118,6 +119,23 @@ Json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>&
   j["assd_mm"] = (sum(p_to_t) + sum(t_to_p)) / double(np + nt);
   j["masd_mm"] = 0.5 * (sum(p_to_t) / double(np) + sum(t_to_p) / double(nt));
   j["nsd"] = (within(p_to_t) + within(t_to_p)) / double(np + nt);
+  return j;
+}
+
+Json clDice(const Volume<std::uint8_t>& pred_skeleton, const Volume<std::uint8_t>& truth, const Volume<std::uint8_t>& truth_skeleton,
+           const Volume<std::uint8_t>& pred) {
+  std::int64_t sp = 0, sp_in = 0, st = 0, st_in = 0;
+  for (std::size_t i = 0; i < pred.data.size(); ++i) {
+    if (pred_skeleton.data[i]) ++sp, sp_in += truth.data[i] != 0;
+    if (truth_skeleton.data[i]) ++st, st_in += pred.data[i] != 0;
+  }
+  const Json tprec = ratio(double(sp_in), double(sp)), tsens = ratio(double(st_in), double(st));
+  Json j{{"topology_precision", tprec}, {"topology_sensitivity", tsens}};
+  if (tprec.is_null() || tsens.is_null()) j["cldice"] = nullptr;
+  else {
+    const double a = tprec.get<double>(), b = tsens.get<double>();
+    j["cldice"] = a + b > 0 ? 2 * a * b / (a + b) : 0.0;
+  }
   return j;
 }
 
@@ -289,6 +307,10 @@ Json scoreCase(const std::filesystem::path& pred_file, const TruthFiles& files, 
     if (centre.values.data[i] > 0) ++cl, cl_hit += p.data[i] != 0;
   j["centreline"] = Json{{"voxels", cl}, {"recall", ratio(double(cl_hit), double(cl))}};
   {
+    const Volume<std::uint8_t> sp = skeletonize(p), st = skeletonize(t), sc = binary(centre.values);
+    j["cldice"] = Json{{"skeletons", clDice(sp, t, st, p)}, {"exact_centreline", clDice(sp, t, sc, p)}};
+  }
+  {
     const Betti bp = bettiNumbers(p), bt = bettiNumbers(t);
     const auto json = [](const Betti& b) { return Json{{"b0", b.b0}, {"b1", b.b1}, {"b2", b.b2}, {"euler_characteristic", b.euler}}; };
     j["topology"] = Json{{"prediction", json(bp)},
@@ -310,6 +332,9 @@ Json scoreCase(const std::filesystem::path& pred_file, const TruthFiles& files, 
       {"topology", "Betti numbers: b0 pieces of the foreground (26-connected), b2 cavities (6-connected background pieces not reaching the "
                    "outside; the volume padded with background), b1 tunnels = b0 + b2 - the Euler characteristic of the union of closed voxel "
                    "cubes; errors |prediction - truth|"},
+      {"cldice", "clDice = 2 Tprec Tsens / (Tprec + Tsens), Tprec = share of the prediction's skeleton in the truth mask, Tsens = share "
+                 "of the truth's skeleton in the prediction; skeletons by Lee's thinning in scikit-image's order (skeletonize_3d); "
+                 "`exact_centreline` takes the exact centreline as the truth's skeleton; null when a skeleton is empty"},
       {"centreline", "share of the exact centreline's voxels (centerline.nii.gz) in the prediction: clDice's topology sensitivity with the exact skeleton"},
       {"calibre", "centreline voxels binned by the exact radius there (radius.nii.gz; in voxels of the smallest edge, or mm): recall = share in "
                   "the prediction, truth_coverage = share in the truth mask"},

@@ -38,6 +38,11 @@ std::vector<double> directedBorderDistances(const Volume<std::uint8_t>& from_bor
 nlohmann::ordered_json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, double tolerance_mm,
                                      bool topcow);
 
+// clDice (Shit et al. 2021) from the two skeletons and masks: topology precision, sensitivity,
+// their harmonic mean (null when a skeleton is empty).
+nlohmann::ordered_json clDice(const Volume<std::uint8_t>& pred_skeleton, const Volume<std::uint8_t>& truth,
+                              const Volume<std::uint8_t>& truth_skeleton, const Volume<std::uint8_t>& pred);
+
 // 95th percentile, linear interpolation between order statistics (NumPy's default).
 double percentile95(std::vector<double> values);
 
