@@ -56,7 +56,9 @@ void squaredDistances(std::vector<double>& g, const std::array<int, 3>& n, const
       std::vector<int> v;
       for (std::size_t line = r.begin(); line != r.end(); ++line) {
         double* p = data + (line % std::size_t(na)) * sa + (line / std::size_t(na)) * sb;
-        for (int q = 0; q < len; ++q) f[std::size_t(q)] = p[std::size_t(q) * step];
+        bool any = false;
+        for (int q = 0; q < len; ++q) any |= (f[std::size_t(q)] = p[std::size_t(q) * step]) < kFarSquared;
+        if (!any) continue;  // no site reaches this line yet: it stays far
         edt1d(f, spacing, d, v, z);
         for (int q = 0; q < len; ++q) p[std::size_t(q) * step] = d[std::size_t(q)];
       }

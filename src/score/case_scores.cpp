@@ -12,6 +12,7 @@
 #include "io/nifti_reader.hpp"
 #include "io/param_checks.hpp"
 #include "score/betti.hpp"
+#include "score/keypoints.hpp"
 #include "score/skeleton.hpp"
 
 namespace angiosynth {
@@ -273,8 +274,9 @@ TruthFiles sampleTruth(const std::filesystem::path& dir) {
       throw InputError(dir.string(), 0, std::string("no ") + name + " in the sample directory; allowed: a directory angiosynth generate wrote (with volumes)");
     return f;
   };
-  TruthFiles t{need("mask.nii.gz"), need("centerline.nii.gz"), need("radius.nii.gz"), {}, dir.string()};
+  TruthFiles t{need("mask.nii.gz"), need("centerline.nii.gz"), need("radius.nii.gz"), {}, {}, dir.string()};
   if (std::filesystem::is_regular_file(dir / "edges.csv") && std::filesystem::is_regular_file(dir / "nodes.csv")) t.edges = dir / "edges.csv";
+  if (std::filesystem::is_regular_file(dir / "keypoints.csv")) t.keypoints = dir / "keypoints.csv";
   return t;
 }
 
@@ -306,9 +308,16 @@ Json scoreCase(const std::filesystem::path& pred_file, const TruthFiles& files, 
   for (std::size_t i = 0; i < centre.values.data.size(); ++i)
     if (centre.values.data[i] > 0) ++cl, cl_hit += p.data[i] != 0;
   j["centreline"] = Json{{"voxels", cl}, {"recall", ratio(double(cl_hit), double(cl))}};
+  const Volume<std::uint8_t> pred_skeleton = skeletonize(p);
   {
-    const Volume<std::uint8_t> sp = skeletonize(p), st = skeletonize(t), sc = binary(centre.values);
-    j["cldice"] = Json{{"skeletons", clDice(sp, t, st, p)}, {"exact_centreline", clDice(sp, t, sc, p)}};
+    const Volume<std::uint8_t> st = skeletonize(t), sc = binary(centre.values);
+    j["cldice"] = Json{{"skeletons", clDice(pred_skeleton, t, st, p)}, {"exact_centreline", clDice(pred_skeleton, t, sc, p)}};
+  }
+  if (!files.keypoints.empty()) {
+    const KeyPoints found = skeletonKeyPoints(pred_skeleton), known = truthKeyPoints(files.keypoints, g);
+    j["keypoints"] = Json{{"tolerance_mm", Json{{"at_least", 2 * voxel}, {"or", "the truth point's radius, if larger"}}},
+                          {"bifurcations", matchKeyPoints(found.bifurcations, known.bifurcations, 2 * voxel)},
+                          {"endpoints", matchKeyPoints(found.endpoints, known.endpoints, 2 * voxel)}};
   }
   {
     const Betti bp = bettiNumbers(p), bt = bettiNumbers(t);
@@ -335,6 +344,10 @@ Json scoreCase(const std::filesystem::path& pred_file, const TruthFiles& files, 
       {"cldice", "clDice = 2 Tprec Tsens / (Tprec + Tsens), Tprec = share of the prediction's skeleton in the truth mask, Tsens = share "
                  "of the truth's skeleton in the prediction; skeletons by Lee's thinning in scikit-image's order (skeletonize_3d); "
                  "`exact_centreline` takes the exact centreline as the truth's skeleton; null when a skeleton is empty"},
+      {"keypoints", "bifurcations and endpoints of the prediction's skeleton (26-neighbour count 1: an endpoint; each 26-connected "
+                    "cluster of voxels with 3 or more: one bifurcation at its centroid) against the truth graph's bifurcations and "
+                    "endpoints (terminals and roots, keypoints.csv), matched one to one closest first within max(2 voxels, the truth "
+                    "point's radius); precision, recall, F1"},
       {"centreline", "share of the exact centreline's voxels (centerline.nii.gz) in the prediction: clDice's topology sensitivity with the exact skeleton"},
       {"calibre", "centreline voxels binned by the exact radius there (radius.nii.gz; in voxels of the smallest edge, or mm): recall = share in "
                   "the prediction, truth_coverage = share in the truth mask"},

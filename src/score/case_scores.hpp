@@ -49,7 +49,7 @@ double percentile95(std::vector<double> values);
 // The truth of one case: its mask, exact centreline and radius volumes, and its graph's edges
 // file (with nodes beside it; empty: no vessel scores).
 struct TruthFiles {
-  std::filesystem::path mask, centerline, radius, edges;
+  std::filesystem::path mask, centerline, radius, edges, keypoints;  // edges, keypoints: optional
   std::string name;  // how the output names the truth
 };
 // The files of a sample directory `generate` wrote (mask.nii.gz, centerline.nii.gz, …).

@@ -27,7 +27,14 @@ const std::vector<std::pair<const char*, const char*>>& headline() {
       {"/surface/nsd", "nsd"},
       {"/centreline/recall", "centreline_recall"},
       {"/vessels/detected_rate", "vessels_detected_rate"},
-      {"/vessels/tree_length_detected", "tree_length_detected"}};
+      {"/vessels/tree_length_detected", "tree_length_detected"},
+      {"/cldice/skeletons/cldice", "cldice"},
+      {"/cldice/exact_centreline/cldice", "cldice_exact_centreline"},
+      {"/topology/b0_error", "b0_error"},
+      {"/topology/b1_error", "b1_error"},
+      {"/topology/b2_error", "b2_error"},
+      {"/keypoints/bifurcations/f1", "bifurcation_f1"},
+      {"/keypoints/endpoints/f1", "endpoint_f1"}};
   return h;
 }
 
@@ -96,7 +103,7 @@ TruthFiles datasetCaseTruth(const fs::path& ds, const std::string& id) {
     for (const auto& [name, rec] : sample["degradation"].items())
       if (fs::exists(g / ("centerline_" + name + ".nii.gz"))) suffix = "_" + name;
   const auto file = [&](const std::string& stem, const char* ext) { return g / (stem + suffix + ext); };
-  TruthFiles t{file("mask", ".nii.gz"), file("centerline", ".nii.gz"), file("radius", ".nii.gz"), {}, (ds.filename() / "groundtruth" / id).string()};
+  TruthFiles t{file("mask", ".nii.gz"), file("centerline", ".nii.gz"), file("radius", ".nii.gz"), {}, {}, (ds.filename() / "groundtruth" / id).string()};
   if (!fs::is_regular_file(t.mask)) {
     // Moved into labelsTr: the dataset's labels are the mask (binary labels).
     const Json spec = readJson(ds / "spec.json");
@@ -109,6 +116,7 @@ TruthFiles datasetCaseTruth(const fs::path& ds, const std::string& id) {
   for (const auto* f : {&t.mask, &t.centerline, &t.radius})
     if (!fs::is_regular_file(*f)) throw InputError(f->string(), 0, "missing: the dataset is incomplete (run `angiosynth dataset verify`)");
   if (fs::is_regular_file(file("edges", ".csv")) && fs::is_regular_file(file("nodes", ".csv"))) t.edges = file("edges", ".csv");
+  if (fs::is_regular_file(file("keypoints", ".csv"))) t.keypoints = file("keypoints", ".csv");
   return t;
 }
 

@@ -33,21 +33,35 @@ int vertexTerm(const int c[2][2][2]) {
   return 8 * (cubes > 0) - 4 * edges + 2 * faces - cubes;
 }
 
+// The change of a vertex's term when the cube at c[0][0][0] goes, for each configuration of the
+// other seven (bit a + 2b + 4d), computed once.
+const std::array<int, 256>& vertexChange() {
+  static const std::array<int, 256> table = [] {
+    std::array<int, 256> t{};
+    for (int bits = 0; bits < 256; bits += 2) {
+      int c[2][2][2];
+      for (int q = 0; q < 8; ++q) c[q & 1][(q >> 1) & 1][q >> 2] = (bits >> q) & 1;
+      c[0][0][0] = 1;
+      const int with = vertexTerm(c);
+      c[0][0][0] = 0;
+      t[std::size_t(bits)] = with - vertexTerm(c);
+    }
+    return t;
+  }();
+  return table;
+}
+
 // Removing the centre leaves the Euler characteristic unchanged (Lee's condition 1): the
 // change is the sum over the 8 vertices of the centre's cube.
 bool eulerInvariant(const Neighbourhood& n) {
+  const auto& table = vertexChange();
   int change = 0;
   for (int sx = -1; sx <= 1; sx += 2)
     for (int sy = -1; sy <= 1; sy += 2)
       for (int sz = -1; sz <= 1; sz += 2) {
-        int c[2][2][2];
-        for (int a = 0; a < 2; ++a)
-          for (int b = 0; b < 2; ++b)
-            for (int d = 0; d < 2; ++d) c[a][b][d] = n[std::size_t(at(a * sx, b * sy, d * sz))];
-        c[0][0][0] = 1;
-        const int with = vertexTerm(c);
-        c[0][0][0] = 0;
-        change += with - vertexTerm(c);
+        int bits = 0;
+        for (int q = 1; q < 8; ++q) bits |= n[std::size_t(at((q & 1) * sx, ((q >> 1) & 1) * sy, (q >> 2) * sz))] << q;
+        change += table[std::size_t(bits)];
       }
   return change == 0;
 }
