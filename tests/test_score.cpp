@@ -12,6 +12,7 @@
 #include "io/nifti_reader.hpp"
 #include "io/volume_writers.hpp"
 #include "score/betti.hpp"
+#include "score/calibre_plot.hpp"
 #include "score/case_scores.hpp"
 #include "score/skeleton.hpp"
 
@@ -363,6 +364,30 @@ print('mask', int(m.sum()), 'skeleton', int(ref.sum()), 'different', int((ref !=
     EXPECT_GT(skeleton, 10) << mask;
     EXPECT_LT(skeleton, mask_voxels) << mask;  // not vacuous: thinning removed voxels
   }
+}
+
+}  // namespace
+
+namespace {
+
+// The calibre plot puts each curve's points where its recall says, in its colour, and leaves a
+// bin without voxels empty.
+TEST(Score, CalibrePlotDrawsEachCurveAtItsRecall) {
+  const CalibreCurve a{{0, 0.5, 1, 2}, {0.0, 0.5, 1.0, NAN}}, b{{0, 0.5, 1, 2}, {1.0, 1.0, 1.0, 1.0}};
+  const Image8 img = plotCalibreCurves({a, b});
+  ASSERT_EQ(img.channels, 3);
+  // The plot area: 720 × 440 with margins 90 left, 110 right, 30 top, 80 bottom (4 bins).
+  const auto rgb = [&](int x, int y) {
+    const auto* p = &img.pixels[(std::size_t(y) * img.width + x) * 3];
+    return (std::uint32_t(p[0]) << 16) | (std::uint32_t(p[1]) << 8) | p[2];
+  };
+  const int pw = 720 - 90 - 110, ph = 440 - 30 - 80;
+  const auto px = [&](int bin) { return 90 + int((bin + 0.5) * pw / 4.0); };
+  const auto py = [&](double r) { return 30 + int((1 - r) * ph); };
+  EXPECT_EQ(rgb(px(1), py(0.5)), 0xD62728u);   // curve 1 at recall 0.5
+  EXPECT_EQ(rgb(px(0), py(0.0) - 2), 0xD62728u);
+  EXPECT_EQ(rgb(px(3), py(1.0)), 0x1F77B4u);   // curve 2 (drawn last) at recall 1
+  EXPECT_EQ(rgb(px(3), py(0.6)), 0xFFFFFFu);   // curve 1 has no point in its empty bin (0.6: off the grid lines)
 }
 
 }  // namespace

@@ -1,13 +1,16 @@
 // `angiosynth score PRED SAMPLE_DIR`: a segmentation scored against a generated sample's exact
 // truth (src/score). Thin: options, the files, the report.
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "io/text_file.hpp"
 #include "score/case_scores.hpp"
+#include "score/calibre_plot.hpp"
 #include "score/dataset_scores.hpp"
+#include "io/volume_writers.hpp"
 
 namespace angiosynth::cli {
 
@@ -46,7 +49,8 @@ CLI::App* addScore(CLI::App& app, ScoreArgs& a) {
   c->add_option("--bins-voxels", a.bins_voxels, "calibre bins: increasing lower edges of the radius in voxels (default 0 0.5 1 2 4)")
       ->expected(1, 64);
   c->add_option("--bins-mm", a.bins_mm, "calibre bins in mm: increasing lower edges of the radius")->expected(1, 64);
-  c->add_flag("--force", a.force, "replace existing --out and --csv files");
+  c->add_option("--plot", a.plot, "also draw the calibre curve (recall by radius in voxels) as a PNG here");
+  c->add_flag("--force", a.force, "replace existing --out, --csv and --plot files");
   addCommonOptions(*c, a.common);
   return c;
 }
@@ -55,6 +59,7 @@ int runScore(const ScoreArgs& a) {
   const auto guard = limitThreads(a.common.threads);
   checkOutput(a.out, a);
   checkOutput(a.csv, a);
+  checkOutput(a.plot, a);
   ScoreOptions opt;
   opt.tolerance_mm = a.tolerance_mm;
   opt.topcow = a.topcow;
@@ -79,6 +84,7 @@ int runScore(const ScoreArgs& a) {
   if (a.out.empty()) std::cout << j.dump(2) << "\n";
   else writeTextFile(a.out, [&](std::ostream& o) { o << j.dump(2) << "\n"; });
   if (!a.csv.empty()) writeTextFile(a.csv, [&](std::ostream& o) { o << csv; });
+  if (!a.plot.empty()) writePng(a.plot, plotCalibreCurves({calibreCurve(j)}));
   if (!a.common.quiet) {
     const Json& s = dataset ? j["summary"] : j;
     const auto show = [&](const char* pointer) {
@@ -92,6 +98,32 @@ int runScore(const ScoreArgs& a) {
       std::cerr << "Dice " << show("/overlap/dice") << ", HD95 " << show("/surface/hd95_mm") << " mm, centreline recall "
                 << show("/centreline/recall") << "\n";
   }
+  return 0;
+}
+
+CLI::App* addPlotCalibre(CLI::App& app, PlotCalibreArgs& a) {
+  auto* c = app.add_subcommand("plot-calibre", "draw the calibre curves of score results (JSON of `angiosynth score`, one case or a "
+                                               "dataset's mean) as one PNG: curve k in colour k, numbered in the legend");
+  c->add_option("OUT", a.out, "the PNG to write")->required();
+  c->add_option("SCORES", a.scores, "score results (.json)")->required()->expected(1, 8);
+  c->add_flag("--force", a.force, "replace an existing OUT");
+  return c;
+}
+
+int runPlotCalibre(const PlotCalibreArgs& a) {
+  if (fs::exists(a.out) && !a.force) throw InputError(a.out, 0, "exists; give --force to replace it");
+  std::vector<CalibreCurve> curves;
+  for (const auto& f : a.scores) {
+    std::ifstream in(f);
+    const Json j = Json::parse(in, nullptr, /*allow_exceptions=*/false);
+    if (j.is_discarded() || !j.is_object()) throw InputError(f, 0, "is not a score result (JSON of angiosynth score)");
+    const CalibreCurve c = calibreCurve(j);
+    if (c.lower.empty()) throw InputError(f, 0, "holds no calibre bins; allowed: the JSON angiosynth score writes");
+    if (!curves.empty() && c.lower != curves.front().lower) throw InputError(f, 0, "has other calibre bins than " + a.scores.front());
+    curves.push_back(c);
+  }
+  writePng(a.out, plotCalibreCurves(curves));
+  for (std::size_t k = 0; k < a.scores.size(); ++k) std::cerr << "curve " << k + 1 << ": " << a.scores[k] << "\n";
   return 0;
 }
 

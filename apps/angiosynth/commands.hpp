@@ -64,6 +64,7 @@ int runDatasetCommand(const DatasetArgs& a, const std::string& command_line);
 struct ScoreArgs {
   std::string prediction, sample, out, csv;
   std::string dataset, predictions;  // --dataset mode
+  std::string plot;
   double tolerance_mm = 0;
   bool topcow = false, force = false;
   std::vector<double> bins_voxels, bins_mm;
@@ -71,5 +72,13 @@ struct ScoreArgs {
 };
 CLI::App* addScore(CLI::App& app, ScoreArgs& a);
 int runScore(const ScoreArgs& a);
+
+struct PlotCalibreArgs {
+  std::string out;
+  std::vector<std::string> scores;
+  bool force = false;
+};
+CLI::App* addPlotCalibre(CLI::App& app, PlotCalibreArgs& a);
+int runPlotCalibre(const PlotCalibreArgs& a);
 
 }  // namespace angiosynth::cli

@@ -31,6 +31,8 @@ int main(int argc, char** argv) {
   auto* in = cli::addInit(app, ia);
   cli::ScoreArgs sa;
   auto* sc = cli::addScore(app, sa);
+  cli::PlotCalibreArgs pc;
+  auto* pl = cli::addPlotCalibre(app, pc);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -45,6 +47,7 @@ int main(int argc, char** argv) {
     if (pm->parsed()) return cli::runParams(pa);
     if (in->parsed()) return cli::runInit(ia);
     if (sc->parsed()) return cli::runScore(sa);
+    if (pl->parsed()) return cli::runPlotCalibre(pc);
     if (fx->parsed()) {
       std::cout << effectReference();
       return 0;

@@ -1,0 +1,145 @@
+#include "score/calibre_plot.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+namespace angiosynth {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+// A 5 × 7 pixel font for the few characters a plot needs (rows top down, bit 4 leftmost).
+const std::map<char, std::array<std::uint8_t, 7>>& font() {
+  static const std::map<char, std::array<std::uint8_t, 7>> f{
+      {'0', {0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E}}, {'1', {0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E}},
+      {'2', {0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F}}, {'3', {0x1E, 0x01, 0x01, 0x0E, 0x01, 0x01, 0x1E}},
+      {'4', {0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02}}, {'5', {0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E}},
+      {'6', {0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E}}, {'7', {0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08}},
+      {'8', {0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E}}, {'9', {0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C}},
+      {'.', {0x00, 0x00, 0x00, 0x00, 0x00, 0x0C, 0x0C}}, {'-', {0x00, 0x00, 0x00, 0x1F, 0x00, 0x00, 0x00}},
+      {' ', {0, 0, 0, 0, 0, 0, 0}},                     {'r', {0x00, 0x00, 0x16, 0x19, 0x10, 0x10, 0x10}},
+      {'e', {0x00, 0x00, 0x0E, 0x11, 0x1F, 0x10, 0x0E}}, {'c', {0x00, 0x00, 0x0E, 0x10, 0x10, 0x11, 0x0E}},
+      {'a', {0x00, 0x00, 0x0E, 0x01, 0x0F, 0x11, 0x0F}}, {'l', {0x0C, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E}},
+      {'d', {0x01, 0x01, 0x0D, 0x13, 0x11, 0x11, 0x0F}}, {'i', {0x04, 0x00, 0x0C, 0x04, 0x04, 0x04, 0x0E}},
+      {'u', {0x00, 0x00, 0x11, 0x11, 0x11, 0x13, 0x0D}}, {'s', {0x00, 0x00, 0x0E, 0x10, 0x0E, 0x01, 0x1E}},
+      {'v', {0x00, 0x00, 0x11, 0x11, 0x11, 0x0A, 0x04}}, {'o', {0x00, 0x00, 0x0E, 0x11, 0x11, 0x11, 0x0E}},
+      {'x', {0x00, 0x00, 0x11, 0x0A, 0x04, 0x0A, 0x11}}, {'n', {0x00, 0x00, 0x16, 0x19, 0x11, 0x11, 0x11}}};
+  return f;
+}
+
+struct Canvas {
+  Image8 img;
+  Canvas(int w, int h) {
+    img.width = w, img.height = h, img.channels = 3;
+    img.pixels.assign(std::size_t(w) * h * 3, 255);
+  }
+  void dot(int x, int y, std::uint32_t rgb) {
+    if (x < 0 || y < 0 || x >= img.width || y >= img.height) return;
+    auto* p = &img.pixels[(std::size_t(y) * img.width + x) * 3];
+    p[0] = std::uint8_t(rgb >> 16), p[1] = std::uint8_t(rgb >> 8), p[2] = std::uint8_t(rgb);
+  }
+  void box(int x0, int y0, int x1, int y1, std::uint32_t rgb) {
+    for (int y = std::min(y0, y1); y <= std::max(y0, y1); ++y)
+      for (int x = std::min(x0, x1); x <= std::max(x0, x1); ++x) dot(x, y, rgb);
+  }
+  void line(int x0, int y0, int x1, int y1, std::uint32_t rgb, int width) {
+    const int n = std::max({std::abs(x1 - x0), std::abs(y1 - y0), 1});
+    for (int s = 0; s <= n; ++s) {
+      const int x = x0 + (x1 - x0) * s / n, y = y0 + (y1 - y0) * s / n;
+      box(x - width / 2, y - width / 2, x + (width - 1) / 2, y + (width - 1) / 2, rgb);
+    }
+  }
+  // Text at scale 2, left edge x (or centred on x), top y; `vertical` runs bottom up.
+  void text(const std::string& s, int x, int y, bool centred = false, bool vertical = false) {
+    const int scale = 2, advance = 6 * scale, len = int(s.size()) * advance;
+    if (centred) (vertical ? y : x) += (vertical ? len : -len) / 2;
+    for (std::size_t c = 0; c < s.size(); ++c) {
+      const auto it = font().find(s[c]);
+      if (it == font().end()) continue;
+      for (int row = 0; row < 7; ++row)
+        for (int col = 0; col < 5; ++col) {
+          if (!((it->second[std::size_t(row)] >> (4 - col)) & 1)) continue;
+          const int u = int(c) * advance + col * scale, v = row * scale;
+          if (vertical) box(x + v, y - u, x + v + scale - 1, y - u - scale + 1, 0x000000);
+          else box(x + u, y + v, x + u + scale - 1, y + v + scale - 1, 0x000000);
+        }
+    }
+  }
+};
+
+std::string label(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
+
+}  // namespace
+
+CalibreCurve calibreCurve(const Json& scores) {
+  CalibreCurve c;
+  if (scores.contains("calibre")) {
+    for (const auto& b : scores["calibre"]) {
+      c.lower.push_back(b["radius_voxels"][0].get<double>());
+      c.recall.push_back(b["recall"].is_number() ? b["recall"].get<double>() : NAN);
+    }
+    return c;
+  }
+  // A dataset: the mean per bin over the cases where the bin holds voxels.
+  if (scores.contains("per_case") && !scores["per_case"].empty()) {
+    const auto& first = scores["per_case"][0]["calibre"];
+    std::vector<double> sum(first.size(), 0);
+    std::vector<int> n(first.size(), 0);
+    for (const auto& cs : scores["per_case"])
+      for (std::size_t b = 0; b < std::min(first.size(), cs["calibre"].size()); ++b)
+        if (cs["calibre"][b]["recall"].is_number()) sum[b] += cs["calibre"][b]["recall"].get<double>(), ++n[b];
+    for (std::size_t b = 0; b < first.size(); ++b) {
+      c.lower.push_back(first[b]["radius_voxels"][0].get<double>());
+      c.recall.push_back(n[b] ? sum[b] / n[b] : NAN);
+    }
+  }
+  return c;
+}
+
+Image8 plotCalibreCurves(const std::vector<CalibreCurve>& curves) {
+  static const std::uint32_t colours[] = {0xD62728, 0x1F77B4, 0x2CA02C, 0xFF7F0E, 0x9467BD, 0x8C564B, 0x17BECF, 0x7F7F7F};
+  const int W = 720, H = 440, left = 90, right = 110, top = 30, bottom = 80;
+  Canvas c(W, H);
+  const int pw = W - left - right, ph = H - top - bottom;
+  std::size_t bins = 0;
+  for (const auto& cv : curves) bins = std::max(bins, cv.lower.size());
+  const auto px = [&](std::size_t b) { return left + int((b + 0.5) * pw / double(std::max<std::size_t>(bins, 1))); };
+  const auto py = [&](double r) { return top + int((1 - r) * ph); };
+  for (int k = 0; k <= 4; ++k) c.line(left, py(k / 4.0), left + pw, py(k / 4.0), 0xE0E0E0, 1);  // grid
+  c.line(left, top, left, top + ph, 0x000000, 2);
+  c.line(left, top + ph, left + pw, top + ph, 0x000000, 2);
+  for (double r : {0.0, 0.5, 1.0}) c.text(label(r), left - 14 - int(label(r).size()) * 12, py(r) - 7);
+  if (!curves.empty())
+    for (std::size_t b = 0; b < curves.front().lower.size(); ++b) {  // each bin's lower edge, at the bin's start
+      const int x = left + int(double(b) * pw / double(std::max<std::size_t>(bins, 1)));
+      c.line(x, top + ph, x, top + ph + 6, 0x000000, 2);
+      c.text(label(curves.front().lower[b]), x - int(label(curves.front().lower[b]).size()) * 6, top + ph + 12);
+    }
+  c.text("radius in voxels", left + pw / 2, H - 34, true);
+  c.text("recall", 20, top + ph / 2, true, true);
+  for (std::size_t k = 0; k < curves.size(); ++k) {
+    const auto colour = colours[k % 8];
+    const auto& cv = curves[k];
+    int last_x = -1, last_y = -1;
+    for (std::size_t b = 0; b < cv.recall.size(); ++b) {
+      if (!std::isfinite(cv.recall[b])) continue;
+      const int x = px(b), y = py(std::clamp(cv.recall[b], 0.0, 1.0));
+      if (last_x >= 0) c.line(last_x, last_y, x, y, colour, 3);
+      c.box(x - 4, y - 4, x + 4, y + 4, colour);
+      last_x = x, last_y = y;
+    }
+    // Legend: the curve's number beside its colour.
+    const int ly = top + 10 + int(k) * 24;
+    c.box(W - right + 20, ly, W - right + 34, ly + 14, colour);
+    c.text(std::to_string(k + 1), W - right + 42, ly);
+  }
+  return c.img;
+}
+
+}  // namespace angiosynth
