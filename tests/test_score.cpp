@@ -391,3 +391,43 @@ TEST(Score, CalibrePlotDrawsEachCurveAtItsRecall) {
 }
 
 }  // namespace
+
+namespace {
+
+// Per class: an artery-vein forest scored with its own classes as the prediction (each class
+// perfect), with the labels swapped (each class 0), and as a binary prediction (recall only).
+TEST_F(ScoreRun, PerClassScoresTellArteryFromVein) {
+  std::ofstream(dir_ / "av.toml") << "seed = 5\n[domain]\nshape = \"sphere\"\nradius = \"8 mm\"\nvoxel_size = \"0.25 mm\"\n"
+                                     "[tree]\nmethod = \"cco\"\nterminals = 80\n"
+                                     "[[tree.inlet]]\nkind = \"artery\"\nroot_offset = [-1.5, 7.8, 0]\n"
+                                     "[[tree.inlet]]\nkind = \"vein\"\nroot_offset = [1.5, 7.8, 0]\n"
+                                     "[physics]\nperfusion_pressure = \"100 mmHg\"\nterminal_pressure = \"60 mmHg\"\nperfusion_flow = \"20 mL/min\"\n"
+                                     "[image]\nformats = [\"nifti\"]\n";
+  ASSERT_EQ(run("generate av.toml --out s --quiet", dir_).code, 0);
+  const NiftiVolume cls = readNiftiVolume(dir_ / "s/classes.nii.gz", 1ULL << 32, 4, "classes");
+  Volume<std::uint8_t> same(cls.values.grid), swapped(cls.values.grid), binary(cls.values.grid);
+  for (std::size_t i = 0; i < same.data.size(); ++i) {
+    const auto c = std::uint8_t(std::lround(cls.values.data[i]));
+    same.data[i] = c;
+    swapped.data[i] = c == 1 ? 2 : c == 2 ? 1 : 0;
+    binary.data[i] = c > 0;
+  }
+  writeNifti(dir_ / "same.nii.gz", viewOf(same, true, "kinds"));
+  writeNifti(dir_ / "swapped.nii.gz", viewOf(swapped, true, "kinds swapped"));
+  writeNifti(dir_ / "binary.nii.gz", viewOf(binary, true, "binary"));
+  for (const std::string p : {"same", "swapped", "binary"}) {
+    ASSERT_EQ(run("score " + p + ".nii.gz s --out " + p + ".json --quiet", dir_).code, 0) << p;
+    const Json j = Json::parse(slurp(dir_ / (p + ".json")));
+    ASSERT_TRUE(j.contains("per_class")) << p;
+    for (const char* kind : {"artery", "vein"}) {
+      const Json& c = j["per_class"]["classes"][kind];
+      const double want = p == "swapped" ? 0.0 : 1.0;
+      EXPECT_EQ(c["overlap"]["recall"].get<double>(), want) << p << " " << kind;
+      EXPECT_EQ(c["centreline"]["recall"].get<double>(), want) << p << " " << kind;
+      EXPECT_EQ(c["overlap"].contains("dice"), p != "binary") << p << " " << kind;
+      EXPECT_GT(c["centreline"]["voxels"].get<int>(), 50) << kind;
+    }
+  }
+}
+
+}  // namespace

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 
 #include "core/distance_transform.hpp"
 #include "core/error.hpp"
@@ -266,6 +267,26 @@ Json vesselDetection(const Volume<std::uint8_t>& pred, const VascularTree& t) {
 
 }  // namespace
 
+std::map<int, std::string> classLegend(const nlohmann::ordered_json& sample) {
+  std::map<int, std::string> legend;
+  if (sample.contains("classes") && sample["classes"].is_object())
+    for (const auto& [k, v] : sample["classes"].items()) {
+      if (!v.is_string()) continue;
+      try {
+        const int value = std::stoi(k);
+        if (value > 0 && value < 256) legend[value] = v.get<std::string>();
+      } catch (const std::exception&) {
+      }
+    }
+  return legend;
+}
+
+std::map<int, std::string> classLegend(const std::filesystem::path& sample_json) {
+  std::ifstream in(sample_json);
+  const Json j = Json::parse(in, nullptr, /*allow_exceptions=*/false);
+  return j.is_discarded() ? std::map<int, std::string>{} : classLegend(j);
+}
+
 TruthFiles sampleTruth(const std::filesystem::path& dir) {
   if (!std::filesystem::is_directory(dir)) throw InputError(dir.string(), 0, "is not a directory; allowed: a sample directory angiosynth generate wrote");
   const auto need = [&](const char* name) {
@@ -274,9 +295,15 @@ TruthFiles sampleTruth(const std::filesystem::path& dir) {
       throw InputError(dir.string(), 0, std::string("no ") + name + " in the sample directory; allowed: a directory angiosynth generate wrote (with volumes)");
     return f;
   };
-  TruthFiles t{need("mask.nii.gz"), need("centerline.nii.gz"), need("radius.nii.gz"), {}, {}, dir.string()};
+  TruthFiles t;
+  t.mask = need("mask.nii.gz"), t.centerline = need("centerline.nii.gz"), t.radius = need("radius.nii.gz");
+  t.name = dir.string();
   if (std::filesystem::is_regular_file(dir / "edges.csv") && std::filesystem::is_regular_file(dir / "nodes.csv")) t.edges = dir / "edges.csv";
   if (std::filesystem::is_regular_file(dir / "keypoints.csv")) t.keypoints = dir / "keypoints.csv";
+  if (std::filesystem::is_regular_file(dir / "classes.nii.gz") && std::filesystem::is_regular_file(dir / "sample.json")) {
+    t.classes = dir / "classes.nii.gz";
+    t.legend = classLegend(dir / "sample.json");
+  }
   return t;
 }
 
@@ -331,6 +358,36 @@ Json scoreCase(const std::filesystem::path& pred_file, const TruthFiles& files, 
   j["calibre"] = calibreRecall(p, t, centre.values, radius.values, opt.bins_voxels, voxel, "voxels");
   if (!opt.bins_mm.empty()) j["calibre_mm"] = calibreRecall(p, t, centre.values, radius.values, opt.bins_mm, 1.0, "mm");
   if (!files.edges.empty()) j["vessels"] = vesselDetection(p, readNetwork(files.edges).tree);
+  if (!files.classes.empty() && files.legend.size() >= 2) {
+    const NiftiVolume cls = readNiftiVolume(files.classes, opt.memory_limit, kBytesPerVoxel, "the truth classes");
+    checkSameGrid(cls, truth, files.classes.string(), mask_file.string());
+    // A prediction labelled by kind (values above 1) is scored class by class; a binary one only
+    // by what each class of the truth keeps (recall, centreline, calibre).
+    const bool labelled = std::any_of(pred.values.data.begin(), pred.values.data.end(), [](float v) { return v > 1.5f; });
+    Json per = Json::object();
+    for (const auto& [value, name] : files.legend) {
+      Volume<std::uint8_t> pk(g), tk(g);
+      Volume<float> ck(g);
+      for (std::size_t i = 0; i < pk.data.size(); ++i) {
+        tk.data[i] = std::lround(cls.values.data[i]) == value;
+        pk.data[i] = labelled ? std::lround(pred.values.data[i]) == value : p.data[i];
+        ck.data[i] = tk.data[i] ? centre.values.data[i] : 0.0f;
+      }
+      Json c{{"label", value}};
+      Json ov = overlapScores(pk, tk, opt.topcow);
+      if (!labelled) ov = Json{{"recall", ov["recall"]}};
+      c["overlap"] = ov;
+      if (labelled) c["surface"] = surfaceScores(pk, tk, tau, opt.topcow);
+      std::int64_t n = 0, hit = 0;
+      for (std::size_t i = 0; i < ck.data.size(); ++i)
+        if (ck.data[i] > 0) ++n, hit += pk.data[i] != 0;
+      c["centreline"] = Json{{"voxels", n}, {"recall", ratio(double(hit), double(n))}};
+      c["calibre"] = calibreRecall(pk, tk, ck, radius.values, opt.bins_voxels, voxel, "voxels");
+      per[name] = c;
+    }
+    j["per_class"] = Json{{"prediction", labelled ? "labelled by kind (the truth's class values)" : "binary: recall-type scores only"},
+                          {"classes", per}};
+  }
   j["definitions"] = Json{
       {"prediction", "voxels > 0 are vessel"},
       {"truth", "the sample's mask.nii.gz (partial volume >= 0.5 or crossed by a centreline)"},
@@ -348,6 +405,9 @@ Json scoreCase(const std::filesystem::path& pred_file, const TruthFiles& files, 
                     "cluster of voxels with 3 or more: one bifurcation at its centroid) against the truth graph's bifurcations and "
                     "endpoints (terminals and roots, keypoints.csv), matched one to one closest first within max(2 voxels, the truth "
                     "point's radius); precision, recall, F1"},
+      {"per_class", "with a truth of several kinds (classes.nii.gz, its legend in sample.json): each class's voxels against the "
+                    "prediction's voxels of that value (a prediction labelled by kind), or, for a binary prediction, the share of each "
+                    "class the prediction covers (recall, centreline recall, calibre)"},
       {"centreline", "share of the exact centreline's voxels (centerline.nii.gz) in the prediction: clDice's topology sensitivity with the exact skeleton"},
       {"calibre", "centreline voxels binned by the exact radius there (radius.nii.gz; in voxels of the smallest edge, or mm): recall = share in "
                   "the prediction, truth_coverage = share in the truth mask"},

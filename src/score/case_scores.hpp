@@ -5,6 +5,8 @@
 // is written into the result.
 #include <cstdint>
 #include <filesystem>
+#include <map>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -51,7 +53,14 @@ double percentile95(std::vector<double> values);
 struct TruthFiles {
   std::filesystem::path mask, centerline, radius, edges, keypoints;  // edges, keypoints: optional
   std::string name;  // how the output names the truth
+  // Optional: the kind of each mask voxel and the legend of its values (1 artery, 2 vein, …).
+  std::filesystem::path classes;
+  std::map<int, std::string> legend;
 };
+// The legend of the classes volume from a sample.json ({"1": "artery", …}; background left out).
+std::map<int, std::string> classLegend(const nlohmann::ordered_json& sample);
+std::map<int, std::string> classLegend(const std::filesystem::path& sample_json);
+
 // The files of a sample directory `generate` wrote (mask.nii.gz, centerline.nii.gz, …).
 TruthFiles sampleTruth(const std::filesystem::path& sample_dir);
 

@@ -103,7 +103,9 @@ TruthFiles datasetCaseTruth(const fs::path& ds, const std::string& id) {
     for (const auto& [name, rec] : sample["degradation"].items())
       if (fs::exists(g / ("centerline_" + name + ".nii.gz"))) suffix = "_" + name;
   const auto file = [&](const std::string& stem, const char* ext) { return g / (stem + suffix + ext); };
-  TruthFiles t{file("mask", ".nii.gz"), file("centerline", ".nii.gz"), file("radius", ".nii.gz"), {}, {}, (ds.filename() / "groundtruth" / id).string()};
+  TruthFiles t;
+  t.mask = file("mask", ".nii.gz"), t.centerline = file("centerline", ".nii.gz"), t.radius = file("radius", ".nii.gz");
+  t.name = (ds.filename() / "groundtruth" / id).string();
   if (!fs::is_regular_file(t.mask)) {
     // Moved into labelsTr: the dataset's labels are the mask (binary labels).
     const Json spec = readJson(ds / "spec.json");
@@ -117,6 +119,10 @@ TruthFiles datasetCaseTruth(const fs::path& ds, const std::string& id) {
     if (!fs::is_regular_file(*f)) throw InputError(f->string(), 0, "missing: the dataset is incomplete (run `angiosynth dataset verify`)");
   if (fs::is_regular_file(file("edges", ".csv")) && fs::is_regular_file(file("nodes", ".csv"))) t.edges = file("edges", ".csv");
   if (fs::is_regular_file(file("keypoints", ".csv"))) t.keypoints = file("keypoints", ".csv");
+  // Kinds: the classes volume where the case keeps it, else labelsTr when it holds the classes.
+  t.legend = classLegend(sample);
+  if (fs::is_regular_file(file("classes", ".nii.gz"))) t.classes = file("classes", ".nii.gz");
+  else if (meta.contains("label_values") && !meta["label_values"].contains("vessel")) t.classes = ds / "labelsTr" / (id + ".nii.gz");
   return t;
 }
 
