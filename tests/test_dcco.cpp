@@ -298,6 +298,7 @@ TEST_P(DccoExample, TreeMeetsEveryConstraintOfItsStages) {
 
 INSTANTIATE_TEST_SUITE_P(Shipped, DccoExample,
                          ::testing::Values("dcco_scale_specific_2d.toml", "dcco_hierarchical_2d.toml", "dcco_pdf_mixture_2d.toml",
+                                           "dcco_pdf_uniform_2d.toml", "dcco_pdf_gaussian_2d.toml",
                                            "dcco_sphere_pries_3d.toml", "dcco_outlet_half_2d.toml", "dcco_outlet_most_2d.toml",
                                            "dcco_two_inlets_2d.toml", "dcco_two_inlets_3d.toml", "dcco_sequential_2d.toml",
                                            "dcco_brain_shell_3d.toml"),
