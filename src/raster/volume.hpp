@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <sys/mman.h>
+
 #include "core/vec3.hpp"
 
 namespace angiosynth {
@@ -33,6 +35,18 @@ struct VolumeGrid {
   bool operator==(const VolumeGrid&) const = default;
 };
 
+// Large volumes in transparent huge pages where the system allows it: a voxel read before it is
+// written maps the shared zero page, and the write that follows then costs a page fault and a TLB
+// flush on every core, per 4 KiB page; per 2 MiB page this is 512 times rarer (the rasteriser's
+// centreline pass spent a third of its time there).
+inline void adviseHugePages(void* p, std::size_t bytes) {
+  constexpr std::size_t kHuge = std::size_t(2) << 20;
+  if (bytes < 4 * kHuge) return;
+  const auto begin = (reinterpret_cast<std::uintptr_t>(p) + kHuge - 1) & ~(kHuge - 1);
+  const auto end = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kHuge - 1);
+  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+}
+
 // Allocates zeroed memory with calloc and skips value-initialisation, so a mostly empty volume
 // costs no time and no resident memory until its voxels are written (the kernel hands out zero
 // pages lazily); zero-filling a 512³ float volume otherwise takes most of a second.
@@ -43,7 +57,10 @@ struct ZeroAllocator {
   template <class U>
   ZeroAllocator(const ZeroAllocator<U>&) {}
   T* allocate(std::size_t n) {
-    if (void* p = std::calloc(n, sizeof(T))) return static_cast<T*>(p);
+    if (void* p = std::calloc(n, sizeof(T))) {
+      adviseHugePages(p, n * sizeof(T));
+      return static_cast<T*>(p);
+    }
     throw std::bad_alloc();
   }
   void deallocate(T* p, std::size_t) { std::free(p); }
