@@ -1,5 +1,7 @@
 #include "pipeline/degraded_outputs.hpp"
 
+#include <optional>
+
 #include "degrade/degrade.hpp"
 #include "io/graph_writers.hpp"
 #include "io/text_file.hpp"
@@ -54,17 +56,16 @@ void writeDegradedImages(const Forest& forest, const std::vector<std::uint8_t>& 
       Label label;
       if (ip.labels.perProfile() || (ip.labels.writesLabel() && d.labels)) {
         const GroundTruthVolumes& truth = d.labels ? *d.labels : gt;
-        Json& rec = d.record["label"];
+        std::optional<ProfileVisibility> vis;  // visible: this image's contrast and noise
+        VisibilityEvidence evidence;
         if (ip.labels.perProfile()) {
-          const ProfileVisibility vis = profileVisibility(profile, in, d.image, truth.fraction);
-          const VisibilityEvidence evidence{&vis.contrast, vis.noise_sigma};
-          label = makeLabel(ip.labels, truth, req.label_numbering, &evidence);
-          rec["noise_sigma"] = vis.noise_sigma;
-        } else {
-          label = makeLabel(ip.labels, truth, req.label_numbering);
+          vis = profileVisibility(profile, in, d.image, truth.fraction);
+          evidence = {&vis->contrast, vis->noise_sigma};
         }
-        const Json kept = labelLengthKept(label, ip.labels, req.label_numbering, d.tree ? *d.tree : forest.vessels);
-        for (const auto& [k, v] : kept.items()) rec[k] = v;
+        label = makeLabel(ip.labels, truth, req.label_numbering, vis ? &evidence : nullptr);
+        Json& rec = d.record["label"];
+        rec = labelLengthKept(label, ip.labels, req.label_numbering, d.tree ? *d.tree : forest.vessels);
+        if (vis) rec["noise_sigma"] = vis->noise_sigma;
         channels.push_back(labelChannel(label, ip.labels, "label" + suffix));
       }
       writeChannels(channels, ip.formats, dir, files);

@@ -119,9 +119,15 @@ void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::fil
     makeTypedImage(image, gt.fraction, ip.background, ip.vessel - ip.background, ip.dtype, "angiosynth image");
     std::vector<Channel> channels{{"image", image.view}};
     for (auto& c : labelChannels(gt, "")) channels.push_back(c);
-    const Label label = makeLabel(ip.labels, gt, req.label_numbering);
-    if (ip.labels.writesLabel()) channels.push_back(labelChannel(label, ip.labels, "label"));
-    stats["label"] = labelLengthKept(label, ip.labels, req.label_numbering, tree);
+    // The binary label is the mask: its record needs no copy of it.
+    Label label;
+    if (ip.labels.writesLabel()) {
+      label = makeLabel(ip.labels, gt, req.label_numbering);
+      channels.push_back(labelChannel(label, ip.labels, "label"));
+      stats["label"] = labelLengthKept(label, ip.labels, req.label_numbering, tree);
+    } else {
+      stats["label"] = labelLengthKept(&gt.mask, nullptr, ip.labels, req.label_numbering, tree);
+    }
     writeChannels(channels, ip.formats, dir, files);
     if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end()) writeMips(gt.fraction, previewClasses(forest.trees, gt), 0, 1, "", dir, files);
     if (req.slices) writeSlices(image.view, gt.fraction, 0, 1, req.slice_dir, "original_image", req.slice_format, dir, files);

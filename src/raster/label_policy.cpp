@@ -88,7 +88,12 @@ Label makeLabel(const LabelPolicy& p, const GroundTruthVolumes& gt, const LabelN
 }
 
 Json labelLengthKept(const Label& label, const LabelPolicy& p, const LabelNumbering& n, const VascularTree& t) {
-  const VolumeGrid& g = p.isSoft() ? label.soft.grid : label.values.grid;
+  return p.isSoft() ? labelLengthKept(nullptr, &label.soft, p, n, t) : labelLengthKept(&label.values, nullptr, p, n, t);
+}
+
+Json labelLengthKept(const Volume<std::uint8_t>* values, const Volume<float>* soft, const LabelPolicy& p, const LabelNumbering& n,
+                     const VascularTree& t) {
+  const VolumeGrid& g = soft ? soft->grid : values->grid;
   const double h = std::min({g.spacing_mm.x, g.spacing_mm.y, g.spacing_mm.z});
   constexpr int kBins = int(kBinLower.size());
   // Per segment and bin: length inside the grid, length on vessel labels (or Σ soft value ×
@@ -113,10 +118,10 @@ Json labelLengthKept(const Label& label, const LabelPolicy& p, const LabelNumber
         const int bin = calibreBin(radius / h);
         acc[3 * bin] += piece;
         const std::int64_t v = g.flat(i, j, kk);
-        if (p.isSoft()) {
-          acc[3 * bin + 1] += piece * label.soft.data[v];
+        if (soft) {
+          acc[3 * bin + 1] += piece * soft->data[v];
         } else {
-          const std::uint8_t l = label.values.data[v];
+          const std::uint8_t l = values->data[v];
           if (l == n.ignore_value && p.name == "ignore") acc[3 * bin + 2] += piece;
           else if (l) acc[3 * bin + 1] += piece;
         }

@@ -62,5 +62,9 @@ Label makeLabel(const LabelPolicy& p, const GroundTruthVolumes& gt, const LabelN
 // in voxels (the smallest edge). For soft labels the mean label value along the centreline.
 nlohmann::ordered_json labelLengthKept(const Label& label, const LabelPolicy& p, const LabelNumbering& n,
                                        const VascularTree& tree);
+// The same on label values held elsewhere (`values`, or `soft` for the soft policy): the binary
+// label is the mask itself and needs no copy.
+nlohmann::ordered_json labelLengthKept(const Volume<std::uint8_t>* values, const Volume<float>* soft, const LabelPolicy& p,
+                                       const LabelNumbering& n, const VascularTree& tree);
 
 }  // namespace angiosynth

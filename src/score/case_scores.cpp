@@ -21,9 +21,6 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
-// A ratio, or null when its denominator is 0 (undefined).
-Json ratio(double num, double den) { return den > 0 ? Json(num / den) : Json(nullptr); }
-
 Volume<std::uint8_t> binary(const Volume<float>& v) {
   Volume<std::uint8_t> out(v.grid);
   for (std::size_t i = 0; i < v.data.size(); ++i) out.data[i] = v.data[i] > 0;
@@ -33,6 +30,8 @@ Volume<std::uint8_t> binary(const Volume<float>& v) {
 double smallestEdge(const VolumeGrid& g) { return std::min({g.spacing_mm.x, g.spacing_mm.y, g.spacing_mm.z}); }
 
 }  // namespace
+
+Json ratio(double num, double den) { return den > 0 ? Json(num / den) : Json(nullptr); }
 
 Json overlapScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, bool topcow) {
   std::int64_t tp = 0, fp = 0, fn = 0;

@@ -23,6 +23,9 @@ struct ScoreOptions {
   std::uint64_t memory_limit = 0;
 };
 
+// A ratio, or null when its denominator is 0 (undefined): how every score states an empty case.
+nlohmann::ordered_json ratio(double num, double den);
+
 // Overlap of two binary volumes on one grid: tp, fp, fn, Dice, Jaccard, precision, recall.
 nlohmann::ordered_json overlapScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, bool topcow);
 

@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "io/text_lines.hpp"
+#include "score/case_scores.hpp"
 
 namespace angiosynth {
 
@@ -105,7 +106,6 @@ nlohmann::ordered_json matchKeyPoints(const std::vector<KeyPoint>& pred, const s
   std::int64_t matched = 0;
   for (const auto& [d, t, p] : pairs)
     if (!t_used[t] && !p_used[p]) t_used[t] = p_used[p] = true, ++matched;
-  const auto ratio = [](double a, double b) { return b > 0 ? nlohmann::ordered_json(a / b) : nlohmann::ordered_json(nullptr); };
   nlohmann::ordered_json j{{"truth", truth.size()}, {"predicted", pred.size()}, {"matched", matched},
                            {"precision", ratio(double(matched), double(pred.size()))},
                            {"recall", ratio(double(matched), double(truth.size()))}};
