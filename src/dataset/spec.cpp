@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <fstream>
 #include <sstream>
@@ -41,6 +42,13 @@ struct Quantity {
   std::string unit;  // empty for a plain number
   bool integer = false;
 };
+
+// toml++'s value<int64_t>() converts a float node by a cast that is undefined
+// beyond the int64 range (found by fuzzing), so only integer nodes are read.
+std::optional<std::int64_t> wholeNumber(const toml::node& n) {
+  if (!n.is_integer()) return std::nullopt;
+  return n.as_integer()->get();
+}
 
 Quantity quantityOf(const toml::node& n, const std::string& file, const std::string& what) {
   Quantity q;
@@ -261,13 +269,13 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
   };
   s.name = need("name").value_or<std::string>("");
   if (!validName(s.name)) throw InputError(s.file, lineOf(need("name")), "name must be letters, digits, '-' or '_' (no dots or spaces)");
-  const auto id = need("id").value<std::int64_t>();
+  const auto id = wholeNumber(need("id"));
   if (!id || *id < 1 || *id > 999) throw InputError(s.file, lineOf(need("id")), "id must be a whole number in 1…999 (nnU-Net's DatasetNNN)");
   s.id = static_cast<int>(*id);
-  const auto n = need("samples").value<std::int64_t>();
+  const auto n = wholeNumber(need("samples"));
   if (!n || *n < 1 || *n > 100000000) throw InputError(s.file, lineOf(need("samples")), "samples must be a whole number in 1…10^8");
   s.samples = *n;
-  const auto seed = need("seed").value<std::int64_t>();
+  const auto seed = wholeNumber(need("seed"));
   if (!seed || *seed < 0) throw InputError(s.file, lineOf(need("seed")), "seed must be a whole number >= 0");
   s.seed = static_cast<std::uint64_t>(*seed);
   if (const auto* c = d.get("channel_name")) {
