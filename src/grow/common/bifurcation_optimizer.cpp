@@ -49,21 +49,48 @@ double BifurcationOptimizer::costAt(std::int32_t s, const Vec3& b, const Vec3& t
 }
 
 bool BifurcationOptimizer::admissible(std::int32_t s, const Vec3& b, const Vec3& term) const {
+  return admissible(s, b, term, {min_length_, min_length_, min_length_});
+}
+
+bool BifurcationOptimizer::admissible(std::int32_t s, const Vec3& b, const Vec3& term, const MinLengths& m) const {
   const Vec3& p = tree_.position[tree_.parent[s]];
   const Vec3& o = tree_.position[s];
-  if (distance(p, b) < min_length_ || distance(b, o) < min_length_ || distance(b, term) < min_length_) return false;
+  if (distance(p, b) < m[0] || distance(b, o) < m[1] || distance(b, term) < m[2]) return false;
   return map_.segmentClear(p, b) && map_.segmentClear(b, o) && map_.segmentClear(b, term);
 }
 
-Vec3 BifurcationOptimizer::keepLengths(Vec3 b, const std::array<Vec3, 3>& ends) const {
+std::array<double, 3> BifurcationOptimizer::radiiAt(std::int32_t s, const Vec3& b, const Vec3& term) const {
+  std::vector<PathLevel> path;
+  const double l_up = std::max(distance(tree_.position[tree_.parent[s]], b), min_length_);
+  cost(s, l_up, std::max(distance(b, tree_.position[s]), min_length_), std::max(distance(b, term), min_length_), &path);
+  const auto& top = path.back();
+  double r = rootRadius(params_, top.terminals * params_.terminalFlow(), top.reduced_resistance);
+  for (std::size_t k = path.size() - 1; k >= 1; --k) r *= path[k].beta_child;  // down to the new segment
+  return {r, r * path[0].beta_child, r * path[0].beta_other};
+}
+
+bool BifurcationOptimizer::keepsLengthRatio(const Connection& c) const {
+  return !(length_ratio_ > 0) || admissible(c.segment, c.bifurcation, c.terminal, minimumsAt(c.segment, c.bifurcation, c.terminal));
+}
+
+BifurcationOptimizer::MinLengths BifurcationOptimizer::minimumsAt(std::int32_t s, const Vec3& b, const Vec3& term) const {
+  MinLengths m{min_length_, min_length_, min_length_};
+  if (!(length_ratio_ > 0)) return m;
+  const auto r = radiiAt(s, b, term);
+  for (int j = 0; j < 3; ++j) m[j] = std::max(m[j], length_ratio_ * radius_scale_ * r[j]);
+  if (tree_.parent[s] == 0) m[0] = std::max(m[0], length_ratio_ * root_radius_scale_ * r[0]);
+  return m;
+}
+
+Vec3 BifurcationOptimizer::keepLengths(Vec3 b, const std::array<Vec3, 3>& ends, const MinLengths& m) const {
   // Push b out to the minimum length from each end it comes too close to, so that the search
   // slides along the constraint (the optimum often wants b to merge into a node) instead of
   // stopping at it.
-  const double r = min_length_ * (1 + 1e-9);
-  for (const Vec3& x : ends) {
-    const Vec3 d = b - x;
+  for (int j = 0; j < 3; ++j) {
+    const double r = m[j] * (1 + 1e-9);
+    const Vec3 d = b - ends[j];
     const double len = norm(d);
-    if (len < r && len > 0) b = x + d * (r / len);
+    if (len < r && len > 0) b = ends[j] + d * (r / len);
   }
   return b;
 }
@@ -126,9 +153,26 @@ BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, 
 
 Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int max_iterations) const {
   const std::array<Vec3, 3> ends{tree_.position[tree_.parent[s]], tree_.position[s], term};
+  MinLengths m = minimumsAt(s, (ends[0] + ends[1]) * 0.5, term);
+  Connection c = search(s, term, m, max_iterations);
+  // The radii, and so the minimums, move a little with the bifurcation: search again with the
+  // larger of the two until the result keeps its own minimums (once or twice at most).
+  for (int pass = 0; pass < 3 && c.valid && length_ratio_ > 0; ++pass) {
+    const MinLengths at = minimumsAt(s, c.bifurcation, term);
+    if (admissible(s, c.bifurcation, term, at)) return c;
+    for (int j = 0; j < 3; ++j) m[j] = std::max(m[j], at[j] * (1 + 1e-6));
+    c = search(s, term, m, max_iterations);
+  }
+  if (c.valid && !keepsLengthRatio(c)) c.valid = false;
+  return c;
+}
+
+Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const MinLengths& m, int max_iterations) const {
+  const std::array<Vec3, 3> ends{tree_.position[tree_.parent[s]], tree_.position[s], term};
   Connection best;
   best.segment = s;
   best.terminal = term;
+  best.min_lengths = m;
   const auto lengths = [&](const Vec3& x, double (&l)[3]) {
     for (int j = 0; j < 3; ++j) l[j] = std::max(distance(x, ends[j]), min_length_);
   };
@@ -139,8 +183,9 @@ Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int 
   double l[3];
   Evaluation e{};
   bool have = false;
-  for (const Vec3& start : {mid + (term - mid) * (1.0 / 3.0), mid}) {
-    if (!admissible(s, start, term)) continue;
+  for (Vec3 start : {mid + (term - mid) * (1.0 / 3.0), mid}) {
+    if (length_ratio_ > 0) start = keepLengths(start, ends, m);
+    if (!admissible(s, start, term, m)) continue;
     double ls[3];
     lengths(start, ls);
     const Evaluation es = evaluate(s, ls);
@@ -187,8 +232,8 @@ Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int 
     double ln[3];
     Evaluation en{};
     for (double t = 1.0; t > 1e-3 && !moved; t *= 0.5) {
-      next = keepLengths(b + dir * t, ends);
-      if (!admissible(s, next, term)) continue;
+      next = keepLengths(b + dir * t, ends, m);
+      if (!admissible(s, next, term, m)) continue;
       lengths(next, ln);
       en = evaluate(s, ln);
       moved = en.cost < e.cost + 1e-4 * t * slope || (t < 0.2 && en.cost < e.cost);
@@ -243,8 +288,8 @@ void BifurcationOptimizer::polish(Connection& c) const {
     for (int d = 0; d < 6 && evals < kPolishEvaluations; ++d) {
       Vec3 next = b;
       (d / 2 == 0 ? next.x : (d / 2 == 1 ? next.y : next.z)) += (d % 2 ? -step : step);
-      next = keepLengths(next, ends);
-      if (!admissible(s, next, term)) continue;
+      next = keepLengths(next, ends, c.min_lengths);
+      if (!admissible(s, next, term, c.min_lengths)) continue;
       ++evals;
       double ln[3];
       for (int j = 0; j < 3; ++j) ln[j] = std::max(distance(next, ends[j]), min_length_);

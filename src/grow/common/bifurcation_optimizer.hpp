@@ -11,6 +11,11 @@
 // that cross zero demand; trial points are pushed out to the minimum segment length so the
 // search slides along that constraint. A compass search polishes connections that did not
 // converge. It reaches lower cost than VascuSynth's 20-step axis hill-climb (tested).
+//
+// With a length ratio k > 0 each of the three segments must also be at least k times its radius
+// (CCO's l > 2r), the radius taken at the connection's start point and scaled by the growth the
+// caller predicts: the search slides along these spheres too, so a bifurcation whose optimum
+// merges into a node (a disguised multifurcation) is moved out, not left as a stub.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -41,13 +46,19 @@ struct Connection {
   std::vector<PathLevel> path;  // filled by `record`
   bool valid = false;
   bool converged = false;     // the quasi-Newton iteration reached a stationary point
+  std::array<double, 3> min_lengths{};  // parent part, distal part, terminal (mm), set by optimise
 };
 
 class BifurcationOptimizer {
  public:
+  // length_ratio k: segments at least k × radius × radius_scale long (0: only the absolute
+  // minimum); a new root segment k × radius × root_radius_scale. The scales stand for the growth
+  // a vessel's radius has still to come.
   BifurcationOptimizer(const VascularTree& tree, const PhysicsParameters& p, const DemandMap& map,
-                       double min_segment_length_mm)
-      : tree_(tree), params_(p), kernel_(p), map_(map), min_length_(min_segment_length_mm) {}
+                       double min_segment_length_mm, double length_ratio = 0, double radius_scale = 1,
+                       double root_radius_scale = 1)
+      : tree_(tree), params_(p), kernel_(p), map_(map), min_length_(min_segment_length_mm),
+        length_ratio_(length_ratio), radius_scale_(radius_scale), root_radius_scale_(root_radius_scale) {}
 
   // Best valid bifurcation on segment s for terminal t; valid = false when every trial point
   // makes a segment cross a zero-demand voxel or shorter than the minimum length.
@@ -74,10 +85,19 @@ class BifurcationOptimizer {
   void record(Connection& c) const;
   // True if the three segments meeting at b are long enough and cross no zero-demand voxel.
   bool admissible(std::int32_t s, const Vec3& b, const Vec3& t) const;
+  using MinLengths = std::array<double, 3>;
+  bool admissible(std::int32_t s, const Vec3& b, const Vec3& t, const MinLengths& m) const;
+  // Radii of the three segments meeting at b (parent part, distal part, terminal) after the
+  // connection, in the tree as it is now.
+  // True if c's three segments keep the length ratio at their radii at c's bifurcation.
+  bool keepsLengthRatio(const Connection& c) const;
+  std::array<double, 3> radiiAt(std::int32_t s, const Vec3& b, const Vec3& t) const;
 
  private:
   struct Level0 { double R, V; };
-  Vec3 keepLengths(Vec3 b, const std::array<Vec3, 3>& ends) const;
+  MinLengths minimumsAt(std::int32_t s, const Vec3& b, const Vec3& t) const;
+  Connection search(std::int32_t s, const Vec3& t, const MinLengths& m, int max_iterations) const;
+  Vec3 keepLengths(Vec3 b, const std::array<Vec3, 3>& ends, const MinLengths& m) const;
   Level0 level0(std::int32_t s, double l_up, double l_down, double l_term) const;
 
   const VascularTree& tree_;
@@ -85,6 +105,9 @@ class BifurcationOptimizer {
   PowerKernel kernel_;
   const DemandMap& map_;
   double min_length_;
+  double length_ratio_;
+  double radius_scale_;
+  double root_radius_scale_;
 };
 
 }  // namespace angiosynth

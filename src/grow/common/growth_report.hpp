@@ -16,6 +16,7 @@ struct GrowthReport {
   std::int64_t retracted_terminals = 0;    // terminals pulled back along their segment to clear a vessel
   std::int64_t moved_nodes = 0;            // nodes moved to separate two vessels
   std::int64_t repaired_terminals = 0;     // terminals removed and regrown by the final check
+  std::int64_t relaxed_bifurcations = 0;   // vascusynth: bifurcation moves of the final relaxation sweeps
   int repair_rounds = 0;
   std::int64_t intersecting_pairs = 0;     // in the final tree (target 0)
   // CCO only.

@@ -33,6 +33,12 @@ class PreparedVascuSynth final : public PreparedGrowth {
     opt.sample = sample;
     return singleTreeForest(growVascuSynth(map_, opt, report, progress));
   }
+  void addStatistics(const GrowthReport& report, Json& stats) const override {
+    stats["relaxed_bifurcations"] = report.relaxed_bifurcations;
+    if (!(setup_.growth.min_length_ratio > 0)) return;
+    stats["short_segments"] = report.short_segments;
+    stats["short_segments_definition"] = "segments shorter than min_length_ratio times their radius";
+  }
 
  private:
   const VascuSynthSetup& setup_;
@@ -69,6 +75,11 @@ std::shared_ptr<const GrowthSetup> readVascuSynthToml(const TomlReader& r, const
     g.min_segment_length_mm = r.quantity(tree, "tree", "min_segment_length", Dimension::Length, d.voxel_mm);
     checkRange(g.min_segment_length_mm, 0, true, Limits::kMaxLength, false, r.at(tree, "min_segment_length"), "min_segment_length (mm)");
   }
+  if (tree.get("min_length_ratio")) {
+    g.min_length_ratio = r.number(tree, "tree", "min_length_ratio");
+    checkRange(g.min_length_ratio, 0, false, 100, false, r.at(tree, "min_length_ratio"), "min_length_ratio (length / radius; 0 turns the rule off)");
+  }
+  g.relax_sweeps = int(declaredCount(r, m, tree, "tree", "relax_sweeps", 0, 100));
   g.avoid_intersections = r.boolean(tree, "avoid_intersections", true);
   g.terminals = readTerminals(r, tree, s->terminals_line);
   g.closest_neighbours = declaredCount(r, m, tree, "tree", "closest_neighbours", 1, std::int64_t(Limits::kMaxNeighbours));
@@ -95,6 +106,8 @@ Json VascuSynthSetup::describe() const {
   j["min_distance"] = quantityJson(g.min_distance_mm, "mm");
   j["closest_neighbours"] = g.closest_neighbours;
   j["min_segment_length"] = quantityJson(g.minSegmentLength(d.voxel_mm), "mm");
+  j["min_length_ratio"] = g.min_length_ratio;
+  j["relax_sweeps"] = g.relax_sweeps;
   j["avoid_intersections"] = g.avoid_intersections;
   j["murray_exponent"] = p.murray_exponent;
   j["cost_radius_exponent"] = p.cost_radius_exponent;
@@ -128,6 +141,8 @@ const GrowthMethod kVascuSynthMethod{
         {"tree", "closest_neighbours", "count", "5", "segments tried per candidate terminal"},
         {"tree", "min_distance", "mm", "1 voxel", "candidates closer than this to any vessel are drawn again"},
         {"tree", "min_segment_length", "mm", "0.05 voxel", "no segment shorter than this"},
+        {"tree", "min_length_ratio", "ratio", "2", "no segment shorter than this × its radius (CCO's l > 2r; 0: VascuSynth's rule, which leaves stubs where bifurcations merge)"},
+        {"tree", "relax_sweeps", "count", "4", "final sweeps that move every bifurcation to its cost optimum for the final radii, keeping every constraint (0: the greedy tree as grown)"},
         {"tree", "avoid_intersections", "true/false", "true", "refuse connections whose vessels would overlap"},
     }, true, nullptr, nullptr, nullptr, nullptr),
     &readVascuSynthToml};
