@@ -91,7 +91,7 @@ TEST_F(MethodFiles, KeysAreCheckedAgainstTheDeclarations) {
     return std::string("no error");
   };
   std::string m = message(head + "[tree]\nmethod = \"cco\"\nterminals = 100\nbranching = 3\n");
-  EXPECT_NE(m.find("p.toml:8: unknown key 'branching' in [tree] of method cco; allowed: closest_neighbours,"), std::string::npos) << m;
+  EXPECT_NE(m.find("p.toml:8: unknown key 'branching' in [tree] of method cco; allowed: bifurcation, closest_neighbours,"), std::string::npos) << m;
   m = message(head + "[tree]\nmethod = \"cco\"\nterminals = 100\nmin_distance = \"1 mm\"\n");
   EXPECT_NE(m.find("p.toml:8: 'min_distance' in [tree] is for method vascusynth"), std::string::npos) << m;
   m = message(head + "[tree]\nmethod = \"diffusion\"\nterminals = 100\n");

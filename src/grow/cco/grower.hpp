@@ -40,6 +40,13 @@ struct CcoOptions {
   double kamiya_tolerance = 1e-6;     // of the bifurcation's step, relative to its three lengths
   int draws_before_relaxing = 100;
   double relaxation = 0.9;
+  // What a drawn terminal keeps δ from: the terminal points (seed 000's Algorithm 2 and
+  // OpenCCO's code), or every segment (the wording of its §3.3.2), which spreads terminals
+  // evenly but forces long connections. Either way it lies outside every vessel.
+  bool spacing_from_segments = false;
+  // Each connection's bifurcation also from the optimiser of the exact tree volume, started at
+  // Kamiya's fixed point; false: Kamiya's point alone, as seed 000.
+  bool exact_bifurcations = true;
   PhysicsParameters physics;          // λ = 2 and μ = 1 (volume) are imposed
   std::uint64_t seed = 1;
   std::uint64_t sample = 0;

@@ -249,6 +249,15 @@ std::shared_ptr<const GrowthSetup> readCcoToml(const TomlReader& r, const Growth
   checkRange(c.kamiya_tolerance, 0, true, 1, true, r.at(tree, "kamiya_tolerance"), "kamiya_tolerance");
   c.relaxation = declaredNumber(r, m, tree, "tree", "relaxation");
   checkRange(c.relaxation, 0, true, 1, true, r.at(tree, "relaxation"), "relaxation");
+  const auto choice = [&](const char* key, const char* a, const char* b, const char* what) {
+    if (!tree.get(key)) return true;
+    const std::string v = r.string(tree, "tree", key);
+    if (v != a && v != b)
+      throw InputError(r.file(), r.lineOf(tree.get(key)), std::string(key) + " = \"" + v + "\" is unknown; allowed: \"" + a + "\" or \"" + b + "\" (" + what + ")");
+    return v == a;
+  };
+  c.spacing_from_segments = !choice("spacing_from", "terminals", "segments", "what a drawn terminal keeps delta_max from");
+  c.exact_bifurcations = choice("bifurcation", "exact", "kamiya", "how a connection's bifurcation is placed");
   return s;
 }
 
@@ -287,6 +296,8 @@ Json CcoSetup::describe() const {
   j["kamiya_tolerance"] = c.kamiya_tolerance;
   j["draws_before_relaxing"] = c.draws_before_relaxing;
   j["relaxation"] = c.relaxation;
+  j["spacing_from"] = c.spacing_from_segments ? "segments" : "terminals";
+  j["bifurcation"] = c.exact_bifurcations ? "exact" : "kamiya";
   j["murray_exponent"] = c.physics.murray_exponent;
   describePhysics(c.physics, c.terminals, j);
   if (inlet_tables) {
@@ -328,6 +339,8 @@ const GrowthMethod kCcoMethod{
         {"tree", "kamiya_tolerance", "", "1e-6", "its step, relative to the three lengths, at convergence"},
         {"tree", "draws_before_relaxing", "count", "100", "failed draws before the distance threshold shrinks"},
         {"tree", "relaxation", "", "0.9", "the factor on the distance threshold after such a run"},
+        {"tree", "spacing_from", "terminals/segments", "terminals", "a drawn terminal keeps delta_max from the terminal points (seed 000's Algorithm 2, OpenCCO's code) or from every segment (its §3.3.2 wording; evenly spread terminals, long connections, 10 % more volume); either way it lies outside every vessel"},
+        {"tree", "bifurcation", "exact/kamiya", "exact", "each connection's bifurcation: the lighter of Kamiya's fixed point and the exact minimum of the tree's volume (which slides along l = 2r), or Kamiya's point alone (seed 000)"},
         {"tree.inlet", "id", "text", "its kind (kind_1, kind_2, ... when several)", "the tree's name in graphs and sample.json"},
         {"tree.inlet", "kind", "text", "artery", "artery, vein or a free name; inlets of one kind compete for its `terminals`, each kind fills the domain"},
         {"tree.inlet", "root_offset", "[x, y(, z)] mm", nullptr, "analytic shapes: the root relative to the centre"},

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <span>
 
 #include "domain/demand_map.hpp"
 
@@ -56,7 +57,7 @@ bool BifurcationOptimizer::admissible(std::int32_t s, const Vec3& b, const Vec3&
   const Vec3& p = tree_.position[tree_.parent[s]];
   const Vec3& o = tree_.position[s];
   if (distance(p, b) < m[0] || distance(b, o) < m[1] || distance(b, term) < m[2]) return false;
-  return map_.segmentClear(p, b) && map_.segmentClear(b, o) && map_.segmentClear(b, term);
+  return !check_obstacles_ || (map_.segmentClear(p, b) && map_.segmentClear(b, o) && map_.segmentClear(b, term));
 }
 
 std::array<double, 3> BifurcationOptimizer::radiiAt(std::int32_t s, const Vec3& b, const Vec3& term) const {
@@ -151,23 +152,24 @@ BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, 
   return e;
 }
 
-Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int max_iterations) const {
+Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int max_iterations, const Vec3* start) const {
   const std::array<Vec3, 3> ends{tree_.position[tree_.parent[s]], tree_.position[s], term};
-  MinLengths m = minimumsAt(s, (ends[0] + ends[1]) * 0.5, term);
-  Connection c = search(s, term, m, max_iterations);
+  MinLengths m = minimumsAt(s, start ? *start : (ends[0] + ends[1]) * 0.5, term);
+  Connection c = search(s, term, m, max_iterations, start);
   // The radii, and so the minimums, move a little with the bifurcation: search again with the
   // larger of the two until the result keeps its own minimums (once or twice at most).
   for (int pass = 0; pass < 3 && c.valid && length_ratio_ > 0; ++pass) {
     const MinLengths at = minimumsAt(s, c.bifurcation, term);
     if (admissible(s, c.bifurcation, term, at)) return c;
     for (int j = 0; j < 3; ++j) m[j] = std::max(m[j], at[j] * (1 + 1e-6));
-    c = search(s, term, m, max_iterations);
+    c = search(s, term, m, max_iterations, start);
   }
   if (c.valid && !keepsLengthRatio(c)) c.valid = false;
   return c;
 }
 
-Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const MinLengths& m, int max_iterations) const {
+Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const MinLengths& m, int max_iterations,
+                                        const Vec3* given) const {
   const std::array<Vec3, 3> ends{tree_.position[tree_.parent[s]], tree_.position[s], term};
   Connection best;
   best.segment = s;
@@ -183,7 +185,8 @@ Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const 
   double l[3];
   Evaluation e{};
   bool have = false;
-  for (Vec3 start : {mid + (term - mid) * (1.0 / 3.0), mid}) {
+  const std::array<Vec3, 2> starts{given ? *given : mid + (term - mid) * (1.0 / 3.0), mid};
+  for (Vec3 start : std::span(starts.data(), given ? 1 : 2)) {
     if (length_ratio_ > 0) start = keepLengths(start, ends, m);
     if (!admissible(s, start, term, m)) continue;
     double ls[3];

@@ -62,7 +62,11 @@ class BifurcationOptimizer {
 
   // Best valid bifurcation on segment s for terminal t; valid = false when every trial point
   // makes a segment cross a zero-demand voxel or shorter than the minimum length.
-  Connection optimise(std::int32_t s, const Vec3& t, int max_iterations = 20) const;
+  // `start`: a known good point (Kamiya's) to start from instead of the midpoint rule.
+  Connection optimise(std::int32_t s, const Vec3& t, int max_iterations = 20, const Vec3* start = nullptr) const;
+  // Off: trial points are not tested against zero-demand voxels (a caller that checks the
+  // domain exactly on the result, as CCO's capsule test does).
+  void checkObstacles(bool on) { check_obstacles_ = on; }
   // Exact whole-tree cost with the three new lengths (parent part, distal part, terminal).
   double cost(std::int32_t s, double l_up, double l_down, double l_term, std::vector<PathLevel>* record = nullptr) const;
   // Exact cost and its derivatives with respect to the three new lengths, from one walk to the
@@ -96,7 +100,7 @@ class BifurcationOptimizer {
  private:
   struct Level0 { double R, V; };
   MinLengths minimumsAt(std::int32_t s, const Vec3& b, const Vec3& t) const;
-  Connection search(std::int32_t s, const Vec3& t, const MinLengths& m, int max_iterations) const;
+  Connection search(std::int32_t s, const Vec3& t, const MinLengths& m, int max_iterations, const Vec3* start) const;
   Vec3 keepLengths(Vec3 b, const std::array<Vec3, 3>& ends, const MinLengths& m) const;
   Level0 level0(std::int32_t s, double l_up, double l_down, double l_term) const;
 
@@ -108,6 +112,7 @@ class BifurcationOptimizer {
   double length_ratio_;
   double radius_scale_;
   double root_radius_scale_;
+  bool check_obstacles_ = true;
 };
 
 }  // namespace angiosynth
