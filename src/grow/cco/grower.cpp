@@ -137,6 +137,16 @@ class CcoGrower {
     growUntilTargets(progress);
     repair(progress);
     report_.root_radius_mm = trees_[0].tree.radius[trees_[0].tree.rootSegment()];
+    report_.short_list.clear();
+    for (std::size_t k = 0; k < trees_.size(); ++k) {
+      const auto& T = trees_[k].tree;
+      for (std::int32_t s = 1; s < T.nodeCount(); ++s)
+        if (!(T.length[s] > 2 * T.radius[s])) {
+          const Vec3 a = T.position[T.parent[s]], e = T.position[s];
+          report_.short_list.push_back({int(k), {a.x, a.y, a.z}, {e.x, e.y, e.z}, T.length[s], T.radius[s]});
+        }
+    }
+    report_.short_segments = static_cast<std::int64_t>(report_.short_list.size());
     std::vector<VascularTree> out;
     for (auto& t : trees_) out.push_back(std::move(t.tree));
     return out;

@@ -97,6 +97,18 @@ class PreparedCco final : public PreparedGrowth {
     stats["kamiya_failures"] = report.kamiya_failures;
     stats["short_segments"] = report.short_segments;
     stats["short_segments_definition"] = "segments not longer than twice their radius";
+    if (!report.short_list.empty()) {
+      Json list = Json::array();
+      for (const auto& x : report.short_list)
+        list.push_back(Json{{"tree", setup_.inlets[std::size_t(x.tree)].id},
+                            {"proximal_mm", {x.proximal[0], x.proximal[1], x.proximal[2]}},
+                            {"distal_mm", {x.distal[0], x.distal[1], x.distal[2]}},
+                            {"length_mm", x.length},
+                            {"radius_mm", x.radius}});
+      stats["short_segments_left"] = list;
+      stats["short_segments_left_why"] =
+          "the final check could neither lengthen these (moving either end, or the distal one along or around the vessel, collides or leaves the domain) nor remove the side branch that merges them with a child (more than 15 % of the terminals)";
+    }
     stats["outside_segments"] = report.outside_segments;
     if (setup_.inlets.size() > 1) {
       stats["lenient_connections"] = report.lenient_connections;

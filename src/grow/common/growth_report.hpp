@@ -5,6 +5,7 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace angiosynth {
 
@@ -24,6 +25,13 @@ struct GrowthReport {
   std::int64_t neighbour_doublings = 0;    // ν doubled because every candidate failed
   std::int64_t kamiya_failures = 0;        // Kamiya's iteration found no bifurcation
   std::int64_t short_segments = 0;         // final segments with length <= 2 r (target 0)
+  // CCO: each segment left shorter than 2r by the final check (one its repair could not fix),
+  // by its tree and its ends (mm), so that a user can find it.
+  struct ShortSegment {
+    int tree;
+    double proximal[3], distal[3], length, radius;
+  };
+  std::vector<ShortSegment> short_list;
   std::int64_t outside_segments = 0;       // final segments leaving the domain (target 0)
   std::int64_t lenient_connections = 0;    // forests: connections whose thickened ancestors were checked only in part
   double root_radius_mm = 0;
