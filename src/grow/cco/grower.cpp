@@ -96,7 +96,6 @@ constexpr int kRefineIterations = 4;
 // neighbours, and as they thicken their ancestors collide and refuse every later connection
 // below them (measured: 300 terminals took 24 s instead of 0.5 s).
 constexpr double kInteriorMargin = 1.05;
-constexpr double kRefineWithin = 2.0;
 constexpr double kRootMargin = 1.25;
 constexpr std::size_t kRefineNearest = 8;
 
@@ -445,27 +444,18 @@ class CcoGrower {
         // Two halves: finer tasks cost more in scheduling than the few microseconds each takes.
         const std::size_t grain = std::max<std::size_t>(1, (g.near.size() - g.done + 1) / 2);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(g.done, g.near.size(), grain), [&](const auto& r) {
-          for (auto j = r.begin(); j != r.end(); ++j) trials[j] = evaluate(g, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
+          for (auto j = r.begin(); j != r.end(); ++j) {
+            trials[j] = evaluate(g, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
+            // The exact point where Kamiya found a valid one, and on the kRefineNearest nearest
+            // segments where he found none (merged or l <= 2r: there the exact optimum often
+            // lies inside). Measured on 4000 terminals in seed 000's sphere: refining every
+            // segment 748.8 mm³ in 1.04 s, these 754.9 mm³ in 0.85 s; Kamiya alone 886.8 mm³ in
+            // 0.56 s (with the §3.3.2 spacing).
+            const auto& k = trials[j].c[0];
+            if (opt_.exact_bifurcations && (k.valid || j < kRefineNearest))
+              trials[j].c[1] = refine(g, k, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
+          }
         }, tbb::simple_partitioner());
-        if (opt_.exact_bifurcations) {
-          // The exact point where Kamiya's adds at most kRefineWithin times the lightest of his
-          // (refining lowers the added volume by a fraction, so it does not reorder candidates
-          // much farther apart), and on the kRefineNearest nearest segments where he found none
-          // (merged or l <= 2r: there the exact optimum often lies inside). Measured on 4000
-          // terminals in seed 000's sphere: refining every segment 748.8 mm³ in 1.04 s, these
-          // 754.9 mm³ in 0.85 s; Kamiya alone 886.8 mm³ in 0.56 s (with segment spacing).
-          const double now = treeCostNow(g);
-          double best = std::numeric_limits<double>::infinity();
-          for (std::size_t j = g.done; j < g.near.size(); ++j)
-            if (trials[j].c[0].valid) best = std::min(best, trials[j].c[0].cost - now);
-          tbb::parallel_for(tbb::blocked_range<std::size_t>(g.done, g.near.size(), grain), [&](const auto& r) {
-            for (auto j = r.begin(); j != r.end(); ++j) {
-              const auto& k = trials[j].c[0];
-              if (k.valid ? k.cost - now <= kRefineWithin * best : j < kRefineNearest)
-                trials[j].c[1] = refine(g, k, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
-            }
-          }, tbb::simple_partitioner());
-        }
         for (std::size_t j = g.done; j < g.near.size(); ++j) {
           if (trials[j].kamiya_failed) ++report_.kamiya_failures;
           if (trials[j].c[0].valid) ranked_.push_back({int(i), j, 0, trials[j].c[0].cost - base[i]});
