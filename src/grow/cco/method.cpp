@@ -261,15 +261,8 @@ std::shared_ptr<const GrowthSetup> readCcoToml(const TomlReader& r, const Growth
   checkRange(c.kamiya_tolerance, 0, true, 1, true, r.at(tree, "kamiya_tolerance"), "kamiya_tolerance");
   c.relaxation = declaredNumber(r, m, tree, "tree", "relaxation");
   checkRange(c.relaxation, 0, true, 1, true, r.at(tree, "relaxation"), "relaxation");
-  const auto choice = [&](const char* key, const char* a, const char* b, const char* what) {
-    if (!tree.get(key)) return true;
-    const std::string v = r.string(tree, "tree", key);
-    if (v != a && v != b)
-      throw InputError(r.file(), r.lineOf(tree.get(key)), std::string(key) + " = \"" + v + "\" is unknown; allowed: \"" + a + "\" or \"" + b + "\" (" + what + ")");
-    return v == a;
-  };
-  c.spacing_from_segments = !choice("spacing_from", "terminals", "segments", "what a drawn terminal keeps delta_max from");
-  c.exact_bifurcations = choice("bifurcation", "exact", "kamiya", "how a connection's bifurcation is placed");
+  c.spacing_from_segments = choice<bool>(r, tree, "tree", "spacing_from", false, {{"terminals", false}, {"segments", true}});
+  c.exact_bifurcations = choice<bool>(r, tree, "tree", "bifurcation", true, {{"exact", true}, {"kamiya", false}});
   return s;
 }
 

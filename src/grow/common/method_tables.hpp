@@ -4,7 +4,10 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "core/error.hpp"
 #include "core/units.hpp"
 #include "grow/method.hpp"
 #include "io/toml_reader.hpp"
@@ -19,6 +22,21 @@ const MethodParam* findParam(const GrowthMethod& m, const std::string& table, co
 const toml::table& methodTable(const TomlReader& r, const GrowthMethod& m, const std::string& name);
 // Checks the keys of a table already in hand (sub-tables such as [[tree.inlet]]).
 void checkMethodKeys(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& name);
+
+// table.key as one of `values` (by name), or `fallback` when absent; an unknown word is an
+// error listing the allowed ones.
+template <class E>
+E choice(const TomlReader& r, const toml::table& t, const std::string& table, const std::string& key, E fallback,
+         const std::vector<std::pair<const char*, E>>& values) {
+  if (!t.get(key)) return fallback;
+  const auto v = r.string(t, table, key);
+  std::string allowed;
+  for (const auto& [name, value] : values) {
+    if (v == name) return value;
+    allowed += (allowed.empty() ? "" : ", ") + std::string(name);
+  }
+  throw InputError(r.file(), r.lineOf(t.get(key)), key + " '" + v + "'; allowed: " + allowed);
+}
 
 // table.key as a quantity, or the declared default (an error naming the key when it has none).
 double declaredQuantity(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table,

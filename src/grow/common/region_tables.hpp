@@ -1,9 +1,8 @@
 #pragma once
 // [[region]] tables (named analytic shapes, relative to the domain's centre) and the helpers
-// their readers share: a stage names regions, a key takes one of a list of words.
+// their readers share: a stage names regions.
 #include <set>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "core/error.hpp"
@@ -12,21 +11,6 @@
 #include "io/network_files.hpp"
 
 namespace angiosynth {
-
-// table.key as one of `values` (by name), or `fallback` when absent; an unknown word is an
-// error listing the allowed ones.
-template <class E>
-E choice(const TomlReader& r, const toml::table& t, const std::string& table, const std::string& key, E fallback,
-         const std::vector<std::pair<const char*, E>>& values) {
-  if (!t.get(key)) return fallback;
-  const auto v = r.string(t, table, key);
-  std::string allowed;
-  for (const auto& [name, value] : values) {
-    if (v == name) return value;
-    allowed += (allowed.empty() ? "" : ", ") + std::string(name);
-  }
-  throw InputError(r.file(), r.lineOf(t.get(key)), key + " '" + v + "'; allowed: " + allowed);
-}
 
 // The region names of t.key (one name or an array), each defined in `known`.
 std::vector<std::string> regionNames(const TomlReader& r, const toml::table& t, const std::string& key, const std::set<std::string>& known);

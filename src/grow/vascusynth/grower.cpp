@@ -166,16 +166,16 @@ class Grower {
   // junction reached over the parent or the sibling is then often cheaper.
   void withFamilies(std::vector<std::pair<double, std::int32_t>>& near) const {
     const auto n = near.size();
+    const auto add = [&](double d, std::int32_t id) {
+      if (std::none_of(near.begin(), near.end(), [&](const auto& e) { return e.second == id; })) near.emplace_back(d, id);
+    };
     for (std::size_t i = 0; i < n; ++i) {
-      const auto s = near[i].second;
-      if (const auto p = tree_.parent[s]; p > 0) near.emplace_back(near[i].first, p);
-      if (tree_.parent[s] > 0) near.emplace_back(near[i].first, tree_.sibling(s));
+      const auto [d, s] = near[i];
+      if (tree_.parent[s] > 0) {
+        add(d, tree_.parent[s]);
+        add(d, tree_.sibling(s));
+      }
     }
-    std::sort(near.begin() + std::ptrdiff_t(n), near.end(), [](auto& a, auto& b) { return a.second < b.second; });
-    near.erase(std::remove_if(near.begin() + std::ptrdiff_t(n), near.end(), [&](auto& x) {
-      return std::any_of(near.begin(), near.begin() + std::ptrdiff_t(n), [&](auto& y) { return y.second == x.second; });
-    }), near.end());
-    near.erase(std::unique(near.begin() + std::ptrdiff_t(n), near.end(), [](auto& a, auto& b) { return a.second == b.second; }), near.end());
   }
 
   // Applies a recorded connection: new bifurcation b (splitting s) and terminal t.
