@@ -10,7 +10,9 @@
 #include <set>
 
 #include "core/error.hpp"
+#include "core/rng.hpp"
 #include "grow/colonisation/grower.hpp"
+#include "grow/common/point_hash.hpp"
 #include "grow_file.hpp"
 #include "test_support.hpp"
 
@@ -281,4 +283,39 @@ TEST(Colonisation, StumpsOfAnExistingTreeGrowOn) {
       murray = std::max(murray, std::abs(rk - std::pow(t.radius[t.child0[i]], 2.55) - std::pow(t.radius[t.child1[i]], 2.55)) / rk);
     }
   EXPECT_LE(murray, 1e-12);
+}
+
+// The ring search of the nearest point answers exactly as a brute-force scan: clustered and
+// sparse clouds, queries inside and outside the grid, exact ties (the smaller id wins), flat and
+// solid grids.
+TEST(PointHash, NearestEqualsBruteForce) {
+  for (const bool flat : {true, false}) {
+    Rng rng(7, flat, Stage::Growth);
+    const Vec3 lo(-1, -1, flat ? 0 : -1), hi(1, 1, flat ? 0 : 1);
+    PointHash grid(lo, hi, 0.05, flat);
+    std::vector<Vec3> pts;
+    const auto draw = [&](double spread) {
+      return Vec3(rng.uniform(-spread, spread), rng.uniform(-spread, spread), flat ? 0.0 : rng.uniform(-spread, spread));
+    };
+    for (int i = 0; i < 3000; ++i) pts.push_back(i % 3 == 0 ? draw(1.3) : draw(0.3) * 0.5 + Vec3(0.4, -0.2, 0));
+    pts.push_back(pts[10]);  // an exact tie: the earlier id must win
+    for (std::size_t i = 0; i < pts.size(); ++i) grid.insert(pts[i], std::int32_t(i));
+    int found = 0, ties = 0;
+    for (int q = 0; q < 4000; ++q) {
+      const Vec3 p = q < 50 ? pts[10] : draw(1.5);
+      const double r = q % 4 == 0 ? 0.02 : q % 4 == 1 ? 0.13 : q % 4 == 2 ? 0.4 : 3.0;
+      std::int32_t want = -1;
+      double bd = r * r;
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        const double d2 = dot(pts[i] - p, pts[i] - p);
+        if (d2 < bd) bd = d2, want = std::int32_t(i);
+      }
+      const auto got = grid.nearest(p, r, [&](std::int32_t id) { return dot(pts[std::size_t(id)] - p, pts[std::size_t(id)] - p); });
+      ASSERT_EQ(got, want) << "flat " << flat << " query " << q << " r " << r;
+      found += got >= 0;
+      ties += q < 50;
+    }
+    EXPECT_GT(found, 2000);  // most queries have an answer: the comparison is not of empty results
+    EXPECT_EQ(ties, 50);
+  }
 }

@@ -203,6 +203,7 @@ class Grower {
     art_.vein = false;
     ven_.vein = true;
     art_.kappa = ven_.kappa = o.murray_exponent;
+    symmetric_angle_ = symmetricMurrayAngle(o.murray_exponent);
     for (std::size_t k = 0; k < o.roots.size(); ++k) {
       const auto& r = o.roots[k];
       auto& s = r.vein ? ven_ : art_;
@@ -258,14 +259,15 @@ class Grower {
   }
 
  private:
-  // Cells (0) of the node grid: the smallest perception distance; (1) of the near-node grid:
+  // Cells (0) of the node grid: half the smallest perception distance (the ring search of the
+  // nearest node stops after a few small cells when a node is close); (1) of the near-node grid:
   // the smallest satisfaction distance; (2) of the drain grid: half the perception distance, or
   // the spacing if larger (live drains are sparse: a few fuller cells scan faster than many
   // empty ones).
   static double cell(const ColonisationOptions& o, int which) {
     double c = INFINITY;
     for (const auto& st : o.stages)
-      c = std::min(c, which == 0 ? st.perception_distance : which == 1 ? st.satisfaction_distance : std::max(st.drain_spacing, st.perception_distance / 2));
+      c = std::min(c, which == 0 ? st.perception_distance / 2 : which == 1 ? st.satisfaction_distance : std::max(st.drain_spacing, st.perception_distance / 2));
     return std::max(c, 1e-6);
   }
 
@@ -366,83 +368,114 @@ class Grower {
     return stat == SpreadStatistic::RootMeanSquare ? std::sqrt(sum2 / n) : std::sqrt(std::max(0.0, sum2 / n - mean * mean));
   }
 
-  bool tryAdd(System& s, const ColonisationStage& st, std::int32_t from, Vec3 dir, double len) {
+  struct Pending {
+    std::int32_t from;
+    Vec3 position, direction;
+  };
+  enum class Move : char { None, Bifurcation, Elongation, Lateral };
+  // What one perceiving node does this step: up to two new nodes, and the tries refused.
+  struct Decision {
+    Pending add[2];
+    int added = 0, outside = 0, crossing = 0;
+    Move move = Move::None;
+  };
+
+  // A new node of s from `from` along dir, unless it leaves the world or crosses a vessel.
+  bool tryAdd(const System& s, const ColonisationStage& st, std::int32_t from, Vec3 dir, double len, Decision& d) const {
     Vec3 p = toShell(st, s.pos[from] + dir * len);
     if (!inside(s.pos[from], p)) {
-      ++cr_.outside_rejected;
+      ++d.outside;
       return false;
     }
     if (crosses(s, from, s.pos[from], p, terminal_radius_)) {
-      ++cr_.crossing_rejected;
+      ++d.crossing;
       return false;
     }
-    pending_.push_back({from, p, unit(p - s.pos[from])});
+    d.add[d.added++] = {from, p, unit(p - s.pos[from])};
     return true;
+  }
+
+  // Node j's response to the drains it perceives (pairs [a, b)): it reads the step's starting
+  // state only, so the nodes decide in parallel.
+  Decision decide(const System& s, const ColonisationStage& st, const std::vector<std::pair<std::int32_t, std::int32_t>>& pairs, std::size_t a,
+                  std::size_t b, double len) const {
+    Decision d;
+    const std::int32_t j = pairs[a].first;
+    const Vec3 pj = s.pos[j], e = s.dir[j];
+    thread_local std::vector<Vec3> u;
+    u.clear();
+    Vec3 m(0, 0, 0), c(0, 0, 0);
+    for (std::size_t q = a; q < b; ++q) {
+      const Vec3 p = s.drain[pairs[q].second];
+      u.push_back(unit(p - pj));
+      m += u.back();
+      c += p;
+    }
+    const double n = double(u.size());
+    m = unit(m / n);
+    if (!(norm(m) > 0)) m = e;
+    if (s.child0[j] < 0) {
+      // A leaf (not a root): split when the drains spread wider than φ, else elongate.
+      if (s.parent[j] >= 0 && u.size() >= 2 && spread(u, m, st.spread) > st.bifurcation_spread * kDeg) {
+        c = c / n;
+        double cov[3][3] = {};
+        for (std::size_t q = 0; q < u.size(); ++q) {
+          const Vec3 v = s.drain[pairs[a + q].second] - c;
+          for (int r = 0; r < 3; ++r)
+            for (int w = 0; w < 3; ++w) cov[r][w] += v[r] * v[w];
+        }
+        Vec3 w = dominantAxis(cov);
+        w = w - e * dot(w, e);
+        if (!(norm(w) > 1e-9)) w = m - e * dot(m, e);
+        if (!(norm(w) > 1e-9)) w = perpendicular(e);
+        w = unit(w);
+        const double alpha_s = symmetric_angle_;
+        const Vec3 d1 = e * std::cos(alpha_s) + w * std::sin(alpha_s), d2 = e * std::cos(alpha_s) - w * std::sin(alpha_s);
+        if (tryAdd(s, st, j, d1, len, d) && tryAdd(s, st, j, d2, len, d)) {
+          d.move = Move::Bifurcation;
+          return d;
+        }
+        d.added = 0;
+      }
+      Vec3 g = e * st.bias + m * (1 - st.bias);
+      if (!(norm(g) > 1e-12)) g = e;
+      if (tryAdd(s, st, j, unit(g), len, d)) d.move = Move::Elongation;
+    } else if (s.child1[j] < 0) {
+      // An inter-node: a lateral branch at the Murray angle, turned toward the drains.
+      const double alpha = lateralMurrayAngle(s.radiusOf(j), terminal_radius_, o_.murray_exponent);
+      Vec3 w = m - e * dot(m, e);
+      if (!(norm(w) > 1e-9)) return d;
+      const Vec3 v = e * std::cos(alpha) + unit(w) * std::sin(alpha);
+      Vec3 g = v * st.bias + m * (1 - st.bias);
+      if (!(norm(g) > 1e-12)) g = v;
+      if (tryAdd(s, st, j, unit(g), len, d)) d.move = Move::Lateral;
+    }
+    return d;
   }
 
   void grow(System& s, const ColonisationStage& st, double k) {
     const double len = st.step * k, delta = st.perception_distance * k;
     const auto pairs = assign(s, st, delta);
-    pending_.clear();
-    const double alpha_s = symmetricMurrayAngle(o_.murray_exponent);
-    for (std::size_t a = 0; a < pairs.size();) {
-      std::size_t b = a;
-      while (b < pairs.size() && pairs[b].first == pairs[a].first) ++b;
-      const std::int32_t j = pairs[a].first;
-      const std::size_t first = a;
-      const Vec3 pj = s.pos[j], e = s.dir[j];
-      std::vector<Vec3> u;
-      Vec3 m(0, 0, 0), c(0, 0, 0);
-      for (std::size_t q = a; q < b; ++q) {
-        const Vec3 p = s.drain[pairs[q].second];
-        u.push_back(unit(p - pj));
-        m += u.back();
-        c += p;
+    std::vector<std::size_t> start;
+    for (std::size_t a = 0; a < pairs.size(); ++a)
+      if (a == 0 || pairs[a].first != pairs[a - 1].first) start.push_back(a);
+    start.push_back(pairs.size());
+    std::vector<Decision> decisions(start.size() - 1);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, decisions.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t g = r.begin(); g != r.end(); ++g) decisions[g] = decide(s, st, pairs, start[g], start[g + 1], len);
+    });
+    // Nodes join in the order of their parents: the same tree on any thread count.
+    for (const auto& d : decisions) {
+      cr_.outside_rejected += d.outside;
+      cr_.crossing_rejected += d.crossing;
+      cr_.bifurcations += d.move == Move::Bifurcation;
+      cr_.elongations += d.move == Move::Elongation;
+      cr_.lateral_branches += d.move == Move::Lateral;
+      for (int i = 0; i < d.added; ++i) {
+        const auto& p = d.add[i];
+        s.add(p.position, p.from, p.direction, terminal_radius_, s.root_of[p.from]);
+        max_edge_ = std::max(max_edge_, distance(p.position, s.pos[p.from]));
       }
-      a = b;
-      const double n = double(u.size());
-      m = unit(m / n);
-      if (!(norm(m) > 0)) m = e;
-      if (s.child0[j] < 0) {
-        // A leaf (not a root): split when the drains spread wider than φ, else elongate.
-        if (s.parent[j] >= 0 && u.size() >= 2 && spread(u, m, st.spread) > st.bifurcation_spread * kDeg) {
-          c = c / n;
-          double cov[3][3] = {};
-          for (std::size_t q = 0; q < u.size(); ++q) {
-            const Vec3 d = s.drain[pairs[first + q].second] - c;
-            for (int r = 0; r < 3; ++r)
-              for (int w = 0; w < 3; ++w) cov[r][w] += d[r] * d[w];
-          }
-          Vec3 w = dominantAxis(cov);
-          w = w - e * dot(w, e);
-          if (!(norm(w) > 1e-9)) w = m - e * dot(m, e);
-          if (!(norm(w) > 1e-9)) w = perpendicular(e);
-          w = unit(w);
-          const Vec3 d1 = e * std::cos(alpha_s) + w * std::sin(alpha_s), d2 = e * std::cos(alpha_s) - w * std::sin(alpha_s);
-          const std::size_t before = pending_.size();
-          if (tryAdd(s, st, j, d1, len) && tryAdd(s, st, j, d2, len)) {
-            ++cr_.bifurcations;
-            continue;
-          }
-          pending_.resize(before);
-        }
-        Vec3 g = e * st.bias + m * (1 - st.bias);
-        if (!(norm(g) > 1e-12)) g = e;
-        if (tryAdd(s, st, j, unit(g), len)) ++cr_.elongations;
-      } else if (s.child1[j] < 0) {
-        // An inter-node: a lateral branch at the Murray angle, turned toward the drains.
-        const double alpha = lateralMurrayAngle(s.radiusOf(j), terminal_radius_, o_.murray_exponent);
-        Vec3 w = m - e * dot(m, e);
-        if (!(norm(w) > 1e-9)) continue;
-        const Vec3 v = e * std::cos(alpha) + unit(w) * std::sin(alpha);
-        Vec3 g = v * st.bias + m * (1 - st.bias);
-        if (!(norm(g) > 1e-12)) g = v;
-        if (tryAdd(s, st, j, unit(g), len)) ++cr_.lateral_branches;
-      }
-    }
-    for (const auto& p : pending_) {
-      s.add(p.position, p.from, p.direction, terminal_radius_, s.root_of[p.from]);
-      max_edge_ = std::max(max_edge_, distance(p.position, s.pos[p.from]));
     }
   }
 
@@ -544,21 +577,15 @@ class Grower {
     ++step_;
   }
 
-  struct Pending {
-    std::int32_t from;
-    Vec3 position, direction;
-  };
-
   const ColonisationOptions& o_;
   GrowthReport& report_;
   ColonisationReport& cr_;
   const GrowthDomain& world_;
   System art_, ven_;
-  std::vector<Pending> pending_;
   std::vector<Vec3> candidates_;
   std::vector<char> flags_;
   std::vector<std::int32_t> art_near_, ven_near_;
-  double terminal_radius_ = 0, max_edge_ = 0, max_radius_ = 0;
+  double terminal_radius_ = 0, max_edge_ = 0, max_radius_ = 0, symmetric_angle_ = 0;
   std::int32_t step_ = 0;
 };
 

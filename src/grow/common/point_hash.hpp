@@ -62,18 +62,63 @@ class PointHash {
             if (pred(id)) return true;
     return false;
   }
-  // The id minimising dist2(id) among points within r (ties: the smaller id), or -1.
+  // The id minimising dist2(id) among points within r (ties: the smaller id), or -1. Cells are
+  // visited in rings around p's cell and the search stops once the next ring is farther than the
+  // best point: in a dense cloud the nearest point is found in a few cells whatever r is.
   template <class Dist2>
   std::int32_t nearest(const Vec3& p, double r, Dist2&& dist2) const {
     std::int32_t best = -1;
     double bd = r * r;
-    forEachNear(p, r, [&](std::int32_t id) {
-      const double d2 = dist2(id);
-      if (d2 < bd || (d2 == bd && best >= 0 && id < best)) {
-        bd = d2;
-        best = id;
+    const auto visit = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+      for (auto id = head_[index(x, y, z)]; id >= 0; id = next_[std::size_t(id)]) {
+        const double d2 = dist2(id);
+        if (d2 < bd || (d2 == bd && best >= 0 && id < best)) {
+          bd = d2;
+          best = id;
+        }
       }
-    });
+    };
+    const std::int64_t lo[3] = {axis(p.x - r, 0), axis(p.y - r, 1), axis(p.z - r, 2)};
+    const std::int64_t hi[3] = {axis(p.x + r, 0), axis(p.y + r, 1), axis(p.z + r, 2)};
+    // p's position in cell units; the ring bound holds for p inside the grid (points clamped into
+    // a border cell lie beyond it, no nearer to an inside p than the cell itself).
+    const double g[3] = {(p.x - lo_.x) * inv_, (p.y - lo_.y) * inv_, (p.z - lo_.z) * inv_};
+    const int axes = n_[2] == 1 ? 2 : 3;
+    bool inside = true;
+    for (int a = 0; a < axes; ++a) inside = inside && g[a] >= 0 && g[a] < double(n_[a]);
+    if (!inside) {
+      for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+        for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+          for (std::int64_t x = lo[0]; x <= hi[0]; ++x) visit(x, y, z);
+      return best;
+    }
+    std::int64_t c[3] = {0, 0, 0};
+    std::int64_t rings = 0;
+    for (int a = 0; a < axes; ++a) {
+      c[a] = std::min<std::int64_t>(static_cast<std::int64_t>(g[a]), n_[a] - 1);
+      rings = std::max({rings, c[a] - lo[a], hi[a] - c[a]});
+    }
+    for (std::int64_t k = 0; k <= rings; ++k) {
+      if (k > 0) {
+        // Every point of ring k lies outside the block of cells within k − 1 of p's cell.
+        double gap = INFINITY;
+        for (int a = 0; a < axes; ++a) gap = std::min({gap, g[a] - double(c[a] - k + 1), double(c[a] + k) - g[a]});
+        gap *= cell_ * (1 - 1e-12);
+        if (gap * gap > bd) break;
+      }
+      const std::int64_t z0 = std::max(lo[2], c[2] - k), z1 = std::min(hi[2], c[2] + k);
+      const std::int64_t y0 = std::max(lo[1], c[1] - k), y1 = std::min(hi[1], c[1] + k);
+      const std::int64_t x0 = std::max(lo[0], c[0] - k), x1 = std::min(hi[0], c[0] + k);
+      for (std::int64_t z = z0; z <= z1; ++z)
+        for (std::int64_t y = y0; y <= y1; ++y) {
+          if (std::abs(z - c[2]) == k || std::abs(y - c[1]) == k) {
+            for (std::int64_t x = x0; x <= x1; ++x) visit(x, y, z);
+            continue;
+          }
+          if (c[0] - k >= x0) visit(c[0] - k, y, z);
+          if (k > 0 && c[0] + k <= x1) visit(c[0] + k, y, z);
+        }
+    }
     return best;
   }
 
