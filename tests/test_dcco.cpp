@@ -2,6 +2,8 @@
 // invariants of every shipped dcco example's tree (Murray, flow, pressure, stages, δ, θ, roles,
 // no overlapping vessels), terminal density against the pdf, and determinism across threads.
 #include <gtest/gtest.h>
+
+#include <map>
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -208,7 +210,7 @@ TEST_P(DccoExample, TreeMeetsEveryConstraintOfItsStages) {
   } else {
     std::int64_t short_segments = 0, outside = 0;
     for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
-      if (t.isRoot(i)) continue;
+      if (t.isRoot(i) || t.isLink(i)) continue;  // a link joins an N-ary junction's nodes at one point
       short_segments += !(t.length[i] > 2 * t.radius[i]);
       if (t.stage[i] < 0) continue;
       for (int k = 0; k <= 64; ++k)
@@ -282,13 +284,15 @@ TEST_P(DccoExample, TreeMeetsEveryConstraintOfItsStages) {
     return v;
   };
   const auto stages = values("stage"), functions = values("vesselFunction"), branching = values("branchingType");
-  ASSERT_EQ(stages.size(), std::size_t(t.nodeCount()) - t.roots().size());
+  std::size_t links = 0;  // an N-ary junction's links are no cells
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i) links += t.isLink(i);
+  ASSERT_EQ(stages.size(), std::size_t(t.nodeCount()) - t.roots().size() - links);
   std::size_t k = 0;
   const auto vitaBranching = [](std::uint8_t b) {
     return Branching(b) == Branching::None ? 0 : Branching(b) == Branching::Fixed ? 1 : Branching(b) == Branching::Distal ? 3 : 2;
   };
   for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
-    if (t.isRoot(i)) continue;
+    if (t.isRoot(i) || t.isLink(i)) continue;
     EXPECT_EQ(stages[k], t.stage[i]);
     EXPECT_EQ(functions[k], VesselRole(t.role[i]) == VesselRole::Distribution ? 0 : VesselRole(t.role[i]) == VesselRole::Perforator ? 1 : 2);
     EXPECT_EQ(branching[k], vitaBranching(t.branching[i]));
@@ -301,7 +305,7 @@ INSTANTIATE_TEST_SUITE_P(Shipped, DccoExample,
                                            "dcco_pdf_uniform_2d.toml", "dcco_pdf_gaussian_2d.toml",
                                            "dcco_sphere_pries_3d.toml", "dcco_outlet_half_2d.toml", "dcco_outlet_most_2d.toml",
                                            "dcco_two_inlets_2d.toml", "dcco_two_inlets_3d.toml", "dcco_sequential_2d.toml",
-                                           "dcco_brain_shell_3d.toml"),
+                                           "dcco_brain_shell_3d.toml", "dcco_junctions_2d.toml"),
                          [](const auto& info) {
                            std::string n = info.param;
                            return n.substr(5, n.size() - 10);  // dcco_<name>.toml
@@ -496,6 +500,55 @@ TEST(DccoInitial, OutletCarriesItsShareAndTheDomainTreeScalesAsFig5Says) {
 
 // VItA's .cco: a grown tree written, read, written and read again keeps every position, radius,
 // outflow, role, branching, stage and link (to 1e-12; the writer prints round-trip digits).
+// N-ary junctions of an initial network stay junctions while the tree grows from every vessel:
+// one point, Murray's law over all children, the flow conserved, one pressure; and the tree grows
+// new branches on each of their vessels.
+TEST(DccoInitial, NaryJunctionsStayJunctionsWithMurrayOverAllTheirChildren) {
+  const auto g = growFile(test::sourceDir() / "examples/dcco_junctions_2d.toml");
+  const auto& t = g.forest.vessels;
+  const double gamma = g.setup->stages.front().stage.gamma;
+  const Vec3 c = g.prepared->domain()->center();
+  std::map<int, Vec3> junctions;  // children → place (mm from the centre)
+  double worst_murray = 0, worst_flow = 0;
+  std::int64_t branched = 0, children_total = 0;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    if (t.isRoot(i)) continue;
+    if (t.isLink(i)) {
+      EXPECT_EQ(t.pressure[i], t.pressure[t.parent[i]]);  // no drop along a link
+      EXPECT_EQ(t.flow[i], t.flow[t.child0[i]] + t.flow[t.child1[i]]);
+      continue;
+    }
+    if (t.graphType(i) != NodeType::Junction) continue;
+    std::vector<std::int32_t> kids;
+    t.junctionChildren(i, kids);
+    junctions[int(kids.size())] = t.position[i] - c;
+    double rk = 0, q = 0;
+    for (auto k : kids) {
+      rk += std::pow(t.radius[k], gamma);
+      q += t.flow[k];
+      EXPECT_EQ(distance(t.position[t.junction(t.parent[k])], t.position[i]), 0.0);
+      ++children_total;
+    }
+    worst_murray = std::max(worst_murray, std::abs(std::pow(t.radius[i], gamma) - rk) / std::pow(t.radius[i], gamma));
+    worst_flow = std::max(worst_flow, std::abs(t.flow[i] - q) / t.flow[i]);
+  }
+  ASSERT_EQ(junctions.size(), 2u);
+  EXPECT_LE(distance(junctions.at(4), Vec3(0, 13, 0)), 1e-9);
+  EXPECT_LE(distance(junctions.at(3), Vec3(0, 5, 0)), 1e-9);
+  EXPECT_LE(worst_murray, 1e-9);
+  EXPECT_LE(worst_flow, 1e-12);
+  EXPECT_EQ(children_total, 7);
+  // Outside the junctions the network grew: every one of its six terminals now feeds a subtree.
+  std::int64_t given_terminals = 0;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) given_terminals += t.stage[i] < 0 && t.isTerminal(i);
+  EXPECT_EQ(given_terminals, 6);  // sample ends keep their place (new vessels split them or leave them)
+  // The tree grew from the network: new vessels hang from its vessels.
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i)
+    if (t.stage[i] < 0 && !t.isRoot(i))
+      for (auto k : {t.child0[i], t.child1[i]}) branched += k >= 0 && t.stage[k] >= 0;
+  EXPECT_GE(branched, 11) << "new branches on the network's 11 vessels";
+}
+
 TEST(DccoInitial, CcoReadWriteReadRoundTripIsExact) {
   const auto g = growFile(test::sourceDir() / "examples/dcco_outlet_half_2d.toml");
   const auto dir = scratchToml("x.toml", "").parent_path();

@@ -65,6 +65,7 @@ TEST(ExampleOutputs, EveryFileTheShippedExamplesWriteIsByteIdenticalToTheRecord)
   ASSERT_EQ(run("generate " + ex("cco_artery_vein_3d.toml") + " --out cco_artery_vein_3d --quiet", dir).code, 0);
   ASSERT_EQ(run("generate " + ex("dcco_scale_specific_2d.toml") + " --out dcco_scale_specific_2d --quiet", dir).code, 0);
   ASSERT_EQ(run("generate " + ex("dcco_outlet_half_2d.toml") + " --out dcco_outlet_half_2d --quiet", dir).code, 0);
+  ASSERT_EQ(run("generate " + ex("dcco_junctions_2d.toml") + " --out dcco_junctions_2d --quiet", dir).code, 0);
   ASSERT_EQ(run("generate " + ex("colonisation_fig5_2d.toml") + " --out colonisation_fig5_2d --quiet", dir).code, 0);
   ASSERT_EQ(run("generate " + ex("lsystem_lzh_2d.toml") + " --out lsystem_lzh_2d --quiet", dir).code, 0);
   ASSERT_EQ(run("generate " + ex("lsystem_grammar_2d.toml") + " --out lsystem_grammar_2d --quiet", dir).code, 0);
@@ -74,7 +75,7 @@ TEST(ExampleOutputs, EveryFileTheShippedExamplesWriteIsByteIdenticalToTheRecord)
     std::ofstream(dir / "vascusynth" / f, std::ios::binary) << selfContained(src / "examples/vascusynth" / f);
   ASSERT_EQ(run("vascusynth paramList.txt imageNames.txt 0.04 --quiet", dir / "vascusynth").code, 0);
   std::map<std::string, std::string> now;
-  for (const char* out : {"vascusynth_like", "cco_sphere_3d", "cco_sphere_curved_3d", "cco_disc_2d", "cco_two_inlets_2d", "cco_artery_vein_3d", "dcco_scale_specific_2d", "dcco_outlet_half_2d", "colonisation_fig5_2d", "lsystem_lzh_2d", "lsystem_grammar_2d", "dataset_small"}) hashTree(dir / out, out, now);
+  for (const char* out : {"vascusynth_like", "cco_sphere_3d", "cco_sphere_curved_3d", "cco_disc_2d", "cco_two_inlets_2d", "cco_artery_vein_3d", "dcco_scale_specific_2d", "dcco_outlet_half_2d", "dcco_junctions_2d", "colonisation_fig5_2d", "lsystem_lzh_2d", "lsystem_grammar_2d", "dataset_small"}) hashTree(dir / out, out, now);
   for (const char* out : {"image1", "image2"}) hashTree(dir / "vascusynth" / out, std::string("vascusynth/") + out, now);
   const fs::path record = src / "tests/data/example_outputs.sha256";
   // Another compiler rounds some floating-point steps differently and grows other (valid) trees;

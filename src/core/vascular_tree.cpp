@@ -6,12 +6,32 @@
 
 namespace angiosynth {
 
+void VascularTree::junctionChildren(std::int32_t i, std::vector<std::int32_t>& out) const {
+  for (auto c : {child0[i], child1[i]}) {
+    if (c < 0) continue;
+    if (isLink(c)) junctionChildren(c, out);
+    else out.push_back(c);
+  }
+}
+
+NodeType VascularTree::graphType(std::int32_t i) const {
+  if (parent[i] < 0) return NodeType::Root;
+  int n = 0;
+  const auto count = [&](auto&& self, std::int32_t u) -> void {
+    for (auto c : {child0[u], child1[u]})
+      if (c >= 0) isLink(c) ? self(self, c) : void(++n);
+  };
+  count(count, i);
+  return n == 0 ? NodeType::Terminal : n == 1 ? NodeType::Continuation : n == 2 ? NodeType::Bifurcation : NodeType::Junction;
+}
+
 const char* nodeTypeName(NodeType t) {
   switch (t) {
     case NodeType::Root: return "root";
     case NodeType::Bifurcation: return "bifurcation";
     case NodeType::Terminal: return "terminal";
     case NodeType::Continuation: return "continuation";
+    case NodeType::Junction: return "junction";
   }
   return "";
 }

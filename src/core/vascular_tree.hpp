@@ -13,7 +13,8 @@
 namespace angiosynth {
 
 // Continuation: a node inside a vessel with one child, as in polyline trees (warped graphs).
-enum class NodeType { Root, Bifurcation, Terminal, Continuation };
+// Junction: a node of three or more children (graphs of N-ary networks, see isLink).
+enum class NodeType { Root, Bifurcation, Terminal, Continuation, Junction };
 
 struct VascularTree {
   std::vector<Vec3> position;               // mm
@@ -68,6 +69,19 @@ struct VascularTree {
     if (child0[i] < 0) return NodeType::Terminal;
     return child1[i] < 0 ? NodeType::Continuation : NodeType::Bifurcation;
   }
+  // A link: a zero-length segment that joins two nodes of one N-ary junction (a network file's
+  // node with three or more children is a chain of bifurcations at one point, so the tree stays
+  // binary; graph writers and adjacency tests merge the chain back into one junction).
+  bool isLink(std::int32_t i) const { return parent[i] >= 0 && position[i] == position[parent[i]]; }
+  // The node a link chain hangs from (i itself for an ordinary node).
+  std::int32_t junction(std::int32_t i) const {
+    while (isLink(i)) i = parent[i];
+    return i;
+  }
+  // Segments leaving the junction of node i (links followed, not listed), appended to out.
+  void junctionChildren(std::int32_t i, std::vector<std::int32_t>& out) const;
+  // The node's type in a graph, its links merged: a junction of three or more children.
+  NodeType graphType(std::int32_t i) const;
   // The other segment leaving the proximal node of segment i (-1 if none).
   std::int32_t sibling(std::int32_t i) const {
     const std::int32_t p = parent[i];

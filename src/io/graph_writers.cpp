@@ -53,15 +53,16 @@ void writeGxl(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
          "<gxl xmlns:xlink=\"http://www.w3.org/1999/xlink\">\n"
       << "  <graph id=\"" << graph_id << "\" edgeids=\"true\" edgemode=\"directed\" hypergraph=\"false\">\n";
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    if (t.isLink(i)) continue;
     out << "    <node id=\"n" << i << "\">\n"
-        << "      <attr name=\"type\"><string>" << nodeTypeName(t.type(i)) << "</string></attr>\n"
+        << "      <attr name=\"type\"><string>" << nodeTypeName(t.graphType(i)) << "</string></attr>\n"
         << stringAttr("tree", treeOf(trees, t, i).id) << stringAttr("kind", treeOf(trees, t, i).kind)
         << tupAttr("position", t.position[i]) << tupAttr("position_voxel", t.position[i] / f.voxel_mm) << "    </node>\n";
   }
   const bool tapered = t.hasTapers() || t.hasWalls(), staged = t.hasStages();
   for (auto i : t.topDownOrder()) {
-    if (t.isRoot(i)) continue;
-    out << "    <edge id=\"e" << i << "\" from=\"n" << t.parent[i] << "\" to=\"n" << i << "\">\n"
+    if (t.isRoot(i) || t.isLink(i)) continue;
+    out << "    <edge id=\"e" << i << "\" from=\"n" << t.junction(t.parent[i]) << "\" to=\"n" << i << "\">\n"
         << stringAttr("tree", treeOf(trees, t, i).id) << stringAttr("kind", treeOf(trees, t, i).kind)
         << floatAttr("radius", t.radius[i]) << floatAttr("length", t.length[i]) << floatAttr("flow", t.flow[i])
         << floatAttr("pressure_proximal", t.pressure[t.parent[i]]) << floatAttr("pressure_distal", t.pressure[i])
@@ -75,16 +76,18 @@ void writeVascuSynthGxl(std::ostream& out, const VascularTree& t, const GraphFra
   const double len = f.vs_units.mm_per_length;
   out << "<gxl><graph id=\"" << graph_id << "\" edgeids=\" true\" edgemode=\" directed\" hypergraph=\" false\">\n";
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    if (t.isLink(i)) continue;
     const Vec3 v = t.position[i] / f.voxel_mm;
+    const auto type = t.graphType(i);  // VascuSynth's three types: a junction is its bifurcation
     out << "  <node id=\"n" << i << "\">\n"
-        << "    <attr name=\" nodeType\"><string>" << kTypes[static_cast<int>(t.type(i))] << "</string></attr>\n"
+        << "    <attr name=\" nodeType\"><string>" << kTypes[type == NodeType::Root ? 0 : type == NodeType::Terminal ? 2 : 1] << "</string></attr>\n"
         << "    <attr name=\" position\"><tup><float>" << sig6(v.x) << "</float><float>" << sig6(v.y) << "</float><float>"
         << sig6(v.z) << "</float></tup></attr>\n"
         << "  </node>\n";
   }
   for (auto i : t.topDownOrder()) {
-    if (t.isRoot(i)) continue;
-    out << "  <edge id=\"e" << i << "\" to=\"n" << i << "\" from=\"n" << t.parent[i] << "\">\n"
+    if (t.isRoot(i) || t.isLink(i)) continue;
+    out << "  <edge id=\"e" << i << "\" to=\"n" << i << "\" from=\"n" << t.junction(t.parent[i]) << "\">\n"
         << "    <attr name=\" flow\"><float>" << sig6(t.flow[i] / f.vs_units.mm3s_per_flow()) << "</float></attr>\n"
         << "    <attr name=\" radius\"><float>" << sig6(t.radius[i] / len) << "</float></attr>\n"
         << "  </edge>\n";
@@ -96,14 +99,15 @@ void writeDot(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
   out << "digraph tree {\n  // positions in mm; radius and length in mm, flow in mm^3/s, pressure in Pa\n";
   const bool staged = t.hasStages(), tapered = t.hasTapers() || t.hasWalls();
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    if (t.isLink(i)) continue;
     const Vec3& p = t.position[i];
-    out << "  n" << i << " [type=" << nodeTypeName(t.type(i)) << ", tree=\"" << treeOf(trees, t, i).id << "\", kind=\""
+    out << "  n" << i << " [type=" << nodeTypeName(t.graphType(i)) << ", tree=\"" << treeOf(trees, t, i).id << "\", kind=\""
         << treeOf(trees, t, i).kind << "\", position=\"" << exactNumber(p.x) << ","
         << exactNumber(p.y) << "," << exactNumber(p.z) << "\"];\n";
   }
   for (auto i : t.topDownOrder()) {
-    if (t.isRoot(i)) continue;
-    out << "  n" << t.parent[i] << " -> n" << i << " [tree=\"" << treeOf(trees, t, i).id << "\", kind=\""
+    if (t.isRoot(i) || t.isLink(i)) continue;
+    out << "  n" << t.junction(t.parent[i]) << " -> n" << i << " [tree=\"" << treeOf(trees, t, i).id << "\", kind=\""
         << treeOf(trees, t, i).kind << "\", radius=" << exactNumber(t.radius[i])
         << ", length=" << exactNumber(t.length[i]) << ", flow=" << exactNumber(t.flow[i])
         << ", pressure=" << exactNumber(t.pressure[i]);

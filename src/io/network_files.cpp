@@ -70,10 +70,6 @@ ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, 
     const auto p = at.find(rows[k].parent);
     if (p == at.end()) throw InputError(file, rows[k].line, "parent " + rows[k].parent + " of " + rows[k].id + " is not defined");
     kids[p->second].push_back(k);
-    if (kids[p->second].size() > 2)
-      throw InputError(file, rows[p->second].line,
-                       rows[p->second].id + " has more than two children: N-ary junctions are not supported yet; split it into "
-                                            "bifurcations (a short segment between them)");
   }
   if (roots.empty()) throw InputError(file, rows.empty() ? 0 : rows.front().line, "no root (parent -1): the network is a cycle or empty");
   ExistingNetwork net;
@@ -105,7 +101,21 @@ ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, 
     std::vector<std::size_t> queue{roots[tr]};
     for (std::size_t q = 0; q < queue.size(); ++q) {
       const auto k = queue[q];
-      for (auto c : kids[k]) {
+      // An N-ary junction (m ≥ 3 children) becomes a chain of m − 2 links at its point: child j
+      // (j ≥ 1) hangs from a new link while two or more children are left.
+      std::int32_t from = node[k];
+      for (std::size_t j = 0; j < kids[k].size(); ++j) {
+        const auto c = kids[k][j];
+        if (j >= 1 && kids[k].size() - j >= 2) {
+          const auto link = t.addNode(t.position[node[k]], from);
+          net.ids.push_back("");
+          net.lines.push_back(rows[k].line);
+          t.radius[link] = t.radius[node[k]];
+          t.stage[link] = rows[k].stage;
+          t.role[link] = rows[k].role;
+          t.branching[link] = std::uint8_t(Branching::None);
+          from = link;
+        }
         const auto& row = rows[c];
         if (!swc) {
           const double tol = 1e-9 * (1 + norm(rows[k].dist));
@@ -113,7 +123,7 @@ ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, 
             throw InputError(file, row.line, "vessel " + row.id + " starts at " + show3(row.prox) + ", not where its parent " + rows[k].id +
                                                  " ends (" + show3(rows[k].dist) + ")");
         }
-        node[c] = t.addNode(row.dist * unit_mm, node[k]);
+        node[c] = t.addNode(row.dist * unit_mm, from);
         note(node[c], row);
         ++placed;
         queue.push_back(c);
@@ -124,7 +134,7 @@ ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, 
     for (std::size_t k = 0; k < rows.size(); ++k)
       if (node[k] < 0) throw InputError(file, rows[k].line, rows[k].id + " is not connected to a root: its parents form a cycle");
   for (std::int32_t i = 0; i < t.nodeCount(); ++i)
-    if (!t.isRoot(i) && !(t.length[i] > 0)) throw InputError(file, net.lines[i], net.ids[i] + " has zero length");
+    if (!t.isRoot(i) && !(t.length[i] > 0) && !net.ids[i].empty()) throw InputError(file, net.lines[i], net.ids[i] + " has zero length");
   return net;
 }
 
@@ -345,9 +355,12 @@ void writeCco(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
         << exactNumber(t.pressure[root] - terminal_pressure) << ' ' << t.totalTerminals() << ' ' << exactNumber(terminal_pressure) << ' '
         << t.nodeCount() << ' ' << exactNumber(t.radius[seg]) << " 1e-06\n";
   }
-  out << "\n*Vessels\n" << t.nodeCount() - std::int32_t(roots.size()) << '\n';
+  // Links are not vessels: an N-ary junction's vessels list each other as parent and children.
+  std::int32_t links = 0;
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i) links += t.isLink(i);
+  out << "\n*Vessels\n" << t.nodeCount() - std::int32_t(roots.size()) - links << '\n';
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
-    if (t.isRoot(i)) continue;
+    if (t.isRoot(i) || t.isLink(i)) continue;
     const Vec3 &a = t.position[t.parent[i]], &b = t.position[i];
     const double dp = t.pressure[t.parent[i]] - t.pressure[i];
     out << i << ' ' << exactNumber(a.x) << ' ' << exactNumber(a.y) << ' ' << exactNumber(a.z) << ' ' << exactNumber(b.x) << ' '
@@ -357,11 +370,14 @@ void writeCco(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
         << vitaFunction(t.role[i]) << " 0 0 " << t.stage[i] << '\n';
   }
   out << "\n*Connectivity\n";
+  std::vector<std::int32_t> kids;
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
-    if (t.isRoot(i)) continue;
-    out << i << ' ' << (t.isRoot(t.parent[i]) ? -1 : t.parent[i]);
-    if (t.child0[i] >= 0) out << ' ' << t.child0[i];
-    if (t.child1[i] >= 0) out << ' ' << t.child1[i];
+    if (t.isRoot(i) || t.isLink(i)) continue;
+    const auto from = t.junction(t.parent[i]);
+    out << i << ' ' << (t.isRoot(from) ? -1 : from);
+    kids.clear();
+    t.junctionChildren(i, kids);
+    for (auto c : kids) out << ' ' << c;
     out << '\n';
   }
 }

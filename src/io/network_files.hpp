@@ -21,8 +21,9 @@ struct ExistingNetwork {
 };
 
 // Reads `file` by its extension (.cco, .swc); lengths are multiplied by `unit_mm`. Throws
-// InputError (file:line) for malformed rows, unknown ids, cycles, vessels that do not start
-// where their parent ends, and junctions of more than two children (not supported yet).
+// InputError (file:line) for malformed rows, unknown ids, cycles and vessels that do not start
+// where their parent ends. A node of m ≥ 3 children becomes a chain of m − 2 links at its point
+// (VascularTree::isLink).
 ExistingNetwork readNetwork(const std::filesystem::path& file, double unit_mm = 1);
 
 // VItA's .cco layout: *Tree (root point, inflow, 0, pressure drop, terminals, terminal pressure,

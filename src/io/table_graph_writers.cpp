@@ -22,10 +22,11 @@ double segmentVolume(const VascularTree& t, std::int32_t i) {
 void writeNodesCsv(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees) {
   out << "id,pos_x,pos_y,pos_z,type,pressure,tree,kind\n";
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    if (t.isLink(i)) continue;
     const Vec3& p = t.position[i];
     const TreeInfo& tr = treeOf(trees, t, i);
     out << i << ',' << exactNumber(p.x) << ',' << exactNumber(p.y) << ',' << exactNumber(p.z) << ','
-        << nodeTypeName(t.type(i)) << ',' << exactNumber(t.pressure[i]) << ',' << tr.id << ',' << tr.kind << '\n';
+        << nodeTypeName(t.graphType(i)) << ',' << exactNumber(t.pressure[i]) << ',' << tr.id << ',' << tr.kind << '\n';
   }
 }
 
@@ -34,9 +35,9 @@ void writeEdgesCsv(std::ostream& out, const VascularTree& t, const std::vector<T
   out << "id,node1id,node2id,length,radius,flow,volume,tree,kind" << (staged ? ",stage,role,branching" : "")
       << (tapered ? ",radius_start,wall_start,wall" : "") << "\n";
   for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
-    if (t.isRoot(i)) continue;
+    if (t.isRoot(i) || t.isLink(i)) continue;
     const TreeInfo& tr = treeOf(trees, t, i);
-    out << i << ',' << t.parent[i] << ',' << i << ',' << exactNumber(t.length[i]) << ',' << exactNumber(t.radius[i]) << ','
+    out << i << ',' << t.junction(t.parent[i]) << ',' << i << ',' << exactNumber(t.length[i]) << ',' << exactNumber(t.radius[i]) << ','
         << exactNumber(t.flow[i]) << ',' << exactNumber(segmentVolume(t, i)) << ',' << tr.id << ',' << tr.kind;
     if (staged) out << ',' << t.stage[i] << ',' << roleName(t.role[i]) << ',' << branchingName(t.branching[i]);
     if (tapered) out << ',' << exactNumber(t.startRadius(i)) << ',' << exactNumber(t.wall_start[i]) << ',' << exactNumber(t.wall[i]);
@@ -84,26 +85,28 @@ void writeVitaCellArrays(std::ostream& out, const VascularTree& t, const std::ve
 }  // namespace
 
 void writeVtp(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees) {
-  const auto n = t.nodeCount();
-  std::vector<std::int32_t> segments;
-  for (std::int32_t i = 1; i < n; ++i)
-    if (!t.isRoot(i)) segments.push_back(i);
+  // Points: the nodes but links (an N-ary junction is one point), numbered in node order.
+  std::vector<std::int32_t> points, point_of(std::size_t(t.nodeCount()), -1), segments;
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i)
+    if (!t.isLink(i)) point_of[std::size_t(i)] = std::int32_t(points.size()), points.push_back(i);
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i)
+    if (!t.isRoot(i) && !t.isLink(i)) segments.push_back(i);
+  const auto n = std::int32_t(points.size());
   const auto treeIndex = [&](std::int32_t i) { return t.tree.empty() ? 0 : t.tree[i]; };
   out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\">\n<PolyData>\n"
       << "<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"0\" NumberOfLines=\"" << segments.size()
       << "\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n"
       << "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (std::int32_t i = 0; i < n; ++i)
-    out << exactNumber(t.position[i].x) << ' ' << exactNumber(t.position[i].y) << ' ' << exactNumber(t.position[i].z) << '\n';
+  for (auto i : points) out << exactNumber(t.position[i].x) << ' ' << exactNumber(t.position[i].y) << ' ' << exactNumber(t.position[i].z) << '\n';
   // A segment is a cylinder: its radius is the cell's (active scalars). Per point, for viewers
   // that need point radii, the radius of the segment ending there, named so it is not mistaken
   // for the vessel's (interpolated between points it tapers every vessel).
   out << "</DataArray>\n</Points>\n<PointData>\n<DataArray type=\"Float64\" Name=\"NodeRadius\" format=\"ascii\">\n";
-  for (std::int32_t i = 0; i < n; ++i) out << exactNumber(nodeRadius(t, i)) << '\n';
+  for (auto i : points) out << exactNumber(nodeRadius(t, i)) << '\n';
   out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"Tree\" format=\"ascii\">\n";
-  for (std::int32_t i = 0; i < n; ++i) out << treeIndex(i) << '\n';
+  for (auto i : points) out << treeIndex(i) << '\n';
   out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"Class\" format=\"ascii\">\n";
-  for (std::int32_t i = 0; i < n; ++i) out << treeOf(trees, t, i).class_label << '\n';
+  for (auto i : points) out << treeOf(trees, t, i).class_label << '\n';
   out << "</DataArray>\n</PointData>\n<CellData Scalars=\"Radius\">\n<DataArray type=\"Float64\" Name=\"Radius\" format=\"ascii\">\n";
   for (auto i : segments) out << exactNumber(t.radius[i]) << '\n';
   out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"Flow\" format=\"ascii\">\n";
@@ -129,7 +132,7 @@ void writeVtp(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
     array("Wall", [&](std::int32_t i) { return t.wall[i]; });
   }
   out << "</DataArray>\n</CellData>\n<Lines>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (auto i : segments) out << t.parent[i] << ' ' << i << '\n';
+  for (auto i : segments) out << point_of[std::size_t(t.junction(t.parent[i]))] << ' ' << point_of[std::size_t(i)] << '\n';
   out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
   for (std::size_t k = 1; k <= segments.size(); ++k) out << 2 * k << '\n';
   out << "</DataArray>\n</Lines>\n</Piece>\n</PolyData>\n</VTKFile>\n";
@@ -139,7 +142,9 @@ void writeSwc(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
   out << "# angiosynth vascular forest; x y z R in mm; type 1 = root, 1 + class for vessel nodes (2 artery, 3 vein, "
          "further kinds on)\n";
   // SWC ids start at 1 and a parent must precede its children.
-  const auto order = t.topDownOrder();
+  std::vector<std::int32_t> order;
+  for (auto i : t.topDownOrder())
+    if (!t.isLink(i)) order.push_back(i);  // an N-ary junction is one sample
   std::vector<std::int64_t> id(t.nodeCount(), -1);
   for (std::size_t k = 0; k < order.size(); ++k) id[order[k]] = std::int64_t(k) + 1;
   for (auto i : order) {
@@ -147,7 +152,7 @@ void writeSwc(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
     const bool root = t.isRoot(i);
     out << id[i] << ' ' << (root ? 1 : 1 + treeOf(trees, t, i).class_label) << ' ' << exactNumber(p.x) << ' '
         << exactNumber(p.y) << ' ' << exactNumber(p.z) << ' ' << exactNumber(nodeRadius(t, i)) << ' '
-        << (root ? -1 : id[t.parent[i]]) << '\n';
+        << (root ? -1 : id[t.junction(t.parent[i])]) << '\n';
   }
 }
 
@@ -179,17 +184,18 @@ void writeGraphml(std::ostream& out, const VascularTree& t, const std::vector<Tr
            "  <key id=\"branching\" for=\"edge\" attr.name=\"branching\" attr.type=\"string\"/>\n";
   out << "  <graph id=\"tree\" edgedefault=\"directed\">\n";
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    if (t.isLink(i)) continue;
     const Vec3& p = t.position[i];
     const TreeInfo& tr = treeOf(trees, t, i);
     out << "    <node id=\"n" << i << "\"><data key=\"x\">" << exactNumber(p.x) << "</data><data key=\"y\">" << exactNumber(p.y)
-        << "</data><data key=\"z\">" << exactNumber(p.z) << "</data><data key=\"type\">" << nodeTypeName(t.type(i))
+        << "</data><data key=\"z\">" << exactNumber(p.z) << "</data><data key=\"type\">" << nodeTypeName(t.graphType(i))
         << "</data><data key=\"node_radius\">" << exactNumber(nodeRadius(t, i)) << "</data><data key=\"node_tree\">" << tr.id
         << "</data><data key=\"node_kind\">" << tr.kind << "</data></node>\n";
   }
   for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
-    if (t.isRoot(i)) continue;
+    if (t.isRoot(i) || t.isLink(i)) continue;
     const TreeInfo& tr = treeOf(trees, t, i);
-    out << "    <edge id=\"e" << i << "\" source=\"n" << t.parent[i] << "\" target=\"n" << i << "\"><data key=\"length\">"
+    out << "    <edge id=\"e" << i << "\" source=\"n" << t.junction(t.parent[i]) << "\" target=\"n" << i << "\"><data key=\"length\">"
         << exactNumber(t.length[i]) << "</data><data key=\"radius\">" << exactNumber(t.radius[i]) << "</data><data key=\"flow\">"
         << exactNumber(t.flow[i]) << "</data><data key=\"tree\">" << tr.id << "</data><data key=\"kind\">" << tr.kind << "</data>";
     if (staged)

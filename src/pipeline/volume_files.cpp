@@ -30,9 +30,10 @@ void convert(Volume<T>& out, const Volume<float>& src, double offset, double sca
 void writeKeypoints(std::ostream& out, const VascularTree& t, const std::vector<TreeInfo>& trees, const VolumeGrid& g) {
   out << "id,type,x_voxel,y_voxel,z_voxel,x_mm,y_mm,z_mm,radius_mm,tree,kind\n";
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    if (t.isLink(i)) continue;  // an N-ary junction is one key point
     const Vec3& p = t.position[i];
     const Vec3 v = g.index(p);
-    out << i << ',' << nodeTypeName(t.type(i)) << ',' << exactNumber(v.x) << ',' << exactNumber(v.y) << ',' << exactNumber(v.z)
+    out << i << ',' << nodeTypeName(t.graphType(i)) << ',' << exactNumber(v.x) << ',' << exactNumber(v.y) << ',' << exactNumber(v.z)
         << ',' << exactNumber(p.x) << ',' << exactNumber(p.y) << ',' << exactNumber(p.z) << ',' << exactNumber(nodeRadius(t, i))
         << ',' << treeOf(trees, t, i).id << ',' << treeOf(trees, t, i).kind << '\n';
   }

@@ -205,14 +205,13 @@ Json calibreRecall(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>&
 Json vesselDetection(const Volume<std::uint8_t>& pred, const VascularTree& t) {
   const VolumeGrid& g = pred.grid;
   const double step = smallestEdge(g) / 4;
-  const auto children = [&](std::int32_t i) { return int(t.child0[i] >= 0) + int(t.child1[i] >= 0); };
-  // Level and vessel of each segment, top down.
+  // Level and vessel of each segment, top down (an N-ary junction's links merged into its node).
   std::vector<std::int32_t> level(t.nodeCount(), 0), vessel(t.nodeCount(), -1);
   std::vector<std::int32_t> vessel_level;
   for (auto i : t.topDownOrder()) {
-    if (t.isRoot(i)) continue;
-    const auto p = t.parent[i];
-    if (t.isRoot(p) || children(p) != 1) {
+    if (t.isRoot(i) || t.isLink(i)) continue;
+    const auto p = t.junction(t.parent[i]);
+    if (t.isRoot(p) || t.graphType(p) != NodeType::Continuation) {
       level[i] = t.isRoot(p) ? 0 : level[p] + 1;
       vessel[i] = std::int32_t(vessel_level.size());
       vessel_level.push_back(level[i]);
@@ -223,7 +222,7 @@ Json vesselDetection(const Volume<std::uint8_t>& pred, const VascularTree& t) {
   }
   std::vector<double> length(vessel_level.size(), 0), found(vessel_level.size(), 0);
   for (std::int32_t s = 0; s < t.nodeCount(); ++s) {
-    if (t.isRoot(s)) continue;
+    if (t.isRoot(s) || t.isLink(s)) continue;
     const Vec3 a = t.position[t.parent[s]], b = t.position[s];
     const double len = distance(a, b);
     const int n = std::max(1, int(std::ceil(len / step)));

@@ -84,7 +84,7 @@ KeyPoints truthKeyPoints(const std::filesystem::path& file, const VolumeGrid& g)
                      parseNumber(cells[r], file.string(), number, "radius_mm")};
     const Vec3 v = g.index(p.mm);
     if (!g.contains(std::llround(v.x), std::llround(v.y), std::llround(v.z))) continue;
-    if (cells[type] == "bifurcation") out.bifurcations.push_back(p);
+    if (cells[type] == "bifurcation" || cells[type] == "junction") out.bifurcations.push_back(p);  // a junction: one branch point
     else if (cells[type] == "terminal" || cells[type] == "root") out.endpoints.push_back(p);
   }
   return out;

@@ -398,9 +398,13 @@ class DccoGrower {
   bool hitsVessel(const Vec3& a, const Vec3& e, double r, Kind&& kind) {
     bool hit = false;
     const auto test = [&](std::int32_t y) {
-      if (hit || y >= t_.nodeCount() || t_.parent[y] < 0) return;
+      // A link lies inside the cap of the vessel that ends at its junction: that vessel stands for it.
+      if (hit || y >= t_.nodeCount() || t_.parent[y] < 0 || t_.isLink(y)) return;
       const auto k = kind(y);
       if (k == Neighbour::Meets) return;
+      // Vessels that meet at an N-ary junction share its point, with links between them.
+      const Vec3 &ya = t_.position[t_.parent[y]], &ye = t_.position[y];
+      if (ya == a || ya == e || ye == a || ye == e) return;
       const double d = segmentSegmentDistance(a, e, t_.position[t_.parent[y]], t_.position[y]);
       const double ry = kMargin * radiusOf(y);
       hit = k == Neighbour::Near ? d < 0.5 * std::min(r, ry) : d < r + ry;
@@ -416,8 +420,10 @@ class DccoGrower {
     for (std::int32_t i = 1; i < t_.nodeCount(); ++i)
       if (t_.parent[i] >= 0 && rel_[i] >= kThickList) thick_.push_back(i);
   }
+  // True if segments x and y meet at a node (an N-ary junction's nodes count as one).
   bool sharesNode(std::int32_t x, std::int32_t y) const {
-    return t_.parent[x] == t_.parent[y] || t_.parent[x] == y || t_.parent[y] == x;
+    const auto px = t_.junction(t_.parent[x]), py = t_.junction(t_.parent[y]);
+    return px == py || px == t_.junction(y) || py == t_.junction(x);
   }
 
   // The three new vessels of a trial against the tree before it is committed, each with the
@@ -656,8 +662,8 @@ class DccoGrower {
     const auto evaluate = [&](std::size_t c) {
       const auto s = near_[c].second;
       const auto pts = bifurcationLattice(x, t_.position[t_.parent[s]], t_.position[s], st.delta_v, Branching(t_.branching[s]));
-      int level = -1;  // bifurcation level of the proximal part: bifurcations above it
-      for (std::int32_t y = t_.parent[s]; t_.parent[y] >= 0; y = t_.parent[y]) ++level;
+      int level = -1;  // bifurcation level of the proximal part: bifurcations above it (links are no level)
+      for (std::int32_t y = t_.parent[s]; t_.parent[y] >= 0; y = t_.parent[y]) level += !t_.isLink(y);
       std::vector<Level> path;
       auto& out = trials_[c];
       counts_[c] = pts.size();
@@ -769,8 +775,9 @@ class DccoGrower {
     for (std::int32_t x = 1; x < T.nodeCount(); ++x) {
       if (T.parent[x] < 0) continue;
       const Vec3 a = T.position[T.parent[x]], e = T.position[x];
+      if (T.isLink(x)) continue;
       index_.forEachNearSegment(a, e, T.radius[x] + r_max, [&](std::int32_t y) {
-        if (y <= x || y >= T.nodeCount() || T.parent[y] < 0 || sharesNode(x, y) || !withinTwoSegments(T, x, y)) return;
+        if (y <= x || y >= T.nodeCount() || T.parent[y] < 0 || T.isLink(y) || sharesNode(x, y) || !withinTwoSegments(T, x, y)) return;
         if (T.stage[x] < 0 && T.stage[y] < 0 && given_ > 0) return;
         if (segmentSegmentDistance(a, e, T.position[T.parent[y]], T.position[y]) < 0.5 * std::min(T.radius[x], T.radius[y])) {
           ++dr_.folded_pairs;
@@ -780,7 +787,7 @@ class DccoGrower {
       });
     }
     for (std::int32_t s = 1; s < T.nodeCount(); ++s) {
-      if (T.isRoot(s)) continue;
+      if (T.isRoot(s) || T.isLink(s)) continue;
       if (!(T.length[s] > 2 * T.radius[s]) && !(fix && lengthen(s))) {
         ++dr_.short_segments;
         const auto a = T.child0[s], b = T.child1[s];
