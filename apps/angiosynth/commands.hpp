@@ -73,6 +73,17 @@ struct ScoreArgs {
 CLI::App* addScore(CLI::App& app, ScoreArgs& a);
 int runScore(const ScoreArgs& a);
 
+struct MeshArgs {
+  std::string input, out;
+  double voxel_mm = 0;
+  int samples_across = 4;
+  std::vector<std::string> formats;
+  bool force = false;
+  CommonOptions common;
+};
+CLI::App* addMesh(CLI::App& app, MeshArgs& a);
+int runMesh(const MeshArgs& a, const std::string& command_line);
+
 struct PlotCalibreArgs {
   std::string out;
   std::vector<std::string> scores;

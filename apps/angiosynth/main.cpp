@@ -31,6 +31,8 @@ int main(int argc, char** argv) {
   auto* in = cli::addInit(app, ia);
   cli::ScoreArgs sa;
   auto* sc = cli::addScore(app, sa);
+  cli::MeshArgs ma;
+  auto* me = cli::addMesh(app, ma);
   cli::PlotCalibreArgs pc;
   auto* pl = cli::addPlotCalibre(app, pc);
   try {
@@ -48,6 +50,7 @@ int main(int argc, char** argv) {
     if (in->parsed()) return cli::runInit(ia);
     if (sc->parsed()) return cli::runScore(sa);
     if (pl->parsed()) return cli::runPlotCalibre(pc);
+    if (me->parsed()) return cli::runMesh(ma, cmdline);
     if (fx->parsed()) {
       std::cout << effectReference();
       return 0;

@@ -78,6 +78,8 @@ ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, 
     net.ids.push_back(r.id);
     net.lines.push_back(r.line);
     t.radius[node] = r.radius * unit_mm;
+    // A tapered vessel keeps its proximal radius (a cylinder's equals its radius: none).
+    if (r.radius_start >= 0 && r.radius_start != r.radius) t.radius_start[node] = r.radius_start * unit_mm;
     t.outflow[node] = r.outflow;
     t.stage[node] = r.stage;
     t.role[node] = r.role;

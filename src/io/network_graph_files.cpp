@@ -154,7 +154,7 @@ ExistingNetwork readCsv(const std::string& file, double unit_mm) {
   }
   const int eid = edges.column("id", false), from = edges.column("node1id", true), to = edges.column("node2id", true),
             radius = edges.column("radius", true), stage = edges.column("stage", false), role = edges.column("role", false),
-            branching = edges.column("branching", false);
+            branching = edges.column("branching", false), radius_start = edges.column("radius_start", false);
   std::vector<PointSegment> segments;
   for (const auto& [line, c] : edges.rows) {
     const auto& f = edges.file;
@@ -168,6 +168,10 @@ ExistingNetwork readCsv(const std::string& file, double unit_mm) {
     }
     s.row.radius = finite(f, line, c[radius].c_str(), "radius");
     if (!(s.row.radius >= 0)) throw InputError(f, line, "radius must not be negative");
+    if (radius_start >= 0) {
+      s.row.radius_start = finite(f, line, c[radius_start].c_str(), "radius_start");
+      if (!(s.row.radius_start >= 0)) throw InputError(f, line, "radius_start must not be negative");
+    }
     if (stage >= 0) {
       const double v = finite(f, line, c[stage].c_str(), "stage");
       if (v != std::floor(v) || v < -1 || v > 30000) throw InputError(f, line, "stage must be an integer in [-1, 30000]");

@@ -1,0 +1,170 @@
+"""Independent check of surface meshes angiosynth wrote (VTK from Debian, numpy, scipy).
+
+    check_mesh.py MESH_DIR NODES_CSV EDGES_CSV
+
+Reads surface.stl, .obj, .ply, .vtp with VTK's readers and surface.off by hand; for each: the
+counts of boundary and non-manifold edges (vtkFeatureEdges), duplicate and degenerate faces, the
+connected regions with their Euler characteristic (genus), the enclosed volume
+(vtkMassProperties) and the signed volume (outward orientation). Estimates the volume of the
+union of the tree's capsules by Monte Carlo, independently of the mesher: points drawn
+uniformly in each capsule count 1/(capsules holding them). Prints one JSON object.
+"""
+import csv
+import json
+import sys
+
+import numpy as np
+import vtk
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
+from vtk.util.numpy_support import vtk_to_numpy
+
+
+def read(path):
+    ext = path.rsplit(".", 1)[1]
+    if ext == "off":
+        with open(path) as f:
+            assert f.readline().strip() == "OFF"
+            nv, nf, _ = map(int, f.readline().split())
+            pts = np.array([list(map(float, f.readline().split())) for _ in range(nv)])
+            faces = np.array([list(map(int, f.readline().split()))[1:] for _ in range(nf)])
+        poly = vtk.vtkPolyData()
+        p = vtk.vtkPoints()
+        p.SetNumberOfPoints(nv)
+        for i, x in enumerate(pts):
+            p.SetPoint(i, *x)
+        cells = vtk.vtkCellArray()
+        for t in faces:
+            cells.InsertNextCell(3, [int(v) for v in t])
+        poly.SetPoints(p)
+        poly.SetPolys(cells)
+        return poly
+    reader = {"stl": vtk.vtkSTLReader, "obj": vtk.vtkOBJReader, "ply": vtk.vtkPLYReader, "vtp": vtk.vtkXMLPolyDataReader}[ext]()
+    reader.SetFileName(path)
+    reader.Update()
+    poly = reader.GetOutput()
+    if ext == "stl":  # STL repeats each corner: weld exactly equal points (tolerance 0)
+        clean = vtk.vtkCleanPolyData()
+        clean.SetInputData(poly)
+        clean.SetTolerance(0.0)
+        clean.PointMergingOn()
+        clean.Update()
+        poly = clean.GetOutput()
+    return poly
+
+
+def faces_of(poly):
+    conn = vtk_to_numpy(poly.GetPolys().GetConnectivityArray())
+    return conn.reshape(-1, 3)
+
+
+def edge_counts(poly):
+    # One vtkFeatureEdges per kind (VTK 9.1 fails re-running one filter with other flags).
+    counts = []
+    for boundary in (True, False):
+        fe = vtk.vtkFeatureEdges()
+        fe.SetInputData(poly)
+        fe.SetBoundaryEdges(boundary)
+        fe.SetNonManifoldEdges(not boundary)
+        fe.FeatureEdgesOff()
+        fe.ManifoldEdgesOff()
+        fe.Update()
+        counts.append(fe.GetOutput().GetNumberOfLines())
+    return counts
+
+
+def regions(pts, faces):
+    # Connected components over shared vertices; per component V − E + F and the signed volume.
+    n = len(pts)
+    graph = coo_matrix((np.ones(2 * len(faces)), (np.concatenate([faces[:, 0], faces[:, 0]]), np.concatenate([faces[:, 1], faces[:, 2]]))), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    comp_of_face = label[faces[:, 0]]
+    out = []
+    for r in np.unique(comp_of_face):
+        f = faces[comp_of_face == r]
+        v = len(np.unique(f))
+        e = np.unique(np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1), axis=0)
+        a, b, c = pts[f[:, 0]], pts[f[:, 1]], pts[f[:, 2]]
+        vol = float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6)
+        chi = v - len(e) + len(f)
+        lo, hi = pts[np.unique(f)].min(axis=0), pts[np.unique(f)].max(axis=0)
+        out.append({"vertices": int(v), "faces": int(len(f)), "euler": int(chi), "genus": (2 - chi) / 2, "signed_volume": vol,
+                    "box": [lo.tolist(), hi.tolist()]})
+    return out
+
+
+def capsule_union_volume(nodes_csv, edges_csv, per_capsule=4000, seed=5):
+    pos = {}
+    with open(nodes_csv) as f:
+        for r in csv.DictReader(f):
+            pos[r["id"]] = np.array([float(r["pos_x"]), float(r["pos_y"]), float(r["pos_z"])])
+    a, b, rad = [], [], []
+    with open(edges_csv) as f:
+        for r in csv.DictReader(f):
+            a.append(pos[r["node1id"]])
+            b.append(pos[r["node2id"]])
+            rad.append(float(r["radius"]))
+    a, b, rad = np.array(a), np.array(b), np.array(rad)
+    d = b - a
+    length = np.linalg.norm(d, axis=1)
+    vol = np.pi * rad**2 * length + 4 / 3 * np.pi * rad**3
+    mid = (a + b) / 2
+    reach = length / 2 + rad
+    tree = cKDTree(mid)
+    rng = np.random.default_rng(seed)
+    estimate = 0.0
+    for s in range(len(a)):
+        # Uniform points in capsule s: rejection from its bounding box.
+        lo = np.minimum(a[s], b[s]) - rad[s]
+        hi = np.maximum(a[s], b[s]) + rad[s]
+        pts = np.empty((0, 3))
+        while len(pts) < per_capsule:
+            p = rng.uniform(lo, hi, size=(4 * per_capsule, 3))
+            pts = np.vstack([pts, p[inside(p, a[s], d[s], rad[s])]])
+        pts = pts[:per_capsule]
+        idx = np.array(tree.query_ball_point(mid[s], reach[s] + reach.max()))  # capsules that may overlap it
+        ap = pts[:, None, :] - a[idx][None, :, :]
+        t = np.clip(np.einsum("pkj,kj->pk", ap, d[idx]) / np.einsum("kj,kj->k", d[idx], d[idx]), 0, 1)
+        q = a[idx][None, :, :] + t[:, :, None] * d[idx][None, :, :]
+        count = (np.linalg.norm(pts[:, None, :] - q, axis=2) <= rad[idx][None, :]).sum(axis=1)
+        estimate += vol[s] * np.mean(1 / count)
+    return estimate
+
+
+def inside(p, a, d, r):
+    t = np.clip(((p - a) @ d) / (d @ d), 0, 1)
+    q = a + t[:, None] * d
+    return np.linalg.norm(p - q, axis=1) <= r
+
+
+def main():
+    mesh_dir, nodes_csv, edges_csv = sys.argv[1:4]
+    result = {"formats": {}}
+    for ext in ["stl", "obj", "ply", "off", "vtp"]:
+        poly = read(f"{mesh_dir}/surface.{ext}")
+        pts = vtk_to_numpy(poly.GetPoints().GetData()).astype(float)
+        faces = faces_of(poly)
+        boundary, nonmanifold = edge_counts(poly)
+        sorted_faces = np.sort(faces, axis=1)
+        duplicate = len(faces) - len(np.unique(sorted_faces, axis=0))
+        area2 = np.linalg.norm(np.cross(pts[faces[:, 1]] - pts[faces[:, 0]], pts[faces[:, 2]] - pts[faces[:, 0]]), axis=1)
+        mass = vtk.vtkMassProperties()
+        mass.SetInputData(poly)
+        mass.Update()
+        result["formats"][ext] = {
+            "points": int(len(pts)),
+            "triangles": int(len(faces)),
+            "boundary_edges": int(boundary),
+            "nonmanifold_edges": int(nonmanifold),
+            "duplicate_faces": int(duplicate),
+            "degenerate_faces": int((area2 == 0).sum()),
+            "volume": mass.GetVolume(),
+            "regions": regions(pts, faces),
+        }
+    result["union_volume_monte_carlo"] = capsule_union_volume(nodes_csv, edges_csv)
+    print(json.dumps(result))
+
+
+if __name__ == "__main__":
+    main()
