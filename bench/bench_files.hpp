@@ -20,6 +20,17 @@ struct FileArgs {
   std::unique_ptr<tbb::global_control> threads;
 };
 
+// Takes `NAME VALUE` out of argv (its last occurrence wins): VALUE, or `fallback` if absent.
+// The arguments left are in `rest` (the program name first), for parseFileArgs.
+inline double takeOption(int argc, char** argv, const char* name, double fallback, std::vector<char*>& rest) {
+  rest.clear();
+  for (int i = 0; i < argc; ++i) {
+    if (!std::strcmp(argv[i], name) && i + 1 < argc) fallback = std::atof(argv[++i]);
+    else rest.push_back(argv[i]);
+  }
+  return fallback;
+}
+
 inline FileArgs parseFileArgs(int argc, char** argv) {
   FileArgs a;
   for (int i = 1; i < argc; ++i) {

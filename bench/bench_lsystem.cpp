@@ -14,12 +14,8 @@ using namespace angiosynth;
 
 int main(int argc, char** argv) {
   // --supersampling S (default 4, the image default; 1: one sample per voxel, a binary-like mask).
-  int supersampling = 4;
   std::vector<char*> rest;
-  for (int i = 0; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--supersampling") && i + 1 < argc) supersampling = std::atoi(argv[++i]);
-    else rest.push_back(argv[i]);
-  }
+  const int supersampling = int(bench::takeOption(argc, argv, "--supersampling", 4, rest));
   const auto args = bench::parseFileArgs(int(rest.size()), rest.data());
   std::printf("%-32s %9s %9s %9s %9s %10s %10s\n", "file", "grow ms", "check ms", "tips", "segments", "raster ms", "peak MiB");
   for (const auto& f : args.files) {

@@ -4,8 +4,6 @@
 // Prints the step, the time, triangles in all and per segment, and the peak memory.
 // Targets (issue 15): 10k segments ≤ 10 s, ≤ 4 GB, ≤ 500 triangles per segment; 100k ≤ 2 min.
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 
 #include "bench_files.hpp"
 #include "core/memory.hpp"
@@ -14,12 +12,8 @@
 using namespace angiosynth;
 
 int main(int argc, char** argv) {
-  double voxel = 0;
   std::vector<char*> rest;
-  for (int i = 0; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--voxel") && i + 1 < argc) voxel = std::atof(argv[++i]);
-    else rest.push_back(argv[i]);
-  }
+  const double voxel = bench::takeOption(argc, argv, "--voxel", 0, rest);
   const auto args = bench::parseFileArgs(int(rest.size()), rest.data());
   std::printf("%-34s %9s %9s %10s %12s %10s %8s %9s\n", "file", "segments", "step mm", "mesh s", "triangles", "tri/seg", "genus0", "peak MiB");
   for (const auto& f : args.files) {

@@ -45,6 +45,14 @@ void expectSameNetwork(const VascularTree& read, const VascularTree& want, const
   EXPECT_EQ(differ, 0) << what;
 }
 
+// Writes dir/name with writer(stream); returns its path.
+template <class Writer>
+std::filesystem::path writeFile(const std::filesystem::path& dir, const std::string& name, Writer&& writer) {
+  std::ofstream out(dir / name);
+  writer(out);
+  return dir / name;
+}
+
 }  // namespace
 
 TEST(NetworkFiles, EveryGraphFormatTheProjectWritesReadsBackTheGrownTree) {
@@ -54,11 +62,7 @@ TEST(NetworkFiles, EveryGraphFormatTheProjectWritesReadsBackTheGrownTree) {
   const auto dir = scratch();
   GraphFrame frame;
   frame.voxel_mm = 0.1;
-  const auto write = [&](const std::string& name, auto&& writer) {
-    std::ofstream out(dir / name);
-    writer(out);
-    return dir / name;
-  };
+  const auto write = [&](const std::string& name, auto&& writer) { return writeFile(dir, name, writer); };
   const auto gxl = write("tree.gxl", [&](std::ostream& o) { writeGxl(o, t, g.forest.trees, frame, "tree"); });
   write("nodes.csv", [&](std::ostream& o) { writeNodesCsv(o, t, g.forest.trees); });
   const auto edges = write("edges.csv", [&](std::ostream& o) { writeEdgesCsv(o, t, g.forest.trees); });
@@ -111,11 +115,7 @@ TEST(NetworkFiles, NaryJunctionsAreKeptThroughEveryGraphFormat) {
   std::filesystem::create_directories(dir);
   GraphFrame frame;
   frame.voxel_mm = 0.1;
-  const auto write = [&](const std::string& name, auto&& writer) {
-    std::ofstream out(dir / name);
-    writer(out);
-    return dir / name;
-  };
+  const auto write = [&](const std::string& name, auto&& writer) { return writeFile(dir, name, writer); };
   const std::vector<std::filesystem::path> files = {
       write("tree.gxl", [&](std::ostream& o) { writeGxl(o, t, g.forest.trees, frame, "tree"); }),
       write("edges.csv", [&](std::ostream& o) { writeEdgesCsv(o, t, g.forest.trees); }),
