@@ -3,6 +3,8 @@
 // vtk_network_fixtures.py: every encoding, and VItA's layout with polylines) read alike.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -306,4 +308,31 @@ TEST(NetworkFiles, GrowthContinuesFromTheProjectsOwnVtp) {
   EXPECT_EQ(moved, 0);
   EXPECT_EQ(terminals, 32 + 100);
   EXPECT_EQ(new_outside, 0) << "origin = corner puts the given tree over the disc, where the new terminals are";
+}
+
+// A junction of 20,000 children (a chain of 19,998 links) reads, counts its children and writes
+// back as one node, without deep recursion.
+TEST(NetworkFiles, AJunctionOfThousandsOfChildrenIsOneNode) {
+  const auto dir = scratch();
+  {
+    std::ofstream swc(dir / "star.swc");
+    swc << "1 1 0 0 0 1 -1\n2 2 0 0 10 1 1\n";
+    for (int k = 0; k < 20000; ++k)
+      swc << k + 3 << " 2 " << std::cos(k * 0.001) * 5 << ' ' << std::sin(k * 0.001) * 5 << " 10 0.01 2\n";
+  }
+  const auto t = readNetwork(dir / "star.swc").tree;
+  std::int32_t links = 0, junction = -1;
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    links += t.isLink(i);
+    if (!t.isLink(i) && t.graphType(i) == NodeType::Junction) junction = i;
+  }
+  EXPECT_EQ(links, 19998);
+  ASSERT_GE(junction, 0);
+  std::vector<std::int32_t> kids;
+  t.junctionChildren(junction, kids);
+  EXPECT_EQ(kids.size(), 20000u);
+  std::ostringstream edges;
+  writeEdgesCsv(edges, t, {TreeInfo{}});
+  const std::string text = edges.str();
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1 + 1 + 20000);  // header, root vessel, children
 }

@@ -7,22 +7,30 @@
 namespace angiosynth {
 
 void VascularTree::junctionChildren(std::int32_t i, std::vector<std::int32_t>& out) const {
-  for (auto c : {child0[i], child1[i]}) {
-    if (c < 0) continue;
-    if (isLink(c)) junctionChildren(c, out);
+  // Depth first, child0 before child1, without recursion: a file's junction may have thousands
+  // of children, hence a chain of as many links.
+  std::vector<std::int32_t> stack;
+  const auto push = [&](std::int32_t u) {
+    if (child1[u] >= 0) stack.push_back(child1[u]);
+    if (child0[u] >= 0) stack.push_back(child0[u]);
+  };
+  push(i);
+  while (!stack.empty()) {
+    const auto c = stack.back();
+    stack.pop_back();
+    if (isLink(c)) push(c);
     else out.push_back(c);
   }
 }
 
 NodeType VascularTree::graphType(std::int32_t i) const {
   if (parent[i] < 0) return NodeType::Root;
-  int n = 0;
-  const auto count = [&](auto&& self, std::int32_t u) -> void {
-    for (auto c : {child0[u], child1[u]})
-      if (c >= 0) isLink(c) ? self(self, c) : void(++n);
-  };
-  count(count, i);
-  return n == 0 ? NodeType::Terminal : n == 1 ? NodeType::Continuation : n == 2 ? NodeType::Bifurcation : NodeType::Junction;
+  if (child0[i] < 0) return NodeType::Terminal;
+  if (child1[i] < 0 && !isLink(child0[i])) return NodeType::Continuation;
+  if (!isLink(child0[i]) && !isLink(child1[i])) return NodeType::Bifurcation;
+  std::vector<std::int32_t> kids;
+  junctionChildren(i, kids);
+  return kids.size() == 1 ? NodeType::Continuation : kids.size() == 2 ? NodeType::Bifurcation : NodeType::Junction;
 }
 
 const char* nodeTypeName(NodeType t) {

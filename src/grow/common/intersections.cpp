@@ -11,18 +11,11 @@ bool withinTwoSegments(const VascularTree& t, std::int32_t x, std::int32_t y) {
   // The nodes of an N-ary junction (joined by links) count as one node.
   thread_local std::vector<std::int32_t> near;
   near.clear();
-  const auto children = [&](auto&& self, std::int32_t u) -> void {
-    for (auto c : {t.child0[u], t.child1[u]}) {
-      if (c < 0) continue;
-      if (t.isLink(c)) self(self, c);
-      else near.push_back(c);
-    }
-  };
   for (auto end : {t.parent[x], x}) {
     const auto u = t.junction(end);
     near.push_back(u);
     if (t.parent[u] >= 0) near.push_back(t.junction(t.parent[u]));
-    children(children, u);
+    t.junctionChildren(u, near);
   }
   const auto a = t.junction(y), b = t.junction(t.parent[y]);
   return std::find(near.begin(), near.end(), a) != near.end() || std::find(near.begin(), near.end(), b) != near.end();
