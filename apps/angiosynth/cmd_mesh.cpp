@@ -52,9 +52,7 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   o.samples_across = a.samples_across;
   o.memory_limit = memoryLimit(a.common);
   SurfaceReport report;
-  const auto progress = progressPrinter(a.common, "meshing");
-  const auto mesh = vesselSurface(net.tree, o, &report, progress ? [&](std::int64_t d, std::int64_t n) { progress(d, n); }
-                                                                 : std::function<void(std::int64_t, std::int64_t)>());
+  const auto mesh = vesselSurface(net.tree, o, &report, progressPrinter(a.common, "meshing"));
   const auto topo = meshTopology(mesh);
   const std::vector<std::string> formats = a.formats.empty() ? std::vector<std::string>{"stl"} : a.formats;
   Json files = Json::object();

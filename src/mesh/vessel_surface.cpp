@@ -53,6 +53,13 @@ constexpr int kRootIterations = 12;
 
 constexpr int kTets[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
 
+// Signed distance to the union of the capsules (+∞ for none).
+double unionDistance(const std::vector<Capsule>& caps, const Vec3& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& c : caps) best = std::min(best, c.depth(p));
+  return best;
+}
+
 class BrickContourer {
  public:
   BrickContourer(const VolumeGrid& g, std::int32_t tree, const double* f, const std::vector<Capsule>& caps, const std::int64_t base[3],
@@ -107,11 +114,6 @@ class BrickContourer {
     return {{tree_, point * 8 + (hi ^ lo)}, pa + (pb - pa) * t};
   }
 
-  double distance(const Vec3& p) const {
-    double best = std::numeric_limits<double>::infinity();
-    for (const auto& c : caps_) best = std::min(best, c.depth(p));
-    return best;
-  }
   // Where the distance crosses zero between a (inside, fa < 0) and b (fb > 0), as a share of
   // the edge: regula falsi with the Illinois step, so the vertex lies on the vessels' surface
   // and not where the linear interpolation puts it (off by up to half a step at the creases
@@ -122,7 +124,7 @@ class BrickContourer {
     int side = 0;
     for (int it = 0; it < kRootIterations; ++it) {
       const double t = (lo * fb - hi * fa) / (fb - fa);
-      const double ft = distance(a + (b - a) * t);
+      const double ft = unionDistance(caps_, a + (b - a) * t);
       if (ft < 0) {
         lo = t, fa = ft;
         if (side == -1) fb /= 2;
@@ -159,20 +161,14 @@ void sampleDistance(const VolumeGrid& g, const std::int64_t base[3], const std::
   for (int k = 0; k < kPoints; ++k)
     for (int j = 0; j < kPoints; ++j)
       for (int i = 0; i < kPoints; ++i) {
-        double best = std::numeric_limits<double>::infinity();
         const std::int64_t x = base[0] + i, y = base[1] + j, z = base[2] + k;
-        if (g.contains(x, y, z)) {
-          const Vec3 p = g.centre(x, y, z);
-          for (const auto& c : caps) best = std::min(best, c.depth(p));
-        }
+        const double best = g.contains(x, y, z) ? unionDistance(caps, g.centre(x, y, z)) : std::numeric_limits<double>::infinity();
         f[i + kPoints * (j + kPoints * k)] = best == 0 ? std::numeric_limits<double>::min() : best;
       }
 }
 
-// Drops the closed components that enclose a negative volume: pockets of outside space the grid
-// cannot resolve (a wedge between two vessels closed off between grid points), which the union
-// of a tree's vessels does not have. Returns how many.
-std::int64_t removeCavities(SurfaceMesh& m) {
+// The connected surface of each vertex (through shared triangles), as one representative vertex.
+std::vector<std::int32_t> componentOf(const SurfaceMesh& m) {
   std::vector<std::int32_t> parent(m.vertices.size());
   for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = std::int32_t(i);
   const auto find = [&](std::int32_t v) {
@@ -184,26 +180,29 @@ std::int64_t removeCavities(SurfaceMesh& m) {
     parent[std::size_t(find(t[1]))] = a;
     parent[std::size_t(find(t[2]))] = a;
   }
-  std::vector<double> volume(m.vertices.size(), 0.0);  // per component root: 6 × its signed volume
-  for (const auto& t : m.triangles) volume[std::size_t(find(t[0]))] += dot(m.vertices[t[0]], cross(m.vertices[t[1]], m.vertices[t[2]]));
+  for (std::size_t v = 0; v < parent.size(); ++v) parent[v] = find(std::int32_t(v));
+  return parent;
+}
+
+// Drops the closed components that enclose a negative volume: pockets of outside space the grid
+// cannot resolve (a wedge between two vessels closed off between grid points), which the union
+// of a tree's vessels does not have. Returns how many.
+std::int64_t removeCavities(SurfaceMesh& m) {
+  const auto component = componentOf(m);
+  std::vector<double> volume(m.vertices.size(), 0.0);  // per component representative: 6 × its signed volume
+  for (const auto& t : m.triangles) volume[std::size_t(component[std::size_t(t[0])])] += dot(m.vertices[t[0]], cross(m.vertices[t[1]], m.vertices[t[2]]));
   std::int64_t removed = 0;
-  for (std::size_t v = 0; v < volume.size(); ++v) removed += find(std::int32_t(v)) == std::int32_t(v) && volume[v] < 0;
+  for (std::size_t v = 0; v < volume.size(); ++v) removed += component[v] == std::int32_t(v) && volume[v] < 0;
   if (removed == 0) return 0;
+  // Kept vertices keep their order.
   std::vector<std::int32_t> renumber(m.vertices.size(), -1);
   std::vector<Vec3> vertices;
   std::vector<std::array<std::int32_t, 3>> triangles;
   std::vector<std::int32_t> trees;
-  for (std::size_t k = 0; k < m.triangles.size(); ++k) {
-    auto t = m.triangles[k];
-    if (volume[std::size_t(find(t[0]))] < 0) continue;
-    for (auto& v : t) {
-      if (renumber[std::size_t(v)] < 0) renumber[std::size_t(v)] = -2;  // kept; numbered below in vertex order
-    }
-    triangles.push_back(t);
-    trees.push_back(m.triangle_tree[k]);
-  }
   for (std::size_t v = 0; v < renumber.size(); ++v)
-    if (renumber[v] == -2) renumber[v] = std::int32_t(vertices.size()), vertices.push_back(m.vertices[v]);
+    if (!(volume[std::size_t(component[v])] < 0)) renumber[v] = std::int32_t(vertices.size()), vertices.push_back(m.vertices[v]);
+  for (std::size_t k = 0; k < m.triangles.size(); ++k)
+    if (renumber[std::size_t(m.triangles[k][0])] >= 0) triangles.push_back(m.triangles[k]), trees.push_back(m.triangle_tree[k]);
   for (auto& t : triangles)
     for (auto& v : t) v = renumber[std::size_t(v)];
   m.vertices = std::move(vertices);
@@ -362,24 +361,16 @@ MeshTopology meshTopology(const SurfaceMesh& m) {
   for (auto tree : m.triangle_tree) trees = std::max(trees, tree + 1);
   out.tree_components.assign(std::size_t(trees), 0);
   out.tree_euler.assign(std::size_t(trees), 0);
-  std::vector<std::int32_t> parent(m.vertices.size()), tree_of(m.vertices.size(), -1);
-  for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = std::int32_t(i);
-  const auto find = [&](std::int32_t v) {
-    while (parent[std::size_t(v)] != v) v = parent[std::size_t(v)] = parent[std::size_t(parent[std::size_t(v)])];
-    return v;
-  };
+  const auto component = componentOf(m);
+  std::vector<std::int32_t> tree_of(m.vertices.size(), -1);
   for (std::size_t k = 0; k < m.triangles.size(); ++k) {
-    const auto& t = m.triangles[k];
     out.tree_euler[std::size_t(m.triangle_tree[k])] += 1;  // F
-    for (auto v : t) tree_of[std::size_t(v)] = m.triangle_tree[k];
-    const auto a = find(t[0]);
-    parent[std::size_t(find(t[1]))] = a;
-    parent[std::size_t(find(t[2]))] = a;
+    for (auto v : m.triangles[k]) tree_of[std::size_t(v)] = m.triangle_tree[k];
   }
-  for (std::size_t v = 0; v < parent.size(); ++v) {
+  for (std::size_t v = 0; v < component.size(); ++v) {
     if (tree_of[v] < 0) continue;
     out.tree_euler[std::size_t(tree_of[v])] += 1;  // V
-    out.tree_components[std::size_t(tree_of[v])] += find(std::int32_t(v)) == std::int32_t(v);
+    out.tree_components[std::size_t(tree_of[v])] += component[v] == std::int32_t(v);
   }
   for (std::size_t i = 0; i < edges.size(); i += 2) out.tree_euler[std::size_t(tree_of[std::size_t(edges[i].a)])] -= 1;  // E (closed: two uses each)
   return out;

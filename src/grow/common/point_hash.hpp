@@ -69,14 +69,15 @@ class PointHash {
   std::int32_t nearest(const Vec3& p, double r, Dist2&& dist2) const {
     std::int32_t best = -1;
     double bd = r * r;
-    const auto visit = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-      for (auto id = head_[index(x, y, z)]; id >= 0; id = next_[std::size_t(id)]) {
-        const double d2 = dist2(id);
-        if (d2 < bd || (d2 == bd && best >= 0 && id < best)) {
-          bd = d2;
-          best = id;
-        }
+    const auto consider = [&](std::int32_t id) {
+      const double d2 = dist2(id);
+      if (d2 < bd || (d2 == bd && best >= 0 && id < best)) {
+        bd = d2;
+        best = id;
       }
+    };
+    const auto visit = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+      for (auto id = head_[index(x, y, z)]; id >= 0; id = next_[std::size_t(id)]) consider(id);
     };
     const std::int64_t lo[3] = {axis(p.x - r, 0), axis(p.y - r, 1), axis(p.z - r, 2)};
     const std::int64_t hi[3] = {axis(p.x + r, 0), axis(p.y + r, 1), axis(p.z + r, 2)};
@@ -87,9 +88,7 @@ class PointHash {
     bool inside = true;
     for (int a = 0; a < axes; ++a) inside = inside && g[a] >= 0 && g[a] < double(n_[a]);
     if (!inside) {
-      for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
-        for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-          for (std::int64_t x = lo[0]; x <= hi[0]; ++x) visit(x, y, z);
+      forEachNear(p, r, consider);
       return best;
     }
     std::int64_t c[3] = {0, 0, 0};
