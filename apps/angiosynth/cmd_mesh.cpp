@@ -25,10 +25,16 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
   c->add_option("INPUT", a.input, "a sample directory (its nodes.csv and edges.csv are read) or a graph file: .csv, .gxl, .vtp, .swc, .cco")
       ->required();
   c->add_option("--out", a.out, "output directory (default: <INPUT>_mesh next to the input)");
-  c->add_option("--voxel", a.voxel_mm, "grid step in mm (default: the thinnest vessel's diameter / --samples-across)")
+  c->add_option("--voxel", a.voxel_mm, "finest grid step in mm (default: the thinnest vessel's diameter / --samples-across)")
       ->check(finiteIn(0, 1e6));
-  c->add_option("--samples-across", a.samples_across, "grid steps across the thinnest vessel when --voxel is not given (default 4)")
+  c->add_option("--samples-across", a.samples_across,
+                "grid steps across each vessel's thinnest end: each vessel is sampled at the coarsest step (the finest times a power of 2) "
+                "that keeps this many (default 4)")
       ->check(CLI::Range(1, 64));
+  c->add_flag("--uniform", a.uniform, "sample every vessel at the finest step (no adaptive resolution)");
+  c->add_flag("--on-surface", a.on_surface,
+              "keep every vertex exactly on the vessels' surface (default: vertices move by a fraction of the chords' sagitta so the "
+              "enclosed volume is the vessels')");
   c->add_option("--format", a.formats, "mesh formats: stl (binary), obj, ply (binary), off, vtp (default stl)")
       ->delimiter(',')
       ->check(CLI::IsMember({"stl", "obj", "ply", "off", "vtp"}));
@@ -50,6 +56,8 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   SurfaceOptions o;
   o.voxel_mm = a.voxel_mm;
   o.samples_across = a.samples_across;
+  o.adaptive = !a.uniform;
+  o.restore_volume = !a.on_surface;
   o.memory_limit = memoryLimit(a.common);
   SurfaceReport report;
   const auto mesh = vesselSurface(net.tree, o, &report, progressPrinter(a.common, "meshing"));
@@ -68,15 +76,20 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   Json j = {{"tool", "angiosynth " + std::string(kVersion)},
             {"command_line", command_line},
             {"input", graph.string()},
-            {"parameters", {{"voxel_mm", report.voxel_mm}, {"samples_across", a.voxel_mm > 0 ? Json(nullptr) : Json(a.samples_across)}}},
-            {"method", "marching tetrahedra (Freudenthal split) of the signed distance to the union of each tree's capsules and round cones"},
+            {"parameters", {{"voxel_mm", a.voxel_mm > 0 ? Json(a.voxel_mm) : Json(nullptr)}, {"samples_across", a.samples_across}, {"adaptive", !a.uniform}, {"volume_restored", !a.on_surface}}},
+            {"method", "marching tetrahedra of the signed distance to the union of each tree's capsules and round cones, on a 2:1-balanced "
+                       "octree of cells sized to each vessel's radius, split into conforming tetrahedra"},
             {"statistics",
              {{"trees", trees},
               {"segments", segments},
               {"vertices", mesh.vertices.size()},
               {"triangles", mesh.triangles.size()},
               {"triangles_per_segment", segments > 0 ? double(mesh.triangles.size()) / double(segments) : 0.0},
-              {"bricks", report.bricks},
+              {"finest_step_mm", report.voxel_mm},
+              {"coarsest_cell_mm", report.coarsest_mm},
+              {"levels", report.levels},
+              {"cells", report.cells},
+              {"largest_volume_move_mm", report.largest_volume_move_mm},
               {"estimated_bytes", report.estimated_bytes},
               {"enclosed_volume_mm3", topo.volume_mm3},
               {"boundary_edges", topo.boundary_edges},

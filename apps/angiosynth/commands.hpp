@@ -77,6 +77,7 @@ struct MeshArgs {
   std::string input, out;
   double voxel_mm = 0;
   int samples_across = 4;
+  bool uniform = false, on_surface = false;
   std::vector<std::string> formats;
   bool force = false;
   CommonOptions common;

@@ -1,24 +1,29 @@
 #include "mesh/vessel_surface.hpp"
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 
 #include "core/error.hpp"
 #include "core/memory.hpp"
+#include "mesh/balanced_octree.hpp"
 #include "raster/capsule_rasterizer.hpp"
 #include "raster/vessel_capsule.hpp"
 
 namespace angiosynth {
 namespace {
 
-// A vertex of the mesh is the zero crossing on one grid edge: its tree, then the edge (the lower
-// grid point's index × 8 + the edge's direction, 1 … 7 as the bits x, y, z of its step).
+// A vertex of the mesh is the zero crossing on one edge of the tetrahedra: its tree, then the
+// edge, named by its midpoint (in quarter steps, packed; in a conforming mesh no two edges share one).
 struct EdgeKey {
   std::int32_t tree;
   std::int64_t edge;
@@ -28,6 +33,7 @@ struct EdgeKey {
 struct EdgeVertex {
   EdgeKey key;
   Vec3 position;
+  float step;  // mm, the length of the edge it lies on
 };
 
 struct KeyedTriangle {
@@ -35,23 +41,23 @@ struct KeyedTriangle {
   std::int64_t edge[3];
 };
 
-struct BrickMesh {
-  std::vector<EdgeVertex> vertices;  // may repeat: every tetrahedron on an edge lists its vertex
-  std::vector<KeyedTriangle> triangles;
+struct UnitMesh {
+  std::vector<EdgeVertex> vertices;  // one per (tree, edge) the unit's tetrahedra cross, in key order
+  std::vector<std::array<std::int32_t, 3>> triangles;  // into vertices
+  std::vector<std::int32_t> triangle_tree;
 };
-
-constexpr int kPoints = kBrick + 1;  // grid points per brick edge (the next brick's first layer too)
 
 // A crossing never sits closer than this share of its edge to a grid point: triangles keep a
 // positive area and vertices stay apart after single-precision formats round them (the surface
 // moves by at most 1 % of a step).
 constexpr double kEdgeMargin = 0.01;
 
-// The six tetrahedra of a cube: corner paths 0 → 7 (corner bits x, y, z), one per axis order.
 // Regula falsi steps for a vertex on its edge.
 constexpr int kRootIterations = 12;
 
-constexpr int kTets[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+// Leaves are meshed in units: the level-3 cell (8³ finest cells) holding them, or a coarser leaf
+// on its own; a unit samples the distance once per lattice point it uses.
+constexpr int kUnitLevel = 3;
 
 // Signed distance to the union of the capsules (+∞ for none).
 double unionDistance(const std::vector<Capsule>& caps, const Vec3& p) {
@@ -60,71 +66,122 @@ double unionDistance(const std::vector<Capsule>& caps, const Vec3& p) {
   return best;
 }
 
-class BrickContourer {
- public:
-  BrickContourer(const VolumeGrid& g, std::int32_t tree, const double* f, const std::vector<Capsule>& caps, const std::int64_t base[3],
-                 BrickMesh& out)
-      : g_(g), tree_(tree), f_(f), caps_(caps), out_(out) {
-    for (int a = 0; a < 3; ++a) base_[a] = base[a];
-  }
+// The lattice the octree lives on (level-0 cells one step wide; points in half steps) and the
+// segments binned on its 8³ bricks. The distance at a point is the minimum over the capsules of
+// the one bin that holds it, so every unit that samples a point gets the same value; bins hold
+// every capsule within a band of the bin, so the value is exact inside vessels and near their
+// surface and positive wherever the union's distance is.
+struct Lattice {
+  Vec3 origin;   // mm, lattice point 0
+  double h = 0;  // mm, one step
+  VolumeGrid grid;  // bins: voxel centres at the lattice's whole steps
+  BrickBins bins;
 
-  void cube(int i, int j, int k) {
-    double v[8];
-    bool any_in = false, any_out = false;
-    for (int c = 0; c < 8; ++c) {
-      v[c] = f_[at(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1))];
-      (v[c] < 0 ? any_in : any_out) = true;
+  Vec3 position(const HalfPoint& q) const { return origin + Vec3(double(q[0]), double(q[1]), double(q[2])) * (0.5 * h); }
+  // The bin of a point: voxel x covers [x − ½, x + ½) steps, brick b voxels 8b … 8b + 7.
+  static std::int64_t binOf(std::int64_t half) { return (half + 1) / (2 * kBrick); }
+};
+
+class UnitMesher {
+ public:
+  UnitMesher(const VascularTree& t, const Lattice& lat, LeafSplitter& splitter) : t_(t), lat_(lat), splitter_(splitter) {}
+
+  void mesh(int level, const std::array<std::int64_t, 3>& cell, const OctreeLeaf* first, const OctreeLeaf* last, UnitMesh& out) {
+    // The unit's lattice: its points are those of its finest leaves' faces (balance: at most one
+    // level finer), so steps of 2^(finest − 1) half steps (1 at level 0).
+    int finest = level;
+    for (auto* l = first; l != last; ++l) finest = std::min(finest, l->level);
+    shift_ = std::max(0, finest - 1);
+    const std::int64_t span = std::int64_t(2) << level;
+    n_ = (span >> shift_) + 1;
+    for (int a = 0; a < 3; ++a) base_[std::size_t(a)] = cell[std::size_t(a)] * span;
+    tets_.clear();
+    scratch_.clear();
+    for (auto* l = first; l != last; ++l) splitter_.tetrahedra(*l, scratch_);
+    for (const auto& tet : scratch_) {
+      std::array<std::int32_t, 4> local;
+      for (int q = 0; q < 4; ++q) local[std::size_t(q)] = localIndex(tet[std::size_t(q)]);
+      tets_.push_back(local);
     }
-    if (!(any_in && any_out)) return;
-    for (const auto& tet : kTets) {
-      int in[4], out[4], ni = 0, no = 0;
-      for (int q = 0; q < 4; ++q) (v[tet[q]] < 0 ? in[ni++] : out[no++]) = tet[q];
-      if (ni == 0 || no == 0) continue;
-      Vec3 c_in(0, 0, 0), c_out(0, 0, 0);
-      for (int q = 0; q < ni; ++q) c_in += corner(i, j, k, in[q]) / double(ni);
-      for (int q = 0; q < no; ++q) c_out += corner(i, j, k, out[q]) / double(no);
-      const Vec3 outward = c_out - c_in;
-      if (ni == 1) {
-        triangle(i, j, k, v, {in[0], out[0]}, {in[0], out[1]}, {in[0], out[2]}, outward);
-      } else if (ni == 3) {
-        triangle(i, j, k, v, {in[0], out[0]}, {in[1], out[0]}, {in[2], out[0]}, outward);
-      } else {  // a quadrilateral, in its cyclic order, as two triangles
-        triangle(i, j, k, v, {in[0], out[0]}, {in[0], out[1]}, {in[1], out[1]}, outward);
-        triangle(i, j, k, v, {in[0], out[0]}, {in[1], out[1]}, {in[1], out[0]}, outward);
-      }
+    // The bins the unit's points fall in, and the trees with vessels there.
+    for (int a = 0; a < 3; ++a) {
+      bin_lo_[std::size_t(a)] = Lattice::binOf(base_[std::size_t(a)]);
+      bin_n_[std::size_t(a)] = Lattice::binOf(base_[std::size_t(a)] + span) - bin_lo_[std::size_t(a)] + 1;
+    }
+    unit_bins_.clear();
+    std::vector<std::int32_t> trees;
+    for (std::int64_t k = 0; k < bin_n_[2]; ++k)
+      for (std::int64_t j = 0; j < bin_n_[1]; ++j)
+        for (std::int64_t i = 0; i < bin_n_[0]; ++i) {
+          const auto& b = lat_.bins;
+          const std::int64_t id = (bin_lo_[0] + i) + std::int64_t(b.bricks[0]) * ((bin_lo_[1] + j) + std::int64_t(b.bricks[1]) * (bin_lo_[2] + k));
+          const auto it = std::lower_bound(b.brick_ids.begin(), b.brick_ids.end(), id);
+          const std::vector<std::int32_t>* segs = (it != b.brick_ids.end() && *it == id) ? &b.segments[std::size_t(it - b.brick_ids.begin())] : nullptr;
+          unit_bins_.push_back(segs);
+          if (segs)
+            for (auto s : *segs) trees.push_back(treeOf(s));
+        }
+    std::sort(trees.begin(), trees.end());
+    trees.erase(std::unique(trees.begin(), trees.end()), trees.end());
+    keyed_.clear();
+    for (auto tree : trees) meshTree(tree, out);
+    // Vertices in key order (trees apart), triangles by their index in the unit.
+    std::sort(out.vertices.begin(), out.vertices.end(), [](const EdgeVertex& x, const EdgeVertex& y) { return x.key < y.key; });
+    const auto local = [&](std::int32_t tree, std::int64_t edge) {
+      const EdgeKey key{tree, edge};
+      return std::int32_t(std::lower_bound(out.vertices.begin(), out.vertices.end(), key, [](const EdgeVertex& v, const EdgeKey& k) { return v.key < k; }) -
+                          out.vertices.begin());
+    };
+    for (const auto& k : keyed_) {
+      out.triangles.push_back({local(k.tree, k.edge[0]), local(k.tree, k.edge[1]), local(k.tree, k.edge[2])});
+      out.triangle_tree.push_back(k.tree);
     }
   }
 
  private:
-  using Edge = std::array<int, 2>;  // two corners of the cube
+  std::int32_t treeOf(std::int32_t s) const { return t_.tree.empty() ? 0 : t_.tree[s]; }
 
-  std::size_t at(int i, int j, int k) const { return std::size_t(i + kPoints * (j + kPoints * k)); }
-  Vec3 corner(int i, int j, int k, int c) const {
-    return g_.centre(base_[0] + i + (c & 1), base_[1] + j + ((c >> 1) & 1), base_[2] + k + ((c >> 2) & 1));
+  std::int32_t localIndex(const HalfPoint& q) const {
+    std::int64_t idx = 0;
+    for (int a = 2; a >= 0; --a) {
+      const std::int64_t d = q[std::size_t(a)] - base_[std::size_t(a)];
+      if (d < 0 || (d & ((std::int64_t(1) << shift_) - 1)) != 0 || (d >> shift_) >= n_)
+        throw std::logic_error("surface mesher: a tetrahedron's corner is off its unit's lattice");
+      idx = idx * n_ + (d >> shift_);
+    }
+    return std::int32_t(idx);
+  }
+  HalfPoint halfPoint(std::int32_t idx) const {
+    return {base_[0] + ((idx % n_) << shift_), base_[1] + (((idx / n_) % n_) << shift_), base_[2] + ((idx / (n_ * n_)) << shift_)};
+  }
+  // The distance at a point given in half steps: the minimum over the capsules of its bin.
+  double distance(const Vec3& q) const {
+    std::int64_t b = 0;
+    for (int a = 2; a >= 0; --a) b = b * bin_n_[std::size_t(a)] + (std::int64_t(std::floor((q[a] + 1) / (2 * kBrick))) - bin_lo_[std::size_t(a)]);
+    return unionDistance(caps_[std::size_t(b)], lat_.origin + q * (0.5 * lat_.h));
+  }
+  double value(std::int32_t idx) {
+    if (stamp_[std::size_t(idx)] == generation_) return f_[std::size_t(idx)];
+    double v = distance(asVec(halfPoint(idx)));
+    if (v == 0) v = std::numeric_limits<double>::min();  // on the surface counts as outside: crossings lie inside edges
+    stamp_[std::size_t(idx)] = generation_;
+    return f_[std::size_t(idx)] = v;
   }
 
-  // The vertex on the edge between corners a (inside) and b (outside): its key and position.
-  EdgeVertex crossing(int i, int j, int k, const double* v, Edge e) const {
-    int lo = e[0], hi = e[1];
-    if (lo > hi) std::swap(lo, hi);  // Freudenthal edges step up: corner bits of lo ⊂ those of hi
-    const std::int64_t x = base_[0] + i + (lo & 1), y = base_[1] + j + ((lo >> 1) & 1), z = base_[2] + k + ((lo >> 2) & 1);
-    const std::int64_t point = x + std::int64_t(g_.dims[0]) * (y + std::int64_t(g_.dims[1]) * z);
-    const Vec3 pa = corner(i, j, k, e[0]), pb = corner(i, j, k, e[1]);
-    const double t = std::clamp(zeroOnEdge(pa, pb, v[e[0]], v[e[1]]), kEdgeMargin, 1 - kEdgeMargin);
-    return {{tree_, point * 8 + (hi ^ lo)}, pa + (pb - pa) * t};
-  }
-
-  // Where the distance crosses zero between a (inside, fa < 0) and b (fb > 0), as a share of
-  // the edge: regula falsi with the Illinois step, so the vertex lies on the vessels' surface
-  // and not where the linear interpolation puts it (off by up to half a step at the creases
-  // where vessels meet). Every brick that holds the edge computes the same point: the same
-  // values (all capsules within the band) in the same order.
+  // Where the distance crosses zero between a (inside, fa < 0) and b (fb > 0, maybe +∞: no
+  // vessel listed there), as a share of the edge: regula falsi with the Illinois step, so the
+  // vertex lies on the vessels' surface and not where the linear interpolation puts it (off by
+  // up to half a step at the creases where vessels meet). Every unit that holds the edge
+  // computes the same point: the same values at the same points, from the points' own bins.
   double zeroOnEdge(const Vec3& a, const Vec3& b, double fa, double fb) const {
     double lo = 0, hi = 1;
     int side = 0;
+    const auto next = [&] { return std::isfinite(fb) ? (lo * fb - hi * fa) / (fb - fa) : 0.5 * (lo + hi); };
+    const double close = 1e-5 * norm(b - a) * (0.5 * lat_.h);  // mm: below the single precision of STL at 10 cm
     for (int it = 0; it < kRootIterations; ++it) {
-      const double t = (lo * fb - hi * fa) / (fb - fa);
-      const double ft = unionDistance(caps_, a + (b - a) * t);
+      const double t = next();
+      const double ft = distance(a + (b - a) * t);
+      if (std::abs(ft) < close) return t;
       if (ft < 0) {
         lo = t, fa = ft;
         if (side == -1) fb /= 2;
@@ -136,36 +193,92 @@ class BrickContourer {
       }
       if (hi - lo < 1e-9) break;
     }
-    return (lo * fb - hi * fa) / (fb - fa);
+    return next();
   }
 
-  void triangle(int i, int j, int k, const double* v, Edge e0, Edge e1, Edge e2, const Vec3& outward) {
-    EdgeVertex p[3] = {crossing(i, j, k, v, e0), crossing(i, j, k, v, e1), crossing(i, j, k, v, e2)};
-    if (dot(cross(p[1].position - p[0].position, p[2].position - p[0].position), outward) < 0) std::swap(p[1], p[2]);
-    out_.triangles.push_back({tree_, {p[0].key.edge, p[1].key.edge, p[2].key.edge}});
-    for (const auto& q : p) out_.vertices.push_back(q);
-  }
-
-  const VolumeGrid& g_;
-  std::int32_t tree_;
-  const double* f_;
-  const std::vector<Capsule>& caps_;
-  std::int64_t base_[3];
-  BrickMesh& out_;
-};
-
-// The signed distance at the brick's 9³ grid points for one tree's vessels (min over its
-// capsules; a point exactly on the surface counts as outside, so every crossing lies inside an
-// edge); points beyond the grid are outside.
-void sampleDistance(const VolumeGrid& g, const std::int64_t base[3], const std::vector<Capsule>& caps, double* f) {
-  for (int k = 0; k < kPoints; ++k)
-    for (int j = 0; j < kPoints; ++j)
-      for (int i = 0; i < kPoints; ++i) {
-        const std::int64_t x = base[0] + i, y = base[1] + j, z = base[2] + k;
-        const double best = g.contains(x, y, z) ? unionDistance(caps, g.centre(x, y, z)) : std::numeric_limits<double>::infinity();
-        f[i + kPoints * (j + kPoints * k)] = best == 0 ? std::numeric_limits<double>::min() : best;
+  void meshTree(std::int32_t tree, UnitMesh& out) {
+    caps_.assign(unit_bins_.size(), {});
+    for (std::size_t b = 0; b < unit_bins_.size(); ++b)
+      if (unit_bins_[b])
+        for (auto s : *unit_bins_[b])
+          if (treeOf(s) == tree) caps_[b].push_back(capsuleOf(t_, s));
+    const std::size_t points = std::size_t(n_ * n_ * n_);
+    if (stamp_.size() < points) stamp_.resize(points, 0), f_.resize(points);
+    ++generation_;
+    crossings_.clear();
+    for (const auto& tet : tets_) {
+      double v[4];
+      int in[4], outside[4], ni = 0, no = 0;
+      for (int q = 0; q < 4; ++q) {
+        v[q] = value(tet[std::size_t(q)]);
+        (v[q] < 0 ? in[ni++] : outside[no++]) = q;
       }
-}
+      if (ni == 0 || no == 0) continue;
+      HalfPoint p[4];
+      for (int q = 0; q < 4; ++q) p[q] = halfPoint(tet[std::size_t(q)]);
+      Vec3 c_in(0, 0, 0), c_out(0, 0, 0);
+      for (int q = 0; q < ni; ++q) c_in += asVec(p[in[q]]) / double(ni);
+      for (int q = 0; q < no; ++q) c_out += asVec(p[outside[q]]) / double(no);
+      const Vec3 outward = c_out - c_in;
+      const auto edge = [&](int a, int b) { return Crossing{v[a], v[b], p[a], p[b]}; };
+      if (ni == 1) {
+        triangle(tree, edge(in[0], outside[0]), edge(in[0], outside[1]), edge(in[0], outside[2]), outward);
+      } else if (ni == 3) {
+        triangle(tree, edge(in[0], outside[0]), edge(in[1], outside[0]), edge(in[2], outside[0]), outward);
+      } else {  // a quadrilateral, in its cyclic order, as two triangles
+        triangle(tree, edge(in[0], outside[0]), edge(in[0], outside[1]), edge(in[1], outside[1]), outward);
+        triangle(tree, edge(in[0], outside[0]), edge(in[1], outside[1]), edge(in[1], outside[0]), outward);
+      }
+    }
+    // One vertex per crossed edge, on the surface.
+    std::sort(crossings_.begin(), crossings_.end(), [](const Crossing& x, const Crossing& y) { return x.key < y.key; });
+    crossings_.erase(std::unique(crossings_.begin(), crossings_.end(), [](const Crossing& x, const Crossing& y) { return x.key == y.key; }),
+                     crossings_.end());
+    for (const auto& c : crossings_) {
+      const double t = std::clamp(zeroOnEdge(asVec(c.pa), asVec(c.pb), c.fa, c.fb), kEdgeMargin, 1 - kEdgeMargin);
+      const Vec3 pa = lat_.position(c.pa), pb = lat_.position(c.pb);
+      out.vertices.push_back({{tree, c.key}, pa + (pb - pa) * t, float(norm(pb - pa))});
+    }
+  }
+
+  struct Crossing {
+    std::int64_t key;  // the edge's midpoint in quarter steps, packed
+    HalfPoint pa, pb;  // inside, outside
+    double fa, fb;
+    Crossing(double va, double vb, const HalfPoint& a, const HalfPoint& b) : pa(a), pb(b), fa(va), fb(vb) {
+      key = std::int64_t(cellCode(a[0] + b[0], a[1] + b[1], a[2] + b[2]));
+    }
+  };
+  static Vec3 asVec(const HalfPoint& q) { return Vec3(double(q[0]), double(q[1]), double(q[2])); }
+
+  // The triangle's turn is that of the edges' midpoints (exact in half steps): a vertex moves
+  // along its edge's open interior, where the triangle never degenerates, so the turn holds.
+  void triangle(std::int32_t tree, const Crossing& e0, const Crossing& e1, const Crossing& e2, const Vec3& outward) {
+    const Vec3 m0 = asVec(e0.pa) + asVec(e0.pb), m1 = asVec(e1.pa) + asVec(e1.pb), m2 = asVec(e2.pa) + asVec(e2.pb);
+    const bool flip = dot(cross(m1 - m0, m2 - m0), outward) < 0;
+    keyed_.push_back({tree, {e0.key, flip ? e2.key : e1.key, flip ? e1.key : e2.key}});
+    crossings_.push_back(e0);
+    crossings_.push_back(e1);
+    crossings_.push_back(e2);
+  }
+
+  const VascularTree& t_;
+  const Lattice& lat_;
+  LeafSplitter& splitter_;
+  int shift_ = 0;
+  std::int64_t n_ = 0;
+  HalfPoint base_{};
+  std::array<std::int64_t, 3> bin_lo_{}, bin_n_{};
+  std::vector<const std::vector<std::int32_t>*> unit_bins_;
+  std::vector<std::vector<Capsule>> caps_;  // per unit bin, the current tree's
+  std::vector<std::array<HalfPoint, 4>> scratch_;
+  std::vector<std::array<std::int32_t, 4>> tets_;
+  std::vector<std::uint32_t> stamp_;
+  std::vector<double> f_;
+  std::uint32_t generation_ = 0;
+  std::vector<Crossing> crossings_;
+  std::vector<KeyedTriangle> keyed_;
+};
 
 // The connected surface of each vertex (through shared triangles), as one representative vertex.
 std::vector<std::int32_t> componentOf(const SurfaceMesh& m) {
@@ -197,18 +310,73 @@ std::int64_t removeCavities(SurfaceMesh& m) {
   // Kept vertices keep their order.
   std::vector<std::int32_t> renumber(m.vertices.size(), -1);
   std::vector<Vec3> vertices;
+  std::vector<float> steps;
   std::vector<std::array<std::int32_t, 3>> triangles;
   std::vector<std::int32_t> trees;
   for (std::size_t v = 0; v < renumber.size(); ++v)
-    if (!(volume[std::size_t(component[v])] < 0)) renumber[v] = std::int32_t(vertices.size()), vertices.push_back(m.vertices[v]);
+    if (!(volume[std::size_t(component[v])] < 0)) {
+      renumber[v] = std::int32_t(vertices.size());
+      vertices.push_back(m.vertices[v]);
+      steps.push_back(m.vertex_step[v]);
+    }
   for (std::size_t k = 0; k < m.triangles.size(); ++k)
     if (renumber[std::size_t(m.triangles[k][0])] >= 0) triangles.push_back(m.triangles[k]), trees.push_back(m.triangle_tree[k]);
   for (auto& t : triangles)
     for (auto& v : t) v = renumber[std::size_t(v)];
   m.vertices = std::move(vertices);
+  m.vertex_step = std::move(steps);
   m.triangles = std::move(triangles);
   m.triangle_tree = std::move(trees);
   return removed;
+}
+
+// Each vessel's level (cells of 2^level steps h): the coarsest that puts samples_across samples
+// across its thinnest end. (The volume the coarser chords of thick vessels lose is restored
+// after contouring, restoreVolume.)
+std::vector<std::int8_t> vesselLevels(const VascularTree& t, const std::vector<std::int32_t>& vessels, double h, const SurfaceOptions& o) {
+  std::vector<std::int8_t> level(std::size_t(t.nodeCount()), 0);
+  if (!o.adaptive) return level;
+  for (auto s : vessels) {
+    const double c = 2 * std::min(t.radius[s], t.startRadius(s)) / std::max(1, o.samples_across);
+    if (c >= 2 * h) level[std::size_t(s)] = std::int8_t(std::min(kMaxSurfaceLevel, int(std::floor(std::log2(c / h) + 1e-9))));
+  }
+  return level;
+}
+
+// Flat triangles through points of a vessel's surface lie inside it where it is convex (chords)
+// and lose volume: about c²/(12 r²) of a vessel sampled by cells of size c (more where cells are
+// coarse); at creases they stand out. Each triangle's gap is measured at its centroid with the
+// exact distance; over a triangle whose corners lie on the surface the gap averages ¾ of that
+// (a quadratic vanishing at the corners), so moving each vertex along its normal by ¾ of the
+// area-weighted gap of its triangles restores the enclosed volume. The move is a fraction of
+// the chord's sagitta, small against the vertex's step. Returns the largest move.
+double restoreVolume(SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
+  const std::size_t nt = m.triangles.size();
+  std::vector<double> gap(nt, 0.0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k != r.end(); ++k) {
+      const auto& t = m.triangles[k];
+      const Vec3 c = (m.vertices[std::size_t(t[0])] + m.vertices[std::size_t(t[1])] + m.vertices[std::size_t(t[2])]) / 3.0;
+      const double d = distance(m.triangle_tree[k], c);
+      gap[k] = std::isfinite(d) ? -0.75 * d : 0.0;
+    }
+  });
+  std::vector<Vec3> normal(m.vertices.size(), Vec3(0, 0, 0));  // area-weighted (× 2)
+  std::vector<double> weighted(m.vertices.size(), 0.0), area(m.vertices.size(), 0.0);
+  for (std::size_t k = 0; k < nt; ++k) {
+    const auto& t = m.triangles[k];
+    const Vec3 n = cross(m.vertices[std::size_t(t[1])] - m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[2])] - m.vertices[std::size_t(t[0])]);
+    const double a = norm(n);
+    for (auto v : t) normal[std::size_t(v)] += n, weighted[std::size_t(v)] += a * gap[k], area[std::size_t(v)] += a;
+  }
+  double largest = 0;
+  for (std::size_t v = 0; v < m.vertices.size(); ++v) {
+    if (!(area[v] > 0)) continue;
+    const double move = weighted[v] / area[v];
+    m.vertices[v] += unit(normal[v]) * move;
+    largest = std::max(largest, std::abs(move));
+  }
+  return largest;
 }
 
 }  // namespace
@@ -217,162 +385,252 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
                           const std::function<void(std::int64_t, std::int64_t)>& progress) {
   SurfaceMesh mesh;
   Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
-  double r_min = INFINITY, area = 0;
+  double r_min = INFINITY;
+  std::vector<std::int32_t> vessels;
   for (std::int32_t s = 0; s < t.nodeCount(); ++s) {
     if (t.isRoot(s) || t.isLink(s)) continue;  // a link lies inside the cap of the vessel ending at its junction
+    vessels.push_back(s);
     const double r = t.maxRadius(s);
     r_min = std::min({r_min, t.radius[s], t.startRadius(s)});
     for (const Vec3& p : {t.position[t.parent[s]], t.position[s]}) {
       lo = componentMin(lo, p - Vec3(r, r, r));
       hi = componentMax(hi, p + Vec3(r, r, r));
     }
-    area += 2 * std::numbers::pi * r * t.length[s] + 4 * std::numbers::pi * r * r;
   }
-  if (!(r_min < INFINITY)) return mesh;
+  if (vessels.empty()) return mesh;
   if (!(r_min > 0)) throw InputError("", 0, "a vessel of radius 0 has no surface; every radius must be > 0");
-  const double h = o.voxel_mm > 0 ? o.voxel_mm : 2 * r_min / std::max(1, o.samples_across);
-  // Bricks hold every vessel whose surface lies within `band` of their grid points: a crossing
-  // edge (≤ √3 h long) has both ends that close, so neighbouring bricks agree on their values.
-  const double band = 3 * h;
-  VolumeGrid g;
-  g.spacing_mm = Vec3(h, h, h);
-  g.origin_mm = lo - Vec3(band, band, band);
+  const int across = std::max(1, o.samples_across);
+  const double h = o.voxel_mm > 0 ? o.voxel_mm : 2 * r_min / across;
+  const auto level = vesselLevels(t, vessels, h, o);
+  int top = 0;
+  for (auto s : vessels) top = std::max<int>(top, level[std::size_t(s)]);
+  const auto cellSize = [&](int l) { return h * double(std::int64_t(1) << l); };
+  // Room around the vessels for the requested cells (up to two cells of their level beyond the
+  // vessel) and the coarsest cells the balance adds around them (two of level top + 1); midpoints
+  // of edges in quarter steps must fit 21 bits.
+  const double room = 6 * cellSize(top + 1);
+  Lattice lat;
+  lat.h = h;
+  lat.origin = lo - Vec3(room, room, room);
+  std::int64_t steps[3];
   for (int a = 0; a < 3; ++a) {
-    const double n = std::ceil((hi[a] - lo[a] + 2 * band) / h) + 1;
-    if (!(n < double(1 << 20)))
+    const double n = std::ceil((hi[a] - lo[a] + 2 * room) / h) + 1;
+    if (!(n < double(std::int64_t(1) << 19)))
       throw InputError("", 0, "a surface step of " + std::to_string(h) + " mm needs " + std::to_string(n) +
-                                  " grid points along an axis; allowed: at most 2^20 (choose a larger voxel)");
-    g.dims[a] = std::int32_t(n);
+                                  " grid points along an axis; allowed: at most 2^19 (choose a larger voxel)");
+    steps[a] = std::int64_t(n);
   }
+  // Bins list each vessel within one cell of its level (and a step) of the bin: the distance
+  // near the surface is exact, its sign everywhere.
   VascularTree inflated = t;
-  for (std::int32_t s = 0; s < t.nodeCount(); ++s) {
+  double area_over_cell2 = 0;
+  for (auto s : vessels) {
+    const double c = cellSize(level[std::size_t(s)]), band = c + h, r = t.maxRadius(s);
     inflated.radius[s] += band;
     if (inflated.radius_start[s] >= 0) inflated.radius_start[s] += band;
+    area_over_cell2 += (2 * std::numbers::pi * r * t.length[s] + 4 * std::numbers::pi * r * r) / (c * c);
   }
-  // Bins (12 bytes a pair), then about 8 triangles per h² of vessel surface (marching
-  // tetrahedra; measured 7.7), at a peak of about 170 bytes each (measured 166): the keyed
-  // triangles, the vertices of every brick until they are welded, and the mesh.
-  const double estimate = brickPairBound(inflated, g) * 12 + area / (h * h) * 8 * 170;
-  if (report) report->voxel_mm = h, report->estimated_bytes = estimate;
+  lat.grid.spacing_mm = Vec3(h, h, h);
+  lat.grid.origin_mm = lat.origin;
+  for (int a = 0; a < 3; ++a) lat.grid.dims[a] = std::int32_t(steps[a] + 1);
+  // Bins (12 bytes a pair); about 4 octree cells per cell² of vessel surface (64 bytes in the
+  // octree's sets); about 8 triangles per cell² (marching tetrahedra; measured 6–8) at a peak
+  // of about 170 bytes each (the units' triangles and vertices until they are welded, and the
+  // mesh). Measured: 2.0 GB against 2.4 estimated for examples/vascusynth_like.toml.
+  const double estimate = brickPairBound(inflated, lat.grid) * 12 + area_over_cell2 * (4 * 64 + 8 * 170);
+  if (report) report->voxel_mm = h, report->coarsest_mm = cellSize(top), report->estimated_bytes = estimate;
   if (o.memory_limit > 0 && estimate > double(o.memory_limit))
     throw InputError("", 0, "the surface at a step of " + std::to_string(h) + " mm needs about " + formatBytes(std::uint64_t(estimate)) +
                                 " of memory, more than the limit of " + formatBytes(o.memory_limit) +
                                 "; allowed: a larger voxel or a higher --memory-limit");
-  const BrickBins bins = binSegments(inflated, g);
-  if (report) report->bricks = std::int64_t(bins.brick_ids.size());
-  const std::int64_t nb = std::int64_t(bins.brick_ids.size());
-  std::vector<BrickMesh> bricks(bins.brick_ids.size());
-  // In batches, so progress is reported from this thread.
-  const std::int64_t batch = 4096;
-  for (std::int64_t first = 0; first < nb; first += batch) {
-    const std::int64_t last = std::min(nb, first + batch);
-    tbb::parallel_for(tbb::blocked_range<std::int64_t>(first, last, 8), [&](const tbb::blocked_range<std::int64_t>& r) {
-      std::vector<double> f(std::size_t(kPoints * kPoints * kPoints));
-      std::vector<Capsule> caps;
-      for (std::int64_t b = r.begin(); b != r.end(); ++b) {
-        const std::int64_t id = bins.brick_ids[std::size_t(b)];
-        const std::int64_t base[3] = {kBrick * (id % bins.bricks[0]), kBrick * ((id / bins.bricks[0]) % bins.bricks[1]),
-                                      kBrick * (id / (std::int64_t(bins.bricks[0]) * bins.bricks[1]))};
-        const auto& segs = bins.segments[std::size_t(b)];
-        std::vector<std::int32_t> trees;
-        for (auto s : segs)
-          if (!t.isLink(s)) trees.push_back(t.tree.empty() ? 0 : t.tree[s]);
-        std::sort(trees.begin(), trees.end());
-        trees.erase(std::unique(trees.begin(), trees.end()), trees.end());
-        for (auto tree : trees) {
-          caps.clear();
-          for (auto s : segs)
-            if (!t.isLink(s) && (t.tree.empty() ? 0 : t.tree[s]) == tree) caps.push_back(capsuleOf(t, s));
-          sampleDistance(g, base, caps, f.data());
-          BrickContourer contour(g, tree, f.data(), caps, base, bricks[std::size_t(b)]);
-          for (int k = 0; k < kBrick; ++k)
-            for (int j = 0; j < kBrick; ++j)
-              for (int i = 0; i < kBrick; ++i) contour.cube(i, j, k);
+  lat.bins = binSegments(inflated, lat.grid);
+  inflated = VascularTree();
+
+  // Cells asked for: at each vessel's level, those its surface may pass through, found by
+  // descending from the top level.
+  std::vector<std::vector<std::uint64_t>> requests(std::size_t(top + 1));
+  {
+    tbb::enumerable_thread_specific<std::vector<std::vector<std::uint64_t>>> local([&] { return std::vector<std::vector<std::uint64_t>>(std::size_t(top + 1)); });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vessels.size(), 16), [&](const tbb::blocked_range<std::size_t>& r) {
+      auto& out = local.local();
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        const auto s = vessels[i];
+        const int l = level[std::size_t(s)];
+        const Capsule cap = capsuleOf(t, s);
+        // A cell the surface passes through has its centre within half a diagonal of it (the
+        // distance is 1-Lipschitz); the cells around are the balance's and the top cells' job.
+        const double margin = 1e-9 * cellSize(l), reach = t.maxRadius(s) + cellSize(l);
+        const Vec3 a = t.position[t.parent[s]], b = t.position[s];
+        std::int64_t c0[3], c1[3];
+        for (int ax = 0; ax < 3; ++ax) {
+          c0[ax] = std::int64_t(std::floor((std::min(a[ax], b[ax]) - reach - lat.origin[ax]) / cellSize(top)));
+          c1[ax] = std::int64_t(std::floor((std::max(a[ax], b[ax]) + reach - lat.origin[ax]) / cellSize(top)));
         }
-        // Each tetrahedron listed its three vertices: keep one per edge (a fifth of them).
-        auto& v = bricks[std::size_t(b)].vertices;
-        std::sort(v.begin(), v.end(), [](const EdgeVertex& x, const EdgeVertex& y) { return x.key < y.key; });
-        v.erase(std::unique(v.begin(), v.end(), [](const EdgeVertex& x, const EdgeVertex& y) { return x.key == y.key; }), v.end());
-        v.shrink_to_fit();
+        const std::function<void(int, std::int64_t, std::int64_t, std::int64_t)> descend = [&](int m, std::int64_t x, std::int64_t y, std::int64_t z) {
+          const double c = cellSize(m);
+          const Vec3 centre = lat.origin + Vec3((double(x) + 0.5) * c, (double(y) + 0.5) * c, (double(z) + 0.5) * c);
+          if (std::abs(cap.depth(centre)) > 0.8660254037844387 * c + margin) return;
+          if (m == l) {
+            out[std::size_t(l)].push_back(cellCode(x, y, z));
+            return;
+          }
+          for (int k = 0; k < 8; ++k) descend(m - 1, 2 * x + (k & 1), 2 * y + ((k >> 1) & 1), 2 * z + ((k >> 2) & 1));
+        };
+        for (std::int64_t z = c0[2]; z <= c1[2]; ++z)
+          for (std::int64_t y = c0[1]; y <= c1[1]; ++y)
+            for (std::int64_t x = c0[0]; x <= c1[0]; ++x) descend(top, x, y, z);
       }
     });
-    if (progress) progress(last, nb);
-  }
-  // Weld: one vertex per (tree, edge), numbered in key order; triangles in brick order.
-  std::vector<EdgeVertex> all;
-  std::size_t triangles = 0;
-  for (auto& b : bricks) {
-    all.insert(all.end(), b.vertices.begin(), b.vertices.end());
-    triangles += b.triangles.size();
-    std::vector<EdgeVertex>().swap(b.vertices);
-  }
-  std::sort(all.begin(), all.end(), [](const EdgeVertex& a, const EdgeVertex& b) { return a.key < b.key; });
-  all.erase(std::unique(all.begin(), all.end(), [](const EdgeVertex& a, const EdgeVertex& b) { return a.key == b.key; }), all.end());
-  mesh.vertices.reserve(all.size());
-  for (const auto& v : all) mesh.vertices.push_back(v.position);
-  mesh.triangles.reserve(triangles);
-  mesh.triangle_tree.reserve(triangles);
-  const auto index = [&](std::int32_t tree, std::int64_t edge) {
-    const EdgeKey key{tree, edge};
-    const auto it = std::lower_bound(all.begin(), all.end(), key, [](const EdgeVertex& v, const EdgeKey& k) { return v.key < k; });
-    return std::int32_t(it - all.begin());
-  };
-  for (const auto& b : bricks)
-    for (const auto& tri : b.triangles) {
-      mesh.triangles.push_back({index(tri.tree, tri.edge[0]), index(tri.tree, tri.edge[1]), index(tri.tree, tri.edge[2])});
-      mesh.triangle_tree.push_back(tri.tree);
+    for (auto& per_thread : local)
+      for (int l = 0; l <= top; ++l) requests[std::size_t(l)].insert(requests[std::size_t(l)].end(), per_thread[std::size_t(l)].begin(), per_thread[std::size_t(l)].end());
+    for (auto& r : requests) {
+      std::sort(r.begin(), r.end());
+      r.erase(std::unique(r.begin(), r.end()), r.end());
     }
+  }
+  const BalancedOctree octree(top, std::move(requests));
+  // Units: the level-3 nodes (8³ finest cells) with their leaves, and the coarser leaves alone.
+  const std::vector<OctreeLeaf> units = octree.units(kUnitLevel);
+  std::atomic<std::int64_t> cells{0};
+  const std::int64_t nu = std::int64_t(units.size());
+  std::vector<UnitMesh> meshes(units.size());
+  // In batches, so progress is reported from this thread.
+  const std::int64_t batch = 4096;
+  for (std::int64_t first = 0; first < nu; first += batch) {
+    const std::int64_t last = std::min(nu, first + batch);
+    tbb::parallel_for(tbb::blocked_range<std::int64_t>(first, last, 4), [&](const tbb::blocked_range<std::int64_t>& r) {
+      LeafSplitter splitter(octree);
+      UnitMesher mesher(t, lat, splitter);
+      std::vector<OctreeLeaf> leaves;
+      for (std::int64_t u = r.begin(); u != r.end(); ++u) {
+        const auto& unit = units[std::size_t(u)];
+        auto& out = meshes[std::size_t(u)];
+        splitter.leaves(unit, leaves);
+        cells += std::int64_t(leaves.size());
+        mesher.mesh(unit.level, unit.cell, leaves.data(), leaves.data() + leaves.size(), out);
+        out.vertices.shrink_to_fit();
+        out.triangles.shrink_to_fit();
+        out.triangle_tree.shrink_to_fit();
+      }
+    });
+    if (progress) progress(last, nu);
+  }
+  if (report) report->cells = cells, report->units = nu, report->levels = top + 1;
+  // Weld: one vertex per (tree, edge), numbered in key order; triangles in unit order. Units
+  // that share an edge computed the same vertex, so the first copy stands for all.
+  struct Copy {
+    EdgeKey key;
+    std::uint32_t unit, local;
+  };
+  std::vector<Copy> copies;
+  std::vector<std::size_t> offset(meshes.size() + 1, 0);
+  for (std::size_t u = 0; u < meshes.size(); ++u) {
+    for (std::size_t v = 0; v < meshes[u].vertices.size(); ++v) copies.push_back({meshes[u].vertices[v].key, std::uint32_t(u), std::uint32_t(v)});
+    offset[u + 1] = offset[u] + meshes[u].triangles.size();
+  }
+  tbb::parallel_sort(copies.begin(), copies.end(), [](const Copy& a, const Copy& b) { return std::tie(a.key, a.unit, a.local) < std::tie(b.key, b.unit, b.local); });
+  std::vector<std::vector<std::int32_t>> global(meshes.size());
+  for (std::size_t u = 0; u < meshes.size(); ++u) global[u].resize(meshes[u].vertices.size());
+  for (std::size_t i = 0; i < copies.size(); ++i) {
+    const auto& c = copies[i];
+    if (i == 0 || !(copies[i - 1].key == c.key)) {
+      const auto& v = meshes[c.unit].vertices[c.local];
+      mesh.vertices.push_back(v.position);
+      mesh.vertex_step.push_back(v.step);
+    }
+    global[c.unit][c.local] = std::int32_t(mesh.vertices.size() - 1);
+  }
+  std::vector<Copy>().swap(copies);
+  mesh.triangles.resize(offset.back());
+  mesh.triangle_tree.resize(offset.back());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, meshes.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t u = r.begin(); u != r.end(); ++u) {
+      for (std::size_t k = 0; k < meshes[u].triangles.size(); ++k) {
+        const auto& tri = meshes[u].triangles[k];
+        mesh.triangles[offset[u] + k] = {global[u][std::size_t(tri[0])], global[u][std::size_t(tri[1])], global[u][std::size_t(tri[2])]};
+        mesh.triangle_tree[offset[u] + k] = meshes[u].triangle_tree[k];
+      }
+      UnitMesh().vertices.swap(meshes[u].vertices);
+    }
+  });
   const auto removed = removeCavities(mesh);
   if (report) report->cavities_removed = removed;
+  if (o.restore_volume) {
+    std::vector<Capsule> capsules(std::size_t(t.nodeCount()));
+    for (auto s : vessels) capsules[std::size_t(s)] = capsuleOf(t, s);
+    const double moved = restoreVolume(mesh, [&](std::int32_t tree, const Vec3& p) {
+      // The bin of the point, as the units sample it.
+      const Vec3 x = lat.grid.index(p);
+      std::int64_t id = 0;
+      for (int a = 2; a >= 0; --a) {
+        const std::int64_t b = std::int64_t(std::floor((x[a] + 0.5) / kBrick));
+        if (b < 0 || b >= lat.bins.bricks[std::size_t(a)]) return std::numeric_limits<double>::infinity();
+        id = id * lat.bins.bricks[std::size_t(a)] + b;
+      }
+      const auto it = std::lower_bound(lat.bins.brick_ids.begin(), lat.bins.brick_ids.end(), id);
+      double best = std::numeric_limits<double>::infinity();
+      if (it == lat.bins.brick_ids.end() || *it != id) return best;
+      for (auto s : lat.bins.segments[std::size_t(it - lat.bins.brick_ids.begin())])
+        if ((t.tree.empty() ? 0 : t.tree[s]) == tree) best = std::min(best, capsules[std::size_t(s)].depth(p));
+      return best;
+    });
+    if (report) report->largest_volume_move_mm = moved;
+  }
   return mesh;
 }
 
 MeshTopology meshTopology(const SurfaceMesh& m) {
   MeshTopology out;
-  // Directed edges (from, to) sorted by their undirected pair: a closed, consistently oriented
-  // surface uses every edge once in each direction.
-  struct Use {
-    std::int64_t a, b;
-    bool forward;
-  };
-  std::vector<Use> edges;
-  edges.reserve(3 * m.triangles.size());
+  // Directed edges (from, to) bucketed by their lower vertex (a counting sort, linear): a
+  // closed, consistently oriented surface uses every edge once in each direction.
+  const std::size_t nv = m.vertices.size();
+  std::vector<std::uint32_t> first(nv + 1, 0);
   double six_v = 0;
   for (const auto& tri : m.triangles) {
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) ++out.degenerate_triangles;
-    for (int e = 0; e < 3; ++e) {
-      const std::int64_t a = tri[e], b = tri[(e + 1) % 3];
-      edges.push_back({std::min(a, b), std::max(a, b), a < b});
-    }
+    for (int e = 0; e < 3; ++e) ++first[std::size_t(std::min(tri[e], tri[(e + 1) % 3])) + 1];
     six_v += dot(m.vertices[tri[0]], cross(m.vertices[tri[1]], m.vertices[tri[2]]));
   }
   out.volume_mm3 = six_v / 6;
-  std::sort(edges.begin(), edges.end(), [](const Use& x, const Use& y) { return std::tie(x.a, x.b, x.forward) < std::tie(y.a, y.b, y.forward); });
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i;
-    while (j < edges.size() && edges[j].a == edges[i].a && edges[j].b == edges[i].b) ++j;
-    if (j - i == 1) ++out.boundary_edges;
-    else if (j - i > 2) ++out.nonmanifold_edges;
-    else if (edges[i].forward == edges[i + 1].forward) ++out.misoriented_edges;
-    i = j;
+  for (std::size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
+  std::vector<std::int64_t> uses(first[nv]);  // the upper vertex × 2 + (forward)
+  {
+    std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
+    for (const auto& tri : m.triangles)
+      for (int e = 0; e < 3; ++e) {
+        const std::int64_t a = tri[e], b = tri[(e + 1) % 3];
+        uses[fill[std::size_t(std::min(a, b))]++] = std::max(a, b) * 2 + (a < b);
+      }
   }
-  // Components (union-find over shared vertices) and V − E + F, per tree.
   std::int32_t trees = 0;
   for (auto tree : m.triangle_tree) trees = std::max(trees, tree + 1);
   out.tree_components.assign(std::size_t(trees), 0);
   out.tree_euler.assign(std::size_t(trees), 0);
-  const auto component = componentOf(m);
-  std::vector<std::int32_t> tree_of(m.vertices.size(), -1);
+  std::vector<std::int32_t> tree_of(nv, -1);
   for (std::size_t k = 0; k < m.triangles.size(); ++k) {
     out.tree_euler[std::size_t(m.triangle_tree[k])] += 1;  // F
     for (auto v : m.triangles[k]) tree_of[std::size_t(v)] = m.triangle_tree[k];
   }
-  for (std::size_t v = 0; v < component.size(); ++v) {
+  for (std::size_t v = 0; v < nv; ++v) {
+    const auto b = uses.begin() + first[v], e = uses.begin() + first[v + 1];
+    std::sort(b, e);
+    for (auto i = b; i != e;) {
+      auto j = i;
+      while (j != e && (*j >> 1) == (*i >> 1)) ++j;
+      if (j - i == 1) ++out.boundary_edges;
+      else if (j - i > 2) ++out.nonmanifold_edges;
+      else if ((*i & 1) == (*(i + 1) & 1)) ++out.misoriented_edges;
+      out.tree_euler[std::size_t(tree_of[v])] -= 1;  // E
+      i = j;
+    }
+  }
+  // Components (union-find over shared vertices) and V, per tree.
+  const auto component = componentOf(m);
+  for (std::size_t v = 0; v < nv; ++v) {
     if (tree_of[v] < 0) continue;
     out.tree_euler[std::size_t(tree_of[v])] += 1;  // V
     out.tree_components[std::size_t(tree_of[v])] += component[v] == std::int32_t(v);
   }
-  for (std::size_t i = 0; i < edges.size(); i += 2) out.tree_euler[std::size_t(tree_of[std::size_t(edges[i].a)])] -= 1;  // E (closed: two uses each)
   return out;
 }
 

@@ -1,12 +1,13 @@
 #pragma once
 // The outer surface of a vascular forest as a triangle mesh, one closed surface per tree: the
 // zero set of the signed distance to the union of the tree's vessels (capsules and round cones,
-// the solids the labels rasterise) sampled on a grid and contoured by marching tetrahedra.
-// The grid's cubes are split into six tetrahedra along their main diagonal (Freudenthal), so
-// neighbouring tetrahedra share faces and the surface of the piecewise-linear distance is closed,
-// manifold and free of self-intersections by construction; vertices are welded by the grid edge
-// they lie on. Only the 8³ bricks near a vessel surface are visited (in parallel), and the mesh
-// does not depend on the thread count.
+// the solids the labels rasterise) sampled on an adaptive grid and contoured by marching
+// tetrahedra. Each vessel is sampled at its own step (cells of 2^l finest steps, the coarsest
+// that keep samples_across samples across it), in the cells near its surface only; the cells
+// form a 2:1-balanced octree split into conforming tetrahedra (balanced_octree.hpp), so the
+// surface of the piecewise-linear distance is closed, manifold and free of self-intersections
+// by construction; vertices lie on the vessels' surface and are welded by the edge they lie on.
+// Units of cells are meshed in parallel, and the mesh does not depend on the thread count.
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -20,19 +21,30 @@ struct SurfaceMesh {
   std::vector<Vec3> vertices;                          // mm
   std::vector<std::array<std::int32_t, 3>> triangles;  // counter-clockwise seen from outside
   std::vector<std::int32_t> triangle_tree;             // the tree (forest index) of each triangle
+  std::vector<float> vertex_step;                      // mm: the sampling step where each vertex was found
 };
 
+// Cells grow up to 2^kMaxSurfaceLevel finest steps.
+constexpr int kMaxSurfaceLevel = 10;
+
 struct SurfaceOptions {
-  double voxel_mm = 0;         // grid step; 0: the thinnest vessel's diameter / samples_across
-  int samples_across = 4;      // samples across the thinnest vessel when the step is automatic
+  double voxel_mm = 0;         // finest grid step; 0: the thinnest vessel's diameter / samples_across
+  int samples_across = 4;      // samples across each vessel's thinnest end (at least)
+  bool adaptive = true;        // false: every vessel at the finest step
+  // Move vertices off the surface by ¾ of their triangles' mean gap (a fraction of the chords'
+  // sagitta) so the enclosed volume is the vessels'; false: every vertex on the surface.
+  bool restore_volume = true;
   std::uint64_t memory_limit = 0;  // bytes; 0: no limit
 };
 
 struct SurfaceReport {
-  double voxel_mm = 0;
-  std::int64_t bricks = 0;
+  double voxel_mm = 0;     // the finest step
+  double coarsest_mm = 0;  // the coarsest cell
+  int levels = 0;
+  std::int64_t cells = 0, units = 0;
   double estimated_bytes = 0;
-  std::int64_t cavities_removed = 0;  // closed pockets of outside space below the grid's resolution
+  std::int64_t cavities_removed = 0;
+  double largest_volume_move_mm = 0;  // closed pockets of outside space below the grid's resolution
 };
 
 // Throws InputError (no file) when the grid would exceed the memory limit or the index range.
