@@ -9,7 +9,7 @@ pkgs=(build-essential cmake pkg-config ccache
       libopenvdb-dev libboost-iostreams-dev libssl-dev libceres-dev)
 if [ "${1:-all}" != program ]; then
   pkgs+=(libgtest-dev libbenchmark-dev
-         libopenimageio-dev python3-nibabel python3-networkx python3-scipy python3-skimage python3-vtk9  # independent readers and references
+         libopenimageio-dev python3-nibabel python3-networkx python3-scipy python3-skimage python3-vtk9 tetgen  # independent readers and references
          clang libclang-rt-14-dev)  # the sanitizer build and libFuzzer (scripts/sanitize.sh)
 fi
 missing=()

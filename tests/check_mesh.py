@@ -1,6 +1,7 @@
 """Independent check of surface meshes angiosynth wrote (VTK from Debian, numpy, scipy).
 
     check_mesh.py MESH_DIR NODES_CSV EDGES_CSV
+    check_mesh.py --self-intersections MESH_DIR EXT...
 
 Reads surface.stl, .obj, .ply, .vtp with VTK's readers and surface.off by hand; for each: the
 counts of boundary and non-manifold edges (vtkFeatureEdges), duplicate and degenerate faces, the
@@ -8,10 +9,18 @@ connected regions with their Euler characteristic (genus), the enclosed volume
 (vtkMassProperties) and the signed volume (outward orientation). Estimates the volume of the
 union of the tree's capsules by Monte Carlo, independently of the mesher: points drawn
 uniformly in each capsule count 1/(capsules holding them). Prints one JSON object.
+
+With --self-intersections: each surface.EXT as VTK reads it (so with the precision the format
+keeps) goes to TetGen (Debian's tetgen), whose -d switch tests every pair of faces for an
+intersection with exact predicates; prints {EXT: intersecting pairs}.
 """
 import csv
 import json
+import os
+import re
+import subprocess
 import sys
+import tempfile
 
 import numpy as np
 import vtk
@@ -138,7 +147,33 @@ def inside(p, a, d, r):
     return np.linalg.norm(p - q, axis=1) <= r
 
 
+def self_intersections(mesh_dir, exts):
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for ext in exts:
+            poly = read(f"{mesh_dir}/surface.{ext}")
+            pts = vtk_to_numpy(poly.GetPoints().GetData()).astype(float)
+            faces = faces_of(poly)
+            path = os.path.join(tmp, f"{ext}.off")
+            with open(path, "w") as f:  # repr: every double exactly
+                f.write(f"OFF\n{len(pts)} {len(faces)} 0\n")
+                f.writelines(f"{x!r} {y!r} {z!r}\n" for x, y, z in pts)
+                f.writelines(f"3 {a} {b} {c}\n" for a, b, c in faces)
+            log = subprocess.run(["tetgen", "-d", path], capture_output=True, text=True).stdout
+            found = re.search(r"Found (\d+) pairs of faces are intersecting", log)
+            if found:
+                out[ext] = int(found.group(1))
+            elif "No faces are intersecting" in log:
+                out[ext] = 0
+            else:
+                raise SystemExit(f"tetgen -d gave no verdict on {ext}:\n{log[-2000:]}")
+    return out
+
+
 def main():
+    if sys.argv[1] == "--self-intersections":
+        print(json.dumps(self_intersections(sys.argv[2], sys.argv[3:])))
+        return
     mesh_dir, nodes_csv, edges_csv = sys.argv[1:4]
     result = {"formats": {}}
     for ext in ["stl", "obj", "ply", "off", "vtp"]:

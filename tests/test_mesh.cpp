@@ -128,6 +128,34 @@ TEST(Mesh, WrittenFilesReadBackClosedByVtkWithTheUnionsVolume) {
   std::filesystem::remove_all(dir);
 }
 
+// TetGen's exact face-pair test (tetgen -d, Debian) on every format as VTK re-reads it: no two
+// faces intersect, after the volume restoration moved the vertices and after single-precision
+// STL rounded them. A coarser mesh of the same forest (two samples across, three levels of
+// cells) keeps TetGen's run short.
+TEST(Mesh, TetgenFindsNoSelfIntersectionInAnyFormat) {
+  const auto& t = forest().forest.vessels;
+  const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_tetgen_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  SurfaceOptions o;
+  o.samples_across = 2;
+  SurfaceReport rep;
+  const auto m = vesselSurface(t, o, &rep);
+  EXPECT_GE(rep.levels, 3);
+  EXPECT_GT(rep.largest_volume_move_mm, 0);
+  for (const char* f : {"stl", "obj", "ply", "off", "vtp"}) {
+    std::ofstream out(dir / (std::string("surface.") + f), std::ios::binary);
+    meshWriter(f)(out, m);
+  }
+  const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' --self-intersections '" + dir.string() +
+                          "' stl obj ply off vtp > '" + (dir / "tetgen.json").string() + "'";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  const auto j = nlohmann::json::parse(readText(dir / "tetgen.json"));
+  ASSERT_EQ(j.size(), 5u);
+  for (const auto& [ext, pairs] : j.items()) EXPECT_EQ(pairs, 0) << ext << ": intersecting face pairs";
+  std::cout << m.triangles.size() << " triangles, " << j.dump() << "\n";
+  std::filesystem::remove_all(dir);
+}
+
 // `angiosynth mesh` end to end: a sample directory in, the surface and mesh.json out; a missing
 // input and a surface beyond the memory limit are refused (exit 2) with nothing written.
 TEST(Mesh, CommandWritesTheSurfaceAndRefusesWhatItCannotDo) {

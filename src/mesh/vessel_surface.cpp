@@ -33,7 +33,8 @@ struct EdgeKey {
 struct EdgeVertex {
   EdgeKey key;
   Vec3 position;
-  float step;  // mm, the length of the edge it lies on
+  Vec3 along;  // mm: its edge, from the inside end to the outside end
+  double t;    // where on the edge it lies
 };
 
 struct KeyedTriangle {
@@ -237,7 +238,7 @@ class UnitMesher {
     for (const auto& c : crossings_) {
       const double t = std::clamp(zeroOnEdge(asVec(c.pa), asVec(c.pb), c.fa, c.fb), kEdgeMargin, 1 - kEdgeMargin);
       const Vec3 pa = lat_.position(c.pa), pb = lat_.position(c.pb);
-      out.vertices.push_back({{tree, c.key}, pa + (pb - pa) * t, float(norm(pb - pa))});
+      out.vertices.push_back({{tree, c.key}, pa + (pb - pa) * t, pb - pa, t});
     }
   }
 
@@ -347,10 +348,15 @@ std::vector<std::int8_t> vesselLevels(const VascularTree& t, const std::vector<s
 // and lose volume: about c²/(12 r²) of a vessel sampled by cells of size c (more where cells are
 // coarse); at creases they stand out. Each triangle's gap is measured at its centroid with the
 // exact distance; over a triangle whose corners lie on the surface the gap averages ¾ of that
-// (a quadratic vanishing at the corners), so moving each vertex along its normal by ¾ of the
-// area-weighted gap of its triangles restores the enclosed volume. The move is a fraction of
-// the chord's sagitta, small against the vertex's step. Returns the largest move.
-double restoreVolume(SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
+// (a quadratic vanishing at the corners), so moving each vertex outwards by ¾ of the
+// area-weighted gap of its triangles restores the enclosed volume. A vertex slides along its
+// own edge of the tetrahedra (by the move over the edge's outward component, within the edge's
+// inner 98 % and at most a fifth of it): every triangle stays inside its tetrahedron, so the surface keeps free of
+// self-intersections. The move is a fraction of the chord's sagitta. Returns the largest.
+constexpr double kLargestSlide = 0.2;  // share of the edge: a grazing edge would carry the vertex far from the surface
+
+double restoreVolume(SurfaceMesh& m, const std::vector<Vec3>& along, std::vector<double>& on_edge,
+                     const std::function<double(std::int32_t, const Vec3&)>& distance) {
   const std::size_t nt = m.triangles.size();
   std::vector<double> gap(nt, 0.0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -371,10 +377,14 @@ double restoreVolume(SurfaceMesh& m, const std::function<double(std::int32_t, co
   }
   double largest = 0;
   for (std::size_t v = 0; v < m.vertices.size(); ++v) {
-    if (!(area[v] > 0)) continue;
-    const double move = weighted[v] / area[v];
-    m.vertices[v] += unit(normal[v]) * move;
-    largest = std::max(largest, std::abs(move));
+    const double outward = dot(along[v], unit(normal[v]));
+    if (!(area[v] > 0) || !(outward > 0)) continue;
+    const Vec3 start = m.vertices[v] - along[v] * on_edge[v];
+    const double slide = std::clamp(weighted[v] / area[v] / outward, -kLargestSlide, kLargestSlide);
+    const double t = std::clamp(on_edge[v] + slide, kEdgeMargin, 1 - kEdgeMargin);
+    largest = std::max(largest, std::abs(t - on_edge[v]) * norm(along[v]));
+    on_edge[v] = t;
+    m.vertices[v] = start + along[v] * t;
   }
   return largest;
 }
@@ -523,6 +533,8 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
     std::uint32_t unit, local;
   };
   std::vector<Copy> copies;
+  std::vector<Vec3> along;  // per vertex, its edge
+  std::vector<double> on_edge;
   std::vector<std::size_t> offset(meshes.size() + 1, 0);
   for (std::size_t u = 0; u < meshes.size(); ++u) {
     for (std::size_t v = 0; v < meshes[u].vertices.size(); ++v) copies.push_back({meshes[u].vertices[v].key, std::uint32_t(u), std::uint32_t(v)});
@@ -536,7 +548,9 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
     if (i == 0 || !(copies[i - 1].key == c.key)) {
       const auto& v = meshes[c.unit].vertices[c.local];
       mesh.vertices.push_back(v.position);
-      mesh.vertex_step.push_back(v.step);
+      mesh.vertex_step.push_back(float(norm(v.along)));
+      along.push_back(v.along);
+      on_edge.push_back(v.t);
     }
     global[c.unit][c.local] = std::int32_t(mesh.vertices.size() - 1);
   }
@@ -553,12 +567,10 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
       UnitMesh().vertices.swap(meshes[u].vertices);
     }
   });
-  const auto removed = removeCavities(mesh);
-  if (report) report->cavities_removed = removed;
   if (o.restore_volume) {
     std::vector<Capsule> capsules(std::size_t(t.nodeCount()));
     for (auto s : vessels) capsules[std::size_t(s)] = capsuleOf(t, s);
-    const double moved = restoreVolume(mesh, [&](std::int32_t tree, const Vec3& p) {
+    const double moved = restoreVolume(mesh, along, on_edge, [&](std::int32_t tree, const Vec3& p) {
       // The bin of the point, as the units sample it.
       const Vec3 x = lat.grid.index(p);
       std::int64_t id = 0;
@@ -576,6 +588,8 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
     });
     if (report) report->largest_volume_move_mm = moved;
   }
+  const auto removed = removeCavities(mesh);
+  if (report) report->cavities_removed = removed;
   return mesh;
 }
 
