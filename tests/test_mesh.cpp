@@ -182,3 +182,40 @@ TEST(Mesh, CommandWritesTheSurfaceAndRefusesWhatItCannotDo) {
   EXPECT_FALSE(std::filesystem::exists(dir / "big"));
   std::filesystem::remove_all(dir);
 }
+
+// [mesh] in a parameter file: generate writes the surface beside the graphs, describes it in
+// sample.json, gives the same surface as `angiosynth mesh` on the written graph, and refuses
+// a bad value with its line, writing nothing.
+TEST(Mesh, MeshTableInAParameterFileWritesTheSurfaceWithTheSample) {
+  const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_table_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto text = readText(test::sourceDir() / "examples/cco_artery_vein_3d.toml");
+  text.replace(text.find("terminals = 4000"), 16, "terminals = 6");
+  std::ofstream(dir / "with_mesh.toml") << text << "\n[mesh]\nformats = [\"stl\", \"off\"]\nsamples_across = 3\n";
+  const auto ok = run("generate with_mesh.toml --out sample --no-image --quiet", dir);
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  const auto j = nlohmann::json::parse(readText(dir / "sample/sample.json"));
+  EXPECT_EQ(j["files"]["surface_stl"], "surface.stl");
+  EXPECT_EQ(j["files"]["surface_off"], "surface.off");
+  EXPECT_EQ(j["parameters"]["mesh"]["samples_across"], 3);
+  const auto& st = j["statistics"]["surface"];
+  EXPECT_EQ(st["trees"], 2);
+  EXPECT_EQ(st["boundary_edges"], 0);
+  EXPECT_EQ(st["nonmanifold_edges"], 0);
+  EXPECT_EQ(st["tree_components"], nlohmann::json::array({1, 1}));
+  // The command on the sample's own graph files gives the same surface, byte for byte.
+  ASSERT_EQ(run("mesh sample --out again --format off --samples-across 3 --quiet", dir).code, 0);
+  EXPECT_EQ(readText(dir / "again/surface.off"), readText(dir / "sample/surface.off"));
+
+  std::ofstream(dir / "bad.toml") << text << "\n[mesh]\nsamples_across = 0\n";
+  const auto bad = run("generate bad.toml --out bad --no-image --quiet", dir);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("bad.toml:"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("samples_across = 0 is out of range; allowed: [1, 64]"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad"));
+  std::ofstream(dir / "bad2.toml") << text << "\n[mesh]\nformats = [\"3mf\"]\n";
+  const auto bad2 = run("generate bad2.toml --out bad2 --no-image --quiet", dir);
+  EXPECT_EQ(bad2.code, 2);
+  EXPECT_NE(bad2.err.find("'3mf' is not a format; allowed: stl, obj, ply, off, vtp"), std::string::npos) << bad2.err;
+  std::filesystem::remove_all(dir);
+}

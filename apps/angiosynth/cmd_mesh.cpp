@@ -9,10 +9,9 @@
 #include "angiosynth/version.hpp"
 #include "commands.hpp"
 #include "core/error.hpp"
-#include "io/mesh_writers.hpp"
 #include "io/network_files.hpp"
 #include "io/staged_directory.hpp"
-#include "mesh/vessel_surface.hpp"
+#include "pipeline/mesh_outputs.hpp"
 
 namespace angiosynth::cli {
 
@@ -53,59 +52,26 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   const auto net = readNetwork(graph);
   const fs::path out = a.out.empty() ? fs::path(in.lexically_normal().string() + "_mesh") : fs::path(a.out);
   StagedDirectory dir(out, a.force ? ExistingOutput::ReplaceOwn : ExistingOutput::Refuse, {in});
-  SurfaceOptions o;
-  o.voxel_mm = a.voxel_mm;
-  o.samples_across = a.samples_across;
-  o.adaptive = !a.uniform;
-  o.restore_volume = !a.on_surface;
-  o.memory_limit = memoryLimit(a.common);
-  SurfaceReport report;
-  const auto mesh = vesselSurface(net.tree, o, &report, progressPrinter(a.common, "meshing"));
-  const auto topo = meshTopology(mesh);
-  const std::vector<std::string> formats = a.formats.empty() ? std::vector<std::string>{"stl"} : a.formats;
-  Json files = Json::object();
-  for (const auto& f : formats) {
-    const std::string name = "surface." + f;
-    std::ofstream os(dir.path() / name, std::ios::binary);
-    meshWriter(f)(os, mesh);
-    if (!os) throw std::runtime_error("cannot write " + (dir.path() / name).string());
-    files[f] = name;
-  }
-  std::int64_t trees = 0, segments = 0;
-  for (std::int32_t i = 0; i < net.tree.nodeCount(); ++i) trees += net.tree.isRoot(i), segments += !net.tree.isRoot(i) && !net.tree.isLink(i);
+  MeshParameters p;
+  p.voxel_mm = a.voxel_mm;
+  p.samples_across = a.samples_across;
+  p.uniform = a.uniform;
+  p.on_surface = a.on_surface;
+  if (!a.formats.empty()) p.formats = a.formats;
+  const auto surface = writeSurfaceFiles(net.tree, p, memoryLimit(a.common), dir.path(), progressPrinter(a.common, "meshing"));
   Json j = {{"tool", "angiosynth " + std::string(kVersion)},
             {"command_line", command_line},
             {"input", graph.string()},
-            {"parameters", {{"voxel_mm", a.voxel_mm > 0 ? Json(a.voxel_mm) : Json(nullptr)}, {"samples_across", a.samples_across}, {"adaptive", !a.uniform}, {"volume_restored", !a.on_surface}}},
-            {"method", "marching tetrahedra of the signed distance to the union of each tree's capsules and round cones, on a 2:1-balanced "
-                       "octree of cells sized to each vessel's radius, split into conforming tetrahedra"},
-            {"statistics",
-             {{"trees", trees},
-              {"segments", segments},
-              {"vertices", mesh.vertices.size()},
-              {"triangles", mesh.triangles.size()},
-              {"triangles_per_segment", segments > 0 ? double(mesh.triangles.size()) / double(segments) : 0.0},
-              {"finest_step_mm", report.voxel_mm},
-              {"coarsest_cell_mm", report.coarsest_mm},
-              {"levels", report.levels},
-              {"cells", report.cells},
-              {"largest_volume_move_mm", report.largest_volume_move_mm},
-              {"estimated_bytes", report.estimated_bytes},
-              {"enclosed_volume_mm3", topo.volume_mm3},
-              {"boundary_edges", topo.boundary_edges},
-              {"nonmanifold_edges", topo.nonmanifold_edges},
-              {"misoriented_edges", topo.misoriented_edges},
-              {"degenerate_triangles", topo.degenerate_triangles},
-              {"cavities_removed", report.cavities_removed},
-              {"tree_components", topo.tree_components},
-              {"tree_euler_characteristic", topo.tree_euler}}},
-            {"files", files},
+            {"parameters", surface.parameters},
+            {"statistics", surface.statistics},
+            {"files", surface.files},
             {"timing_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()}};
   std::ofstream(dir.path() / "mesh.json") << j.dump(2) << '\n';
   dir.commit();
   if (!a.common.quiet)
-    std::cerr << "wrote " << dir.target().string() << ": " << mesh.triangles.size() << " triangles (" << trees << " trees, "
-              << segments << " segments, step " << report.voxel_mm << " mm), enclosed volume " << topo.volume_mm3 << " mm^3\n";
+    std::cerr << "wrote " << dir.target().string() << ": " << surface.statistics["triangles"] << " triangles (" << surface.statistics["trees"]
+              << " trees, " << surface.statistics["segments"] << " segments, finest step " << surface.statistics["finest_step_mm"]
+              << " mm), enclosed volume " << surface.statistics["enclosed_volume_mm3"] << " mm^3\n";
   return 0;
 }
 

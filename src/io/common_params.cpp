@@ -34,6 +34,12 @@ const std::vector<MethodParam>& commonParams() {
        "label_policy = ignore: vessel at partial volume >= high; nnU-Net's ignore label on (low, high) and on centreline voxels below high"},
       {"degrade", "profiles", "[text]", "[]", "degraded images to write, one image_<name> each: shipped profile names, .toml profiles or VascuSynth noise files"},
       {"output", "gxl_dialect", "text", "gxl", "gxl (GXL 1.0) or vascusynth"},
+      {"mesh", "enabled", "true/false", "true", "with a [mesh] table: write the vessels' surface (one closed mesh per tree) beside the graphs"},
+      {"mesh", "formats", "[text]", "[\"stl\"]", "any of stl, obj, ply, off, vtp: surface.<format> each"},
+      {"mesh", "voxel_size", "mm", "the thinnest vessel's diameter / samples_across", "the finest grid step"},
+      {"mesh", "samples_across", "count", "4", "grid steps across each vessel's thinnest end (1 … 64); thicker vessels get coarser cells"},
+      {"mesh", "uniform", "true/false", "false", "every vessel at the finest step"},
+      {"mesh", "on_surface", "true/false", "false", "vertices exactly on the surface (no volume restoration)"},
   };
   return p;
 }

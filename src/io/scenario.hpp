@@ -38,6 +38,16 @@ struct ImageParameters {
   int labels_line = 0;
 };
 
+// [mesh]: the outer surface of each tree, written beside the graphs (src/mesh; `angiosynth mesh`).
+struct MeshParameters {
+  bool enabled = false;
+  std::vector<std::string> formats{"stl"};  // stl, obj, ply, off, vtp
+  double voxel_mm = 0;                      // finest step; 0: the thinnest vessel's diameter / samples_across
+  int samples_across = 4;
+  bool uniform = false;                     // every vessel at the finest step
+  bool on_surface = false;                  // no volume restoration: vertices exactly on the surface
+};
+
 struct Scenario {
   std::string parameter_file;
   std::string format;  // "vascusynth" or "toml"
@@ -47,6 +57,8 @@ struct Scenario {
   int curves_line = 0;
   ImageParameters image;
   int image_line = 0;                          // line of [image], for errors about its size
+  MeshParameters mesh;
+  int mesh_line = 0;
   std::string gxl_dialect = "gxl";             // "gxl" (GXL 1.0) or "vascusynth"
   std::vector<std::string> profiles;           // [degrade] profiles: names or files
   int profiles_line = 0;

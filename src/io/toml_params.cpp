@@ -70,7 +70,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   const GrowthMethod* m = findGrowthMethod(method);
   if (!m) throw InputError(file, r.lineOf(method_node), "method '" + method + "' is not available; allowed: " + growthMethodNames());
   // The top-level tables: the common ones and those the method declares ([[stage]], [[region]]).
-  std::set<std::string> top{"seed", "domain", "tree", "physics", "curves", "image", "degrade", "output"};
+  std::set<std::string> top{"seed", "domain", "tree", "physics", "curves", "image", "degrade", "output", "mesh"};
   const auto tableOf = [](const MethodParam& p) { return std::string(p.table).substr(0, std::string(p.table).find('.')); };
   for (const auto& p : m->params) top.insert(tableOf(p));
   for (const auto& [k, v] : root) {
@@ -126,8 +126,8 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     if (ip.dtype != "uint8" && ip.dtype != "uint16" && ip.dtype != "int16" && ip.dtype != "float32")
       throw InputError(file, r.lineOf(im.get("dtype")), "dtype '" + ip.dtype + "'; allowed: uint8, uint16, int16, float32");
   }
-  const auto strings = [&](const char* key, const std::vector<std::string>& allowed) {
-    const toml::node* n = im.get(key);
+  const auto stringsOf = [&](const toml::table& table, const char* key, const std::vector<std::string>& allowed) {
+    const toml::node* n = table.get(key);
     std::vector<std::string> out;
     const auto* arr = n->as_array();
     if (!arr) throw InputError(file, r.lineOf(n), std::string(key) + " must be an array of strings");
@@ -142,8 +142,25 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     return out;
   };
   readLabelPolicy(r, im, ip);
-  if (im.get("formats")) ip.formats = strings("formats", {"nifti", "nrrd", "tiff", "png", "vdb"});
-  if (im.get("graph_formats")) ip.graph_formats = strings("graph_formats", {"csv", "vtp", "swc", "graphml", "cco"});
+  if (im.get("formats")) ip.formats = stringsOf(im, "formats", {"nifti", "nrrd", "tiff", "png", "vdb"});
+  if (im.get("graph_formats")) ip.graph_formats = stringsOf(im, "graph_formats", {"csv", "vtp", "swc", "graphml", "cco"});
+
+  // [mesh]: the vessels' surface beside the graphs (src/mesh); the table's presence enables it.
+  const auto& me = r.table("mesh", {"enabled", "formats", "voxel_size", "samples_across", "uniform", "on_surface"});
+  if (const auto* n = root.get("mesh")) {
+    auto& mp = sc.mesh;
+    sc.mesh_line = r.lineOf(n);
+    mp.enabled = r.boolean(me, "enabled", true);
+    if (me.get("formats")) mp.formats = stringsOf(me, "formats", {"stl", "obj", "ply", "off", "vtp"});
+    if (mp.formats.empty()) throw InputError(file, r.lineOf(me.get("formats")), "formats must name at least one of stl, obj, ply, off, vtp");
+    if (me.get("voxel_size")) {
+      mp.voxel_mm = r.quantity(me, "mesh", "voxel_size", Dimension::Length, voxel_mm);
+      checkRange(mp.voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, r.at(me, "voxel_size"), "mesh voxel_size (mm)");
+    }
+    if (me.get("samples_across")) mp.samples_across = r.smallInteger(me, "mesh", "samples_across", 1, 64);
+    mp.uniform = r.boolean(me, "uniform", mp.uniform);
+    mp.on_surface = r.boolean(me, "on_surface", mp.on_surface);
+  }
 
   if (root.get("curves")) {
     const auto& cv = r.table("curves", {"tortuosity", "tortuosity_sd", "wavelength", "wavelength_radii", "piece_length", "wall_clearance",

@@ -1,4 +1,5 @@
 #include "pipeline/generate_sample.hpp"
+#include "pipeline/mesh_outputs.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -51,6 +52,12 @@ Json describeParameters(const Scenario& sc) {
     j["curves"] = cj;
   }
   j["profiles"] = sc.profiles;
+  if (sc.mesh.enabled)
+    j["mesh"] = Json{{"formats", sc.mesh.formats},
+                     {"voxel_size", sc.mesh.voxel_mm > 0 ? quantityJson(sc.mesh.voxel_mm, "mm") : Json(nullptr)},
+                     {"samples_across", sc.mesh.samples_across},
+                     {"uniform", sc.mesh.uniform},
+                     {"on_surface", sc.mesh.on_surface}};
   return j;
 }
 
@@ -187,6 +194,14 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
     t0 = Clock::now();
     writeGraphFiles(tree, forest.trees, imageGrid(map, sc.image, sc.parameter_file, sc.image_line), sc.image.graph_formats, "", dir, files);
     timing["write_graphs"] = timing["write_graphs"].get<double>() + seconds(t0);
+  }
+
+  if (sc.mesh.enabled) {
+    t0 = Clock::now();
+    const auto surface = writeSurfaceFiles(tree, sc.mesh, req.memory_limit, dir);
+    for (const auto& [format, name] : surface.files.items()) files["surface_" + format] = name;
+    stats["surface"] = surface.statistics;
+    timing["mesh"] = seconds(t0);
   }
 
   // Statistics of the final tree.
