@@ -5,7 +5,7 @@ set -euo pipefail
 # argument also what the tests, benchmarks and sanitizer build need (scripts/test.sh).
 pkgs=(build-essential cmake pkg-config ccache
       libtbb-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libtinyxml2-dev
-      zlib1g-dev libnifti2-dev libtiff-dev libpng-dev libjpeg-dev
+      zlib1g-dev libzip-dev libnifti2-dev libtiff-dev libpng-dev libjpeg-dev
       libopenvdb-dev libboost-iostreams-dev libssl-dev libceres-dev)
 if [ "${1:-all}" != program ]; then
   pkgs+=(libgtest-dev libbenchmark-dev

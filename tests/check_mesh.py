@@ -3,7 +3,8 @@
     check_mesh.py MESH_DIR NODES_CSV EDGES_CSV
     check_mesh.py --self-intersections MESH_DIR EXT...
 
-Reads surface.stl, .obj, .ply, .vtp with VTK's readers and surface.off by hand; for each: the
+Reads surface.stl, .obj, .ply, .vtp with VTK's readers, surface.off by hand and surface.3mf with
+the standard library's zipfile and ElementTree (unit millimetre); for each: the
 counts of boundary and non-manifold edges (vtkFeatureEdges), duplicate and degenerate faces, the
 connected regions with their Euler characteristic (genus), the enclosed volume
 (vtkMassProperties) and the signed volume (outward orientation). Estimates the volume of the
@@ -21,6 +22,8 @@ import re
 import subprocess
 import sys
 import tempfile
+import xml.etree.ElementTree as ET
+import zipfile
 
 import numpy as np
 import vtk
@@ -30,14 +33,38 @@ from scipy.spatial import cKDTree
 from vtk.util.numpy_support import vtk_to_numpy
 
 
+def read_3mf(path):
+    """3MF by the standard library (zipfile, ElementTree): every object's mesh, in millimetres."""
+    ns = {"m": "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"}
+    with zipfile.ZipFile(path) as z:
+        assert "[Content_Types].xml" in z.namelist() and "_rels/.rels" in z.namelist()
+        rels = ET.fromstring(z.read("_rels/.rels"))
+        target = rels[0].get("Target").lstrip("/")
+        root = ET.fromstring(z.read(target))
+    assert root.get("unit") == "millimeter", root.get("unit")
+    pts, faces = [], []
+    built = {item.get("objectid") for item in root.find("m:build", ns)}
+    for obj in root.find("m:resources", ns).findall("m:object", ns):
+        assert obj.get("id") in built, "every object is built"
+        mesh = obj.find("m:mesh", ns)
+        base = len(pts)
+        pts += [[float(v.get(c)) for c in "xyz"] for v in mesh.find("m:vertices", ns)]
+        faces += [[base + int(t.get(k)) for k in ("v1", "v2", "v3")] for t in mesh.find("m:triangles", ns)]
+    return np.array(pts), np.array(faces)
+
+
 def read(path):
     ext = path.rsplit(".", 1)[1]
-    if ext == "off":
-        with open(path) as f:
-            assert f.readline().strip() == "OFF"
-            nv, nf, _ = map(int, f.readline().split())
-            pts = np.array([list(map(float, f.readline().split())) for _ in range(nv)])
-            faces = np.array([list(map(int, f.readline().split()))[1:] for _ in range(nf)])
+    if ext in ("off", "3mf"):
+        if ext == "3mf":
+            pts, faces = read_3mf(path)
+            nv = len(pts)
+        else:
+            with open(path) as f:
+                assert f.readline().strip() == "OFF"
+                nv, nf, _ = map(int, f.readline().split())
+                pts = np.array([list(map(float, f.readline().split())) for _ in range(nv)])
+                faces = np.array([list(map(int, f.readline().split()))[1:] for _ in range(nf)])
         poly = vtk.vtkPolyData()
         p = vtk.vtkPoints()
         p.SetNumberOfPoints(nv)
@@ -176,7 +203,7 @@ def main():
         return
     mesh_dir, nodes_csv, edges_csv = sys.argv[1:4]
     result = {"formats": {}}
-    for ext in ["stl", "obj", "ply", "off", "vtp"]:
+    for ext in ["stl", "obj", "ply", "off", "vtp", "3mf"]:
         poly = read(f"{mesh_dir}/surface.{ext}")
         pts = vtk_to_numpy(poly.GetPoints().GetData()).astype(float)
         faces = faces_of(poly)

@@ -97,7 +97,7 @@ TEST(Mesh, WrittenFilesReadBackClosedByVtkWithTheUnionsVolume) {
   const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_files_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const auto m = vesselSurface(t, SurfaceOptions{});
-  for (const char* f : {"stl", "obj", "ply", "off", "vtp"}) {
+  for (const char* f : {"stl", "obj", "ply", "off", "vtp", "3mf"}) {
     std::ofstream out(dir / (std::string("surface.") + f), std::ios::binary);
     meshWriter(f)(out, m);
   }
@@ -114,6 +114,7 @@ TEST(Mesh, WrittenFilesReadBackClosedByVtkWithTheUnionsVolume) {
   const double mc = j["union_volume_monte_carlo"];
   std::cout << "mesh volume " << volume << " mm^3, Monte Carlo union " << mc << " mm^3\n";
   EXPECT_LT(std::abs(volume - mc) / mc, 0.005);
+  EXPECT_EQ(j["formats"].size(), 6u);
   for (const auto& [ext, f] : j["formats"].items()) {
     EXPECT_EQ(f["points"], m.vertices.size()) << ext << ": vertices welded as written";
     EXPECT_EQ(f["triangles"], m.triangles.size()) << ext;
@@ -142,15 +143,15 @@ TEST(Mesh, TetgenFindsNoSelfIntersectionInAnyFormat) {
   const auto m = vesselSurface(t, o, &rep);
   EXPECT_GE(rep.levels, 3);
   EXPECT_GT(rep.largest_volume_move_mm, 0);
-  for (const char* f : {"stl", "obj", "ply", "off", "vtp"}) {
+  for (const char* f : {"stl", "obj", "ply", "off", "vtp", "3mf"}) {
     std::ofstream out(dir / (std::string("surface.") + f), std::ios::binary);
     meshWriter(f)(out, m);
   }
   const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' --self-intersections '" + dir.string() +
-                          "' stl obj ply off vtp > '" + (dir / "tetgen.json").string() + "'";
+                          "' stl obj ply off vtp 3mf > '" + (dir / "tetgen.json").string() + "'";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   const auto j = nlohmann::json::parse(readText(dir / "tetgen.json"));
-  ASSERT_EQ(j.size(), 5u);
+  ASSERT_EQ(j.size(), 6u);
   for (const auto& [ext, pairs] : j.items()) EXPECT_EQ(pairs, 0) << ext << ": intersecting face pairs";
   std::cout << m.triangles.size() << " triangles, " << j.dump() << "\n";
   std::filesystem::remove_all(dir);
@@ -213,9 +214,9 @@ TEST(Mesh, MeshTableInAParameterFileWritesTheSurfaceWithTheSample) {
   EXPECT_NE(bad.err.find("bad.toml:"), std::string::npos) << bad.err;
   EXPECT_NE(bad.err.find("samples_across = 0 is out of range; allowed: [1, 64]"), std::string::npos) << bad.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "bad"));
-  std::ofstream(dir / "bad2.toml") << text << "\n[mesh]\nformats = [\"3mf\"]\n";
+  std::ofstream(dir / "bad2.toml") << text << "\n[mesh]\nformats = [\"amf\"]\n";
   const auto bad2 = run("generate bad2.toml --out bad2 --no-image --quiet", dir);
   EXPECT_EQ(bad2.code, 2);
-  EXPECT_NE(bad2.err.find("'3mf' is not a format; allowed: stl, obj, ply, off, vtp"), std::string::npos) << bad2.err;
+  EXPECT_NE(bad2.err.find("'amf' is not a format; allowed: stl, obj, ply, off, vtp, 3mf"), std::string::npos) << bad2.err;
   std::filesystem::remove_all(dir);
 }

@@ -34,9 +34,9 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
   c->add_flag("--on-surface", a.on_surface,
               "keep every vertex exactly on the vessels' surface (default: vertices move by a fraction of the chords' sagitta so the "
               "enclosed volume is the vessels')");
-  c->add_option("--format", a.formats, "mesh formats: stl (binary), obj, ply (binary), off, vtp (default stl)")
+  c->add_option("--format", a.formats, "mesh formats: stl (binary), obj, ply (binary), off, vtp, 3mf (default stl)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"stl", "obj", "ply", "off", "vtp"}));
+      ->check(CLI::IsMember({"stl", "obj", "ply", "off", "vtp", "3mf"}));
   c->add_flag("--force", a.force, "replace an earlier angiosynth output in --out (only the files it wrote there)");
   addCommonOptions(*c, a.common);
   return c;

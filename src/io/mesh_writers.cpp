@@ -89,7 +89,8 @@ MeshWriter meshWriter(const std::string& format) {
   if (format == "ply") return writePly;
   if (format == "off") return writeOff;
   if (format == "vtp") return writeMeshVtp;
-  throw std::invalid_argument("mesh format '" + format + "'; allowed: stl, obj, ply, off, vtp");
+  if (format == "3mf") return writeThreeMf;
+  throw std::invalid_argument("mesh format '" + format + "'; allowed: stl, obj, ply, off, vtp, 3mf");
 }
 
 }  // namespace angiosynth

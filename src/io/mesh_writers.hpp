@@ -1,5 +1,5 @@
 #pragma once
-// Surface mesh files: binary STL, OBJ, binary PLY, OFF and VTK PolyData. Vertices are shared
+// Surface mesh files: binary STL, OBJ, binary PLY, OFF, VTK PolyData and 3MF. Vertices are shared
 // (welded) in every format that has a vertex list; STL has none, and its single-precision
 // corners still weld back exactly (the mesher keeps vertices far apart compared with float
 // rounding). Positions in mm; OBJ, PLY, OFF and VTP keep every bit of them.
@@ -15,8 +15,9 @@ void writeObj(std::ostream& out, const SurfaceMesh& m);
 void writePly(std::ostream& out, const SurfaceMesh& m);  // binary little endian; face property `tree`
 void writeOff(std::ostream& out, const SurfaceMesh& m);
 void writeMeshVtp(std::ostream& out, const SurfaceMesh& m);  // cell array `Tree`
+void writeThreeMf(std::ostream& out, const SurfaceMesh& m);  // 3MF, millimetres, one object per tree (mesh_3mf.cpp)
 
-// The writer of a format name (stl, obj, ply, off, vtp) and its file extension; throws
+// The writer of a format name (stl, obj, ply, off, vtp, 3mf), also its file extension; throws
 // std::invalid_argument for another name.
 using MeshWriter = void (*)(std::ostream&, const SurfaceMesh&);
 MeshWriter meshWriter(const std::string& format);

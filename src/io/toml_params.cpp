@@ -151,8 +151,8 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     auto& mp = sc.mesh;
     sc.mesh_line = r.lineOf(n);
     mp.enabled = r.boolean(me, "enabled", true);
-    if (me.get("formats")) mp.formats = stringsOf(me, "formats", {"stl", "obj", "ply", "off", "vtp"});
-    if (mp.formats.empty()) throw InputError(file, r.lineOf(me.get("formats")), "formats must name at least one of stl, obj, ply, off, vtp");
+    if (me.get("formats")) mp.formats = stringsOf(me, "formats", {"stl", "obj", "ply", "off", "vtp", "3mf"});
+    if (mp.formats.empty()) throw InputError(file, r.lineOf(me.get("formats")), "formats must name at least one of stl, obj, ply, off, vtp, 3mf");
     if (me.get("voxel_size")) {
       mp.voxel_mm = r.quantity(me, "mesh", "voxel_size", Dimension::Length, voxel_mm);
       checkRange(mp.voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, r.at(me, "voxel_size"), "mesh voxel_size (mm)");
