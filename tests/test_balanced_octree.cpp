@@ -38,7 +38,7 @@ TEST(BalancedOctree, LeavesSplitIntoAConformingTetrahedralMeshAcrossLevels) {
     requests[std::size_t(l)].push_back(cellCode(off + std::int64_t(rng() % span), off + std::int64_t(rng() % span), off + std::int64_t(rng() % span)));
   }
   const BalancedOctree octree(top, requests);
-  const auto leaves = octree.leaves();
+  const auto leaves = octree.units(0);  // at level 0 the units are the leaves
   std::map<int, int> per_level;
   for (const auto& l : leaves) ++per_level[l.level];
   ASSERT_GE(per_level.size(), 3u) << "leaves of several levels";

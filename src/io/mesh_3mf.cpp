@@ -7,6 +7,7 @@
 #include <ctime>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/format.hpp"
@@ -85,11 +86,9 @@ void writeThreeMf(std::ostream& out, const SurfaceMesh& m) {
   std::tm day{};
   day.tm_year = 80, day.tm_mday = 1, day.tm_hour = 12;
   const std::time_t fixed = std::mktime(&day);
-  for (const auto& [name, text] : {std::pair<const char*, const std::string*>{"[Content_Types].xml", nullptr},
-                                   {"_rels/.rels", nullptr}, {"3D/3dmodel.model", &model}}) {
-    const char* data = text ? text->data() : (std::string(name) == "_rels/.rels" ? kRelationships : kContentTypes);
-    const std::size_t size = text ? text->size() : std::char_traits<char>::length(data);
-    zip_source_t* s = zip_source_buffer(za, data, size, 0);
+  for (const auto& [name, text] : {std::pair<const char*, std::string_view>{"[Content_Types].xml", kContentTypes},
+                                   {"_rels/.rels", kRelationships}, {"3D/3dmodel.model", model}}) {
+    zip_source_t* s = zip_source_buffer(za, text.data(), text.size(), 0);
     check(s != nullptr, "cannot add a file", za);
     const zip_int64_t index = zip_file_add(za, name, s, ZIP_FL_ENC_UTF_8);
     if (index < 0) zip_source_free(s);

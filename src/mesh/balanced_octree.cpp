@@ -81,19 +81,6 @@ bool BalancedOctree::refined(int level, std::int64_t x, std::int64_t y, std::int
   return refined_[std::size_t(level)].contains(cellCode(x, y, z));
 }
 
-std::vector<OctreeLeaf> BalancedOctree::leaves() const {
-  std::vector<OctreeLeaf> out;
-  for (int l = top_; l >= 0; --l)
-    for (auto code : refined_[std::size_t(l + 1)].sorted()) {
-      const auto p = cellCoords(code);
-      for (int c = 0; c < 8; ++c) {
-        const std::array<std::int64_t, 3> cell{2 * p[0] + (c & 1), 2 * p[1] + ((c >> 1) & 1), 2 * p[2] + ((c >> 2) & 1)};
-        if (!refined(l, cell[0], cell[1], cell[2])) out.push_back({l, cell});
-      }
-    }
-  return out;
-}
-
 std::vector<OctreeLeaf> BalancedOctree::units(int level) const {
   std::vector<OctreeLeaf> out;
   if (level > top_) {

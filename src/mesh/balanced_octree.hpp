@@ -61,10 +61,9 @@ class BalancedOctree {
 
   int top() const { return top_; }
   bool refined(int level, std::int64_t x, std::int64_t y, std::int64_t z) const;
-  // Every leaf, coarsest level first.
-  std::vector<OctreeLeaf> leaves() const;
   // Work units that cover the leaves once: the nodes of level `level` (a leaf or a refined cell;
-  // the top cells if they are coarser) and the leaves above that level, coarsest first.
+  // the top cells if they are coarser) and the leaves above that level, coarsest first. At level
+  // 0 these are all the leaves.
   std::vector<OctreeLeaf> units(int level) const;
   std::size_t bytes() const;
 

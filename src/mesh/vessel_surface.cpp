@@ -79,8 +79,15 @@ struct Lattice {
   BrickBins bins;
 
   Vec3 position(const HalfPoint& q) const { return origin + Vec3(double(q[0]), double(q[1]), double(q[2])) * (0.5 * h); }
-  // The bin of a point: voxel x covers [x − ½, x + ½) steps, brick b voxels 8b … 8b + 7.
-  static std::int64_t binOf(std::int64_t half) { return (half + 1) / (2 * kBrick); }
+  // The bin of a coordinate in half steps: voxel x covers [x − ½, x + ½) steps, brick b voxels 8b … 8b + 7.
+  static std::int64_t binOf(double half) { return std::int64_t(std::floor((half + 1) / (2 * kBrick))); }
+  // The segments binned in brick (x, y, z); nullptr for none or a brick outside the grid.
+  const std::vector<std::int32_t>* segmentsIn(std::int64_t x, std::int64_t y, std::int64_t z) const {
+    if (x < 0 || y < 0 || z < 0 || x >= bins.bricks[0] || y >= bins.bricks[1] || z >= bins.bricks[2]) return nullptr;
+    const std::int64_t id = x + std::int64_t(bins.bricks[0]) * (y + std::int64_t(bins.bricks[1]) * z);
+    const auto it = std::lower_bound(bins.brick_ids.begin(), bins.brick_ids.end(), id);
+    return it != bins.brick_ids.end() && *it == id ? &bins.segments[std::size_t(it - bins.brick_ids.begin())] : nullptr;
+  }
 };
 
 class UnitMesher {
@@ -106,18 +113,15 @@ class UnitMesher {
     }
     // The bins the unit's points fall in, and the trees with vessels there.
     for (int a = 0; a < 3; ++a) {
-      bin_lo_[std::size_t(a)] = Lattice::binOf(base_[std::size_t(a)]);
-      bin_n_[std::size_t(a)] = Lattice::binOf(base_[std::size_t(a)] + span) - bin_lo_[std::size_t(a)] + 1;
+      bin_lo_[std::size_t(a)] = Lattice::binOf(double(base_[std::size_t(a)]));
+      bin_n_[std::size_t(a)] = Lattice::binOf(double(base_[std::size_t(a)] + span)) - bin_lo_[std::size_t(a)] + 1;
     }
     unit_bins_.clear();
     std::vector<std::int32_t> trees;
     for (std::int64_t k = 0; k < bin_n_[2]; ++k)
       for (std::int64_t j = 0; j < bin_n_[1]; ++j)
         for (std::int64_t i = 0; i < bin_n_[0]; ++i) {
-          const auto& b = lat_.bins;
-          const std::int64_t id = (bin_lo_[0] + i) + std::int64_t(b.bricks[0]) * ((bin_lo_[1] + j) + std::int64_t(b.bricks[1]) * (bin_lo_[2] + k));
-          const auto it = std::lower_bound(b.brick_ids.begin(), b.brick_ids.end(), id);
-          const std::vector<std::int32_t>* segs = (it != b.brick_ids.end() && *it == id) ? &b.segments[std::size_t(it - b.brick_ids.begin())] : nullptr;
+          const auto* segs = lat_.segmentsIn(bin_lo_[0] + i, bin_lo_[1] + j, bin_lo_[2] + k);
           unit_bins_.push_back(segs);
           if (segs)
             for (auto s : *segs) trees.push_back(treeOf(s));
@@ -158,7 +162,7 @@ class UnitMesher {
   // The distance at a point given in half steps: the minimum over the capsules of its bin.
   double distance(const Vec3& q) const {
     std::int64_t b = 0;
-    for (int a = 2; a >= 0; --a) b = b * bin_n_[std::size_t(a)] + (std::int64_t(std::floor((q[a] + 1) / (2 * kBrick))) - bin_lo_[std::size_t(a)]);
+    for (int a = 2; a >= 0; --a) b = b * bin_n_[std::size_t(a)] + (Lattice::binOf(q[a]) - bin_lo_[std::size_t(a)]);
     return unionDistance(caps_[std::size_t(b)], lat_.origin + q * (0.5 * lat_.h));
   }
   double value(std::int32_t idx) {
@@ -572,18 +576,11 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
     for (auto s : vessels) capsules[std::size_t(s)] = capsuleOf(t, s);
     const double moved = restoreVolume(mesh, along, on_edge, [&](std::int32_t tree, const Vec3& p) {
       // The bin of the point, as the units sample it.
-      const Vec3 x = lat.grid.index(p);
-      std::int64_t id = 0;
-      for (int a = 2; a >= 0; --a) {
-        const std::int64_t b = std::int64_t(std::floor((x[a] + 0.5) / kBrick));
-        if (b < 0 || b >= lat.bins.bricks[std::size_t(a)]) return std::numeric_limits<double>::infinity();
-        id = id * lat.bins.bricks[std::size_t(a)] + b;
-      }
-      const auto it = std::lower_bound(lat.bins.brick_ids.begin(), lat.bins.brick_ids.end(), id);
+      const Vec3 half = (p - lat.origin) / (0.5 * lat.h);
       double best = std::numeric_limits<double>::infinity();
-      if (it == lat.bins.brick_ids.end() || *it != id) return best;
-      for (auto s : lat.bins.segments[std::size_t(it - lat.bins.brick_ids.begin())])
-        if ((t.tree.empty() ? 0 : t.tree[s]) == tree) best = std::min(best, capsules[std::size_t(s)].depth(p));
+      if (const auto* segs = lat.segmentsIn(Lattice::binOf(half.x), Lattice::binOf(half.y), Lattice::binOf(half.z)))
+        for (auto s : *segs)
+          if ((t.tree.empty() ? 0 : t.tree[s]) == tree) best = std::min(best, capsules[std::size_t(s)].depth(p));
       return best;
     });
     if (report) report->largest_volume_move_mm = moved;
