@@ -1,6 +1,7 @@
 """Independent check of surface meshes angiosynth wrote (VTK from Debian, numpy, scipy).
 
     check_mesh.py MESH_DIR NODES_CSV EDGES_CSV
+    check_mesh.py --ends MESH_DIR
     check_mesh.py --self-intersections MESH_DIR EXT...
 
 Reads surface.stl, .obj, .ply, .vtp with VTK's readers, surface.off by hand and surface.3mf with
@@ -10,6 +11,11 @@ connected regions with their Euler characteristic (genus), the enclosed volume
 (vtkMassProperties) and the signed volume (outward orientation). Estimates the volume of the
 union of the tree's capsules by Monte Carlo, independently of the mesher: points drawn
 uniformly in each capsule count 1/(capsules holding them). Prints one JSON object.
+
+With --ends MESH_DIR: the cut ends of surface.vtp (VTK's reader) against surface_faces.csv:
+per capped end, the largest distance of its cap's points from its plane, its area over πr² and
+the smallest cosine between its triangles' normals and the plane's outward normal; the
+boundary loops (open ends) with the largest distance of their points from the nearest plane.
 
 With --self-intersections: each surface.EXT as VTK reads it (so with the precision the format
 keeps) goes to TetGen (Debian's tetgen), whose -d switch tests every pair of faces for an
@@ -197,7 +203,67 @@ def self_intersections(mesh_dir, exts):
     return out
 
 
+def ends(mesh_dir):
+    poly = read(f"{mesh_dir}/surface.vtp")
+    pts = vtk_to_numpy(poly.GetPoints().GetData()).astype(float)
+    faces = faces_of(poly)
+    cd = poly.GetCellData()
+    ids = vtk_to_numpy(cd.GetArray("ModelFaceID"))
+    assert (ids == vtk_to_numpy(cd.GetArray("CellEntityIds"))).all()
+    rows = list(csv.DictReader(open(f"{mesh_dir}/surface_faces.csv")))
+    planes = []
+    out = {"faces": len(rows), "wall_triangles": int((ids == 1).sum()), "caps": 0, "max_cap_plane_distance": 0.0,
+           "min_cap_area_ratio": 9.0, "max_cap_area_ratio": 0.0, "min_cap_normal_cosine": 1.0, "states": {}}
+    for row in rows[1:]:
+        out["states"][row["state"]] = out["states"].get(row["state"], 0) + 1
+        c = np.array([float(row[f"centre_{a}"]) for a in "xyz"])
+        n = np.array([float(row[f"normal_{a}"]) for a in "xyz"])
+        r = float(row["radius"])
+        planes.append((c, n, r))
+        mine = faces[ids == int(row["face_id"])]
+        if row["state"] != "capped":
+            assert len(mine) == 0, row
+            continue
+        out["caps"] += 1
+        p = pts[mine]
+        out["max_cap_plane_distance"] = max(out["max_cap_plane_distance"], float(np.abs((p - c) @ n).max() / r))
+        cr = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        area = 0.5 * np.linalg.norm(cr, axis=1)
+        ratio = float(area.sum() / (np.pi * r * r))
+        out["min_cap_area_ratio"] = min(out["min_cap_area_ratio"], ratio)
+        out["max_cap_area_ratio"] = max(out["max_cap_area_ratio"], ratio)
+        out["min_cap_normal_cosine"] = min(out["min_cap_normal_cosine"], float(((cr / (2 * area[:, None])) @ n).min()))
+    # Boundary loops: connected sets of boundary edges, each within a plane.
+    fe = vtk.vtkFeatureEdges()
+    fe.SetInputData(poly)
+    fe.BoundaryEdgesOn()
+    fe.NonManifoldEdgesOff()
+    fe.FeatureEdgesOff()
+    fe.ManifoldEdgesOff()
+    fe.Update()
+    edges = fe.GetOutput()
+    loops, worst = 0, 0.0
+    if edges.GetNumberOfCells() > 0:
+        conn = vtk.vtkPolyDataConnectivityFilter()
+        conn.SetInputData(edges)
+        conn.SetExtractionModeToAllRegions()
+        conn.ColorRegionsOn()
+        conn.Update()
+        loops = conn.GetNumberOfExtractedRegions()
+        lp = vtk_to_numpy(conn.GetOutput().GetPoints().GetData()).astype(float)
+        region = vtk_to_numpy(conn.GetOutput().GetPointData().GetArray("RegionId"))
+        for k in range(loops):
+            q = lp[region == k]
+            worst = max(worst, min(float(np.abs((q - c) @ n).max() / r) for c, n, r in planes))
+    out["boundary_loops"] = int(loops)
+    out["max_loop_plane_distance"] = worst
+    return out
+
+
 def main():
+    if sys.argv[1] == "--ends":
+        print(json.dumps(ends(sys.argv[2])))
+        return
     if sys.argv[1] == "--self-intersections":
         print(json.dumps(self_intersections(sys.argv[2], sys.argv[3:])))
         return

@@ -6,6 +6,8 @@
 #include <tbb/global_control.h>
 
 #include <fstream>
+#include <map>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "io/graph_writers.hpp"
@@ -192,7 +194,7 @@ TEST(Mesh, MeshTableInAParameterFileWritesTheSurfaceWithTheSample) {
   std::filesystem::create_directories(dir);
   auto text = readText(test::sourceDir() / "examples/cco_artery_vein_3d.toml");
   text.replace(text.find("terminals = 4000"), 16, "terminals = 6");
-  std::ofstream(dir / "with_mesh.toml") << text << "\n[mesh]\nformats = [\"stl\", \"off\"]\nsamples_across = 3\n";
+  std::ofstream(dir / "with_mesh.toml") << text << "\n[mesh]\nformats = [\"stl\", \"off\"]\nsamples_across = 3\nends = \"capped\"\n";
   const auto ok = run("generate with_mesh.toml --out sample --no-image --quiet", dir);
   ASSERT_EQ(ok.code, 0) << ok.err;
   const auto j = nlohmann::json::parse(readText(dir / "sample/sample.json"));
@@ -205,8 +207,25 @@ TEST(Mesh, MeshTableInAParameterFileWritesTheSurfaceWithTheSample) {
   EXPECT_EQ(st["nonmanifold_edges"], 0);
   EXPECT_EQ(st["tree_components"], nlohmann::json::array({1, 1}));
   // The command on the sample's own graph files gives the same surface, byte for byte.
-  ASSERT_EQ(run("mesh sample --out again --format off --samples-across 3 --quiet", dir).code, 0);
-  EXPECT_EQ(readText(dir / "again/surface.off"), readText(dir / "sample/surface.off"));
+  ASSERT_EQ(run("mesh sample --out again --format off --samples-across 3 --ends capped --quiet", dir).code, 0);
+  EXPECT_TRUE(readText(dir / "again/surface.off") == readText(dir / "sample/surface.off"));  // (no diff of megabytes on failure)
+  // The sample knows its vein: blood leaves the venous tree at its root.
+  const auto faces = readText(dir / "sample/surface_faces.csv");
+  std::istringstream rows(faces);
+  std::map<std::string, std::string> root_kind;  // per tree
+  for (std::string row; std::getline(rows, row);) {
+    std::vector<std::string> field;
+    std::istringstream cells(row);
+    for (std::string f; std::getline(cells, f, ',');) field.push_back(f);
+    if (field.size() > 4 && field[4] == "root") root_kind[field[2]] = field[1];
+  }
+  EXPECT_EQ(root_kind["0"], "inlet") << faces;
+  EXPECT_EQ(root_kind["1"], "outlet") << faces;
+  EXPECT_EQ(j["files"]["surface_faces"], "surface_faces.csv");
+  std::ofstream(dir / "bad3.toml") << text << "\n[mesh]\nends = \"round\"\n";
+  const auto bad3 = run("generate bad3.toml --out bad3 --no-image --quiet", dir);
+  EXPECT_EQ(bad3.code, 2);
+  EXPECT_NE(bad3.err.find("ends 'round'; allowed: closed, open, capped"), std::string::npos) << bad3.err;
 
   std::ofstream(dir / "bad.toml") << text << "\n[mesh]\nsamples_across = 0\n";
   const auto bad = run("generate bad.toml --out bad --no-image --quiet", dir);
@@ -218,5 +237,63 @@ TEST(Mesh, MeshTableInAParameterFileWritesTheSurfaceWithTheSample) {
   const auto bad2 = run("generate bad2.toml --out bad2 --no-image --quiet", dir);
   EXPECT_EQ(bad2.code, 2);
   EXPECT_NE(bad2.err.find("'amf' is not a format; allowed: stl, obj, ply, off, vtp, 3mf"), std::string::npos) << bad2.err;
+  std::filesystem::remove_all(dir);
+}
+
+// CFD ends: each tree's inlet and every outlet cut by the plane through its end node after a
+// flow extension, judged by VTK on the written VTP against surface_faces.csv: capped, every cap
+// lies in its plane, covers πr² (the loop is a polygon inscribed in the vessel's circle) and faces
+// outwards, the surface is closed with one sphere-like component per tree, and TetGen finds no
+// intersecting faces; open, there is exactly one planar boundary loop per end and each tree's
+// Euler characteristic is the capped one less its ends (each cap a disc).
+TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
+  const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_ends_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto text = readText(test::sourceDir() / "examples/cco_artery_vein_3d.toml");
+  text.replace(text.find("terminals = 4000"), 16, "terminals = 12");
+  std::ofstream(dir / "av.toml") << text;
+  ASSERT_EQ(run("generate av.toml --out sample --no-image --quiet", dir).code, 0);
+  const auto check = [&](const std::string& sub, const char* mode) {
+    const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' " + mode + " '" + (dir / sub).string() + "'" +
+                            (std::string(mode) == "--ends" ? "" : " vtp off") + " > '" + (dir / (sub + ".json")).string() + "'";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    return nlohmann::json::parse(readText(dir / (sub + ".json")));
+  };
+
+  const auto capped = run("mesh sample --out capped --format vtp,off --ends capped --flow-extension 3 --samples-across 2 --quiet", dir);
+  ASSERT_EQ(capped.code, 0) << capped.err;
+  const auto st = nlohmann::json::parse(readText(dir / "capped/mesh.json"))["statistics"];
+  EXPECT_EQ(st["ends"], 26);  // per tree: its root and 12 leaves
+  EXPECT_EQ(st["ends_cut"], 26);
+  EXPECT_EQ(st["boundary_edges"], 0);
+  EXPECT_EQ(st["nonmanifold_edges"], 0);
+  EXPECT_EQ(st["misoriented_edges"], 0);
+  EXPECT_EQ(st["tree_components"], nlohmann::json::array({1, 1}));
+  EXPECT_EQ(st["tree_euler_characteristic"], nlohmann::json::array({2, 2}));
+  const auto caps = check("capped", "--ends");
+  EXPECT_EQ(caps["caps"], 26);
+  EXPECT_EQ(caps["boundary_loops"], 0);
+  EXPECT_LT(caps["max_cap_plane_distance"].get<double>(), 1e-9);  // share of the radius
+  EXPECT_GT(caps["min_cap_area_ratio"].get<double>(), 0.97);
+  EXPECT_LT(caps["max_cap_area_ratio"].get<double>(), 1.01);
+  EXPECT_GT(caps["min_cap_normal_cosine"].get<double>(), 0.999999);
+  const auto tetgen = check("capped", "--self-intersections");
+  for (const auto& [ext, pairs] : tetgen.items()) EXPECT_EQ(pairs, 0) << ext << ": intersecting face pairs";
+  const auto faces = readText(dir / "capped/surface_faces.csv");
+  EXPECT_EQ(faces.substr(0, faces.find('\n')), "face_id,kind,tree,vessel,end,state,centre_x,centre_y,centre_z,normal_x,normal_y,normal_z,radius,cap_area,loop_vertices");
+
+  const auto open = run("mesh sample --out open --format vtp --ends open --flow-extension 3 --samples-across 2 --quiet", dir);
+  ASSERT_EQ(open.code, 0) << open.err;
+  const auto so = nlohmann::json::parse(readText(dir / "open/mesh.json"))["statistics"];
+  EXPECT_EQ(so["nonmanifold_edges"], 0);
+  EXPECT_EQ(so["tree_euler_characteristic"], nlohmann::json::array({2 - 13, 2 - 13}));
+  const auto loops = check("open", "--ends");
+  EXPECT_EQ(loops["boundary_loops"], 26);
+  EXPECT_LT(loops["max_loop_plane_distance"].get<double>(), 1e-9);
+
+  const auto bad = run("mesh sample --out bad --flow-extension 2 --quiet", dir);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--flow-extension needs --ends open or capped"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad"));
   std::filesystem::remove_all(dir);
 }

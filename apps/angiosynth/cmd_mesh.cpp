@@ -34,6 +34,13 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
   c->add_flag("--on-surface", a.on_surface,
               "keep every vertex exactly on the vessels' surface (default: vertices move by a fraction of the chords' sagitta so the "
               "enclosed volume is the vessels')");
+  c->add_option("--ends", a.ends,
+                "closed: round vessel ends (default); open: each tree's inlet and every outlet cut by the plane through its end node, "
+                "perpendicular to its vessel; capped: planar caps on those cuts, faces labelled (CellEntityIds/ModelFaceID in VTP, "
+                "`face` in PLY, groups in OBJ; surface_faces.csv)")
+      ->check(CLI::IsMember({"closed", "open", "capped"}));
+  c->add_option("--flow-extension", a.flow_extension, "with --ends open or capped: prolong each end straight by this many radii (default 0)")
+      ->check(finiteIn(0, 100));
   c->add_option("--format", a.formats, "mesh formats: stl (binary), obj, ply (binary), off, vtp, 3mf (default stl)")
       ->delimiter(',')
       ->check(CLI::IsMember({"stl", "obj", "ply", "off", "vtp", "3mf"}));
@@ -57,8 +64,11 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   p.samples_across = a.samples_across;
   p.uniform = a.uniform;
   p.on_surface = a.on_surface;
+  p.ends = a.ends;
+  p.flow_extension = a.flow_extension;
+  if (p.ends == "closed" && p.flow_extension > 0) throw InputError("", 0, "--flow-extension needs --ends open or capped");
   if (!a.formats.empty()) p.formats = a.formats;
-  const auto surface = writeSurfaceFiles(net.tree, p, memoryLimit(a.common), dir.path(), progressPrinter(a.common, "meshing"));
+  const auto surface = writeSurfaceFiles(net.tree, p, memoryLimit(a.common), dir.path(), progressPrinter(a.common, "meshing"), {}, net.ids);
   Json j = {{"tool", "angiosynth " + std::string(kVersion)},
             {"command_line", command_line},
             {"input", graph.string()},

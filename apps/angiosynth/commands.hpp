@@ -78,6 +78,8 @@ struct MeshArgs {
   double voxel_mm = 0;
   int samples_across = 4;
   bool uniform = false, on_surface = false;
+  std::string ends = "closed";
+  double flow_extension = 0;
   std::vector<std::string> formats;
   bool force = false;
   CommonOptions common;

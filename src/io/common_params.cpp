@@ -40,6 +40,11 @@ const std::vector<MethodParam>& commonParams() {
       {"mesh", "samples_across", "count", "4", "grid steps across each vessel's thinnest end (1 … 64); thicker vessels get coarser cells"},
       {"mesh", "uniform", "true/false", "false", "every vessel at the finest step"},
       {"mesh", "on_surface", "true/false", "false", "vertices exactly on the surface (no volume restoration)"},
+      {"mesh", "ends", "closed/open/capped", "closed",
+       "closed: round vessel ends; open: each tree's inlet and every outlet cut by the plane through its end node, perpendicular to "
+       "its vessel (one boundary loop per end); capped: those loops filled by planar caps, faces labelled (CellEntityIds/ModelFaceID "
+       "1 the wall, 2 … the caps; surface_faces.csv)"},
+      {"mesh", "flow_extension", "radii", "0", "open/capped: each end prolonged straight by this many radii of its vessel before the cut (0 … 100)"},
   };
   return p;
 }

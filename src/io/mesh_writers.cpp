@@ -42,9 +42,15 @@ void writeStl(std::ostream& out, const SurfaceMesh& m) {
 void writeObj(std::ostream& out, const SurfaceMesh& m) {
   out << "# angiosynth vessel surface; mm; faces counter-clockwise seen from outside\n";
   for (const auto& v : m.vertices) out << "v " << exactNumber(v.x) << ' ' << exactNumber(v.y) << ' ' << exactNumber(v.z) << '\n';
-  std::int32_t tree = -1;
+  // Groups: each tree's wall, then (ends cut) each cap: g tree<T> and g tree<T>_face<ModelFaceID>.
+  std::int32_t tree = -1, face = 0;
   for (std::size_t k = 0; k < m.triangles.size(); ++k) {
-    if (m.triangle_tree[k] != tree) out << "g tree" << (tree = m.triangle_tree[k]) << '\n';
+    const std::int32_t f = m.triangle_face.empty() ? 0 : m.triangle_face[k];
+    if (m.triangle_tree[k] != tree || f != face) {
+      out << "g tree" << (tree = m.triangle_tree[k]);
+      if ((face = f) > 0) out << "_face" << f + 1;
+      out << '\n';
+    }
     const auto& t = m.triangles[k];
     out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
   }
@@ -53,13 +59,15 @@ void writeObj(std::ostream& out, const SurfaceMesh& m) {
 void writePly(std::ostream& out, const SurfaceMesh& m) {
   out << "ply\nformat binary_little_endian 1.0\ncomment angiosynth vessel surface, mm\n"
       << "element vertex " << m.vertices.size() << "\nproperty double x\nproperty double y\nproperty double z\n"
-      << "element face " << m.triangles.size() << "\nproperty list uchar int vertex_indices\nproperty int tree\nend_header\n";
+      << "element face " << m.triangles.size() << "\nproperty list uchar int vertex_indices\nproperty int tree\n"
+      << (m.triangle_face.empty() ? "" : "property int face\n") << "end_header\n";
   for (const auto& v : m.vertices)
     for (double c : {v.x, v.y, v.z}) put(out, c);
   for (std::size_t k = 0; k < m.triangles.size(); ++k) {
     put(out, std::uint8_t(3));
     for (auto v : m.triangles[k]) put(out, std::int32_t(v));
     put(out, std::int32_t(m.triangle_tree[k]));
+    if (!m.triangle_face.empty()) put(out, std::int32_t(m.triangle_face[k] + 1));
   }
 }
 
@@ -76,6 +84,12 @@ void writeMeshVtp(std::ostream& out, const SurfaceMesh& m) {
   for (const auto& v : m.vertices) out << exactNumber(v.x) << ' ' << exactNumber(v.y) << ' ' << exactNumber(v.z) << '\n';
   out << "</DataArray>\n</Points>\n<CellData Scalars=\"Tree\">\n<DataArray type=\"Int32\" Name=\"Tree\" format=\"ascii\">\n";
   for (auto tree : m.triangle_tree) out << tree << '\n';
+  // Face labels as VMTK (CellEntityIds) and SimVascular (ModelFaceID) read them: 1 the wall, 2 … the caps.
+  for (const char* name : {"CellEntityIds", "ModelFaceID"}) {
+    if (m.triangle_face.empty()) break;
+    out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"" << name << "\" format=\"ascii\">\n";
+    for (auto f : m.triangle_face) out << f + 1 << '\n';
+  }
   out << "</DataArray>\n</CellData>\n<Polys>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
   for (const auto& t : m.triangles) out << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
   out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";

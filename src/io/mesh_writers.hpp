@@ -12,9 +12,9 @@ namespace angiosynth {
 
 void writeStl(std::ostream& out, const SurfaceMesh& m);
 void writeObj(std::ostream& out, const SurfaceMesh& m);
-void writePly(std::ostream& out, const SurfaceMesh& m);  // binary little endian; face property `tree`
+void writePly(std::ostream& out, const SurfaceMesh& m);  // binary little endian; face properties `tree` and (ends cut) `face`
 void writeOff(std::ostream& out, const SurfaceMesh& m);
-void writeMeshVtp(std::ostream& out, const SurfaceMesh& m);  // cell array `Tree`
+void writeMeshVtp(std::ostream& out, const SurfaceMesh& m);  // cell arrays `Tree` and (ends cut) `CellEntityIds`, `ModelFaceID`
 void writeThreeMf(std::ostream& out, const SurfaceMesh& m);  // 3MF, millimetres, one object per tree (mesh_3mf.cpp)
 
 // The writer of a format name (stl, obj, ply, off, vtp, 3mf), also its file extension; throws

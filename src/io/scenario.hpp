@@ -46,6 +46,8 @@ struct MeshParameters {
   int samples_across = 4;
   bool uniform = false;                     // every vessel at the finest step
   bool on_surface = false;                  // no volume restoration: vertices exactly on the surface
+  std::string ends = "closed";              // closed (round), open (cut at planes) or capped (planar caps, labelled faces)
+  double flow_extension = 0;                // open/capped: straight extension of each end, in radii of its vessel
 };
 
 struct Scenario {

@@ -146,7 +146,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   if (im.get("graph_formats")) ip.graph_formats = stringsOf(im, "graph_formats", {"csv", "vtp", "swc", "graphml", "cco"});
 
   // [mesh]: the vessels' surface beside the graphs (src/mesh); the table's presence enables it.
-  const auto& me = r.table("mesh", {"enabled", "formats", "voxel_size", "samples_across", "uniform", "on_surface"});
+  const auto& me = r.table("mesh", {"enabled", "formats", "voxel_size", "samples_across", "uniform", "on_surface", "ends", "flow_extension"});
   if (const auto* n = root.get("mesh")) {
     auto& mp = sc.mesh;
     sc.mesh_line = r.lineOf(n);
@@ -160,6 +160,17 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     if (me.get("samples_across")) mp.samples_across = r.smallInteger(me, "mesh", "samples_across", 1, 64);
     mp.uniform = r.boolean(me, "uniform", mp.uniform);
     mp.on_surface = r.boolean(me, "on_surface", mp.on_surface);
+    if (me.get("ends")) {
+      mp.ends = r.string(me, "mesh", "ends");
+      if (mp.ends != "closed" && mp.ends != "open" && mp.ends != "capped")
+        throw InputError(file, r.lineOf(me.get("ends")), "ends '" + mp.ends + "'; allowed: closed, open, capped");
+    }
+    if (me.get("flow_extension")) {
+      mp.flow_extension = r.number(me, "mesh", "flow_extension");
+      checkRange(mp.flow_extension, 0, false, 100, false, r.at(me, "flow_extension"), "flow_extension (radii)");
+      if (mp.ends == "closed" && mp.flow_extension > 0)
+        throw InputError(file, r.lineOf(me.get("flow_extension")), "flow_extension needs open or capped ends; allowed: ends = \"open\" or \"capped\"");
+    }
   }
 
   if (root.get("curves")) {

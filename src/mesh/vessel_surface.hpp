@@ -22,6 +22,7 @@ struct SurfaceMesh {
   std::vector<std::array<std::int32_t, 3>> triangles;  // counter-clockwise seen from outside
   std::vector<std::int32_t> triangle_tree;             // the tree (forest index) of each triangle
   std::vector<float> vertex_step;                      // mm: the sampling step where each vertex was found
+  std::vector<std::int32_t> triangle_face;             // empty, or per triangle: 0 the wall, k + 1 the cap of end k (vessel_ends.hpp)
 };
 
 // Cells grow up to 2^kMaxSurfaceLevel finest steps.

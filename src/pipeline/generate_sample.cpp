@@ -198,7 +198,9 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
 
   if (sc.mesh.enabled) {
     t0 = Clock::now();
-    const auto surface = writeSurfaceFiles(tree, sc.mesh, req.memory_limit, dir);
+    std::vector<std::string> kinds;
+    for (const auto& t : forest.trees) kinds.push_back(t.kind);
+    const auto surface = writeSurfaceFiles(tree, sc.mesh, req.memory_limit, dir, {}, kinds);
     for (const auto& [format, name] : surface.files.items()) files["surface_" + format] = name;
     stats["surface"] = surface.statistics;
     timing["mesh"] = seconds(t0);

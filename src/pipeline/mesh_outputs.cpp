@@ -4,14 +4,40 @@
 #include <stdexcept>
 
 #include "io/mesh_writers.hpp"
+#include "core/format.hpp"
+#include "mesh/vessel_ends.hpp"
 #include "mesh/vessel_surface.hpp"
 
 namespace angiosynth {
 
 using Json = nlohmann::ordered_json;
 
+namespace {
+
+// surface_faces.csv: one row per face label (the wall, then each end), as the ids the VTP and
+// PLY files carry (ModelFaceID = CellEntityIds = face + 1).
+void writeFaces(std::ostream& os, const std::vector<VesselEnd>& ends, const EndCutReport& cut, const std::string& mode,
+                const std::vector<std::string>& kinds, const std::vector<std::string>& vessel_ids) {
+  os << "face_id,kind,tree,vessel,end,state,centre_x,centre_y,centre_z,normal_x,normal_y,normal_z,radius,cap_area,loop_vertices\n";
+  os << "1,wall,,,,,,,,,,,,,\n";
+  std::vector<char> closed(ends.size(), 0);
+  for (auto e : cut.left_closed) closed[std::size_t(e)] = 1;
+  for (std::size_t k = 0; k < ends.size(); ++k) {
+    const auto& e = ends[k];
+    const bool vein = std::size_t(e.tree) < kinds.size() && kinds[std::size_t(e.tree)] == "vein";
+    os << k + 2 << ',' << ((e.root != vein) ? "inlet" : "outlet") << ',' << e.tree << ','
+       << (std::size_t(e.vessel) < vessel_ids.size() ? vessel_ids[std::size_t(e.vessel)] : std::to_string(e.vessel)) << ',' << (e.root ? "root" : "leaf") << ','
+       << (closed[k] ? "left_closed" : mode) << ',' << exactNumber(e.centre.x) << ',' << exactNumber(e.centre.y) << ',' << exactNumber(e.centre.z) << ','
+       << exactNumber(e.normal.x) << ',' << exactNumber(e.normal.y) << ',' << exactNumber(e.normal.z) << ',' << exactNumber(e.radius) << ','
+       << exactNumber(cut.cap_area_mm2[k]) << ',' << cut.loop_vertices[k] << '\n';
+  }
+}
+
+}  // namespace
+
 SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p, std::uint64_t memory_limit, const std::filesystem::path& dir,
-                               const std::function<void(std::int64_t, std::int64_t)>& progress) {
+                               const std::function<void(std::int64_t, std::int64_t)>& progress, const std::vector<std::string>& tree_kinds,
+                               const std::vector<std::string>& vessel_ids) {
   SurfaceOptions o;
   o.voxel_mm = p.voxel_mm;
   o.samples_across = p.samples_across;
@@ -19,10 +45,20 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   o.restore_volume = !p.on_surface;
   o.memory_limit = memory_limit;
   SurfaceReport report;
-  const auto mesh = vesselSurface(tree, o, &report, progress);
+  const bool cut_ends = p.ends != "closed";
+  const auto ends = cut_ends ? openEnds(tree, p.flow_extension) : std::vector<VesselEnd>{};
+  auto mesh = vesselSurface(cut_ends ? prolongEnds(tree, ends) : tree, o, &report, progress);
+  EndCutReport cut;
+  if (cut_ends) cut = cutEnds(mesh, ends, p.ends == "capped");
   const auto topo = meshTopology(mesh);
   SurfaceFiles out;
   out.files = Json::object();
+  if (cut_ends) {
+    std::ofstream os(dir / "surface_faces.csv", std::ios::binary);
+    writeFaces(os, ends, cut, p.ends, tree_kinds, vessel_ids);
+    if (!os) throw std::runtime_error("cannot write " + (dir / "surface_faces.csv").string());
+    out.files["faces"] = "surface_faces.csv";
+  }
   for (const auto& f : p.formats) {
     const std::string name = "surface." + f;
     std::ofstream os(dir / name, std::ios::binary);
@@ -37,6 +73,8 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"samples_across", p.samples_across},
                     {"adaptive", !p.uniform},
                     {"volume_restored", !p.on_surface},
+                    {"ends", p.ends},
+                    {"flow_extension_radii", p.flow_extension},
                     {"method", "marching tetrahedra of the signed distance to the union of each tree's capsules and round cones, on a "
                                "2:1-balanced octree of cells sized to each vessel's radius, split into conforming tetrahedra"}};
   out.statistics = {{"trees", trees},
@@ -56,6 +94,9 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"misoriented_edges", topo.misoriented_edges},
                     {"degenerate_triangles", topo.degenerate_triangles},
                     {"cavities_removed", report.cavities_removed},
+                    {"ends", ends.size()},
+                    {"ends_cut", cut.cut},
+                    {"ends_left_closed", cut.left_closed.size()},
                     {"tree_components", topo.tree_components},
                     {"tree_euler_characteristic", topo.tree_euler}};
   return out;

@@ -20,7 +20,11 @@ struct SurfaceFiles {
 };
 
 // Throws InputError (nothing written) when the surface would exceed the memory limit.
+// `tree_kinds` (per tree, may be empty): a "vein" drains to its root, so its root end is the
+// outlet and its leaves the inlets; other trees flow from the root. `vessel_ids` (per node, may
+// be empty): the ids surface_faces.csv names vessels by (a graph file's own), else node ids.
 SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p, std::uint64_t memory_limit, const std::filesystem::path& dir,
-                               const std::function<void(std::int64_t, std::int64_t)>& progress = {});
+                               const std::function<void(std::int64_t, std::int64_t)>& progress = {},
+                               const std::vector<std::string>& tree_kinds = {}, const std::vector<std::string>& vessel_ids = {});
 
 }  // namespace angiosynth

@@ -1,0 +1,433 @@
+#include "mesh/vessel_ends.hpp"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace angiosynth {
+
+namespace {
+
+// The prolongation beyond each plane, in radii: the surface crosses the plane as a tube, a
+// radius from the prolongation's round tip (longer ones merge with more neighbours).
+constexpr double kOvershootRadii = 1;
+
+// A vertex this close to a plane (share of the radius) is moved onto it: cut points never fall
+// next to a vertex, so no sliver triangles.
+constexpr double kSnap = 1e-6;
+
+std::uint64_t pairKey(std::int32_t a, std::int32_t b) {
+  if (a > b) std::swap(a, b);
+  return (std::uint64_t(std::uint32_t(a)) << 32) | std::uint32_t(b);
+}
+std::uint64_t directedKey(std::int32_t a, std::int32_t b) { return (std::uint64_t(std::uint32_t(a)) << 32) | std::uint32_t(b); }
+
+// The region an end's cut may touch: its tube from a radius (plus two steps) before the plane
+// to the prolongation's tip, out to 1.5 radii (plus two steps) from the axis.
+struct EndRegion {
+  Vec3 c, n;
+  double r;
+  bool holds(const Vec3& p, double step) const {
+    const double h = 2 * std::min(step, 2 * r);
+    const Vec3 v = p - c;
+    const double s = dot(v, n), rho2 = dot(v, v) - s * s;
+    const double reach = 1.5 * r + h;
+    return s >= -(r + h) && s <= (kOvershootRadii + 1) * r + h && rho2 <= reach * reach;
+  }
+  // Its bounding box.
+  void box(Vec3& lo, Vec3& hi) const {
+    const double h = 4 * r, reach = 1.5 * r + h;
+    lo = hi = c - n * (r + h);
+    for (const Vec3& p : {c - n * (r + h), c + n * ((kOvershootRadii + 1) * r + h)}) {
+      lo = componentMin(lo, p - Vec3(reach, reach, reach));
+      hi = componentMax(hi, p + Vec3(reach, reach, reach));
+    }
+  }
+};
+
+// (end, vertex) pairs of vertices inside each end's region, sorted: ends are binned on a grid of
+// cells about as large as the typical region (larger regions are tested against every vertex).
+std::vector<std::pair<std::int32_t, std::int32_t>> verticesNearEnds(const SurfaceMesh& m, const std::vector<EndRegion>& regions) {
+  std::vector<double> sizes;
+  for (const auto& e : regions) {
+    Vec3 lo, hi;
+    e.box(lo, hi);
+    sizes.push_back(std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z}));
+  }
+  std::vector<double> sorted = sizes;
+  std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(sorted.size() * 9 / 10), sorted.end());
+  const double g = std::max(sorted[sorted.size() * 9 / 10], 1e-9);
+  const auto cellOf = [g](double v) { return std::int64_t(std::floor(v / g)); };
+  const auto code = [](std::int64_t x, std::int64_t y, std::int64_t z) {
+    return (std::uint64_t(x & 0x1fffff) << 42) | (std::uint64_t(y & 0x1fffff) << 21) | std::uint64_t(z & 0x1fffff);
+  };
+  std::unordered_map<std::uint64_t, std::vector<std::int32_t>> bins;
+  std::vector<std::int32_t> large;
+  for (std::size_t e = 0; e < regions.size(); ++e) {
+    if (sizes[e] > 4 * g) {
+      large.push_back(std::int32_t(e));
+      continue;
+    }
+    Vec3 lo, hi;
+    regions[e].box(lo, hi);
+    for (auto z = cellOf(lo.z); z <= cellOf(hi.z); ++z)
+      for (auto y = cellOf(lo.y); y <= cellOf(hi.y); ++y)
+        for (auto x = cellOf(lo.x); x <= cellOf(hi.x); ++x) bins[code(x, y, z)].push_back(std::int32_t(e));
+  }
+  tbb::enumerable_thread_specific<std::vector<std::pair<std::int32_t, std::int32_t>>> found;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m.vertices.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    auto& out = found.local();
+    for (std::size_t v = r.begin(); v != r.end(); ++v) {
+      const Vec3& p = m.vertices[v];
+      const double step = m.vertex_step.empty() ? 0.0 : double(m.vertex_step[v]);
+      const auto test = [&](std::int32_t e) {
+        if (regions[std::size_t(e)].holds(p, step)) out.emplace_back(e, std::int32_t(v));
+      };
+      if (const auto it = bins.find(code(cellOf(p.x), cellOf(p.y), cellOf(p.z))); it != bins.end())
+        for (auto e : it->second) test(e);
+      for (auto e : large) test(e);
+    }
+  });
+  std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
+  for (auto& f : found) pairs.insert(pairs.end(), f.begin(), f.end());
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+// Ear clipping of a simple polygon counter-clockwise in the plane (u, w): triangles as indices
+// into it, or empty if it is not simple enough to clip.
+std::vector<std::array<int, 3>> clipEars(const std::vector<Vec3>& polygon, const Vec3& u, const Vec3& w) {
+  const int n = int(polygon.size());
+  std::vector<double> x(polygon.size()), y(polygon.size());
+  for (int i = 0; i < n; ++i) x[std::size_t(i)] = dot(polygon[std::size_t(i)], u), y[std::size_t(i)] = dot(polygon[std::size_t(i)], w);
+  const auto orient = [&](int a, int b, int c) {
+    return (x[std::size_t(b)] - x[std::size_t(a)]) * (y[std::size_t(c)] - y[std::size_t(a)]) -
+           (y[std::size_t(b)] - y[std::size_t(a)]) * (x[std::size_t(c)] - x[std::size_t(a)]);
+  };
+  std::vector<int> ring(polygon.size());
+  for (int i = 0; i < n; ++i) ring[std::size_t(i)] = i;
+  std::vector<std::array<int, 3>> out;
+  while (ring.size() > 3) {
+    bool clipped = false;
+    const std::size_t k = ring.size();
+    for (std::size_t i = 0; i < k && !clipped; ++i) {
+      const int a = ring[(i + k - 1) % k], b = ring[i], c = ring[(i + 1) % k];
+      if (!(orient(a, b, c) > 0)) continue;
+      bool empty = true;
+      for (std::size_t j = 0; j < k && empty; ++j) {
+        const int p = ring[j];
+        if (p == a || p == b || p == c) continue;
+        empty = !(orient(a, b, p) >= 0 && orient(b, c, p) >= 0 && orient(c, a, p) >= 0);
+      }
+      if (!empty) continue;
+      out.push_back({a, b, c});
+      ring.erase(ring.begin() + std::ptrdiff_t(i));
+      clipped = true;
+    }
+    if (!clipped) return {};
+  }
+  if (!(orient(ring[0], ring[1], ring[2]) > 0)) return {};
+  out.push_back({ring[0], ring[1], ring[2]});
+  return out;
+}
+
+}  // namespace
+
+std::vector<VesselEnd> openEnds(const VascularTree& t, double extension_radii) {
+  std::vector<VesselEnd> ends;
+  const auto add = [&](std::int32_t vessel, bool root) {
+    const std::int32_t node = root ? t.parent[vessel] : vessel, other = root ? vessel : t.parent[vessel];
+    const Vec3 d = t.position[node] - t.position[other];
+    if (!(norm(d) > 0)) return;
+    VesselEnd e;
+    e.vessel = vessel;
+    e.tree = t.tree.empty() ? 0 : t.tree[vessel];
+    e.root = root;
+    e.node = t.position[node];
+    e.normal = unit(d);
+    e.radius = root ? t.startRadius(vessel) : t.radius[vessel];
+    e.centre = e.node + e.normal * (extension_radii * e.radius);
+    if (e.radius > 0) ends.push_back(e);
+  };
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i)
+    if (t.isRoot(i) && t.child0[i] >= 0 && t.child1[i] < 0 && !t.isLink(t.child0[i])) add(t.child0[i], true);
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i)
+    if (!t.isRoot(i) && t.child0[i] < 0 && !t.isLink(i)) add(i, false);
+  // In an order of the geometry alone, so a tree read back from its graph files (numbered
+  // otherwise) gives the same files.
+  std::sort(ends.begin(), ends.end(), [](const VesselEnd& a, const VesselEnd& b) {
+    return std::make_tuple(a.tree, !a.root, a.node.x, a.node.y, a.node.z) < std::make_tuple(b.tree, !b.root, b.node.x, b.node.y, b.node.z);
+  });
+  return ends;
+}
+
+VascularTree prolongEnds(const VascularTree& t, const std::vector<VesselEnd>& ends) {
+  VascularTree out = t;
+  for (const auto& e : ends) {
+    const std::int32_t node = e.root ? t.parent[e.vessel] : e.vessel;
+    const auto id = out.addNode(e.centre + e.normal * (kOvershootRadii * e.radius), node);
+    out.radius[id] = e.radius;
+  }
+  return out;
+}
+
+EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool caps) {
+  EndCutReport rep;
+  rep.cap_area_mm2.assign(ends.size(), 0.0);
+  rep.loop_vertices.assign(ends.size(), 0);
+  m.triangle_face.assign(m.triangles.size(), 0);
+  if (ends.empty() || m.triangles.empty()) return rep;
+  std::vector<EndRegion> regions;
+  for (const auto& e : ends) regions.push_back({e.centre, e.normal, e.radius});
+  const auto near = verticesNearEnds(m, regions);
+
+  // Triangles at each vertex near an end (vertex-to-triangle incidence of those vertices only).
+  const std::size_t nv = m.vertices.size();
+  std::vector<char> is_near(nv, 0);
+  for (const auto& p : near) is_near[std::size_t(p.second)] = 1;
+  std::vector<std::uint32_t> first(nv + 1, 0);
+  for (const auto& tri : m.triangles)
+    for (auto v : tri) first[std::size_t(v) + 1] += is_near[std::size_t(v)];
+  for (std::size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
+  std::vector<std::int32_t> incident(first[nv]);
+  {
+    std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
+    for (std::size_t k = 0; k < m.triangles.size(); ++k)
+      for (auto v : m.triangles[k])
+        if (is_near[std::size_t(v)]) incident[fill[std::size_t(v)]++] = std::int32_t(k);
+  }
+
+  std::vector<char> removed(m.triangles.size(), 0);
+  std::vector<std::int32_t> region_of(nv, -1);  // the end whose region a vertex was last found in
+  std::vector<double> side(nv, 0.0);            // its signed distance to that end's plane
+  std::size_t at = 0;
+  for (std::size_t e = 0; e < ends.size(); ++e) {
+    const auto& end = ends[e];
+    const auto& reg = regions[e];
+    std::vector<std::int32_t> local;
+    for (; at < near.size() && near[at].first == std::int32_t(e); ++at) local.push_back(near[at].second);
+    const auto leaveClosed = [&] { rep.left_closed.push_back(std::int32_t(e)); };
+    // Signed distances to the plane; vertices within kSnap·r go onto it.
+    std::int32_t apex = -1;
+    double apex_distance = INFINITY;
+    const Vec3 tip = reg.c + reg.n * ((kOvershootRadii + 1) * reg.r);
+    for (auto v : local) {
+      double s = dot(m.vertices[std::size_t(v)] - reg.c, reg.n);
+      if (std::abs(s) < kSnap * reg.r) {
+        m.vertices[std::size_t(v)] = m.vertices[std::size_t(v)] - reg.n * s;
+        s = 0;
+      }
+      region_of[std::size_t(v)] = std::int32_t(e);
+      side[std::size_t(v)] = s;
+      // The apex: the vertex nearest the prolongation's tip.
+      const double d = distance(m.vertices[std::size_t(v)], tip);
+      if (apex < 0 || d < apex_distance) apex = v, apex_distance = d;
+    }
+    if (apex < 0 || !(side[std::size_t(apex)] > 0)) {
+      leaveClosed();
+      continue;
+    }
+    const auto mine = [&](std::int32_t v) { return region_of[std::size_t(v)] == std::int32_t(e); };
+    const auto beyond = [&](std::int32_t k) {
+      const auto& tri = m.triangles[std::size_t(k)];
+      return side[std::size_t(tri[0])] > 0 || side[std::size_t(tri[1])] > 0 || side[std::size_t(tri[2])] > 0;
+    };
+    // The prolongation's triangles: those with a vertex beyond the plane connected to the apex.
+    // All their vertices must lie in the end's region (else it merged with another vessel).
+    std::vector<std::int32_t> cut;
+    std::unordered_set<std::int32_t> in_cut;
+    bool ok = true;
+    for (auto k = first[std::size_t(apex)]; k < first[std::size_t(apex) + 1]; ++k)
+      if (in_cut.insert(incident[k]).second) cut.push_back(incident[k]);
+    // The triangle across edge (a, b) of triangle k, or −1.
+    const auto across = [&](std::int32_t k, std::int32_t a, std::int32_t b) {
+      for (auto q = first[std::size_t(a)]; q < first[std::size_t(a) + 1]; ++q) {
+        const auto o = incident[q];
+        if (o == k || removed[std::size_t(o)]) continue;
+        const auto& tri = m.triangles[std::size_t(o)];
+        if (tri[0] == b || tri[1] == b || tri[2] == b) return o;
+      }
+      return std::int32_t(-1);
+    };
+    std::vector<std::uint64_t> boundary_side;  // directed edges of untouched neighbours facing the cut
+    for (std::size_t q = 0; q < cut.size() && ok; ++q) {
+      const auto k = cut[q];
+      const auto& tri = m.triangles[std::size_t(k)];
+      if (removed[std::size_t(k)] || !mine(tri[0]) || !mine(tri[1]) || !mine(tri[2])) {
+        ok = false;
+        break;
+      }
+      for (int i = 0; i < 3; ++i) {
+        const auto a = tri[std::size_t(i)], b = tri[std::size_t((i + 1) % 3)];
+        const auto o = across(k, a, b);
+        if (o < 0) {
+          ok = false;
+          break;
+        }
+        if (in_cut.count(o)) continue;
+        const auto& ot = m.triangles[std::size_t(o)];
+        if ((mine(ot[0]) && mine(ot[1]) && mine(ot[2])) && beyond(o)) {
+          in_cut.insert(o);
+          cut.push_back(o);
+        } else {
+          boundary_side.push_back(directedKey(b, a));
+        }
+      }
+    }
+    if (!ok) {
+      leaveClosed();
+      continue;
+    }
+    // Clip each triangle of the cut to the side s ≤ 0; cut points are shared through their edge.
+    std::unordered_map<std::uint64_t, std::int32_t> cut_point;
+    std::vector<Vec3> new_vertices;
+    std::vector<float> new_steps;
+    const std::int32_t base = std::int32_t(m.vertices.size());
+    const auto pointOn = [&](std::int32_t a, std::int32_t b) {
+      const auto key = pairKey(a, b);
+      if (const auto it = cut_point.find(key); it != cut_point.end()) return it->second;
+      const double sa = side[std::size_t(a)], sb = side[std::size_t(b)];
+      Vec3 p = m.vertices[std::size_t(a)] + (m.vertices[std::size_t(b)] - m.vertices[std::size_t(a)]) * (sa / (sa - sb));
+      p = p - reg.n * dot(p - reg.c, reg.n);
+      const auto id = base + std::int32_t(new_vertices.size());
+      new_vertices.push_back(p);
+      new_steps.push_back(m.vertex_step.empty() ? 0.f : std::min(m.vertex_step[std::size_t(a)], m.vertex_step[std::size_t(b)]));
+      cut_point.emplace(key, id);
+      return id;
+    };
+    const auto sideOf = [&](std::int32_t v) { return v >= base ? 0.0 : side[std::size_t(v)]; };
+    const auto at_of = [&](std::int32_t v) -> const Vec3& { return v >= base ? new_vertices[std::size_t(v - base)] : m.vertices[std::size_t(v)]; };
+    std::vector<std::array<std::int32_t, 3>> kept;
+    std::vector<std::int32_t> kept_tree;
+    std::sort(cut.begin(), cut.end());
+    for (auto k : cut) {
+      const auto& tri = m.triangles[std::size_t(k)];
+      std::int32_t poly[4];
+      int n = 0;
+      for (int i = 0; i < 3; ++i) {
+        const auto a = tri[std::size_t(i)], b = tri[std::size_t((i + 1) % 3)];
+        const double sa = side[std::size_t(a)], sb = side[std::size_t(b)];
+        if (sa <= 0) poly[n++] = a;
+        if ((sa < 0 && sb > 0) || (sa > 0 && sb < 0)) poly[n++] = pointOn(a, b);
+      }
+      if (n < 3) continue;
+      // A quad splits along its shorter diagonal.
+      if (n == 4 && distance(at_of(poly[1]), at_of(poly[3])) < distance(at_of(poly[0]), at_of(poly[2]))) std::rotate(poly, poly + 1, poly + 4);
+      for (int i = 1; i + 1 < n; ++i) {
+        kept.push_back({poly[0], poly[i], poly[i + 1]});
+        kept_tree.push_back(m.triangle_tree[std::size_t(k)]);
+      }
+    }
+    // The loop: directed edges of the kept pieces and of the neighbours facing the cut that have
+    // no reverse among them.
+    std::unordered_set<std::uint64_t> edges(boundary_side.begin(), boundary_side.end());
+    for (const auto& tri : kept)
+      for (int i = 0; i < 3; ++i) edges.insert(directedKey(tri[std::size_t(i)], tri[std::size_t((i + 1) % 3)]));
+    std::unordered_map<std::int32_t, std::int32_t> next;
+    std::int32_t start = -1;
+    for (auto key : edges) {
+      const auto a = std::int32_t(key >> 32), b = std::int32_t(key & 0xffffffffu);
+      if (edges.count(directedKey(b, a))) continue;
+      if (sideOf(a) != 0 || sideOf(b) != 0 || !next.emplace(a, b).second) ok = false;
+      if (start < 0 || a < start) start = a;
+    }
+    std::vector<std::int32_t> loop;
+    for (std::int32_t v = start; ok && v >= 0;) {
+      loop.push_back(v);
+      const auto it = next.find(v);
+      if (it == next.end()) ok = false;
+      else v = it->second == start ? -1 : it->second;
+      if (loop.size() > next.size()) ok = false;
+    }
+    if (!ok || loop.size() < 3 || loop.size() != next.size()) {
+      leaveClosed();
+      continue;
+    }
+    // The cap: a fan from the plane's centre when the loop is star-shaped around it (seen along
+    // the outward normal), else the loop's ears.
+    std::vector<std::array<std::int32_t, 3>> cap;
+    double area = 0;
+    if (caps) {
+      const auto centre = base + std::int32_t(new_vertices.size());
+      bool star = true;
+      for (std::size_t i = 0; i < loop.size(); ++i) {
+        const auto a = loop[i], b = loop[(i + 1) % loop.size()];
+        const double twice = dot(cross(at_of(a) - end.centre, at_of(b) - end.centre), reg.n);
+        star = star && twice < 0;  // the wall runs a → b; the cap runs b → a around the normal
+      }
+      if (star) {
+        for (std::size_t i = 0; i < loop.size(); ++i) cap.push_back({loop[(i + 1) % loop.size()], loop[i], centre});
+        float step = INFINITY;
+        for (auto v : loop) step = std::min(step, v >= base ? new_steps[std::size_t(v - base)] : m.vertex_step.empty() ? 0.f : m.vertex_step[std::size_t(v)]);
+        new_vertices.push_back(end.centre);
+        new_steps.push_back(step);
+      } else {
+        std::vector<Vec3> polygon;
+        for (std::size_t i = loop.size(); i-- > 0;) polygon.push_back(at_of(loop[i]));
+        const Vec3 u = unit(std::abs(reg.n.x) < 0.9 ? cross(reg.n, Vec3(1, 0, 0)) : cross(reg.n, Vec3(0, 1, 0))), w = cross(reg.n, u);
+        const auto ears = clipEars(polygon, u, w);
+        if (ears.empty()) {
+          leaveClosed();
+          continue;
+        }
+        const auto vertexOf = [&](int i) { return loop[loop.size() - 1 - std::size_t(i)]; };
+        for (const auto& ear : ears) cap.push_back({vertexOf(ear[0]), vertexOf(ear[1]), vertexOf(ear[2])});
+      }
+      for (const auto& tri : cap) area += 0.5 * norm(cross(at_of(tri[1]) - at_of(tri[0]), at_of(tri[2]) - at_of(tri[0])));
+    }
+    // Commit.
+    for (auto k : cut) removed[std::size_t(k)] = 1;
+    m.vertices.insert(m.vertices.end(), new_vertices.begin(), new_vertices.end());
+    if (!m.vertex_step.empty()) m.vertex_step.insert(m.vertex_step.end(), new_steps.begin(), new_steps.end());
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+      m.triangles.push_back(kept[i]);
+      m.triangle_tree.push_back(kept_tree[i]);
+      m.triangle_face.push_back(0);
+      removed.push_back(0);
+    }
+    for (const auto& tri : cap) {
+      m.triangles.push_back(tri);
+      m.triangle_tree.push_back(end.tree);
+      m.triangle_face.push_back(std::int32_t(e) + 1);
+      removed.push_back(0);
+    }
+    ++rep.cut;
+    rep.cap_area_mm2[e] = area;
+    rep.loop_vertices[e] = std::int32_t(loop.size());
+  }
+
+  // Drop the prolongations and the vertices only they used; the others keep their order.
+  std::vector<std::int32_t> renumber(m.vertices.size(), -1);
+  std::size_t nt = 0;
+  for (std::size_t k = 0; k < m.triangles.size(); ++k) {
+    if (removed[k]) continue;
+    m.triangles[nt] = m.triangles[k];
+    m.triangle_tree[nt] = m.triangle_tree[k];
+    m.triangle_face[nt] = m.triangle_face[k];
+    for (auto v : m.triangles[nt]) renumber[std::size_t(v)] = 0;
+    ++nt;
+  }
+  m.triangles.resize(nt);
+  m.triangle_tree.resize(nt);
+  m.triangle_face.resize(nt);
+  std::size_t kept_vertices = 0;
+  for (std::size_t v = 0; v < renumber.size(); ++v) {
+    if (renumber[v] < 0) continue;
+    renumber[v] = std::int32_t(kept_vertices);
+    m.vertices[kept_vertices] = m.vertices[v];
+    if (!m.vertex_step.empty()) m.vertex_step[kept_vertices] = m.vertex_step[v];
+    ++kept_vertices;
+  }
+  m.vertices.resize(kept_vertices);
+  if (!m.vertex_step.empty()) m.vertex_step.resize(kept_vertices);
+  for (auto& tri : m.triangles)
+    for (auto& v : tri) v = renumber[std::size_t(v)];
+  return rep;
+}
+
+}  // namespace angiosynth
