@@ -12,6 +12,7 @@
 
 #include "io/graph_writers.hpp"
 #include "io/mesh_writers.hpp"
+#include "mesh/decimate.hpp"
 #include "mesh/vessel_surface.hpp"
 #include "raster/vessel_capsule.hpp"
 #include "grow_file.hpp"
@@ -41,6 +42,24 @@ const test::Grown& forest() {
   return g;
 }
 
+// The largest |distance| of a vertex from its tree's union of capsules, over its local step.
+double largestDistanceOverStep(const VascularTree& t, const SurfaceMesh& m) {
+  std::vector<std::vector<Capsule>> caps(t.roots().size());
+  for (std::int32_t s = 0; s < t.nodeCount(); ++s)
+    if (!t.isRoot(s)) caps[std::size_t(t.tree[s])].push_back(capsuleOf(t, s));
+  EXPECT_EQ(m.vertex_step.size(), m.vertices.size());
+  std::vector<std::int32_t> tree_of(m.vertices.size(), 0);
+  for (std::size_t k = 0; k < m.triangles.size(); ++k)
+    for (auto v : m.triangles[k]) tree_of[std::size_t(v)] = m.triangle_tree[k];
+  double worst = 0;
+  for (std::size_t v = 0; v < m.vertices.size(); ++v) {
+    double d = INFINITY;
+    for (const auto& c : caps[std::size_t(tree_of[v])]) d = std::min(d, c.depth(m.vertices[v]));
+    worst = std::max(worst, std::abs(d) / m.vertex_step[v]);
+  }
+  return worst;
+}
+
 }  // namespace
 
 TEST(Mesh, OneClosedOrientedSurfacePerTreeWithItsVerticesOnTheVessels) {
@@ -67,21 +86,9 @@ TEST(Mesh, OneClosedOrientedSurfacePerTreeWithItsVerticesOnTheVessels) {
   }
   // Every vertex within half its local step of the union's surface (its tree's capsules): the
   // volume restoration moves vertices by a fraction of the chords' sagitta only.
-  std::vector<std::vector<Capsule>> caps(2);
-  for (std::int32_t s = 0; s < t.nodeCount(); ++s)
-    if (!t.isRoot(s)) caps[std::size_t(t.tree[s])].push_back(capsuleOf(t, s));
-  std::vector<double> worst(2, 0);  // |distance| / local step
-  ASSERT_EQ(m.vertex_step.size(), m.vertices.size());
-  std::vector<std::int32_t> tree_of(m.vertices.size(), 0);
-  for (std::size_t k = 0; k < m.triangles.size(); ++k)
-    for (auto v : m.triangles[k]) tree_of[std::size_t(v)] = m.triangle_tree[k];
-  for (std::size_t v = 0; v < m.vertices.size(); ++v) {
-    double d = INFINITY;
-    for (const auto& c : caps[std::size_t(tree_of[v])]) d = std::min(d, c.depth(m.vertices[v]));
-    worst[std::size_t(tree_of[v])] = std::max(worst[std::size_t(tree_of[v])], std::abs(d) / m.vertex_step[v]);
-  }
-  for (double w : worst) EXPECT_LE(w, 0.5);
-  std::cout << "largest distance from the surface / local step: " << std::max(worst[0], worst[1]) << "; largest volume move "
+  const double worst = largestDistanceOverStep(t, m);
+  EXPECT_LE(worst, 0.5);
+  std::cout << "largest distance from the surface / local step: " << worst << "; largest volume move "
             << rep.largest_volume_move_mm << " mm; finest step " << rep.voxel_mm << " mm\n";
   EXPECT_GT(rep.levels, 1) << "thick vessels sampled coarser than thin ones";
   // The same mesh, bit for bit, on one thread.
@@ -295,5 +302,51 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("--flow-extension needs --ends open or capped"), std::string::npos) << bad.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "bad"));
+  std::filesystem::remove_all(dir);
+}
+
+// Decimation keeps what the marching-tetrahedra surface guarantees and changes its triangles
+// only: the same components and Euler characteristics per tree (the link condition), closed,
+// manifold and outward, the enclosed volume (each collapse keeps it), every vertex it places
+// within max_error of its step from the vessels (measured here on the capsules, not the mesher's
+// bins), and TetGen's exact test finds no intersecting faces; a tenth of the triangles or fewer.
+TEST(Mesh, DecimationKeepsTopologyVolumeAndSurface) {
+  const auto& t = forest().forest.vessels;
+  SurfaceOptions o;
+  const auto fine = vesselSurface(t, o);
+  const auto before = meshTopology(fine);
+  DecimateReport rep;
+  DecimateOptions d;
+  o.finish = [&](SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) { rep = decimate(m, d, distance); };
+  const auto m = vesselSurface(t, o);
+  const auto topo = meshTopology(m);
+  EXPECT_EQ(rep.before, std::int64_t(fine.triangles.size()));
+  EXPECT_EQ(rep.after, std::int64_t(m.triangles.size()));
+  EXPECT_LT(m.triangles.size() * 10, fine.triangles.size());
+  EXPECT_EQ(topo.boundary_edges, 0);
+  EXPECT_EQ(topo.nonmanifold_edges, 0);
+  EXPECT_EQ(topo.misoriented_edges, 0);
+  EXPECT_EQ(topo.degenerate_triangles, 0);
+  EXPECT_EQ(topo.tree_components, before.tree_components);
+  EXPECT_EQ(topo.tree_euler, before.tree_euler);
+  EXPECT_NEAR(topo.volume_mm3, before.volume_mm3, 1e-6 * before.volume_mm3);
+  // Vertices it places stay within max_error steps; the others stay where the volume
+  // restoration put them.
+  const double worst = largestDistanceOverStep(t, m);
+  EXPECT_LE(worst, std::max(largestDistanceOverStep(t, fine), d.max_error) * (1 + 1e-9));
+  EXPECT_LE(worst, 0.5);
+  const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_decimated_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const char* f : {"off", "stl"}) {
+    std::ofstream out(dir / (std::string("surface.") + f), std::ios::binary);
+    meshWriter(f)(out, m);
+  }
+  const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' --self-intersections '" + dir.string() +
+                          "' off stl > '" + (dir / "tetgen.json").string() + "'";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  const auto j = nlohmann::json::parse(readText(dir / "tetgen.json"));
+  for (const auto& [ext, pairs] : j.items()) EXPECT_EQ(pairs, 0) << ext << ": intersecting face pairs";
+  std::cout << fine.triangles.size() << " -> " << m.triangles.size() << " triangles; volume " << before.volume_mm3 << " -> " << topo.volume_mm3
+            << " mm^3; largest distance / step " << worst << "; " << j.dump() << "\n";
   std::filesystem::remove_all(dir);
 }

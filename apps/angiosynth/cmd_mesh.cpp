@@ -41,6 +41,12 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
       ->check(CLI::IsMember({"closed", "open", "capped"}));
   c->add_option("--flow-extension", a.flow_extension, "with --ends open or capped: prolong each end straight by this many radii (default 0)")
       ->check(finiteIn(0, 100));
+  c->add_flag("--decimate", a.decimate,
+              "collapse edges (quadric error) while the surface stays within --max-error of the vessels, its topology and its "
+              "triangles' shape (no flips, no new angle below 15 degrees unless it was already)");
+  c->add_option("--max-error", a.max_error, "with --decimate: largest distance of a moved vertex or a new triangle's centroid from the "
+                                             "vessels' surface, as a share of the local grid step (default 0.1)")
+      ->check(finiteIn(0, 1));
   c->add_option("--format", a.formats, "mesh formats: stl (binary), obj, ply (binary), off, vtp, 3mf (default stl)")
       ->delimiter(',')
       ->check(CLI::IsMember({"stl", "obj", "ply", "off", "vtp", "3mf"}));
@@ -66,6 +72,8 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   p.on_surface = a.on_surface;
   p.ends = a.ends;
   p.flow_extension = a.flow_extension;
+  p.decimate = a.decimate;
+  p.max_error = a.max_error;
   if (p.ends == "closed" && p.flow_extension > 0) throw InputError("", 0, "--flow-extension needs --ends open or capped");
   if (!a.formats.empty()) p.formats = a.formats;
   const auto surface = writeSurfaceFiles(net.tree, p, memoryLimit(a.common), dir.path(), progressPrinter(a.common, "meshing"), {}, net.ids);

@@ -80,6 +80,8 @@ struct MeshArgs {
   bool uniform = false, on_surface = false;
   std::string ends = "closed";
   double flow_extension = 0;
+  bool decimate = false;
+  double max_error = 0.1;
   std::vector<std::string> formats;
   bool force = false;
   CommonOptions common;

@@ -44,6 +44,11 @@ const std::vector<MethodParam>& commonParams() {
        "closed: round vessel ends; open: each tree's inlet and every outlet cut by the plane through its end node, perpendicular to "
        "its vessel (one boundary loop per end); capped: those loops filled by planar caps, faces labelled (CellEntityIds/ModelFaceID "
        "1 the wall, 2 … the caps; surface_faces.csv)"},
+      {"mesh", "decimate", "true/false", "false",
+       "collapse edges (quadric error, volume kept) while the surface keeps its topology, its triangles do not fold or turn by more than "
+       "45 degrees, no new angle falls below 15 degrees (unless one already was), and every moved vertex and new triangle stays within "
+       "max_error of the vessels"},
+      {"mesh", "max_error", "share of the local step", "0.1", "with decimate: the largest distance from the vessels' surface, (0, 1]"},
       {"mesh", "flow_extension", "radii", "0", "open/capped: each end prolonged straight by this many radii of its vessel before the cut (0 … 100)"},
   };
   return p;

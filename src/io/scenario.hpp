@@ -48,6 +48,8 @@ struct MeshParameters {
   bool on_surface = false;                  // no volume restoration: vertices exactly on the surface
   std::string ends = "closed";              // closed (round), open (cut at planes) or capped (planar caps, labelled faces)
   double flow_extension = 0;                // open/capped: straight extension of each end, in radii of its vessel
+  bool decimate = false;                    // edge-collapse decimation within max_error of the surface
+  double max_error = 0.1;                   // share of the local step
 };
 
 struct Scenario {

@@ -146,7 +146,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   if (im.get("graph_formats")) ip.graph_formats = stringsOf(im, "graph_formats", {"csv", "vtp", "swc", "graphml", "cco"});
 
   // [mesh]: the vessels' surface beside the graphs (src/mesh); the table's presence enables it.
-  const auto& me = r.table("mesh", {"enabled", "formats", "voxel_size", "samples_across", "uniform", "on_surface", "ends", "flow_extension"});
+  const auto& me = r.table("mesh", {"enabled", "formats", "voxel_size", "samples_across", "uniform", "on_surface", "ends", "flow_extension", "decimate", "max_error"});
   if (const auto* n = root.get("mesh")) {
     auto& mp = sc.mesh;
     sc.mesh_line = r.lineOf(n);
@@ -164,6 +164,11 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
       mp.ends = r.string(me, "mesh", "ends");
       if (mp.ends != "closed" && mp.ends != "open" && mp.ends != "capped")
         throw InputError(file, r.lineOf(me.get("ends")), "ends '" + mp.ends + "'; allowed: closed, open, capped");
+    }
+    mp.decimate = r.boolean(me, "decimate", mp.decimate);
+    if (me.get("max_error")) {
+      mp.max_error = r.number(me, "mesh", "max_error");
+      checkRange(mp.max_error, 0, true, 1, false, r.at(me, "max_error"), "max_error (share of the local step)");
     }
     if (me.get("flow_extension")) {
       mp.flow_extension = r.number(me, "mesh", "flow_extension");

@@ -571,22 +571,24 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
       UnitMesh().vertices.swap(meshes[u].vertices);
     }
   });
+  std::vector<Capsule> capsules(std::size_t(t.nodeCount()));
+  for (auto s : vessels) capsules[std::size_t(s)] = capsuleOf(t, s);
+  const std::function<double(std::int32_t, const Vec3&)> distance = [&](std::int32_t tree, const Vec3& p) {
+    // The bin of the point, as the units sample it.
+    const Vec3 half = (p - lat.origin) / (0.5 * lat.h);
+    double best = std::numeric_limits<double>::infinity();
+    if (const auto* segs = lat.segmentsIn(Lattice::binOf(half.x), Lattice::binOf(half.y), Lattice::binOf(half.z)))
+      for (auto s : *segs)
+        if ((t.tree.empty() ? 0 : t.tree[s]) == tree) best = std::min(best, capsules[std::size_t(s)].depth(p));
+    return best;
+  };
   if (o.restore_volume) {
-    std::vector<Capsule> capsules(std::size_t(t.nodeCount()));
-    for (auto s : vessels) capsules[std::size_t(s)] = capsuleOf(t, s);
-    const double moved = restoreVolume(mesh, along, on_edge, [&](std::int32_t tree, const Vec3& p) {
-      // The bin of the point, as the units sample it.
-      const Vec3 half = (p - lat.origin) / (0.5 * lat.h);
-      double best = std::numeric_limits<double>::infinity();
-      if (const auto* segs = lat.segmentsIn(Lattice::binOf(half.x), Lattice::binOf(half.y), Lattice::binOf(half.z)))
-        for (auto s : *segs)
-          if ((t.tree.empty() ? 0 : t.tree[s]) == tree) best = std::min(best, capsules[std::size_t(s)].depth(p));
-      return best;
-    });
+    const double moved = restoreVolume(mesh, along, on_edge, distance);
     if (report) report->largest_volume_move_mm = moved;
   }
   const auto removed = removeCavities(mesh);
   if (report) report->cavities_removed = removed;
+  if (o.finish) o.finish(mesh, distance);
   return mesh;
 }
 

@@ -36,6 +36,9 @@ struct SurfaceOptions {
   // sagitta) so the enclosed volume is the vessels'; false: every vertex on the surface.
   bool restore_volume = true;
   std::uint64_t memory_limit = 0;  // bytes; 0: no limit
+  // Called on the finished mesh while the exact signed distance to each tree's surface is at
+  // hand (distance(tree, p), mm): cutting ends, decimation.
+  std::function<void(SurfaceMesh&, const std::function<double(std::int32_t, const Vec3&)>&)> finish;
 };
 
 struct SurfaceReport {

@@ -5,6 +5,7 @@
 
 #include "io/mesh_writers.hpp"
 #include "core/format.hpp"
+#include "mesh/decimate.hpp"
 #include "mesh/vessel_ends.hpp"
 #include "mesh/vessel_surface.hpp"
 
@@ -47,9 +48,17 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   SurfaceReport report;
   const bool cut_ends = p.ends != "closed";
   const auto ends = cut_ends ? openEnds(tree, p.flow_extension) : std::vector<VesselEnd>{};
-  auto mesh = vesselSurface(cut_ends ? prolongEnds(tree, ends) : tree, o, &report, progress);
   EndCutReport cut;
-  if (cut_ends) cut = cutEnds(mesh, ends, p.ends == "capped");
+  DecimateReport reduced;
+  o.finish = [&](SurfaceMesh& mesh, const std::function<double(std::int32_t, const Vec3&)>& distance) {
+    if (cut_ends) cut = cutEnds(mesh, ends, p.ends == "capped");
+    if (p.decimate) {
+      DecimateOptions d;
+      d.max_error = p.max_error;
+      reduced = decimate(mesh, d, distance);
+    }
+  };
+  auto mesh = vesselSurface(cut_ends ? prolongEnds(tree, ends) : tree, o, &report, progress);
   const auto topo = meshTopology(mesh);
   SurfaceFiles out;
   out.files = Json::object();
@@ -75,6 +84,8 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"volume_restored", !p.on_surface},
                     {"ends", p.ends},
                     {"flow_extension_radii", p.flow_extension},
+                    {"decimate", p.decimate},
+                    {"max_error_steps", p.max_error},
                     {"method", "marching tetrahedra of the signed distance to the union of each tree's capsules and round cones, on a "
                                "2:1-balanced octree of cells sized to each vessel's radius, split into conforming tetrahedra"}};
   out.statistics = {{"trees", trees},
@@ -94,6 +105,9 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"misoriented_edges", topo.misoriented_edges},
                     {"degenerate_triangles", topo.degenerate_triangles},
                     {"cavities_removed", report.cavities_removed},
+                    {"triangles_before_decimation", p.decimate ? Json(reduced.before) : Json(nullptr)},
+                    {"decimation_collapses", reduced.collapses},
+                    {"decimation_largest_error_mm", reduced.largest_error_mm},
                     {"ends", ends.size()},
                     {"ends_cut", cut.cut},
                     {"ends_left_closed", cut.left_closed.size()},

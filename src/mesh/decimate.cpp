@@ -1,0 +1,366 @@
+#include "mesh/decimate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <queue>
+
+namespace angiosynth {
+
+namespace {
+
+// Σ w·(n·p + d)² over planes, as the symmetric 4×4 matrix of (x, y, z, 1).
+struct Quadric {
+  double xx = 0, xy = 0, xz = 0, xw = 0, yy = 0, yz = 0, yw = 0, zz = 0, zw = 0, ww = 0;
+  void addPlane(const Vec3& n, double d, double w) {
+    xx += w * n.x * n.x, xy += w * n.x * n.y, xz += w * n.x * n.z, xw += w * n.x * d;
+    yy += w * n.y * n.y, yz += w * n.y * n.z, yw += w * n.y * d;
+    zz += w * n.z * n.z, zw += w * n.z * d, ww += w * d * d;
+  }
+  Quadric& operator+=(const Quadric& q) {
+    xx += q.xx, xy += q.xy, xz += q.xz, xw += q.xw, yy += q.yy, yz += q.yz, yw += q.yw, zz += q.zz, zw += q.zw, ww += q.ww;
+    return *this;
+  }
+  double operator()(const Vec3& v) const {
+    return xx * v.x * v.x + 2 * xy * v.x * v.y + 2 * xz * v.x * v.z + 2 * xw * v.x + yy * v.y * v.y + 2 * yz * v.y * v.z + 2 * yw * v.y +
+           zz * v.z * v.z + 2 * zw * v.z + ww;
+  }
+  // A x = r for the quadric's 3×3 part plus alpha·I (Cramer's rule).
+  bool solve(double alpha, const Vec3& r, Vec3& x) const {
+    const double a = xx + alpha, e = yy + alpha, i = zz + alpha;
+    const double det = a * (e * i - yz * yz) - xy * (xy * i - yz * xz) + xz * (xy * yz - e * xz);
+    if (!(std::abs(det) > 0)) return false;
+    x.x = (r.x * (e * i - yz * yz) - xy * (r.y * i - yz * r.z) + xz * (r.y * yz - e * r.z)) / det;
+    x.y = (a * (r.y * i - yz * r.z) - r.x * (xy * i - yz * xz) + xz * (xy * r.z - r.y * xz)) / det;
+    x.z = (a * (e * r.z - r.y * yz) - xy * (xy * r.z - r.y * xz) + r.x * (xy * yz - e * xz)) / det;
+    return std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z);
+  }
+};
+
+double smallestAngle(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const auto angle = [](const Vec3& p, const Vec3& q, const Vec3& r) { return std::atan2(norm(cross(q - p, r - p)), dot(q - p, r - p)); };
+  return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
+}
+
+double orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) { return dot(b - a, cross(c - a, d - a)); }
+
+// Segment p–q passes through the inside of triangle abc (touching counts as not: vertices
+// shared between the two are handled by the caller).
+bool crosses(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double sp = orient(a, b, c, p), sq = orient(a, b, c, q);
+  if (!((sp > 0 && sq < 0) || (sp < 0 && sq > 0))) return false;
+  const double s1 = orient(p, q, a, b), s2 = orient(p, q, b, c), s3 = orient(p, q, c, a);
+  return (s1 > 0 && s2 > 0 && s3 > 0) || (s1 < 0 && s2 < 0 && s3 < 0);
+}
+
+// Triangles (by vertex ids and positions) that cut through each other. Sharing an edge, they
+// can only fold onto each other (the caller's normal check); sharing a vertex, only their
+// opposite edges can cross the other.
+bool intersect(const std::array<std::int32_t, 3>& s, const Vec3* ps, const std::array<std::int32_t, 3>& t, const Vec3* pt) {
+  int shared = 0;
+  for (auto a : s)
+    for (auto b : t) shared += a == b;
+  if (shared >= 2) return false;
+  for (int pass = 0; pass < 2; ++pass) {
+    const auto& e = pass == 0 ? s : t;
+    const Vec3* pe = pass == 0 ? ps : pt;
+    const auto& f = pass == 0 ? t : s;
+    const Vec3* pf = pass == 0 ? pt : ps;
+    for (int i = 0; i < 3; ++i) {
+      const auto a = e[std::size_t(i)], b = e[std::size_t((i + 1) % 3)];
+      if (shared == 1 && (std::find(f.begin(), f.end(), a) != f.end() || std::find(f.begin(), f.end(), b) != f.end())) continue;
+      if (crosses(pe[i], pe[(i + 1) % 3], pf[0], pf[1], pf[2])) return true;
+    }
+  }
+  return false;
+}
+
+struct Candidate {
+  double cost;
+  std::int32_t u, v;
+  std::uint32_t version_u, version_v;
+  bool operator<(const Candidate& o) const {  // for a min-heap on (cost, u, v)
+    if (cost != o.cost) return cost > o.cost;
+    if (u != o.u) return u > o.u;
+    return v > o.v;
+  }
+};
+
+class Decimator {
+ public:
+  Decimator(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance)
+      : m_(m), o_(o), distance_(distance), around_(m.vertices.size()), quadric_(m.vertices.size()), version_(m.vertices.size(), 0),
+        vertex_alive_(m.vertices.size(), 1), locked_(m.vertices.size(), 0), triangle_alive_(m.triangles.size(), 1) {
+    cos_turn_ = std::cos(o.max_turn_deg * std::numbers::pi / 180);
+    min_angle_ = o.min_angle_deg * std::numbers::pi / 180;
+    for (std::size_t k = 0; k < m.triangles.size(); ++k) {
+      const auto& t = m.triangles[k];
+      const Vec3 n = cross(m.vertices[std::size_t(t[1])] - m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[2])] - m.vertices[std::size_t(t[0])]);
+      const double area2 = norm(n);
+      for (auto v : t) around_[std::size_t(v)].push_back(std::int32_t(k));
+      if (!m.triangle_face.empty() && m.triangle_face[k] != 0)
+        for (auto v : t) locked_[std::size_t(v)] = 1;
+      if (!(area2 > 0)) continue;
+      const Vec3 u = n / area2;
+      for (auto v : t) quadric_[std::size_t(v)].addPlane(u, -dot(u, m.vertices[std::size_t(t[0])]), 0.5 * area2);
+    }
+    // A vertex on a boundary loop has one more neighbour than triangles.
+    std::vector<std::int32_t> ring;
+    for (std::size_t v = 0; v < around_.size(); ++v) {
+      neighbours(std::int32_t(v), ring);
+      if (ring.size() != around_[v].size()) locked_[v] = 1;
+    }
+    alive_triangles_ = std::int64_t(m.triangles.size());
+  }
+
+  DecimateReport run() {
+    DecimateReport rep;
+    rep.before = alive_triangles_;
+    for (std::size_t k = 0; k < m_.triangles.size(); ++k) {
+      const auto& t = m_.triangles[k];
+      for (int i = 0; i < 3; ++i)
+        if (t[std::size_t(i)] < t[std::size_t((i + 1) % 3)]) push(t[std::size_t(i)], t[std::size_t((i + 1) % 3)]);
+    }
+    std::vector<std::int32_t> ring;
+    while (!queue_.empty() && (o_.target_triangles <= 0 || alive_triangles_ > o_.target_triangles)) {
+      const Candidate c = queue_.top();
+      queue_.pop();
+      if (!vertex_alive_[std::size_t(c.u)] || !vertex_alive_[std::size_t(c.v)] || version_[std::size_t(c.u)] != c.version_u ||
+          version_[std::size_t(c.v)] != c.version_v)
+        continue;
+      Vec3 w;
+      double error = 0;
+      if (!allowed(c.u, c.v, w, error)) continue;
+      collapse(c.u, c.v, w);
+      rep.largest_error_mm = std::max(rep.largest_error_mm, error);
+      ++rep.collapses;
+      neighbours(c.u, ring);
+      for (auto x : ring) push(std::min(c.u, x), std::max(c.u, x));
+    }
+    compact();
+    rep.after = alive_triangles_;
+    return rep;
+  }
+
+ private:
+  void neighbours(std::int32_t v, std::vector<std::int32_t>& out) const {
+    out.clear();
+    for (auto k : around_[std::size_t(v)])
+      for (auto x : m_.triangles[std::size_t(k)])
+        if (x != v) out.push_back(x);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+
+  // Where u and v would meet: a locked vertex stays; else the quadric's minimum under the
+  // constraint that the enclosed volume stays (linear in the position: Lindstrom and Turk), with
+  // a faint pull to the edge's midpoint so that flat and cylindrical patches (a line or plane
+  // of minima) have one answer.
+  Vec3 placement(std::int32_t u, std::int32_t v, const Quadric& q) const {
+    const Vec3 pu = m_.vertices[std::size_t(u)], pv = m_.vertices[std::size_t(v)], mid = (pu + pv) * 0.5;
+    if (locked_[std::size_t(u)]) return pu;
+    if (locked_[std::size_t(v)]) return pv;
+    // 6 × volume of the triangles around u and v (as cones from the origin) = Σ det, and the
+    // same after the collapse = w · g.
+    double six_volume = 0;
+    Vec3 g(0, 0, 0);
+    for (const std::int32_t end : {u, v})
+      for (auto k : around_[std::size_t(end)]) {
+        const auto& t = m_.triangles[std::size_t(k)];
+        const bool has_u = t[0] == u || t[1] == u || t[2] == u, has_v = t[0] == v || t[1] == v || t[2] == v;
+        if (end == v && has_u) continue;  // counted from u
+        const Vec3 a = m_.vertices[std::size_t(t[0])], b = m_.vertices[std::size_t(t[1])], c = m_.vertices[std::size_t(t[2])];
+        six_volume += dot(a, cross(b, c));
+        if (has_u && has_v) continue;  // collapses away
+        const int i = t[0] == end ? 0 : t[1] == end ? 1 : 2;
+        g += cross(m_.vertices[std::size_t(t[std::size_t((i + 1) % 3)])], m_.vertices[std::size_t(t[std::size_t((i + 2) % 3)])]);
+      }
+    const double alpha = 1e-3 * (q.xx + q.yy + q.zz) / 3 + 1e-300;
+    Vec3 w0, y;
+    if (!q.solve(alpha, Vec3(-q.xw, -q.yw, -q.zw) + mid * alpha, w0)) return mid;
+    if (!(dot(g, g) > 0) || !q.solve(alpha, g, y) || !(std::abs(dot(g, y)) > 0)) return w0;
+    return w0 + y * ((six_volume - dot(g, w0)) / dot(g, y));
+  }
+
+  void push(std::int32_t u, std::int32_t v) {
+    if (locked_[std::size_t(u)] && locked_[std::size_t(v)]) return;
+    Quadric q = quadric_[std::size_t(u)];
+    q += quadric_[std::size_t(v)];
+    const Vec3 w = placement(u, v, q);
+    queue_.push({std::max(0.0, q(w)), u, v, version_[std::size_t(u)], version_[std::size_t(v)]});
+  }
+
+  // The checks of a collapse of edge u–v into u at w; `error`: |distance| at w.
+  bool allowed(std::int32_t u, std::int32_t v, Vec3& w, double& error) {
+    if (locked_[std::size_t(u)] && locked_[std::size_t(v)]) return false;
+    // The edge's two triangles and their third vertices.
+    std::int32_t shared[2], opposite[2];
+    int ns = 0;
+    for (auto k : around_[std::size_t(u)]) {
+      const auto& t = m_.triangles[std::size_t(k)];
+      if (t[0] != v && t[1] != v && t[2] != v) continue;
+      if (ns == 2) return false;
+      shared[ns] = k;
+      opposite[ns++] = t[0] != u && t[0] != v ? t[0] : t[1] != u && t[1] != v ? t[1] : t[2];
+    }
+    if (ns != 2 || opposite[0] == opposite[1]) return false;
+    for (auto o : opposite)
+      if (around_[std::size_t(o)].size() <= 3) return false;
+    // Link condition: u and v have no other common neighbour.
+    neighbours(u, ring_u_);
+    neighbours(v, ring_v_);
+    int common = 0;
+    for (std::size_t i = 0, j = 0; i < ring_u_.size() && j < ring_v_.size();) {
+      if (ring_u_[i] < ring_v_[j]) ++i;
+      else if (ring_v_[j] < ring_u_[i]) ++j;
+      else ++common, ++i, ++j;
+    }
+    if (common != 2) return false;
+    Quadric q = quadric_[std::size_t(u)];
+    q += quadric_[std::size_t(v)];
+    w = placement(u, v, q);
+    const std::int32_t tree = m_.triangle_tree[std::size_t(shared[0])];
+    const double step = std::min(stepOf(u), stepOf(v)), limit = o_.max_error * step;
+    error = std::abs(distance_(tree, w));
+    if (!(error <= limit)) return false;
+    // The triangles that stay, moved: no flip, no sharp turn, no new angle below the floor (or
+    // below the smallest of those it replaces), near the surface.
+    double old_min = INFINITY;
+    for (const std::int32_t end : {u, v})
+      for (auto k : around_[std::size_t(end)]) {
+        const auto& t = m_.triangles[std::size_t(k)];
+        old_min = std::min(old_min, smallestAngle(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]));
+      }
+    const double floor = std::min(min_angle_, old_min);
+    moved_.clear();
+    for (const std::int32_t end : {u, v})
+      for (auto k : around_[std::size_t(end)]) {
+        if (k == shared[0] || k == shared[1]) continue;
+        const auto& t = m_.triangles[std::size_t(k)];
+        Vec3 before[3], after[3];
+        for (int i = 0; i < 3; ++i) {
+          before[i] = m_.vertices[std::size_t(t[std::size_t(i)])];
+          after[i] = t[std::size_t(i)] == u || t[std::size_t(i)] == v ? w : before[i];
+        }
+        const Vec3 n0 = cross(before[1] - before[0], before[2] - before[0]), n1 = cross(after[1] - after[0], after[2] - after[0]);
+        const double l0 = norm(n0), l1 = norm(n1);
+        if (!(l1 > 0) || !(dot(n0, n1) >= cos_turn_ * l0 * l1)) return false;
+        if (!(smallestAngle(after[0], after[1], after[2]) >= floor)) return false;
+        if (!(std::abs(distance_(tree, (after[0] + after[1] + after[2]) / 3.0)) <= limit)) return false;
+        std::array<std::int32_t, 3> ids = t;
+        for (auto& x : ids)
+          if (x == v) x = u;
+        moved_.push_back({ids, {after[0], after[1], after[2]}});
+      }
+    return !foldsIntoNeighbours(u, v);
+  }
+
+  // The moved triangles (moved_, with v renamed u) against each other and against every other
+  // triangle at a vertex of the collapse's ring: a fold through the neighbourhood.
+  bool foldsIntoNeighbours(std::int32_t u, std::int32_t v) {
+    nearby_.clear();
+    for (const auto* ring : {&ring_u_, &ring_v_})
+      for (auto x : *ring)
+        for (auto k : around_[std::size_t(x)]) {
+          const auto& t = m_.triangles[std::size_t(k)];
+          if (t[0] == u || t[1] == u || t[2] == u || t[0] == v || t[1] == v || t[2] == v) continue;
+          nearby_.push_back(k);
+        }
+    std::sort(nearby_.begin(), nearby_.end());
+    nearby_.erase(std::unique(nearby_.begin(), nearby_.end()), nearby_.end());
+    for (std::size_t i = 0; i < moved_.size(); ++i) {
+      for (std::size_t j = i + 1; j < moved_.size(); ++j)
+        if (intersect(moved_[i].ids, moved_[i].at, moved_[j].ids, moved_[j].at)) return true;
+      for (auto k : nearby_) {
+        const auto& t = m_.triangles[std::size_t(k)];
+        const Vec3 at[3] = {m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]};
+        if (intersect(moved_[i].ids, moved_[i].at, t, at)) return true;
+      }
+    }
+    return false;
+  }
+
+  double stepOf(std::int32_t v) const { return m_.vertex_step.empty() ? INFINITY : double(m_.vertex_step[std::size_t(v)]); }
+
+  void collapse(std::int32_t u, std::int32_t v, const Vec3& w) {
+    m_.vertices[std::size_t(u)] = w;
+    quadric_[std::size_t(u)] += quadric_[std::size_t(v)];
+    if (!m_.vertex_step.empty()) m_.vertex_step[std::size_t(u)] = std::min(m_.vertex_step[std::size_t(u)], m_.vertex_step[std::size_t(v)]);
+    locked_[std::size_t(u)] |= locked_[std::size_t(v)];
+    const auto drop = [&](std::int32_t x, std::int32_t k) {
+      auto& list = around_[std::size_t(x)];
+      list.erase(std::find(list.begin(), list.end(), k));
+    };
+    for (auto k : around_[std::size_t(v)]) {
+      auto& t = m_.triangles[std::size_t(k)];
+      if (t[0] == u || t[1] == u || t[2] == u) {
+        triangle_alive_[std::size_t(k)] = 0;
+        --alive_triangles_;
+        for (auto x : t)
+          if (x != v) drop(x, k);
+      } else {
+        for (auto& x : t)
+          if (x == v) x = u;
+        around_[std::size_t(u)].push_back(k);
+      }
+    }
+    std::vector<std::int32_t>().swap(around_[std::size_t(v)]);
+    vertex_alive_[std::size_t(v)] = 0;
+    ++version_[std::size_t(u)];
+    ++version_[std::size_t(v)];
+  }
+
+  void compact() {
+    std::vector<std::int32_t> renumber(m_.vertices.size(), -1);
+    std::size_t nv = 0;
+    for (std::size_t v = 0; v < m_.vertices.size(); ++v) {
+      if (!vertex_alive_[v] || around_[v].empty()) continue;
+      renumber[v] = std::int32_t(nv);
+      m_.vertices[nv] = m_.vertices[v];
+      if (!m_.vertex_step.empty()) m_.vertex_step[nv] = m_.vertex_step[v];
+      ++nv;
+    }
+    m_.vertices.resize(nv);
+    if (!m_.vertex_step.empty()) m_.vertex_step.resize(nv);
+    std::size_t nt = 0;
+    for (std::size_t k = 0; k < m_.triangles.size(); ++k) {
+      if (!triangle_alive_[k]) continue;
+      auto t = m_.triangles[k];
+      for (auto& x : t) x = renumber[std::size_t(x)];
+      m_.triangles[nt] = t;
+      m_.triangle_tree[nt] = m_.triangle_tree[k];
+      if (!m_.triangle_face.empty()) m_.triangle_face[nt] = m_.triangle_face[k];
+      ++nt;
+    }
+    m_.triangles.resize(nt);
+    m_.triangle_tree.resize(nt);
+    if (!m_.triangle_face.empty()) m_.triangle_face.resize(nt);
+  }
+
+  SurfaceMesh& m_;
+  const DecimateOptions& o_;
+  const std::function<double(std::int32_t, const Vec3&)>& distance_;
+  std::vector<std::vector<std::int32_t>> around_;  // per vertex, its triangles
+  std::vector<Quadric> quadric_;
+  std::vector<std::uint32_t> version_;
+  std::vector<char> vertex_alive_, locked_, triangle_alive_;
+  std::priority_queue<Candidate> queue_;
+  std::vector<std::int32_t> ring_u_, ring_v_, nearby_;
+  struct Moved {
+    std::array<std::int32_t, 3> ids;
+    Vec3 at[3];
+  };
+  std::vector<Moved> moved_;
+  std::int64_t alive_triangles_ = 0;
+  double cos_turn_ = 0, min_angle_ = 0;
+};
+
+}  // namespace
+
+DecimateReport decimate(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance) {
+  if (m.triangles.empty()) return {};
+  Decimator d(m, o, distance);
+  return d.run();
+}
+
+}  // namespace angiosynth

@@ -1,0 +1,34 @@
+#pragma once
+// Edge-collapse decimation of a vessel surface (Garland–Heckbert quadrics), with the checks that
+// keep it a valid surface of the vessels: the link condition (no change of topology), no
+// triangle turned by more than a bound, no new angle below a floor (or below the smallest it
+// replaces), and every new vertex and new triangle's centroid within a share of its local step
+// of the vessels' exact surface (the distance the mesher contoured). Marching tetrahedra put
+// isotropic triangles of the cell size everywhere; along straight vessels long triangles do as
+// well, so most of them go. Serial, in a deterministic order (cost, then vertex ids).
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "mesh/vessel_surface.hpp"
+
+namespace angiosynth {
+
+struct DecimateOptions {
+  double max_error = 0.1;         // share of the local step: largest distance of a new vertex or centroid from the surface
+  double min_angle_deg = 15;      // a new triangle's angles stay above this (or above the smallest they replace)
+  double max_turn_deg = 45;       // largest turn of a triangle's normal by one collapse
+  std::int64_t target_triangles = 0;  // stop at this many triangles (0: when no collapse is allowed)
+};
+
+struct DecimateReport {
+  std::int64_t before = 0, after = 0, collapses = 0;
+  double largest_error_mm = 0;  // largest |distance| of a vertex placed
+};
+
+// `distance(tree, p)`: signed distance (mm, negative inside) from p to the surface of tree
+// `tree`. Vertices of cap faces (triangle_face ≠ 0) and of boundary loops do not move. Vertices
+// the collapses remove are dropped (the others keep their order).
+DecimateReport decimate(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance);
+
+}  // namespace angiosynth
