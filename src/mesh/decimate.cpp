@@ -113,10 +113,31 @@ class Decimator {
     alive_triangles_ = std::int64_t(m.triangles.size());
   }
 
+  // Collapses until none is allowed, then flips of edges that raise their triangles' smallest
+  // angle (which frees further collapses), and again, a few rounds.
   DecimateReport run() {
     DecimateReport rep;
     rep.before = alive_triangles_;
+    for (int round = 0; round < kRounds; ++round) {
+      const auto collapses = rep.collapses;
+      collapsePass(rep);
+      if (round > 0 && rep.collapses == collapses) break;
+      if (o_.target_triangles > 0 && alive_triangles_ <= o_.target_triangles) break;
+      rep.flips += flipPass();
+    }
+    compact();
+    rep.after = alive_triangles_;
+    return rep;
+  }
+
+ private:
+  static constexpr int kRounds = 4;
+  static constexpr double kFlatFlip = 0.9848;  // cos 10°
+
+  void collapsePass(DecimateReport& rep) {
+    queue_ = {};
     for (std::size_t k = 0; k < m_.triangles.size(); ++k) {
+      if (!triangle_alive_[k]) continue;
       const auto& t = m_.triangles[k];
       for (int i = 0; i < 3; ++i)
         if (t[std::size_t(i)] < t[std::size_t((i + 1) % 3)]) push(t[std::size_t(i)], t[std::size_t((i + 1) % 3)]);
@@ -137,12 +158,75 @@ class Decimator {
       neighbours(c.u, ring);
       for (auto x : ring) push(std::min(c.u, x), std::max(c.u, x));
     }
-    compact();
-    rep.after = alive_triangles_;
-    return rep;
   }
 
- private:
+  // The triangle other than k with the edge a–b, or −1.
+  std::int32_t across(std::int32_t k, std::int32_t a, std::int32_t b) const {
+    for (auto o : around_[std::size_t(a)]) {
+      const auto& t = m_.triangles[std::size_t(o)];
+      if (o != k && (t[0] == b || t[1] == b || t[2] == b)) return o;
+    }
+    return -1;
+  }
+
+  // One sweep over the edges in triangle order; returns the flips made.
+  std::int64_t flipPass() {
+    std::int64_t flips = 0;
+    for (std::size_t k = 0; k < m_.triangles.size(); ++k)
+      for (int i = 0; i < 3 && triangle_alive_[k]; ++i) {
+        const auto a = m_.triangles[k][std::size_t(i)], b = m_.triangles[k][std::size_t((i + 1) % 3)];
+        if (a < b && flip(std::int32_t(k), a, b)) ++flips;
+      }
+    return flips;
+  }
+
+  // Flips edge a–b of triangle k = (a, b, c) and its neighbour (b, a, d) into (c, a, d) and
+  // (d, b, c) if that raises their smallest angle, neither turns by more than the bound from
+  // either old one, the centroids stay near the surface and nothing nearby is cut.
+  bool flip(std::int32_t k1, std::int32_t a, std::int32_t b) {
+    const std::int32_t k2 = across(k1, a, b);
+    if (k2 < 0) return false;
+    if (!m_.triangle_face.empty() && (m_.triangle_face[std::size_t(k1)] != 0 || m_.triangle_face[std::size_t(k2)] != 0)) return false;
+    const auto third = [&](std::int32_t k) {
+      const auto& t = m_.triangles[std::size_t(k)];
+      return t[0] != a && t[0] != b ? t[0] : t[1] != a && t[1] != b ? t[1] : t[2];
+    };
+    const std::int32_t c = third(k1), d = third(k2);
+    if (c == d || across(-1, c, d) >= 0) return false;  // the new edge exists already
+    const Vec3 pa = m_.vertices[std::size_t(a)], pb = m_.vertices[std::size_t(b)], pc = m_.vertices[std::size_t(c)], pd = m_.vertices[std::size_t(d)];
+    const double old_min = std::min(smallestAngle(pa, pb, pc), smallestAngle(pb, pa, pd));
+    const double new_min = std::min(smallestAngle(pc, pa, pd), smallestAngle(pd, pb, pc));
+    if (!(new_min > old_min * 1.01)) return false;
+    const Vec3 n1 = cross(pb - pa, pc - pa), n2 = cross(pa - pb, pd - pb), m1 = cross(pa - pc, pd - pc), m2 = cross(pb - pd, pc - pd);
+    // Nearly flat pairs only: a flip across a crease moves the surface (and, on convex vessels,
+    // always inwards: it would take volume).
+    if (!(dot(n1, n2) >= kFlatFlip * norm(n1) * norm(n2))) return false;
+    for (const Vec3& mnew : {m1, m2})
+      for (const Vec3& nold : {n1, n2})
+        if (!(dot(mnew, nold) >= cos_turn_ * norm(mnew) * norm(nold))) return false;
+    const std::int32_t tree = m_.triangle_tree[std::size_t(k1)];
+    const double limit = o_.max_error * std::min({stepOf(a), stepOf(b), stepOf(c), stepOf(d)});
+    if (!(std::abs(distance_(tree, (pc + pa + pd) / 3.0)) <= limit) || !(std::abs(distance_(tree, (pd + pb + pc) / 3.0)) <= limit)) return false;
+    moved_.clear();
+    moved_.push_back({{c, a, d}, {pc, pa, pd}});
+    moved_.push_back({{d, b, c}, {pd, pb, pc}});
+    nearby_.clear();
+    for (auto x : {a, b, c, d})
+      for (auto k : around_[std::size_t(x)])
+        if (k != k1 && k != k2) nearby_.push_back(k);
+    if (cutsNearby()) return false;
+    m_.triangles[std::size_t(k1)] = {c, a, d};
+    m_.triangles[std::size_t(k2)] = {d, b, c};
+    const auto drop = [&](std::int32_t x, std::int32_t k) {
+      auto& list = around_[std::size_t(x)];
+      list.erase(std::find(list.begin(), list.end(), k));
+    };
+    drop(a, k2);
+    drop(b, k1);
+    around_[std::size_t(c)].push_back(k2);
+    around_[std::size_t(d)].push_back(k1);
+    return true;
+  }
   void neighbours(std::int32_t v, std::vector<std::int32_t>& out) const {
     out.clear();
     for (auto k : around_[std::size_t(v)])
@@ -266,15 +350,25 @@ class Decimator {
           if (t[0] == u || t[1] == u || t[2] == u || t[0] == v || t[1] == v || t[2] == v) continue;
           nearby_.push_back(k);
         }
+    return cutsNearby();
+  }
+
+  // moved_ against each other and against nearby_ (boxes first).
+  bool cutsNearby() {
     std::sort(nearby_.begin(), nearby_.end());
     nearby_.erase(std::unique(nearby_.begin(), nearby_.end()), nearby_.end());
     for (std::size_t i = 0; i < moved_.size(); ++i) {
+      const Vec3 lo = componentMin(componentMin(moved_[i].at[0], moved_[i].at[1]), moved_[i].at[2]);
+      const Vec3 hi = componentMax(componentMax(moved_[i].at[0], moved_[i].at[1]), moved_[i].at[2]);
       for (std::size_t j = i + 1; j < moved_.size(); ++j)
         if (intersect(moved_[i].ids, moved_[i].at, moved_[j].ids, moved_[j].at)) return true;
       for (auto k : nearby_) {
         const auto& t = m_.triangles[std::size_t(k)];
         const Vec3 at[3] = {m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]};
-        if (intersect(moved_[i].ids, moved_[i].at, t, at)) return true;
+        bool apart = false;
+        for (int ax = 0; ax < 3 && !apart; ++ax)
+          apart = std::max({at[0][ax], at[1][ax], at[2][ax]}) < lo[ax] || std::min({at[0][ax], at[1][ax], at[2][ax]}) > hi[ax];
+        if (!apart && intersect(moved_[i].ids, moved_[i].at, t, at)) return true;
       }
     }
     return false;

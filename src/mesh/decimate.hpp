@@ -22,7 +22,7 @@ struct DecimateOptions {
 };
 
 struct DecimateReport {
-  std::int64_t before = 0, after = 0, collapses = 0;
+  std::int64_t before = 0, after = 0, collapses = 0, flips = 0;
   double largest_error_mm = 0;  // largest |distance| of a vertex placed
 };
 
