@@ -5,6 +5,9 @@
 #include <numbers>
 #include <queue>
 
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
 namespace angiosynth {
 
 namespace {
@@ -37,9 +40,14 @@ struct Quadric {
   }
 };
 
-double smallestAngle(const Vec3& a, const Vec3& b, const Vec3& c) {
-  const auto angle = [](const Vec3& p, const Vec3& q, const Vec3& r) { return std::atan2(norm(cross(q - p, r - p)), dot(q - p, r - p)); };
-  return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
+// The cosine of a triangle's smallest angle (the largest of its corners' cosines): angles
+// compare as their cosines do, reversed, without an arc function.
+double smallestAngleCosine(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, bc = c - b, ca = a - c;
+  const double lab = dot(ab, ab), lbc = dot(bc, bc), lca = dot(ca, ca);
+  const double at_a = -dot(ab, ca) / std::sqrt(lab * lca), at_b = -dot(bc, ab) / std::sqrt(lbc * lab), at_c = -dot(ca, bc) / std::sqrt(lca * lbc);
+  const double m = std::max({at_a, at_b, at_c});
+  return std::isfinite(m) ? m : 1.0;
 }
 
 double orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) { return dot(b - a, cross(c - a, d - a)); }
@@ -86,64 +94,97 @@ struct Candidate {
   }
 };
 
-class Decimator {
- public:
-  Decimator(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance)
-      : m_(m), o_(o), distance_(distance), around_(m.vertices.size()), quadric_(m.vertices.size()), version_(m.vertices.size(), 0),
-        vertex_alive_(m.vertices.size(), 1), locked_(m.vertices.size(), 0), triangle_alive_(m.triangles.size(), 1) {
-    cos_turn_ = std::cos(o.max_turn_deg * std::numbers::pi / 180);
-    min_angle_ = o.min_angle_deg * std::numbers::pi / 180;
+// What every worker shares: the mesh, each vertex's triangles, quadric, version, state and
+// block; a worker changes only what lies in its block.
+struct State {
+  State(SurfaceMesh& mesh, const DecimateOptions& options, const std::function<double(std::int32_t, const Vec3&)>& dist)
+      : m(mesh), o(options), distance(dist), around(mesh.vertices.size()), quadric(mesh.vertices.size()), version(mesh.vertices.size(), 0),
+        vertex_alive(mesh.vertices.size(), 1), locked(mesh.vertices.size(), 0), triangle_alive(mesh.triangles.size(), 1), block(mesh.vertices.size(), 0) {
     for (std::size_t k = 0; k < m.triangles.size(); ++k) {
       const auto& t = m.triangles[k];
       const Vec3 n = cross(m.vertices[std::size_t(t[1])] - m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[2])] - m.vertices[std::size_t(t[0])]);
       const double area2 = norm(n);
-      for (auto v : t) around_[std::size_t(v)].push_back(std::int32_t(k));
+      for (auto v : t) around[std::size_t(v)].push_back(std::int32_t(k));
       if (!m.triangle_face.empty() && m.triangle_face[k] != 0)
-        for (auto v : t) locked_[std::size_t(v)] = 1;
+        for (auto v : t) locked[std::size_t(v)] = 1;
       if (!(area2 > 0)) continue;
       const Vec3 u = n / area2;
-      for (auto v : t) quadric_[std::size_t(v)].addPlane(u, -dot(u, m.vertices[std::size_t(t[0])]), 0.5 * area2);
+      for (auto v : t) quadric[std::size_t(v)].addPlane(u, -dot(u, m.vertices[std::size_t(t[0])]), 0.5 * area2);
     }
     // A vertex on a boundary loop has one more neighbour than triangles.
     std::vector<std::int32_t> ring;
-    for (std::size_t v = 0; v < around_.size(); ++v) {
-      neighbours(std::int32_t(v), ring);
-      if (ring.size() != around_[v].size()) locked_[v] = 1;
+    for (std::size_t v = 0; v < around.size(); ++v) {
+      ring.clear();
+      for (auto k : around[v])
+        for (auto x : m.triangles[std::size_t(k)])
+          if (x != std::int32_t(v)) ring.push_back(x);
+      std::sort(ring.begin(), ring.end());
+      if (std::size_t(std::unique(ring.begin(), ring.end()) - ring.begin()) != around[v].size()) locked[v] = 1;
     }
-    alive_triangles_ = std::int64_t(m.triangles.size());
   }
 
-  // Collapses until none is allowed, then flips of edges that raise their triangles' smallest
-  // angle (which frees further collapses), and again, a few rounds.
-  DecimateReport run() {
-    DecimateReport rep;
-    rep.before = alive_triangles_;
-    for (int round = 0; round < kRounds; ++round) {
-      const auto collapses = rep.collapses;
-      collapsePass(rep);
-      if (round > 0 && rep.collapses == collapses) break;
-      if (o_.target_triangles > 0 && alive_triangles_ <= o_.target_triangles) break;
-      rep.flips += flipPass();
+  void compact() {
+    std::vector<std::int32_t> renumber(m.vertices.size(), -1);
+    std::size_t nv = 0;
+    for (std::size_t v = 0; v < m.vertices.size(); ++v) {
+      if (!vertex_alive[v] || around[v].empty()) continue;
+      renumber[v] = std::int32_t(nv);
+      m.vertices[nv] = m.vertices[v];
+      if (!m.vertex_step.empty()) m.vertex_step[nv] = m.vertex_step[v];
+      ++nv;
     }
-    compact();
-    rep.after = alive_triangles_;
-    return rep;
+    m.vertices.resize(nv);
+    if (!m.vertex_step.empty()) m.vertex_step.resize(nv);
+    std::size_t nt = 0;
+    for (std::size_t k = 0; k < m.triangles.size(); ++k) {
+      if (!triangle_alive[k]) continue;
+      auto t = m.triangles[k];
+      for (auto& x : t) x = renumber[std::size_t(x)];
+      m.triangles[nt] = t;
+      m.triangle_tree[nt] = m.triangle_tree[k];
+      if (!m.triangle_face.empty()) m.triangle_face[nt] = m.triangle_face[k];
+      ++nt;
+    }
+    m.triangles.resize(nt);
+    m.triangle_tree.resize(nt);
+    if (!m.triangle_face.empty()) m.triangle_face.resize(nt);
   }
 
- private:
-  static constexpr int kRounds = 4;
-  static constexpr double kFlatFlip = 0.9848;  // cos 10°
 
-  void collapsePass(DecimateReport& rep) {
-    queue_ = {};
-    for (std::size_t k = 0; k < m_.triangles.size(); ++k) {
-      if (!triangle_alive_[k]) continue;
-      const auto& t = m_.triangles[k];
+  SurfaceMesh& m;
+  const DecimateOptions& o;
+  const std::function<double(std::int32_t, const Vec3&)>& distance;
+  std::vector<std::vector<std::int32_t>> around;  // per vertex, its triangles
+  std::vector<Quadric> quadric;
+  std::vector<std::uint32_t> version;
+  std::vector<char> vertex_alive, locked, triangle_alive;
+  std::vector<std::int64_t> block;  // per vertex, the block of the current pass
+};
+
+// One block's collapses or flips: only where everything read and written lies in the block, so
+// blocks run in parallel and the result does not depend on the thread count.
+class Worker {
+ public:
+  Worker(State& s, std::int64_t block)
+      : m_(s.m), o_(s.o), distance_(s.distance), around_(s.around), quadric_(s.quadric), version_(s.version), vertex_alive_(s.vertex_alive),
+        locked_(s.locked), triangle_alive_(s.triangle_alive), block_(s.block), mine_(block) {
+    cos_turn_ = std::cos(o_.max_turn_deg * std::numbers::pi / 180);
+    cos_min_angle_ = std::cos(o_.min_angle_deg * std::numbers::pi / 180);
+  }
+
+  std::int64_t collapses = 0, flips = 0, removed = 0;
+  double largest_error = 0;
+
+  // Collapses among the edges of `triangles` (and those their collapses make) until none is allowed.
+  void collapsePass(const std::int32_t* first, const std::int32_t* last) {
+    for (auto k = first; k != last; ++k) {
+      if (!triangle_alive_[std::size_t(*k)]) continue;
+      const auto& t = m_.triangles[std::size_t(*k)];
       for (int i = 0; i < 3; ++i)
         if (t[std::size_t(i)] < t[std::size_t((i + 1) % 3)]) push(t[std::size_t(i)], t[std::size_t((i + 1) % 3)]);
     }
     std::vector<std::int32_t> ring;
-    while (!queue_.empty() && (o_.target_triangles <= 0 || alive_triangles_ > o_.target_triangles)) {
+    while (!queue_.empty()) {
       const Candidate c = queue_.top();
       queue_.pop();
       if (!vertex_alive_[std::size_t(c.u)] || !vertex_alive_[std::size_t(c.v)] || version_[std::size_t(c.u)] != c.version_u ||
@@ -153,11 +194,36 @@ class Decimator {
       double error = 0;
       if (!allowed(c.u, c.v, w, error)) continue;
       collapse(c.u, c.v, w);
-      rep.largest_error_mm = std::max(rep.largest_error_mm, error);
-      ++rep.collapses;
+      largest_error = std::max(largest_error, error);
+      ++collapses;
       neighbours(c.u, ring);
       for (auto x : ring) push(std::min(c.u, x), std::max(c.u, x));
     }
+  }
+
+  // One sweep over the edges of `triangles`, in order.
+  void flipPass(const std::int32_t* first, const std::int32_t* last) {
+    for (auto k = first; k != last; ++k)
+      for (int i = 0; i < 3 && triangle_alive_[std::size_t(*k)]; ++i) {
+        const auto a = m_.triangles[std::size_t(*k)][std::size_t(i)], b = m_.triangles[std::size_t(*k)][std::size_t((i + 1) % 3)];
+        if (a < b && flip(*k, a, b)) ++flips;
+      }
+  }
+
+ private:
+  static constexpr double kFlatFlip = 0.9848;  // cos 10°
+
+  bool mine(std::int32_t v) const { return block_[std::size_t(v)] == mine_; }
+  bool ringMine(std::int32_t v) const {
+    for (auto k : around_[std::size_t(v)])
+      for (auto x : m_.triangles[std::size_t(k)])
+        if (!mine(x)) return false;
+    return true;
+  }
+  bool mine(const std::vector<std::int32_t>& vs) const {
+    for (auto v : vs)
+      if (!mine(v)) return false;
+    return true;
   }
 
   // The triangle other than k with the edge a–b, or −1.
@@ -167,17 +233,6 @@ class Decimator {
       if (o != k && (t[0] == b || t[1] == b || t[2] == b)) return o;
     }
     return -1;
-  }
-
-  // One sweep over the edges in triangle order; returns the flips made.
-  std::int64_t flipPass() {
-    std::int64_t flips = 0;
-    for (std::size_t k = 0; k < m_.triangles.size(); ++k)
-      for (int i = 0; i < 3 && triangle_alive_[k]; ++i) {
-        const auto a = m_.triangles[k][std::size_t(i)], b = m_.triangles[k][std::size_t((i + 1) % 3)];
-        if (a < b && flip(std::int32_t(k), a, b)) ++flips;
-      }
-    return flips;
   }
 
   // Flips edge a–b of triangle k = (a, b, c) and its neighbour (b, a, d) into (c, a, d) and
@@ -192,11 +247,13 @@ class Decimator {
       return t[0] != a && t[0] != b ? t[0] : t[1] != a && t[1] != b ? t[1] : t[2];
     };
     const std::int32_t c = third(k1), d = third(k2);
+    if (!mine(a) || !mine(b) || !mine(c) || !mine(d)) return false;
     if (c == d || across(-1, c, d) >= 0) return false;  // the new edge exists already
     const Vec3 pa = m_.vertices[std::size_t(a)], pb = m_.vertices[std::size_t(b)], pc = m_.vertices[std::size_t(c)], pd = m_.vertices[std::size_t(d)];
-    const double old_min = std::min(smallestAngle(pa, pb, pc), smallestAngle(pb, pa, pd));
-    const double new_min = std::min(smallestAngle(pc, pa, pd), smallestAngle(pd, pb, pc));
-    if (!(new_min > old_min * 1.01)) return false;
+    // The smallest angle must grow (by a margin: no flipping back and forth).
+    const double old_cos = std::max(smallestAngleCosine(pa, pb, pc), smallestAngleCosine(pb, pa, pd));
+    const double new_cos = std::max(smallestAngleCosine(pc, pa, pd), smallestAngleCosine(pd, pb, pc));
+    if (!(new_cos < old_cos - 1e-3)) return false;
     const Vec3 n1 = cross(pb - pa, pc - pa), n2 = cross(pa - pb, pd - pb), m1 = cross(pa - pc, pd - pc), m2 = cross(pb - pd, pc - pd);
     // Nearly flat pairs only: a flip across a crease moves the surface (and, on convex vessels,
     // always inwards: it would take volume).
@@ -212,8 +269,11 @@ class Decimator {
     moved_.push_back({{d, b, c}, {pd, pb, pc}});
     nearby_.clear();
     for (auto x : {a, b, c, d})
-      for (auto k : around_[std::size_t(x)])
+      for (auto k : around_[std::size_t(x)]) {
+        const auto& t = m_.triangles[std::size_t(k)];
+        if (!mine(t[0]) || !mine(t[1]) || !mine(t[2])) return false;
         if (k != k1 && k != k2) nearby_.push_back(k);
+      }
     if (cutsNearby()) return false;
     m_.triangles[std::size_t(k1)] = {c, a, d};
     m_.triangles[std::size_t(k2)] = {d, b, c};
@@ -268,6 +328,8 @@ class Decimator {
 
   void push(std::int32_t u, std::int32_t v) {
     if (locked_[std::size_t(u)] && locked_[std::size_t(v)]) return;
+    // Both ends and every vertex placement() reads in this worker's block.
+    if (!ringMine(u) || !ringMine(v)) return;
     Quadric q = quadric_[std::size_t(u)];
     q += quadric_[std::size_t(v)];
     const Vec3 w = placement(u, v, q);
@@ -293,6 +355,7 @@ class Decimator {
     // Link condition: u and v have no other common neighbour.
     neighbours(u, ring_u_);
     neighbours(v, ring_v_);
+    if (!mine(ring_u_) || !mine(ring_v_)) return false;
     int common = 0;
     for (std::size_t i = 0, j = 0; i < ring_u_.size() && j < ring_v_.size();) {
       if (ring_u_[i] < ring_v_[j]) ++i;
@@ -309,13 +372,13 @@ class Decimator {
     if (!(error <= limit)) return false;
     // The triangles that stay, moved: no flip, no sharp turn, no new angle below the floor (or
     // below the smallest of those it replaces), near the surface.
-    double old_min = INFINITY;
+    double old_cos = -1;
     for (const std::int32_t end : {u, v})
       for (auto k : around_[std::size_t(end)]) {
         const auto& t = m_.triangles[std::size_t(k)];
-        old_min = std::min(old_min, smallestAngle(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]));
+        old_cos = std::max(old_cos, smallestAngleCosine(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]));
       }
-    const double floor = std::min(min_angle_, old_min);
+    const double floor = std::max(cos_min_angle_, old_cos);  // as a cosine
     moved_.clear();
     for (const std::int32_t end : {u, v})
       for (auto k : around_[std::size_t(end)]) {
@@ -329,7 +392,7 @@ class Decimator {
         const Vec3 n0 = cross(before[1] - before[0], before[2] - before[0]), n1 = cross(after[1] - after[0], after[2] - after[0]);
         const double l0 = norm(n0), l1 = norm(n1);
         if (!(l1 > 0) || !(dot(n0, n1) >= cos_turn_ * l0 * l1)) return false;
-        if (!(smallestAngle(after[0], after[1], after[2]) >= floor)) return false;
+        if (!(smallestAngleCosine(after[0], after[1], after[2]) <= floor)) return false;
         if (!(std::abs(distance_(tree, (after[0] + after[1] + after[2]) / 3.0)) <= limit)) return false;
         std::array<std::int32_t, 3> ids = t;
         for (auto& x : ids)
@@ -348,6 +411,7 @@ class Decimator {
         for (auto k : around_[std::size_t(x)]) {
           const auto& t = m_.triangles[std::size_t(k)];
           if (t[0] == u || t[1] == u || t[2] == u || t[0] == v || t[1] == v || t[2] == v) continue;
+          if (!mine(t[0]) || !mine(t[1]) || !mine(t[2])) return true;  // reaches out of the block: not in this pass
           nearby_.push_back(k);
         }
     return cutsNearby();
@@ -389,7 +453,7 @@ class Decimator {
       auto& t = m_.triangles[std::size_t(k)];
       if (t[0] == u || t[1] == u || t[2] == u) {
         triangle_alive_[std::size_t(k)] = 0;
-        --alive_triangles_;
+        ++removed;
         for (auto x : t)
           if (x != v) drop(x, k);
       } else {
@@ -404,40 +468,15 @@ class Decimator {
     ++version_[std::size_t(v)];
   }
 
-  void compact() {
-    std::vector<std::int32_t> renumber(m_.vertices.size(), -1);
-    std::size_t nv = 0;
-    for (std::size_t v = 0; v < m_.vertices.size(); ++v) {
-      if (!vertex_alive_[v] || around_[v].empty()) continue;
-      renumber[v] = std::int32_t(nv);
-      m_.vertices[nv] = m_.vertices[v];
-      if (!m_.vertex_step.empty()) m_.vertex_step[nv] = m_.vertex_step[v];
-      ++nv;
-    }
-    m_.vertices.resize(nv);
-    if (!m_.vertex_step.empty()) m_.vertex_step.resize(nv);
-    std::size_t nt = 0;
-    for (std::size_t k = 0; k < m_.triangles.size(); ++k) {
-      if (!triangle_alive_[k]) continue;
-      auto t = m_.triangles[k];
-      for (auto& x : t) x = renumber[std::size_t(x)];
-      m_.triangles[nt] = t;
-      m_.triangle_tree[nt] = m_.triangle_tree[k];
-      if (!m_.triangle_face.empty()) m_.triangle_face[nt] = m_.triangle_face[k];
-      ++nt;
-    }
-    m_.triangles.resize(nt);
-    m_.triangle_tree.resize(nt);
-    if (!m_.triangle_face.empty()) m_.triangle_face.resize(nt);
-  }
-
   SurfaceMesh& m_;
   const DecimateOptions& o_;
   const std::function<double(std::int32_t, const Vec3&)>& distance_;
-  std::vector<std::vector<std::int32_t>> around_;  // per vertex, its triangles
-  std::vector<Quadric> quadric_;
-  std::vector<std::uint32_t> version_;
-  std::vector<char> vertex_alive_, locked_, triangle_alive_;
+  std::vector<std::vector<std::int32_t>>& around_;
+  std::vector<Quadric>& quadric_;
+  std::vector<std::uint32_t>& version_;
+  std::vector<char>&vertex_alive_, &locked_, &triangle_alive_;
+  const std::vector<std::int64_t>& block_;
+  const std::int64_t mine_;
   std::priority_queue<Candidate> queue_;
   std::vector<std::int32_t> ring_u_, ring_v_, nearby_;
   struct Moved {
@@ -445,16 +484,87 @@ class Decimator {
     Vec3 at[3];
   };
   std::vector<Moved> moved_;
-  std::int64_t alive_triangles_ = 0;
-  double cos_turn_ = 0, min_angle_ = 0;
+  double cos_turn_ = 0, cos_min_angle_ = 1;
 };
+
+// Blocks: cubes of kBlockSteps median steps, shifted by half a block in odd passes so that what
+// one pass leaves at block borders the next has inside.
+constexpr double kBlockSteps = 128;
+constexpr int kRounds = 4;
+
+// Alive triangles with all three vertices in one block, grouped by block (blocks and triangles
+// in ascending order).
+std::vector<std::vector<std::int32_t>> partition(State& st, double size, double shift) {
+  const auto& m = st.m;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m.vertices.size(), 8192), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t v = r.begin(); v != r.end(); ++v) {
+      const Vec3& p = m.vertices[v];
+      const auto c = [&](double x) { return std::int64_t(std::floor(x / size + shift)) & 0x1fffff; };
+      st.block[v] = (c(p.x) << 42) | (c(p.y) << 21) | c(p.z);
+    }
+  });
+  std::vector<std::pair<std::int64_t, std::int32_t>> keyed;
+  for (std::size_t k = 0; k < m.triangles.size(); ++k) {
+    if (!st.triangle_alive[k]) continue;
+    const auto& t = m.triangles[k];
+    const auto b = st.block[std::size_t(t[0])];
+    if (st.block[std::size_t(t[1])] == b && st.block[std::size_t(t[2])] == b) keyed.emplace_back(b, std::int32_t(k));
+  }
+  tbb::parallel_sort(keyed.begin(), keyed.end());
+  std::vector<std::vector<std::int32_t>> blocks;
+  for (std::size_t i = 0; i < keyed.size(); ++i) {
+    if (i == 0 || keyed[i].first != keyed[i - 1].first) blocks.emplace_back();
+    blocks.back().push_back(keyed[i].second);
+  }
+  return blocks;
+}
 
 }  // namespace
 
 DecimateReport decimate(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance) {
-  if (m.triangles.empty()) return {};
-  Decimator d(m, o, distance);
-  return d.run();
+  DecimateReport rep;
+  rep.before = rep.after = std::int64_t(m.triangles.size());
+  if (m.triangles.empty()) return rep;
+  State st(m, o, distance);
+  std::vector<float> steps = m.vertex_step;
+  double size = 1;
+  if (!steps.empty()) {
+    std::nth_element(steps.begin(), steps.begin() + std::ptrdiff_t(steps.size() / 2), steps.end());
+    size = kBlockSteps * double(steps[steps.size() / 2]);
+  } else {
+    Vec3 lo = m.vertices[0], hi = lo;
+    for (const auto& p : m.vertices) lo = componentMin(lo, p), hi = componentMax(hi, p);
+    size = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, 1e-9}) / 8;
+  }
+  // Collapses in both partitions, then flips; rounds until a round collapses nothing.
+  const auto pass = [&](double shift, bool flips) {
+    const auto blocks = partition(st, size, shift);
+    std::vector<Worker> workers;
+    workers.reserve(blocks.size());
+    for (const auto& b : blocks) workers.emplace_back(st, st.block[std::size_t(m.triangles[std::size_t(b.front())][0])]);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        const auto* first = blocks[i].data();
+        if (flips) workers[i].flipPass(first, first + blocks[i].size());
+        else workers[i].collapsePass(first, first + blocks[i].size());
+      }
+    });
+    std::int64_t made = 0;
+    for (const auto& w : workers) {
+      made += w.collapses + w.flips;
+      rep.collapses += w.collapses, rep.flips += w.flips, rep.after -= w.removed;
+      rep.largest_error_mm = std::max(rep.largest_error_mm, w.largest_error);
+    }
+    return made;
+  };
+  for (int round = 0; round < kRounds; ++round) {
+    std::int64_t collapsed = 0;
+    for (double shift : {0.0, 0.5}) collapsed += pass(shift, false);
+    if (round > 0 && collapsed == 0) break;
+    pass(round % 2 ? 0.5 : 0.0, true);
+  }
+  st.compact();
+  return rep;
 }
 
 }  // namespace angiosynth

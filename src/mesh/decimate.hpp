@@ -5,7 +5,9 @@
 // replaces), and every new vertex and new triangle's centroid within a share of its local step
 // of the vessels' exact surface (the distance the mesher contoured). Marching tetrahedra put
 // isotropic triangles of the cell size everywhere; along straight vessels long triangles do as
-// well, so most of them go. Serial, in a deterministic order (cost, then vertex ids).
+// well, so most of them go. Blocks of space are decimated in parallel, each in the order (cost,
+// vertex ids) and only where all it reads lies inside it, so the result does not depend on the
+// thread count.
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -18,7 +20,6 @@ struct DecimateOptions {
   double max_error = 0.1;         // share of the local step: largest distance of a new vertex or centroid from the surface
   double min_angle_deg = 15;      // a new triangle's angles stay above this (or above the smallest they replace)
   double max_turn_deg = 45;       // largest turn of a triangle's normal by one collapse
-  std::int64_t target_triangles = 0;  // stop at this many triangles (0: when no collapse is allowed)
 };
 
 struct DecimateReport {
