@@ -298,6 +298,24 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
   EXPECT_EQ(loops["boundary_loops"], 26);
   EXPECT_LT(loops["max_loop_plane_distance"].get<double>(), 1e-9);
 
+  // Decimated, the caps (fixed) and the closedness stay, and TetGen meshes the volume with
+  // quality (radius–edge ratio 1.414; -T1e-16: TetGen's default tolerance merges the nearly
+  // coplanar neighbours of flat decimated patches into one facet and gives up).
+  const auto coarse = run("mesh sample --out coarse --format vtp,off --ends capped --flow-extension 3 --samples-across 2 --decimate --quiet", dir);
+  ASSERT_EQ(coarse.code, 0) << coarse.err;
+  const auto sc = nlohmann::json::parse(readText(dir / "coarse/mesh.json"))["statistics"];
+  EXPECT_EQ(sc["boundary_edges"], 0);
+  EXPECT_EQ(sc["nonmanifold_edges"], 0);
+  EXPECT_EQ(sc["tree_euler_characteristic"], nlohmann::json::array({2, 2}));
+  EXPECT_LT(sc["triangles"].get<double>() * 5, st["triangles"].get<double>());
+  const auto coarse_caps = check("coarse", "--ends");
+  EXPECT_EQ(coarse_caps["caps"], 26);
+  EXPECT_LT(coarse_caps["max_cap_plane_distance"].get<double>(), 1e-9);
+  EXPECT_EQ(coarse_caps["min_cap_area_ratio"], caps["min_cap_area_ratio"]);
+  const std::string tetgen_q = "cd '" + (dir / "coarse").string() + "' && tetgen -pq1.414 -T1e-16 -Q surface.off > tetgen.log 2>&1";
+  EXPECT_EQ(std::system(tetgen_q.c_str()), 0) << tetgen_q;
+  EXPECT_TRUE(std::filesystem::exists(dir / "coarse/surface.1.ele"));
+
   const auto bad = run("mesh sample --out bad --flow-extension 2 --quiet", dir);
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("--flow-extension needs --ends open or capped"), std::string::npos) << bad.err;
