@@ -123,33 +123,7 @@ struct State {
     }
   }
 
-  void compact() {
-    std::vector<std::int32_t> renumber(m.vertices.size(), -1);
-    std::size_t nv = 0;
-    for (std::size_t v = 0; v < m.vertices.size(); ++v) {
-      if (!vertex_alive[v] || around[v].empty()) continue;
-      renumber[v] = std::int32_t(nv);
-      m.vertices[nv] = m.vertices[v];
-      if (!m.vertex_step.empty()) m.vertex_step[nv] = m.vertex_step[v];
-      ++nv;
-    }
-    m.vertices.resize(nv);
-    if (!m.vertex_step.empty()) m.vertex_step.resize(nv);
-    std::size_t nt = 0;
-    for (std::size_t k = 0; k < m.triangles.size(); ++k) {
-      if (!triangle_alive[k]) continue;
-      auto t = m.triangles[k];
-      for (auto& x : t) x = renumber[std::size_t(x)];
-      m.triangles[nt] = t;
-      m.triangle_tree[nt] = m.triangle_tree[k];
-      if (!m.triangle_face.empty()) m.triangle_face[nt] = m.triangle_face[k];
-      ++nt;
-    }
-    m.triangles.resize(nt);
-    m.triangle_tree.resize(nt);
-    if (!m.triangle_face.empty()) m.triangle_face.resize(nt);
-  }
-
+  void compact() { keepTriangles(m, triangle_alive); }
 
   SurfaceMesh& m;
   const DecimateOptions& o;

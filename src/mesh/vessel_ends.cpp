@@ -402,31 +402,8 @@ EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool ca
   }
 
   // Drop the prolongations and the vertices only they used; the others keep their order.
-  std::vector<std::int32_t> renumber(m.vertices.size(), -1);
-  std::size_t nt = 0;
-  for (std::size_t k = 0; k < m.triangles.size(); ++k) {
-    if (removed[k]) continue;
-    m.triangles[nt] = m.triangles[k];
-    m.triangle_tree[nt] = m.triangle_tree[k];
-    m.triangle_face[nt] = m.triangle_face[k];
-    for (auto v : m.triangles[nt]) renumber[std::size_t(v)] = 0;
-    ++nt;
-  }
-  m.triangles.resize(nt);
-  m.triangle_tree.resize(nt);
-  m.triangle_face.resize(nt);
-  std::size_t kept_vertices = 0;
-  for (std::size_t v = 0; v < renumber.size(); ++v) {
-    if (renumber[v] < 0) continue;
-    renumber[v] = std::int32_t(kept_vertices);
-    m.vertices[kept_vertices] = m.vertices[v];
-    if (!m.vertex_step.empty()) m.vertex_step[kept_vertices] = m.vertex_step[v];
-    ++kept_vertices;
-  }
-  m.vertices.resize(kept_vertices);
-  if (!m.vertex_step.empty()) m.vertex_step.resize(kept_vertices);
-  for (auto& tri : m.triangles)
-    for (auto& v : tri) v = renumber[std::size_t(v)];
+  for (auto& r : removed) r = !r;
+  keepTriangles(m, removed);
   return rep;
 }
 

@@ -312,26 +312,9 @@ std::int64_t removeCavities(SurfaceMesh& m) {
   std::int64_t removed = 0;
   for (std::size_t v = 0; v < volume.size(); ++v) removed += component[v] == std::int32_t(v) && volume[v] < 0;
   if (removed == 0) return 0;
-  // Kept vertices keep their order.
-  std::vector<std::int32_t> renumber(m.vertices.size(), -1);
-  std::vector<Vec3> vertices;
-  std::vector<float> steps;
-  std::vector<std::array<std::int32_t, 3>> triangles;
-  std::vector<std::int32_t> trees;
-  for (std::size_t v = 0; v < renumber.size(); ++v)
-    if (!(volume[std::size_t(component[v])] < 0)) {
-      renumber[v] = std::int32_t(vertices.size());
-      vertices.push_back(m.vertices[v]);
-      steps.push_back(m.vertex_step[v]);
-    }
-  for (std::size_t k = 0; k < m.triangles.size(); ++k)
-    if (renumber[std::size_t(m.triangles[k][0])] >= 0) triangles.push_back(m.triangles[k]), trees.push_back(m.triangle_tree[k]);
-  for (auto& t : triangles)
-    for (auto& v : t) v = renumber[std::size_t(v)];
-  m.vertices = std::move(vertices);
-  m.vertex_step = std::move(steps);
-  m.triangles = std::move(triangles);
-  m.triangle_tree = std::move(trees);
+  std::vector<char> keep(m.triangles.size());
+  for (std::size_t k = 0; k < m.triangles.size(); ++k) keep[k] = !(volume[std::size_t(component[std::size_t(m.triangles[k][0])])] < 0);
+  keepTriangles(m, keep);
   return removed;
 }
 
@@ -590,6 +573,34 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
   if (report) report->cavities_removed = removed;
   if (o.finish) o.finish(mesh, distance);
   return mesh;
+}
+
+void keepTriangles(SurfaceMesh& m, const std::vector<char>& keep) {
+  std::vector<std::int32_t> renumber(m.vertices.size(), -1);
+  std::size_t nt = 0;
+  for (std::size_t k = 0; k < m.triangles.size(); ++k) {
+    if (!keep[k]) continue;
+    m.triangles[nt] = m.triangles[k];
+    m.triangle_tree[nt] = m.triangle_tree[k];
+    if (!m.triangle_face.empty()) m.triangle_face[nt] = m.triangle_face[k];
+    for (auto v : m.triangles[nt]) renumber[std::size_t(v)] = 0;
+    ++nt;
+  }
+  m.triangles.resize(nt);
+  m.triangle_tree.resize(nt);
+  if (!m.triangle_face.empty()) m.triangle_face.resize(nt);
+  std::size_t nv = 0;
+  for (std::size_t v = 0; v < renumber.size(); ++v) {
+    if (renumber[v] < 0) continue;
+    renumber[v] = std::int32_t(nv);
+    m.vertices[nv] = m.vertices[v];
+    if (!m.vertex_step.empty()) m.vertex_step[nv] = m.vertex_step[v];
+    ++nv;
+  }
+  m.vertices.resize(nv);
+  if (!m.vertex_step.empty()) m.vertex_step.resize(nv);
+  for (auto& t : m.triangles)
+    for (auto& v : t) v = renumber[std::size_t(v)];
 }
 
 MeshTopology meshTopology(const SurfaceMesh& m) {

@@ -55,6 +55,10 @@ struct SurfaceReport {
 SurfaceMesh vesselSurface(const VascularTree& forest, const SurfaceOptions& options, SurfaceReport* report = nullptr,
                           const std::function<void(std::int64_t done, std::int64_t total)>& progress = {});
 
+// Keeps the triangles flagged in `keep` (with their tree and face labels) and the vertices they
+// use, both in their order.
+void keepTriangles(SurfaceMesh& m, const std::vector<char>& keep);
+
 // The mesh's own account of itself (the tests judge written files with VTK): edges used once
 // (boundary) or more than twice, edges both triangles run the same way (inconsistent
 // orientation), triangles with a repeated vertex, and the enclosed volume (divergence theorem).
