@@ -249,7 +249,7 @@ TEST(Mesh, MeshTableInAParameterFileWritesTheSurfaceWithTheSample) {
 
 // CFD ends: each tree's inlet and every outlet cut by the plane through its end node after a
 // flow extension, judged by VTK on the written VTP against surface_faces.csv: capped, every cap
-// lies in its plane, covers πr² (the loop is a polygon inscribed in the vessel's circle) and faces
+// lies in its plane, covers πr² but for a polygon inscribed in the vessel's circle, and faces
 // outwards, the surface is closed with one sphere-like component per tree, and TetGen finds no
 // intersecting faces; open, there is exactly one planar boundary loop per end and each tree's
 // Euler characteristic is the capped one less its ends (each cap a disc).
@@ -281,7 +281,7 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
   EXPECT_EQ(caps["caps"], 26);
   EXPECT_EQ(caps["boundary_loops"], 0);
   EXPECT_LT(caps["max_cap_plane_distance"].get<double>(), 1e-9);  // share of the radius
-  EXPECT_GT(caps["min_cap_area_ratio"].get<double>(), 0.97);
+  EXPECT_GT(caps["min_cap_area_ratio"].get<double>(), 0.95);  // at two samples across a loop can have 12 vertices (0.955 πr²)
   EXPECT_LT(caps["max_cap_area_ratio"].get<double>(), 1.01);
   EXPECT_GT(caps["min_cap_normal_cosine"].get<double>(), 0.999999);
   const auto tetgen = check("capped", "--self-intersections");
