@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "grow/colonisation/grower.hpp"
+#include "grow/common/neighbourhood_count.hpp"
 #include "grow/common/point_hash.hpp"
 #include "grow_file.hpp"
 #include "test_support.hpp"
@@ -285,10 +286,11 @@ TEST(Colonisation, StumpsOfAnExistingTreeGrowOn) {
   EXPECT_LE(murray, 1e-12);
 }
 
-// The ring search of the nearest point answers exactly as a brute-force scan: clustered and
-// sparse clouds, queries inside and outside the grid, exact ties (the smaller id wins), flat and
-// solid grids.
-TEST(PointHash, NearestEqualsBruteForce) {
+// The grid's nearest point and "any point within r" answer exactly as a brute-force scan, and the
+// neighbourhood count never denies a point within its cell: clustered and sparse clouds,
+// queries inside and outside the grid, exact ties (the smaller id wins), points exactly at the
+// distance asked, flat and solid grids.
+TEST(PointHash, QueriesEqualBruteForce) {
   for (const bool flat : {true, false}) {
     Rng rng(7, flat, Stage::Growth);
     const Vec3 lo(-1, -1, flat ? 0 : -1), hi(1, 1, flat ? 0 : 1);
@@ -299,8 +301,9 @@ TEST(PointHash, NearestEqualsBruteForce) {
     };
     for (int i = 0; i < 3000; ++i) pts.push_back(i % 3 == 0 ? draw(1.3) : draw(0.3) * 0.5 + Vec3(0.4, -0.2, 0));
     pts.push_back(pts[10]);  // an exact tie: the earlier id must win
-    for (std::size_t i = 0; i < pts.size(); ++i) grid.insert(pts[i], std::int32_t(i));
-    int found = 0, ties = 0;
+    NeighbourhoodCount counts(lo, hi, 0.02, flat);
+    for (std::size_t i = 0; i < pts.size(); ++i) grid.insert(pts[i], std::int32_t(i)), counts.insert(pts[i]);
+    int found = 0, ties = 0, far = 0;
     for (int q = 0; q < 4000; ++q) {
       const Vec3 p = q < 50 ? pts[10] : draw(1.5);
       const double r = q % 4 == 0 ? 0.02 : q % 4 == 1 ? 0.13 : q % 4 == 2 ? 0.4 : 3.0;
@@ -312,10 +315,23 @@ TEST(PointHash, NearestEqualsBruteForce) {
       }
       const auto got = grid.nearest(p, r, [&](std::int32_t id) { return dot(pts[std::size_t(id)] - p, pts[std::size_t(id)] - p); });
       ASSERT_EQ(got, want) << "flat " << flat << " query " << q << " r " << r;
+      // Radii at a point's distance (to rounding) and a hair beyond it, where cells are cut finest.
+      const double exact = q % 7 == 0 && want >= 0 ? std::sqrt(bd) : r;
+      for (const double rr : {exact, std::nextafter(exact, 1e9)}) {
+        bool any = false;
+        for (const auto& x : pts) any = any || dot(x - p, x - p) < rr * rr;
+        const bool got_any = grid.anyNear(p, rr, [&](std::int32_t id) { return dot(pts[std::size_t(id)] - p, pts[std::size_t(id)] - p) < rr * rr; });
+        ASSERT_EQ(got_any, any) << "flat " << flat << " query " << q << " r " << rr;
+        if (rr <= 0.02 && any) {
+          ASSERT_TRUE(counts.mayBeNear(p)) << "flat " << flat << " query " << q;
+        }
+        far += !counts.mayBeNear(p);
+      }
       found += got >= 0;
       ties += q < 50;
     }
     EXPECT_GT(found, 2000);  // most queries have an answer: the comparison is not of empty results
     EXPECT_EQ(ties, 50);
+    EXPECT_GT(far, 200) << far;  // and the count does say "none near" for many
   }
 }

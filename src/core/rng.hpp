@@ -21,9 +21,11 @@ enum class Stage : std::uint64_t { Growth = 1, Repair = 2, Raster = 3, Degrade =
 
 class Rng {
  public:
-  Rng(std::uint64_t seed, std::uint64_t sample, Stage stage, std::uint64_t item = 0)
-      : key_(mix64(mix64(mix64(seed ^ 0x6a09e667f3bcc908ULL) + sample) +
-                   static_cast<std::uint64_t>(stage)) + item) {}
+  Rng(std::uint64_t seed, std::uint64_t sample, Stage stage, std::uint64_t item = 0) : key_(streamKey(seed, sample, stage) + item) {}
+  // The key of item 0: fromKey(streamKey(…) + item) is Rng(…, item), for loops over many items.
+  static constexpr std::uint64_t streamKey(std::uint64_t seed, std::uint64_t sample, Stage stage) {
+    return mix64(mix64(mix64(seed ^ 0x6a09e667f3bcc908ULL) + sample) + static_cast<std::uint64_t>(stage));
+  }
 
   // A stream from a key drawn from another stream (sub-streams of an effect or a voxel).
   static Rng fromKey(std::uint64_t key) { return Rng(key); }

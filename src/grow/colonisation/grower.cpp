@@ -2,12 +2,14 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 
 #include "core/rng.hpp"
+#include "grow/common/neighbourhood_count.hpp"
 #include "grow/common/point_hash.hpp"
 
 namespace angiosynth {
@@ -66,6 +68,7 @@ struct System {
   std::vector<Vec3> pos, dir;               // dir: unit direction of the edge ending at the node (root: its heading)
   std::vector<std::int32_t> parent, child0, child1, root_of;
   std::vector<double> leaf_radius;           // the radius a leaf carries
+  std::vector<double> leaf_rk;               // leaf_radius^κ
   std::vector<double> rk;                    // Σ leaf_radius^κ over the leaves below: the edge's radius^κ (Murray)
   std::vector<double> radius;                // exact Murray radii, set by finishRadii()
   std::vector<std::int32_t> roots;           // the root nodes
@@ -73,34 +76,43 @@ struct System {
   PointHash nodes;   // cells of the perception distance
   PointHash close;   // cells of the satisfaction distance: "is a node this close?"
   PointHash drains;  // cells of the drain spacing
-  PointHash fresh;   // the drains added in this step's sampling, same cells
+  NeighbourhoodCount far;  // cells of the longest query distance: most "no node near" answers in one read
   std::vector<Vec3> drain;
   std::vector<std::int32_t> born;           // the step a drain appeared
   // A drain's nearest node within the perception distance (−1: none), found when it was made,
-  // and the node count then: still exact while the step and the nodes are the same.
+  // and the node count then: still exact while the step and the nodes are the same, and in the
+  // same step it settles satisfaction by the nodes made before.
   std::vector<std::int32_t> near, near_count;
   bool flat = false;
   std::vector<std::int32_t> cone_stamp;      // per node: the step its perception bounds were computed
   std::vector<double> cos_lo, cos_hi;
+  std::vector<double> lateral_angle;         // an inter-node's Murray angle of a lateral branch, same step
 
   System(const Vec3& lo, const Vec3& hi, double node_cell, double close_cell, double drain_cell, bool is_flat)
       : nodes(lo, hi, node_cell, is_flat), close(lo, hi, close_cell, is_flat), drains(lo, hi, drain_cell, is_flat),
-        fresh(lo, hi, drain_cell, is_flat), flat(is_flat), lo_(lo), hi_(hi), scale_(1) {}
+        flat(is_flat), lo_(lo), hi_(hi), scale_(1) {}
 
   // The grids' cells follow the step's lengths (× σ_T/σ_t, up to 3× the last step's early in a
   // run): a query then scans a few cells, not dozens. Queries answer the same on any cells.
-  void rescale(double node_cell, double close_cell, double drain_cell, double k) {
+  // `reach`: the longest distance a "node within" question asks at this step; the far grid is
+  // rebuilt when it no longer covers it or when it is 20 % too coarse.
+  void rescale(double node_cell, double close_cell, double drain_cell, double k, double reach) {
+    if (!(far_reach_ >= reach && far_reach_ <= 1.2 * reach)) {
+      far_reach_ = reach;
+      far = NeighbourhoodCount(lo_, hi_, reach, flat);
+      for (const auto& p : pos) far.insert(p);
+    }
     if (std::abs(std::log(k / scale_)) < std::log(1.25)) return;
     scale_ = k;
     nodes = PointHash(lo_, hi_, node_cell * k, flat);
     close = PointHash(lo_, hi_, close_cell * k, flat);
     drains = PointHash(lo_, hi_, drain_cell * k, flat);
-    fresh = PointHash(lo_, hi_, drain_cell * k, flat);  // emptied before every use
     for (std::size_t i = 0; i < pos.size(); ++i) nodes.insert(pos[i], std::int32_t(i)), close.insert(pos[i], std::int32_t(i));
     for (std::size_t d = 0; d < drain.size(); ++d) drains.insert(drain[d], std::int32_t(d));
   }
   Vec3 lo_, hi_;
-  double scale_;
+  double scale_, far_reach_ = 0;
+  double last_leaf_r_ = -1, last_leaf_rk_ = 0;
 
   double radiusOf(std::int32_t i) const { return std::pow(rk[std::size_t(i)], 1.0 / kappa); }
 
@@ -112,19 +124,23 @@ struct System {
     child0.push_back(-1);
     child1.push_back(-1);
     root_of.push_back(root);
+    // Every leaf of a step has the same radius: its power is taken once.
+    if (leaf_r != last_leaf_r_) last_leaf_r_ = leaf_r, last_leaf_rk_ = std::pow(leaf_r, kappa);
+    const double own = last_leaf_rk_;
     leaf_radius.push_back(leaf_r);
-    const double own = std::pow(leaf_r, kappa);
+    leaf_rk.push_back(own);
     rk.push_back(own);
     if (par < 0) roots.push_back(id);
     if (par >= 0) {
       // Murray's law in r^κ is additive: the new leaf adds its share to every ancestor, and a
       // leaf that becomes a parent no longer counts its own.
-      const double delta = child0[par] < 0 ? own - std::pow(leaf_radius[par], kappa) : own;
+      const double delta = child0[par] < 0 ? own - leaf_rk[std::size_t(par)] : own;
       (child0[par] < 0 ? child0[par] : child1[par]) = id;
       for (std::int32_t a = par; a >= 0; a = parent[a]) rk[a] += delta;
     }
     nodes.insert(p, id);
     close.insert(p, id);
+    far.insert(p);
     return id;
   }
   // `nearest`: its nearest node within this step's perception distance, or −2 (not known).
@@ -135,18 +151,19 @@ struct System {
     near.push_back(nearest);
     near_count.push_back(std::int32_t(pos.size()));
     drains.insert(p, id);
-    fresh.insert(p, id);
   }
-  // True if a node lies within r (r at most a few cells of `close`).
+  // True if a node lies within r (r at most a few cells of `close`, and at most the reach).
   bool nodeWithin(const Vec3& p, double r) const {
+    if (!far.mayBeNear(p)) return false;
     const double r2 = r * r;
     return (r > 2 * close.cell() ? nodes : close).anyNear(p, r, [&](std::int32_t id) {
       const Vec3 v = pos[id] - p;
       return dot(v, v) < r2;
     });
   }
-  // Nearest node within r (ties: the smaller id), or -1.
+  // Nearest node within r (at most the reach; ties: the smaller id), or -1.
   std::int32_t nearestNode(const Vec3& p, double r) const {
+    if (!far.mayBeNear(p)) return -1;
     return nodes.nearest(p, r, [&](std::int32_t id) {
       const Vec3 v = pos[id] - p;
       return dot(v, v);
@@ -156,12 +173,9 @@ struct System {
   bool knowsNearest(std::size_t k, std::int32_t step) const {
     return near[k] != -2 && born[k] == step && near_count[k] == std::int32_t(pos.size());
   }
-  bool anyDrainWithin(const Vec3& p, double r) const { return drainWithin(drains, p, r); }
-  // Only the drains added since the step began (the others were checked in parallel).
-  bool freshDrainWithin(const Vec3& p, double r) const { return drainWithin(fresh, p, r); }
-  bool drainWithin(const PointHash& grid, const Vec3& p, double r) const {
+  bool anyDrainWithin(const Vec3& p, double r) const {
     const double r2 = r * r;
-    return grid.anyNear(p, r, [&](std::int32_t id) {
+    return drains.anyNear(p, r, [&](std::int32_t id) {
       const Vec3 v = drain[id] - p;
       return dot(v, v) < r2;
     });
@@ -194,6 +208,15 @@ struct System {
   }
 };
 
+// One step's lengths (a stage's, × σ_T/σ_t) and index: passed along, because the veins of step t
+// grow while the candidates of step t + 1 are tested against the arteries.
+struct StepScale {
+  const ColonisationStage* st = nullptr;
+  std::int32_t index = 0;
+  double k = 1;  // σ_T/σ_t
+  double len = 0, delta = 0, sat = 0, spacing = 0, co2 = 0, terminal_radius = 0;
+};
+
 class Grower {
  public:
   Grower(const ColonisationOptions& o, GrowthReport& report, ColonisationReport& cr)
@@ -204,6 +227,7 @@ class Grower {
     ven_.vein = true;
     art_.kappa = ven_.kappa = o.murray_exponent;
     symmetric_angle_ = symmetricMurrayAngle(o.murray_exponent);
+    for (const auto& st : o.stages) reach_ = std::max({reach_, st.perception_distance, st.co2_distance, st.satisfaction_distance});
     for (std::size_t k = 0; k < o.roots.size(); ++k) {
       const auto& r = o.roots[k];
       auto& s = r.vein ? ven_ : art_;
@@ -221,17 +245,68 @@ class Grower {
         id[std::size_t(i)] = s.add(t.position[i], root ? -1 : id[std::size_t(t.parent[i])], unit(d), radius, std::int32_t(k));
       }
     }
+    veins_ = o.veins && !ven_.pos.empty();
   }
 
+  // Step t: (1) candidates meet the arteries, while the veins of step t − 1 grow; (2) candidates
+  // meet the veins and become venous drains, while they become arterial drains and the arteries
+  // grow; (3) the arteries satisfy drains, which turn into CO₂ sources for the veins. Tasks side
+  // by side read and write disjoint state (vein growth with avoid_crossing reads the arteries,
+  // so then it takes its turn), and every system sees its state in the order of a plain
+  // sequence of steps: the trees are the same on any thread count.
   void run(const ProgressFn& progress) {
     const auto scales = colonisationScales(o_);
-    std::size_t t = 0;
-    for (const auto& st : o_.stages) {
-      for (int s = 0; s < st.steps; ++s, ++t) {
-        step(st, scales[t]);
-        cr_.nodes_per_step.push_back(std::int64_t(art_.pos.size() + ven_.pos.size()));
-        if (progress) progress(std::int64_t(t + 1), std::int64_t(scales.size()));
+    std::vector<StepScale> steps;
+    for (const auto& st : o_.stages)
+      for (int i = 0; i < st.steps; ++i) {
+        const double k = scales[steps.size()];
+        StepScale t;
+        t.st = &st;
+        t.index = std::int32_t(steps.size());
+        t.len = st.step * k;
+        t.delta = st.perception_distance * k;
+        t.sat = st.satisfaction_distance * k;
+        t.spacing = st.drain_spacing * k;
+        t.co2 = st.co2_distance * k;
+        t.terminal_radius = st.terminal_radius * k;
+        t.k = k;
+        steps.push_back(t);
       }
+    std::int64_t arteries_after = 0;  // artery nodes at the end of the step whose veins are pending
+    const auto finished = [&](const StepScale& t) {
+      cr_.nodes_per_step.push_back(arteries_after + std::int64_t(ven_.pos.size()));
+      if (progress) progress(std::int64_t(t.index + 1), std::int64_t(steps.size()));
+    };
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+      StepScale& t = steps[i];
+      const StepScale* before = i > 0 ? &steps[i - 1] : nullptr;
+      art_.rescale(cell(o_, 0), cell(o_, 1), cell(o_, 2), t.k, reach_ * t.k);
+      if (before && !o_.avoid_crossing) {
+        tbb::parallel_invoke([&] { growVeins(*before); }, [&] { meetArteries(t); });
+      } else {
+        if (before) growVeins(*before);
+        meetArteries(t);
+      }
+      if (before) finished(*before);
+      ven_.rescale(cell(o_, 0), cell(o_, 1), cell(o_, 2), t.k, reach_ * t.k);
+      report_.candidates += std::int64_t(candidates_.size());
+      tbb::parallel_invoke(
+          [&] {
+            meetVeins(t);
+            admitVeins(t);
+          },
+          [&] {
+            admitArteries(t);
+            grow(art_, t);
+          });
+      for (const System* s : {&art_, &ven_})
+        for (auto r : s->roots) max_radius_ = std::max(max_radius_, s->radiusOf(r));
+      satisfy(art_, t, veins_ ? &ven_ : nullptr);
+      arteries_after = std::int64_t(art_.pos.size());
+    }
+    if (!steps.empty()) {
+      growVeins(steps.back());
+      finished(steps.back());
     }
   }
 
@@ -278,7 +353,7 @@ class Grower {
     return world_.depth(b) > 0 && world_.frame().segmentClear(a, b);
   }
 
-  Vec3 sampleDrain(const ColonisationStage& st, Rng& rng) const {
+  Vec3 sampleDrain(const ColonisationStage& st, Rng&& rng) const {
     const GrowthDomain& d = *st.drains;
     if (st.source == DrainSource::Volume) return d.sample(rng);
     for (int tries = 0;; ++tries) {  // surface: rejection to the shell of depth ≤ surface_depth
@@ -322,28 +397,30 @@ class Grower {
 
   // Which node perceives each live drain (its closest node, if the drain lies in that node's
   // perception volume), grouped by node.
-  std::vector<std::pair<std::int32_t, std::int32_t>> assign(System& s, const ColonisationStage& st, double delta) {
+  std::vector<std::pair<std::int32_t, std::int32_t>> assign(System& s, const StepScale& t) {
+    const ColonisationStage& st = *t.st;
     const double half = st.perception_angle * kDeg / 2, cos_half = std::cos(half);
     std::vector<std::int32_t> owner(s.drain.size(), -1);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.drain.size(), 512), [&](const tbb::blocked_range<std::size_t>& b) {
-      for (std::size_t k = b.begin(); k != b.end(); ++k) owner[k] = s.knowsNearest(k, step_) ? s.near[k] : s.nearestNode(s.drain[k], delta);
+      for (std::size_t k = b.begin(); k != b.end(); ++k) owner[k] = s.knowsNearest(k, t.index) ? s.near[k] : s.nearestNode(s.drain[k], t.delta);
     });
     // Perception bounds of the nodes that are nearest to some drain, computed once per step.
     s.cone_stamp.resize(s.pos.size(), -1);
     s.cos_lo.resize(s.pos.size());
     s.cos_hi.resize(s.pos.size());
+    s.lateral_angle.resize(s.pos.size());
     std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
     for (std::size_t k = 0; k < s.drain.size(); ++k) {
       const auto j = owner[k];
       if (j < 0) continue;
-      if (s.cone_stamp[j] != step_) {
-        s.cone_stamp[j] = step_;
+      if (s.cone_stamp[j] != t.index) {
+        s.cone_stamp[j] = t.index;
         s.cos_lo[j] = s.cos_hi[j] = 2.0;  // perceives nothing
         if (s.child0[j] < 0) {
           s.cos_lo[j] = cos_half;
           s.cos_hi[j] = 1.0;
         } else if (st.lateral && s.child1[j] < 0 && s.parent[j] >= 0) {
-          const double alpha = lateralMurrayAngle(s.radiusOf(j), terminal_radius_, o_.murray_exponent);
+          const double alpha = s.lateral_angle[j] = lateralMurrayAngle(s.radiusOf(j), t.terminal_radius, o_.murray_exponent);
           s.cos_lo[j] = std::cos(std::min(std::numbers::pi, alpha + half));
           s.cos_hi[j] = std::cos(std::max(0.0, alpha - half));
         }
@@ -381,13 +458,13 @@ class Grower {
   };
 
   // A new node of s from `from` along dir, unless it leaves the world or crosses a vessel.
-  bool tryAdd(const System& s, const ColonisationStage& st, std::int32_t from, Vec3 dir, double len, Decision& d) const {
-    Vec3 p = toShell(st, s.pos[from] + dir * len);
+  bool tryAdd(const System& s, const StepScale& t, std::int32_t from, Vec3 dir, Decision& d) const {
+    Vec3 p = toShell(*t.st, s.pos[from] + dir * t.len);
     if (!inside(s.pos[from], p)) {
       ++d.outside;
       return false;
     }
-    if (crosses(s, from, s.pos[from], p, terminal_radius_)) {
+    if (crosses(s, from, s.pos[from], p, t.terminal_radius)) {
       ++d.crossing;
       return false;
     }
@@ -397,8 +474,9 @@ class Grower {
 
   // Node j's response to the drains it perceives (pairs [a, b)): it reads the step's starting
   // state only, so the nodes decide in parallel.
-  Decision decide(const System& s, const ColonisationStage& st, const std::vector<std::pair<std::int32_t, std::int32_t>>& pairs, std::size_t a,
-                  std::size_t b, double len) const {
+  Decision decide(const System& s, const StepScale& t, const std::vector<std::pair<std::int32_t, std::int32_t>>& pairs, std::size_t a,
+                  std::size_t b) const {
+    const ColonisationStage& st = *t.st;
     Decision d;
     const std::int32_t j = pairs[a].first;
     const Vec3 pj = s.pos[j], e = s.dir[j];
@@ -431,7 +509,7 @@ class Grower {
         w = unit(w);
         const double alpha_s = symmetric_angle_;
         const Vec3 d1 = e * std::cos(alpha_s) + w * std::sin(alpha_s), d2 = e * std::cos(alpha_s) - w * std::sin(alpha_s);
-        if (tryAdd(s, st, j, d1, len, d) && tryAdd(s, st, j, d2, len, d)) {
+        if (tryAdd(s, t, j, d1, d) && tryAdd(s, t, j, d2, d)) {
           d.move = Move::Bifurcation;
           return d;
         }
@@ -439,30 +517,29 @@ class Grower {
       }
       Vec3 g = e * st.bias + m * (1 - st.bias);
       if (!(norm(g) > 1e-12)) g = e;
-      if (tryAdd(s, st, j, unit(g), len, d)) d.move = Move::Elongation;
+      if (tryAdd(s, t, j, unit(g), d)) d.move = Move::Elongation;
     } else if (s.child1[j] < 0) {
       // An inter-node: a lateral branch at the Murray angle, turned toward the drains.
-      const double alpha = lateralMurrayAngle(s.radiusOf(j), terminal_radius_, o_.murray_exponent);
+      const double alpha = s.lateral_angle[j];  // a drain in its shell was assigned: set this step
       Vec3 w = m - e * dot(m, e);
       if (!(norm(w) > 1e-9)) return d;
       const Vec3 v = e * std::cos(alpha) + unit(w) * std::sin(alpha);
       Vec3 g = v * st.bias + m * (1 - st.bias);
       if (!(norm(g) > 1e-12)) g = v;
-      if (tryAdd(s, st, j, unit(g), len, d)) d.move = Move::Lateral;
+      if (tryAdd(s, t, j, unit(g), d)) d.move = Move::Lateral;
     }
     return d;
   }
 
-  void grow(System& s, const ColonisationStage& st, double k) {
-    const double len = st.step * k, delta = st.perception_distance * k;
-    const auto pairs = assign(s, st, delta);
+  void grow(System& s, const StepScale& t) {
+    const auto pairs = assign(s, t);
     std::vector<std::size_t> start;
     for (std::size_t a = 0; a < pairs.size(); ++a)
       if (a == 0 || pairs[a].first != pairs[a - 1].first) start.push_back(a);
     start.push_back(pairs.size());
     std::vector<Decision> decisions(start.size() - 1);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, decisions.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t g = r.begin(); g != r.end(); ++g) decisions[g] = decide(s, st, pairs, start[g], start[g + 1], len);
+      for (std::size_t g = r.begin(); g != r.end(); ++g) decisions[g] = decide(s, t, pairs, start[g], start[g + 1]);
     });
     // Nodes join in the order of their parents: the same tree on any thread count.
     for (const auto& d : decisions) {
@@ -473,7 +550,7 @@ class Grower {
       cr_.lateral_branches += d.move == Move::Lateral;
       for (int i = 0; i < d.added; ++i) {
         const auto& p = d.add[i];
-        s.add(p.position, p.from, p.direction, terminal_radius_, s.root_of[p.from]);
+        s.add(p.position, p.from, p.direction, t.terminal_radius, s.root_of[p.from]);
         max_edge_ = std::max(max_edge_, distance(p.position, s.pos[p.from]));
       }
     }
@@ -482,99 +559,131 @@ class Grower {
   // Drains of s within `sat` of one of its nodes are satisfied: removed (an artery's become the
   // veins' CO₂ sources).
   // `delta`: the perception distance, for the nearest vein of each new CO₂ source.
-  void satisfy(System& s, double sat, System* co2, int lifetime, double delta) {
-    std::vector<char> done(s.drain.size(), 0);
+  void satisfy(System& s, const StepScale& t, System* co2) {
+    const double sat = t.sat, sat2 = sat * sat, delta = t.delta;
+    const int lifetime = t.st->drain_lifetime;
+    // A drain made this step knows its nearest node within δ ≥ sat among the nodes before
+    // growth, so only the few nodes made since can satisfy it otherwise: they look for drains.
+    enum : char { Open = 0, Satisfied = 1, Unknown = 2 };
+    std::vector<char> done(s.drain.size(), Unknown);
+    auto first_new = std::int32_t(s.pos.size());
+    for (std::size_t k = 0; k < s.drain.size(); ++k) {
+      if (!(delta >= sat) || s.born[k] != t.index || s.near[k] == -2) continue;
+      const auto j = s.near[k];
+      done[k] = j >= 0 && dot(s.drain[k] - s.pos[std::size_t(j)], s.drain[k] - s.pos[std::size_t(j)]) < sat2 ? Satisfied : Open;
+      first_new = std::min(first_new, s.near_count[k]);
+    }
+    for (auto n = first_new; n < std::int32_t(s.pos.size()); ++n)
+      s.drains.forEachNear(s.pos[std::size_t(n)], sat, [&](std::int32_t d) {
+        const Vec3 v = s.drain[std::size_t(d)] - s.pos[std::size_t(n)];
+        if (done[std::size_t(d)] == Open && n >= s.near_count[std::size_t(d)] && dot(v, v) < sat2) done[std::size_t(d)] = Satisfied;
+      });
     std::vector<std::int32_t> vein_near(co2 ? s.drain.size() : 0, -2);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.drain.size(), 512), [&](const tbb::blocked_range<std::size_t>& b) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.drain.size(), 256), [&](const tbb::blocked_range<std::size_t>& b) {
       for (std::size_t k = b.begin(); k != b.end(); ++k) {
-        done[k] = s.nodeWithin(s.drain[k], sat);
-        if (done[k] && co2) vein_near[k] = co2->nearestNode(s.drain[k], delta);
+        if (done[k] == Unknown) done[k] = s.nodeWithin(s.drain[k], sat) ? Satisfied : Open;
+        if (done[k] == Satisfied && co2) vein_near[k] = co2->nearestNode(s.drain[k], delta);
       }
     });
     std::vector<std::int32_t> keep;
     for (std::size_t k = 0; k < s.drain.size(); ++k) {
-      if (!done[k]) {
-        if (lifetime <= 0 || step_ - s.born[k] + 1 < lifetime) keep.push_back(std::int32_t(k));  // else expired unsatisfied
+      if (done[k] == Open) {
+        if (lifetime <= 0 || t.index - s.born[k] + 1 < lifetime) keep.push_back(std::int32_t(k));  // else expired unsatisfied
         continue;
       }
       if (!s.vein) ++cr_.satisfied;
       if (co2) {
-        co2->addDrain(s.drain[k], step_, vein_near[k]);
+        co2->addDrain(s.drain[k], t.index, vein_near[k]);
         ++cr_.venous_drains;
       }
     }
     s.keepDrains(keep);
   }
 
-  void step(const ColonisationStage& st, double k) {
-    for (System* s : {&art_, &ven_}) s->rescale(cell(o_, 0), cell(o_, 1), cell(o_, 2), k);
-    terminal_radius_ = st.terminal_radius * k;
-    const double sat = st.satisfaction_distance * k, spacing = st.drain_spacing * k;
-    const double co2 = st.co2_distance * k, delta = st.perception_distance * k;
-    const bool veins = o_.veins && !ven_.pos.empty();
-    // 1. Oxygen drains where the tissue is not yet supplied, apart from each other. Candidate q
-    // of step t is drawn from its own stream and tested against the trees and the drains the
-    // step began with in parallel; the spacing among this step's drains is kept in draw order.
-    enum : char { Supplied = 1, Oxygenated = 2, Drained = 4, NearVeinDrain = 8, NearArteryDrain = 16 };
+  // Oxygen drains go where the tissue is not yet supplied, apart from each other. Candidate q of
+  // step t is drawn from its own stream and tested in parallel against the trees and the drains
+  // the step began with; the spacing among this step's drains is kept in draw order (admit).
+  enum : char { Supplied = 1, Oxygenated = 2, Drained = 4, NearVeinDrain = 8, NearArteryDrain = 16 };
+
+  // Draws the step's candidates and tests them against the arteries. Supplied: an artery within
+  // the satisfaction distance; oxygenated: within the CO₂ distance (such tissue makes CO₂, a
+  // source for the veins unless a vein drains it). A candidate that may become a drain also finds
+  // the node that will perceive it.
+  void meetArteries(const StepScale& t) {
+    const ColonisationStage& st = *t.st;
+    const std::uint64_t stream = Rng::streamKey(o_.seed, o_.sample, Stage::Growth);
     candidates_.resize(std::size_t(st.drains_per_step));
-    flags_.assign(candidates_.size(), 0);
+    art_flags_.assign(candidates_.size(), 0);
     art_near_.assign(candidates_.size(), -2);
-    ven_near_.assign(candidates_.size(), -2);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates_.size(), 256), [&](const tbb::blocked_range<std::size_t>& b) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates_.size(), 64), [&](const tbb::blocked_range<std::size_t>& b) {
       for (std::size_t q = b.begin(); q != b.end(); ++q) {
-        Rng rng(o_.seed, o_.sample, Stage::Growth, 1 + (std::uint64_t(step_) << 32) + q);
-        const Vec3 p = candidates_[q] = sampleDrain(st, rng);
-        // Supplied: an artery within the satisfaction distance; oxygenated: within the CO₂
-        // distance. Such tissue makes CO₂, a source for the veins unless a vein drains it.
-        // A candidate that may become a drain also finds the node that will perceive it.
+        // ≡ Rng(seed, sample, Growth, 1 + (t << 32) + q): candidate q of step t has a stream of its own
+        const Vec3 p = candidates_[q] = sampleDrain(st, Rng::fromKey(stream + 1 + (std::uint64_t(t.index) << 32) + q));
         char f = 0;
-        if (art_.nodeWithin(p, sat)) {
+        if (art_.nodeWithin(p, t.sat)) {
           f = Supplied;
-        } else if (art_.anyDrainWithin(p, spacing)) {
-          f = NearArteryDrain | (veins && art_.nodeWithin(p, co2) ? Oxygenated : 0);
+        } else if (art_.anyDrainWithin(p, t.spacing)) {
+          f = NearArteryDrain | (veins_ && art_.nodeWithin(p, t.co2) ? Oxygenated : 0);
         } else {
-          const auto j = art_.nearestNode(p, std::max(delta, co2));
+          const auto j = art_.nearestNode(p, std::max(t.delta, t.co2));
           const Vec3 v = j >= 0 ? art_.pos[std::size_t(j)] - p : Vec3(0, 0, 0);
           const double d2 = j >= 0 ? dot(v, v) : INFINITY;
-          if (veins && d2 < co2 * co2) f = Oxygenated;
-          art_near_[q] = d2 < delta * delta ? j : -1;
+          if (veins_ && d2 < t.co2 * t.co2) f = Oxygenated;
+          art_near_[q] = d2 < t.delta * t.delta ? j : -1;
         }
-        if (veins && (f & (Supplied | Oxygenated))) {
-          if (ven_.nodeWithin(p, sat)) f |= Drained;
-          else if (ven_.anyDrainWithin(p, spacing)) f |= NearVeinDrain;
-          else ven_near_[q] = ven_.nearestNode(p, delta);
-        }
-        flags_[q] = f;
+        art_flags_[q] = f;
       }
     });
-    art_.fresh.clear();
-    ven_.fresh.clear();
+  }
+
+  // Tests the candidates that make CO₂ against the veins.
+  void meetVeins(const StepScale& t) {
+    ven_flags_.assign(candidates_.size(), 0);
+    ven_near_.assign(candidates_.size(), -2);
+    if (!veins_) return;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates_.size(), 64), [&](const tbb::blocked_range<std::size_t>& b) {
+      for (std::size_t q = b.begin(); q != b.end(); ++q) {
+        if (!(art_flags_[q] & (Supplied | Oxygenated))) continue;
+        const Vec3 p = candidates_[q];
+        if (ven_.nodeWithin(p, t.sat)) ven_flags_[q] = Drained;
+        else if (ven_.anyDrainWithin(p, t.spacing)) ven_flags_[q] = NearVeinDrain;
+        else ven_near_[q] = ven_.nearestNode(p, t.delta);
+      }
+    });
+  }
+
+  // The candidates become drains in draw order, each apart from those before it (one near a
+  // drain the step began with was flagged already, so the test against all drains is the test
+  // against this step's). Veins and arteries each keep their own drains.
+  void admitVeins(const StepScale& t) {
+    if (!veins_) return;
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
       const Vec3 p = candidates_[i];
-      const char f = flags_[i];
-      ++report_.candidates;
-      if ((f & (Supplied | Oxygenated)) && !(f & (Drained | NearVeinDrain)) && !ven_.freshDrainWithin(p, spacing)) {
-        ven_.addDrain(p, step_, ven_near_[i]);
+      if ((art_flags_[i] & (Supplied | Oxygenated)) && !(ven_flags_[i] & (Drained | NearVeinDrain)) && !ven_.anyDrainWithin(p, t.spacing)) {
+        ven_.addDrain(p, t.index, ven_near_[i]);
         ++cr_.venous_drains;
       }
+    }
+  }
+  void admitArteries(const StepScale& t) {
+    for (std::size_t i = 0; i < candidates_.size(); ++i) {
+      const Vec3 p = candidates_[i];
+      const char f = art_flags_[i];
       if (f & Supplied) {
         ++report_.rejected_too_close;
         continue;
       }
-      if ((f & NearArteryDrain) || art_.freshDrainWithin(p, spacing)) continue;
-      art_.addDrain(p, step_, art_near_[i]);
+      if ((f & NearArteryDrain) || art_.anyDrainWithin(p, t.spacing)) continue;
+      art_.addDrain(p, t.index, art_near_[i]);
       ++cr_.arterial_drains;
     }
-    // 2. Arteries grow; the drains they reach turn into CO₂ sources too; 3. veins grow to those.
-    grow(art_, st, k);
-    for (const System* s : {&art_, &ven_})
-      for (auto r : s->roots) max_radius_ = std::max(max_radius_, s->radiusOf(r));
-    satisfy(art_, sat, veins ? &ven_ : nullptr, st.drain_lifetime, delta);
-    if (veins) {
-      grow(ven_, st, k);
-      satisfy(ven_, sat, nullptr, st.drain_lifetime, delta);
-    }
-    ++step_;
+  }
+
+  // The veins grow to their drains and CO₂ sources, which they satisfy.
+  void growVeins(const StepScale& t) {
+    if (!veins_) return;
+    grow(ven_, t);
+    satisfy(ven_, t, nullptr);
   }
 
   const ColonisationOptions& o_;
@@ -583,10 +692,11 @@ class Grower {
   const GrowthDomain& world_;
   System art_, ven_;
   std::vector<Vec3> candidates_;
-  std::vector<char> flags_;
+  std::vector<char> art_flags_, ven_flags_;
   std::vector<std::int32_t> art_near_, ven_near_;
-  double terminal_radius_ = 0, max_edge_ = 0, max_radius_ = 0, symmetric_angle_ = 0;
-  std::int32_t step_ = 0;
+  double max_edge_ = 0, max_radius_ = 0, symmetric_angle_ = 0;
+  double reach_ = 0;    // the longest "node within" distance of any stage (last step's)
+  bool veins_ = false;  // the venous system grows (asked for, and it has a root)
 };
 
 }  // namespace
