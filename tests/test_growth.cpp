@@ -13,6 +13,7 @@
 #include "grow/common/segment_index.hpp"
 #include "physics/hemodynamics.hpp"
 #include "test_support.hpp"
+#include "tree_checks.hpp"
 
 using namespace angiosynth;
 
@@ -70,6 +71,36 @@ TEST(Growth, FinalRelaxationLowersTheCostAndKeepsEveryConstraint) {
     EXPECT_GE(relaxed.length[s], 2 * relaxed.radius[s]) << "segment " << s;
     const Vec3 a = relaxed.position[relaxed.parent[s]], b = relaxed.position[s];
     for (int k = 0; k <= 16; ++k) EXPECT_TRUE(ex.map.perfusable(a + (b - a) * (k / 16.0))) << "segment " << s;
+  }
+}
+
+// The final check's pairs (each sought from its thicker vessel, in parallel blocks) are exactly
+// the brute-force pairs: a random tree in 3D and in a plane, radii from a hair to trunks, many of
+// them equal (ties), more than one block of segments, on 1 and 2 threads.
+TEST(Growth, IntersectingPairsEqualBruteForce) {
+  for (const bool planar : {false, true}) {
+    Rng rng(11, planar, Stage::Growth);
+    VascularTree t;
+    t.addNode(Vec3(10, 10, planar ? 0 : 10), -1);
+    std::vector<std::int32_t> open{0};  // nodes with fewer than two children
+    const auto in = [](double v) { return std::clamp(v, 0.0, 20.0); };
+    for (int i = 1; i < 2600; ++i) {
+      const auto k = std::size_t(rng.uniform() * double(open.size()));
+      const auto par = open[k];
+      const Vec3 d(rng.uniform(-1, 1), rng.uniform(-1, 1), planar ? 0.0 : rng.uniform(-1, 1));
+      const Vec3 q = t.position[par] + d * 1.5;
+      const auto id = t.addNode(Vec3(in(q.x), in(q.y), planar ? 0.0 : in(q.z)), par);
+      if (t.child1[par] >= 0) open.erase(open.begin() + std::ptrdiff_t(k));
+      open.push_back(id);
+      const double u = rng.uniform();
+      t.radius[id] = u < 0.3 ? 0.05 : u < 0.95 ? 0.02 + 0.2 * rng.uniform() : 0.5 + 1.5 * rng.uniform();
+    }
+    const auto want = test::bruteForcePairs(t);
+    ASSERT_GT(want.size(), 200u) << "the comparison is not of empty lists";
+    for (const int threads : {1, 2}) {
+      tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+      EXPECT_EQ(intersectingPairs(t, Vec3(0, 0, 0), Vec3(20, 20, planar ? 0 : 20)), want) << "planar " << planar << ", threads " << threads;
+    }
   }
 }
 

@@ -10,10 +10,11 @@
 
 namespace angiosynth::test {
 
-// Every pair of segments more than one segment apart (within and across the trees of a forest), by brute force (independent of the grid
-// the grower and its final check use): their capsules must not overlap.
-inline std::int64_t bruteForceIntersections(const VascularTree& t) {
-  std::int64_t hits = 0;
+// Every pair of segments more than one segment apart (within and across the trees of a forest)
+// whose capsules overlap, by brute force (independent of the grid the grower and its final check
+// use), as (smaller id, larger id) in order.
+inline std::vector<std::pair<std::int32_t, std::int32_t>> bruteForcePairs(const VascularTree& t) {
+  std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
   for (std::int32_t x = 1; x < t.nodeCount(); ++x)
     for (std::int32_t y = x + 1; y < t.nodeCount(); ++y) {
       if (t.isRoot(x) || t.isRoot(y)) continue;  // a forest: the roots of later trees
@@ -25,10 +26,11 @@ inline std::int64_t bruteForceIntersections(const VascularTree& t) {
                 std::min(b0[ax], b1[ax]) - t.radius[y] > std::max(a0[ax], a1[ax]) + t.radius[x];
       if (apart) continue;
       if (withinTwoSegments(t, x, y)) continue;
-      if (segmentSegmentDistance(a0, a1, b0, b1) < t.radius[x] + t.radius[y]) ++hits;
+      if (segmentSegmentDistance(a0, a1, b0, b1) < t.radius[x] + t.radius[y]) pairs.emplace_back(x, y);
     }
-  return hits;
+  return pairs;
 }
+inline std::int64_t bruteForceIntersections(const VascularTree& t) { return std::int64_t(bruteForcePairs(t).size()); }
 
 // Geometry invariants of a final tree: length > 2r, inside the domain (checked by sampling the
 // capsule's centreline against the domain's depth), no intersecting pair.

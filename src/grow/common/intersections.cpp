@@ -1,5 +1,8 @@
 #include "grow/common/intersections.hpp"
 
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 
 #include "grow/common/segment_index.hpp"
@@ -27,20 +30,29 @@ std::vector<std::pair<std::int32_t, std::int32_t>> intersectingPairs(const Vascu
   if (t.segmentCount() < 2) return pairs;
   SegmentIndex index(lo, hi);
   index.refresh(t, true);
-  double r_max = 0;
-  for (std::int32_t s = 1; s < t.nodeCount(); ++s) r_max = std::max(r_max, t.radius[s]);
-  // Links are skipped: each lies inside the cap of the vessel ending at its junction.
-  for (std::int32_t x = 1; x < t.nodeCount(); ++x) {
-    if (t.isRoot(x) || t.isLink(x)) continue;
-    const Vec3& a0 = t.position[t.parent[x]];
-    const Vec3& a1 = t.position[x];
-    const double reach = t.radius[x] + r_max;
-    index.forEachNearSegment(a0, a1, reach, [&](std::int32_t y) {
-      if (y <= x || t.isLink(y) || withinTwoSegments(t, x, y)) return;
-      if (capsulesOverlap(a0, a1, t.radius[x], t.position[t.parent[y]], t.position[y], t.radius[y]))
-        pairs.emplace_back(x, y);
-    });
-  }
+  // Each pair is sought from its thicker vessel (ties: the smaller id), whose reach 2r covers any
+  // thinner one it can touch: the many thin vessels look only close by, not as far as the root's
+  // radius. Blocks of segments run in parallel, each with its own list; the lists join in order.
+  const auto thinner = [&](std::int32_t y, std::int32_t x) { return t.radius[y] < t.radius[x] || (t.radius[y] == t.radius[x] && y > x); };
+  constexpr std::int32_t kBlock = 1024;
+  const std::int32_t n = t.nodeCount(), blocks = (n + kBlock - 1) / kBlock;
+  std::vector<std::vector<std::pair<std::int32_t, std::int32_t>>> found(static_cast<std::size_t>(blocks));
+  tbb::enumerable_thread_specific<SegmentIndex::Marks> marks;
+  tbb::parallel_for(std::int32_t(0), blocks, [&](std::int32_t b) {
+    auto& m = marks.local();
+    for (std::int32_t x = std::max(1, b * kBlock); x < std::min(n, (b + 1) * kBlock); ++x) {
+      // Links are skipped: each lies inside the cap of the vessel ending at its junction.
+      if (t.isRoot(x) || t.isLink(x)) continue;
+      const Vec3& a0 = t.position[t.parent[x]];
+      const Vec3& a1 = t.position[x];
+      index.forEachNearSegment(a0, a1, 2 * t.radius[x], m, [&](std::int32_t y) {
+        if (!thinner(y, x) || t.isLink(y) || withinTwoSegments(t, x, y)) return;
+        if (capsulesOverlap(a0, a1, t.radius[x], t.position[t.parent[y]], t.position[y], t.radius[y]))
+          found[std::size_t(b)].emplace_back(std::min(x, y), std::max(x, y));
+      });
+    }
+  });
+  for (const auto& f : found) pairs.insert(pairs.end(), f.begin(), f.end());
   std::sort(pairs.begin(), pairs.end());
   return pairs;
 }

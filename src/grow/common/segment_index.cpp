@@ -73,7 +73,7 @@ void SegmentIndex::nearest(const VascularTree& tree, const Vec3& p, int k,
     margin[ax][0] = p[ax] - (lo_[ax] + c[ax] * cell_);
     margin[ax][1] = lo_[ax] + (c[ax] + 1) * cell_ - p[ax];
   }
-  ++stamp_;
+  ++marks_.stamp;
   const int max_ring = std::max({n_[0], n_[1], n_[2]});
   for (int r = 0; r <= max_ring; ++r) {
     for (int kk = c[2] - r; kk <= c[2] + r; ++kk) {
@@ -84,7 +84,7 @@ void SegmentIndex::nearest(const VascularTree& tree, const Vec3& p, int k,
         for (int ii = c[0] - r; ii <= c[0] + r; ii += (face || r == 0) ? 1 : 2 * r) {
           if (ii < 0 || ii >= n_[0]) continue;
           for (auto s : cells_[cellId(ii, jj, kk)]) {
-            if (!mark(s)) continue;
+            if (!marks_.mark(s)) continue;
             const double d = pointSegmentDistance(p, tree.position[tree.parent[s]], tree.position[s]);
             if (static_cast<int>(out.size()) < k || d < out.back().first ||
                 (d == out.back().first && s < out.back().second)) {
@@ -112,6 +112,7 @@ bool SegmentIndex::anyWithin(const VascularTree& tree, const Vec3& p, double rad
   // Rings of cells outward from p's cell, so that the usual hit (a segment close by) returns
   // after a few cells; a segment within `radius` has its closest point, and so a registered
   // cell, within ring ⌈radius / cell⌉.
+  ++marks_.stamp;
   int c[3];
   for (int ax = 0; ax < 3; ++ax) {
     const double u = (p[ax] - lo_[ax]) / cell_;
@@ -123,12 +124,11 @@ bool SegmentIndex::anyWithin(const VascularTree& tree, const Vec3& p, double rad
         for (int j = a[1]; j <= b[1]; ++j)
           for (int i = a[0]; i <= b[0]; ++i)
             for (auto s : cells_[cellId(i, j, k)])
-              if (mark(s) && pointSegmentDistance(p, tree.position[tree.parent[s]], tree.position[s]) < radius) return true;
+              if (marks_.mark(s) && pointSegmentDistance(p, tree.position[tree.parent[s]], tree.position[s]) < radius) return true;
       return false;
     }
     c[ax] = static_cast<int>(u);
   }
-  ++stamp_;
   const int rings = std::min(static_cast<int>(std::ceil(radius / cell_)), std::max({n_[0], n_[1], n_[2]}));
   for (int r = 0; r <= rings; ++r)
     for (int kk = std::max(0, c[2] - r); kk <= std::min(n_[2] - 1, c[2] + r); ++kk)
@@ -137,7 +137,7 @@ bool SegmentIndex::anyWithin(const VascularTree& tree, const Vec3& p, double rad
         for (int ii = c[0] - r; ii <= c[0] + r; ii += (face || r == 0) ? 1 : 2 * r) {
           if (ii < 0 || ii >= n_[0]) continue;
           for (auto s : cells_[cellId(ii, jj, kk)])
-            if (mark(s) && pointSegmentDistance(p, tree.position[tree.parent[s]], tree.position[s]) < radius) return true;
+            if (marks_.mark(s) && pointSegmentDistance(p, tree.position[tree.parent[s]], tree.position[s]) < radius) return true;
         }
       }
   return false;

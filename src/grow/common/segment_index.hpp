@@ -28,34 +28,51 @@ class SegmentIndex {
                std::vector<std::pair<double, std::int32_t>>& out);
   // True if some segment lies closer than `radius` to p.
   bool anyWithin(const VascularTree& tree, const Vec3& p, double radius);
+  // Which segments a query has already met; one per concurrent caller of the const queries.
+  struct Marks {
+    std::vector<std::uint32_t> stamps;
+    std::uint32_t stamp = 0;
+    bool mark(std::int32_t s) {
+      if (s >= static_cast<std::int32_t>(stamps.size())) stamps.resize(2 * std::size_t(s) + 16, 0);
+      if (stamps[std::size_t(s)] == stamp) return false;
+      stamps[std::size_t(s)] = stamp;
+      return true;
+    }
+  };
+
   // Calls f(id) once for every segment whose cells overlap the box [lo, hi].
   template <class F>
   void forEachInBox(const Vec3& lo, const Vec3& hi, F&& f) {
     int a[3], b[3];
     cellRange(lo, hi, a, b);
-    ++stamp_;
+    ++marks_.stamp;
     for (int k = a[2]; k <= b[2]; ++k)
       for (int j = a[1]; j <= b[1]; ++j)
         for (int i = a[0]; i <= b[0]; ++i)
           for (auto s : cells_[cellId(i, j, k)])
-            if (mark(s)) f(s);
+            if (marks_.mark(s)) f(s);
   }
   // Calls f(id) once for every segment registered in a cell within `reach` of segment a–b.
   template <class F>
   void forEachNearSegment(const Vec3& a, const Vec3& b, double reach, F&& f) {
+    forEachNearSegment(a, b, reach, marks_, f);
+  }
+  // The same for one of several threads querying at once, each with its own marks.
+  template <class F>
+  void forEachNearSegment(const Vec3& a, const Vec3& b, double reach, Marks& marks, F&& f) const {
     int lo[3], hi[3];
     const Vec3 r(reach, reach, reach);
     cellRange(Vec3(std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)) - r,
               Vec3(std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)) + r, lo, hi);
     const double limit = reach + 0.8660254037844387 * cell_;
     const bool big = (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1) > 27;
-    ++stamp_;
+    ++marks.stamp;
     for (int k = lo[2]; k <= hi[2]; ++k)
       for (int j = lo[1]; j <= hi[1]; ++j)
         for (int i = lo[0]; i <= hi[0]; ++i) {
           if (big && pointSegmentDistance(lo_ + Vec3(i + 0.5, j + 0.5, k + 0.5) * cell_, a, b) > limit) continue;
           for (auto s : cells_[cellId(i, j, k)])
-            if (mark(s)) f(s);
+            if (marks.mark(s)) f(s);
         }
   }
   double cellSize() const { return cell_; }
@@ -64,20 +81,13 @@ class SegmentIndex {
   void build(const VascularTree& tree, double cell);
   void cellRange(const Vec3& lo, const Vec3& hi, int* a, int* b) const;
   std::int64_t cellId(int i, int j, int k) const { return i + std::int64_t(n_[0]) * (j + std::int64_t(n_[1]) * k); }
-  bool mark(std::int32_t s) {
-    if (s >= static_cast<std::int32_t>(stamps_.size())) stamps_.resize(2 * s + 16, 0);
-    if (stamps_[s] == stamp_) return false;
-    stamps_[s] = stamp_;
-    return true;
-  }
 
   Vec3 lo_, hi_;
   bool planar_ = false;
   double cell_ = 0;
   int n_[3] = {0, 0, 0};
   std::vector<std::vector<std::int32_t>> cells_;
-  std::vector<std::uint32_t> stamps_;
-  std::uint32_t stamp_ = 0;
+  Marks marks_;
   std::int32_t built_for_ = 0;
 };
 
