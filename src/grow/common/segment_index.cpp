@@ -11,7 +11,9 @@ void SegmentIndex::refresh(const VascularTree& tree, bool force) {
   const Vec3 ext = hi_ - lo_;
   // About two segments per cell on average; never more than ~2^22 cells.
   double cell;
-  if (planar_) {
+  // A box without thickness (a 2D tree's, given flat) is planar whatever the caller said: its
+  // volume would give cells of no size.
+  if (planar_ || !(ext.z > 1e-9 * std::max(ext.x, ext.y))) {
     const double area = std::max(ext.x * ext.y, 1e-30);
     cell = std::max(std::sqrt(2.0 * area / std::max<std::int32_t>(n, 1)), std::sqrt(area / double(1 << 22)));
   } else {
