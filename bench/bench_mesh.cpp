@@ -1,12 +1,19 @@
 // Surface meshing (issue 15): the forest of each parameter file grown once, then its closed
-// surface (src/mesh) at the automatic step (4 samples across the thinnest vessel) or --voxel MM:
-//   bench_mesh FILE.toml ... [--voxel MM] [--threads T]
+// surface (src/mesh) at the automatic step (4 samples across the thinnest vessel) or --voxel MM,
+// contoured whole (--tubes 0) or as tubes joined to contoured junctions (--tubes 1, with
+// --samples N across each vessel at the junctions, default 3):
+//   bench_mesh FILE.toml ... [--voxel MM] [--tubes 0|1] [--samples N] [--threads T]
 // Prints the step, the time, triangles in all and per segment, and the peak memory.
 // Targets (issue 15): 10k segments ≤ 10 s, ≤ 4 GB, ≤ 500 triangles per segment; 100k ≤ 2 min.
 #include <cstdio>
 
 #include "bench_files.hpp"
 #include "core/memory.hpp"
+#include <cstdlib>
+#include <fstream>
+
+#include "io/mesh_writers.hpp"
+#include "mesh/tube_surface.hpp"
 #include "mesh/vessel_surface.hpp"
 
 using namespace angiosynth;
@@ -14,7 +21,12 @@ using namespace angiosynth;
 int main(int argc, char** argv) {
   std::vector<char*> rest;
   const double voxel = bench::takeOption(argc, argv, "--voxel", 0, rest);
-  const auto args = bench::parseFileArgs(int(rest.size()), rest.data());
+  std::vector<char*> rest2, rest3;
+  const bool tubes = bench::takeOption(int(rest.size()), rest.data(), "--tubes", 0, rest2) != 0;
+  const int samples = int(bench::takeOption(int(rest2.size()), rest2.data(), "--samples", 3, rest3));
+  std::vector<char*> rest4;
+  const bool decimated = bench::takeOption(int(rest3.size()), rest3.data(), "--decimate", 0, rest4) != 0;
+  const auto args = bench::parseFileArgs(int(rest4.size()), rest4.data());
   std::printf("%-34s %9s %9s %10s %12s %10s %8s %9s\n", "file", "segments", "step mm", "mesh s", "triangles", "tri/seg", "genus0", "peak MiB");
   for (const auto& f : args.files) {
     const auto sc = readTomlParameters(f);
@@ -27,13 +39,36 @@ int main(int argc, char** argv) {
     SurfaceOptions o;
     o.voxel_mm = voxel;
     SurfaceReport rep;
+    TubeSurfaceReport trep;
     const auto t0 = std::chrono::steady_clock::now();
-    const auto m = vesselSurface(t, o, &rep);
+    SurfaceMesh m;
+    if (tubes) {
+      TubeSurfaceOptions to;
+      to.junction = o;
+      to.junction.samples_across = samples;
+      to.decimate = decimated;
+      m = tubeSurface(t, to, &trep);
+      rep.voxel_mm = trep.finest_step_mm;
+    } else {
+      m = vesselSurface(t, o, &rep);
+    }
     const double s = bench::millisecondsSince(t0) / 1e3;
+    if (const char* dump = std::getenv("MESH_DUMP")) {
+      std::ofstream os(dump, std::ios::binary);
+      meshWriter("off")(os, m);
+    }
     const auto topo = meshTopology(m);
     int genus0 = 0;
     for (std::size_t k = 0; k < topo.tree_euler.size(); ++k) genus0 += topo.tree_components[k] == 1 && topo.tree_euler[k] == 2;
     std::printf("%-34s %9lld %9.4f %10.2f %12zu %10.0f %5d/%-2zu %9.0f\n", f.c_str(), (long long)segments, rep.voxel_mm, s, m.triangles.size(),
                 double(m.triangles.size()) / double(segments), genus0, topo.tree_euler.size(), peakRssBytes() / 1048576.0);
+    std::printf("  boundary %lld, non-manifold %lld, misoriented %lld, degenerate %lld, volume %.4f mm3, euler", (long long)topo.boundary_edges,
+                (long long)topo.nonmanifold_edges, (long long)topo.misoriented_edges, (long long)topo.degenerate_triangles, topo.volume_mm3);
+    for (auto e : topo.tree_euler) std::printf(" %lld", (long long)e);
+    if (tubes)
+      std::printf("\n  tubes %lld of %lld vessels, clusters %lld (largest %lld vessels), contour %lld + tube %lld triangles, fallbacks %lld",
+                  (long long)trep.tubes, (long long)trep.vessels, (long long)trep.clusters, (long long)trep.largest_cluster_vessels,
+                  (long long)trep.contour_triangles, (long long)trep.tube_triangles, (long long)trep.fallbacks);
+    std::printf("\n");
   }
 }

@@ -24,11 +24,16 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
   c->add_option("INPUT", a.input, "a sample directory (its nodes.csv and edges.csv are read) or a graph file: .csv, .gxl, .vtp, .swc, .cco")
       ->required();
   c->add_option("--out", a.out, "output directory (default: <INPUT>_mesh next to the input)");
+  c->add_option("--method", a.method,
+                "tubes: each vessel's free middle a tube of rings on its wall, the parts where vessels meet contoured and joined to "
+                "them (default); contour: the whole surface contoured from the signed distance")
+      ->check(CLI::IsMember({"tubes", "contour"}));
+  c->add_option("--ring-spacing", a.ring_spacing, "tubes: rings at most this many radii apart (default 2)")->check(finiteIn(0.1, 100));
   c->add_option("--voxel", a.voxel_mm, "finest grid step in mm (default: the thinnest vessel's diameter / --samples-across)")
       ->check(finiteIn(0, 1e6));
   c->add_option("--samples-across", a.samples_across,
-                "grid steps across each vessel's thinnest end: each vessel is sampled at the coarsest step (the finest times a power of 2) "
-                "that keeps this many (default 4)")
+                "grid steps across each vessel's thinnest end where it is contoured: each vessel is sampled at the coarsest step (the "
+                "finest times a power of 2) that keeps this many (default 3 with --method tubes, 4 with contour)")
       ->check(CLI::Range(1, 64));
   c->add_flag("--uniform", a.uniform, "sample every vessel at the finest step (no adaptive resolution)");
   c->add_flag("--on-surface", a.on_surface,
@@ -66,6 +71,8 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   const fs::path out = a.out.empty() ? fs::path(in.lexically_normal().string() + "_mesh") : fs::path(a.out);
   StagedDirectory dir(out, a.force ? ExistingOutput::ReplaceOwn : ExistingOutput::Refuse, {in});
   MeshParameters p;
+  p.method = a.method;
+  p.ring_spacing = a.ring_spacing;
   p.voxel_mm = a.voxel_mm;
   p.samples_across = a.samples_across;
   p.uniform = a.uniform;

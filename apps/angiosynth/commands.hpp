@@ -75,8 +75,10 @@ int runScore(const ScoreArgs& a);
 
 struct MeshArgs {
   std::string input, out;
+  std::string method = "tubes";
   double voxel_mm = 0;
-  int samples_across = 4;
+  int samples_across = 0;
+  double ring_spacing = 2;
   bool uniform = false, on_surface = false;
   std::string ends = "closed";
   double flow_extension = 0;

@@ -36,8 +36,14 @@ const std::vector<MethodParam>& commonParams() {
       {"output", "gxl_dialect", "text", "gxl", "gxl (GXL 1.0) or vascusynth"},
       {"mesh", "enabled", "true/false", "true", "with a [mesh] table: write the vessels' surface (one closed mesh per tree) beside the graphs"},
       {"mesh", "formats", "[text]", "[\"stl\"]", "any of stl, obj, ply, off, vtp: surface.<format> each"},
+      {"mesh", "method", "tubes/contour", "tubes",
+       "tubes: each vessel's free middle (no other vessel near its wall) a tube of rings on its exact wall, the parts where vessels "
+       "meet (bifurcations, round ends, vessels that touch) contoured and joined to the tubes ring to ring; contour: the whole surface "
+       "contoured from the signed distance"},
       {"mesh", "voxel_size", "mm", "the thinnest vessel's diameter / samples_across", "the finest grid step"},
-      {"mesh", "samples_across", "count", "4", "grid steps across each vessel's thinnest end (1 … 64); thicker vessels get coarser cells"},
+      {"mesh", "samples_across", "count", "3 (tubes), 4 (contour)",
+       "grid steps across each vessel's thinnest end where it is contoured (1 … 64); thicker vessels get coarser cells"},
+      {"mesh", "ring_spacing", "radii", "2", "tubes: rings at most this many radii of the vessel apart (0.1 … 100)"},
       {"mesh", "uniform", "true/false", "false", "every vessel at the finest step"},
       {"mesh", "on_surface", "true/false", "false", "vertices exactly on the surface (no volume restoration)"},
       {"mesh", "ends", "closed/open/capped", "closed",

@@ -42,8 +42,10 @@ struct ImageParameters {
 struct MeshParameters {
   bool enabled = false;
   std::vector<std::string> formats{"stl"};  // stl, obj, ply, off, vtp
+  std::string method = "tubes";             // tubes (rings along free vessels, contoured junctions) or contour (all contoured)
   double voxel_mm = 0;                      // finest step; 0: the thinnest vessel's diameter / samples_across
-  int samples_across = 4;
+  int samples_across = 0;                   // 0: the method's (contour 4, tubes 3)
+  double ring_spacing = 2;                  // tubes: rings at most this many radii apart
   bool uniform = false;                     // every vessel at the finest step
   bool on_surface = false;                  // no volume restoration: vertices exactly on the surface
   std::string ends = "closed";              // closed (round), open (cut at planes) or capped (planar caps, labelled faces)

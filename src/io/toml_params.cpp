@@ -146,7 +146,8 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   if (im.get("graph_formats")) ip.graph_formats = stringsOf(im, "graph_formats", {"csv", "vtp", "swc", "graphml", "cco"});
 
   // [mesh]: the vessels' surface beside the graphs (src/mesh); the table's presence enables it.
-  const auto& me = r.table("mesh", {"enabled", "formats", "voxel_size", "samples_across", "uniform", "on_surface", "ends", "flow_extension", "decimate", "max_error"});
+  const auto& me = r.table("mesh", {"enabled", "method", "formats", "voxel_size", "samples_across", "ring_spacing", "uniform", "on_surface", "ends",
+                                    "flow_extension", "decimate", "max_error"});
   if (const auto* n = root.get("mesh")) {
     auto& mp = sc.mesh;
     sc.mesh_line = r.lineOf(n);
@@ -157,7 +158,16 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
       mp.voxel_mm = r.quantity(me, "mesh", "voxel_size", Dimension::Length, voxel_mm);
       checkRange(mp.voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, r.at(me, "voxel_size"), "mesh voxel_size (mm)");
     }
+    if (me.get("method")) {
+      mp.method = r.string(me, "mesh", "method");
+      if (mp.method != "tubes" && mp.method != "contour")
+        throw InputError(file, r.lineOf(me.get("method")), "method '" + mp.method + "'; allowed: tubes, contour");
+    }
     if (me.get("samples_across")) mp.samples_across = r.smallInteger(me, "mesh", "samples_across", 1, 64);
+    if (me.get("ring_spacing")) {
+      mp.ring_spacing = r.number(me, "mesh", "ring_spacing");
+      checkRange(mp.ring_spacing, 0.1, false, 100, false, r.at(me, "ring_spacing"), "ring_spacing (radii)");
+    }
     mp.uniform = r.boolean(me, "uniform", mp.uniform);
     mp.on_surface = r.boolean(me, "on_surface", mp.on_surface);
     if (me.get("ends")) {

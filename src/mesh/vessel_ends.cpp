@@ -32,12 +32,12 @@ std::uint64_t directedKey(std::int32_t a, std::int32_t b) { return (std::uint64_
 struct EndRegion {
   Vec3 c, n;
   double r;
+  bool tight;
   bool holds(const Vec3& p, double step) const {
-    const double h = 2 * std::min(step, 2 * r);
+    const auto x = endCutExtent(r, step, tight);
     const Vec3 v = p - c;
     const double s = dot(v, n), rho2 = dot(v, v) - s * s;
-    const double reach = 1.5 * r + h;
-    return s >= -(r + h) && s <= (kOvershootRadii + 1) * r + h && rho2 <= reach * reach;
+    return s >= -x.before && s <= x.beyond && rho2 <= x.reach * x.reach;
   }
   // Its bounding box.
   void box(Vec3& lo, Vec3& hi) const {
@@ -138,6 +138,15 @@ std::vector<std::array<int, 3>> clipEars(const std::vector<Vec3>& polygon, const
 
 }  // namespace
 
+EndCutExtent endCutExtent(double r, double step, bool tight) {
+  if (tight) {
+    const double h = std::min(step, 2 * r);
+    return {1.5 * h, (kOvershootRadii + 1) * r + h, r + 0.5 * h};
+  }
+  const double h = 2 * std::min(step, 2 * r);
+  return {r + h, (kOvershootRadii + 1) * r + h, 1.5 * r + h};
+}
+
 std::vector<VesselEnd> openEnds(const VascularTree& t, double extension_radii) {
   std::vector<VesselEnd> ends;
   const auto add = [&](std::int32_t vessel, bool root) {
@@ -183,7 +192,7 @@ EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool ca
   m.triangle_face.assign(m.triangles.size(), 0);
   if (ends.empty() || m.triangles.empty()) return rep;
   std::vector<EndRegion> regions;
-  for (const auto& e : ends) regions.push_back({e.centre, e.normal, e.radius});
+  for (const auto& e : ends) regions.push_back({e.centre, e.normal, e.radius, e.tight});
   const auto near = verticesNearEnds(m, regions);
 
   // Triangles at each vertex near an end (vertex-to-triangle incidence of those vertices only).
@@ -352,7 +361,7 @@ EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool ca
     // the outward normal), else the loop's ears.
     std::vector<std::array<std::int32_t, 3>> cap;
     double area = 0;
-    if (caps) {
+    if (caps && !end.open) {
       const auto centre = base + std::int32_t(new_vertices.size());
       bool star = true;
       for (std::size_t i = 0; i < loop.size(); ++i) {

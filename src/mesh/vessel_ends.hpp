@@ -23,7 +23,18 @@ struct VesselEnd {
   Vec3 centre;               // the cut plane's point on the axis (node + normal × extension), mm
   Vec3 normal;               // unit, pointing out of the vessel
   double radius = 0;         // the vessel's radius at that end, mm
+  bool open = false;         // never capped (a tube's cut, joined to its rings later)
+  bool tight = false;        // read only a step around the tube (the caller keeps other vessels out of it)
 };
+
+// The space an end's cut reads around its axis: from `before` behind its plane to `beyond` past
+// it, within `reach` of the axis (mm), for an end of radius r where the contour's step is `step`.
+// A vertex of another vessel inside it leaves the end closed. A tight end reads a step around
+// its tube; an ordinary one a radius more, since its neighbours are wherever growth put them.
+struct EndCutExtent {
+  double before, beyond, reach;
+};
+EndCutExtent endCutExtent(double radius, double step, bool tight = false);
 
 // The open ends of a tree: each root with a single vessel leaving it and every leaf; per tree,
 // the root first, then the leaves by position (x, y, z); `extension_radii` ≥ 0 moves each plane
@@ -41,8 +52,9 @@ struct EndCutReport {
   std::vector<std::int32_t> loop_vertices;  // per end: vertices of its boundary loop
 };
 
-// Cuts `m` (the surface of prolongEnds' tree) at every end's plane; `caps` fills each loop with a
-// fan of triangles from the plane's centre (the loop is checked to be star-shaped around it).
+// Cuts `m` (the surface of prolongEnds' tree) at every end's plane; `caps` fills each loop (of an
+// end not `open`) with a fan of triangles from the plane's centre (the loop is checked to be
+// star-shaped around it, else its ears are clipped).
 // Sets m.triangle_face. Vertices no triangle uses any more are dropped.
 EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool caps);
 

@@ -6,6 +6,7 @@
 #include "io/mesh_writers.hpp"
 #include "core/format.hpp"
 #include "mesh/decimate.hpp"
+#include "mesh/tube_surface.hpp"
 #include "mesh/vessel_ends.hpp"
 #include "mesh/vessel_surface.hpp"
 
@@ -39,9 +40,10 @@ void writeFaces(std::ostream& os, const std::vector<VesselEnd>& ends, const EndC
 SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p, std::uint64_t memory_limit, const std::filesystem::path& dir,
                                const std::function<void(std::int64_t, std::int64_t)>& progress, const std::vector<std::string>& tree_kinds,
                                const std::vector<std::string>& vessel_ids) {
+  const bool tubes = p.method == "tubes";
   SurfaceOptions o;
   o.voxel_mm = p.voxel_mm;
-  o.samples_across = p.samples_across;
+  o.samples_across = p.samples_across > 0 ? p.samples_across : tubes ? 3 : 4;
   o.adaptive = !p.uniform;
   o.restore_volume = !p.on_surface;
   o.memory_limit = memory_limit;
@@ -50,15 +52,32 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   const auto ends = cut_ends ? openEnds(tree, p.flow_extension) : std::vector<VesselEnd>{};
   EndCutReport cut;
   DecimateReport reduced;
-  o.finish = [&](SurfaceMesh& mesh, const std::function<double(std::int32_t, const Vec3&)>& distance) {
-    if (cut_ends) cut = cutEnds(mesh, ends, p.ends == "capped");
-    if (p.decimate) {
-      DecimateOptions d;
-      d.max_error = p.max_error;
-      reduced = decimate(mesh, d, distance);
-    }
-  };
-  auto mesh = vesselSurface(cut_ends ? prolongEnds(tree, ends) : tree, o, &report, progress);
+  DecimateOptions d;
+  d.max_error = p.max_error;
+  TubeSurfaceReport tube_report;
+  SurfaceMesh mesh;
+  if (tubes) {
+    TubeSurfaceOptions to;
+    to.junction = o;
+    to.ring_spacing_radii = p.ring_spacing;
+    to.ends = ends;
+    to.cap_ends = p.ends == "capped";
+    to.decimate = p.decimate;
+    to.decimation = d;
+    mesh = tubeSurface(tree, to, &tube_report, progress);
+    cut = tube_report.ends;
+    report.voxel_mm = tube_report.finest_step_mm;
+    report.estimated_bytes = tube_report.estimated_bytes;
+    reduced.before = tube_report.triangles_before_decimation + tube_report.tube_triangles;
+    reduced.collapses = tube_report.decimation_collapses;
+    reduced.largest_error_mm = tube_report.decimation_largest_error_mm;
+  } else {
+    o.finish = [&](SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
+      if (cut_ends) cut = cutEnds(m, ends, p.ends == "capped");
+      if (p.decimate) reduced = decimate(m, d, distance);
+    };
+    mesh = vesselSurface(cut_ends ? prolongEnds(tree, ends) : tree, o, &report, progress);
+  }
   const auto topo = meshTopology(mesh);
   SurfaceFiles out;
   out.files = Json::object();
@@ -78,33 +97,45 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   std::int64_t trees = 0, segments = 0;
   for (std::int32_t i = 0; i < tree.nodeCount(); ++i) trees += tree.isRoot(i), segments += !tree.isRoot(i) && !tree.isLink(i);
   out.parameters = {{"formats", p.formats},
+                    {"method", p.method},
                     {"voxel_mm", p.voxel_mm > 0 ? Json(p.voxel_mm) : Json(nullptr)},
-                    {"samples_across", p.samples_across},
+                    {"samples_across", o.samples_across},
+                    {"ring_spacing_radii", tubes ? Json(p.ring_spacing) : Json(nullptr)},
                     {"adaptive", !p.uniform},
                     {"volume_restored", !p.on_surface},
                     {"ends", p.ends},
                     {"flow_extension_radii", p.flow_extension},
                     {"decimate", p.decimate},
                     {"max_error_steps", p.max_error},
-                    {"method", "marching tetrahedra of the signed distance to the union of each tree's capsules and round cones, on a "
-                               "2:1-balanced octree of cells sized to each vessel's radius, split into conforming tetrahedra"}};
+                    {"description", tubes ? "each vessel's free middle a tube of rings on its exact wall (at most ring_spacing_radii radii "
+                                            "apart); where vessels meet, marching tetrahedra of the signed distance to the union of their "
+                                            "capsules and round cones (2:1-balanced octree of cells sized to each vessel's radius), cut by "
+                                            "planes across the tubes and joined to their rings"
+                                          : "marching tetrahedra of the signed distance to the union of each tree's capsules and round cones, on a "
+                                            "2:1-balanced octree of cells sized to each vessel's radius, split into conforming tetrahedra"}};
   out.statistics = {{"trees", trees},
                     {"segments", segments},
                     {"vertices", mesh.vertices.size()},
                     {"triangles", mesh.triangles.size()},
                     {"triangles_per_segment", segments > 0 ? double(mesh.triangles.size()) / double(segments) : 0.0},
                     {"finest_step_mm", report.voxel_mm},
-                    {"coarsest_cell_mm", report.coarsest_mm},
-                    {"levels", report.levels},
-                    {"cells", report.cells},
-                    {"largest_volume_move_mm", report.largest_volume_move_mm},
+                    {"coarsest_cell_mm", tubes ? Json(nullptr) : Json(report.coarsest_mm)},
+                    {"levels", tubes ? Json(nullptr) : Json(report.levels)},
+                    {"cells", tubes ? Json(nullptr) : Json(report.cells)},
+                    {"largest_volume_move_mm", tubes ? Json(nullptr) : Json(report.largest_volume_move_mm)},
+                    {"tubes", tubes ? Json(tube_report.tubes) : Json(nullptr)},
+                    {"contoured_parts", tubes ? Json(tube_report.clusters) : Json(nullptr)},
+                    {"largest_contoured_part_vessels", tubes ? Json(tube_report.largest_cluster_vessels) : Json(nullptr)},
+                    {"tube_triangles", tubes ? Json(tube_report.tube_triangles) : Json(nullptr)},
+                    {"contoured_triangles", tubes ? Json(tube_report.contour_triangles) : Json(nullptr)},
+                    {"tubes_given_up", tubes ? Json(tube_report.fallbacks) : Json(nullptr)},
                     {"estimated_bytes", report.estimated_bytes},
                     {"enclosed_volume_mm3", topo.volume_mm3},
                     {"boundary_edges", topo.boundary_edges},
                     {"nonmanifold_edges", topo.nonmanifold_edges},
                     {"misoriented_edges", topo.misoriented_edges},
                     {"degenerate_triangles", topo.degenerate_triangles},
-                    {"cavities_removed", report.cavities_removed},
+                    {"cavities_removed", tubes ? tube_report.cavities_removed : report.cavities_removed},
                     {"triangles_before_decimation", p.decimate ? Json(reduced.before) : Json(nullptr)},
                     {"decimation_collapses", reduced.collapses},
                     {"decimation_largest_error_mm", reduced.largest_error_mm},

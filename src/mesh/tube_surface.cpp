@@ -1,0 +1,773 @@
+#include "mesh/tube_surface.hpp"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <tuple>
+#include <unordered_map>
+
+#include "core/error.hpp"
+#include "grow/common/segment_index.hpp"
+#include "mesh/decimate.hpp"
+
+namespace angiosynth {
+namespace {
+
+constexpr double kTwoPi = 2 * std::numbers::pi;
+// Vessels whose axes come closer than this many times the sum of their radii touch.
+constexpr double kTouching = 1.1;
+// A part with a handle it should not have is contoured again at most this many times, finer.
+constexpr int kRefinements = 2;
+// A tube is at least this many radii long.
+constexpr double kShortestTube = 0.25;
+
+// A vessel as the mesher sees it: its two junction nodes (links merged), its axis and radii, and
+// where its tube starts and ends.
+struct Vessel {
+  std::int32_t s = -1, tree = 0;
+  std::int32_t node[2] = {-1, -1};  // junction nodes at its proximal (0) and distal (1) end
+  Vec3 a, b, u;                     // ends and unit axis a → b, mm
+  double len = 0, ra = 0, rb = 0;
+  double sin_a = 0, cos_a = 1;      // a round cone's side slope
+  bool nested = false;              // a cone with no side (one sphere holds the other)
+  // Distances of the tube's ends from a (side 0) and from b (side 1) along the axis: a cut's
+  // plane, or a CFD end's plane beyond the node (negative).
+  double plane[2] = {0, 0};
+  int end[2] = {-1, -1};            // the CFD end (options.ends index) at each side, or -1
+  bool tube = false;
+
+  double rmax() const { return std::max(ra, rb); }
+  // The wall's distance from the axis at distance y from a along it (a CFD prolongation beyond
+  // an end is a cylinder of that end's radius).
+  double radiusAt(double y) const {
+    if (ra == rb) return ra;
+    if (y <= 0) return ra;
+    if (y >= len) return rb;
+    return (ra - y * sin_a) / cos_a;
+  }
+  // Side k's node, its direction into the vessel, and the distance along that direction from
+  // the node to the point at distance y from a.
+  Vec3 nodeAt(int k) const { return k == 0 ? a : b; }
+  Vec3 into(int k) const { return k == 0 ? u : u * -1.0; }
+  double fromA(int k, double d) const { return k == 0 ? d : len - d; }
+};
+
+// The contour step near a vessel of radius r (vesselLevels: cells of 2r / samples_across).
+double stepNear(double r, const SurfaceOptions& o) { return 2 * r / std::max(1, o.samples_across); }
+
+// Where side k's cut must lie so that no other vessel at its node enters the region the cut
+// reads (endCutExtent: behind the plane, past it, around the axis): a vessel o leaving the node
+// at angle θ to this one has its points within r_o of its axis, so along this axis it reaches
+// r_o where it turns away (θ ≥ 90°), else d·cos θ + r_o up to the distance d where its axis is
+// reach + r_o from this one's.
+// The region is read around each vertex with that vertex's step: the coarser of the two vessels'.
+double cutDistance(const Vessel& v, int k, const std::vector<const Vessel*>& others, const SurfaceOptions& o) {
+  const double r = v.rmax();
+  const Vec3 w = v.into(k);
+  double plane = endCutExtent(r, stepNear(r, o), true).before;
+  for (const Vessel* q : others) {
+    if (q == &v) continue;
+    const int kq = q->node[0] == v.node[k] ? 0 : 1;
+    const double c = dot(w, q->into(kq)), ro = q->rmax();
+    const auto x = endCutExtent(r, std::max(stepNear(r, o), stepNear(ro, o)), true);
+    double axial = ro;
+    if (c > 0) {
+      const double sin_t = std::sqrt(std::max(0.0, 1 - c * c));
+      const double d = sin_t > 1e-12 ? std::min(q->len, (x.reach + ro) / sin_t) : q->len;
+      axial = d * c + ro;
+    }
+    plane = std::max(plane, axial + x.before);
+  }
+  return plane;
+}
+
+// Union-find over node ids.
+struct Groups {
+  std::vector<std::int32_t> up;
+  explicit Groups(std::size_t n) : up(n) {
+    for (std::size_t i = 0; i < n; ++i) up[i] = std::int32_t(i);
+  }
+  std::int32_t find(std::int32_t v) {
+    while (up[std::size_t(v)] != v) v = up[std::size_t(v)] = up[std::size_t(up[std::size_t(v)])];
+    return v;
+  }
+  void join(std::int32_t a, std::int32_t b) {
+    a = find(a), b = find(b);
+    if (a != b) up[std::size_t(std::max(a, b))] = std::min(a, b);
+  }
+};
+
+// A tube's end as a cluster cuts it.
+struct Stub {
+  std::int32_t vessel;  // index into the vessels
+  int side;
+};
+
+struct Cluster {
+  std::int32_t tree = 0;
+  std::vector<std::int32_t> whole;  // vessels contoured whole
+  std::vector<Stub> stubs;          // tubes cut at this cluster's side
+  bool touching = false;            // holds vessels that touch without sharing a node (its union may have handles)
+};
+
+// What a cluster gives: its surface (its own vertex numbering) and each stub's loop, counter-
+// clockwise around the vessel's axis a → b, or empty if its cut failed.
+struct ClusterMesh {
+  SurfaceMesh mesh;
+  std::vector<std::vector<std::int32_t>> loops;
+  std::vector<std::int32_t> end_ids;     // CFD ends cut here (options.ends indices)
+  EndCutReport ends;                     // for those, in that order
+  double estimated_bytes = 0, step = 0;
+  std::int64_t cavities_removed = 0;
+  DecimateReport decimation;
+  int refinements = 0;                   // contoured again, finer, to lose a handle
+};
+
+// The boundary loops of a mesh: directed edges used once, chained (a chain that branches or
+// breaks off is left out).
+std::vector<std::vector<std::int32_t>> boundaryLoops(const SurfaceMesh& m) {
+  std::vector<std::pair<std::int64_t, std::int64_t>> edges;  // (min·2^32 + max, from·2^32 + to)
+  for (const auto& t : m.triangles)
+    for (int i = 0; i < 3; ++i) {
+      const std::int64_t a = t[std::size_t(i)], b = t[std::size_t((i + 1) % 3)];
+      edges.emplace_back((std::min(a, b) << 32) | std::max(a, b), (a << 32) | b);
+    }
+  std::sort(edges.begin(), edges.end());
+  std::vector<std::pair<std::int32_t, std::int32_t>> next;  // from → to of edges used once
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    if (j - i == 1) next.emplace_back(std::int32_t(edges[i].second >> 32), std::int32_t(edges[i].second & 0xffffffff));
+    i = j;
+  }
+  std::sort(next.begin(), next.end());
+  const auto from = [&](std::int32_t v) {
+    const auto it = std::lower_bound(next.begin(), next.end(), std::make_pair(v, std::int32_t(-1)));
+    const bool one = it != next.end() && it->first == v && (it + 1 == next.end() || (it + 1)->first != v);
+    return one ? std::size_t(it - next.begin()) : next.size();
+  };
+  std::vector<char> used(next.size(), 0);
+  std::vector<std::vector<std::int32_t>> loops;
+  for (std::size_t i = 0; i < next.size(); ++i) {
+    if (used[i]) continue;
+    std::vector<std::int32_t> loop;
+    bool ok = true;
+    for (std::size_t at = i;;) {
+      used[at] = 1;
+      loop.push_back(next[at].first);
+      at = from(next[at].second);
+      if (at == next.size()) {
+        ok = false;
+        break;
+      }
+      if (at == i) break;
+      if (used[at]) {
+        ok = false;
+        break;
+      }
+    }
+    if (ok) loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+// Angle of p around the axis through c along u, from e1 towards e2 = u × e1, in [0, 2π).
+double angleAround(const Vec3& p, const Vec3& c, const Vec3& e1, const Vec3& e2) {
+  const double a = std::atan2(dot(p - c, e2), dot(p - c, e1));
+  return a < 0 ? a + kTwoPi : a;
+}
+
+// e1 ⟂ u, and e2 = u × e1: (e1, e2, u) is right-handed.
+void frameOf(const Vec3& u, Vec3& e1, Vec3& e2) {
+  const Vec3 pick = std::abs(u.x) < 0.6 ? Vec3(1, 0, 0) : std::abs(u.y) < 0.6 ? Vec3(0, 1, 0) : Vec3(0, 0, 1);
+  e1 = unit(pick - u * dot(pick, u));
+  e2 = cross(u, e1);
+}
+
+class TubeMesher {
+ public:
+  TubeMesher(const VascularTree& t, const TubeSurfaceOptions& o) : t_(t), o_(o) {}
+
+  SurfaceMesh run(TubeSurfaceReport& rep, const std::function<void(std::int64_t, std::int64_t)>& progress) {
+    collectVessels();
+    rep.vessels = std::int64_t(vessels_.size());
+    if (vessels_.empty()) return {};
+    placeCuts();
+    std::vector<char> give_up(vessels_.size(), 0);
+    std::vector<ClusterMesh> meshes;
+    std::vector<Cluster> clusters;
+    // Each round gives up at least one more tube, so it ends (at worst with every vessel whole).
+    for (;;) {
+      decideTubes(give_up);
+      std::vector<Cluster> next = buildClusters();
+      // A part the last round meshed already (same vessels, same cuts) is kept.
+      std::map<std::vector<std::int64_t>, std::size_t> before;
+      for (std::size_t c = 0; c < clusters.size(); ++c) before.emplace(keyOf(clusters[c]), c);
+      std::vector<ClusterMesh> next_meshes(next.size());
+      std::vector<std::size_t> todo;
+      for (std::size_t c = 0; c < next.size(); ++c) {
+        const auto it = before.find(keyOf(next[c]));
+        if (it != before.end()) next_meshes[c] = std::move(meshes[it->second]);
+        else todo.push_back(c);
+      }
+      clusters = std::move(next);
+      meshes = std::move(next_meshes);
+      const std::int64_t total = std::int64_t(todo.size());
+      // In batches, so progress is reported from this thread.
+      for (std::int64_t first = 0; first < total; first += 1024) {
+        const std::int64_t last = std::min(total, first + 1024);
+        tbb::parallel_for(first, last, [&](std::int64_t i) {
+          const auto c = todo[std::size_t(i)];
+          meshes[c] = meshCluster(clusters[c]);
+        });
+        if (progress) progress(last, total);
+      }
+      // A failed cut gives its tube up: the vessel is contoured whole, with its neighbours.
+      bool again = false;
+      for (auto c : todo)
+        for (std::size_t k = 0; k < clusters[c].stubs.size(); ++k)
+          if (meshes[c].loops[k].empty()) give_up[std::size_t(clusters[c].stubs[k].vessel)] = 1, again = true, ++rep.fallbacks;
+      if (!again) break;
+    }
+    return assemble(clusters, meshes, rep);
+  }
+
+ private:
+  std::int32_t treeOf(std::int32_t s) const { return t_.tree.empty() ? 0 : t_.tree[s]; }
+
+  void collectVessels() {
+    for (std::int32_t s = 0; s < t_.nodeCount(); ++s) {
+      if (t_.isRoot(s) || t_.isLink(s)) continue;
+      Vessel v;
+      v.s = s;
+      v.tree = treeOf(s);
+      v.node[0] = t_.junction(t_.parent[s]);
+      v.node[1] = s;
+      v.a = t_.position[t_.parent[s]];
+      v.b = t_.position[s];
+      v.len = distance(v.a, v.b);
+      v.u = v.len > 0 ? (v.b - v.a) / v.len : Vec3(1, 0, 0);
+      v.ra = t_.startRadius(s);
+      v.rb = t_.radius[s];
+      if (!(v.ra > 0 && v.rb > 0)) throw InputError("", 0, "a vessel of radius 0 has no surface; every radius must be > 0");
+      if (v.ra != v.rb) {
+        v.nested = std::abs(v.ra - v.rb) >= v.len;
+        if (!v.nested) {
+          v.sin_a = (v.ra - v.rb) / v.len;
+          v.cos_a = std::sqrt(1 - v.sin_a * v.sin_a);
+        }
+      }
+      vessels_.push_back(v);
+    }
+    // In an order of the geometry alone (as openEnds), so a tree read back from its graph files,
+    // numbered otherwise, gives the same mesh.
+    std::sort(vessels_.begin(), vessels_.end(), [](const Vessel& x, const Vessel& y) {
+      return std::make_tuple(x.tree, x.a.x, x.a.y, x.a.z, x.b.x, x.b.y, x.b.z) < std::make_tuple(y.tree, y.a.x, y.a.y, y.a.z, y.b.x, y.b.y, y.b.z);
+    });
+    for (std::size_t i = 0; i < vessels_.size(); ++i) index_of_[vessels_[i].s] = std::int32_t(i);
+    at_node_.assign(std::size_t(t_.nodeCount()), {});
+    for (auto& v : vessels_)
+      for (int k = 0; k < 2; ++k) at_node_[std::size_t(v.node[k])].push_back(&v);
+    for (std::size_t e = 0; e < o_.ends.size(); ++e) {
+      const auto& end = o_.ends[e];
+      const auto it = index_of_.find(end.vessel);
+      if (it == index_of_.end()) continue;
+      vessels_[std::size_t(it->second)].end[end.root ? 0 : 1] = int(e);
+    }
+  }
+
+  // Each side's plane: a CFD end's (beyond its node), else past the other vessels at the node.
+  void placeCuts() {
+    for (auto& v : vessels_)
+      for (int k = 0; k < 2; ++k) {
+        if (v.end[k] >= 0) {
+          const auto& e = o_.ends[std::size_t(v.end[k])];
+          v.plane[k] = -dot(e.centre - e.node, e.normal);
+        } else {
+          v.plane[k] = cutDistance(v, k, at_node_[std::size_t(v.node[k])], o_.junction);
+        }
+      }
+  }
+
+  // A vessel keeps a tube when its free middle has some length and no
+  // vessel of its tree that shares no node with it touches it (else the two are contoured
+  // together, so the surface is their union). Separate surfaces must not cross either: vessels
+  // closer than a tenth of their radii count as touching (rings and contours stand off the exact
+  // wall by a few hundredths of a radius).
+  void decideTubes(const std::vector<char>& give_up) {
+    for (std::size_t i = 0; i < vessels_.size(); ++i) {
+      auto& v = vessels_[i];
+      // The two cuts belong to different contoured parts, so their regions may overlap; the
+      // tube between them needs only some length.
+      const double free_length = v.len - v.plane[0] - v.plane[1];
+      v.tube = !give_up[i] && !v.nested && free_length >= kShortestTube * v.rmax();
+    }
+    // Vessels that share no node and touch.
+    SegmentIndex index(boxLo(), boxHi());
+    VascularTree axes;  // one segment per vessel, its CFD prolongations included
+    for (const auto& v : vessels_) {
+      const Vec3 a = v.a - v.u * std::max(0.0, -v.plane[0]), b = v.b + v.u * std::max(0.0, -v.plane[1]);
+      const auto root = axes.addNode(a, -1, v.tree);
+      axes.addNode(b, root);
+    }
+    index.refresh(axes, true);
+    std::vector<double> reach(vessels_.size());
+    for (std::size_t i = 0; i < vessels_.size(); ++i) reach[i] = kTouching * vessels_[i].rmax();
+    tbb::enumerable_thread_specific<SegmentIndex::Marks> marks;
+    std::vector<char> near(vessels_.size(), 0);
+    std::vector<std::vector<std::pair<std::int32_t, std::int32_t>>> found(vessels_.size());
+    tbb::parallel_for(std::size_t(0), vessels_.size(), [&](std::size_t i) {
+      const auto& v = vessels_[i];
+      const std::int32_t seg = 2 * std::int32_t(i) + 1;
+      index.forEachNearSegment(axes.position[std::size_t(seg) - 1], axes.position[std::size_t(seg)], 2 * reach[i], marks.local(), [&](std::int32_t y) {
+        const std::size_t j = std::size_t(y - 1) / 2;
+        if (j == i || !(reach[j] < reach[i] || (reach[j] == reach[i] && j > i))) return;
+        const auto& w = vessels_[j];
+        if (w.tree != v.tree || w.node[0] == v.node[0] || w.node[0] == v.node[1] || w.node[1] == v.node[0] || w.node[1] == v.node[1]) return;
+        const double d = segmentSegmentDistance(axes.position[std::size_t(seg) - 1], axes.position[std::size_t(seg)], axes.position[std::size_t(y) - 1],
+                                                axes.position[std::size_t(y)]);
+        if (d < reach[i] + reach[j]) found[i].emplace_back(std::int32_t(i), std::int32_t(j));
+      });
+    });
+    close_pairs_.clear();
+    for (const auto& f : found)
+      for (const auto& p : f) {
+        close_pairs_.push_back(p);
+        vessels_[std::size_t(p.first)].tube = vessels_[std::size_t(p.second)].tube = false;
+      }
+  }
+  Vec3 boxLo() const {
+    Vec3 lo(INFINITY, INFINITY, INFINITY);
+    for (const auto& v : vessels_) lo = componentMin(lo, componentMin(v.a, v.b) - Vec3(1, 1, 1) * (v.rmax() + std::max(0.0, -std::min(v.plane[0], v.plane[1]))));
+    return lo;
+  }
+  Vec3 boxHi() const {
+    Vec3 hi(-INFINITY, -INFINITY, -INFINITY);
+    for (const auto& v : vessels_) hi = componentMax(hi, componentMax(v.a, v.b) + Vec3(1, 1, 1) * (v.rmax() + std::max(0.0, -std::min(v.plane[0], v.plane[1]))));
+    return hi;
+  }
+
+  // Clusters: nodes joined by vessels without a tube and by close pairs; in the order of their
+  // smallest node, so the mesh does not depend on the thread count.
+  std::vector<Cluster> buildClusters() {
+    Groups g(std::size_t(t_.nodeCount()));
+    for (const auto& v : vessels_)
+      if (!v.tube) g.join(v.node[0], v.node[1]);
+    for (const auto& [i, j] : close_pairs_) g.join(vessels_[std::size_t(i)].node[0], vessels_[std::size_t(j)].node[0]);
+    std::vector<char> touching_root(std::size_t(t_.nodeCount()), 0);
+    for (const auto& pr : close_pairs_) touching_root[std::size_t(g.find(vessels_[std::size_t(pr.first)].node[0]))] = 1;
+    std::vector<std::int32_t> slot(std::size_t(t_.nodeCount()), -1);
+    std::vector<Cluster> out;
+    const auto clusterOf = [&](std::int32_t node, std::int32_t tree) -> Cluster& {
+      const auto r = g.find(node);
+      if (slot[std::size_t(r)] < 0) {
+        slot[std::size_t(r)] = std::int32_t(out.size());
+        out.emplace_back();
+        out.back().tree = tree;
+        out.back().touching = touching_root[std::size_t(r)];
+      }
+      return out[std::size_t(slot[std::size_t(r)])];
+    };
+    // Numbered as vessels (in node order) first reach them: the same on any thread count.
+    for (std::size_t i = 0; i < vessels_.size(); ++i) {
+      const auto& v = vessels_[i];
+      if (!v.tube) {
+        clusterOf(v.node[0], v.tree).whole.push_back(std::int32_t(i));
+        continue;
+      }
+      for (int k = 0; k < 2; ++k)
+        if (v.end[k] < 0) clusterOf(v.node[k], v.tree).stubs.push_back({std::int32_t(i), k});
+    }
+    return out;
+  }
+
+  // What a part is made of: its whole vessels, then its stubs (vessel, side), as one list.
+  static std::vector<std::int64_t> keyOf(const Cluster& c) {
+    std::vector<std::int64_t> key(c.whole.begin(), c.whole.end());
+    key.push_back(-1);
+    for (const auto& st : c.stubs) key.push_back(2 * std::int64_t(st.vessel) + st.side);
+    return key;
+  }
+
+  // A stub's cut as an end: its plane across the tube at the cut distance from its node.
+  VesselEnd stubPlane(const Vessel& v, int k) const {
+    VesselEnd e;
+    e.tree = v.tree;
+    e.vessel = v.s;
+    e.node = v.nodeAt(k);
+    e.normal = v.into(k);
+    e.centre = e.node + e.normal * v.plane[k];
+    e.radius = v.radiusAt(v.fromA(k, v.plane[k]));
+    e.open = true;
+    e.tight = true;
+    return e;
+  }
+
+  ClusterMesh meshCluster(const Cluster& c) const {
+    ClusterMesh out;
+    VascularTree sub;
+    const auto piece = [&](const Vec3& a, const Vec3& b, double ra, double rb) {
+      const auto root = sub.addNode(a, -1, 0);
+      const auto id = sub.addNode(b, root);
+      sub.radius[id] = rb;
+      if (ra != rb) sub.radius_start[id] = ra;
+    };
+    std::vector<VesselEnd> planes;
+    for (const auto& st : c.stubs) {
+      const auto& v = vessels_[std::size_t(st.vessel)];
+      const auto e = stubPlane(v, st.side);
+      // Prolonged a radius past the plane (the cut's overshoot), then cut away again.
+      const double d = v.plane[st.side] + e.radius;
+      piece(e.node, e.node + e.normal * d, v.radiusAt(v.fromA(st.side, 0)), v.radiusAt(v.fromA(st.side, d)));
+      planes.push_back(e);
+    }
+    for (auto i : c.whole) {
+      const auto& v = vessels_[std::size_t(i)];
+      piece(v.a, v.b, v.ra, v.rb);
+      for (int k = 0; k < 2; ++k) {
+        if (v.end[k] < 0) continue;
+        const auto& e = o_.ends[std::size_t(v.end[k])];
+        piece(e.node, e.centre + e.normal * e.radius, e.radius, e.radius);  // prolongEnds' prolongation
+        out.end_ids.push_back(v.end[k]);
+      }
+    }
+    for (auto e : out.end_ids) planes.push_back(o_.ends[std::size_t(e)]);
+    // Marching tetrahedra bridge a wedge between two vessels narrower than a step: a part whose
+    // vessels form a tree (no touching pair) must come out without handles, else it is contoured
+    // again at twice (then four times) the samples across.
+    const int base = std::max(1, o_.junction.samples_across);
+    for (int refine = 0;; ++refine) {
+      contourCluster(c, sub, planes, base << refine, out);
+      if (c.touching || refine == kRefinements || handles(out.mesh) == 0) break;
+      ++out.refinements;
+    }
+    return out;
+  }
+
+  // Twice the handles of a contoured part: 2 × components − boundary loops − V + E − F.
+  static std::int64_t handles(const SurfaceMesh& m) {
+    const auto topo = meshTopology(m);
+    std::int64_t chi = 0, components = 0;
+    for (auto e : topo.tree_euler) chi += e;
+    for (auto k : topo.tree_components) components += k;
+    return 2 * components - std::int64_t(boundaryLoops(m).size()) - chi;
+  }
+
+  // The part's surface at `samples` across each vessel, cut at its planes, with its stubs' loops.
+  void contourCluster(const Cluster& c, const VascularTree& sub, const std::vector<VesselEnd>& planes, int samples, ClusterMesh& out) const {
+    SurfaceReport sr;
+    SurfaceOptions so = o_.junction;
+    so.samples_across = samples;
+    EndCutReport cut;
+    // Cut while the exact distance is at hand, then decimate (loops and caps stay where they are).
+    out.decimation = DecimateReport();
+    so.finish = [&](SurfaceMesh& mesh, const std::function<double(std::int32_t, const Vec3&)>& distance) {
+      cut = cutEnds(mesh, planes, o_.cap_ends);
+      if (o_.decimate) out.decimation = decimate(mesh, o_.decimation, distance);
+    };
+    out.mesh = vesselSurface(sub, so, &sr);
+    out.estimated_bytes = sr.estimated_bytes;
+    out.step = sr.voxel_mm;
+    out.cavities_removed = sr.cavities_removed;
+    for (auto& tr : out.mesh.triangle_tree) tr = c.tree;
+    // The CFD ends' part of the report, and their faces as options.ends numbers them.
+    const std::size_t ns = c.stubs.size();
+    out.ends = EndCutReport();
+    out.ends.cut = std::int64_t(out.end_ids.size());
+    for (std::size_t k = 0; k < out.end_ids.size(); ++k) {
+      out.ends.cap_area_mm2.push_back(cut.cap_area_mm2[ns + k]);
+      out.ends.loop_vertices.push_back(cut.loop_vertices[ns + k]);
+    }
+    for (auto e : cut.left_closed)
+      if (std::size_t(e) >= ns) out.ends.left_closed.push_back(out.end_ids[std::size_t(e) - ns]), --out.ends.cut;
+    for (auto& f : out.mesh.triangle_face)
+      f = f > std::int32_t(ns) ? out.end_ids[std::size_t(f) - 1 - ns] + 1 : 0;
+    // Each stub's loop: the boundary loop in its plane, near its axis, made star-shaped around it.
+    out.loops.assign(ns, {});
+    std::vector<char> closed(ns, 0);
+    for (auto e : cut.left_closed)
+      if (std::size_t(e) < ns) closed[std::size_t(e)] = 1;
+    const auto loops = boundaryLoops(out.mesh);
+    std::vector<char> keep(out.mesh.triangles.size(), 1);
+    std::unordered_map<std::int32_t, std::vector<std::int32_t>> around;  // loop vertex → its triangles
+    for (const auto& loop : loops)
+      for (auto p : loop) around[p];
+    for (std::size_t t = 0; t < out.mesh.triangles.size(); ++t)
+      for (auto p : out.mesh.triangles[t])
+        if (const auto it = around.find(p); it != around.end()) it->second.push_back(std::int32_t(t));
+    for (std::size_t k = 0; k < ns; ++k) {
+      if (closed[k]) continue;
+      const auto& e = planes[k];
+      const auto& v = vessels_[std::size_t(c.stubs[k].vessel)];
+      for (const auto& loop : loops) {
+        bool mine = true;
+        for (auto p : loop) {
+          const Vec3 q = out.mesh.vertices[std::size_t(p)];
+          mine = mine && std::abs(dot(q - e.centre, e.normal)) <= 1e-9 * e.radius && distance(q, e.centre) < 2 * e.radius;
+        }
+        if (!mine) continue;
+        // Counter-clockwise around u.
+        double turn = 0;
+        for (std::size_t i = 0; i < loop.size(); ++i)
+          turn += dot(cross(out.mesh.vertices[std::size_t(loop[i])] - e.centre, out.mesh.vertices[std::size_t(loop[(i + 1) % loop.size()])] - e.centre), v.u);
+        std::vector<std::int32_t> ccw = loop;
+        if (turn < 0) std::reverse(ccw.begin(), ccw.end());
+        if (makeStarShaped(out.mesh, ccw, around, keep, e.centre, v.u, e.radius)) out.loops[k] = std::move(ccw);
+        break;
+      }
+    }
+    // Drop what the loops' repairs removed, and renumber the loops as keepTriangles does.
+    std::vector<std::int32_t> renumber(out.mesh.vertices.size(), -1);
+    for (std::size_t t = 0; t < keep.size(); ++t)
+      if (keep[t])
+        for (auto p : out.mesh.triangles[t]) renumber[std::size_t(p)] = 0;
+    std::int32_t used = 0;
+    for (auto& r : renumber)
+      if (r == 0) r = used++;
+    keepTriangles(out.mesh, keep);
+    for (auto& l : out.loops)
+      for (auto& p : l) p = renumber[std::size_t(p)];
+  }
+
+  // A contoured loop may step back by a hair where two of its vertices sit at one angle (a cut
+  // point next to a vertex the volume restoration slid); the tube's triangle on that edge would
+  // face inwards. Such an edge, at most kHair of the radius long, is collapsed into its first
+  // vertex (the one contour triangle on it goes) when that keeps the surface a manifold and turns
+  // no triangle over. True when the loop's angles then rise all the way round.
+  static bool makeStarShaped(SurfaceMesh& m, std::vector<std::int32_t>& loop, std::unordered_map<std::int32_t, std::vector<std::int32_t>>& around,
+                             std::vector<char>& keep, const Vec3& centre, const Vec3& u, double r) {
+    constexpr double kHair = 0.05;
+    const auto rises = [&](std::int32_t a, std::int32_t b) { return dot(cross(m.vertices[std::size_t(a)] - centre, m.vertices[std::size_t(b)] - centre), u) > 0; };
+    for (std::size_t i = 0; i < loop.size() && loop.size() >= 3;) {
+      const auto p = loop[i], q = loop[(i + 1) % loop.size()];
+      if (rises(p, q)) {
+        ++i;
+        continue;
+      }
+      if (!(distance(m.vertices[std::size_t(p)], m.vertices[std::size_t(q)]) <= kHair * r)) return false;
+      auto& tp = around[p];
+      auto& tq = around[q];
+      std::vector<std::int32_t> shared, others;
+      const auto has = [&](std::int32_t t, std::int32_t x) {
+        const auto& tri = m.triangles[std::size_t(t)];
+        return tri[0] == x || tri[1] == x || tri[2] == x;
+      };
+      for (auto t : tq)
+        if (keep[std::size_t(t)]) (has(t, p) ? shared : others).push_back(t);
+      if (shared.size() != 1) return false;
+      // Link condition: the vertices next to both are the shared triangle's third one only.
+      std::vector<std::int32_t> np, nq;
+      for (auto t : tp)
+        if (keep[std::size_t(t)])
+          for (auto x : m.triangles[std::size_t(t)]) np.push_back(x);
+      for (auto t : tq)
+        if (keep[std::size_t(t)])
+          for (auto x : m.triangles[std::size_t(t)]) nq.push_back(x);
+      std::sort(np.begin(), np.end());
+      np.erase(std::unique(np.begin(), np.end()), np.end());
+      std::sort(nq.begin(), nq.end());
+      nq.erase(std::unique(nq.begin(), nq.end()), nq.end());
+      std::vector<std::int32_t> common;
+      std::set_intersection(np.begin(), np.end(), nq.begin(), nq.end(), std::back_inserter(common));
+      if (common.size() != 3) return false;  // p, q and the shared triangle's third vertex
+      // No triangle of q's turns over when q moves onto p.
+      for (auto t : others) {
+        auto tri = m.triangles[std::size_t(t)];
+        const auto normal = [&](const std::array<std::int32_t, 3>& x) {
+          return cross(m.vertices[std::size_t(x[1])] - m.vertices[std::size_t(x[0])], m.vertices[std::size_t(x[2])] - m.vertices[std::size_t(x[0])]);
+        };
+        const Vec3 before = normal(tri);
+        for (auto& x : tri)
+          if (x == q) x = p;
+        if (!(dot(before, normal(tri)) > 0)) return false;
+      }
+      keep[std::size_t(shared[0])] = 0;
+      for (auto t : others) {
+        for (auto& x : m.triangles[std::size_t(t)])
+          if (x == q) x = p;
+        tp.push_back(t);
+      }
+      loop.erase(loop.begin() + std::ptrdiff_t((i + 1) % loop.size()));
+      if ((i + 1) % (loop.size() + 1) == 0 && i > 0) --i;  // q was the first: p moved down one
+      i = i > 0 ? i - 1 : 0;                               // the step before p may have changed
+    }
+    for (std::size_t i = 0; i < loop.size(); ++i)
+      if (!rises(loop[i], loop[(i + 1) % loop.size()])) return false;
+    return loop.size() >= 3;
+  }
+
+  // A ring of n vertices around the axis at distance y from a: on the wall, or (restoring the
+  // volume) where the polygon's area is the circle's.
+  void ring(SurfaceMesh& m, const Vessel& v, double y, int n, std::vector<std::int32_t>& out) const {
+    Vec3 e1, e2;
+    frameOf(v.u, e1, e2);
+    const double r = v.radiusAt(y), step = kTwoPi / n;
+    const double R = o_.junction.restore_volume ? r * std::sqrt(step / std::sin(step)) : r;
+    const Vec3 c = v.a + v.u * y;
+    out.clear();
+    for (int k = 0; k < n; ++k) {
+      const double phi = step * k;
+      out.push_back(std::int32_t(m.vertices.size()));
+      m.vertices.push_back(c + (e1 * std::cos(phi) + e2 * std::sin(phi)) * R);
+      m.vertex_step.push_back(float(step * R));
+    }
+  }
+
+  // Triangles between ring A (nearer a) and ring B, both counter-clockwise around u: from the
+  // vertex of each at the smallest angle, always advancing on the ring whose next vertex comes
+  // first around the axis.
+  static void zip(SurfaceMesh& m, const Vessel& v, const std::vector<std::int32_t>& A, const std::vector<std::int32_t>& B, std::int32_t tree) {
+    Vec3 e1, e2;
+    frameOf(v.u, e1, e2);
+    // Angles around the axis (not the ring's centroid: a contoured loop is star-shaped around the
+    // axis, checked), from the vertex at the smallest, each the last plus its turn in (−π, π].
+    const auto unwrap = [&](const std::vector<std::int32_t>& ring, std::vector<double>& ang) {
+      const std::size_t n = ring.size();
+      const Vec3 c = v.a + v.u * dot(m.vertices[std::size_t(ring[0])] - v.a, v.u);
+      std::size_t first = 0;
+      std::vector<double> raw(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        raw[i] = angleAround(m.vertices[std::size_t(ring[i])], c, e1, e2);
+        if (raw[i] < raw[first]) first = i;
+      }
+      ang.resize(n + 1);
+      ang[0] = raw[first];
+      for (std::size_t i = 1; i <= n; ++i) {
+        double d = raw[(first + i) % n] - raw[(first + i - 1) % n];
+        if (d <= -std::numbers::pi) d += kTwoPi;
+        if (d > std::numbers::pi) d -= kTwoPi;
+        ang[i] = ang[i - 1] + d;
+      }
+      return first;
+    };
+    std::vector<double> aa, ab;
+    const std::size_t fa = unwrap(A, aa), fb = unwrap(B, ab), p = A.size(), q = B.size();
+    const auto a = [&](std::size_t i) { return A[(fa + i) % p]; };
+    const auto b = [&](std::size_t j) { return B[(fb + j) % q]; };
+    std::size_t i = 0, j = 0;
+    while (i < p || j < q) {
+      const bool advance_a = j == q || (i < p && aa[i + 1] <= ab[j + 1]);
+      if (advance_a) {
+        m.triangles.push_back({a(i), a(i + 1), b(j)});
+        ++i;
+      } else {
+        m.triangles.push_back({a(i), b(j + 1), b(j)});
+        ++j;
+      }
+      m.triangle_tree.push_back(tree);
+      m.triangle_face.push_back(0);
+    }
+  }
+
+  SurfaceMesh assemble(const std::vector<Cluster>& clusters, std::vector<ClusterMesh>& meshes, TubeSurfaceReport& rep) const {
+    SurfaceMesh m;
+    m.triangle_face.clear();
+    // Where each tube's end loops are in the joined mesh.
+    std::vector<std::array<std::vector<std::int32_t>, 2>> loops(vessels_.size());
+    rep.ends.cap_area_mm2.assign(o_.ends.size(), 0.0);
+    rep.ends.loop_vertices.assign(o_.ends.size(), 0);
+    for (std::size_t c = 0; c < clusters.size(); ++c) {
+      auto& cm = meshes[c];
+      const auto base = std::int32_t(m.vertices.size());
+      m.vertices.insert(m.vertices.end(), cm.mesh.vertices.begin(), cm.mesh.vertices.end());
+      m.vertex_step.insert(m.vertex_step.end(), cm.mesh.vertex_step.begin(), cm.mesh.vertex_step.end());
+      for (auto t : cm.mesh.triangles) m.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+      m.triangle_tree.insert(m.triangle_tree.end(), cm.mesh.triangle_tree.begin(), cm.mesh.triangle_tree.end());
+      m.triangle_face.insert(m.triangle_face.end(), cm.mesh.triangle_face.begin(), cm.mesh.triangle_face.end());
+      rep.contour_triangles += std::int64_t(cm.mesh.triangles.size());
+      rep.cavities_removed += cm.cavities_removed;
+      rep.refinements += cm.refinements;
+      rep.triangles_before_decimation += cm.decimation.before;
+      rep.decimation_collapses += cm.decimation.collapses;
+      rep.decimation_largest_error_mm = std::max(rep.decimation_largest_error_mm, cm.decimation.largest_error_mm);
+      rep.estimated_bytes = std::max(rep.estimated_bytes, cm.estimated_bytes);
+      rep.finest_step_mm = rep.finest_step_mm > 0 ? std::min(rep.finest_step_mm, cm.step) : cm.step;
+      rep.largest_cluster_vessels = std::max<std::int64_t>(rep.largest_cluster_vessels, std::int64_t(clusters[c].whole.size() + clusters[c].stubs.size()));
+      for (std::size_t k = 0; k < clusters[c].stubs.size(); ++k) {
+        auto& l = loops[std::size_t(clusters[c].stubs[k].vessel)][std::size_t(clusters[c].stubs[k].side)];
+        for (auto p : cm.loops[k]) l.push_back(p + base);
+      }
+      for (std::size_t k = 0; k < cm.end_ids.size(); ++k) {
+        const auto e = std::size_t(cm.end_ids[k]);
+        rep.ends.cap_area_mm2[e] = cm.ends.cap_area_mm2[k];
+        rep.ends.loop_vertices[e] = cm.ends.loop_vertices[k];
+      }
+      rep.ends.cut += cm.ends.cut;
+      rep.ends.left_closed.insert(rep.ends.left_closed.end(), cm.ends.left_closed.begin(), cm.ends.left_closed.end());
+      SurfaceMesh().vertices.swap(cm.mesh.vertices);
+    }
+    rep.clusters = std::int64_t(clusters.size());
+    // The tubes, ring to ring.
+    const auto before = m.triangles.size();
+    std::vector<std::int32_t> A, B;
+    for (std::size_t i = 0; i < vessels_.size(); ++i) {
+      const auto& v = vessels_[i];
+      if (!v.tube) continue;
+      ++rep.tubes;
+      const double y0 = v.plane[0], y1 = v.len - v.plane[1];
+      const int n_ring = std::max(o_.min_ring_vertices, int(std::ceil(std::numbers::pi * std::max(1, o_.junction.samples_across))));
+      for (int k = 0; k < 2; ++k) {
+        auto& l = loops[i][std::size_t(k)];
+        if (v.end[k] < 0) continue;
+        // A CFD end: its ring in its plane, open or capped.
+        ring(m, v, k == 0 ? y0 : y1, n_ring, l);
+        const auto& e = o_.ends[std::size_t(v.end[k])];
+        ++rep.ends.cut;
+        rep.ends.loop_vertices[std::size_t(v.end[k])] = std::int32_t(l.size());
+        if (!o_.cap_ends) continue;
+        const auto centre = std::int32_t(m.vertices.size());
+        m.vertices.push_back(e.centre);
+        m.vertex_step.push_back(m.vertex_step[std::size_t(l[0])]);
+        double area = 0;
+        for (std::size_t q = 0; q < l.size(); ++q) {
+          const auto p0 = l[q], p1 = l[(q + 1) % l.size()];
+          // Outward: +u at the distal end, −u at the proximal one.
+          if (k == 1) m.triangles.push_back({centre, p0, p1});
+          else m.triangles.push_back({centre, p1, p0});
+          m.triangle_tree.push_back(v.tree);
+          m.triangle_face.push_back(v.end[k] + 1);
+          area += 0.5 * norm(cross(m.vertices[std::size_t(p0)] - e.centre, m.vertices[std::size_t(p1)] - e.centre));
+        }
+        rep.ends.cap_area_mm2[std::size_t(v.end[k])] = area;
+      }
+      // Rings at most ring_spacing_radii radii apart.
+      const double spacing = o_.ring_spacing_radii * 0.5 * (v.radiusAt(y0) + v.radiusAt(y1));
+      const int pieces = std::max(1, int(std::ceil((y1 - y0) / std::max(spacing, 1e-12))));
+      A = loops[i][0];
+      for (int q = 1; q <= pieces; ++q) {
+        if (q < pieces) ring(m, v, y0 + (y1 - y0) * q / pieces, n_ring, B);
+        else B = loops[i][1];
+        zip(m, v, A, B, v.tree);
+        A = B;
+      }
+    }
+    rep.tube_triangles = std::int64_t(m.triangles.size() - before);
+    if (o_.ends.empty()) m.triangle_face.clear();  // no labelled faces without cut ends
+    std::sort(rep.ends.left_closed.begin(), rep.ends.left_closed.end());
+    return m;
+  }
+
+  const VascularTree& t_;
+  const TubeSurfaceOptions& o_;
+  std::vector<Vessel> vessels_;
+  std::unordered_map<std::int32_t, std::int32_t> index_of_;  // segment id → vessel index
+  std::vector<std::vector<const Vessel*>> at_node_;          // per junction node, its vessels
+  std::vector<std::pair<std::int32_t, std::int32_t>> close_pairs_;
+};
+
+}  // namespace
+
+SurfaceMesh tubeSurface(const VascularTree& forest, const TubeSurfaceOptions& options, TubeSurfaceReport* report,
+                        const std::function<void(std::int64_t, std::int64_t)>& progress) {
+  TubeSurfaceReport local;
+  TubeSurfaceReport& rep = report ? *report : local;
+  rep = TubeSurfaceReport();
+  TubeMesher mesher(forest, options);
+  return mesher.run(rep, progress);
+}
+
+}  // namespace angiosynth
