@@ -38,6 +38,7 @@ struct Vessel {
   // plane, or a CFD end's plane beyond the node (negative).
   double plane[2] = {0, 0};
   int end[2] = {-1, -1};            // the CFD end (options.ends index) at each side, or -1
+  bool round[2] = {false, false};   // a round end of the tree (no other vessel at that node)
   bool tube = false;
 
   double rmax() const { return std::max(ra, rb); }
@@ -64,7 +65,7 @@ double stepNear(double r, const SurfaceOptions& o) { return 2 * r / std::max(1, 
 // at angle θ to this one has its points within r_o of its axis, so along this axis it reaches
 // r_o where it turns away (θ ≥ 90°), else d·cos θ + r_o up to the distance d where its axis is
 // reach + r_o from this one's.
-// The region is read around each vertex with that vertex's step: the coarser of the two vessels'.
+// The region is read with the stub's own step.
 double cutDistance(const Vessel& v, int k, const std::vector<const Vessel*>& others, const SurfaceOptions& o) {
   const double r = v.rmax();
   const Vec3 w = v.into(k);
@@ -73,7 +74,7 @@ double cutDistance(const Vessel& v, int k, const std::vector<const Vessel*>& oth
     if (q == &v) continue;
     const int kq = q->node[0] == v.node[k] ? 0 : 1;
     const double c = dot(w, q->into(kq)), ro = q->rmax();
-    const auto x = endCutExtent(r, std::max(stepNear(r, o), stepNear(ro, o)), true);
+    const auto x = endCutExtent(r, stepNear(r, o), true);
     double axial = ro;
     if (c > 0) {
       const double sin_t = std::sqrt(std::max(0.0, 1 - c * c));
@@ -128,13 +129,14 @@ struct ClusterMesh {
 };
 
 // The boundary loops of a mesh: directed edges used once, chained (a chain that branches or
-// breaks off is left out).
-std::vector<std::vector<std::int32_t>> boundaryLoops(const SurfaceMesh& m) {
+// breaks off is left out). Cut loops lie in planes: only edges between vertices `on` flags can
+// be on them (every triangle holding such an edge is looked at, so the count is exact).
+std::vector<std::vector<std::int32_t>> boundaryLoops(const SurfaceMesh& m, const std::vector<char>& on) {
   std::vector<std::pair<std::int64_t, std::int64_t>> edges;  // (min·2^32 + max, from·2^32 + to)
   for (const auto& t : m.triangles)
     for (int i = 0; i < 3; ++i) {
       const std::int64_t a = t[std::size_t(i)], b = t[std::size_t((i + 1) % 3)];
-      edges.emplace_back((std::min(a, b) << 32) | std::max(a, b), (a << 32) | b);
+      if (on[std::size_t(a)] && on[std::size_t(b)]) edges.emplace_back((std::min(a, b) << 32) | std::max(a, b), (a << 32) | b);
     }
   std::sort(edges.begin(), edges.end());
   std::vector<std::pair<std::int32_t, std::int32_t>> next;  // from → to of edges used once
@@ -287,6 +289,9 @@ class TubeMesher {
         if (v.end[k] >= 0) {
           const auto& e = o_.ends[std::size_t(v.end[k])];
           v.plane[k] = -dot(e.centre - e.node, e.normal);
+        } else if (at_node_[std::size_t(v.node[k])].size() == 1) {
+          v.round[k] = true;  // the tube runs to the node and ends in a cap of rings
+          v.plane[k] = 0;
         } else {
           v.plane[k] = cutDistance(v, k, at_node_[std::size_t(v.node[k])], o_.junction);
         }
@@ -380,7 +385,7 @@ class TubeMesher {
         continue;
       }
       for (int k = 0; k < 2; ++k)
-        if (v.end[k] < 0) clusterOf(v.node[k], v.tree).stubs.push_back({std::int32_t(i), k});
+        if (v.end[k] < 0 && !v.round[k]) clusterOf(v.node[k], v.tree).stubs.push_back({std::int32_t(i), k});
     }
     return out;
   }
@@ -404,6 +409,7 @@ class TubeMesher {
     e.radius = v.radiusAt(v.fromA(k, v.plane[k]));
     e.open = true;
     e.tight = true;
+    e.step = stepNear(v.rmax(), o_.junction);
     return e;
   }
 
@@ -442,19 +448,48 @@ class TubeMesher {
     const int base = std::max(1, o_.junction.samples_across);
     for (int refine = 0;; ++refine) {
       contourCluster(c, sub, planes, base << refine, out);
-      if (c.touching || refine == kRefinements || handles(out.mesh) == 0) break;
+      if (c.touching || refine == kRefinements || handles(out.mesh, planes) == 0) break;
       ++out.refinements;
     }
     return out;
   }
 
   // Twice the handles of a contoured part: 2 × components − boundary loops − V + E − F.
-  static std::int64_t handles(const SurfaceMesh& m) {
+  static std::int64_t handles(const SurfaceMesh& m, const std::vector<VesselEnd>& planes) {
     const auto topo = meshTopology(m);
     std::int64_t chi = 0, components = 0;
     for (auto e : topo.tree_euler) chi += e;
     for (auto k : topo.tree_components) components += k;
-    return 2 * components - std::int64_t(boundaryLoops(m).size()) - chi;
+    return 2 * components - std::int64_t(boundaryLoops(m, onPlanes(m, planes)).size()) - chi;
+  }
+  // The vertices in one of the planes (the cuts put them there exactly), within 2 radii of its
+  // centre: planes binned on cells of the largest such reach.
+  static std::vector<char> onPlanes(const SurfaceMesh& m, const std::vector<VesselEnd>& planes) {
+    std::vector<char> on(m.vertices.size(), 0);
+    if (planes.empty()) return on;
+    double g = 0;
+    for (const auto& e : planes) g = std::max(g, 2 * e.radius);
+    const auto key = [g](const Vec3& p) {
+      return (std::uint64_t(std::int64_t(std::floor(p.x / g)) & 0x1fffff) << 42) | (std::uint64_t(std::int64_t(std::floor(p.y / g)) & 0x1fffff) << 21) |
+             std::uint64_t(std::int64_t(std::floor(p.z / g)) & 0x1fffff);
+    };
+    std::unordered_map<std::uint64_t, std::vector<std::int32_t>> bins;
+    for (std::size_t k = 0; k < planes.size(); ++k)
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) bins[key(planes[k].centre + Vec3(dx, dy, dz) * g)].push_back(std::int32_t(k));
+    for (std::size_t v = 0; v < m.vertices.size(); ++v) {
+      const auto it = bins.find(key(m.vertices[v]));
+      if (it == bins.end()) continue;
+      for (auto k : it->second) {
+        const auto& e = planes[std::size_t(k)];
+        if (std::abs(dot(m.vertices[v] - e.centre, e.normal)) <= 1e-9 * e.radius && distance(m.vertices[v], e.centre) < 2 * e.radius) {
+          on[v] = 1;
+          break;
+        }
+      }
+    }
+    return on;
   }
 
   // The part's surface at `samples` across each vessel, cut at its planes, with its stubs' loops.
@@ -491,7 +526,7 @@ class TubeMesher {
     std::vector<char> closed(ns, 0);
     for (auto e : cut.left_closed)
       if (std::size_t(e) < ns) closed[std::size_t(e)] = 1;
-    const auto loops = boundaryLoops(out.mesh);
+    const auto loops = boundaryLoops(out.mesh, onPlanes(out.mesh, planes));
     std::vector<char> keep(out.mesh.triangles.size(), 1);
     std::unordered_map<std::int32_t, std::vector<std::int32_t>> around;  // loop vertex → its triangles
     for (const auto& loop : loops)
@@ -617,6 +652,83 @@ class TubeMesher {
     }
   }
 
+  // A round end of rings: latitude rings on the sphere of the end's radius around its node, and
+  // its pole. The rings' polygons keep the tube's area correction, and the whole cap is scaled
+  // so its volume is the hemisphere's (on_surface: every vertex on the sphere).
+  void roundCap(SurfaceMesh& m, const Vessel& v, int k, const std::vector<std::int32_t>& base, int n) const {
+    const int bands = std::max(2, int(std::lround(n / 4.0)));
+    const bool restore = o_.junction.restore_volume;
+    const double step = kTwoPi / n, area = restore ? std::sqrt(step / std::sin(step)) : 1.0;
+    const double f = restore ? capScale(n, bands, area) : 1.0;
+    const double r = v.radiusAt(k == 0 ? 0.0 : v.len);
+    const Vec3 node = v.nodeAt(k), out = v.into(k) * -1.0;
+    Vec3 e1, e2;
+    frameOf(v.u, e1, e2);
+    std::vector<std::vector<std::int32_t>> rings{base};
+    for (int j = 1; j < bands; ++j) {
+      const double phi = std::numbers::pi / 2 * j / bands;
+      std::vector<std::int32_t> ring;
+      for (int q = 0; q < n; ++q) {
+        const double a = step * q;
+        ring.push_back(std::int32_t(m.vertices.size()));
+        m.vertices.push_back(node + out * (f * r * std::sin(phi)) + (e1 * std::cos(a) + e2 * std::sin(a)) * (f * area * r * std::cos(phi)));
+        m.vertex_step.push_back(float(step * r));
+      }
+      rings.push_back(std::move(ring));
+    }
+    const auto pole = std::int32_t(m.vertices.size());
+    m.vertices.push_back(node + out * (f * r));
+    m.vertex_step.push_back(float(step * r));
+    // Ring after ring away from the node; zip takes the ring nearer a first.
+    for (std::size_t j = 0; j + 1 < rings.size(); ++j) {
+      if (k == 1) zip(m, v, rings[j], rings[j + 1], v.tree);
+      else zip(m, v, rings[j + 1], rings[j], v.tree);
+    }
+    const auto& last = rings.back();
+    for (std::size_t q = 0; q < last.size(); ++q) {
+      const auto p0 = last[q], p1 = last[(q + 1) % last.size()];
+      if (k == 1) m.triangles.push_back({p0, p1, pole});
+      else m.triangles.push_back({pole, p1, p0});
+      m.triangle_tree.push_back(v.tree);
+      m.triangle_face.push_back(0);
+    }
+  }
+  // The scale of a cap's rings and pole (its base ring fixed, of radius `area`) that gives it the
+  // volume of the unit hemisphere: bisection on the divergence theorem's volume.
+  static double capScale(int n, int bands, double area) {
+    const auto volume = [&](double f) {
+      std::vector<std::vector<Vec3>> rings;
+      for (int j = 0; j < bands; ++j) {
+        const double phi = std::numbers::pi / 2 * j / bands, s = j == 0 ? 1.0 : f;
+        std::vector<Vec3> ring;
+        for (int q = 0; q < n; ++q) {
+          const double a = kTwoPi * q / n;
+          ring.push_back(Vec3(std::cos(a) * s * area * std::cos(phi), std::sin(a) * s * area * std::cos(phi), s * std::sin(phi)));
+        }
+        rings.push_back(ring);
+      }
+      const Vec3 pole(0, 0, f);
+      double six = 0;  // the cap closed by its base polygon (at z = 0, adding nothing)
+      const auto tri = [&](const Vec3& a, const Vec3& b, const Vec3& c) { six += dot(a, cross(b, c)); };
+      for (std::size_t j = 0; j + 1 < rings.size(); ++j)
+        for (int q = 0; q < n; ++q) {
+          const auto& A = rings[j];
+          const auto& B = rings[j + 1];
+          tri(A[std::size_t(q)], A[std::size_t((q + 1) % n)], B[std::size_t(q)]);
+          tri(A[std::size_t((q + 1) % n)], B[std::size_t((q + 1) % n)], B[std::size_t(q)]);
+        }
+      for (int q = 0; q < n; ++q) tri(rings.back()[std::size_t(q)], rings.back()[std::size_t((q + 1) % n)], pole);
+      return six / 6;
+    };
+    const double want = 2 * std::numbers::pi / 3;
+    double lo = 0.8, hi = 1.3;
+    for (int it = 0; it < 60; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (volume(mid) < want ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+  }
+
   // Triangles between ring A (nearer a) and ring B, both counter-clockwise around u: from the
   // vertex of each at the smallest angle, always advancing on the ring whose next vertex comes
   // first around the axis.
@@ -712,6 +824,11 @@ class TubeMesher {
       const int n_ring = std::max(o_.min_ring_vertices, int(std::ceil(std::numbers::pi * std::max(1, o_.junction.samples_across))));
       for (int k = 0; k < 2; ++k) {
         auto& l = loops[i][std::size_t(k)];
+        if (v.round[k]) {
+          ring(m, v, k == 0 ? y0 : y1, n_ring, l);
+          roundCap(m, v, k, l, n_ring);
+          continue;
+        }
         if (v.end[k] < 0) continue;
         // A CFD end: its ring in its plane, open or capped.
         ring(m, v, k == 0 ? y0 : y1, n_ring, l);

@@ -33,8 +33,9 @@ struct EndRegion {
   Vec3 c, n;
   double r;
   bool tight;
-  bool holds(const Vec3& p, double step) const {
-    const auto x = endCutExtent(r, step, tight);
+  double step;  // > 0: the end's step, else the vertex's
+  bool holds(const Vec3& p, double vertex_step) const {
+    const auto x = endCutExtent(r, step > 0 ? step : vertex_step, tight);
     const Vec3 v = p - c;
     const double s = dot(v, n), rho2 = dot(v, v) - s * s;
     return s >= -x.before && s <= x.beyond && rho2 <= x.reach * x.reach;
@@ -192,7 +193,7 @@ EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool ca
   m.triangle_face.assign(m.triangles.size(), 0);
   if (ends.empty() || m.triangles.empty()) return rep;
   std::vector<EndRegion> regions;
-  for (const auto& e : ends) regions.push_back({e.centre, e.normal, e.radius, e.tight});
+  for (const auto& e : ends) regions.push_back({e.centre, e.normal, e.radius, e.tight, e.tight ? e.step : 0.0});
   const auto near = verticesNearEnds(m, regions);
 
   // Triangles at each vertex near an end (vertex-to-triangle incidence of those vertices only).

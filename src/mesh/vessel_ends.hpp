@@ -25,6 +25,7 @@ struct VesselEnd {
   double radius = 0;         // the vessel's radius at that end, mm
   bool open = false;         // never capped (a tube's cut, joined to its rings later)
   bool tight = false;        // read only a step around the tube (the caller keeps other vessels out of it)
+  double step = 0;           // tight: that step (mm), else each vertex's own
 };
 
 // The space an end's cut reads around its axis: from `before` behind its plane to `beyond` past
