@@ -3,6 +3,7 @@
     check_mesh.py MESH_DIR NODES_CSV EDGES_CSV
     check_mesh.py --ends MESH_DIR
     check_mesh.py --self-intersections MESH_DIR EXT...
+    check_mesh.py --wall MESH_DIR NODES_CSV EDGES_CSV THICKNESS_MM
 
 Reads surface.stl, .obj, .ply, .vtp with VTK's readers, surface.off by hand and surface.3mf with
 the standard library's zipfile and ElementTree (unit millimetre); for each: the
@@ -20,6 +21,13 @@ boundary loops (open ends) with the largest distance of their points from the ne
 With --self-intersections: each surface.EXT as VTK reads it (so with the precision the format
 keeps) goes to TetGen (Debian's tetgen), whose -d switch tests every pair of faces for an
 intersection with exact predicates; prints {EXT: intersecting pairs}.
+
+With --wall: a hollow wall of constant thickness (surface.vtp, surface_faces.csv; the ends cut
+where their nodes are): the wall's volume by Monte Carlo, independently of the mesher (points in
+each vessel thickened by the wall, cut by its ends' planes, outside every vessel, counted
+1/(thickened vessels holding them)); and the thickness: every vertex of the outer side (farther
+than half the wall from the vessels) to the lumen side's triangles (VTK's
+vtkImplicitPolyDataDistance), its deviation from the asked thickness in percentiles.
 """
 import csv
 import json
@@ -260,7 +268,106 @@ def ends(mesh_dir):
     return out
 
 
+def read_tree(nodes_csv, edges_csv):
+    pos = {}
+    with open(nodes_csv) as f:
+        for r in csv.DictReader(f):
+            pos[r["id"]] = np.array([float(r["pos_x"]), float(r["pos_y"]), float(r["pos_z"])])
+    a, b, rad = [], [], []
+    with open(edges_csv) as f:
+        for r in csv.DictReader(f):
+            a.append(pos[r["node1id"]])
+            b.append(pos[r["node2id"]])
+            rad.append(float(r["radius"]))
+    return np.array(a), np.array(b), np.array(rad)
+
+
+def lumen_distance(p, a, b, rad):
+    # Signed distance of points p to the union of the capsules (a, b, rad), by brute force in blocks.
+    d = b - a
+    out = np.full(len(p), np.inf)
+    for k in range(0, len(a), 64):
+        aa, dd, rr = a[k:k + 64], d[k:k + 64], rad[k:k + 64]
+        t = np.clip(np.einsum("pkj,kj->pk", p[:, None, :] - aa[None], dd) / np.einsum("kj,kj->k", dd, dd), 0, 1)
+        q = aa[None] + t[:, :, None] * dd[None]
+        out = np.minimum(out, (np.linalg.norm(p[:, None, :] - q, axis=2) - rr[None]).min(axis=1))
+    return out
+
+
+def wall(mesh_dir, nodes_csv, edges_csv, thickness, per_capsule=3000, seed=7):
+    a, b, rad = read_tree(nodes_csv, edges_csv)
+    d = b - a
+    rows = list(csv.DictReader(open(f"{mesh_dir}/surface_faces.csv")))[1:]
+    # Each end's plane belongs to the vessel with an end node at its centre.
+    cuts = [[] for _ in range(len(a))]
+    for row in rows:
+        c = np.array([float(row[f"centre_{x}"]) for x in "xyz"])
+        n = np.array([float(row[f"normal_{x}"]) for x in "xyz"])
+        ends_at = np.minimum(np.linalg.norm(a - c, axis=1), np.linalg.norm(b - c, axis=1))
+        cuts[int(np.argmin(ends_at))].append((c, n))
+    out_r = rad + thickness
+
+    def in_cut_capsule(p, k):
+        keep = inside(p, a[k], d[k], out_r[k])
+        for c, n in cuts[k]:
+            keep &= (p - c) @ n <= 0
+        return keep
+
+    mid = (a + b) / 2
+    reach = np.linalg.norm(d, axis=1) / 2 + out_r
+    kd = cKDTree(mid)
+    rng = np.random.default_rng(seed)
+    volume = 0.0
+    for s in range(len(a)):
+        lo = np.minimum(a[s], b[s]) - out_r[s]
+        hi = np.maximum(a[s], b[s]) + out_r[s]
+        box = float(np.prod(hi - lo))
+        p = rng.uniform(lo, hi, size=(per_capsule * 4, 3))
+        p = p[inside(p, a[s], d[s], out_r[s])]  # uniform in the thickened capsule
+        capsule = np.pi * out_r[s] ** 2 * np.linalg.norm(d[s]) + 4 / 3 * np.pi * out_r[s] ** 3
+        near = kd.query_ball_point(mid[s], reach[s] + reach.max())
+        count = np.zeros(len(p))
+        for k in near:
+            count += in_cut_capsule(p, k)
+        mine = in_cut_capsule(p, s)
+        wall_pt = mine & (lumen_distance(p, a[near], b[near], rad[near]) > 0)
+        volume += capsule * float(np.sum(wall_pt / np.maximum(count, 1))) / len(p)
+    poly = read(f"{mesh_dir}/surface.vtp")
+    pts = vtk_to_numpy(poly.GetPoints().GetData()).astype(float)
+    faces = faces_of(poly)
+    face_id = vtk_to_numpy(poly.GetCellData().GetArray("ModelFaceID"))
+    dist = lumen_distance(pts, a, b, rad)
+    lumen_side = np.abs(dist) < thickness / 2
+    keep = (face_id == 1) & lumen_side[faces].all(axis=1)
+    lp = vtk.vtkPolyData()
+    lp.SetPoints(poly.GetPoints())
+    cells = vtk.vtkCellArray()
+    for t in faces[keep]:
+        cells.InsertNextCell(3, [int(v) for v in t])
+    lp.SetPolys(cells)
+    implicit = vtk.vtkImplicitPolyDataDistance()
+    implicit.SetInput(lp)
+    # Outer-side vertices away from the cut ends (where the wall is cut across, not around).
+    outer = np.where(dist > thickness / 2)[0]
+    far = np.ones(len(outer), bool)
+    for row in rows:
+        c = np.array([float(row[f"centre_{x}"]) for x in "xyz"])
+        far &= np.linalg.norm(pts[outer] - c, axis=1) > 2 * (float(row["radius"]) + thickness)
+    outer = outer[far]
+    thick = np.array([abs(implicit.EvaluateFunction(*pts[i])) for i in outer])
+    dev = np.abs(thick - thickness) / thickness
+    mass = vtk.vtkMassProperties()
+    mass.SetInputData(poly)
+    mass.Update()
+    return {"wall_volume_monte_carlo": volume, "mesh_volume": mass.GetVolume(), "outer_vertices": int(len(outer)),
+            "thickness_deviation_p50": float(np.percentile(dev, 50)), "thickness_deviation_p95": float(np.percentile(dev, 95)),
+            "thickness_min": float(thick.min()), "thickness_max": float(thick.max())}
+
+
 def main():
+    if sys.argv[1] == "--wall":
+        print(json.dumps(wall(sys.argv[2], sys.argv[3], sys.argv[4], float(sys.argv[5]))))
+        return
     if sys.argv[1] == "--ends":
         print(json.dumps(ends(sys.argv[2])))
         return

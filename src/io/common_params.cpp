@@ -44,6 +44,11 @@ const std::vector<MethodParam>& commonParams() {
       {"mesh", "samples_across", "count", "3 (tubes), 4 (contour)",
        "grid steps across each vessel's thinnest end where it is contoured (1 … 64); thicker vessels get coarser cells"},
       {"mesh", "ring_spacing", "radii", "2", "tubes: rings at most this many radii of the vessel apart (0.1 … 100)"},
+      {"mesh", "wall_thickness", "mm", "0 (no wall)",
+       "a hollow wall of this thickness around each vessel's lumen (seed 004): the surface bounds the wall (outer side, lumen, a flat "
+       "ring at each end, all ends open); one of wall_thickness, wall_ratio, wall_from_graph"},
+      {"mesh", "wall_ratio", "share of the radius", "0 (no wall)", "a hollow wall of this share of each vessel's radius at each of its ends"},
+      {"mesh", "wall_from_graph", "true/false", "false", "a hollow wall of each vessel's own thickness (wall values of an [initial] network or a graph file)"},
       {"mesh", "uniform", "true/false", "false", "every vessel at the finest step"},
       {"mesh", "on_surface", "true/false", "false", "vertices exactly on the surface (no volume restoration)"},
       {"mesh", "ends", "closed/open/capped", "closed",

@@ -46,6 +46,9 @@ struct MeshParameters {
   double voxel_mm = 0;                      // finest step; 0: the thinnest vessel's diameter / samples_across
   int samples_across = 0;                   // 0: the method's (contour 4, tubes 3)
   double ring_spacing = 2;                  // tubes: rings at most this many radii apart
+  double wall_thickness = 0;                // mm: a hollow wall of this thickness (0: none), or
+  double wall_ratio = 0;                    // of this share of each vessel's radius, or
+  bool wall_from_graph = false;             // of each vessel's own wall (a graph's wall thickness)
   bool uniform = false;                     // every vessel at the finest step
   bool on_surface = false;                  // no volume restoration: vertices exactly on the surface
   std::string ends = "closed";              // closed (round), open (cut at planes) or capped (planar caps, labelled faces)

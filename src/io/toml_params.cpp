@@ -147,7 +147,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
 
   // [mesh]: the vessels' surface beside the graphs (src/mesh); the table's presence enables it.
   const auto& me = r.table("mesh", {"enabled", "method", "formats", "voxel_size", "samples_across", "ring_spacing", "uniform", "on_surface", "ends",
-                                    "flow_extension", "decimate", "max_error"});
+                                    "flow_extension", "decimate", "max_error", "wall_thickness", "wall_ratio", "wall_from_graph"});
   if (const auto* n = root.get("mesh")) {
     auto& mp = sc.mesh;
     sc.mesh_line = r.lineOf(n);
@@ -179,6 +179,22 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     if (me.get("max_error")) {
       mp.max_error = r.number(me, "mesh", "max_error");
       checkRange(mp.max_error, 0, true, 1, false, r.at(me, "max_error"), "max_error (share of the local step)");
+    }
+    if (me.get("wall_thickness")) {
+      mp.wall_thickness = r.quantity(me, "mesh", "wall_thickness", Dimension::Length, voxel_mm);
+      checkRange(mp.wall_thickness, 0, false, 1e6, false, r.at(me, "wall_thickness"), "wall_thickness (mm)");
+    }
+    if (me.get("wall_ratio")) {
+      mp.wall_ratio = r.number(me, "mesh", "wall_ratio");
+      checkRange(mp.wall_ratio, 0, false, 100, false, r.at(me, "wall_ratio"), "wall_ratio (share of the radius)");
+    }
+    mp.wall_from_graph = r.boolean(me, "wall_from_graph", mp.wall_from_graph);
+    if (int(mp.wall_thickness > 0) + int(mp.wall_ratio > 0) + int(mp.wall_from_graph) > 1)
+      throw InputError(file, r.lineOf(&me), "wall_thickness, wall_ratio and wall_from_graph exclude each other; allowed: one of them");
+    if (mp.wall_thickness > 0 || mp.wall_ratio > 0 || mp.wall_from_graph) {
+      if (mp.method != "tubes") throw InputError(file, r.lineOf(&me), "a hollow wall is built on the tubes; allowed: method = \"tubes\"");
+      if (mp.ends == "capped")
+        throw InputError(file, r.lineOf(me.get("ends")), "a hollow wall keeps its ends open (the lumen runs through); allowed: ends = \"open\" or \"closed\"");
     }
     if (me.get("flow_extension")) {
       mp.flow_extension = r.number(me, "mesh", "flow_extension");

@@ -13,6 +13,7 @@
 #include "core/error.hpp"
 #include "grow/common/segment_index.hpp"
 #include "mesh/decimate.hpp"
+#include "mesh/ring_mesh.hpp"
 
 namespace angiosynth {
 namespace {
@@ -127,68 +128,6 @@ struct ClusterMesh {
   DecimateReport decimation;
   int refinements = 0;                   // contoured again, finer, to lose a handle
 };
-
-// The boundary loops of a mesh: directed edges used once, chained (a chain that branches or
-// breaks off is left out). Cut loops lie in planes: only edges between vertices `on` flags can
-// be on them (every triangle holding such an edge is looked at, so the count is exact).
-std::vector<std::vector<std::int32_t>> boundaryLoops(const SurfaceMesh& m, const std::vector<char>& on) {
-  std::vector<std::pair<std::int64_t, std::int64_t>> edges;  // (min·2^32 + max, from·2^32 + to)
-  for (const auto& t : m.triangles)
-    for (int i = 0; i < 3; ++i) {
-      const std::int64_t a = t[std::size_t(i)], b = t[std::size_t((i + 1) % 3)];
-      if (on[std::size_t(a)] && on[std::size_t(b)]) edges.emplace_back((std::min(a, b) << 32) | std::max(a, b), (a << 32) | b);
-    }
-  std::sort(edges.begin(), edges.end());
-  std::vector<std::pair<std::int32_t, std::int32_t>> next;  // from → to of edges used once
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i;
-    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
-    if (j - i == 1) next.emplace_back(std::int32_t(edges[i].second >> 32), std::int32_t(edges[i].second & 0xffffffff));
-    i = j;
-  }
-  std::sort(next.begin(), next.end());
-  const auto from = [&](std::int32_t v) {
-    const auto it = std::lower_bound(next.begin(), next.end(), std::make_pair(v, std::int32_t(-1)));
-    const bool one = it != next.end() && it->first == v && (it + 1 == next.end() || (it + 1)->first != v);
-    return one ? std::size_t(it - next.begin()) : next.size();
-  };
-  std::vector<char> used(next.size(), 0);
-  std::vector<std::vector<std::int32_t>> loops;
-  for (std::size_t i = 0; i < next.size(); ++i) {
-    if (used[i]) continue;
-    std::vector<std::int32_t> loop;
-    bool ok = true;
-    for (std::size_t at = i;;) {
-      used[at] = 1;
-      loop.push_back(next[at].first);
-      at = from(next[at].second);
-      if (at == next.size()) {
-        ok = false;
-        break;
-      }
-      if (at == i) break;
-      if (used[at]) {
-        ok = false;
-        break;
-      }
-    }
-    if (ok) loops.push_back(std::move(loop));
-  }
-  return loops;
-}
-
-// Angle of p around the axis through c along u, from e1 towards e2 = u × e1, in [0, 2π).
-double angleAround(const Vec3& p, const Vec3& c, const Vec3& e1, const Vec3& e2) {
-  const double a = std::atan2(dot(p - c, e2), dot(p - c, e1));
-  return a < 0 ? a + kTwoPi : a;
-}
-
-// e1 ⟂ u, and e2 = u × e1: (e1, e2, u) is right-handed.
-void frameOf(const Vec3& u, Vec3& e1, Vec3& e2) {
-  const Vec3 pick = std::abs(u.x) < 0.6 ? Vec3(1, 0, 0) : std::abs(u.y) < 0.6 ? Vec3(0, 1, 0) : Vec3(0, 0, 1);
-  e1 = unit(pick - u * dot(pick, u));
-  e2 = cross(u, e1);
-}
 
 class TubeMesher {
  public:
@@ -460,38 +399,8 @@ class TubeMesher {
     std::int64_t chi = 0, components = 0;
     for (auto e : topo.tree_euler) chi += e;
     for (auto k : topo.tree_components) components += k;
-    return 2 * components - std::int64_t(boundaryLoops(m, onPlanes(m, planes)).size()) - chi;
+    return 2 * components - std::int64_t(boundaryLoops(m, verticesInPlanes(m, planes)).size()) - chi;
   }
-  // The vertices in one of the planes (the cuts put them there exactly), within 2 radii of its
-  // centre: planes binned on cells of the largest such reach.
-  static std::vector<char> onPlanes(const SurfaceMesh& m, const std::vector<VesselEnd>& planes) {
-    std::vector<char> on(m.vertices.size(), 0);
-    if (planes.empty()) return on;
-    double g = 0;
-    for (const auto& e : planes) g = std::max(g, 2 * e.radius);
-    const auto key = [g](const Vec3& p) {
-      return (std::uint64_t(std::int64_t(std::floor(p.x / g)) & 0x1fffff) << 42) | (std::uint64_t(std::int64_t(std::floor(p.y / g)) & 0x1fffff) << 21) |
-             std::uint64_t(std::int64_t(std::floor(p.z / g)) & 0x1fffff);
-    };
-    std::unordered_map<std::uint64_t, std::vector<std::int32_t>> bins;
-    for (std::size_t k = 0; k < planes.size(); ++k)
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) bins[key(planes[k].centre + Vec3(dx, dy, dz) * g)].push_back(std::int32_t(k));
-    for (std::size_t v = 0; v < m.vertices.size(); ++v) {
-      const auto it = bins.find(key(m.vertices[v]));
-      if (it == bins.end()) continue;
-      for (auto k : it->second) {
-        const auto& e = planes[std::size_t(k)];
-        if (std::abs(dot(m.vertices[v] - e.centre, e.normal)) <= 1e-9 * e.radius && distance(m.vertices[v], e.centre) < 2 * e.radius) {
-          on[v] = 1;
-          break;
-        }
-      }
-    }
-    return on;
-  }
-
   // The part's surface at `samples` across each vessel, cut at its planes, with its stubs' loops.
   void contourCluster(const Cluster& c, const VascularTree& sub, const std::vector<VesselEnd>& planes, int samples, ClusterMesh& out) const {
     SurfaceReport sr;
@@ -526,113 +435,14 @@ class TubeMesher {
     std::vector<char> closed(ns, 0);
     for (auto e : cut.left_closed)
       if (std::size_t(e) < ns) closed[std::size_t(e)] = 1;
-    const auto loops = boundaryLoops(out.mesh, onPlanes(out.mesh, planes));
-    std::vector<char> keep(out.mesh.triangles.size(), 1);
-    std::unordered_map<std::int32_t, std::vector<std::int32_t>> around;  // loop vertex → its triangles
-    for (const auto& loop : loops)
-      for (auto p : loop) around[p];
-    for (std::size_t t = 0; t < out.mesh.triangles.size(); ++t)
-      for (auto p : out.mesh.triangles[t])
-        if (const auto it = around.find(p); it != around.end()) it->second.push_back(std::int32_t(t));
+    std::vector<char> skip(planes.size(), 1);
+    for (std::size_t k = 0; k < ns; ++k) skip[k] = closed[k];
+    auto loops = starLoops(out.mesh, planes, skip);
     for (std::size_t k = 0; k < ns; ++k) {
-      if (closed[k]) continue;
-      const auto& e = planes[k];
-      const auto& v = vessels_[std::size_t(c.stubs[k].vessel)];
-      for (const auto& loop : loops) {
-        bool mine = true;
-        for (auto p : loop) {
-          const Vec3 q = out.mesh.vertices[std::size_t(p)];
-          mine = mine && std::abs(dot(q - e.centre, e.normal)) <= 1e-9 * e.radius && distance(q, e.centre) < 2 * e.radius;
-        }
-        if (!mine) continue;
-        // Counter-clockwise around u.
-        double turn = 0;
-        for (std::size_t i = 0; i < loop.size(); ++i)
-          turn += dot(cross(out.mesh.vertices[std::size_t(loop[i])] - e.centre, out.mesh.vertices[std::size_t(loop[(i + 1) % loop.size()])] - e.centre), v.u);
-        std::vector<std::int32_t> ccw = loop;
-        if (turn < 0) std::reverse(ccw.begin(), ccw.end());
-        if (makeStarShaped(out.mesh, ccw, around, keep, e.centre, v.u, e.radius)) out.loops[k] = std::move(ccw);
-        break;
-      }
+      // Counter-clockwise around the vessel's axis a → b (the plane's normal points into the tube).
+      if (c.stubs[k].side == 1) std::reverse(loops[k].begin(), loops[k].end());
+      out.loops[k] = std::move(loops[k]);
     }
-    // Drop what the loops' repairs removed, and renumber the loops as keepTriangles does.
-    std::vector<std::int32_t> renumber(out.mesh.vertices.size(), -1);
-    for (std::size_t t = 0; t < keep.size(); ++t)
-      if (keep[t])
-        for (auto p : out.mesh.triangles[t]) renumber[std::size_t(p)] = 0;
-    std::int32_t used = 0;
-    for (auto& r : renumber)
-      if (r == 0) r = used++;
-    keepTriangles(out.mesh, keep);
-    for (auto& l : out.loops)
-      for (auto& p : l) p = renumber[std::size_t(p)];
-  }
-
-  // A contoured loop may step back by a hair where two of its vertices sit at one angle (a cut
-  // point next to a vertex the volume restoration slid); the tube's triangle on that edge would
-  // face inwards. Such an edge, at most kHair of the radius long, is collapsed into its first
-  // vertex (the one contour triangle on it goes) when that keeps the surface a manifold and turns
-  // no triangle over. True when the loop's angles then rise all the way round.
-  static bool makeStarShaped(SurfaceMesh& m, std::vector<std::int32_t>& loop, std::unordered_map<std::int32_t, std::vector<std::int32_t>>& around,
-                             std::vector<char>& keep, const Vec3& centre, const Vec3& u, double r) {
-    constexpr double kHair = 0.05;
-    const auto rises = [&](std::int32_t a, std::int32_t b) { return dot(cross(m.vertices[std::size_t(a)] - centre, m.vertices[std::size_t(b)] - centre), u) > 0; };
-    for (std::size_t i = 0; i < loop.size() && loop.size() >= 3;) {
-      const auto p = loop[i], q = loop[(i + 1) % loop.size()];
-      if (rises(p, q)) {
-        ++i;
-        continue;
-      }
-      if (!(distance(m.vertices[std::size_t(p)], m.vertices[std::size_t(q)]) <= kHair * r)) return false;
-      auto& tp = around[p];
-      auto& tq = around[q];
-      std::vector<std::int32_t> shared, others;
-      const auto has = [&](std::int32_t t, std::int32_t x) {
-        const auto& tri = m.triangles[std::size_t(t)];
-        return tri[0] == x || tri[1] == x || tri[2] == x;
-      };
-      for (auto t : tq)
-        if (keep[std::size_t(t)]) (has(t, p) ? shared : others).push_back(t);
-      if (shared.size() != 1) return false;
-      // Link condition: the vertices next to both are the shared triangle's third one only.
-      std::vector<std::int32_t> np, nq;
-      for (auto t : tp)
-        if (keep[std::size_t(t)])
-          for (auto x : m.triangles[std::size_t(t)]) np.push_back(x);
-      for (auto t : tq)
-        if (keep[std::size_t(t)])
-          for (auto x : m.triangles[std::size_t(t)]) nq.push_back(x);
-      std::sort(np.begin(), np.end());
-      np.erase(std::unique(np.begin(), np.end()), np.end());
-      std::sort(nq.begin(), nq.end());
-      nq.erase(std::unique(nq.begin(), nq.end()), nq.end());
-      std::vector<std::int32_t> common;
-      std::set_intersection(np.begin(), np.end(), nq.begin(), nq.end(), std::back_inserter(common));
-      if (common.size() != 3) return false;  // p, q and the shared triangle's third vertex
-      // No triangle of q's turns over when q moves onto p.
-      for (auto t : others) {
-        auto tri = m.triangles[std::size_t(t)];
-        const auto normal = [&](const std::array<std::int32_t, 3>& x) {
-          return cross(m.vertices[std::size_t(x[1])] - m.vertices[std::size_t(x[0])], m.vertices[std::size_t(x[2])] - m.vertices[std::size_t(x[0])]);
-        };
-        const Vec3 before = normal(tri);
-        for (auto& x : tri)
-          if (x == q) x = p;
-        if (!(dot(before, normal(tri)) > 0)) return false;
-      }
-      keep[std::size_t(shared[0])] = 0;
-      for (auto t : others) {
-        for (auto& x : m.triangles[std::size_t(t)])
-          if (x == q) x = p;
-        tp.push_back(t);
-      }
-      loop.erase(loop.begin() + std::ptrdiff_t((i + 1) % loop.size()));
-      if ((i + 1) % (loop.size() + 1) == 0 && i > 0) --i;  // q was the first: p moved down one
-      i = i > 0 ? i - 1 : 0;                               // the step before p may have changed
-    }
-    for (std::size_t i = 0; i < loop.size(); ++i)
-      if (!rises(loop[i], loop[(i + 1) % loop.size()])) return false;
-    return loop.size() >= 3;
   }
 
   // A ring of n vertices around the axis at distance y from a: on the wall, or (restoring the
@@ -681,8 +491,8 @@ class TubeMesher {
     m.vertex_step.push_back(float(step * r));
     // Ring after ring away from the node; zip takes the ring nearer a first.
     for (std::size_t j = 0; j + 1 < rings.size(); ++j) {
-      if (k == 1) zip(m, v, rings[j], rings[j + 1], v.tree);
-      else zip(m, v, rings[j + 1], rings[j], v.tree);
+      if (k == 1) zipRings(m, v.a, v.u, rings[j], rings[j + 1], v.tree);
+      else zipRings(m, v.a, v.u, rings[j + 1], rings[j], v.tree);
     }
     const auto& last = rings.back();
     for (std::size_t q = 0; q < last.size(); ++q) {
@@ -727,52 +537,6 @@ class TubeMesher {
       (volume(mid) < want ? lo : hi) = mid;
     }
     return 0.5 * (lo + hi);
-  }
-
-  // Triangles between ring A (nearer a) and ring B, both counter-clockwise around u: from the
-  // vertex of each at the smallest angle, always advancing on the ring whose next vertex comes
-  // first around the axis.
-  static void zip(SurfaceMesh& m, const Vessel& v, const std::vector<std::int32_t>& A, const std::vector<std::int32_t>& B, std::int32_t tree) {
-    Vec3 e1, e2;
-    frameOf(v.u, e1, e2);
-    // Angles around the axis (not the ring's centroid: a contoured loop is star-shaped around the
-    // axis, checked), from the vertex at the smallest, each the last plus its turn in (−π, π].
-    const auto unwrap = [&](const std::vector<std::int32_t>& ring, std::vector<double>& ang) {
-      const std::size_t n = ring.size();
-      const Vec3 c = v.a + v.u * dot(m.vertices[std::size_t(ring[0])] - v.a, v.u);
-      std::size_t first = 0;
-      std::vector<double> raw(n);
-      for (std::size_t i = 0; i < n; ++i) {
-        raw[i] = angleAround(m.vertices[std::size_t(ring[i])], c, e1, e2);
-        if (raw[i] < raw[first]) first = i;
-      }
-      ang.resize(n + 1);
-      ang[0] = raw[first];
-      for (std::size_t i = 1; i <= n; ++i) {
-        double d = raw[(first + i) % n] - raw[(first + i - 1) % n];
-        if (d <= -std::numbers::pi) d += kTwoPi;
-        if (d > std::numbers::pi) d -= kTwoPi;
-        ang[i] = ang[i - 1] + d;
-      }
-      return first;
-    };
-    std::vector<double> aa, ab;
-    const std::size_t fa = unwrap(A, aa), fb = unwrap(B, ab), p = A.size(), q = B.size();
-    const auto a = [&](std::size_t i) { return A[(fa + i) % p]; };
-    const auto b = [&](std::size_t j) { return B[(fb + j) % q]; };
-    std::size_t i = 0, j = 0;
-    while (i < p || j < q) {
-      const bool advance_a = j == q || (i < p && aa[i + 1] <= ab[j + 1]);
-      if (advance_a) {
-        m.triangles.push_back({a(i), a(i + 1), b(j)});
-        ++i;
-      } else {
-        m.triangles.push_back({a(i), b(j + 1), b(j)});
-        ++j;
-      }
-      m.triangle_tree.push_back(tree);
-      m.triangle_face.push_back(0);
-    }
   }
 
   SurfaceMesh assemble(const std::vector<Cluster>& clusters, std::vector<ClusterMesh>& meshes, TubeSurfaceReport& rep) const {
@@ -821,7 +585,11 @@ class TubeMesher {
       if (!v.tube) continue;
       ++rep.tubes;
       const double y0 = v.plane[0], y1 = v.len - v.plane[1];
-      const int n_ring = std::max(o_.min_ring_vertices, int(std::ceil(std::numbers::pi * std::max(1, o_.junction.samples_across))));
+      int n_ring = o_.ring_vertices > 0 ? o_.ring_vertices
+                                        : std::max(o_.min_ring_vertices, int(std::ceil(std::numbers::pi * std::max(1, o_.junction.samples_across))));
+      // A chord of a ring of n stands r (1 − cos π/n) inside the wall at its middle.
+      if (o_.ring_tolerance_mm > 0 && o_.ring_tolerance_mm < v.rmax())
+        n_ring = std::max(n_ring, int(std::ceil(std::numbers::pi / std::acos(1 - o_.ring_tolerance_mm / v.rmax()))));
       for (int k = 0; k < 2; ++k) {
         auto& l = loops[i][std::size_t(k)];
         if (v.round[k]) {
@@ -858,7 +626,7 @@ class TubeMesher {
       for (int q = 1; q <= pieces; ++q) {
         if (q < pieces) ring(m, v, y0 + (y1 - y0) * q / pieces, n_ring, B);
         else B = loops[i][1];
-        zip(m, v, A, B, v.tree);
+        zipRings(m, v.a, v.u, A, B, v.tree);
         A = B;
       }
     }

@@ -21,6 +21,8 @@ struct TubeSurfaceOptions {
   SurfaceOptions junction;          // how the meeting parts are contoured (samples across, volume)
   double ring_spacing_radii = 2;    // tube rings at most this many radii apart
   int min_ring_vertices = 8;        // and at least this many around
+  int ring_vertices = 0;            // that many around (0: π × junction samples across, at least min_ring_vertices)
+  double ring_tolerance_mm = 0;     // and more where a ring's chords would stand further than this inside the wall
   std::vector<VesselEnd> ends;      // CFD ends (openEnds): each cut by its plane; empty: round ends
   bool cap_ends = false;            // fill each end's loop with a planar cap (else left open)
   bool decimate = false;            // decimate each contoured part (its cut loops stay)

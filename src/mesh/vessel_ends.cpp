@@ -1,5 +1,7 @@
 #include "mesh/vessel_ends.hpp"
 
+#include "mesh/ring_mesh.hpp"
+
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
@@ -98,43 +100,6 @@ std::vector<std::pair<std::int32_t, std::int32_t>> verticesNearEnds(const Surfac
   for (auto& f : found) pairs.insert(pairs.end(), f.begin(), f.end());
   std::sort(pairs.begin(), pairs.end());
   return pairs;
-}
-
-// Ear clipping of a simple polygon counter-clockwise in the plane (u, w): triangles as indices
-// into it, or empty if it is not simple enough to clip.
-std::vector<std::array<int, 3>> clipEars(const std::vector<Vec3>& polygon, const Vec3& u, const Vec3& w) {
-  const int n = int(polygon.size());
-  std::vector<double> x(polygon.size()), y(polygon.size());
-  for (int i = 0; i < n; ++i) x[std::size_t(i)] = dot(polygon[std::size_t(i)], u), y[std::size_t(i)] = dot(polygon[std::size_t(i)], w);
-  const auto orient = [&](int a, int b, int c) {
-    return (x[std::size_t(b)] - x[std::size_t(a)]) * (y[std::size_t(c)] - y[std::size_t(a)]) -
-           (y[std::size_t(b)] - y[std::size_t(a)]) * (x[std::size_t(c)] - x[std::size_t(a)]);
-  };
-  std::vector<int> ring(polygon.size());
-  for (int i = 0; i < n; ++i) ring[std::size_t(i)] = i;
-  std::vector<std::array<int, 3>> out;
-  while (ring.size() > 3) {
-    bool clipped = false;
-    const std::size_t k = ring.size();
-    for (std::size_t i = 0; i < k && !clipped; ++i) {
-      const int a = ring[(i + k - 1) % k], b = ring[i], c = ring[(i + 1) % k];
-      if (!(orient(a, b, c) > 0)) continue;
-      bool empty = true;
-      for (std::size_t j = 0; j < k && empty; ++j) {
-        const int p = ring[j];
-        if (p == a || p == b || p == c) continue;
-        empty = !(orient(a, b, p) >= 0 && orient(b, c, p) >= 0 && orient(c, a, p) >= 0);
-      }
-      if (!empty) continue;
-      out.push_back({a, b, c});
-      ring.erase(ring.begin() + std::ptrdiff_t(i));
-      clipped = true;
-    }
-    if (!clipped) return {};
-  }
-  if (!(orient(ring[0], ring[1], ring[2]) > 0)) return {};
-  out.push_back({ring[0], ring[1], ring[2]});
-  return out;
 }
 
 }  // namespace
@@ -380,7 +345,7 @@ EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool ca
         std::vector<Vec3> polygon;
         for (std::size_t i = loop.size(); i-- > 0;) polygon.push_back(at_of(loop[i]));
         const Vec3 u = unit(std::abs(reg.n.x) < 0.9 ? cross(reg.n, Vec3(1, 0, 0)) : cross(reg.n, Vec3(0, 1, 0))), w = cross(reg.n, u);
-        const auto ears = clipEars(polygon, u, w);
+        const auto ears = earClip(polygon, u, w);
         if (ears.empty()) {
           leaveClosed();
           continue;

@@ -361,7 +361,8 @@ std::vector<std::int8_t> vesselLevels(const VascularTree& t, const std::vector<s
   std::vector<std::int8_t> level(std::size_t(t.nodeCount()), 0);
   if (!o.adaptive) return level;
   for (auto s : vessels) {
-    const double c = 2 * std::min(t.radius[s], t.startRadius(s)) / std::max(1, o.samples_across);
+    double c = 2 * std::min(t.radius[s], t.startRadius(s)) / std::max(1, o.samples_across);
+    if (o.max_cell_mm > 0) c = std::min(c, o.max_cell_mm);
     if (c >= 2 * h) level[std::size_t(s)] = std::int8_t(std::min(kMaxSurfaceLevel, int(std::floor(std::log2(c / h) + 1e-9))));
   }
   return level;
@@ -433,7 +434,7 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
   if (vessels.empty()) return mesh;
   if (!(r_min > 0)) throw InputError("", 0, "a vessel of radius 0 has no surface; every radius must be > 0");
   const int across = std::max(1, o.samples_across);
-  const double h = o.voxel_mm > 0 ? o.voxel_mm : 2 * r_min / across;
+  const double h = o.voxel_mm > 0 ? o.voxel_mm : o.max_cell_mm > 0 ? std::min(2 * r_min / across, o.max_cell_mm) : 2 * r_min / across;
   const auto level = vesselLevels(t, vessels, h, o);
   std::vector<double> fillet(std::size_t(t.nodeCount()), 0.0);
   for (auto s : vessels) fillet[std::size_t(s)] = kFillet * h * double(std::int64_t(1) << level[std::size_t(s)]);

@@ -31,6 +31,7 @@ constexpr int kMaxSurfaceLevel = 10;
 struct SurfaceOptions {
   double voxel_mm = 0;         // finest grid step; 0: the thinnest vessel's diameter / samples_across
   int samples_across = 4;      // samples across each vessel's thinnest end (at least)
+  double max_cell_mm = 0;      // and cells no larger than this (0: no bound; a hollow wall's thickness)
   bool adaptive = true;        // false: every vessel at the finest step
   // Move vertices off the surface by ¾ of their triangles' mean gap (a fraction of the chords'
   // sagitta) so the enclosed volume is the vessels'; false: every vertex on the surface.

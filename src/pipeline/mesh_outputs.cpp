@@ -6,6 +6,7 @@
 #include "io/mesh_writers.hpp"
 #include "core/format.hpp"
 #include "mesh/decimate.hpp"
+#include "mesh/hollow_wall.hpp"
 #include "mesh/tube_surface.hpp"
 #include "mesh/vessel_ends.hpp"
 #include "mesh/vessel_surface.hpp"
@@ -41,6 +42,11 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                                const std::function<void(std::int64_t, std::int64_t)>& progress, const std::vector<std::string>& tree_kinds,
                                const std::vector<std::string>& vessel_ids) {
   const bool tubes = p.method == "tubes";
+  WallThickness wall;
+  wall.constant_mm = p.wall_thickness;
+  wall.ratio = p.wall_ratio;
+  wall.from_tree = p.wall_from_graph;
+  const bool walls = wall.any();
   SurfaceOptions o;
   o.voxel_mm = p.voxel_mm;
   o.samples_across = p.samples_across > 0 ? p.samples_across : tubes ? 3 : 4;
@@ -48,15 +54,39 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   o.restore_volume = !p.on_surface;
   o.memory_limit = memory_limit;
   SurfaceReport report;
-  const bool cut_ends = p.ends != "closed";
+  const bool cut_ends = p.ends != "closed" || walls;  // a hollow wall's ends are open
   const auto ends = cut_ends ? openEnds(tree, p.flow_extension) : std::vector<VesselEnd>{};
   EndCutReport cut;
   DecimateReport reduced;
   DecimateOptions d;
   d.max_error = p.max_error;
   TubeSurfaceReport tube_report;
+  HollowWallReport wall_report;
   SurfaceMesh mesh;
-  if (tubes) {
+  if (walls) {
+    TubeSurfaceOptions to;
+    to.junction = o;
+    to.ring_spacing_radii = p.ring_spacing;
+    to.ends = ends;
+    to.decimate = p.decimate;
+    to.decimation = d;
+    mesh = hollowWall(tree, to, wall, &wall_report, progress);
+    tube_report = wall_report.outer;
+    report.voxel_mm = std::min(wall_report.outer.finest_step_mm, wall_report.lumen.finest_step_mm);
+    report.estimated_bytes = std::max(wall_report.outer.estimated_bytes, wall_report.lumen.estimated_bytes);
+    cut.cut = wall_report.rings;
+    cut.left_closed = wall_report.not_joined;
+    cut.cap_area_mm2.assign(ends.size(), 0.0);
+    cut.loop_vertices.assign(ends.size(), 0);
+    for (std::size_t k = 0; k < mesh.triangles.size(); ++k) {
+      const auto f = mesh.triangle_face[k];
+      if (f <= 0) continue;
+      const auto& t = mesh.triangles[k];
+      cut.cap_area_mm2[std::size_t(f - 1)] += 0.5 * norm(cross(mesh.vertices[std::size_t(t[1])] - mesh.vertices[std::size_t(t[0])],
+                                                               mesh.vertices[std::size_t(t[2])] - mesh.vertices[std::size_t(t[0])]));
+      ++cut.loop_vertices[std::size_t(f - 1)];  // triangles of the ring: the two loops' vertices together
+    }
+  } else if (tubes) {
     TubeSurfaceOptions to;
     to.junction = o;
     to.ring_spacing_radii = p.ring_spacing;
@@ -83,7 +113,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   out.files = Json::object();
   if (cut_ends) {
     std::ofstream os(dir / "surface_faces.csv", std::ios::binary);
-    writeFaces(os, ends, cut, p.ends, tree_kinds, vessel_ids);
+    writeFaces(os, ends, cut, walls ? "open" : p.ends, tree_kinds, vessel_ids);
     if (!os) throw std::runtime_error("cannot write " + (dir / "surface_faces.csv").string());
     out.files["faces"] = "surface_faces.csv";
   }
@@ -101,9 +131,13 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"voxel_mm", p.voxel_mm > 0 ? Json(p.voxel_mm) : Json(nullptr)},
                     {"samples_across", o.samples_across},
                     {"ring_spacing_radii", tubes ? Json(p.ring_spacing) : Json(nullptr)},
+                    {"wall", !walls ? Json(nullptr)
+                                    : p.wall_thickness > 0 ? Json({{"thickness_mm", p.wall_thickness}})
+                                    : p.wall_ratio > 0     ? Json({{"ratio_of_radius", p.wall_ratio}})
+                                                           : Json({{"from", "the graph's wall values"}})},
                     {"adaptive", !p.uniform},
                     {"volume_restored", !p.on_surface},
-                    {"ends", p.ends},
+                    {"ends", walls ? std::string("open") : p.ends},
                     {"flow_extension_radii", p.flow_extension},
                     {"decimate", p.decimate},
                     {"max_error_steps", p.max_error},
@@ -129,6 +163,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"tube_triangles", tubes ? Json(tube_report.tube_triangles) : Json(nullptr)},
                     {"contoured_triangles", tubes ? Json(tube_report.contour_triangles) : Json(nullptr)},
                     {"tubes_given_up", tubes ? Json(tube_report.fallbacks) : Json(nullptr)},
+                    {"wall_ends_joined", walls ? Json(wall_report.rings) : Json(nullptr)},
                     {"estimated_bytes", report.estimated_bytes},
                     {"enclosed_volume_mm3", topo.volume_mm3},
                     {"boundary_edges", topo.boundary_edges},
