@@ -1,8 +1,8 @@
 // Surface meshing (issue 15): the forest of each parameter file grown once, then its closed
-// surface (src/mesh) at the automatic step (4 samples across the thinnest vessel) or --voxel MM,
-// contoured whole (--tubes 0) or as tubes joined to contoured junctions (--tubes 1, with
-// --samples N across each vessel at the junctions, default 3):
-//   bench_mesh FILE.toml ... [--voxel MM] [--tubes 0|1] [--samples N] [--threads T]
+// surface (src/mesh): tubes joined to contoured junctions (--tubes 1, the default; --samples N
+// across each vessel where vessels meet, default 3) or contoured whole (--tubes 0; 4 samples
+// across), optionally decimated (--decimate 1), at the automatic step or --voxel MM:
+//   bench_mesh FILE.toml ... [--tubes 0|1] [--samples N] [--decimate 0|1] [--voxel MM] [--threads T]
 // Prints the step, the time, triangles in all and per segment, and the peak memory.
 // Targets (issue 15): 10k segments ≤ 10 s, ≤ 4 GB, ≤ 500 triangles per segment; 100k ≤ 2 min.
 #include <cstdio>
@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
   std::vector<char*> rest;
   const double voxel = bench::takeOption(argc, argv, "--voxel", 0, rest);
   std::vector<char*> rest2, rest3;
-  const bool tubes = bench::takeOption(int(rest.size()), rest.data(), "--tubes", 0, rest2) != 0;
+  const bool tubes = bench::takeOption(int(rest.size()), rest.data(), "--tubes", 1, rest2) != 0;
   const int samples = int(bench::takeOption(int(rest2.size()), rest2.data(), "--samples", 3, rest3));
   std::vector<char*> rest4;
   const bool decimated = bench::takeOption(int(rest3.size()), rest3.data(), "--decimate", 0, rest4) != 0;
@@ -69,6 +69,7 @@ int main(int argc, char** argv) {
       std::printf("\n  tubes %lld of %lld vessels, clusters %lld (largest %lld vessels), contour %lld + tube %lld triangles, fallbacks %lld",
                   (long long)trep.tubes, (long long)trep.vessels, (long long)trep.clusters, (long long)trep.largest_cluster_vessels,
                   (long long)trep.contour_triangles, (long long)trep.tube_triangles, (long long)trep.fallbacks);
+    if (tubes) std::printf(", rounds %lld (largest part meshed again: %lld vessels)", (long long)trep.rounds, (long long)trep.largest_remeshed);
     std::printf("\n");
   }
 }

@@ -144,7 +144,7 @@ def regions(pts, faces):
     return out
 
 
-def capsule_union_volume(nodes_csv, edges_csv, per_capsule=4000, seed=5):
+def read_tree(nodes_csv, edges_csv):
     pos = {}
     with open(nodes_csv) as f:
         for r in csv.DictReader(f):
@@ -155,7 +155,11 @@ def capsule_union_volume(nodes_csv, edges_csv, per_capsule=4000, seed=5):
             a.append(pos[r["node1id"]])
             b.append(pos[r["node2id"]])
             rad.append(float(r["radius"]))
-    a, b, rad = np.array(a), np.array(b), np.array(rad)
+    return np.array(a), np.array(b), np.array(rad)
+
+
+def capsule_union_volume(nodes_csv, edges_csv, per_capsule=4000, seed=5):
+    a, b, rad = read_tree(nodes_csv, edges_csv)
     d = b - a
     length = np.linalg.norm(d, axis=1)
     vol = np.pi * rad**2 * length + 4 / 3 * np.pi * rad**3
@@ -266,20 +270,6 @@ def ends(mesh_dir):
     out["boundary_loops"] = int(loops)
     out["max_loop_plane_distance"] = worst
     return out
-
-
-def read_tree(nodes_csv, edges_csv):
-    pos = {}
-    with open(nodes_csv) as f:
-        for r in csv.DictReader(f):
-            pos[r["id"]] = np.array([float(r["pos_x"]), float(r["pos_y"]), float(r["pos_z"])])
-    a, b, rad = [], [], []
-    with open(edges_csv) as f:
-        for r in csv.DictReader(f):
-            a.append(pos[r["node1id"]])
-            b.append(pos[r["node2id"]])
-            rad.append(float(r["radius"]))
-    return np.array(a), np.array(b), np.array(rad)
 
 
 def lumen_distance(p, a, b, rad):

@@ -68,6 +68,19 @@ SurfaceMesh tubeMesh(const VascularTree& t, int samples, TubeSurfaceReport* rep 
   return tubeSurface(t, o, rep);
 }
 
+// A directory with the artery and vein of cco_artery_vein_3d.toml grown at `terminals` each
+// (`extra` appended to its parameter file) into dir/sample by the command.
+std::filesystem::path grownSample(const std::string& name, int terminals, const std::string& extra = "") {
+  const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto text = readText(test::sourceDir() / "examples/cco_artery_vein_3d.toml");
+  text.replace(text.find("terminals = 4000"), 16, "terminals = " + std::to_string(terminals));
+  std::ofstream(dir / "forest.toml") << text << extra;
+  const auto grown = run("generate forest.toml --out sample --no-image --quiet", dir);
+  EXPECT_EQ(grown.code, 0) << grown.err;
+  return dir;
+}
+
 }  // namespace
 
 // The tubes: most vessels of the test forest run free and get rings on their walls, the rest is
@@ -214,12 +227,7 @@ TEST(Mesh, TetgenFindsNoSelfIntersectionInAnyFormat) {
 // `angiosynth mesh` end to end: a sample directory in, the surface and mesh.json out; a missing
 // input and a surface beyond the memory limit are refused (exit 2) with nothing written.
 TEST(Mesh, CommandWritesTheSurfaceAndRefusesWhatItCannotDo) {
-  const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_cli_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  auto text = readText(test::sourceDir() / "examples/cco_artery_vein_3d.toml");
-  text.replace(text.find("terminals = 4000"), 16, "terminals = 6");
-  std::ofstream(dir / "small.toml") << text;
-  ASSERT_EQ(run("generate small.toml --out sample --no-image --quiet", dir).code, 0);
+  const auto dir = grownSample("cli", 6);
   const auto ok = run("mesh sample --out surface --format stl,ply --quiet", dir);
   ASSERT_EQ(ok.code, 0) << ok.err;
   const auto j = nlohmann::json::parse(readText(dir / "surface/mesh.json"));
@@ -305,12 +313,7 @@ TEST(Mesh, MeshTableInAParameterFileWritesTheSurfaceWithTheSample) {
 // intersecting faces; open, there is exactly one planar boundary loop per end and each tree's
 // Euler characteristic is the capped one less its ends (each cap a disc).
 TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
-  const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_ends_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  auto text = readText(test::sourceDir() / "examples/cco_artery_vein_3d.toml");
-  text.replace(text.find("terminals = 4000"), 16, "terminals = 12");
-  std::ofstream(dir / "av.toml") << text;
-  ASSERT_EQ(run("generate av.toml --out sample --no-image --quiet", dir).code, 0);
+  const auto dir = grownSample("ends", 12);
   const auto check = [&](const std::string& sub, const char* mode) {
     const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' " + mode + " '" + (dir / sub).string() + "'" +
                             (std::string(mode) == "--ends" ? "" : " vtp off") + " > '" + (dir / (sub + ".json")).string() + "'";
@@ -388,12 +391,7 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
 // the volume within 1 %, the thickness within 5 % at the 95th percentile. A wall of half the
 // radius (fewer triangles, for TetGen's run) has no intersecting faces.
 TEST(Mesh, HollowWallIsClosedOfGenusEndsLessOneWithItsThicknessAndVolume) {
-  const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_wall_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  auto text = readText(test::sourceDir() / "examples/cco_artery_vein_3d.toml");
-  text.replace(text.find("terminals = 4000"), 16, "terminals = 12");
-  std::ofstream(dir / "av.toml") << text;
-  ASSERT_EQ(run("generate av.toml --out sample --no-image --quiet", dir).code, 0);
+  const auto dir = grownSample("wall", 12);
   const auto made = run("mesh sample --out wall --format vtp,off --wall-thickness 0.1 --quiet", dir);
   ASSERT_EQ(made.code, 0) << made.err;
   const auto st = nlohmann::json::parse(readText(dir / "wall/mesh.json"))["statistics"];

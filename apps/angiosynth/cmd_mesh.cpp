@@ -29,6 +29,12 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
                 "them (default); contour: the whole surface contoured from the signed distance")
       ->check(CLI::IsMember({"tubes", "contour"}));
   c->add_option("--ring-spacing", a.ring_spacing, "tubes: rings at most this many radii apart (default 2)")->check(finiteIn(0.1, 100));
+  c->add_option("--wall-thickness", a.wall_thickness,
+                "a hollow wall of this thickness in mm around each vessel's lumen (seed 004): the wall's surface, outer side, lumen "
+                "and a flat ring at each open end")
+      ->check(finiteIn(0, 1e6));
+  c->add_option("--wall-ratio", a.wall_ratio, "a hollow wall of this share of each vessel's radius")->check(finiteIn(0, 100));
+  c->add_flag("--wall-from-graph", a.wall_from_graph, "a hollow wall of each vessel's own thickness (the graph file's wall values)");
   c->add_option("--voxel", a.voxel_mm, "finest grid step in mm (default: the thinnest vessel's diameter / --samples-across)")
       ->check(finiteIn(0, 1e6));
   c->add_option("--samples-across", a.samples_across,
@@ -73,6 +79,15 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   MeshParameters p;
   p.method = a.method;
   p.ring_spacing = a.ring_spacing;
+  p.wall_thickness = a.wall_thickness;
+  p.wall_ratio = a.wall_ratio;
+  p.wall_from_graph = a.wall_from_graph;
+  if (int(p.wall_thickness > 0) + int(p.wall_ratio > 0) + int(p.wall_from_graph) > 1)
+    throw InputError("", 0, "--wall-thickness, --wall-ratio and --wall-from-graph exclude each other; allowed: one of them");
+  if ((p.wall_thickness > 0 || p.wall_ratio > 0 || p.wall_from_graph) && a.method != "tubes")
+    throw InputError("", 0, "a hollow wall is built on the tubes; allowed: --method tubes");
+  if ((p.wall_thickness > 0 || p.wall_ratio > 0 || p.wall_from_graph) && a.ends == "capped")
+    throw InputError("", 0, "a hollow wall keeps its ends open (the lumen runs through); allowed: --ends open (or closed, which opens them)");
   p.voxel_mm = a.voxel_mm;
   p.samples_across = a.samples_across;
   p.uniform = a.uniform;

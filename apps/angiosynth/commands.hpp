@@ -79,6 +79,8 @@ struct MeshArgs {
   double voxel_mm = 0;
   int samples_across = 0;
   double ring_spacing = 2;
+  double wall_thickness = 0, wall_ratio = 0;
+  bool wall_from_graph = false;
   bool uniform = false, on_surface = false;
   std::string ends = "closed";
   double flow_extension = 0;

@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "core/error.hpp"
+#include "core/union_find.hpp"
 #include "grow/common/segment_index.hpp"
 #include "mesh/decimate.hpp"
 #include "mesh/ring_mesh.hpp"
@@ -87,21 +88,6 @@ double cutDistance(const Vessel& v, int k, const std::vector<const Vessel*>& oth
   return plane;
 }
 
-// Union-find over node ids.
-struct Groups {
-  std::vector<std::int32_t> up;
-  explicit Groups(std::size_t n) : up(n) {
-    for (std::size_t i = 0; i < n; ++i) up[i] = std::int32_t(i);
-  }
-  std::int32_t find(std::int32_t v) {
-    while (up[std::size_t(v)] != v) v = up[std::size_t(v)] = up[std::size_t(up[std::size_t(v)])];
-    return v;
-  }
-  void join(std::int32_t a, std::int32_t b) {
-    a = find(a), b = find(b);
-    if (a != b) up[std::size_t(std::max(a, b))] = std::min(a, b);
-  }
-};
 
 // A tube's end as a cluster cuts it.
 struct Stub {
@@ -158,6 +144,8 @@ class TubeMesher {
       clusters = std::move(next);
       meshes = std::move(next_meshes);
       const std::int64_t total = std::int64_t(todo.size());
+      ++rep.rounds;
+      for (auto c : todo) rep.largest_remeshed = std::max<std::int64_t>(rep.largest_remeshed, std::int64_t(clusters[c].whole.size()));
       // In batches, so progress is reported from this thread.
       for (std::int64_t first = 0; first < total; first += 1024) {
         const std::int64_t last = std::min(total, first + 1024);
@@ -298,10 +286,10 @@ class TubeMesher {
   // Clusters: nodes joined by vessels without a tube and by close pairs; in the order of their
   // smallest node, so the mesh does not depend on the thread count.
   std::vector<Cluster> buildClusters() {
-    Groups g(std::size_t(t_.nodeCount()));
+    UnionFind g(std::size_t(t_.nodeCount()));
     for (const auto& v : vessels_)
-      if (!v.tube) g.join(v.node[0], v.node[1]);
-    for (const auto& [i, j] : close_pairs_) g.join(vessels_[std::size_t(i)].node[0], vessels_[std::size_t(j)].node[0]);
+      if (!v.tube) g.unite(v.node[0], v.node[1]);
+    for (const auto& [i, j] : close_pairs_) g.unite(vessels_[std::size_t(i)].node[0], vessels_[std::size_t(j)].node[0]);
     std::vector<char> touching_root(std::size_t(t_.nodeCount()), 0);
     for (const auto& pr : close_pairs_) touching_root[std::size_t(g.find(vessels_[std::size_t(pr.first)].node[0]))] = 1;
     std::vector<std::int32_t> slot(std::size_t(t_.nodeCount()), -1);

@@ -7,23 +7,9 @@
 #include <numeric>
 #include <vector>
 
+#include "core/union_find.hpp"
+
 namespace angiosynth {
-namespace {
-
-struct UnionFind {
-  std::vector<std::int32_t> parent;
-  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  std::int32_t find(std::int32_t x) {
-    while (parent[std::size_t(x)] != x) x = parent[std::size_t(x)] = parent[std::size_t(parent[std::size_t(x)])];
-    return x;
-  }
-  void unite(std::int32_t a, std::int32_t b) {
-    a = find(a), b = find(b);
-    if (a != b) parent[std::size_t(std::max(a, b))] = std::min(a, b);
-  }
-};
-
-}  // namespace
 
 std::int64_t countComponents(const Volume<std::uint8_t>& v, std::uint8_t value, int connectivity, bool padded) {
   // Runs of equal voxels along x, one union-find node per run: the work scales with the runs, not
