@@ -9,6 +9,7 @@
 #include <numbers>
 #include <set>
 
+#include "core/distributions.hpp"
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "grow/colonisation/grower.hpp"
@@ -303,7 +304,7 @@ TEST(PointHash, QueriesEqualBruteForce) {
     PointHash grid(lo, hi, 0.05, flat);
     std::vector<Vec3> pts;
     const auto draw = [&](double spread) {
-      return Vec3(rng.uniform(-spread, spread), rng.uniform(-spread, spread), flat ? 0.0 : rng.uniform(-spread, spread));
+      return uniformPoint(rng, -spread, spread, flat);
     };
     for (int i = 0; i < 3000; ++i) pts.push_back(i % 3 == 0 ? draw(1.3) : draw(0.3) * 0.5 + Vec3(0.4, -0.2, 0));
     pts.push_back(pts[10]);  // an exact tie: the earlier id must win

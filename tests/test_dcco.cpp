@@ -13,6 +13,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "core/distributions.hpp"
 #include "core/rng.hpp"
 #include "grow/dcco/lattice.hpp"
 #include "grow/dcco/setup.hpp"
@@ -356,7 +357,7 @@ TEST(Dcco, TerminalsFollowEachPdfOfFig4) {
     double total = 0;
     for (const auto& k : st.gaussians) total += k.weight;
     while (drawn[0].size() < 2000) {
-      Vec3 p(rng.uniform(-20, 20), rng.uniform(-20, 20), 0);
+      Vec3 p = uniformPoint(rng, -20, 20, true);
       if (st.pdf == TerminalPdf::Gaussian) {
         double u = rng.uniform() * total;
         const GaussianComponent* k = &st.gaussians.back();
@@ -365,7 +366,8 @@ TEST(Dcco, TerminalsFollowEachPdfOfFig4) {
             k = &q;
             break;
           }
-        p = Vec3(k->mean.x + k->sigma.x * rng.normal(), k->mean.y + k->sigma.y * rng.normal(), 0);
+        const double ny = rng.normal(), nx = rng.normal();  // y first: GCC's order of the once-unsequenced arguments
+        p = Vec3(k->mean.x + k->sigma.x * nx, k->mean.y + k->sigma.y * ny, 0);
       }
       if (domain.depth(c + p) > 0) add(drawn, p);
     }

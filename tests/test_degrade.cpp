@@ -11,6 +11,7 @@
 #include <numeric>
 #include <unistd.h>
 
+#include "core/distributions.hpp"
 #include "core/error.hpp"
 #include "degrade/degrade.hpp"
 #include "degrade/warp.hpp"
@@ -281,7 +282,7 @@ TEST_F(Warp, IsInvertibleAndLabelsAreNeverInvented) {
   ASSERT_TRUE(w.warp);
   const BSplineWarp& warp = *w.warp;
   for (int i = 0; i < 200; ++i) {
-    const Vec3 x(rng.uniform(0, 40), rng.uniform(0, 40), rng.uniform(0, 40));
+    const Vec3 x = uniformPoint(rng, 0, 40);
     EXPECT_LT(distance(warp.pullback(warp.forward(x)), x), 1e-8);
   }
   // Labels are segment ids of the clean tree, on the mask only, and, where the warped image shows
@@ -308,7 +309,7 @@ TEST_F(Warp, IsInvertibleAndLabelsAreNeverInvented) {
   BSplineField fx(grid_, Vec3(j["spacing_mm"][0], j["spacing_mm"][1], j["spacing_mm"][2]));
   fx.coefficients() = j["displacement_x_mm"].get<std::vector<float>>();
   for (int i = 0; i < 50; ++i) {
-    const Vec3 y(rng.uniform(0, 40), rng.uniform(0, 40), rng.uniform(0, 40));
+    const Vec3 y = uniformPoint(rng, 0, 40);
     EXPECT_NEAR(fx.at(y), warp.displacement(y).x, 1e-9);
   }
   // Every piece of the warped graph knows its clean segment.

@@ -6,6 +6,7 @@
 
 #include <tbb/global_control.h>
 
+#include "core/distributions.hpp"
 #include "core/rng.hpp"
 #include "domain/demand_sampler.hpp"
 #include "grow/common/bifurcation_optimizer.hpp"
@@ -87,7 +88,7 @@ TEST(Growth, IntersectingPairsEqualBruteForce) {
     for (int i = 1; i < 2600; ++i) {
       const auto k = std::size_t(rng.uniform() * double(open.size()));
       const auto par = open[k];
-      const Vec3 d(rng.uniform(-1, 1), rng.uniform(-1, 1), planar ? 0.0 : rng.uniform(-1, 1));
+      const Vec3 d = uniformPoint(rng, -1, 1, planar);
       const Vec3 q = t.position[par] + d * 1.5;
       const auto id = t.addNode(Vec3(in(q.x), in(q.y), planar ? 0.0 : in(q.z)), par);
       if (t.child1[par] >= 0) open.erase(open.begin() + std::ptrdiff_t(k));
@@ -165,7 +166,7 @@ TEST(Growth, OptimiserBeatsVascuSynthAxisHillClimb) {
   int compared = 0, better = 0;
   std::vector<std::pair<double, std::int32_t>> near;
   for (int trial = 0; trial < 400; ++trial) {
-    const Vec3 cand = ex.map.toMm(Vec3(rng.uniform(1, 99), rng.uniform(1, 99), rng.uniform(1, 99)));
+    const Vec3 cand = ex.map.toMm(uniformPoint(rng, 1, 99));
     if (!ex.map.perfusable(cand)) continue;
     index.nearest(t, cand, 5, near);
     const std::int32_t s = near[trial % 5].second;  // the segments growth tries
@@ -222,7 +223,7 @@ TEST(SegmentIndex, NearestMatchesBruteForce) {
   Rng rng(7, 0, Stage::Growth);
   std::vector<std::pair<double, std::int32_t>> got;
   for (int q = 0; q < 300; ++q) {
-    const Vec3 p = ex.map.extentMm() * 0.0 + Vec3(rng.uniform(0, 40), rng.uniform(0, 40), rng.uniform(0, 40));
+    const Vec3 p = ex.map.extentMm() * 0.0 + uniformPoint(rng, 0, 40);
     index.nearest(t, p, 5, got);
     std::vector<std::pair<double, std::int32_t>> all;
     for (std::int32_t s = 1; s < t.nodeCount(); ++s)

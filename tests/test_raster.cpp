@@ -6,6 +6,7 @@
 #include <numbers>
 #include <queue>
 
+#include "core/distributions.hpp"
 #include "core/rng.hpp"
 #include "raster/ground_truth.hpp"
 #include "test_support.hpp"
@@ -41,7 +42,7 @@ TEST(Raster, CapsulesAtRandomOrientationsMatchTheirAnalyticVolume) {
       const Vec3 dir(std::sqrt(1 - z * z) * std::cos(phi), std::sqrt(1 - z * z) * std::sin(phi), z);
       const int n = static_cast<int>(std::ceil((len + 2 * r) / h)) + 6;
       const VolumeGrid g = cubeGrid(n, h);
-      const Vec3 centre = g.centre(n / 2, n / 2, n / 2) + Vec3(rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5)) * h;
+      const Vec3 centre = g.centre(n / 2, n / 2, n / 2) + uniformPoint(rng, -0.5, 0.5) * h;
       const VascularTree t = singleSegment(centre - dir * (len / 2), centre + dir * (len / 2), r);
       Volume<float> f;
       Volume<std::uint32_t> id;

@@ -5,8 +5,20 @@
 #include <cstdint>
 
 #include "core/rng.hpp"
+#include "core/vec3.hpp"
 
 namespace angiosynth {
+
+// A point uniform in [lo, hi)^3, or in [lo, hi)^2 at z = flat_z when `flat`. The coordinates
+// are drawn z, y, x in turn: written as three arguments of one call they were unsequenced
+// (GCC drew right to left, Clang left to right, giving different trees); this fixes GCC's order
+// so that trees grown before stay as they were.
+inline Vec3 uniformPoint(Rng& rng, double lo, double hi, bool flat = false, double flat_z = 0) {
+  const double z = flat ? flat_z : rng.uniform(lo, hi);
+  const double y = rng.uniform(lo, hi);
+  const double x = rng.uniform(lo, hi);
+  return Vec3(x, y, z);
+}
 
 // Poisson(λ): Knuth's product of uniforms below λ = 10 (a dozen draws at most on average), and
 // Hörmann's transformed rejection with squeeze (PTRS, 1993) above, whose cost does not grow

@@ -5,6 +5,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "core/distributions.hpp"
+
 namespace angiosynth {
 
 const char* domainShapeName(DomainShape s) {
@@ -152,7 +154,7 @@ Vec3 GrowthDomain::sample(Rng& rng) const {
   if (shape_ != DomainShape::Mask) {
     // Rejection from the bounding box: exactly uniform.
     for (;;) {
-      const Vec3 u(rng.uniform(-1, 1), rng.uniform(-1, 1), dimension_ == 2 ? 0.0 : rng.uniform(-1, 1));
+      const Vec3 u = uniformPoint(rng, -1, 1, dimension_ == 2);
       const Vec3 p = center_ + u * size_;
       if (depth(p) > 0) return p;
     }
@@ -167,7 +169,7 @@ Vec3 GrowthDomain::sample(Rng& rng) const {
       const double rank = u * double(inside_->size());  // u·N may round up to N: no voxel, draw again
       if (rank < double(inside_->size())) v = (*inside_)[std::size_t(rank)];
     }
-    const Vec3 jitter(rng.uniform(), rng.uniform(), dimension_ == 2 ? 0.5 : rng.uniform());
+    const Vec3 jitter = uniformPoint(rng, 0, 1, dimension_ == 2, 0.5);
     if (v < 0) continue;
     const std::int64_t nx = m.dims[0], ny = m.dims[1];
     const Vec3 p = m.toMm(Vec3(double(v % nx), double((v / nx) % ny), double(v / (nx * ny))) + jitter);

@@ -7,6 +7,7 @@
 #include <numbers>
 #include <tuple>
 
+#include "core/distributions.hpp"
 #include "core/rng.hpp"
 #include "domain/demand_sampler.hpp"
 #include "domain/supply.hpp"
@@ -59,7 +60,7 @@ class Grower {
   Vec3 drawCandidate() {
     for (;;) {
       const auto v = sampler_.sample(rng_.uniform());
-      const Vec3 jitter(rng_.uniform(), rng_.uniform(), rng_.uniform());
+      const Vec3 jitter = uniformPoint(rng_, 0, 1);
       if (v < 0) continue;
       const std::int64_t nx = map_.dims[0], ny = map_.dims[1];
       const Vec3 corner(double(v % nx), double((v / nx) % ny), double(v / (nx * ny)));
