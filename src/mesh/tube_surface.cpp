@@ -24,8 +24,15 @@ constexpr double kTwoPi = 2 * std::numbers::pi;
 constexpr double kTouching = 1.1;
 // A part with a handle it should not have is contoured again at most this many times, finer.
 constexpr int kRefinements = 2;
+// Gaps are not resolved in parts of more vessels (a gap's step multiplies their grid).
+constexpr std::size_t kLargestGapPart = 64;
 // A tube is at least this many radii long.
 constexpr double kShortestTube = 0.25;
+// Two vessels of a tree that come close without touching are contoured together, with cells of
+// a third of their gap (the fillet then stays in the gap and no tetrahedron spans it) along the
+// stretch of each where its wall comes within two of its own cells of the other's, unless that
+// is more than this many times finer than their own cells: then they count as touching.
+constexpr double kGapCells = 3, kFinestGapCells = 16;
 
 // A vessel as the mesher sees it: its two junction nodes (links merged), its axis and radii, and
 // where its tube starts and ends.
@@ -95,12 +102,30 @@ struct Stub {
   int side;
 };
 
+// Two vessels of a tree, sharing no node, whose axes come closer than kTouching times their
+// radii: the cell that resolves the gap between their walls, or 0 where they touch.
+struct ClosePair {
+  std::int32_t i, j;
+  double gap_cell;
+  double span_i[2], span_j[2];  // the close stretches, distances from each vessel's a
+  bool touching = true;         // else apart: across a gap, or with a joining vessel between them
+};
+
+// Where a part's vessel needs fine cells: from y0 to y1 (distances from its a), cells no larger than `cell`.
+struct GapSpan {
+  std::int32_t vessel;
+  double cell, y0, y1;
+};
+
 struct Cluster {
   std::int32_t tree = 0;
   std::vector<std::int32_t> whole;  // vessels contoured whole
   std::vector<Stub> stubs;          // tubes cut at this cluster's side
   bool touching = false;            // holds vessels that touch without sharing a node (its union may have handles)
+  std::int32_t parts = 1;           // components of its union (vessels close across a gap stay apart)
+  std::vector<GapSpan> gap_spans;   // whole vessels that need finer cells along a stretch
 };
+
 
 // What a cluster gives: its surface (its own vertex numbering) and each stub's loop, counter-
 // clockwise around the vessel's axis a → b, or empty if its cut failed.
@@ -251,7 +276,13 @@ class TubeMesher {
     for (std::size_t i = 0; i < vessels_.size(); ++i) reach[i] = kTouching * vessels_[i].rmax();
     tbb::enumerable_thread_specific<SegmentIndex::Marks> marks;
     std::vector<char> near(vessels_.size(), 0);
-    std::vector<std::vector<std::pair<std::int32_t, std::int32_t>>> found(vessels_.size());
+    std::vector<std::vector<ClosePair>> found(vessels_.size());
+    // The wall's distance from the axis at parameter s of vessel i's axis segment (prolonged).
+    const auto radiusOn = [&](std::size_t i, double s) {
+      const auto& v = vessels_[i];
+      const double before = std::max(0.0, -v.plane[0]), after = std::max(0.0, -v.plane[1]);
+      return v.radiusAt(s * (v.len + before + after) - before);
+    };
     tbb::parallel_for(std::size_t(0), vessels_.size(), [&](std::size_t i) {
       const auto& v = vessels_[i];
       const std::int32_t seg = 2 * std::int32_t(i) + 1;
@@ -260,17 +291,64 @@ class TubeMesher {
         if (j == i || !(reach[j] < reach[i] || (reach[j] == reach[i] && j > i))) return;
         const auto& w = vessels_[j];
         if (w.tree != v.tree || w.node[0] == v.node[0] || w.node[0] == v.node[1] || w.node[1] == v.node[0] || w.node[1] == v.node[1]) return;
+        double si = 0, sj = 0;
         const double d = segmentSegmentDistance(axes.position[std::size_t(seg) - 1], axes.position[std::size_t(seg)], axes.position[std::size_t(y) - 1],
-                                                axes.position[std::size_t(y)]);
-        if (d < reach[i] + reach[j]) found[i].emplace_back(std::int32_t(i), std::int32_t(j));
+                                                axes.position[std::size_t(y)], si, sj);
+        if (!(d < reach[i] + reach[j])) return;
+        const Vec3 pi = axes.position[std::size_t(seg) - 1] + (axes.position[std::size_t(seg)] - axes.position[std::size_t(seg) - 1]) * si;
+        const Vec3 pj = axes.position[std::size_t(y) - 1] + (axes.position[std::size_t(y)] - axes.position[std::size_t(y) - 1]) * sj;
+        // The walls' gap where the axes are closest (the nearest points of tapered walls lie a
+        // little aside: second order in their slopes). Two vessels that overlap touch, even
+        // through a connector: the union may have a handle there.
+        const double gap = d - radiusOn(i, si) - radiusOn(j, sj);
+        const double cell = gap / kGapCells, own = stepNear(std::min({v.ra, v.rb, w.ra, w.rb}), o_.junction);
+        ClosePair pr{std::int32_t(i), std::int32_t(j), 0.0, {0, 0}, {0, 0}, true};
+        if (gap > 0 && throughConnector(v, w, pi, pj)) pr.touching = false;
+        else if (cell * kFinestGapCells >= own) pr.gap_cell = cell, pr.touching = false;
+        if (pr.gap_cell > 0) {
+          const double within = v.rmax() + w.rmax() + 2 * own;
+          closeSpan(i, axes.position[std::size_t(seg) - 1], axes.position[std::size_t(seg)], si, axes.position[std::size_t(y) - 1], axes.position[std::size_t(y)], within, pr.span_i);
+          closeSpan(j, axes.position[std::size_t(y) - 1], axes.position[std::size_t(y)], sj, axes.position[std::size_t(seg) - 1], axes.position[std::size_t(seg)], within, pr.span_j);
+        }
+        found[i].push_back(pr);
       });
     });
     close_pairs_.clear();
     for (const auto& f : found)
       for (const auto& p : f) {
         close_pairs_.push_back(p);
-        vessels_[std::size_t(p.first)].tube = vessels_[std::size_t(p.second)].tube = false;
+        vessels_[std::size_t(p.i)].tube = vessels_[std::size_t(p.j)].tube = false;
       }
+  }
+  // Whether v and w come closest through a vessel joining their nodes (points pi, pj of their
+  // axes within its radius of the nodes it shares with them): the space between them is that
+  // vessel's, not a gap; they are contoured together, as a part that must keep no handle.
+  bool throughConnector(const Vessel& v, const Vessel& w, const Vec3& pi, const Vec3& pj) const {
+    for (int x = 0; x < 2; ++x)
+      for (const Vessel* m : at_node_[std::size_t(v.node[x])]) {
+        const int other = m->node[0] == v.node[x] ? 1 : 0;
+        for (int y = 0; y < 2; ++y)
+          if (m->node[other] == w.node[y] && distance(pi, v.nodeAt(x)) <= m->rmax() && distance(pj, w.nodeAt(y)) <= m->rmax()) return true;
+      }
+    return false;
+  }
+  // The stretch of vessel i (axis p0 → p1, prolonged) whose points lie within `within` of the
+  // axis q0 → q1, around parameter s where it comes closest: the distance is convex along the
+  // axis, so each side is a bisection. As distances from the vessel's a, within its length.
+  void closeSpan(std::size_t i, const Vec3& p0, const Vec3& p1, double s, const Vec3& q0, const Vec3& q1, double within, double span[2]) const {
+    const auto& v = vessels_[i];
+    const auto near = [&](double x) { return pointSegmentDistance(p0 + (p1 - p0) * x, q0, q1) < within; };
+    const auto edge = [&](double in, double out) {
+      if (near(out)) return out;
+      for (int k = 0; k < 50; ++k) {
+        const double mid = 0.5 * (in + out);
+        (near(mid) ? in : out) = mid;
+      }
+      return out;
+    };
+    const double before = std::max(0.0, -v.plane[0]), total = v.len + before + std::max(0.0, -v.plane[1]);
+    span[0] = std::clamp(edge(s, 0.0) * total - before, 0.0, v.len);
+    span[1] = std::clamp(edge(s, 1.0) * total - before, 0.0, v.len);
   }
   Vec3 boxLo() const {
     Vec3 lo(INFINITY, INFINITY, INFINITY);
@@ -284,14 +362,19 @@ class TubeMesher {
   }
 
   // Clusters: nodes joined by vessels without a tube and by close pairs; in the order of their
-  // smallest node, so the mesh does not depend on the thread count.
+  // smallest node, so the mesh does not depend on the thread count. A part's union has as many
+  // components as its nodes have when only the vessels and the touching pairs join them.
   std::vector<Cluster> buildClusters() {
-    UnionFind g(std::size_t(t_.nodeCount()));
+    UnionFind g(std::size_t(t_.nodeCount())), joined(std::size_t(t_.nodeCount()));
     for (const auto& v : vessels_)
-      if (!v.tube) g.unite(v.node[0], v.node[1]);
-    for (const auto& [i, j] : close_pairs_) g.unite(vessels_[std::size_t(i)].node[0], vessels_[std::size_t(j)].node[0]);
+      if (!v.tube) g.unite(v.node[0], v.node[1]), joined.unite(v.node[0], v.node[1]);
+    for (const auto& pr : close_pairs_) {
+      g.unite(vessels_[std::size_t(pr.i)].node[0], vessels_[std::size_t(pr.j)].node[0]);
+      if (pr.touching) joined.unite(vessels_[std::size_t(pr.i)].node[0], vessels_[std::size_t(pr.j)].node[0]);
+    }
     std::vector<char> touching_root(std::size_t(t_.nodeCount()), 0);
-    for (const auto& pr : close_pairs_) touching_root[std::size_t(g.find(vessels_[std::size_t(pr.first)].node[0]))] = 1;
+    for (const auto& pr : close_pairs_)
+      if (pr.touching) touching_root[std::size_t(g.find(vessels_[std::size_t(pr.i)].node[0]))] = 1;
     std::vector<std::int32_t> slot(std::size_t(t_.nodeCount()), -1);
     std::vector<Cluster> out;
     const auto clusterOf = [&](std::int32_t node, std::int32_t tree) -> Cluster& {
@@ -313,6 +396,26 @@ class TubeMesher {
       }
       for (int k = 0; k < 2; ++k)
         if (v.end[k] < 0 && !v.round[k]) clusterOf(v.node[k], v.tree).stubs.push_back({std::int32_t(i), k});
+    }
+    for (const auto& pr : close_pairs_) {
+      if (!(pr.gap_cell > 0)) continue;
+      auto& gs = clusterOf(vessels_[std::size_t(pr.i)].node[0], vessels_[std::size_t(pr.i)].tree).gap_spans;
+      gs.push_back({pr.i, pr.gap_cell, pr.span_i[0], pr.span_i[1]});
+      gs.push_back({pr.j, pr.gap_cell, pr.span_j[0], pr.span_j[1]});
+    }
+    for (auto& c : out) {
+      // A large part's grid at a gap's step costs more than its handle: its close pairs touch.
+      if (c.whole.size() > kLargestGapPart && !c.gap_spans.empty()) {
+        c.gap_spans.clear();
+        c.touching = true;
+        continue;
+      }
+      std::vector<std::int32_t> roots;
+      for (auto i : c.whole)
+        for (auto n : vessels_[std::size_t(i)].node) roots.push_back(joined.find(n));
+      for (const auto& st : c.stubs) roots.push_back(joined.find(vessels_[std::size_t(st.vessel)].node[st.side]));
+      std::sort(roots.begin(), roots.end());
+      c.parts = std::int32_t(std::unique(roots.begin(), roots.end()) - roots.begin());
     }
     return out;
   }
@@ -348,6 +451,7 @@ class TubeMesher {
       const auto id = sub.addNode(b, root);
       sub.radius[id] = rb;
       if (ra != rb) sub.radius_start[id] = ra;
+      return id;
     };
     std::vector<VesselEnd> planes;
     for (const auto& st : c.stubs) {
@@ -358,9 +462,28 @@ class TubeMesher {
       piece(e.node, e.node + e.normal * d, v.radiusAt(v.fromA(st.side, 0)), v.radiusAt(v.fromA(st.side, d)));
       planes.push_back(e);
     }
+    // A vessel with a close stretch is split there (collinear pieces with the radii of the
+    // capsule's spheres at the splits: the same solid), the middle piece with finer cells.
+    std::map<std::int32_t, GapSpan> span_of;
+    for (const auto& g : c.gap_spans) {
+      const auto it = span_of.find(g.vessel);
+      if (it == span_of.end()) span_of.emplace(g.vessel, g);
+      else it->second = {g.vessel, std::min(it->second.cell, g.cell), std::min(it->second.y0, g.y0), std::max(it->second.y1, g.y1)};
+    }
+    std::vector<std::pair<std::int32_t, double>> fine;  // sub segment, its largest cell
     for (auto i : c.whole) {
       const auto& v = vessels_[std::size_t(i)];
-      piece(v.a, v.b, v.ra, v.rb);
+      const auto it = span_of.find(i);
+      if (it == span_of.end() || !(v.len > 0)) {
+        piece(v.a, v.b, v.ra, v.rb);
+      } else {
+        const auto at = [&](double y) { return v.a + v.u * y; };
+        const auto sphere = [&](double y) { return v.ra + (v.rb - v.ra) * y / v.len; };
+        const double y0 = it->second.y0, y1 = it->second.y1;
+        if (y0 > 0) piece(v.a, at(y0), v.ra, sphere(y0));
+        fine.emplace_back(piece(at(y0), at(y1), sphere(y0), sphere(y1)), it->second.cell);
+        if (y1 < v.len) piece(at(y1), v.b, sphere(y1), v.rb);
+      }
       for (int k = 0; k < 2; ++k) {
         if (v.end[k] < 0) continue;
         const auto& e = o_.ends[std::size_t(v.end[k])];
@@ -369,31 +492,36 @@ class TubeMesher {
       }
     }
     for (auto e : out.end_ids) planes.push_back(o_.ends[std::size_t(e)]);
+    std::vector<double> gap_cells(fine.empty() ? 0 : std::size_t(sub.nodeCount()), 0.0);
+    for (const auto& [s, cell] : fine) gap_cells[std::size_t(s)] = cell;
     // Marching tetrahedra bridge a wedge between two vessels narrower than a step: a part whose
-    // vessels form a tree (no touching pair) must come out without handles, else it is contoured
-    // again at twice (then four times) the samples across.
+    // vessels touch nowhere must come out with as many components as its union and without
+    // handles, else it is contoured again at twice (then four times) the samples across.
     const int base = std::max(1, o_.junction.samples_across);
     for (int refine = 0;; ++refine) {
-      contourCluster(c, sub, planes, base << refine, out);
-      if (c.touching || refine == kRefinements || handles(out.mesh, planes) == 0) break;
+      contourCluster(c, sub, planes, base << refine, gap_cells, out);
+      if (c.touching || !c.gap_spans.empty() || refine == kRefinements || isUnionShaped(out.mesh, planes, c.parts)) break;
       ++out.refinements;
+      for (auto& g : gap_cells) g /= 2;
     }
     return out;
   }
 
-  // Twice the handles of a contoured part: 2 × components − boundary loops − V + E − F.
-  static std::int64_t handles(const SurfaceMesh& m, const std::vector<VesselEnd>& planes) {
+  // A contoured part of genus 0 with `parts` components: 2 × components − boundary loops = V − E + F.
+  static bool isUnionShaped(const SurfaceMesh& m, const std::vector<VesselEnd>& planes, std::int32_t parts) {
     const auto topo = meshTopology(m);
     std::int64_t chi = 0, components = 0;
     for (auto e : topo.tree_euler) chi += e;
     for (auto k : topo.tree_components) components += k;
-    return 2 * components - std::int64_t(boundaryLoops(m, verticesInPlanes(m, planes)).size()) - chi;
+    return components == parts && 2 * components - std::int64_t(boundaryLoops(m, verticesInPlanes(m, planes)).size()) == chi;
   }
   // The part's surface at `samples` across each vessel, cut at its planes, with its stubs' loops.
-  void contourCluster(const Cluster& c, const VascularTree& sub, const std::vector<VesselEnd>& planes, int samples, ClusterMesh& out) const {
+  void contourCluster(const Cluster& c, const VascularTree& sub, const std::vector<VesselEnd>& planes, int samples, const std::vector<double>& gap_cells,
+                      ClusterMesh& out) const {
     SurfaceReport sr;
     SurfaceOptions so = o_.junction;
     so.samples_across = samples;
+    so.vessel_max_cell_mm = gap_cells;
     EndCutReport cut;
     // Cut while the exact distance is at hand, then decimate (loops and caps stay where they are).
     out.decimation = DecimateReport();
@@ -629,7 +757,7 @@ class TubeMesher {
   std::vector<Vessel> vessels_;
   std::unordered_map<std::int32_t, std::int32_t> index_of_;  // segment id → vessel index
   std::vector<std::vector<const Vessel*>> at_node_;          // per junction node, its vessels
-  std::vector<std::pair<std::int32_t, std::int32_t>> close_pairs_;
+  std::vector<ClosePair> close_pairs_;
 };
 
 }  // namespace

@@ -363,6 +363,7 @@ std::vector<std::int8_t> vesselLevels(const VascularTree& t, const std::vector<s
   for (auto s : vessels) {
     double c = 2 * std::min(t.radius[s], t.startRadius(s)) / std::max(1, o.samples_across);
     if (o.max_cell_mm > 0) c = std::min(c, o.max_cell_mm);
+    if (std::size_t(s) < o.vessel_max_cell_mm.size() && o.vessel_max_cell_mm[std::size_t(s)] > 0) c = std::min(c, o.vessel_max_cell_mm[std::size_t(s)]);
     if (c >= 2 * h) level[std::size_t(s)] = std::int8_t(std::min(kMaxSurfaceLevel, int(std::floor(std::log2(c / h) + 1e-9))));
   }
   return level;
@@ -434,7 +435,10 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
   if (vessels.empty()) return mesh;
   if (!(r_min > 0)) throw InputError("", 0, "a vessel of radius 0 has no surface; every radius must be > 0");
   const int across = std::max(1, o.samples_across);
-  const double h = o.voxel_mm > 0 ? o.voxel_mm : o.max_cell_mm > 0 ? std::min(2 * r_min / across, o.max_cell_mm) : 2 * r_min / across;
+  double h = o.voxel_mm > 0 ? o.voxel_mm : o.max_cell_mm > 0 ? std::min(2 * r_min / across, o.max_cell_mm) : 2 * r_min / across;
+  if (!(o.voxel_mm > 0))
+    for (auto c : o.vessel_max_cell_mm)
+      if (c > 0) h = std::min(h, c);
   const auto level = vesselLevels(t, vessels, h, o);
   std::vector<double> fillet(std::size_t(t.nodeCount()), 0.0);
   for (auto s : vessels) fillet[std::size_t(s)] = kFillet * h * double(std::int64_t(1) << level[std::size_t(s)]);

@@ -32,6 +32,9 @@ struct SurfaceOptions {
   double voxel_mm = 0;         // finest grid step; 0: the thinnest vessel's diameter / samples_across
   int samples_across = 4;      // samples across each vessel's thinnest end (at least)
   double max_cell_mm = 0;      // and cells no larger than this (0: no bound; a hollow wall's thickness)
+  // Per segment id of the tree given (empty, or 0 for none): cells around that vessel no larger
+  // than this (two vessels that come close without touching: cells that resolve their gap).
+  std::vector<double> vessel_max_cell_mm;
   bool adaptive = true;        // false: every vessel at the finest step
   // Move vertices off the surface by ¾ of their triangles' mean gap (a fraction of the chords'
   // sagitta) so the enclosed volume is the vessels'; false: every vertex on the surface.
