@@ -158,7 +158,9 @@ TEST(Mesh, VesselsCloseAcrossAGapStayApartAndTheSurfaceKeepsGenusZero) {
 // Two vessels joined by a short third one come close only through it: they do not touch, and
 // the part that holds them is contoured again until it keeps no handle (found in a forest Clang
 // grew when its random draws were unsequenced: one handle before).
-TEST(Mesh, VesselsJoinedByAShortVesselDoNotTouchAndKeepNoHandle) {
+// The junctions Clang's tree had, the vessel between n1 and n2 scaled by `connector` (the rest
+// moved with n2): below 0.95 the vessels on either side of it overlap, through it.
+VascularTree zigzag(double connector) {
   VascularTree t;
   const auto add = [&](const Vec3& p, std::int32_t parent, double r) {
     const auto id = t.addNode(p, parent);
@@ -167,25 +169,33 @@ TEST(Mesh, VesselsJoinedByAShortVesselDoNotTouchAndKeepNoHandle) {
   };
   const auto root = add({24.4, 57.75, 29.4}, -1, 0);
   const auto n1 = add({23.3181, 54.6138, 28.5927}, root, 0.993377);
-  const auto n2 = add({24.3689, 52.8999, 29.0966}, n1, 0.973217);
-  const auto n3 = add({25.7158, 50.7397, 29.5157}, n2, 0.965665);
-  const auto n4 = add({26.6279, 48.9308, 29.4072}, n3, 0.939007);
+  const Vec3 shift = (Vec3(24.3689, 52.8999, 29.0966) - Vec3(23.3181, 54.6138, 28.5927)) * (connector - 1);
+  const auto n2 = add(Vec3(24.3689, 52.8999, 29.0966) + shift, n1, 0.973217);
+  const auto n3 = add(Vec3(25.7158, 50.7397, 29.5157) + shift, n2, 0.965665);
+  const auto n4 = add(Vec3(26.6279, 48.9308, 29.4072) + shift, n3, 0.939007);
   // The side branches, prolonged to 6 mm along their directions.
   const auto branch = [&](std::int32_t from, const Vec3& towards, double r) {
     const Vec3 u = towards - t.position[std::size_t(from)];
     add(t.position[std::size_t(from)] + u / norm(u) * 6.0, from, r);
   };
   branch(n1, {21.8918, 53.7136, 28.0569}, 0.388153);
-  branch(n2, {24.5153, 52.3452, 31.14}, 0.277166);
-  branch(n3, {26.6106, 50.4634, 31.4644}, 0.417047);
-  branch(n4, {25.6497, 46.9178, 30.238}, 0.656128);
-  branch(n4, {28.5636, 47.3164, 28.8893}, 0.817075);
-  const auto m = tubeMesh(t, 3);
-  const auto topo = meshTopology(m);
-  EXPECT_EQ(topo.boundary_edges, 0);
-  EXPECT_EQ(topo.nonmanifold_edges, 0);
-  EXPECT_EQ(topo.tree_components, std::vector<std::int64_t>({1}));
-  EXPECT_EQ(topo.tree_euler, std::vector<std::int64_t>({2}));
+  branch(n2, Vec3(24.5153, 52.3452, 31.14) + shift, 0.277166);
+  branch(n3, Vec3(26.6106, 50.4634, 31.4644) + shift, 0.417047);
+  branch(n4, Vec3(25.6497, 46.9178, 30.238) + shift, 0.656128);
+  branch(n4, Vec3(28.5636, 47.3164, 28.8893) + shift, 0.817075);
+  return t;
+}
+
+TEST(Mesh, VesselsJoinedByAShortVesselDoNotTouchAndKeepNoHandle) {
+  for (double connector : {1.0, 0.9, 0.8, 0.7, 0.6}) {
+    const auto t = zigzag(connector);
+    const auto m = tubeMesh(t, 3);
+    const auto topo = meshTopology(m);
+    EXPECT_EQ(topo.boundary_edges, 0) << connector;
+    EXPECT_EQ(topo.nonmanifold_edges, 0) << connector;
+    EXPECT_EQ(topo.tree_components, std::vector<std::int64_t>({1})) << connector;
+    EXPECT_EQ(topo.tree_euler, std::vector<std::int64_t>({2})) << connector;
+  }
 }
 
 TEST(Mesh, OneClosedOrientedSurfacePerTreeWithItsVerticesOnTheVessels) {

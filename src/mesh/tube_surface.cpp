@@ -15,6 +15,7 @@
 #include "grow/common/segment_index.hpp"
 #include "mesh/decimate.hpp"
 #include "mesh/ring_mesh.hpp"
+#include "raster/vessel_capsule.hpp"
 
 namespace angiosynth {
 namespace {
@@ -108,7 +109,9 @@ struct ClosePair {
   std::int32_t i, j;
   double gap_cell;
   double span_i[2], span_j[2];  // the close stretches, distances from each vessel's a
-  bool touching = true;         // else apart: across a gap, or with a joining vessel between them
+  bool touching = true;         // else apart across a gap, or joined only through the vessel `via`
+  bool overlapping = false;     // their walls overlap (through `via`)
+  std::int32_t via = -1;
 };
 
 // Where a part's vessel needs fine cells: from y0 to y1 (distances from its a), cells no larger than `cell`.
@@ -303,7 +306,8 @@ class TubeMesher {
         const double gap = d - radiusOn(i, si) - radiusOn(j, sj);
         const double cell = gap / kGapCells, own = stepNear(std::min({v.ra, v.rb, w.ra, w.rb}), o_.junction);
         ClosePair pr{std::int32_t(i), std::int32_t(j), 0.0, {0, 0}, {0, 0}, true};
-        if (gap > 0 && throughConnector(v, w, pi, pj)) pr.touching = false;
+        pr.overlapping = !(gap > 0);
+        if (const Vessel* m = throughConnector(v, w, pi, pj, gap > 0)) pr.touching = false, pr.via = std::int32_t(m - vessels_.data());
         else if (cell * kFinestGapCells >= own) pr.gap_cell = cell, pr.touching = false;
         if (pr.gap_cell > 0) {
           const double within = v.rmax() + w.rmax() + 2 * own;
@@ -318,19 +322,43 @@ class TubeMesher {
       for (const auto& p : f) {
         close_pairs_.push_back(p);
         vessels_[std::size_t(p.i)].tube = vessels_[std::size_t(p.j)].tube = false;
+        if (p.via >= 0) vessels_[std::size_t(p.via)].tube = false;  // in their part: the three are one piece
       }
   }
-  // Whether v and w come closest through a vessel joining their nodes (points pi, pj of their
-  // axes within its radius of the nodes it shares with them): the space between them is that
-  // vessel's, not a gap; they are contoured together, as a part that must keep no handle.
-  bool throughConnector(const Vessel& v, const Vessel& w, const Vec3& pi, const Vec3& pj) const {
+  // The vessel m joining a node of v to one of w if v and w meet only through it, so that the
+  // three have a union without a hole (else null): apart, where they come closest within m's
+  // radius of the nodes it shares with them (the space between them is m's, not a gap);
+  // overlapping, where the three solids share a point (convex solids that pairwise meet and
+  // share a point have a union without a hole). The three are contoured together, as a part
+  // that must keep no handle.
+  const Vessel* throughConnector(const Vessel& v, const Vessel& w, const Vec3& pi, const Vec3& pj, bool apart) const {
     for (int x = 0; x < 2; ++x)
       for (const Vessel* m : at_node_[std::size_t(v.node[x])]) {
         const int other = m->node[0] == v.node[x] ? 1 : 0;
-        for (int y = 0; y < 2; ++y)
-          if (m->node[other] == w.node[y] && distance(pi, v.nodeAt(x)) <= m->rmax() && distance(pj, w.nodeAt(y)) <= m->rmax()) return true;
+        for (int y = 0; y < 2; ++y) {
+          if (m->node[other] != w.node[y]) continue;
+          if (apart) {
+            if (distance(pi, v.nodeAt(x)) <= m->rmax() && distance(pj, w.nodeAt(y)) <= m->rmax()) return m;
+            continue;
+          }
+          // The deepest point of the three along lines between their nearest points and the
+          // shared nodes: the largest of three convex distances is convex along a line.
+          const Capsule cv = capsuleOf(t_, v.s), cw = capsuleOf(t_, w.s), cm = capsuleOf(t_, m->s);
+          const auto outside = [&](const Vec3& p) { return std::max({cv.depth(p), cw.depth(p), cm.depth(p)}); };
+          const Vec3 nv = v.nodeAt(x), nw = w.nodeAt(y);
+          for (const auto& [p0, p1] : {std::pair{pi, pj}, std::pair{nv, pj}, std::pair{pi, nw}, std::pair{nv, nw}}) {
+            const auto at = [&](double s) { return p0 + (p1 - p0) * s; };
+            double lo = 0, hi = 1;
+            for (int k = 0; k < 40; ++k) {
+              const double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
+              if (outside(at(m1)) < outside(at(m2))) hi = m2;
+              else lo = m1;
+            }
+            if (outside(at(0.5 * (lo + hi))) < 0) return m;
+          }
+        }
       }
-    return false;
+    return nullptr;
   }
   // The stretch of vessel i (axis p0 → p1, prolonged) whose points lie within `within` of the
   // axis q0 → q1, around parameter s where it comes closest: the distance is convex along the
@@ -370,7 +398,7 @@ class TubeMesher {
       if (!v.tube) g.unite(v.node[0], v.node[1]), joined.unite(v.node[0], v.node[1]);
     for (const auto& pr : close_pairs_) {
       g.unite(vessels_[std::size_t(pr.i)].node[0], vessels_[std::size_t(pr.j)].node[0]);
-      if (pr.touching) joined.unite(vessels_[std::size_t(pr.i)].node[0], vessels_[std::size_t(pr.j)].node[0]);
+      if (pr.touching || pr.overlapping) joined.unite(vessels_[std::size_t(pr.i)].node[0], vessels_[std::size_t(pr.j)].node[0]);
     }
     std::vector<char> touching_root(std::size_t(t_.nodeCount()), 0);
     for (const auto& pr : close_pairs_)
