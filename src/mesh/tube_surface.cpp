@@ -346,7 +346,8 @@ class TubeMesher {
           const Capsule cv = capsuleOf(t_, v.s), cw = capsuleOf(t_, w.s), cm = capsuleOf(t_, m->s);
           const auto outside = [&](const Vec3& p) { return std::max({cv.depth(p), cw.depth(p), cm.depth(p)}); };
           const Vec3 nv = v.nodeAt(x), nw = w.nodeAt(y);
-          for (const auto& [p0, p1] : {std::pair{pi, pj}, std::pair{nv, pj}, std::pair{pi, nw}, std::pair{nv, nw}}) {
+          for (const auto& line : {std::pair{pi, pj}, std::pair{nv, pj}, std::pair{pi, nw}, std::pair{nv, nw}}) {
+            const Vec3 p0 = line.first, p1 = line.second;  // (Clang 14 captures no structured binding)
             const auto at = [&](double s) { return p0 + (p1 - p0) * s; };
             double lo = 0, hi = 1;
             for (int k = 0; k < 40; ++k) {
