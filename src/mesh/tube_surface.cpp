@@ -52,6 +52,10 @@ struct Vessel {
   bool tube = false;
 
   double rmax() const { return std::max(ra, rb); }
+  // How far side k's CFD end prolongs the axis beyond its node (0 without one), and the distance
+  // from a of the point at parameter s of the prolonged axis.
+  double prolonged(int k) const { return std::max(0.0, -plane[k]); }
+  double fromAOnAxis(double s) const { return s * (len + prolonged(0) + prolonged(1)) - prolonged(0); }
   // The wall's distance from the axis at distance y from a along it (a CFD prolongation beyond
   // an end is a cylinder of that end's radius).
   double radiusAt(double y) const {
@@ -270,7 +274,7 @@ class TubeMesher {
     SegmentIndex index(boxLo(), boxHi());
     VascularTree axes;  // one segment per vessel, its CFD prolongations included
     for (const auto& v : vessels_) {
-      const Vec3 a = v.a - v.u * std::max(0.0, -v.plane[0]), b = v.b + v.u * std::max(0.0, -v.plane[1]);
+      const Vec3 a = v.a - v.u * v.prolonged(0), b = v.b + v.u * v.prolonged(1);
       const auto root = axes.addNode(a, -1, v.tree);
       axes.addNode(b, root);
     }
@@ -278,32 +282,25 @@ class TubeMesher {
     std::vector<double> reach(vessels_.size());
     for (std::size_t i = 0; i < vessels_.size(); ++i) reach[i] = kTouching * vessels_[i].rmax();
     tbb::enumerable_thread_specific<SegmentIndex::Marks> marks;
-    std::vector<char> near(vessels_.size(), 0);
     std::vector<std::vector<ClosePair>> found(vessels_.size());
-    // The wall's distance from the axis at parameter s of vessel i's axis segment (prolonged).
-    const auto radiusOn = [&](std::size_t i, double s) {
-      const auto& v = vessels_[i];
-      const double before = std::max(0.0, -v.plane[0]), after = std::max(0.0, -v.plane[1]);
-      return v.radiusAt(s * (v.len + before + after) - before);
-    };
     tbb::parallel_for(std::size_t(0), vessels_.size(), [&](std::size_t i) {
       const auto& v = vessels_[i];
       const std::int32_t seg = 2 * std::int32_t(i) + 1;
-      index.forEachNearSegment(axes.position[std::size_t(seg) - 1], axes.position[std::size_t(seg)], 2 * reach[i], marks.local(), [&](std::int32_t y) {
+      const Vec3 &p0 = axes.position[std::size_t(seg) - 1], &p1 = axes.position[std::size_t(seg)];
+      index.forEachNearSegment(p0, p1, 2 * reach[i], marks.local(), [&](std::int32_t y) {
         const std::size_t j = std::size_t(y - 1) / 2;
         if (j == i || !(reach[j] < reach[i] || (reach[j] == reach[i] && j > i))) return;
         const auto& w = vessels_[j];
         if (w.tree != v.tree || w.node[0] == v.node[0] || w.node[0] == v.node[1] || w.node[1] == v.node[0] || w.node[1] == v.node[1]) return;
+        const Vec3 &q0 = axes.position[std::size_t(y) - 1], &q1 = axes.position[std::size_t(y)];
         double si = 0, sj = 0;
-        const double d = segmentSegmentDistance(axes.position[std::size_t(seg) - 1], axes.position[std::size_t(seg)], axes.position[std::size_t(y) - 1],
-                                                axes.position[std::size_t(y)], si, sj);
+        const double d = segmentSegmentDistance(p0, p1, q0, q1, si, sj);
         if (!(d < reach[i] + reach[j])) return;
-        const Vec3 pi = axes.position[std::size_t(seg) - 1] + (axes.position[std::size_t(seg)] - axes.position[std::size_t(seg) - 1]) * si;
-        const Vec3 pj = axes.position[std::size_t(y) - 1] + (axes.position[std::size_t(y)] - axes.position[std::size_t(y) - 1]) * sj;
+        const Vec3 pi = p0 + (p1 - p0) * si, pj = q0 + (q1 - q0) * sj;
         // The walls' gap where the axes are closest (the nearest points of tapered walls lie a
         // little aside: second order in their slopes). Two vessels that overlap touch, even
         // through a connector: the union may have a handle there.
-        const double gap = d - radiusOn(i, si) - radiusOn(j, sj);
+        const double gap = d - v.radiusAt(v.fromAOnAxis(si)) - w.radiusAt(w.fromAOnAxis(sj));
         const double cell = gap / kGapCells, own = stepNear(std::min({v.ra, v.rb, w.ra, w.rb}), o_.junction);
         ClosePair pr{std::int32_t(i), std::int32_t(j), 0.0, {0, 0}, {0, 0}, true};
         pr.overlapping = !(gap > 0);
@@ -311,8 +308,8 @@ class TubeMesher {
         else if (cell * kFinestGapCells >= own) pr.gap_cell = cell, pr.touching = false;
         if (pr.gap_cell > 0) {
           const double within = v.rmax() + w.rmax() + 2 * own;
-          closeSpan(i, axes.position[std::size_t(seg) - 1], axes.position[std::size_t(seg)], si, axes.position[std::size_t(y) - 1], axes.position[std::size_t(y)], within, pr.span_i);
-          closeSpan(j, axes.position[std::size_t(y) - 1], axes.position[std::size_t(y)], sj, axes.position[std::size_t(seg) - 1], axes.position[std::size_t(seg)], within, pr.span_j);
+          closeSpan(v, p0, p1, si, q0, q1, within, pr.span_i);
+          closeSpan(w, q0, q1, sj, p0, p1, within, pr.span_j);
         }
         found[i].push_back(pr);
       });
@@ -361,11 +358,10 @@ class TubeMesher {
       }
     return nullptr;
   }
-  // The stretch of vessel i (axis p0 → p1, prolonged) whose points lie within `within` of the
+  // The stretch of vessel v (axis p0 → p1, prolonged) whose points lie within `within` of the
   // axis q0 → q1, around parameter s where it comes closest: the distance is convex along the
   // axis, so each side is a bisection. As distances from the vessel's a, within its length.
-  void closeSpan(std::size_t i, const Vec3& p0, const Vec3& p1, double s, const Vec3& q0, const Vec3& q1, double within, double span[2]) const {
-    const auto& v = vessels_[i];
+  static void closeSpan(const Vessel& v, const Vec3& p0, const Vec3& p1, double s, const Vec3& q0, const Vec3& q1, double within, double span[2]) {
     const auto near = [&](double x) { return pointSegmentDistance(p0 + (p1 - p0) * x, q0, q1) < within; };
     const auto edge = [&](double in, double out) {
       if (near(out)) return out;
@@ -375,18 +371,17 @@ class TubeMesher {
       }
       return out;
     };
-    const double before = std::max(0.0, -v.plane[0]), total = v.len + before + std::max(0.0, -v.plane[1]);
-    span[0] = std::clamp(edge(s, 0.0) * total - before, 0.0, v.len);
-    span[1] = std::clamp(edge(s, 1.0) * total - before, 0.0, v.len);
+    span[0] = std::clamp(v.fromAOnAxis(edge(s, 0.0)), 0.0, v.len);
+    span[1] = std::clamp(v.fromAOnAxis(edge(s, 1.0)), 0.0, v.len);
   }
   Vec3 boxLo() const {
     Vec3 lo(INFINITY, INFINITY, INFINITY);
-    for (const auto& v : vessels_) lo = componentMin(lo, componentMin(v.a, v.b) - Vec3(1, 1, 1) * (v.rmax() + std::max(0.0, -std::min(v.plane[0], v.plane[1]))));
+    for (const auto& v : vessels_) lo = componentMin(lo, componentMin(v.a, v.b) - Vec3(1, 1, 1) * (v.rmax() + std::max(v.prolonged(0), v.prolonged(1))));
     return lo;
   }
   Vec3 boxHi() const {
     Vec3 hi(-INFINITY, -INFINITY, -INFINITY);
-    for (const auto& v : vessels_) hi = componentMax(hi, componentMax(v.a, v.b) + Vec3(1, 1, 1) * (v.rmax() + std::max(0.0, -std::min(v.plane[0], v.plane[1]))));
+    for (const auto& v : vessels_) hi = componentMax(hi, componentMax(v.a, v.b) + Vec3(1, 1, 1) * (v.rmax() + std::max(v.prolonged(0), v.prolonged(1))));
     return hi;
   }
 
