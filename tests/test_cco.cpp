@@ -11,8 +11,10 @@
 #include "core/units.hpp"
 #include "domain/growth_domain.hpp"
 #include "grow/cco/grower.hpp"
+#include "grow/common/bifurcation_optimizer.hpp"
 #include "grow/common/intersections.hpp"
 #include "grow/common/kamiya.hpp"
+#include "grow/common/segment_index.hpp"
 #include "physics/hemodynamics.hpp"
 #include "test_support.hpp"
 #include "tree_checks.hpp"
@@ -162,6 +164,60 @@ TEST(Cco, DiscTreeIsPlanarAndMeetsEveryConstraint) {
   test::expectHemodynamicInvariants(t, o.physics, 1500);
   test::expectGeometry(t, d);
   for (const auto& p : t.position) ASSERT_EQ(p.z, d.planeZ());
+}
+
+TEST(Cco, ASegmentHiddenInThePlaneIsReachedOnlyAcrossAVessel) {
+  // The disc tree skips the segments a vessel separates from a drawn point (separatedInPlane)
+  // on the claim that every bifurcation CCO tries for them crosses that vessel. Points drawn
+  // outside the vessels of a grown tree: Kamiya's point and the exact optimiser's (from it, as
+  // the grower refines) for each hidden segment among the 40 nearest must cross a vessel that
+  // shares no end with the segment.
+  const auto d = GrowthDomain::analytic(DomainShape::Disc, 40, 0.2);
+  const auto o = karch(1500, d, 3);
+  GrowthReport rep;
+  const auto t = growCco(d, o, rep);
+  EXPECT_GT(rep.hidden_segments, 1000) << "the grower skips hidden segments";
+  PhysicsParameters volume = o.physics;
+  volume.cost_radius_exponent = 2;
+  volume.cost_length_exponent = 1;
+  BifurcationOptimizer opt(t, volume, d.frame(), 0.0);
+  opt.checkObstacles(false);  // as the grower: the domain is checked on the result
+  SegmentIndex index(d.lo(), d.hi(), true);
+  index.refresh(t, true);
+  Rng rng(5, 0, Stage::Growth);
+  std::vector<std::pair<double, std::int32_t>> near;
+  int hidden = 0, points = 0, uncrossed = 0;
+  const auto crossesAVessel = [&](std::int32_t s, const Vec3& b, const Vec3& p) {
+    const Vec3 x0 = t.position[t.parent[s]], x1 = t.position[s];
+    for (std::int32_t y = 1; y < t.nodeCount(); ++y) {
+      if (y == s || t.parent[y] == t.parent[s] || t.parent[y] == s || y == t.parent[s]) continue;  // an end at x0 or x1
+      const Vec3 y0 = t.position[t.parent[y]], y1 = t.position[y];
+      if (crossInPlane(x0, b, y0, y1) || crossInPlane(b, x1, y0, y1) || crossInPlane(b, p, y0, y1)) return true;
+    }
+    return false;
+  };
+  while (points < 300) {
+    const Vec3 p = d.sample(rng);
+    index.nearest(t, p, 40, near);
+    if (near.front().first <= t.radius[near.front().second]) continue;  // inside a vessel
+    ++points;
+    for (const auto& [dist, s] : near) {
+      if (!separatedInPlane(t, s, p, near, 40)) continue;
+      ++hidden;
+      KamiyaProblem kp;
+      kp.x0 = t.position[t.parent[s]];
+      kp.x1 = t.position[s];
+      kp.x2 = p;
+      kp.f1 = t.terminals[s];
+      const auto k = kamiyaBifurcation(kp);
+      const bool kamiya = k.converged && !k.merged;
+      if (kamiya && !crossesAVessel(s, k.x, p)) ++uncrossed;
+      const auto exact = opt.optimise(s, p, 4, kamiya ? &k.x : nullptr);
+      if (exact.valid && !crossesAVessel(s, exact.bifurcation, p)) ++uncrossed;
+    }
+  }
+  EXPECT_GT(hidden, 1000) << "hidden segments are common on the disc";
+  EXPECT_EQ(uncrossed, 0) << "of " << hidden << " hidden segments";
 }
 
 TEST(Cco, NonConvexMaskKeepsEveryVesselInsideTheMask) {

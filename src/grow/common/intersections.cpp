@@ -24,6 +24,27 @@ bool withinTwoSegments(const VascularTree& t, std::int32_t x, std::int32_t y) {
   return std::find(near.begin(), near.end(), a) != near.end() || std::find(near.begin(), near.end(), b) != near.end();
 }
 
+bool crossInPlane(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const auto side = [](const Vec3& o, const Vec3& u, const Vec3& v) { return (u.x - o.x) * (v.y - o.y) - (u.y - o.y) * (v.x - o.x); };
+  const double s1 = side(a, b, c), s2 = side(a, b, d), s3 = side(c, d, a), s4 = side(c, d, b);
+  return ((s1 > 0 && s2 < 0) || (s1 < 0 && s2 > 0)) && ((s3 > 0 && s4 < 0) || (s3 < 0 && s4 > 0));
+}
+
+bool separatedInPlane(const VascularTree& t, std::int32_t s, const Vec3& p,
+                      const std::vector<std::pair<double, std::int32_t>>& near, std::size_t occluders) {
+  const Vec3& x0 = t.position[t.parent[s]];
+  const Vec3& x1 = t.position[s];
+  const std::size_t n = std::min(near.size(), occluders);
+  for (std::size_t q = 0; q < n; ++q) {
+    const auto y = near[q].second;
+    if (y == s) continue;
+    const Vec3& y0 = t.position[t.parent[y]];
+    const Vec3& y1 = t.position[y];
+    if (crossInPlane(p, x0, y0, y1) && crossInPlane(p, x1, y0, y1)) return true;
+  }
+  return false;
+}
+
 std::vector<std::pair<std::int32_t, std::int32_t>> intersectingPairs(const VascularTree& t, const Vec3& lo,
                                                                      const Vec3& hi) {
   std::vector<std::pair<std::int32_t, std::int32_t>> pairs;

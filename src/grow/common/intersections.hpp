@@ -31,6 +31,20 @@ bool overlapsOtherVessel(const VascularTree& t, std::int32_t x, const Vec3& a, c
   return hit;
 }
 
+// True if segments a–b and c–d cross at a point inside both, in the plane z = const.
+bool crossInPlane(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
+// True if, in the plane, one of the first `occluders` segments of `near` cuts both sides p–x0
+// and p–x1 of the triangle of point p and segment s = x0–x1. That vessel then separates p from
+// s inside the triangle, and a bifurcation b there joins them only across it (x0–b and b–x1
+// cross it if b is on p's side, b–p otherwise), which a collision check refuses whatever the
+// radii: the vessel shares no end with x0 or x1, so it is more than two segments from the one
+// that crosses it. CCO tries bifurcations in the triangle only: Kamiya's point is a weighted
+// mean of the three ends, and the tree's volume grows with each of the three lengths, so its
+// minimum lies there too (projecting b onto the triangle shortens all three).
+bool separatedInPlane(const VascularTree& t, std::int32_t s, const Vec3& p,
+                      const std::vector<std::pair<double, std::int32_t>>& near, std::size_t occluders);
+
 // Every intersecting pair of the tree with its current radii, (smaller id, larger id), sorted.
 // O(N) expected with a uniform grid over [lo, hi].
 std::vector<std::pair<std::int32_t, std::int32_t>> intersectingPairs(const VascularTree& tree, const Vec3& lo,
