@@ -42,6 +42,19 @@ constexpr double kThick = 0.25;
 // hide 3.5 % more trials than 20; 80 only 0.5 % more than 40).
 constexpr std::size_t kOccluders = 40;
 
+// True if, in the plane, c's terminal segment crosses the centreline of a segment in `near` that
+// has no end at either end of the segment it splits: the collision check would refuse it
+// (whatever the radii), and with no other effect, since the new segments come before the
+// ancestors there.
+bool terminalCrossesInPlane(const VascularTree& T, const Connection& c, const std::vector<std::pair<double, std::int32_t>>& near) {
+  const std::int32_t s = c.segment;
+  for (const auto& [d, y] : near) {
+    if (y == s || y == T.parent[s] || T.parent[y] == T.parent[s] || T.parent[y] == s) continue;
+    if (crossInPlane(c.bifurcation, c.terminal, T.position[T.parent[y]], T.position[y])) return true;
+  }
+  return false;
+}
+
 // Kamiya's connection and the exact volume optimiser's, each valid or not: the exact one is
 // lighter but may collide where Kamiya's does not.
 struct Trial {
@@ -476,6 +489,8 @@ class CcoGrower {
             const auto& k = trials[j].c[0];
             if (opt_.exact_bifurcations && (k.valid || j < kRefineNearest))
               trials[j].c[1] = refine(g, k, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
+            if (dom_.dimension() == 2)
+              for (auto& c : trials[j].c) c.crosses = c.valid && terminalCrossesInPlane(g.tree, c, g.near);
           }
         }, tbb::simple_partitioner());
         for (std::size_t j = g.done; j < g.near.size(); ++j) {
@@ -494,6 +509,10 @@ class CcoGrower {
         const int k = open[cand.tree];
         auto& g = trees_[k];
         const Connection& c = trials_[cand.tree][cand.trial].c[cand.which];
+        if (c.crosses) {
+          ++report_.rejected_intersection;
+          continue;
+        }
         const auto undo = commitConnection(g.tree, c, opts[cand.tree], g.kernel, g.rel);
         const double rr = rootRadiusFinal(g, n_new[cand.tree], c.path.back().reduced_resistance, shrink_new);
         if (!collides(k, c, rr)) {
