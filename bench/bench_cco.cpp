@@ -51,6 +51,9 @@ int main(int argc, char** argv) {
                 s / n * 1e6 / std::log2(double(n)), peakRssBytes() / 1048576.0, (long long)rep.intersecting_pairs,
                 (long long)rep.short_segments, treeVolume(tree));
     std::fprintf(stderr, "  draws too close %lld, candidates %lld, unconnectable %lld, relaxations %lld, doublings %lld, kamiya failures %lld, collisions %lld, repair rounds %d, repaired %lld\n", (long long)rep.rejected_too_close, (long long)rep.candidates, (long long)rep.rejected_unreachable, (long long)rep.threshold_relaxations, (long long)rep.neighbour_doublings, (long long)rep.kamiya_failures, (long long)rep.rejected_intersection, rep.repair_rounds, (long long)rep.repaired_terminals);
+    for (const auto& x : rep.short_list)
+      std::fprintf(stderr, "  short segment left: length %.4g mm, radius %.4g mm, distal (%.4g, %.4g, %.4g)\n", x.length, x.radius,
+                   x.distal[0], x.distal[1], x.distal[2]);
     std::fflush(stdout);
   }
 }
