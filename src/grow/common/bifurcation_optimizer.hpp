@@ -25,7 +25,7 @@
 
 namespace angiosynth {
 
-class DemandMap;
+struct DemandMap;
 
 // New values of one segment on the path from the bifurcation to the root after a connection.
 struct PathLevel {
