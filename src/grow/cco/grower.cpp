@@ -45,6 +45,19 @@ constexpr double kThick = 0.25;
 // hide 3.5 % more trials than 20; 80 only 0.5 % more than 40).
 constexpr std::size_t kOccluders = 40;
 
+// True if, in the plane, c's terminal segment crosses the centreline of a segment in `near` that
+// has no end at either end of the segment it splits: the collision check would refuse it
+// (whatever the radii), and with no other effect, since the new segments come before the
+// ancestors there.
+bool terminalCrossesInPlane(const VascularTree& T, const Connection& c, const std::vector<std::pair<double, std::int32_t>>& near) {
+  const std::int32_t s = c.segment;
+  for (const auto& [d, y] : near) {
+    if (y == s || y == T.parent[s] || T.parent[y] == T.parent[s] || T.parent[y] == s) continue;
+    if (crossInPlane(c.bifurcation, c.terminal, T.position[T.parent[y]], T.position[y])) return true;
+  }
+  return false;
+}
+
 // Kamiya's connection and the exact volume optimiser's, each valid or not: the exact one is
 // lighter but may collide where Kamiya's does not.
 struct Trial {
@@ -345,51 +358,6 @@ class CcoGrower {
     return true;
   }
 
-  // True if one of c's three new segments surely overlaps one of the segments `near` that the
-  // collision check would test it against after committing c: it would then refuse c with no
-  // other effect (the new segments come before the ancestors there). The radii are known now:
-  // the new segments' from c's path, and any vessel off c's path keeps its ρ; the 0.1 % margin
-  // covers the rounding of the products. Saves committing, checking and rolling back
-  // candidates that cannot connect (in the plane, most collisions).
-  bool surelyCollides(const TreeGrowth& g, const Connection& c, std::int64_t n_new, double shrink_new) const {
-    const auto& T = g.tree;
-    const std::int32_t s = c.segment, x0 = T.parent[s];
-    double rho_b = 1;
-    for (std::size_t lv = 1; lv < c.path.size(); ++lv) rho_b *= c.path[lv].beta_child;
-    const double rr = rootRadiusFinal(g, n_new, c.path.back().reduced_resistance, shrink_new);
-    const Vec3& a = T.position[x0];
-    const Vec3& e = T.position[s];
-    const Vec3& b = c.bifurcation;
-    // Parent part x0–b, distal part b–x1, terminal b–p, with the nodes (besides b and p) a vessel
-    // must not end at to be more than two segments from them (withinTwoSegments).
-    const std::int32_t sibling = T.child0[x0] == s ? T.child1[x0] : T.child0[x0];
-    const struct {
-      Vec3 p0, p1;
-      double r;
-      std::int32_t near_nodes[4];
-    } parts[3] = {{a, b, rr * rho_b, {x0, T.parent[x0], sibling, s}},
-                  {b, e, rr * rho_b * c.path[0].beta_child, {x0, s, T.child0[s], T.child1[s]}},
-                  {b, c.terminal, rr * rho_b * c.path[0].beta_other, {x0, s, -1, -1}}};
-    const auto onPath = [&](std::int32_t y) {
-      for (std::size_t lv = 1; lv < c.path.size(); ++lv)
-        if (c.path[lv].segment == y || c.path[lv].other == y) return true;
-      return false;
-    };
-    for (const auto& [d, y] : g.near) {
-      if (y == s || onPath(y)) continue;
-      // The check finds a thick vessel only on the thick list (forEachNearVessel).
-      if (g.rel[y] >= kThick && std::find(g.thick.begin(), g.thick.end(), y) == g.thick.end()) continue;
-      const double ry = g.rel[y] * rr;
-      for (const auto& part : parts) {
-        if (std::find(std::begin(part.near_nodes), std::end(part.near_nodes), T.parent[y]) != std::end(part.near_nodes) ||
-            std::find(std::begin(part.near_nodes), std::end(part.near_nodes), y) != std::end(part.near_nodes))
-          continue;
-        if (segmentSegmentDistance(part.p0, part.p1, T.position[T.parent[y]], T.position[y]) < 0.999 * (part.r + ry)) return true;
-      }
-    }
-    return false;
-  }
-
   // True if a segment of tree k touched by the committed connection overlaps a vessel more than
   // one segment away, or one of another tree: the three new segments, and every ancestor (they
   // all thicken) whose radius has grown by more than kRecheckGrowth since it was last checked;
@@ -524,7 +492,8 @@ class CcoGrower {
             const auto& k = trials[j].c[0];
             if (opt_.exact_bifurcations && (k.valid || j < kRefineNearest))
               trials[j].c[1] = refine(g, k, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
-            for (auto& c : trials[j].c) c.collides = c.valid && surelyCollides(g, c, n_new[i], shrink_new);
+            if (dom_.dimension() == 2)
+              for (auto& c : trials[j].c) c.crosses = c.valid && terminalCrossesInPlane(g.tree, c, g.near);
           }
         }, tbb::simple_partitioner());
         for (std::size_t j = g.done; j < g.near.size(); ++j) {
@@ -543,7 +512,7 @@ class CcoGrower {
         const int k = open[cand.tree];
         auto& g = trees_[k];
         const Connection& c = trials_[cand.tree][cand.trial].c[cand.which];
-        if (c.collides) {
+        if (c.crosses) {
           ++report_.rejected_intersection;
           continue;
         }
