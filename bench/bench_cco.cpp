@@ -1,5 +1,5 @@
 // CCO growth time and memory for N terminals in the seed 000 §5 sphere (or the 2D disc):
-//   bench_cco [N ...] [--disc] [--threads T] [--max-nu M]
+//   bench_cco [N ...] [--disc] [--threads T] [--max-nu M] [--seed S]
 // One line per N: seconds, µs per terminal, µs per terminal / log2 N, peak RSS, checks.
 #include <tbb/global_control.h>
 
@@ -21,8 +21,10 @@ int main(int argc, char** argv) {
   bool disc = false;
   int threads = 0;
   int max_nu = 0;  // ν doubles up to this (0: the default)
+  long seed = 1;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--disc")) disc = true;
+    else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) seed = std::atol(argv[++i]);
     else if (!std::strcmp(argv[i], "--max-nu") && i + 1 < argc) max_nu = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::atoi(argv[++i]);
     else sizes.push_back(std::atol(argv[i]));
@@ -39,6 +41,7 @@ int main(int argc, char** argv) {
     CcoOptions o;
     o.terminals = n;
     if (max_nu > 0) o.max_neighbours = max_nu;
+    o.seed = std::uint64_t(seed);
     o.root_mm = dom.defaultRoot();
     o.physics.perfusion_flow = 500 * 1000.0 / 60.0;  // Karch 1999: 500 mL/min for the whole organ
     o.physics.perfusion_pressure = 100 * 133.322;
