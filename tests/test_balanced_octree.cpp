@@ -53,7 +53,7 @@ TEST(BalancedOctree, LeavesSplitIntoAConformingTetrahedralMeshAcrossLevels) {
     }
 
   std::map<std::array<HalfPoint, 3>, int> faces;
-  std::int64_t six_volume = 0, tets = 0;
+  std::int64_t tets = 0;
   std::vector<std::array<HalfPoint, 4>> out;
   LeafSplitter splitter(octree);
   std::vector<OctreeLeaf> unit_leaves;
@@ -81,7 +81,6 @@ TEST(BalancedOctree, LeavesSplitIntoAConformingTetrahedralMeshAcrossLevels) {
     }
     const std::int64_t edge = std::int64_t(2) << leaf.level;  // half steps
     EXPECT_EQ(leaf_volume, 6 * edge * edge * edge) << "the tetrahedra fill their leaf";
-    six_volume += leaf_volume;
    }
   }
   EXPECT_EQ(split, leaves.size()) << "the units hold every leaf once";
