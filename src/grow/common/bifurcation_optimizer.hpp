@@ -46,7 +46,6 @@ struct Connection {
   std::vector<PathLevel> path;  // filled by `record`
   bool valid = false;
   bool converged = false;     // the quasi-Newton iteration reached a stationary point
-  bool crosses = false;       // CCO in the plane: found crossing a vessel before it is tried
   std::array<double, 3> min_lengths{};  // parent part, distal part, terminal (mm), set by optimise
 };
 
