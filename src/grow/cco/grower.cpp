@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <tuple>
@@ -92,6 +93,8 @@ struct TreeGrowth {
   std::vector<double> rel{1.0};  // ρ: radius / root radius
   std::vector<double> checked;         // radius (final units) at which each segment was last found clear
   std::vector<std::uint8_t> blocks;    // connections each segment refused, as an ancestor, by hitting a vessel
+  std::array<std::int32_t, 4> blockers{};  // the last ancestors that refused a connection (0: none)
+  std::uint32_t next_blocker = 0;
   std::vector<std::int32_t> thick{1};  // segments with ρ >= kThick (the first is the root segment)
   std::vector<std::pair<double, std::int32_t>> near;
   std::size_t done = 0;                // near[0, done) evaluated in earlier rounds
@@ -377,6 +380,14 @@ class CcoGrower {
     }
     const auto radius_of = [&](std::int32_t y) { return g.rel[y] * rr; };
     const bool forest = trees_.size() > 1;
+    // A single tree's check only answers yes or no, so its order is free: an ancestor that
+    // refused a recent connection by a collision usually refuses the next one below it too (a
+    // subtree beside a vessel it has thickened into), and is checked first.
+    if (!forest && !repairing_)
+      for (const auto x : g.blockers)
+        if (x > 0 && std::find(check_.begin() + 3, check_.end(), x) != check_.end() &&
+            overlapsOwnTree(g, x, rr, radius_of))
+          return true;
     for (const auto& x : check_) {
       const Vec3& a0 = T.position[T.parent[x]];
       const Vec3& a1 = T.position[x];
@@ -408,10 +419,24 @@ class CcoGrower {
       skipped_ |= big_only;
       if (hit) {
         if (defer && ancestor && g.blocks[x] < 255) ++g.blocks[x];
+        if (ancestor && std::find(g.blockers.begin(), g.blockers.end(), x) == g.blockers.end())
+          g.blockers[g.next_blocker++ % g.blockers.size()] = x;
         return true;
       }
     }
     return false;
+  }
+
+  // True if ancestor x of tree k's committed connection, at root radius rr, overlaps a vessel of
+  // its own tree more than two segments away (collides' check of one ancestor of a single tree).
+  template <class Radius>
+  static bool overlapsOwnTree(TreeGrowth& g, std::int32_t x, double rr, Radius&& radius_of) {
+    const auto& T = g.tree;
+    const Vec3& a0 = T.position[T.parent[x]];
+    const Vec3& a1 = T.position[x];
+    const double rx = g.rel[x] * rr;
+    const auto candidates = [&](auto&& f) { forEachNearVessel(g, a0, a1, rx, rr, radius_of, f); };
+    return overlapsOtherVessel(T, x, a0, a1, rx, candidates, radius_of);
   }
 
   // ρ of the whole tree, and the list of thick segments.
