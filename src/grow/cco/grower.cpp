@@ -27,15 +27,16 @@ constexpr double kMaxRepairShare = 0.05;
 // larger child by losing may be larger (measured: 1 trunk in 10 trees of 4000 terminals).
 constexpr double kMaxShortRepairShare = 0.15;
 // Vessels in the way of a short trunk's lengthening, with at most this many terminals, are
-// removed and regrown rather than leave the trunk short.
+// removed and regrown rather than leave the trunk short; in a single tree's growth, an ancestor
+// that keeps hitting such a vessel stops counting it (the final repair regrows it).
 constexpr std::int32_t kMaxClearedTerminals = 8;
 // An ancestor is checked again for collisions once its radius has grown by this factor.
 constexpr double kRecheckGrowth = 1.02;
 // Connections refused in a row (for one terminal) because an ancestor hit another tree, after
 // which a forest's ancestors skip that check.
 constexpr std::int64_t kLenientAfter = 100;
-// Refusals caused by one ancestor of a forest's tree hitting a vessel, after which only vessels
-// too large for the final repair to regrow still block it.
+// Refusals caused by one ancestor hitting a vessel, after which the vessels the final repair
+// may regrow no longer block it (see `counts`).
 constexpr std::uint8_t kDeferAfter = 8;
 // Nearest segments that first test whether a drawn point lies inside a vessel.
 constexpr int kInsideProbe = 4;
@@ -386,7 +387,7 @@ class CcoGrower {
     if (!forest && !repairing_)
       for (const auto x : g.blockers)
         if (x > 0 && std::find(check_.begin() + 3, check_.end(), x) != check_.end() &&
-            overlapsOwnTree(g, x, rr, radius_of))
+            overlapsOwnTree(g, x, rr, radius_of, [&](std::int32_t y) { return counts(k, x, y, true); }))
           return true;
     for (const auto& x : check_) {
       const Vec3& a0 = T.position[T.parent[x]];
@@ -398,13 +399,14 @@ class CcoGrower {
       // final check finds the others, and the repair regrows them), and after a long run of
       // failures no other tree's vessel does. A single tree does so while the repair regrows:
       // the holes it fills lie beside the trunks that made them (sphere, 20,000 terminals, seed
-      // 4: the first regrowth of 3,109 terminals placed none in 150 s; with this, 1 s).
+      // 4: the first regrowth of 3,109 terminals placed none in 150 s; with this, 1 s); while
+      // it grows, only vessels of a few terminals stop counting.
       const bool ancestor = &x - check_.data() >= 3;
       const bool defer = forest || repairing_;
       const bool big_only = defer && ancestor && g.blocks[x] >= kDeferAfter;
       const auto candidates = [&](auto&& f) {
         forEachNearVessel(g, a0, a1, rx, rr, radius_of, [&](std::int32_t y) {
-          if (!big_only || (y < T.nodeCount() && tooLargeToRegrow(k, y))) f(y);
+          if (counts(k, x, y, ancestor)) f(y);
         });
       };
       bool hit = overlapsOtherVessel(T, x, a0, a1, rx, candidates, radius_of);
@@ -418,7 +420,7 @@ class CcoGrower {
       }
       skipped_ |= big_only;
       if (hit) {
-        if (defer && ancestor && g.blocks[x] < 255) ++g.blocks[x];
+        if (ancestor && g.blocks[x] < 255) ++g.blocks[x];
         if (ancestor && std::find(g.blockers.begin(), g.blockers.end(), x) == g.blockers.end())
           g.blockers[g.next_blocker++ % g.blockers.size()] = x;
         return true;
@@ -427,15 +429,31 @@ class CcoGrower {
     return false;
   }
 
+  // Whether vessel y of tree k blocks segment x of a committed connection. An ancestor that has
+  // refused kDeferAfter connections stops counting the vessels the final repair may regrow: in a
+  // forest, or while the repair regrows, those up to kMaxRepairShare of the terminals; in a
+  // single tree's growth, those of at most kMaxClearedTerminals terminals (sphere, 50,000
+  // terminals, seed 3: 185 s -> 36 s, 1,984 terminals regrown; up to 32 terminals: 17,166).
+  bool counts(int k, std::int32_t x, std::int32_t y, bool ancestor) const {
+    const auto& g = trees_[k];
+    if (!ancestor || y >= g.tree.nodeCount() || g.blocks[x] < kDeferAfter) return true;
+    if (trees_.size() > 1 || repairing_) return tooLargeToRegrow(k, y);
+    return g.tree.terminals[y] > kMaxClearedTerminals;
+  }
   // True if ancestor x of tree k's committed connection, at root radius rr, overlaps a vessel of
-  // its own tree more than two segments away (collides' check of one ancestor of a single tree).
-  template <class Radius>
-  static bool overlapsOwnTree(TreeGrowth& g, std::int32_t x, double rr, Radius&& radius_of) {
+  // its own tree more than two segments away that blocks it (collides' check of one ancestor of
+  // a single tree).
+  template <class Radius, class Blocks>
+  static bool overlapsOwnTree(TreeGrowth& g, std::int32_t x, double rr, Radius&& radius_of, Blocks&& blocks) {
     const auto& T = g.tree;
     const Vec3& a0 = T.position[T.parent[x]];
     const Vec3& a1 = T.position[x];
     const double rx = g.rel[x] * rr;
-    const auto candidates = [&](auto&& f) { forEachNearVessel(g, a0, a1, rx, rr, radius_of, f); };
+    const auto candidates = [&](auto&& f) {
+      forEachNearVessel(g, a0, a1, rx, rr, radius_of, [&](std::int32_t y) {
+        if (blocks(y)) f(y);
+      });
+    };
     return overlapsOtherVessel(T, x, a0, a1, rx, candidates, radius_of);
   }
 
