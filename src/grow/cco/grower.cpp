@@ -474,7 +474,8 @@ class CcoGrower {
 
   // Connects p, drawn for system `sys`, through the cheapest valid bifurcation among the ν
   // nearest segments of each of its trees that still takes terminals, doubling ν while none is
-  // valid. False when p lies in a vessel or no segment can take it.
+  // valid (in space: while none can be made). False when p lies in a vessel or no segment can
+  // take it.
   bool connect(const Vec3& p, const System& sys) {
     const std::int64_t n_sys_new = systemTerminals(sys) + 1;
     const double shrink_new = shrink(sys, n_sys_new);
@@ -587,7 +588,12 @@ class CcoGrower {
         g.done = g.near.size();
         more |= static_cast<std::int32_t>(g.done) < g.tree.segmentCount();
       }
-      if (!more || nu >= opt_.max_neighbours) return false;
+      // In the plane, a point whose valid connections all collide or cross a vessel lies in a
+      // pocket between vessels that farther segments reach only across the same vessels (disc,
+      // 50,000 terminals: 251 of 40,586 such points connected once ν doubled). Stopping there
+      // saves 4 % of the time and the tree is lighter (seeds 1-4: 942.0, 935.0, 955.6, 956.3 ->
+      // 942.5, 928.6, 951.2, 953.5 mm³). In space the point is reached around them.
+      if (!more || nu >= opt_.max_neighbours || (!ranked_.empty() && dom_.dimension() == 2)) return false;
       nu = std::min(2 * nu, opt_.max_neighbours);
       ++report_.neighbour_doublings;
     }
