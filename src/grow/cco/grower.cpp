@@ -28,8 +28,10 @@ constexpr double kMaxRepairShare = 0.05;
 constexpr double kMaxShortRepairShare = 0.15;
 // Vessels in the way of a short trunk's lengthening, with at most this many terminals, are
 // removed and regrown rather than leave the trunk short; in a single tree's growth, an ancestor
-// that keeps hitting such a vessel stops counting it (the final repair regrows it).
+// that keeps hitting such a vessel stops counting it (the final repair regrows it)...
 constexpr std::int32_t kMaxClearedTerminals = 8;
+// ... or, beside a trunk, vessels with at most 1/kSmallBeside of its terminals.
+constexpr std::int32_t kSmallBeside = 64;
 // An ancestor is checked again for collisions once its radius has grown by this factor.
 constexpr double kRecheckGrowth = 1.02;
 // Connections refused in a row (for one terminal) because an ancestor hit another tree, after
@@ -432,13 +434,15 @@ class CcoGrower {
   // Whether vessel y of tree k blocks segment x of a committed connection. An ancestor that has
   // refused kDeferAfter connections stops counting the vessels the final repair may regrow: in a
   // forest, or while the repair regrows, those up to kMaxRepairShare of the terminals; in a
-  // single tree's growth, those of at most kMaxClearedTerminals terminals (sphere, 50,000
-  // terminals, seed 3: 185 s -> 36 s, 1,984 terminals regrown; up to 32 terminals: 17,166).
+  // single tree's growth, those of at most kMaxClearedTerminals terminals or 1/kSmallBeside of
+  // its own. (Sphere, 50,000 terminals: a trunk of 10,070 terminals thickened into a branch of
+  // 23 below it and refused connections 8 million times, seed 2: 184 s -> 36 s; seed 3: 185 s
+  // -> 50 s. Any vessel up to 32 terminals: 17,166 terminals regrown in seed 3.)
   bool counts(int k, std::int32_t x, std::int32_t y, bool ancestor) const {
     const auto& g = trees_[k];
     if (!ancestor || y >= g.tree.nodeCount() || g.blocks[x] < kDeferAfter) return true;
     if (trees_.size() > 1 || repairing_) return tooLargeToRegrow(k, y);
-    return g.tree.terminals[y] > kMaxClearedTerminals;
+    return g.tree.terminals[y] > std::max(kMaxClearedTerminals, g.tree.terminals[x] / kSmallBeside);
   }
   // True if ancestor x of tree k's committed connection, at root radius rr, overlaps a vessel of
   // its own tree more than two segments away that blocks it (collides' check of one ancestor of
