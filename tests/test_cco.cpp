@@ -183,7 +183,7 @@ TEST(Cco, AnAncestorKeptBackByATinyVesselGrowsOnAndTheRepairRegrowsTheVessel) {
   const auto o = karch(20000, d, 4);
   GrowthReport rep;
   const auto t = growCco(d, o, rep);
-  EXPECT_LT(rep.rejected_intersection, 120000);  // 73,206 with the rule
+  EXPECT_LT(rep.rejected_intersection, 120000);  // 28,822 with the rule
   EXPECT_GT(rep.repaired_terminals, 0);
   EXPECT_EQ(rep.short_segments, 0);
   EXPECT_EQ(rep.intersecting_pairs, 0);

@@ -389,8 +389,10 @@ class CcoGrower {
     if (!forest && !repairing_)
       for (const auto x : g.blockers)
         if (x > 0 && std::find(check_.begin() + 3, check_.end(), x) != check_.end() &&
-            overlapsOwnTree(g, x, rr, radius_of, [&](std::int32_t y) { return counts(k, x, y, true); }))
+            overlapsOwnTree(g, x, rr, radius_of, [&](std::int32_t y) { return counts(k, x, y, true); })) {
+          if (g.blocks[x] < 255) ++g.blocks[x];
           return true;
+        }
     for (const auto& x : check_) {
       const Vec3& a0 = T.position[T.parent[x]];
       const Vec3& a1 = T.position[x];
@@ -748,8 +750,8 @@ class CcoGrower {
   // A trunk that thickened past half its length since it was made: slide its distal
   // bifurcation outwards (along the trunk, or towards its children), or its proximal one back,
   // to 2.1–3 r, whichever first fits. Failing that, the same slides to 2.1 r where only small
-  // vessels (at most kMaxClearedTerminals terminals, fewer than the trunk's, so none of its
-  // ancestors) are in the way: they go to `regrow`. Measured: the one trunk left short in the
+  // vessels (at most kMaxClearedTerminals terminals or 1/kSmallBeside of the trunk's, fewer
+  // than its own, so none of its ancestors) are in the way: they go to `regrow`. Measured: the one trunk left short in the
   // sphere at 20,000 terminals was blocked by a single terminal segment.
   bool lengthen(int k, std::int32_t s, std::vector<std::int32_t>& regrow) {
     if (lengthenFree(k, s)) return true;
@@ -761,22 +763,27 @@ class CcoGrower {
     const std::int32_t small = std::min<std::int32_t>(std::max(kMaxClearedTerminals, T.terminals[s] / kSmallBeside), T.terminals[s] - 1);
     if (!T.isTerminal(s) && tryMove(k, s, a + u * L, &regrow, small)) return true;
     if (P > 0 && tryMove(k, P, e - u * L, &regrow, small)) return true;
-    return slideBothEnds(k, s, &regrow, small);
+    return slideWithNeighbour(k, s, &regrow, small);
   }
 
   // In a chain of trunks each near 2r, neither neighbour has the room alone: both ends of s
   // slide half way, to 2.1 r or 2.05 r (sphere, 50,000 terminals, seed 4: a trunk of 21,539
   // terminals, 1.91 mm at r 0.99 mm, whose parent and larger child each had half the 0.1 mm it
-  // lacked, and a terminal segment in the way).
-  bool slideBothEnds(int k, std::int32_t s, std::vector<std::int32_t>* regrow = nullptr, std::int32_t small = 0) {
+  // lacked, and a terminal segment in the way). Or the distal end slides on with one child,
+  // which keeps its length: a root segment's proximal end cannot move (4000 terminals in
+  // OpenCCO's ball, seed 1: a root segment 2.04 mm at r 1.07 mm whose larger child would have
+  // come 0.005 mm short of its own 2r).
+  bool slideWithNeighbour(int k, std::int32_t s, std::vector<std::int32_t>* regrow = nullptr, std::int32_t small = 0) {
     const auto& T = trees_[k].tree;
     const auto P = T.parent[s];
-    if (P <= 0 || T.isTerminal(s)) return false;
+    if (P < 0 || T.isTerminal(s)) return false;
     const Vec3 a = T.position[P], e = T.position[s];
     const Vec3 u = (e - a) / distance(a, e);
     for (double f : {2.1, 2.05}) {
-      const double half = 0.5 * (f * T.radius[s] - distance(a, e));
-      if (tryMove(k, {P, s}, {a - u * half, e + u * half}, regrow, small)) return true;
+      const double grow = f * T.radius[s] - distance(a, e);
+      if (P > 0 && tryMove(k, {P, s}, {a - u * (0.5 * grow), e + u * (0.5 * grow)}, regrow, small)) return true;
+      for (const auto c : {T.child0[s], T.child1[s]})
+        if (tryMove(k, {s, c}, {e + u * grow, T.position[c] + u * grow}, regrow, small)) return true;
     }
     return false;
   }
@@ -798,7 +805,7 @@ class CcoGrower {
       if (P > 0 && tryMove(k, P, e - u * L)) return true;
     }
     if (T.isTerminal(s)) return false;
-    if (slideBothEnds(k, s)) return true;
+    if (slideWithNeighbour(k, s)) return true;
     // Blocked straight ahead (a root segment beside another tree's trunk): the distal
     // bifurcation on cones of 20° and 40° around the segment's direction (in the plane for 2D).
     Vec3 p1 = std::abs(u.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
