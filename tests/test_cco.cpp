@@ -310,6 +310,28 @@ TEST(Cco, DemandWeightedSamplingPutsTerminalsWhereDemandIsHigh) {
   EXPECT_NEAR(weighted, 0.9, 0.04);
 }
 
+TEST(Cco, AShortRootSegmentIsLengthenedWithItsChildWhenNeitherAloneHasRoom) {
+  // OpenCCO's ball at 4000 terminals, seed 1: the root segment ended 2.04 mm long at r 1.07 mm.
+  // Its proximal end is fixed, and sliding its distal end alone left its larger child 0.005 mm
+  // short of its own 2r; the distal end now slides on with that child, which keeps its length.
+  const double radius = std::cbrt(3 * 20000.0 / (4 * std::numbers::pi));
+  const auto d = GrowthDomain::analytic(DomainShape::Sphere, radius, 0.3);
+  CcoOptions o;
+  o.terminals = 4000;
+  o.root_mm = d.defaultRoot();
+  o.physics.perfusion_flow = 8330;
+  o.physics.perfusion_pressure = 13300;
+  o.physics.terminal_pressure = 7980;
+  o.physics.viscosity = 3.6e-3;
+  o.physics.total_terminals = 4000;
+  o.seed = 1;
+  GrowthReport rep;
+  const auto t = growCco(d, o, rep);
+  EXPECT_EQ(rep.short_segments, 0);
+  EXPECT_EQ(rep.intersecting_pairs, 0);
+  for (std::int32_t s = 1; s < t.nodeCount(); ++s) ASSERT_GT(t.length[s], 2 * t.radius[s]) << "segment " << s;
+}
+
 TEST(Cco, TreesAreAsLightAsOpenCcosInItsOwnSetUp) {
   // OpenCCO's set-up: a 20,000 mm³ ball, its constants (13300 Pa, 7980 Pa beyond 250 terminals,
   // 8330 mm³/s, 3.6 mPa·s), 1000 terminals. OpenCCO's trees carry 289–293 mm³ (its geometry with
