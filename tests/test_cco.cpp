@@ -310,21 +310,32 @@ TEST(Cco, DemandWeightedSamplingPutsTerminalsWhereDemandIsHigh) {
   EXPECT_NEAR(weighted, 0.9, 0.04);
 }
 
-TEST(Cco, AShortRootSegmentIsLengthenedWithItsChildWhenNeitherAloneHasRoom) {
-  // OpenCCO's ball at 4000 terminals, seed 1: the root segment ended 2.04 mm long at r 1.07 mm.
-  // Its proximal end is fixed, and sliding its distal end alone left its larger child 0.005 mm
-  // short of its own 2r; the distal end now slides on with that child, which keeps its length.
-  const double radius = std::cbrt(3 * 20000.0 / (4 * std::numbers::pi));
-  const auto d = GrowthDomain::analytic(DomainShape::Sphere, radius, 0.3);
+namespace {
+// OpenCCO's set-up: a 20,000 mm³ ball and its constants (13300 Pa, 7980 Pa, 8330 mm³/s,
+// 3.6 mPa·s).
+GrowthDomain openccoBall() {
+  return GrowthDomain::analytic(DomainShape::Sphere, std::cbrt(3 * 20000.0 / (4 * std::numbers::pi)), 0.3);
+}
+CcoOptions openccoOptions(std::int64_t n, const GrowthDomain& d, std::uint64_t seed) {
   CcoOptions o;
-  o.terminals = 4000;
+  o.terminals = n;
   o.root_mm = d.defaultRoot();
   o.physics.perfusion_flow = 8330;
   o.physics.perfusion_pressure = 13300;
   o.physics.terminal_pressure = 7980;
   o.physics.viscosity = 3.6e-3;
-  o.physics.total_terminals = 4000;
-  o.seed = 1;
+  o.physics.total_terminals = n;
+  o.seed = seed;
+  return o;
+}
+}  // namespace
+
+TEST(Cco, AShortRootSegmentIsLengthenedWithItsChildWhenNeitherAloneHasRoom) {
+  // OpenCCO's ball at 4000 terminals, seed 1: the root segment ended 2.04 mm long at r 1.07 mm.
+  // Its proximal end is fixed, and sliding its distal end alone left its larger child 0.005 mm
+  // short of its own 2r; the distal end now slides on with that child, which keeps its length.
+  const auto d = openccoBall();
+  const auto o = openccoOptions(4000, d, 1);
   GrowthReport rep;
   const auto t = growCco(d, o, rep);
   EXPECT_EQ(rep.short_segments, 0);
@@ -337,18 +348,9 @@ TEST(Cco, TreesAreAsLightAsOpenCcosInItsOwnSetUp) {
   // 8330 mm³/s, 3.6 mPa·s), 1000 terminals. OpenCCO's trees carry 289–293 mm³ (its geometry with
   // these physics). Terminals kept from the terminal points (its Algorithm 2) and the exact
   // bifurcations make ours lighter; the §3.3.2 reading with Kamiya's points alone is 10 % heavier.
-  const double radius = std::cbrt(3 * 20000.0 / (4 * std::numbers::pi));
-  const auto d = GrowthDomain::analytic(DomainShape::Sphere, radius, 0.3);
+  const auto d = openccoBall();
   const auto volume = [&](bool from_segments, bool exact, std::uint64_t seed) {
-    CcoOptions o;
-    o.terminals = 1000;
-    o.root_mm = d.defaultRoot();
-    o.physics.perfusion_flow = 8330;
-    o.physics.perfusion_pressure = 13300;
-    o.physics.terminal_pressure = 7980;
-    o.physics.viscosity = 3.6e-3;
-    o.physics.total_terminals = 1000;
-    o.seed = seed;
+    auto o = openccoOptions(1000, d, seed);
     o.spacing_from_segments = from_segments;
     o.exact_bifurcations = exact;
     GrowthReport rep;

@@ -383,14 +383,14 @@ class CcoGrower {
     }
     const auto radius_of = [&](std::int32_t y) { return g.rel[y] * rr; };
     const bool forest = trees_.size() > 1;
-    // A single tree's check only answers yes or no, so its order is free: an ancestor that
-    // refused a recent connection by a collision usually refuses the next one below it too (a
-    // subtree beside a vessel it has thickened into), and is checked first.
+    // An ancestor that refused a recent connection by a collision usually refuses the next one
+    // below it too (a subtree beside a vessel it has thickened into): in a single tree, whose
+    // check only answers yes or no, it is checked first, and the refusal counts as its own.
     if (!forest && !repairing_)
       for (const auto x : g.blockers)
         if (x > 0 && std::find(check_.begin() + 3, check_.end(), x) != check_.end() &&
             overlapsOwnTree(g, x, rr, radius_of, [&](std::int32_t y) { return counts(k, x, y, true); })) {
-          if (g.blocks[x] < 255) ++g.blocks[x];
+          countRefusal(g, x);
           return true;
         }
     for (const auto& x : check_) {
@@ -408,12 +408,7 @@ class CcoGrower {
       const bool ancestor = &x - check_.data() >= 3;
       const bool defer = forest || repairing_;
       const bool big_only = defer && ancestor && g.blocks[x] >= kDeferAfter;
-      const auto candidates = [&](auto&& f) {
-        forEachNearVessel(g, a0, a1, rx, rr, radius_of, [&](std::int32_t y) {
-          if (counts(k, x, y, ancestor)) f(y);
-        });
-      };
-      bool hit = overlapsOtherVessel(T, x, a0, a1, rx, candidates, radius_of);
+      bool hit = overlapsOwnTree(g, x, rr, radius_of, [&](std::int32_t y) { return counts(k, x, y, ancestor); });
       if (!hit && forest) {
         if (ancestor && lenient_) {
           skipped_ = true;
@@ -424,9 +419,7 @@ class CcoGrower {
       }
       skipped_ |= big_only;
       if (hit) {
-        if (ancestor && g.blocks[x] < 255) ++g.blocks[x];
-        if (ancestor && std::find(g.blockers.begin(), g.blockers.end(), x) == g.blockers.end())
-          g.blockers[g.next_blocker++ % g.blockers.size()] = x;
+        if (ancestor) countRefusal(g, x);
         return true;
       }
     }
@@ -444,7 +437,19 @@ class CcoGrower {
     const auto& g = trees_[k];
     if (!ancestor || y >= g.tree.nodeCount() || g.blocks[x] < kDeferAfter) return true;
     if (trees_.size() > 1 || repairing_) return tooLargeToRegrow(k, y);
-    return g.tree.terminals[y] > std::max(kMaxClearedTerminals, g.tree.terminals[x] / kSmallBeside);
+    return g.tree.terminals[y] > smallBeside(g.tree, x);
+  }
+  // The most terminals a vessel beside trunk x may have for the repair to regrow it rather than
+  // let it stop the trunk.
+  static std::int32_t smallBeside(const VascularTree& T, std::int32_t x) {
+    return std::max(kMaxClearedTerminals, T.terminals[x] / kSmallBeside);
+  }
+  // Ancestor x refused a connection: counted towards its deferral, and listed to be checked
+  // first next time.
+  static void countRefusal(TreeGrowth& g, std::int32_t x) {
+    if (g.blocks[x] < 255) ++g.blocks[x];
+    if (std::find(g.blockers.begin(), g.blockers.end(), x) == g.blockers.end())
+      g.blockers[g.next_blocker++ % g.blockers.size()] = x;
   }
   // True if ancestor x of tree k's committed connection, at root radius rr, overlaps a vessel of
   // its own tree more than two segments away that blocks it (collides' check of one ancestor of
@@ -751,8 +756,9 @@ class CcoGrower {
   // bifurcation outwards (along the trunk, or towards its children), or its proximal one back,
   // to 2.1–3 r, whichever first fits. Failing that, the same slides to 2.1 r where only small
   // vessels (at most kMaxClearedTerminals terminals or 1/kSmallBeside of the trunk's, fewer
-  // than its own, so none of its ancestors) are in the way: they go to `regrow`. Measured: the one trunk left short in the
-  // sphere at 20,000 terminals was blocked by a single terminal segment.
+  // than its own, so none of its ancestors) are in the way: they go to `regrow`. Measured: the
+  // one trunk left short in the sphere at 20,000 terminals was blocked by a single terminal
+  // segment.
   bool lengthen(int k, std::int32_t s, std::vector<std::int32_t>& regrow) {
     if (lengthenFree(k, s)) return true;
     const auto& T = trees_[k].tree;
@@ -760,7 +766,7 @@ class CcoGrower {
     const Vec3 a = T.position[P], e = T.position[s];
     const Vec3 u = (e - a) / distance(a, e);
     const double L = 2.1 * T.radius[s];
-    const std::int32_t small = std::min<std::int32_t>(std::max(kMaxClearedTerminals, T.terminals[s] / kSmallBeside), T.terminals[s] - 1);
+    const std::int32_t small = std::min(smallBeside(T, s), T.terminals[s] - 1);
     if (!T.isTerminal(s) && tryMove(k, s, a + u * L, &regrow, small)) return true;
     if (P > 0 && tryMove(k, P, e - u * L, &regrow, small)) return true;
     return slideWithNeighbour(k, s, &regrow, small);
