@@ -255,6 +255,52 @@ TEST(Cco, ASegmentHiddenInThePlaneIsReachedOnlyAcrossAVessel) {
   EXPECT_EQ(uncrossed, 0) << "of " << hidden << " hidden segments";
 }
 
+TEST(Cco, APointBesideAVesselCanConnectOnlyBesideThatVessel) {
+  // The grower does not cost connections of a drawn point whose nearest vessel surface lies
+  // within half a terminal's radius (crowdedOut), except on the segments beside that vessel: the
+  // new terminal's vessel ends at the point and would touch it. Points drawn so near a vessel of
+  // a grown disc tree: the exact optimiser's connection on every other segment among the 20
+  // nearest must give the new terminal a radius that reaches the vessel (0 of 4898; with the
+  // whole radius instead of half, 153 of 4916 would not).
+  const auto d = GrowthDomain::analytic(DomainShape::Disc, 40, 0.2);
+  const auto o = karch(1500, d, 3);
+  GrowthReport rep;
+  const auto t = growCco(d, o, rep);
+  EXPECT_GT(rep.crowded_segments, 500) << "the grower skips crowded-out segments";
+  std::vector<double> terminal_radii;
+  for (std::int32_t s = 1; s < t.nodeCount(); ++s)
+    if (t.isTerminal(s)) terminal_radii.push_back(t.radius[s]);
+  std::nth_element(terminal_radii.begin(), terminal_radii.begin() + terminal_radii.size() / 2, terminal_radii.end());
+  const double crowd = 0.5 * terminal_radii[terminal_radii.size() / 2];
+  PhysicsParameters volume = o.physics;
+  volume.cost_radius_exponent = 2;
+  volume.cost_length_exponent = 1;
+  BifurcationOptimizer opt(t, volume, d.frame(), 0.0);
+  opt.checkObstacles(false);
+  SegmentIndex index(d.lo(), d.hi(), true);
+  index.refresh(t, true);
+  Rng rng(7, 0, Stage::Growth);
+  std::vector<std::pair<double, std::int32_t>> near;
+  int points = 0, tried = 0, clear = 0;
+  while (points < 300) {
+    const Vec3 p = d.sample(rng);
+    index.nearest(t, p, 20, near);
+    const auto [dy, y] = near.front();
+    const double gap = dy - t.radius[y];
+    if (gap <= 0 || gap >= crowd) continue;  // inside a vessel, or not crowded
+    ++points;
+    for (const auto& [ds, s] : near) {
+      if (s == y || s == t.parent[y] || t.parent[s] == t.parent[y] || t.parent[s] == y) continue;  // beside y
+      const auto c = opt.optimise(s, p, 4);
+      if (!c.valid) continue;
+      ++tried;
+      if (!(dy < opt.radiiAt(s, c.bifurcation, p)[2] + t.radius[y])) ++clear;
+    }
+  }
+  EXPECT_GT(tried, 1000);
+  EXPECT_EQ(clear, 0) << "of " << tried << " connections from crowded points";
+}
+
 TEST(Cco, NonConvexMaskKeepsEveryVesselInsideTheMask) {
   // An L-shaped slab: the straight line between its arms leaves the domain.
   const auto m = voxelMap({60, 60, 16}, 0.5, [](int i, int j, int k) {

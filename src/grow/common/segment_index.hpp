@@ -5,6 +5,7 @@
 // costs O(1) amortised per insertion. A split segment keeps its id and only shrinks, so stale
 // cell entries are harmless: queries always measure the segment's current geometry.
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -26,6 +27,17 @@ class SegmentIndex {
   // The k segments nearest to p (point–segment distance), nearest first: (distance, id).
   void nearest(const VascularTree& tree, const Vec3& p, int k,
                std::vector<std::pair<double, std::int32_t>>& out);
+  // True if within(id, distance) holds for a segment registered in p's own cell: a look at a few
+  // segments before any search.
+  template <class F>
+  bool anyInCell(const VascularTree& tree, const Vec3& p, F&& within) const {
+    if (!(cell_ > 0)) return false;
+    int c[3];
+    for (int ax = 0; ax < 3; ++ax) c[ax] = std::clamp(static_cast<int>(std::floor((p[ax] - lo_[ax]) / cell_)), 0, n_[ax] - 1);
+    for (auto s : cells_[cellId(c[0], c[1], c[2])])
+      if (within(s, pointSegmentDistance(p, tree.position[tree.parent[s]], tree.position[s]))) return true;
+    return false;
+  }
   // True if some segment lies closer than `radius` to p.
   bool anyWithin(const VascularTree& tree, const Vec3& p, double radius);
   // Which segments a query has already met; one per concurrent caller of the const queries.
