@@ -49,6 +49,28 @@ DemandMap voxelMap(std::array<std::int32_t, 3> dims, double voxel_mm, F&& value)
   return m;
 }
 
+// A disc tree of 1500 terminals (seed 3) with the grower's optimiser for it (on the volume, the
+// domain checked on results only) and a grid of its segments: the set-up of tests that check
+// the grower's claims about points drawn beside its vessels.
+struct GrownDisc {
+  GrowthDomain d = GrowthDomain::analytic(DomainShape::Disc, 40, 0.2);
+  CcoOptions o = karch(1500, d, 3);
+  GrowthReport rep;
+  VascularTree t = growCco(d, o, rep);
+  PhysicsParameters volume = [&] {
+    PhysicsParameters v = o.physics;
+    v.cost_radius_exponent = 2;
+    v.cost_length_exponent = 1;
+    return v;
+  }();
+  BifurcationOptimizer opt{t, volume, d.frame(), 0.0};
+  SegmentIndex index{d.lo(), d.hi(), true};
+  GrownDisc() {
+    opt.checkObstacles(false);
+    index.refresh(t, true);
+  }
+};
+
 }  // namespace
 
 TEST(Kamiya, SolvesKamiyasLawAndPressureDropsAndStopsAtTheVolumeWeightedCentre) {
@@ -207,18 +229,12 @@ TEST(Cco, ASegmentHiddenInThePlaneIsReachedOnlyAcrossAVessel) {
   // outside the vessels of a grown tree: Kamiya's point and the exact optimiser's (from it, as
   // the grower refines) for each hidden segment among the 40 nearest must cross a vessel that
   // shares no end with the segment.
-  const auto d = GrowthDomain::analytic(DomainShape::Disc, 40, 0.2);
-  const auto o = karch(1500, d, 3);
-  GrowthReport rep;
-  const auto t = growCco(d, o, rep);
-  EXPECT_GT(rep.hidden_segments, 1000) << "the grower skips hidden segments";
-  PhysicsParameters volume = o.physics;
-  volume.cost_radius_exponent = 2;
-  volume.cost_length_exponent = 1;
-  BifurcationOptimizer opt(t, volume, d.frame(), 0.0);
-  opt.checkObstacles(false);  // as the grower: the domain is checked on the result
-  SegmentIndex index(d.lo(), d.hi(), true);
-  index.refresh(t, true);
+  GrownDisc disc;
+  const auto& d = disc.d;
+  const auto& t = disc.t;
+  const auto& opt = disc.opt;
+  auto& index = disc.index;
+  EXPECT_GT(disc.rep.hidden_segments, 1000) << "the grower skips hidden segments";
   Rng rng(5, 0, Stage::Growth);
   std::vector<std::pair<double, std::int32_t>> near;
   int hidden = 0, points = 0, uncrossed = 0;
@@ -262,39 +278,30 @@ TEST(Cco, APointBesideAVesselCanConnectOnlyBesideThatVessel) {
   // a grown disc tree: the exact optimiser's connection on every other segment among the 20
   // nearest must give the new terminal a radius that reaches the vessel (0 of 4898; with the
   // whole radius instead of half, 153 of 4916 would not).
-  const auto d = GrowthDomain::analytic(DomainShape::Disc, 40, 0.2);
-  const auto o = karch(1500, d, 3);
-  GrowthReport rep;
-  const auto t = growCco(d, o, rep);
-  EXPECT_GT(rep.crowded_segments, 500) << "the grower skips crowded-out segments";
+  GrownDisc disc;
+  const VascularTree& t = disc.t;
+  EXPECT_GT(disc.rep.crowded_segments, 500) << "the grower skips crowded-out segments";
   std::vector<double> terminal_radii;
   for (std::int32_t s = 1; s < t.nodeCount(); ++s)
     if (t.isTerminal(s)) terminal_radii.push_back(t.radius[s]);
   std::nth_element(terminal_radii.begin(), terminal_radii.begin() + terminal_radii.size() / 2, terminal_radii.end());
   const double crowd = 0.5 * terminal_radii[terminal_radii.size() / 2];
-  PhysicsParameters volume = o.physics;
-  volume.cost_radius_exponent = 2;
-  volume.cost_length_exponent = 1;
-  BifurcationOptimizer opt(t, volume, d.frame(), 0.0);
-  opt.checkObstacles(false);
-  SegmentIndex index(d.lo(), d.hi(), true);
-  index.refresh(t, true);
   Rng rng(7, 0, Stage::Growth);
   std::vector<std::pair<double, std::int32_t>> near;
   int points = 0, tried = 0, clear = 0;
   while (points < 300) {
-    const Vec3 p = d.sample(rng);
-    index.nearest(t, p, 20, near);
+    const Vec3 p = disc.d.sample(rng);
+    disc.index.nearest(t, p, 20, near);
     const auto [dy, y] = near.front();
     const double gap = dy - t.radius[y];
     if (gap <= 0 || gap >= crowd) continue;  // inside a vessel, or not crowded
     ++points;
     for (const auto& [ds, s] : near) {
       if (s == y || s == t.parent[y] || t.parent[s] == t.parent[y] || t.parent[s] == y) continue;  // beside y
-      const auto c = opt.optimise(s, p, 4);
+      const auto c = disc.opt.optimise(s, p, 4);
       if (!c.valid) continue;
       ++tried;
-      if (!(dy < opt.radiiAt(s, c.bifurcation, p)[2] + t.radius[y])) ++clear;
+      if (!(dy < disc.opt.radiiAt(s, c.bifurcation, p)[2] + t.radius[y])) ++clear;
     }
   }
   EXPECT_GT(tried, 1000);
