@@ -221,6 +221,7 @@ TEST(Cco, DiscTreeIsPlanarAndMeetsEveryConstraint) {
   test::expectHemodynamicInvariants(t, o.physics, 1500);
   test::expectGeometry(t, d);
   for (const auto& p : t.position) ASSERT_EQ(p.z, d.planeZ());
+  EXPECT_EQ(rep.neighbour_doublings, 0) << "in the plane ν stays";
 }
 
 TEST(Cco, ASegmentHiddenInThePlaneIsReachedOnlyAcrossAVessel) {
