@@ -627,12 +627,15 @@ class CcoGrower {
         g.done = g.near.size();
         more |= static_cast<std::int32_t>(g.done) < g.tree.segmentCount();
       }
-      // In the plane ν does not double: segments beyond the ν nearest lie behind the vessels
-      // around the point (half of the ν nearest are hidden already), and joining one makes long,
-      // heavy connections. Disc, 50,000 terminals, seed 1: 413 of 53,635 connections came after
-      // ν doubled, from ~12,000 points none of the ν nearest could take and ~28,000 whose valid
-      // connections all collided; without them the trees are lighter (seeds 1-4, 20,000 and
-      // 50,000 terminals: all 8 by 0.1-1.2 %). In space the point is reached around them.
+      // ν doubles only where a user asks for it (max_closest_neighbours), and never in the plane.
+      // The segments beyond the ν nearest are reached by long, heavy connections, around the
+      // vessels near the point (in the plane across them: half of the ν nearest are hidden
+      // already). Without doubling, every tree measured is lighter: sphere, seeds 1-4, 20,000
+      // terminals 920.3, 916.2, 918.3, 967.6 -> 918.3, 915.8, 913.5, 929.1 mm³, 50,000 terminals
+      // 1022.3, 1026.4, 1047.8, 1100.1 -> 1019.9, 1018.4, 1016.0, 1039.9 mm³ (seed 3 then
+      // regrows 849 terminals in the repair instead of 14,228); OpenCCO's ball 282.0 -> 280.4 mm³
+      // at 1000 terminals and 345.7 -> 343.2 at 4000 (10 seeds); the disc, seeds 1-4, all 8 by
+      // 0.1-1.2 % (50,000 terminals, seed 1: 413 of 53,635 connections came after ν doubled).
       if (!more || nu >= opt_.max_neighbours || dom_.dimension() == 2) return false;
       nu = std::min(2 * nu, opt_.max_neighbours);
       ++report_.neighbour_doublings;

@@ -8,8 +8,8 @@
 //   demand map, δ shrinks where demand is above average, by (mean / local)^(1/d);
 // - its ν nearest segments (uniform grid, O(1)) each get Kamiya's bifurcation (§3.2), kept when
 //   all three new segments lie in the domain, are longer than 2r and, with the path to the root
-//   that thickens, overlap no vessel more than one segment away (§3.3.3, §4.4); ν doubles when
-//   every candidate fails; the connection of least total volume wins (§4.5);
+//   that thickens, overlap no vessel more than one segment away (§3.3.3, §4.4); the connection
+//   of least total volume wins (§4.5), and a point none can take is dropped;
 // - R̃, β, ρ and terminal counts are updated along the path to the root only (§3.1.3).
 // The exact final tree is checked again for intersections, short and outside segments; the few
 // offending branches are removed and regrown until none is left.
@@ -34,8 +34,8 @@ struct CcoOptions {
   std::int64_t terminals = 4000;      // N
   Vec3 root_mm;                       // in the domain's frame
   int closest_neighbours = 20;        // ν
-  int max_neighbours = 80;            // ν doubles up to this, then the point is dropped (measured: of
-                                      // 4000 terminals 4098 connect at ν = 20, 28 at 40–80, 4 beyond)
+  int max_neighbours = 20;            // in 3D ν doubles up to this, then the point is dropped (20: it
+                                      // does not double; see connect)
   int kamiya_iterations = 100;
   double kamiya_tolerance = 1e-6;     // of the bifurcation's step, relative to its three lengths
   int draws_before_relaxing = 100;

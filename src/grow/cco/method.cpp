@@ -341,7 +341,7 @@ const GrowthMethod kCcoMethod{
                                        "masks: terminals drawn uniformly, or ∝ the mask value (demand)", {
         {"tree", "terminals", "count", nullptr, "N, the number of terminal segments"},
         {"tree", "closest_neighbours", "count", "20", "ν, the nearest segments tried per terminal"},
-        {"tree", "max_closest_neighbours", "count", "80", "ν doubles up to this while no candidate connects (in 3D; in 2D ν stays)"},
+        {"tree", "max_closest_neighbours", "count", "20", "in 3D, ν doubles up to this while no candidate connects (never in 2D); at most closest_neighbours: ν stays, as doubling joins points to far segments by long, heavy connections"},
         {"tree", "kamiya_iterations", "count", "100", "iterations of Kamiya's bifurcation solver"},
         {"tree", "kamiya_tolerance", "", "1e-6", "its step, relative to the three lengths, at convergence"},
         {"tree", "draws_before_relaxing", "count", "100", "failed draws before the distance threshold shrinks"},
