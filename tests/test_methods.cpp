@@ -78,6 +78,19 @@ TEST_F(MethodFiles, OmittedKeysTakeTheDeclaredDefaults) {
   EXPECT_EQ(std::string(sc.growth->method()), "cco");
 }
 
+// ν stays unless max_closest_neighbours asks for more, whatever ν is.
+TEST_F(MethodFiles, NuDoublesOnlyUpToAMaximumTheFileGives) {
+  const std::string head = "[domain]\nshape = \"sphere\"\nradius = \"10 mm\"\nvoxel_size = \"0.5 mm\"\n"
+                           "[tree]\nmethod = \"cco\"\nterminals = 100\nclosest_neighbours = 10\n";
+  const auto max_nu = [&](const std::string& extra) {
+    const auto sc = readTomlParameters(write(head + extra));
+    return dynamic_cast<const CcoSetup&>(*sc.growth).cco.max_neighbours;
+  };
+  EXPECT_EQ(max_nu(""), 10);
+  EXPECT_EQ(max_nu("max_closest_neighbours = 40\n"), 40);
+  EXPECT_EQ(max_nu("max_closest_neighbours = 10\n"), 10);
+}
+
 // A key no method declares is refused with the method's own keys; a key of another method
 // names that method; an unknown method lists the registered ones.
 TEST_F(MethodFiles, KeysAreCheckedAgainstTheDeclarations) {

@@ -256,6 +256,8 @@ std::shared_ptr<const GrowthSetup> readCcoToml(const TomlReader& r, const Growth
   c.physics.total_terminals = c.terminals;
   readInlets(r, m, tree, *s);
   whole("max_closest_neighbours", c.max_neighbours, c.closest_neighbours, Limits::kMaxNeighbours * 64);
+  // Unset, ν stays whatever its value (the fallback is the default ν's).
+  if (!tree.get("max_closest_neighbours")) c.max_neighbours = c.closest_neighbours;
   c.max_neighbours = std::max(c.max_neighbours, c.closest_neighbours);
   whole("kamiya_iterations", c.kamiya_iterations, 1, 100000);
   whole("draws_before_relaxing", c.draws_before_relaxing, 1, 1000000);
@@ -341,7 +343,7 @@ const GrowthMethod kCcoMethod{
                                        "masks: terminals drawn uniformly, or ∝ the mask value (demand)", {
         {"tree", "terminals", "count", nullptr, "N, the number of terminal segments"},
         {"tree", "closest_neighbours", "count", "20", "ν, the nearest segments tried per terminal"},
-        {"tree", "max_closest_neighbours", "count", "20", "in 3D, ν doubles up to this while no candidate connects (never in 2D); at most closest_neighbours: ν stays, as doubling joins points to far segments by long, heavy connections"},
+        {"tree", "max_closest_neighbours", "count", "20", "in 3D, ν doubles up to this while no candidate connects (never in 2D); unset or at most closest_neighbours: ν stays, as doubling joins points to far segments by long, heavy connections"},
         {"tree", "kamiya_iterations", "count", "100", "iterations of Kamiya's bifurcation solver"},
         {"tree", "kamiya_tolerance", "", "1e-6", "its step, relative to the three lengths, at convergence"},
         {"tree", "draws_before_relaxing", "count", "100", "failed draws before the distance threshold shrinks"},
