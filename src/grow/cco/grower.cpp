@@ -559,14 +559,11 @@ class CcoGrower {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(g.done, g.near.size(), 1), [&](const auto& r) {
           for (auto j = r.begin(); j != r.end(); ++j) {
             // Half the ν nearest segments are hidden so on the disc (separatedInPlane).
-            if (planar && separatedInPlane(g.tree, g.near[j].second, p, g.near, kOccluders)) {
+            const bool hidden = planar && separatedInPlane(g.tree, g.near[j].second, p, g.near, kOccluders);
+            if (hidden || crowdedOut(g, g.near[j].second)) {
               trials[j] = Trial();
-              trials[j].hidden = true;
-              continue;
-            }
-            if (crowdedOut(g, g.near[j].second)) {
-              trials[j] = Trial();
-              trials[j].crowded = true;
+              trials[j].hidden = hidden;
+              trials[j].crowded = !hidden;
               continue;
             }
             trials[j] = evaluate(g, g.near[j].second, p, n_new[i], shrink_new, opts[i]);

@@ -34,8 +34,8 @@ struct CcoOptions {
   std::int64_t terminals = 4000;      // N
   Vec3 root_mm;                       // in the domain's frame
   int closest_neighbours = 20;        // ν
-  int max_neighbours = 20;            // in 3D ν doubles up to this, then the point is dropped (20: it
-                                      // does not double; see connect)
+  int max_neighbours = 20;            // in 3D ν doubles up to this, then the point is dropped (at
+                                      // most ν: it does not double; see connect)
   int kamiya_iterations = 100;
   double kamiya_tolerance = 1e-6;     // of the bifurcation's step, relative to its three lengths
   int draws_before_relaxing = 100;

@@ -67,8 +67,7 @@ void SegmentIndex::nearest(const VascularTree& tree, const Vec3& p, int k,
   if (nseg == 0 || k <= 0) return;
   k = std::min<int>(k, nseg);
   int c[3];
-  for (int ax = 0; ax < 3; ++ax)
-    c[ax] = std::clamp(static_cast<int>(std::floor((p[ax] - lo_[ax]) / cell_)), 0, n_[ax] - 1);
+  cellOf(p, c);
   // Distance from p to the outside of the block of cells within Chebyshev ring r.
   double margin[3][2];
   for (int ax = 0; ax < 3; ++ax) {

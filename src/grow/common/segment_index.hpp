@@ -33,7 +33,7 @@ class SegmentIndex {
   bool anyInCell(const VascularTree& tree, const Vec3& p, F&& within) const {
     if (!(cell_ > 0)) return false;
     int c[3];
-    for (int ax = 0; ax < 3; ++ax) c[ax] = std::clamp(static_cast<int>(std::floor((p[ax] - lo_[ax]) / cell_)), 0, n_[ax] - 1);
+    cellOf(p, c);
     for (auto s : cells_[cellId(c[0], c[1], c[2])])
       if (within(s, pointSegmentDistance(p, tree.position[tree.parent[s]], tree.position[s]))) return true;
     return false;
@@ -92,6 +92,10 @@ class SegmentIndex {
  private:
   void build(const VascularTree& tree, double cell);
   void cellRange(const Vec3& lo, const Vec3& hi, int* a, int* b) const;
+  // The cell holding p, or the nearest one for a point outside the grid.
+  void cellOf(const Vec3& p, int* c) const {
+    for (int ax = 0; ax < 3; ++ax) c[ax] = std::clamp(static_cast<int>(std::floor((p[ax] - lo_[ax]) / cell_)), 0, n_[ax] - 1);
+  }
   std::int64_t cellId(int i, int j, int k) const { return i + std::int64_t(n_[0]) * (j + std::int64_t(n_[1]) * k); }
 
   Vec3 lo_, hi_;
