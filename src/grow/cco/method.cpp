@@ -97,6 +97,7 @@ class PreparedCco final : public PreparedGrowth {
     stats["kamiya_failures"] = report.kamiya_failures;
     stats["hidden_segments"] = report.hidden_segments;
     stats["crowded_segments"] = report.crowded_segments;
+    stats["node_optima"] = report.node_optima;
     stats["short_segments"] = report.short_segments;
     stats["short_segments_definition"] = "segments not longer than twice their radius";
     if (!report.short_list.empty()) {

@@ -152,6 +152,19 @@ BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, 
   return e;
 }
 
+bool BifurcationOptimizer::optimumAtProximalNode(std::int32_t s, const Vec3& term) const {
+  const Vec3& x0 = tree_.position[tree_.parent[s]];
+  const Vec3& x1 = tree_.position[s];
+  const double l1 = distance(x0, x1), l2 = distance(x0, term);
+  if (!(l1 > 0) || !(l2 > 0)) return false;
+  const double l[3] = {1e-9 * (l1 + l2), l1, l2};
+  const Evaluation e = evaluate(s, l);
+  const Vec3 pull = (x1 - x0) * (e.d_length[1] / l1) + (term - x0) * (e.d_length[2] / l2);
+  // With 1 % to spare: where the pulls nearly balance (a straight segment, a tiny terminal) the
+  // cost along the segment is flat, and points beside the node can be cheaper.
+  return norm(pull) <= 0.99 * e.d_length[0];
+}
+
 Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int max_iterations, const Vec3* start) const {
   const std::array<Vec3, 3> ends{tree_.position[tree_.parent[s]], tree_.position[s], term};
   MinLengths m = minimumsAt(s, start ? *start : (ends[0] + ends[1]) * 0.5, term);

@@ -76,6 +76,10 @@ class BifurcationOptimizer {
     double d_length[3];  // ∂C/∂l for parent part, distal part, terminal
   };
   Evaluation evaluate(std::int32_t s, const double (&l)[3]) const;
+  // True if the exact optimum on s lies at s's proximal node: there the pull of the other two
+  // segments, weighted by ∂C/∂l, is weaker than the parent part's by 1 % (the weighted Fermat
+  // condition), one walk to the root.
+  bool optimumAtProximalNode(std::int32_t s, const Vec3& t) const;
   // Cost of the connection at point b (no constraint checks).
   double costAt(std::int32_t s, const Vec3& b, const Vec3& t) const;
   struct Subtree { double reduced_resistance, cost_ratio; };

@@ -26,6 +26,7 @@ struct GrowthReport {
   std::int64_t kamiya_failures = 0;        // Kamiya's iteration found no bifurcation
   std::int64_t hidden_segments = 0;        // 2D: candidate segments a vessel separates from the point
   std::int64_t crowded_segments = 0;       // candidate segments whose connection a vessel at the point would block
+  std::int64_t node_optima = 0;            // candidate segments whose optimum is their proximal node (not refined)
   std::int64_t short_segments = 0;         // final segments with length <= 2 r (target 0)
   // CCO: each segment left shorter than 2r by the final check (one its repair could not fix),
   // by its tree and its ends (mm), so that a user can find it.
