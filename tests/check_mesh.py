@@ -3,7 +3,7 @@
     check_mesh.py MESH_DIR NODES_CSV EDGES_CSV
     check_mesh.py --ends MESH_DIR
     check_mesh.py --self-intersections MESH_DIR EXT...
-    check_mesh.py --wall MESH_DIR NODES_CSV EDGES_CSV THICKNESS_MM
+    check_mesh.py --wall MESH_DIR NODES_CSV EDGES_CSV THICKNESS_MM [X0,Y0,Z0,X1,Y1,Z1]
 
 Reads surface.stl, .obj, .ply, .vtp with VTK's readers, surface.off by hand and surface.3mf with
 the standard library's zipfile and ElementTree (unit millimetre); for each: the
@@ -23,7 +23,8 @@ keeps) goes to TetGen (Debian's tetgen), whose -d switch tests every pair of fac
 intersection with exact predicates; prints {EXT: intersecting pairs}.
 
 With --wall: a hollow wall of constant thickness (surface.vtp, surface_faces.csv; the ends cut
-where their nodes are): the wall's volume by Monte Carlo, independently of the mesher (points in
+where their nodes are; with a box, clipped to it, and then the lumen's openings: open end rings
+and holes in the box's sections): the wall's volume by Monte Carlo (in the box), independently of the mesher (points in
 each vessel thickened by the wall, cut by its ends' planes, outside every vessel, counted
 1/(thickened vessels holding them)); and the thickness: every vertex of the outer side (farther
 than half the wall from the vessels) to the lumen side's triangles (VTK's
@@ -284,10 +285,13 @@ def lumen_distance(p, a, b, rad):
     return out
 
 
-def wall(mesh_dir, nodes_csv, edges_csv, thickness, per_capsule=3000, seed=7):
+def wall(mesh_dir, nodes_csv, edges_csv, thickness, clip=None, per_capsule=3000, seed=7):
     a, b, rad = read_tree(nodes_csv, edges_csv)
     d = b - a
-    rows = list(csv.DictReader(open(f"{mesh_dir}/surface_faces.csv")))[1:]
+    # The ends' rows (a clip box's sides have rows of kind "box": the box itself cuts).
+    rows = [r for r in list(csv.DictReader(open(f"{mesh_dir}/surface_faces.csv")))[1:] if r["kind"] != "box"]
+    in_box = (lambda p: np.ones(len(p), bool)) if clip is None else \
+        (lambda p: np.all((p >= np.array(clip[:3])) & (p <= np.array(clip[3:])), axis=1))
     # Each end's plane belongs to the vessel with an end node at its centre.
     cuts = [[] for _ in range(len(a))]
     for row in rows:
@@ -298,7 +302,7 @@ def wall(mesh_dir, nodes_csv, edges_csv, thickness, per_capsule=3000, seed=7):
     out_r = rad + thickness
 
     def in_cut_capsule(p, k):
-        keep = inside(p, a[k], d[k], out_r[k])
+        keep = inside(p, a[k], d[k], out_r[k]) & in_box(p)
         for c, n in cuts[k]:
             keep &= (p - c) @ n <= 0
         return keep
@@ -343,20 +347,45 @@ def wall(mesh_dir, nodes_csv, edges_csv, thickness, per_capsule=3000, seed=7):
     for row in rows:
         c = np.array([float(row[f"centre_{x}"]) for x in "xyz"])
         far &= np.linalg.norm(pts[outer] - c, axis=1) > 2 * (float(row["radius"]) + thickness)
+    if clip is not None:  # the box cuts the wall across, not around
+        lo, hi = np.array(clip[:3]), np.array(clip[3:])
+        far &= np.minimum(pts[outer] - lo, hi - pts[outer]).min(axis=1) > 2 * thickness
     outer = outer[far]
     thick = np.array([abs(implicit.EvaluateFunction(*pts[i])) for i in outer])
     dev = np.abs(thick - thickness) / thickness
     mass = vtk.vtkMassProperties()
     mass.SetInputData(poly)
     mass.Update()
-    return {"wall_volume_monte_carlo": volume, "mesh_volume": mass.GetVolume(), "outer_vertices": int(len(outer)),
+    openings = {}
+    if clip is not None:
+        # The lumen's openings: the open end rings, and the holes of the box's sections (a
+        # patch of c components and Euler characteristic chi has c - chi holes).
+        all_rows = list(csv.DictReader(open(f"{mesh_dir}/surface_faces.csv")))
+        sec = faces[np.isin(face_id, [int(r["face_id"]) for r in all_rows if r["kind"] == "box"])]
+        edges = {tuple(sorted((int(t[i]), int(t[(i + 1) % 3])))) for t in sec for i in range(3)}
+        verts = np.unique(sec)
+        parent = {int(v): int(v) for v in verts}
+
+        def root(x):
+            while parent[x] != x:
+                parent[x] = parent[parent[x]]
+                x = parent[x]
+            return x
+        for u, v in edges:
+            parent[root(u)] = root(v)
+        components = len({root(int(v)) for v in verts})
+        holes = components - (len(verts) - len(edges) + len(sec))
+        rings = sum(1 for r in rows if r["state"] == "open")
+        openings = {"open_rings": rings, "section_holes": holes, "lumen_openings": rings + holes}
+    return {**openings, "wall_volume_monte_carlo": volume, "mesh_volume": mass.GetVolume(), "outer_vertices": int(len(outer)),
             "thickness_deviation_p50": float(np.percentile(dev, 50)), "thickness_deviation_p95": float(np.percentile(dev, 95)),
             "thickness_min": float(thick.min()), "thickness_max": float(thick.max())}
 
 
 def main():
     if sys.argv[1] == "--wall":
-        print(json.dumps(wall(sys.argv[2], sys.argv[3], sys.argv[4], float(sys.argv[5]))))
+        box = [float(v) for v in sys.argv[6].split(",")] if len(sys.argv) > 6 else None
+        print(json.dumps(wall(sys.argv[2], sys.argv[3], sys.argv[4], float(sys.argv[5]), box)))
         return
     if sys.argv[1] == "--ends":
         print(json.dumps(ends(sys.argv[2])))

@@ -58,6 +58,11 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
   c->add_option("--max-error", a.max_error, "with --decimate: largest distance of a moved vertex or a new triangle's centroid from the "
                                              "vessels' surface, as a share of the local grid step (default 0.1)")
       ->check(finiteIn(0, 1));
+  c->add_option("--clip-box", a.clip_box,
+                "X0,Y0,Z0,X1,Y1,Z1: clip the closed surface to this box (mm), each side's section filled flat (a hollow wall's lumen "
+                "stays open there: the printed block of seed 004)")
+      ->delimiter(',')
+      ->expected(6);
   c->add_option("--format", a.formats, "mesh formats: stl (binary), obj, ply (binary), off, vtp, 3mf (default stl)")
       ->delimiter(',')
       ->check(CLI::IsMember({"stl", "obj", "ply", "off", "vtp", "3mf"}));
@@ -97,6 +102,8 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   p.decimate = a.decimate;
   p.max_error = a.max_error;
   if (p.ends == "closed" && p.flow_extension > 0) throw InputError("", 0, "--flow-extension needs --ends open or capped");
+  p.clip_box = a.clip_box;
+  if (const auto why = clipBoxProblem(p); !why.empty()) throw InputError("", 0, why);
   if (!a.formats.empty()) p.formats = a.formats;
   const auto surface = writeSurfaceFiles(net.tree, p, memoryLimit(a.common), dir.path(), progressPrinter(a.common, "meshing"), {}, net.ids);
   Json j = {{"tool", "angiosynth " + std::string(kVersion)},

@@ -61,6 +61,9 @@ const std::vector<MethodParam>& commonParams() {
        "max_error of the vessels"},
       {"mesh", "max_error", "share of the local step", "0.1", "with decimate: the largest distance from the vessels' surface, (0, 1]"},
       {"mesh", "flow_extension", "radii", "0", "open/capped: each end prolonged straight by this many radii of its vessel before the cut (0 … 100)"},
+      {"mesh", "clip_box", "[mm × 6]", "none",
+       "[x0, y0, z0, x1, y1, z1]: the closed surface (closed or capped ends, or a hollow wall) clipped to this box, each side's section "
+       "filled flat with a hollow wall's lumens left open (seed 004's printed block); ends outside the box are gone"},
   };
   return p;
 }

@@ -55,7 +55,24 @@ struct MeshParameters {
   double flow_extension = 0;                // open/capped: straight extension of each end, in radii of its vessel
   bool decimate = false;                    // edge-collapse decimation within max_error of the surface
   double max_error = 0.1;                   // share of the local step
+  // mm: x0, y0, z0, x1, y1, z1 of a box the closed surface is clipped to, each side's section
+  // filled (a hollow wall's lumen open there); empty: none
+  std::vector<double> clip_box;
 };
+
+// Why p's clip box is refused, or empty: six numbers, each lower bound below its upper one, and
+// a closed surface to clip (closed or capped ends, or a hollow wall, whose ends are joined).
+inline std::string clipBoxProblem(const MeshParameters& p) {
+  if (p.clip_box.empty()) return {};
+  if (p.clip_box.size() != 6) return "clip_box must hold 6 numbers (mm): x0, y0, z0, x1, y1, z1";
+  for (int k = 0; k < 3; ++k)
+    if (!(p.clip_box[std::size_t(k)] < p.clip_box[std::size_t(k + 3)]))
+      return "clip_box's lower corner must lie below its upper one on every axis; allowed: x0 < x1, y0 < y1, z0 < z1 (mm)";
+  const bool wall = p.wall_thickness > 0 || p.wall_ratio > 0 || p.wall_from_graph;
+  if (p.ends == "open" && !wall)
+    return "clip_box clips a closed surface; allowed: ends \"closed\" or \"capped\", or a hollow wall";
+  return {};
+}
 
 struct Scenario {
   std::string parameter_file;

@@ -147,7 +147,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
 
   // [mesh]: the vessels' surface beside the graphs (src/mesh); the table's presence enables it.
   const auto& me = r.table("mesh", {"enabled", "method", "formats", "voxel_size", "samples_across", "ring_spacing", "uniform", "on_surface", "ends",
-                                    "flow_extension", "decimate", "max_error", "wall_thickness", "wall_ratio", "wall_from_graph"});
+                                    "flow_extension", "decimate", "max_error", "wall_thickness", "wall_ratio", "wall_from_graph", "clip_box"});
   if (const auto* n = root.get("mesh")) {
     auto& mp = sc.mesh;
     sc.mesh_line = r.lineOf(n);
@@ -195,6 +195,10 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
       if (mp.method != "tubes") throw InputError(file, r.lineOf(&me), "a hollow wall is built on the tubes; allowed: method = \"tubes\"");
       if (mp.ends == "capped")
         throw InputError(file, r.lineOf(me.get("ends")), "a hollow wall keeps its ends open (the lumen runs through); allowed: ends = \"open\" or \"closed\"");
+    }
+    if (me.get("clip_box")) {
+      mp.clip_box = r.numbers(me.get("clip_box"), "clip_box", 6);
+      if (const auto why = clipBoxProblem(mp); !why.empty()) throw InputError(file, r.lineOf(me.get("clip_box")), why);
     }
     if (me.get("flow_extension")) {
       mp.flow_extension = r.number(me, "mesh", "flow_extension");

@@ -5,6 +5,7 @@
 
 #include "io/mesh_writers.hpp"
 #include "core/format.hpp"
+#include "mesh/box_clip.hpp"
 #include "mesh/decimate.hpp"
 #include "mesh/hollow_wall.hpp"
 #include "mesh/tube_surface.hpp"
@@ -19,20 +20,39 @@ namespace {
 
 // surface_faces.csv: one row per face label (the wall, then each end), as the ids the VTP and
 // PLY files carry (ModelFaceID = CellEntityIds = face + 1).
+// With a clip box, an end outside it is `outside_box`, and each side of the box has a row (kind
+// `box`, end its side, the section's area).
 void writeFaces(std::ostream& os, const std::vector<VesselEnd>& ends, const EndCutReport& cut, const std::string& mode,
-                const std::vector<std::string>& kinds, const std::vector<std::string>& vessel_ids) {
+                const std::vector<std::string>& kinds, const std::vector<std::string>& vessel_ids, const std::vector<double>& box,
+                const BoxClipReport& clipped) {
   os << "face_id,kind,tree,vessel,end,state,centre_x,centre_y,centre_z,normal_x,normal_y,normal_z,radius,cap_area,loop_vertices\n";
   os << "1,wall,,,,,,,,,,,,,\n";
   std::vector<char> closed(ends.size(), 0);
   for (auto e : cut.left_closed) closed[std::size_t(e)] = 1;
+  const auto outside = [&](const Vec3& c) {
+    return !box.empty() && (c.x < box[0] || c.y < box[1] || c.z < box[2] || c.x > box[3] || c.y > box[4] || c.z > box[5]);
+  };
   for (std::size_t k = 0; k < ends.size(); ++k) {
     const auto& e = ends[k];
     const bool vein = std::size_t(e.tree) < kinds.size() && kinds[std::size_t(e.tree)] == "vein";
     os << k + 2 << ',' << ((e.root != vein) ? "inlet" : "outlet") << ',' << e.tree << ','
        << (std::size_t(e.vessel) < vessel_ids.size() ? vessel_ids[std::size_t(e.vessel)] : std::to_string(e.vessel)) << ',' << (e.root ? "root" : "leaf") << ','
-       << (closed[k] ? "left_closed" : mode) << ',' << exactNumber(e.centre.x) << ',' << exactNumber(e.centre.y) << ',' << exactNumber(e.centre.z) << ','
+       << (outside(e.centre) ? "outside_box" : closed[k] ? "left_closed" : mode) << ',' << exactNumber(e.centre.x) << ',' << exactNumber(e.centre.y) << ',' << exactNumber(e.centre.z) << ','
        << exactNumber(e.normal.x) << ',' << exactNumber(e.normal.y) << ',' << exactNumber(e.normal.z) << ',' << exactNumber(e.radius) << ','
        << exactNumber(cut.cap_area_mm2[k]) << ',' << cut.loop_vertices[k] << '\n';
+  }
+  if (box.empty()) return;
+  for (int side = 0; side < 6; ++side) {
+    const int axis = side / 2;
+    const double sign = side % 2 ? 1 : -1;
+    double c[3] = {(box[0] + box[3]) / 2, (box[1] + box[4]) / 2, (box[2] + box[5]) / 2};
+    c[axis] = box[std::size_t(axis + (side % 2 ? 3 : 0))];
+    double n[3] = {0, 0, 0};
+    n[axis] = sign;
+    os << ends.size() + 2 + std::size_t(side) << ",box,,," << kBoxSideNames[side] << ",section";
+    for (double v : c) os << ',' << exactNumber(v);
+    for (double v : n) os << ',' << exactNumber(v);
+    os << ",," << exactNumber(clipped.section_area_mm2[std::size_t(side)]) << ",\n";
   }
 }
 
@@ -108,12 +128,28 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
     };
     mesh = vesselSurface(cut_ends ? prolongEnds(tree, ends) : tree, o, &report, progress);
   }
+  BoxClipReport clipped;
+  if (!p.clip_box.empty()) {
+    const auto& b = p.clip_box;
+    clipped = clipToBox(mesh, Vec3(b[0], b[1], b[2]), Vec3(b[3], b[4], b[5]), std::int32_t(ends.size()) + 1);
+    // What is left of each end's face (a box side may cut it; outside the box it is gone).
+    if (cut_ends) {
+      cut.cap_area_mm2.assign(ends.size(), 0.0);
+      for (std::size_t k = 0; k < mesh.triangles.size(); ++k) {
+        const auto f = mesh.triangle_face[k];
+        if (f <= 0 || std::size_t(f) > ends.size()) continue;
+        const auto& t = mesh.triangles[k];
+        cut.cap_area_mm2[std::size_t(f - 1)] += 0.5 * norm(cross(mesh.vertices[std::size_t(t[1])] - mesh.vertices[std::size_t(t[0])],
+                                                                 mesh.vertices[std::size_t(t[2])] - mesh.vertices[std::size_t(t[0])]));
+      }
+    }
+  }
   const auto topo = meshTopology(mesh);
   SurfaceFiles out;
   out.files = Json::object();
-  if (cut_ends) {
+  if (cut_ends || !p.clip_box.empty()) {
     std::ofstream os(dir / "surface_faces.csv", std::ios::binary);
-    writeFaces(os, ends, cut, walls ? "open" : p.ends, tree_kinds, vessel_ids);
+    writeFaces(os, ends, cut, walls ? "open" : p.ends, tree_kinds, vessel_ids, p.clip_box, clipped);
     if (!os) throw std::runtime_error("cannot write " + (dir / "surface_faces.csv").string());
     out.files["faces"] = "surface_faces.csv";
   }
@@ -139,6 +175,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"volume_restored", !p.on_surface},
                     {"ends", walls ? std::string("open") : p.ends},
                     {"flow_extension_radii", p.flow_extension},
+                    {"clip_box_mm", p.clip_box.empty() ? Json(nullptr) : Json(p.clip_box)},
                     {"decimate", p.decimate},
                     {"max_error_steps", p.max_error},
                     {"description", tubes ? "each vessel's free middle a tube of rings on its exact wall (at most ring_spacing_radii radii "
@@ -177,6 +214,9 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"ends", ends.size()},
                     {"ends_cut", cut.cut},
                     {"ends_left_closed", cut.left_closed.size()},
+                    {"clip_box_removed_triangles", p.clip_box.empty() ? Json(nullptr) : Json(clipped.removed_triangles)},
+                    {"clip_box_section_loops", p.clip_box.empty() ? Json(nullptr) : Json(clipped.section_loops)},
+                    {"clip_box_section_area_mm2", p.clip_box.empty() ? Json(nullptr) : Json(clipped.section_area_mm2)},
                     {"tree_components", topo.tree_components},
                     {"tree_euler_characteristic", topo.tree_euler}};
   return out;

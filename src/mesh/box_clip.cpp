@@ -1,0 +1,360 @@
+#include "mesh/box_clip.hpp"
+
+#include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Constrained_triangulation_face_base_2.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_face_base_with_info_2.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace angiosynth {
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Vb = CGAL::Triangulation_vertex_base_with_info_2<std::int32_t, K>;
+using Fi = CGAL::Triangulation_face_base_with_info_2<int, K>;  // nesting depth: odd inside the section
+using Fb = CGAL::Constrained_triangulation_face_base_2<K, Fi>;
+using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
+// Loops of a closed surface's cut never cross: a crossing is an error, not a new vertex.
+using Cdt = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::No_constraint_intersection_tag>;
+
+std::uint64_t directedKey(std::int32_t a, std::int32_t b) { return (std::uint64_t(std::uint32_t(a)) << 32) | std::uint32_t(b); }
+double coord(const Vec3& p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
+void setCoord(Vec3& p, int axis, double v) { (axis == 0 ? p.x : axis == 1 ? p.y : p.z) = v; }
+
+// Loop edges shorter than kShortLoopEdge of their ends' step collapse into their first vertex
+// (both lie in the plane): a fan of needle triangles cut near its hub leaves cut points a few
+// 10⁻⁵ mm apart, and the section between them would turn over in single precision. A collapse
+// is made only where the two ends share no neighbour but the cut triangle's third vertex (the
+// topology stays) and no triangle turns by more than 60°. Removed triangles get vertex −1.
+// True if any was made.
+bool collapseShortLoopEdges(const SurfaceMesh& m, std::vector<std::array<std::int32_t, 3>>& tris,
+                            const std::vector<std::pair<std::int32_t, std::int32_t>>& loop_edges) {
+  constexpr double kShortLoopEdge = 0.05;
+  std::unordered_map<std::int32_t, std::vector<std::size_t>> at;  // loop vertex -> its triangles
+  for (const auto& [a, b] : loop_edges) at[a], at[b];
+  for (std::size_t k = 0; k < tris.size(); ++k)
+    for (auto v : tris[k])
+      if (auto it = at.find(v); it != at.end()) it->second.push_back(k);
+  const auto stepOf = [&](std::int32_t v) { return m.vertex_step.empty() ? 0.0 : double(m.vertex_step[std::size_t(v)]); };
+  std::unordered_map<std::int32_t, std::int32_t> merged;  // b -> a
+  const auto alive = [&](std::int32_t v) { return !merged.count(v); };
+  bool any = false;
+  for (const auto& [a, b] : loop_edges) {
+    if (!alive(a) || !alive(b)) continue;
+    const Vec3& pa = m.vertices[std::size_t(a)];
+    const Vec3& pb = m.vertices[std::size_t(b)];
+    if (!(distance(pa, pb) < kShortLoopEdge * std::min(stepOf(a), stepOf(b)))) continue;
+    auto& ta = at[a];
+    auto& tb = at[b];
+    std::size_t cut = tris.size();
+    std::vector<std::int32_t> na, nb;
+    for (auto k : ta)
+      for (auto v : tris[k]) na.push_back(v);
+    for (auto k : tb) {
+      const auto& t = tris[k];
+      if (t[0] < 0) continue;
+      if (t[0] == a || t[1] == a || t[2] == a) cut = k;
+      for (auto v : t) nb.push_back(v);
+    }
+    if (cut == tris.size()) continue;
+    std::sort(na.begin(), na.end());
+    std::sort(nb.begin(), nb.end());
+    na.erase(std::unique(na.begin(), na.end()), na.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+    std::vector<std::int32_t> common;
+    std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
+    if (common.size() != 3) continue;  // a, b and the cut triangle's third vertex
+    bool ok = true;
+    for (auto k : tb) {
+      const auto& t = tris[k];
+      if (k == cut || t[0] < 0) continue;
+      const auto P = [&](std::int32_t q, bool after) -> const Vec3& { return after && q == b ? pa : m.vertices[std::size_t(q)]; };
+      const Vec3 before = cross(P(t[1], false) - P(t[0], false), P(t[2], false) - P(t[0], false));
+      const Vec3 now = cross(P(t[1], true) - P(t[0], true), P(t[2], true) - P(t[0], true));
+      ok &= norm(now) > 0 && dot(before, now) > 0.5 * norm(before) * norm(now);
+    }
+    if (!ok) continue;
+    tris[cut] = {-1, -1, -1};
+    for (auto k : tb) {
+      auto& t = tris[k];
+      if (t[0] < 0) continue;
+      for (auto& v : t)
+        if (v == b) v = a;
+      ta.push_back(k);
+    }
+    merged.emplace(b, a);
+    any = true;
+  }
+  return any;
+}
+
+// Keeps the part of m where sigma·(x_axis − c) ≤ 0 and fills the section in the plane.
+void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std::int32_t face, BoxClipReport& rep, int side) {
+  const std::size_t nv0 = m.vertices.size();
+  std::vector<double> s(nv0);
+  for (std::size_t v = 0; v < nv0; ++v) {
+    s[v] = sigma * (coord(m.vertices[v], axis) - c);
+    if (std::abs(s[v]) < snap) {  // onto the plane, exactly
+      setCoord(m.vertices[v], axis, c);
+      s[v] = 0;
+    }
+  }
+  // A cut within kSliver of an edge's end moves that end along the edge onto the plane instead
+  // (it stays on the surface): a sliver there would turn over when a format rounds it to single
+  // precision (STL). A move that would turn one of the vertex's triangles by more than 60° or
+  // shrink it below a tenth is not made.
+  constexpr double kSliver = 0.05;
+  const std::size_t nt = m.triangles.size();
+  std::vector<std::uint32_t> first(m.vertices.size() + 1, 0);
+  for (const auto& tri : m.triangles)
+    for (auto v : tri) ++first[std::size_t(v) + 1];
+  for (std::size_t v = 0; v + 1 < first.size(); ++v) first[v + 1] += first[v];
+  std::vector<std::uint32_t> incident(first.back());
+  {
+    std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
+    for (std::size_t k = 0; k < nt; ++k)
+      for (auto v : m.triangles[k]) incident[fill[std::size_t(v)]++] = std::uint32_t(k);
+  }
+  const auto normalOf = [&](const std::array<std::int32_t, 3>& t, std::int32_t v, const Vec3& at) {
+    const auto P = [&](std::int32_t q) -> const Vec3& { return q == v ? at : m.vertices[std::size_t(q)]; };
+    return cross(P(t[1]) - P(t[0]), P(t[2]) - P(t[0]));
+  };
+  const auto moveOnto = [&](std::int32_t v, Vec3 p) {
+    setCoord(p, axis, c);
+    const Vec3 here = m.vertices[std::size_t(v)];
+    for (auto q = first[std::size_t(v)]; q < first[std::size_t(v) + 1]; ++q) {
+      const auto& t = m.triangles[incident[q]];
+      const Vec3 before = normalOf(t, v, here), after = normalOf(t, v, p);
+      const double nb = norm(before), na = norm(after);
+      if (!(na > 0.1 * nb) || !(dot(before, after) > 0.5 * nb * na)) return;
+    }
+    m.vertices[std::size_t(v)] = p;
+    s[std::size_t(v)] = 0;
+  };
+  for (std::size_t k = 0; k < nt; ++k)
+    for (int i = 0; i < 3; ++i) {
+      const auto a = m.triangles[k][std::size_t(i)], b = m.triangles[k][std::size_t((i + 1) % 3)];
+      const double sa = s[std::size_t(a)], sb = s[std::size_t(b)];
+      if (!((sa < 0 && sb > 0) || (sa > 0 && sb < 0))) continue;
+      const double t = sa / (sa - sb);
+      const Vec3 p = m.vertices[std::size_t(a)] + (m.vertices[std::size_t(b)] - m.vertices[std::size_t(a)]) * t;
+      if (t < kSliver) moveOnto(a, p);
+      else if (t > 1 - kSliver) moveOnto(b, p);
+    }
+  // Cut points, shared through their edge.
+  std::unordered_map<std::uint64_t, std::int32_t> cut_point;
+  const auto pointOn = [&](std::int32_t a, std::int32_t b) {
+    const auto key = directedKey(std::min(a, b), std::max(a, b));
+    if (const auto it = cut_point.find(key); it != cut_point.end()) return it->second;
+    const double sa = s[std::size_t(a)], sb = s[std::size_t(b)];
+    Vec3 p = m.vertices[std::size_t(a)] + (m.vertices[std::size_t(b)] - m.vertices[std::size_t(a)]) * (sa / (sa - sb));
+    setCoord(p, axis, c);
+    const auto id = std::int32_t(m.vertices.size());
+    m.vertices.push_back(p);
+    if (!m.vertex_step.empty()) m.vertex_step.push_back(std::min(m.vertex_step[std::size_t(a)], m.vertex_step[std::size_t(b)]));
+    s.push_back(0);
+    cut_point.emplace(key, id);
+    return id;
+  };
+  std::vector<std::array<std::int32_t, 3>> tris;
+  std::vector<std::int32_t> tree, faces;
+  tris.reserve(m.triangles.size());
+  for (std::size_t k = 0; k < m.triangles.size(); ++k) {
+    const auto tri = m.triangles[k];
+    const double a = s[std::size_t(tri[0])], b = s[std::size_t(tri[1])], d = s[std::size_t(tri[2])];
+    const auto keep = [&](const std::array<std::int32_t, 3>& t) {
+      tris.push_back(t);
+      tree.push_back(m.triangle_tree[k]);
+      faces.push_back(m.triangle_face[k]);
+    };
+    if (a <= 0 && b <= 0 && d <= 0 && (a < 0 || b < 0 || d < 0)) {
+      keep(tri);
+      continue;
+    }
+    if (!(a < 0 || b < 0 || d < 0)) {  // outside, or in the plane (the section replaces it)
+      ++rep.removed_triangles;
+      continue;
+    }
+    std::int32_t poly[4];
+    int n = 0;
+    for (int i = 0; i < 3; ++i) {
+      const auto p = tri[std::size_t(i)], q = tri[std::size_t((i + 1) % 3)];
+      const double sp = s[std::size_t(p)], sq = s[std::size_t(q)];
+      if (sp <= 0) poly[n++] = p;
+      if ((sp < 0 && sq > 0) || (sp > 0 && sq < 0)) poly[n++] = pointOn(p, q);
+    }
+    if (n == 4 && distance(m.vertices[std::size_t(poly[1])], m.vertices[std::size_t(poly[3])]) <
+                      distance(m.vertices[std::size_t(poly[0])], m.vertices[std::size_t(poly[2])]))
+      std::rotate(poly, poly + 1, poly + 4);
+    for (int i = 1; i + 1 < n; ++i) keep({poly[0], poly[i], poly[i + 1]});
+  }
+  // The cut's loops: directed edges in the plane used once (a closed surface has no others).
+  std::unordered_map<std::uint64_t, std::int32_t> edge_tree;
+  std::vector<std::pair<std::int32_t, std::int32_t>> loop_edges;
+  const auto findLoops = [&] {
+    edge_tree.clear();
+    loop_edges.clear();
+    for (std::size_t k = 0; k < tris.size(); ++k)
+      for (int i = 0; i < 3; ++i) {
+        const auto a = tris[k][std::size_t(i)], b = tris[k][std::size_t((i + 1) % 3)];
+        if (s[std::size_t(a)] == 0 && s[std::size_t(b)] == 0) edge_tree.emplace(directedKey(a, b), tree[k]);
+      }
+    for (const auto& [key, t] : edge_tree) {
+      const auto a = std::int32_t(key >> 32), b = std::int32_t(key & 0xffffffffu);
+      if (!edge_tree.count(directedKey(b, a))) loop_edges.emplace_back(a, b);
+    }
+    std::sort(loop_edges.begin(), loop_edges.end());  // the same triangulation whatever the hash order
+  };
+  findLoops();
+  if (collapseShortLoopEdges(m, tris, loop_edges)) {
+    std::vector<char> keep(tris.size());
+    for (std::size_t k = 0; k < tris.size(); ++k) keep[k] = tris[k][0] >= 0;
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < tris.size(); ++k)
+      if (keep[k]) tris[n] = tris[k], tree[n] = tree[k], faces[n] = faces[k], ++n;
+    tris.resize(n), tree.resize(n), faces.resize(n);
+    findLoops();
+  }
+  m.triangles = std::move(tris);
+  m.triangle_tree = std::move(tree);
+  m.triangle_face = std::move(faces);
+  if (loop_edges.empty()) return;
+
+  // The section: a constrained Delaunay triangulation of the loops, inside where it lies behind
+  // an odd number of loops seen from outside them all.
+  const int u = (axis + 1) % 3, w = (axis + 2) % 3;  // e_u × e_w = e_axis
+  Cdt cdt;
+  std::unordered_map<std::int32_t, Cdt::Vertex_handle> handle;
+  const auto vertex = [&](std::int32_t v) {
+    if (const auto it = handle.find(v); it != handle.end()) return it->second;
+    const Vec3& p = m.vertices[std::size_t(v)];
+    const auto before = cdt.number_of_vertices();
+    const auto h = cdt.insert(K::Point_2(coord(p, u), coord(p, w)));
+    if (cdt.number_of_vertices() == before)
+      throw std::runtime_error(std::string("clipping to the box: two vertices meet in the section of side ") + kBoxSideNames[side]);
+    h->info() = v + 1;
+    handle.emplace(v, h);
+    return h;
+  };
+  for (const auto& [a, b] : loop_edges) vertex(a), vertex(b);
+  try {
+    for (const auto& [a, b] : loop_edges) cdt.insert_constraint(vertex(a), vertex(b));
+  } catch (const std::exception&) {
+    throw std::runtime_error(std::string("clipping to the box: the section's loops cross on side ") + kBoxSideNames[side]);
+  }
+  for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f) f->info() = -1;
+  std::vector<Cdt::Face_handle> stack{cdt.infinite_face()}, next;
+  cdt.infinite_face()->info() = 0;
+  for (int depth = 0; !stack.empty(); ++depth) {
+    // Flood each depth through unconstrained edges; a constrained edge leads one deeper.
+    while (!stack.empty()) {
+      const auto f = stack.back();
+      stack.pop_back();
+      for (int i = 0; i < 3; ++i) {
+        const auto g = f->neighbor(i);
+        if (g->info() != -1) continue;
+        if (cdt.is_constrained(Cdt::Edge(f, i))) {
+          next.push_back(g);
+        } else {
+          g->info() = depth;
+          stack.push_back(g);
+        }
+      }
+    }
+    for (auto g : next)
+      if (g->info() == -1) g->info() = depth + 1, stack.push_back(g);
+    next.clear();
+  }
+  // Inside faces, turned to face out of the box (along sigma·e_axis); each takes the tree of the
+  // wall across its loop edges.
+  std::unordered_map<std::uint64_t, char> loop_reverse;
+  for (const auto& [a, b] : loop_edges) loop_reverse.emplace(directedKey(b, a), 0);
+  std::vector<std::array<std::int32_t, 3>> section;
+  for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
+    if (f->info() % 2 == 0) continue;
+    std::array<std::int32_t, 3> t{f->vertex(0)->info() - 1, f->vertex(1)->info() - 1, f->vertex(2)->info() - 1};
+    if (t[0] < 0 || t[1] < 0 || t[2] < 0) throw std::runtime_error("clipping to the box: a section vertex is not on a loop");
+    if (sigma < 0) std::swap(t[1], t[2]);
+    section.push_back(t);
+  }
+  // Every loop edge is matched by one section edge running against it; else the loops did not
+  // bound the section (an open surface, or loops that touch).
+  std::size_t matched = 0;
+  for (const auto& t : section)
+    for (int i = 0; i < 3; ++i)
+      if (auto it = loop_reverse.find(directedKey(t[std::size_t(i)], t[std::size_t((i + 1) % 3)])); it != loop_reverse.end() && !it->second++) ++matched;
+  if (matched != loop_edges.size())
+    throw std::runtime_error(std::string("clipping to the box: the section of side ") + kBoxSideNames[side] + " does not close the cut");
+  // Trees: each section triangle takes the tree of a loop edge of its connected patch.
+  std::unordered_map<std::uint64_t, std::size_t> at_edge;
+  for (std::size_t k = 0; k < section.size(); ++k)
+    for (int i = 0; i < 3; ++i) at_edge.emplace(directedKey(section[k][std::size_t(i)], section[k][std::size_t((i + 1) % 3)]), k);
+  std::vector<std::int32_t> section_tree(section.size(), -1);
+  for (std::size_t k0 = 0; k0 < section.size(); ++k0) {
+    if (section_tree[k0] >= 0) continue;
+    std::vector<std::size_t> patch{k0}, todo{k0};
+    section_tree[k0] = 0;
+    std::int32_t found = -1;
+    while (!todo.empty()) {
+      const auto k = todo.back();
+      todo.pop_back();
+      for (int i = 0; i < 3; ++i) {
+        const auto a = section[k][std::size_t(i)], b = section[k][std::size_t((i + 1) % 3)];
+        if (const auto e = edge_tree.find(directedKey(b, a)); e != edge_tree.end() && found < 0) found = e->second;
+        if (const auto o = at_edge.find(directedKey(b, a)); o != at_edge.end() && section_tree[o->second] < 0) {
+          section_tree[o->second] = 0;
+          patch.push_back(o->second);
+          todo.push_back(o->second);
+        }
+      }
+    }
+    for (auto k : patch) section_tree[k] = std::max(found, 0);
+  }
+  for (std::size_t k = 0; k < section.size(); ++k) {
+    const auto& t = section[k];
+    m.triangles.push_back(t);
+    m.triangle_tree.push_back(section_tree[k]);
+    m.triangle_face.push_back(face);
+    rep.section_area_mm2[std::size_t(side)] +=
+        0.5 * norm(cross(m.vertices[std::size_t(t[1])] - m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[2])] - m.vertices[std::size_t(t[0])]));
+  }
+  rep.section_triangles[std::size_t(side)] = std::int64_t(section.size());
+  // Loops: components of the loop edges' graph.
+  std::unordered_map<std::int32_t, std::int32_t> next_of;
+  for (const auto& [a, b] : loop_edges) next_of.emplace(a, b);
+  std::unordered_map<std::int32_t, char> seen;
+  for (const auto& [a, b] : loop_edges) {
+    if (seen.count(a)) continue;
+    ++rep.section_loops[std::size_t(side)];
+    for (std::int32_t v = a; !seen.count(v);) {
+      seen.emplace(v, 1);
+      const auto it = next_of.find(v);
+      if (it == next_of.end()) break;
+      v = it->second;
+    }
+  }
+}
+
+}  // namespace
+
+BoxClipReport clipToBox(SurfaceMesh& m, const Vec3& lo, const Vec3& hi, std::int32_t first_face) {
+  BoxClipReport rep;
+  if (m.triangle_face.empty()) m.triangle_face.assign(m.triangles.size(), 0);
+  const double snap = 1e-9 * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, 1e-300});
+  for (int side = 0; side < 6; ++side) {
+    const int axis = side / 2;
+    const bool upper = side % 2 == 1;
+    clipSide(m, axis, coord(upper ? hi : lo, axis), upper ? 1.0 : -1.0, snap, first_face + side, rep, side);
+  }
+  keepTriangles(m, std::vector<char>(m.triangles.size(), 1));  // drops the vertices left outside
+  return rep;
+}
+
+}  // namespace angiosynth
