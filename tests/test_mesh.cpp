@@ -367,17 +367,20 @@ TEST(Mesh, MeshTableInAParameterFileWritesTheSurfaceWithTheSample) {
   EXPECT_EQ(root_kind["0"], "inlet") << faces;
   EXPECT_EQ(root_kind["1"], "outlet") << faces;
   EXPECT_EQ(j["files"]["surface_faces"], "surface_faces.csv");
-  std::ofstream(dir / "bad3.toml") << text << "\n[mesh]\nends = \"round\"\n";
-  const auto bad3 = run("generate bad3.toml --out bad3 --no-image --quiet", dir);
-  EXPECT_EQ(bad3.code, 2);
-  EXPECT_NE(bad3.err.find("ends 'round'; allowed: closed, open, capped"), std::string::npos) << bad3.err;
-
-  std::ofstream(dir / "bad4.toml") << text << "\n[mesh]\nwall_ratio = 0.2\nends = \"capped\"\n";
-  const auto bad4 = run("generate bad4.toml --out bad4 --no-image --quiet", dir);
-  EXPECT_EQ(bad4.code, 2);
-  EXPECT_NE(bad4.err.find("bad4.toml:"), std::string::npos) << bad4.err;
-  EXPECT_NE(bad4.err.find("a hollow wall keeps its ends open"), std::string::npos) << bad4.err;
-  EXPECT_FALSE(std::filesystem::exists(dir / "bad4"));
+  // A bad value: exit 2 with the file, its line and the message, and no output.
+  const auto refused = [&](const std::string& name, const std::string& mesh_table, const std::string& message) {
+    std::ofstream(dir / (name + ".toml")) << text << "\n[mesh]\n" << mesh_table;
+    const auto r = run("generate " + name + ".toml --out " + name + " --no-image --quiet", dir);
+    EXPECT_EQ(r.code, 2) << name;
+    EXPECT_NE(r.err.find(name + ".toml:"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / name)) << name;
+  };
+  refused("bad3", "ends = \"round\"\n", "ends 'round'; allowed: closed, open, capped");
+  refused("bad4", "wall_ratio = 0.2\nends = \"capped\"\n", "a hollow wall keeps its ends open");
+  refused("bad5", "ends = \"capped\"\nclip_box = [0, 0, 0, 10, 10]\n", "clip_box must be an array of 6 numbers");
+  refused("bad", "samples_across = 0\n", "samples_across = 0 is out of range; allowed: [1, 64]");
+  refused("bad2", "formats = [\"amf\"]\n", "'amf' is not a format; allowed: stl, obj, ply, off, vtp, 3mf");
   // A clip box from the file: the same surface as the command's --clip-box.
   std::ofstream(dir / "with_box.toml") << text << "\n[mesh]\nformats = [\"off\"]\nsamples_across = 3\nends = \"capped\"\nclip_box = [20, 20, 20, 40, 40, 40]\n";
   ASSERT_EQ(run("generate with_box.toml --out boxed --no-image --quiet", dir).code, 0);
@@ -386,22 +389,6 @@ TEST(Mesh, MeshTableInAParameterFileWritesTheSurfaceWithTheSample) {
   EXPECT_EQ(boxed["boundary_edges"], 0);
   ASSERT_EQ(run("mesh boxed --out boxed_again --format off --samples-across 3 --ends capped --clip-box 20,20,20,40,40,40 --quiet", dir).code, 0);
   EXPECT_TRUE(readText(dir / "boxed_again/surface.off") == readText(dir / "boxed/surface.off"));
-  std::ofstream(dir / "bad5.toml") << text << "\n[mesh]\nends = \"capped\"\nclip_box = [0, 0, 0, 10, 10]\n";
-  const auto bad5 = run("generate bad5.toml --out bad5 --no-image --quiet", dir);
-  EXPECT_EQ(bad5.code, 2);
-  EXPECT_NE(bad5.err.find("bad5.toml:"), std::string::npos) << bad5.err;
-  EXPECT_NE(bad5.err.find("clip_box must be an array of 6 numbers"), std::string::npos) << bad5.err;
-  EXPECT_FALSE(std::filesystem::exists(dir / "bad5"));
-  std::ofstream(dir / "bad.toml") << text << "\n[mesh]\nsamples_across = 0\n";
-  const auto bad = run("generate bad.toml --out bad --no-image --quiet", dir);
-  EXPECT_EQ(bad.code, 2);
-  EXPECT_NE(bad.err.find("bad.toml:"), std::string::npos) << bad.err;
-  EXPECT_NE(bad.err.find("samples_across = 0 is out of range; allowed: [1, 64]"), std::string::npos) << bad.err;
-  EXPECT_FALSE(std::filesystem::exists(dir / "bad"));
-  std::ofstream(dir / "bad2.toml") << text << "\n[mesh]\nformats = [\"amf\"]\n";
-  const auto bad2 = run("generate bad2.toml --out bad2 --no-image --quiet", dir);
-  EXPECT_EQ(bad2.code, 2);
-  EXPECT_NE(bad2.err.find("'amf' is not a format; allowed: stl, obj, ply, off, vtp, 3mf"), std::string::npos) << bad2.err;
   std::filesystem::remove_all(dir);
 }
 

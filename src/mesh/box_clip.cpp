@@ -13,6 +13,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "mesh/plane_clip.hpp"
+
 namespace angiosynth {
 namespace {
 
@@ -182,18 +184,10 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
       ++rep.removed_triangles;
       continue;
     }
-    std::int32_t poly[4];
-    int n = 0;
-    for (int i = 0; i < 3; ++i) {
-      const auto p = tri[std::size_t(i)], q = tri[std::size_t((i + 1) % 3)];
-      const double sp = s[std::size_t(p)], sq = s[std::size_t(q)];
-      if (sp <= 0) poly[n++] = p;
-      if ((sp < 0 && sq > 0) || (sp > 0 && sq < 0)) poly[n++] = pointOn(p, q);
-    }
-    if (n == 4 && distance(m.vertices[std::size_t(poly[1])], m.vertices[std::size_t(poly[3])]) <
-                      distance(m.vertices[std::size_t(poly[0])], m.vertices[std::size_t(poly[2])]))
-      std::rotate(poly, poly + 1, poly + 4);
-    for (int i = 1; i + 1 < n; ++i) keep({poly[0], poly[i], poly[i + 1]});
+    clipTriangleToPlane(
+        tri, [&](std::int32_t v) { return s[std::size_t(v)]; }, pointOn,
+        [&](std::int32_t v) -> const Vec3& { return m.vertices[std::size_t(v)]; },
+        [&](std::int32_t p, std::int32_t q, std::int32_t r) { keep({p, q, r}); });
   }
   // The cut's loops: directed edges in the plane used once (a closed surface has no others).
   std::unordered_map<std::uint64_t, std::int32_t> edge_tree;

@@ -1,5 +1,6 @@
 #include "mesh/vessel_ends.hpp"
 
+#include "mesh/plane_clip.hpp"
 #include "mesh/ring_mesh.hpp"
 
 #include <tbb/enumerable_thread_specific.h>
@@ -280,24 +281,13 @@ EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool ca
     std::vector<std::array<std::int32_t, 3>> kept;
     std::vector<std::int32_t> kept_tree;
     std::sort(cut.begin(), cut.end());
-    for (auto k : cut) {
-      const auto& tri = m.triangles[std::size_t(k)];
-      std::int32_t poly[4];
-      int n = 0;
-      for (int i = 0; i < 3; ++i) {
-        const auto a = tri[std::size_t(i)], b = tri[std::size_t((i + 1) % 3)];
-        const double sa = side[std::size_t(a)], sb = side[std::size_t(b)];
-        if (sa <= 0) poly[n++] = a;
-        if ((sa < 0 && sb > 0) || (sa > 0 && sb < 0)) poly[n++] = pointOn(a, b);
-      }
-      if (n < 3) continue;
-      // A quad splits along its shorter diagonal.
-      if (n == 4 && distance(at_of(poly[1]), at_of(poly[3])) < distance(at_of(poly[0]), at_of(poly[2]))) std::rotate(poly, poly + 1, poly + 4);
-      for (int i = 1; i + 1 < n; ++i) {
-        kept.push_back({poly[0], poly[i], poly[i + 1]});
-        kept_tree.push_back(m.triangle_tree[std::size_t(k)]);
-      }
-    }
+    for (auto k : cut)
+      clipTriangleToPlane(
+          m.triangles[std::size_t(k)], [&](std::int32_t v) { return side[std::size_t(v)]; }, pointOn, at_of,
+          [&](std::int32_t a, std::int32_t b, std::int32_t c) {
+            kept.push_back({a, b, c});
+            kept_tree.push_back(m.triangle_tree[std::size_t(k)]);
+          });
     // The loop: directed edges of the kept pieces and of the neighbours facing the cut that have
     // no reverse among them.
     std::unordered_set<std::uint64_t> edges(boundary_side.begin(), boundary_side.end());
