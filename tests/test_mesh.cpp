@@ -61,6 +61,13 @@ double largestDistanceOverStep(const VascularTree& t, const SurfaceMesh& m) {
   return worst;
 }
 
+// mesh.json's own account of a closed surface: no boundary, non-manifold or misoriented edge,
+// no degenerate triangle.
+void expectClosedInMeshJson(const nlohmann::json& statistics, const std::string& what = {}) {
+  for (const char* key : {"boundary_edges", "nonmanifold_edges", "misoriented_edges", "degenerate_triangles"})
+    EXPECT_EQ(statistics[key], 0) << key << " " << what;
+}
+
 // The tube mesher's surface at `samples` across where vessels meet.
 SurfaceMesh tubeMesh(const VascularTree& t, int samples, TubeSurfaceReport* rep = nullptr) {
   TubeSurfaceOptions o;
@@ -415,9 +422,7 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
     st = nlohmann::json::parse(readText(dir / "capped/mesh.json"))["statistics"];
     EXPECT_EQ(st["ends"], 26) << method;  // per tree: its root and 12 leaves
     EXPECT_EQ(st["ends_cut"], 26) << method;
-    EXPECT_EQ(st["boundary_edges"], 0) << method;
-    EXPECT_EQ(st["nonmanifold_edges"], 0) << method;
-    EXPECT_EQ(st["misoriented_edges"], 0) << method;
+    expectClosedInMeshJson(st, method);
     EXPECT_EQ(st["tree_components"], nlohmann::json::array({1, 1})) << method;
     EXPECT_EQ(st["tree_euler_characteristic"], nlohmann::json::array({2, 2})) << method;
     caps = check("capped", "--ends");
@@ -481,10 +486,7 @@ TEST(Mesh, HollowWallIsClosedOfGenusEndsLessOneWithItsThicknessAndVolume) {
   const auto made = run("mesh sample --out wall --format vtp,off --wall-thickness 0.1 --quiet", dir);
   ASSERT_EQ(made.code, 0) << made.err;
   const auto st = nlohmann::json::parse(readText(dir / "wall/mesh.json"))["statistics"];
-  EXPECT_EQ(st["boundary_edges"], 0);
-  EXPECT_EQ(st["nonmanifold_edges"], 0);
-  EXPECT_EQ(st["misoriented_edges"], 0);
-  EXPECT_EQ(st["degenerate_triangles"], 0);
+  expectClosedInMeshJson(st);
   EXPECT_EQ(st["tree_components"], nlohmann::json::array({1, 1}));
   // Open ends per tree from surface_faces.csv.
   std::vector<int> open(2, 0);
@@ -537,10 +539,7 @@ TEST(Mesh, HollowWallClippedToABoxStaysClosedWithOpenLumensAndTheWallsVolume) {
   const auto made = run("mesh sample --out box --format vtp,off,stl --wall-thickness 0.1 --clip-box " + box + " --quiet", dir);
   ASSERT_EQ(made.code, 0) << made.err;
   const auto st = nlohmann::json::parse(readText(dir / "box/mesh.json"))["statistics"];
-  EXPECT_EQ(st["boundary_edges"], 0);
-  EXPECT_EQ(st["nonmanifold_edges"], 0);
-  EXPECT_EQ(st["misoriented_edges"], 0);
-  EXPECT_EQ(st["degenerate_triangles"], 0);
+  expectClosedInMeshJson(st);
   for (int side = 0; side < 6; ++side) {
     EXPECT_GT(st["clip_box_section_area_mm2"][std::size_t(side)].get<double>(), 0) << "side " << side;
     EXPECT_GE(st["clip_box_section_loops"][std::size_t(side)].get<int>(), 2) << "side " << side;
