@@ -48,7 +48,8 @@ bool collapseShortLoopEdges(const SurfaceMesh& m, std::vector<std::array<std::in
   std::unordered_map<std::int32_t, std::int32_t> merged;  // b -> a
   const auto alive = [&](std::int32_t v) { return !merged.count(v); };
   bool any = false;
-  for (const auto& [a, b] : loop_edges) {
+  for (const auto& edge : loop_edges) {
+    const auto a = edge.first, b = edge.second;  // (clang 14 captures no structured binding)
     if (!alive(a) || !alive(b)) continue;
     const Vec3& pa = m.vertices[std::size_t(a)];
     const Vec3& pb = m.vertices[std::size_t(b)];
