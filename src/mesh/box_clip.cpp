@@ -129,6 +129,15 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
     const auto P = [&](std::int32_t q) -> const Vec3& { return q == v ? at : m.vertices[std::size_t(q)]; };
     return cross(P(t[1]) - P(t[0]), P(t[2]) - P(t[0]));
   };
+  // The vertex opposite edge (v, n) in v's triangle other than `skip`, or -1.
+  const auto opposite = [&](std::int32_t v, std::int32_t n, std::uint32_t skip) {
+    for (auto q = first[std::size_t(v)]; q < first[std::size_t(v) + 1]; ++q) {
+      if (incident[q] == skip) continue;
+      const auto& t = m.triangles[incident[q]];
+      if (t[0] == n || t[1] == n || t[2] == n) return t[0] != v && t[0] != n ? t[0] : t[1] != v && t[1] != n ? t[1] : t[2];
+    }
+    return std::int32_t(-1);
+  };
   const auto moveOnto = [&](std::int32_t v, Vec3 p) {
     setCoord(p, axis, c);
     const Vec3 here = m.vertices[std::size_t(v)];
@@ -137,6 +146,16 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
       const Vec3 before = normalOf(t, v, here), after = normalOf(t, v, p);
       const double nb = norm(before), na = norm(after);
       if (!(na > 0.1 * nb) || !(dot(before, after) > 0.5 * nb * na)) return;
+      // Nor one that lays an edge in the plane between two kept triangles: the surface would
+      // touch the section along it (an edge of four triangles).
+      for (auto n : t) {
+        if (n == v || s[std::size_t(n)] != 0) continue;
+        std::int32_t x = -1;
+        for (auto w : t)
+          if (w != v && w != n) x = w;
+        const auto y = opposite(v, n, incident[q]);
+        if (y >= 0 && s[std::size_t(x)] < 0 && s[std::size_t(y)] < 0) return;
+      }
     }
     m.vertices[std::size_t(v)] = p;
     s[std::size_t(v)] = 0;
