@@ -89,9 +89,9 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   p.wall_from_graph = a.wall_from_graph;
   if (int(p.wall_thickness > 0) + int(p.wall_ratio > 0) + int(p.wall_from_graph) > 1)
     throw InputError("", 0, "--wall-thickness, --wall-ratio and --wall-from-graph exclude each other; allowed: one of them");
-  if ((p.wall_thickness > 0 || p.wall_ratio > 0 || p.wall_from_graph) && a.method != "tubes")
+  if (p.hollowWall() && a.method != "tubes")
     throw InputError("", 0, "a hollow wall is built on the tubes; allowed: --method tubes");
-  if ((p.wall_thickness > 0 || p.wall_ratio > 0 || p.wall_from_graph) && a.ends == "capped")
+  if (p.hollowWall() && a.ends == "capped")
     throw InputError("", 0, "a hollow wall keeps its ends open (the lumen runs through); allowed: --ends open (or closed, which opens them)");
   p.voxel_mm = a.voxel_mm;
   p.samples_across = a.samples_across;

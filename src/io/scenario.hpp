@@ -58,6 +58,7 @@ struct MeshParameters {
   // mm: x0, y0, z0, x1, y1, z1 of a box the closed surface is clipped to, each side's section
   // filled (a hollow wall's lumen open there); empty: none
   std::vector<double> clip_box;
+  bool hollowWall() const { return wall_thickness > 0 || wall_ratio > 0 || wall_from_graph; }
 };
 
 // Why p's clip box is refused, or empty: six numbers, each lower bound below its upper one, and
@@ -68,8 +69,7 @@ inline std::string clipBoxProblem(const MeshParameters& p) {
   for (int k = 0; k < 3; ++k)
     if (!(p.clip_box[std::size_t(k)] < p.clip_box[std::size_t(k + 3)]))
       return "clip_box's lower corner must lie below its upper one on every axis; allowed: x0 < x1, y0 < y1, z0 < z1 (mm)";
-  const bool wall = p.wall_thickness > 0 || p.wall_ratio > 0 || p.wall_from_graph;
-  if (p.ends == "open" && !wall)
+  if (p.ends == "open" && !p.hollowWall())
     return "clip_box clips a closed surface; allowed: ends \"closed\" or \"capped\", or a hollow wall";
   return {};
 }

@@ -191,7 +191,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     mp.wall_from_graph = r.boolean(me, "wall_from_graph", mp.wall_from_graph);
     if (int(mp.wall_thickness > 0) + int(mp.wall_ratio > 0) + int(mp.wall_from_graph) > 1)
       throw InputError(file, r.lineOf(&me), "wall_thickness, wall_ratio and wall_from_graph exclude each other; allowed: one of them");
-    if (mp.wall_thickness > 0 || mp.wall_ratio > 0 || mp.wall_from_graph) {
+    if (mp.hollowWall()) {
       if (mp.method != "tubes") throw InputError(file, r.lineOf(&me), "a hollow wall is built on the tubes; allowed: method = \"tubes\"");
       if (mp.ends == "capped")
         throw InputError(file, r.lineOf(me.get("ends")), "a hollow wall keeps its ends open (the lumen runs through); allowed: ends = \"open\" or \"closed\"");

@@ -228,11 +228,9 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
   };
   findLoops();
   if (collapseShortLoopEdges(m, tris, loop_edges)) {
-    std::vector<char> keep(tris.size());
-    for (std::size_t k = 0; k < tris.size(); ++k) keep[k] = tris[k][0] >= 0;
     std::size_t n = 0;
     for (std::size_t k = 0; k < tris.size(); ++k)
-      if (keep[k]) tris[n] = tris[k], tree[n] = tree[k], faces[n] = faces[k], ++n;
+      if (tris[k][0] >= 0) tris[n] = tris[k], tree[n] = tree[k], faces[n] = faces[k], ++n;
     tris.resize(n), tree.resize(n), faces.resize(n);
     findLoops();
   }
@@ -336,8 +334,7 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
     m.triangles.push_back(t);
     m.triangle_tree.push_back(section_tree[k]);
     m.triangle_face.push_back(face);
-    rep.section_area_mm2[std::size_t(side)] +=
-        0.5 * norm(cross(m.vertices[std::size_t(t[1])] - m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[2])] - m.vertices[std::size_t(t[0])]));
+    rep.section_area_mm2[std::size_t(side)] += triangleArea(m, t);
   }
   rep.section_triangles[std::size_t(side)] = std::int64_t(section.size());
   // Loops: components of the loop edges' graph.

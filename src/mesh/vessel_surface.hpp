@@ -63,6 +63,12 @@ SurfaceMesh vesselSurface(const VascularTree& forest, const SurfaceOptions& opti
 // use, both in their order.
 void keepTriangles(SurfaceMesh& m, const std::vector<char>& keep);
 
+// The area of m's triangle t (mm²).
+inline double triangleArea(const SurfaceMesh& m, const std::array<std::int32_t, 3>& t) {
+  const Vec3& a = m.vertices[std::size_t(t[0])];
+  return 0.5 * norm(cross(m.vertices[std::size_t(t[1])] - a, m.vertices[std::size_t(t[2])] - a));
+}
+
 // The mesh's own account of itself (the tests judge written files with VTK): edges used once
 // (boundary) or more than twice, edges both triangles run the same way (inconsistent
 // orientation), triangles with a repeated vertex, and the enclosed volume (divergence theorem).

@@ -56,6 +56,19 @@ void writeFaces(std::ostream& os, const std::vector<VesselEnd>& ends, const EndC
   }
 }
 
+// The area of each end's face (labels 1 … n), and optionally its triangle count.
+std::vector<double> endFaceAreas(const SurfaceMesh& m, std::size_t n, std::vector<std::int32_t>* triangles = nullptr) {
+  std::vector<double> area(n, 0.0);
+  if (triangles) triangles->assign(n, 0);
+  for (std::size_t k = 0; k < m.triangles.size(); ++k) {
+    const auto f = m.triangle_face[k];
+    if (f <= 0 || std::size_t(f) > n) continue;
+    area[std::size_t(f - 1)] += triangleArea(m, m.triangles[k]);
+    if (triangles) ++(*triangles)[std::size_t(f - 1)];
+  }
+  return area;
+}
+
 }  // namespace
 
 SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p, std::uint64_t memory_limit, const std::filesystem::path& dir,
@@ -96,16 +109,8 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
     report.estimated_bytes = std::max(wall_report.outer.estimated_bytes, wall_report.lumen.estimated_bytes);
     cut.cut = wall_report.rings;
     cut.left_closed = wall_report.not_joined;
-    cut.cap_area_mm2.assign(ends.size(), 0.0);
-    cut.loop_vertices.assign(ends.size(), 0);
-    for (std::size_t k = 0; k < mesh.triangles.size(); ++k) {
-      const auto f = mesh.triangle_face[k];
-      if (f <= 0) continue;
-      const auto& t = mesh.triangles[k];
-      cut.cap_area_mm2[std::size_t(f - 1)] += 0.5 * norm(cross(mesh.vertices[std::size_t(t[1])] - mesh.vertices[std::size_t(t[0])],
-                                                               mesh.vertices[std::size_t(t[2])] - mesh.vertices[std::size_t(t[0])]));
-      ++cut.loop_vertices[std::size_t(f - 1)];  // triangles of the ring: the two loops' vertices together
-    }
+    // A ring's triangles: its two loops' vertices together.
+    cut.cap_area_mm2 = endFaceAreas(mesh, ends.size(), &cut.loop_vertices);
   } else if (tubes) {
     TubeSurfaceOptions to;
     to.junction = o;
@@ -133,16 +138,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
     const auto& b = p.clip_box;
     clipped = clipToBox(mesh, Vec3(b[0], b[1], b[2]), Vec3(b[3], b[4], b[5]), std::int32_t(ends.size()) + 1);
     // What is left of each end's face (a box side may cut it; outside the box it is gone).
-    if (cut_ends) {
-      cut.cap_area_mm2.assign(ends.size(), 0.0);
-      for (std::size_t k = 0; k < mesh.triangles.size(); ++k) {
-        const auto f = mesh.triangle_face[k];
-        if (f <= 0 || std::size_t(f) > ends.size()) continue;
-        const auto& t = mesh.triangles[k];
-        cut.cap_area_mm2[std::size_t(f - 1)] += 0.5 * norm(cross(mesh.vertices[std::size_t(t[1])] - mesh.vertices[std::size_t(t[0])],
-                                                                 mesh.vertices[std::size_t(t[2])] - mesh.vertices[std::size_t(t[0])]));
-      }
-    }
+    if (cut_ends) cut.cap_area_mm2 = endFaceAreas(mesh, ends.size());
   }
   const auto topo = meshTopology(mesh);
   SurfaceFiles out;
