@@ -29,11 +29,14 @@ constexpr int kRefinements = 2;
 constexpr std::size_t kLargestGapPart = 64;
 // A tube is at least this many radii long.
 constexpr double kShortestTube = 0.25;
+// A failed cut is tried again this many times, each this many radii further into its tube.
+constexpr int kCutRetries = 2;
+constexpr double kCutShift = 0.5, kLeastCutShift = 0.02;  // (or less where the tube is short, at least the second)
 // Two vessels of a tree that come close without touching are contoured together, with cells of
 // a third of their gap (the fillet then stays in the gap and no tetrahedron spans it) along the
 // stretch of each where its wall comes within two of its own cells of the other's, unless that
 // is more than this many times finer than their own cells: then they count as touching.
-constexpr double kGapCells = 3, kFinestGapCells = 16;
+constexpr double kFinestGapCells = 16;  // (kGapCells: vessel_surface.hpp)
 
 // A vessel as the mesher sees it: its two junction nodes (links merged), its axis and radii, and
 // where its tube starts and ends.
@@ -116,12 +119,18 @@ struct ClosePair {
   bool touching = true;         // else apart across a gap, or joined only through the vessel `via`
   bool overlapping = false;     // their walls overlap (through `via`)
   std::int32_t via = -1;
+  // Through `via`: the sides of i and j at its nodes, and how far from those nodes their cuts
+  // must lie so that their tubes run clear of each other (the stretch where they come close is
+  // contoured with the connector).
+  int side_i = 0, side_j = 0;
+  double past_i = 0, past_j = 0;
 };
 
 // Where a part's vessel needs fine cells: from y0 to y1 (distances from its a), cells no larger than `cell`.
 struct GapSpan {
   std::int32_t vessel;
   double cell, y0, y1;
+  std::vector<std::int32_t> partners;  // the vessels across the gap: the fine cells stay near them
 };
 
 struct Cluster {
@@ -145,6 +154,8 @@ struct ClusterMesh {
   std::int64_t cavities_removed = 0;
   DecimateReport decimation;
   int refinements = 0;                   // contoured again, finer, to lose a handle
+  std::vector<double> planes;            // each stub's cut distance from its node, as made
+  int cut_retries = 0;                   // contoured again with cuts further into their tubes
 };
 
 class TubeMesher {
@@ -187,7 +198,11 @@ class TubeMesher {
         });
         if (progress) progress(last, total);
       }
-      // A failed cut gives its tube up: the vessel is contoured whole, with its neighbours.
+      // Where each part cut its tubes (a retried cut lies further in), for the tubes' rings.
+      for (auto c : todo)
+        for (std::size_t k = 0; k < clusters[c].stubs.size(); ++k)
+          vessels_[std::size_t(clusters[c].stubs[k].vessel)].plane[clusters[c].stubs[k].side] = meshes[c].planes[k];
+      // A cut that failed still gives its tube up: the vessel is contoured whole, with its neighbours.
       bool again = false;
       for (auto c : todo)
         for (std::size_t k = 0; k < clusters[c].stubs.size(); ++k)
@@ -263,6 +278,20 @@ class TubeMesher {
   // closer than a tenth of their radii count as touching (rings and contours stand off the exact
   // wall by a few hundredths of a radius).
   void decideTubes(const std::vector<char>& give_up) {
+    findClosePairs();
+    // Two vessels that come close only through a connector keep their tubes, cut past the
+    // stretch where they are near each other: that stretch is contoured with the connector, in
+    // the part of its two nodes (the cuts only move away from their nodes: the same every round).
+    // (Not where a CFD end lies at those nodes: its plane is the end's.)
+    const auto cutPastEachOther = [&](const ClosePair& p) {
+      return p.via >= 0 && vessels_[std::size_t(p.i)].end[p.side_i] < 0 && vessels_[std::size_t(p.j)].end[p.side_j] < 0;
+    };
+    for (const auto& p : close_pairs_) {
+      if (!cutPastEachOther(p)) continue;
+      auto& pi = vessels_[std::size_t(p.i)].plane[p.side_i];
+      auto& pj = vessels_[std::size_t(p.j)].plane[p.side_j];
+      pi = std::max(pi, p.past_i), pj = std::max(pj, p.past_j);
+    }
     for (std::size_t i = 0; i < vessels_.size(); ++i) {
       auto& v = vessels_[i];
       // The two cuts belong to different contoured parts, so their regions may overlap; the
@@ -270,7 +299,13 @@ class TubeMesher {
       const double free_length = v.len - v.plane[0] - v.plane[1];
       v.tube = !give_up[i] && !v.nested && free_length >= kShortestTube * v.rmax();
     }
-    // Vessels that share no node and touch.
+    for (const auto& p : close_pairs_) {
+      if (p.via >= 0) vessels_[std::size_t(p.via)].tube = false;  // the connector joins the two cuts' nodes into one part
+      if (!cutPastEachOther(p)) vessels_[std::size_t(p.i)].tube = vessels_[std::size_t(p.j)].tube = false;
+    }
+  }
+  // Pairs of vessels of a tree that share no node and come close (close_pairs_).
+  void findClosePairs() {
     SegmentIndex index(boxLo(), boxHi());
     VascularTree axes;  // one segment per vessel, its CFD prolongations included
     for (const auto& v : vessels_) {
@@ -304,7 +339,11 @@ class TubeMesher {
         const double cell = gap / kGapCells, own = stepNear(std::min({v.ra, v.rb, w.ra, w.rb}), o_.junction);
         ClosePair pr{std::int32_t(i), std::int32_t(j), 0.0, {0, 0}, {0, 0}, true};
         pr.overlapping = !(gap > 0);
-        if (const Vessel* m = throughConnector(v, w, pi, pj, gap > 0)) pr.touching = false, pr.via = std::int32_t(m - vessels_.data());
+        if (const Vessel* m = throughConnector(v, w, pi, pj, gap > 0, pr.side_i, pr.side_j)) {
+          pr.touching = false, pr.via = std::int32_t(m - vessels_.data());
+          pr.past_i = cutPast(v, pr.side_i, p0, p1, w, q0, q1);
+          pr.past_j = cutPast(w, pr.side_j, q0, q1, v, p0, p1);
+        }
         else if (cell * kFinestGapCells >= own) pr.gap_cell = cell, pr.touching = false;
         if (pr.gap_cell > 0) {
           const double within = v.rmax() + w.rmax() + 2 * own;
@@ -315,12 +354,20 @@ class TubeMesher {
       });
     });
     close_pairs_.clear();
-    for (const auto& f : found)
-      for (const auto& p : f) {
-        close_pairs_.push_back(p);
-        vessels_[std::size_t(p.i)].tube = vessels_[std::size_t(p.j)].tube = false;
-        if (p.via >= 0) vessels_[std::size_t(p.via)].tube = false;  // in their part: the three are one piece
-      }
+    for (const auto& f : found) close_pairs_.insert(close_pairs_.end(), f.begin(), f.end());
+  }
+  // How far from its side-k node vessel v (axis p0 → p1) must be cut so that the region its
+  // cut reads (endCutExtent) holds no point of w (axis q0 → q1): past the stretch of v's axis
+  // within reach + r_w of w's axis, by r_w and the region's depth behind the plane.
+  double cutPast(const Vessel& v, int k, const Vec3& p0, const Vec3& p1, const Vessel& w, const Vec3& q0, const Vec3& q1) const {
+    const auto x = endCutExtent(v.rmax(), stepNear(v.rmax(), o_.junction), true);
+    const double within = x.reach + w.rmax();
+    double span[2];
+    double s = 0, t = 0;
+    segmentSegmentDistance(p0, p1, q0, q1, s, t);
+    closeSpan(v, p0, p1, s, q0, q1, within, span);
+    const double far = k == 0 ? span[1] : v.len - span[0];  // from the node, along the axis into the vessel
+    return far + w.rmax() + x.before;
   }
   // The vessel m joining a node of v to one of w if v and w meet only through it, so that the
   // three have a union without a hole (else null): apart, where they come closest within m's
@@ -328,12 +375,14 @@ class TubeMesher {
   // overlapping, where the three solids share a point (convex solids that pairwise meet and
   // share a point have a union without a hole). The three are contoured together, as a part
   // that must keep no handle.
-  const Vessel* throughConnector(const Vessel& v, const Vessel& w, const Vec3& pi, const Vec3& pj, bool apart) const {
+  // `side_v`, `side_w`: the sides of v and w at the connector's nodes.
+  const Vessel* throughConnector(const Vessel& v, const Vessel& w, const Vec3& pi, const Vec3& pj, bool apart, int& side_v, int& side_w) const {
     for (int x = 0; x < 2; ++x)
       for (const Vessel* m : at_node_[std::size_t(v.node[x])]) {
         const int other = m->node[0] == v.node[x] ? 1 : 0;
         for (int y = 0; y < 2; ++y) {
           if (m->node[other] != w.node[y]) continue;
+          side_v = x, side_w = y;
           if (apart) {
             if (distance(pi, v.nodeAt(x)) <= m->rmax() && distance(pj, w.nodeAt(y)) <= m->rmax()) return m;
             continue;
@@ -393,8 +442,10 @@ class TubeMesher {
     for (const auto& v : vessels_)
       if (!v.tube) g.unite(v.node[0], v.node[1]), joined.unite(v.node[0], v.node[1]);
     for (const auto& pr : close_pairs_) {
-      g.unite(vessels_[std::size_t(pr.i)].node[0], vessels_[std::size_t(pr.j)].node[0]);
-      if (pr.touching || pr.overlapping) joined.unite(vessels_[std::size_t(pr.i)].node[0], vessels_[std::size_t(pr.j)].node[0]);
+      // Through a connector: the nodes at its ends (where the two are cut).
+      const auto ni = vessels_[std::size_t(pr.i)].node[pr.side_i], nj = vessels_[std::size_t(pr.j)].node[pr.side_j];
+      g.unite(ni, nj);
+      if (pr.touching || pr.overlapping) joined.unite(ni, nj);
     }
     std::vector<char> touching_root(std::size_t(t_.nodeCount()), 0);
     for (const auto& pr : close_pairs_)
@@ -424,8 +475,8 @@ class TubeMesher {
     for (const auto& pr : close_pairs_) {
       if (!(pr.gap_cell > 0)) continue;
       auto& gs = clusterOf(vessels_[std::size_t(pr.i)].node[0], vessels_[std::size_t(pr.i)].tree).gap_spans;
-      gs.push_back({pr.i, pr.gap_cell, pr.span_i[0], pr.span_i[1]});
-      gs.push_back({pr.j, pr.gap_cell, pr.span_j[0], pr.span_j[1]});
+      gs.push_back({pr.i, pr.gap_cell, pr.span_i[0], pr.span_i[1], {pr.j}});
+      gs.push_back({pr.j, pr.gap_cell, pr.span_j[0], pr.span_j[1], {pr.i}});
     }
     for (auto& c : out) {
       // A large part's grid at a gap's step costs more than its handle: its close pairs touch.
@@ -453,21 +504,46 @@ class TubeMesher {
   }
 
   // A stub's cut as an end: its plane across the tube at the cut distance from its node.
-  VesselEnd stubPlane(const Vessel& v, int k) const {
+  VesselEnd stubPlane(const Vessel& v, int k, double plane) const {
     VesselEnd e;
     e.tree = v.tree;
     e.vessel = v.s;
     e.node = v.nodeAt(k);
     e.normal = v.into(k);
-    e.centre = e.node + e.normal * v.plane[k];
-    e.radius = v.radiusAt(v.fromA(k, v.plane[k]));
+    e.centre = e.node + e.normal * plane;
+    e.radius = v.radiusAt(v.fromA(k, plane));
     e.open = true;
     e.tight = true;
     e.step = stepNear(v.rmax(), o_.junction);
     return e;
   }
 
+  // A part's surface; a stub whose cut fails (its loop in the plane is not star-shaped around
+  // the axis: the node's other vessels or a slid vertex reach into it) is cut again further
+  // into its tube, up to kCutRetries times, while the tube keeps its length. Only this part is
+  // contoured again: giving the tube up would join its vessel to the part at its other end too.
   ClusterMesh meshCluster(const Cluster& c) const {
+    std::vector<double> plane(c.stubs.size());
+    for (std::size_t k = 0; k < c.stubs.size(); ++k) plane[k] = vessels_[std::size_t(c.stubs[k].vessel)].plane[c.stubs[k].side];
+    for (int attempt = 0;; ++attempt) {
+      ClusterMesh out = meshClusterAt(c, plane);
+      out.cut_retries = attempt;
+      bool again = false;
+      for (std::size_t k = 0; k < c.stubs.size() && attempt < kCutRetries; ++k) {
+        if (!out.loops[k].empty()) continue;
+        const auto& v = vessels_[std::size_t(c.stubs[k].vessel)];
+        // Each side may take half of the tube's spare length (the other side's part may move its cut too).
+        const double spare = 0.5 * (v.len - v.plane[0] - v.plane[1] - kShortestTube * v.rmax());
+        const double room = spare - (plane[k] - v.plane[c.stubs[k].side]);
+        if (room >= kLeastCutShift * v.rmax()) plane[k] += std::min(kCutShift * v.rmax(), room), again = true;
+      }
+      if (!again) {
+        out.planes = std::move(plane);
+        return out;
+      }
+    }
+  }
+  ClusterMesh meshClusterAt(const Cluster& c, const std::vector<double>& stub_planes) const {
     ClusterMesh out;
     VascularTree sub;
     const auto piece = [&](const Vec3& a, const Vec3& b, double ra, double rb) {
@@ -478,11 +554,12 @@ class TubeMesher {
       return id;
     };
     std::vector<VesselEnd> planes;
-    for (const auto& st : c.stubs) {
+    for (std::size_t k = 0; k < c.stubs.size(); ++k) {
+      const auto& st = c.stubs[k];
       const auto& v = vessels_[std::size_t(st.vessel)];
-      const auto e = stubPlane(v, st.side);
+      const auto e = stubPlane(v, st.side, stub_planes[k]);
       // Prolonged a radius past the plane (the cut's overshoot), then cut away again.
-      const double d = v.plane[st.side] + e.radius;
+      const double d = stub_planes[k] + e.radius;
       piece(e.node, e.node + e.normal * d, v.radiusAt(v.fromA(st.side, 0)), v.radiusAt(v.fromA(st.side, d)));
       planes.push_back(e);
     }
@@ -491,10 +568,16 @@ class TubeMesher {
     std::map<std::int32_t, GapSpan> span_of;
     for (const auto& g : c.gap_spans) {
       const auto it = span_of.find(g.vessel);
-      if (it == span_of.end()) span_of.emplace(g.vessel, g);
-      else it->second = {g.vessel, std::min(it->second.cell, g.cell), std::min(it->second.y0, g.y0), std::max(it->second.y1, g.y1)};
+      if (it == span_of.end()) {
+        span_of.emplace(g.vessel, g);
+        continue;
+      }
+      auto& m = it->second;
+      m.cell = std::min(m.cell, g.cell), m.y0 = std::min(m.y0, g.y0), m.y1 = std::max(m.y1, g.y1);
+      m.partners.insert(m.partners.end(), g.partners.begin(), g.partners.end());
     }
     std::vector<std::pair<std::int32_t, double>> fine;  // sub segment, its largest cell
+    std::map<std::int32_t, std::int32_t> fine_piece;     // vessel → its fine piece
     for (auto i : c.whole) {
       const auto& v = vessels_[std::size_t(i)];
       const auto it = span_of.find(i);
@@ -506,6 +589,7 @@ class TubeMesher {
         const double y0 = it->second.y0, y1 = it->second.y1;
         if (y0 > 0) piece(v.a, at(y0), v.ra, sphere(y0));
         fine.emplace_back(piece(at(y0), at(y1), sphere(y0), sphere(y1)), it->second.cell);
+        fine_piece[i] = fine.back().first;
         if (y1 < v.len) piece(at(y1), v.b, sphere(y1), v.rb);
       }
       for (int k = 0; k < 2; ++k) {
@@ -518,12 +602,17 @@ class TubeMesher {
     for (auto e : out.end_ids) planes.push_back(o_.ends[std::size_t(e)]);
     std::vector<double> gap_cells(fine.empty() ? 0 : std::size_t(sub.nodeCount()), 0.0);
     for (const auto& [s, cell] : fine) gap_cells[std::size_t(s)] = cell;
+    // Fine cells only near the pieces across each gap (graded away from it).
+    std::vector<std::vector<std::int32_t>> gap_partners(gap_cells.size());
+    for (const auto& [vessel, s] : fine_piece)
+      for (auto q : span_of.at(vessel).partners)
+        if (const auto it = fine_piece.find(q); it != fine_piece.end()) gap_partners[std::size_t(s)].push_back(it->second);
     // Marching tetrahedra bridge a wedge between two vessels narrower than a step: a part whose
     // vessels touch nowhere must come out with as many components as its union and without
     // handles, else it is contoured again at twice (then four times) the samples across.
     const int base = std::max(1, o_.junction.samples_across);
     for (int refine = 0;; ++refine) {
-      contourCluster(c, sub, planes, base << refine, gap_cells, out);
+      contourCluster(c, sub, planes, base << refine, gap_cells, gap_partners, out);
       if (c.touching || !c.gap_spans.empty() || refine == kRefinements || isUnionShaped(out.mesh, planes, c.parts)) break;
       ++out.refinements;
       for (auto& g : gap_cells) g /= 2;
@@ -541,11 +630,12 @@ class TubeMesher {
   }
   // The part's surface at `samples` across each vessel, cut at its planes, with its stubs' loops.
   void contourCluster(const Cluster& c, const VascularTree& sub, const std::vector<VesselEnd>& planes, int samples, const std::vector<double>& gap_cells,
-                      ClusterMesh& out) const {
+                      const std::vector<std::vector<std::int32_t>>& gap_partners, ClusterMesh& out) const {
     SurfaceReport sr;
     SurfaceOptions so = o_.junction;
     so.samples_across = samples;
     so.vessel_max_cell_mm = gap_cells;
+    so.vessel_gap_partners = gap_partners;
     EndCutReport cut;
     // Cut while the exact distance is at hand, then decimate (loops and caps stay where they are).
     out.decimation = DecimateReport();
@@ -697,6 +787,7 @@ class TubeMesher {
       rep.contour_triangles += std::int64_t(cm.mesh.triangles.size());
       rep.cavities_removed += cm.cavities_removed;
       rep.refinements += cm.refinements;
+      rep.cut_retries += cm.cut_retries;
       rep.triangles_before_decimation += cm.decimation.before;
       rep.decimation_collapses += cm.decimation.collapses;
       rep.decimation_largest_error_mm = std::max(rep.decimation_largest_error_mm, cm.decimation.largest_error_mm);

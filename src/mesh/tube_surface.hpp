@@ -34,6 +34,7 @@ struct TubeSurfaceReport {
   std::int64_t largest_cluster_vessels = 0;
   std::int64_t contour_triangles = 0, tube_triangles = 0;
   std::int64_t fallbacks = 0;       // tubes given up because their cut failed (their vessel contoured whole)
+  std::int64_t cut_retries = 0;     // parts contoured again with a failed cut further into its tube
   std::int64_t refinements = 0;     // parts contoured again, finer, to lose a handle a tree's union does not have
   std::int64_t rounds = 0;          // meshing rounds (each after tubes were given up)
   std::int64_t largest_remeshed = 0;

@@ -354,16 +354,23 @@ std::int64_t removeCavities(SurfaceMesh& m) {
   return removed;
 }
 
+bool hasGapPartners(const SurfaceOptions& o, std::int32_t s) {
+  return std::size_t(s) < o.vessel_gap_partners.size() && !o.vessel_gap_partners[std::size_t(s)].empty();
+}
+
 // Each vessel's level (cells of 2^level steps h): the coarsest that puts samples_across samples
 // across its thinnest end. (The volume the coarser chords of thick vessels lose is restored
-// after contouring, restoreVolume.)
-std::vector<std::int8_t> vesselLevels(const VascularTree& t, const std::vector<std::int32_t>& vessels, double h, const SurfaceOptions& o) {
+// after contouring, restoreVolume.) `away_from_gaps`: a vessel with gap partners at its own
+// level, without its gap's bound (which holds only near them).
+std::vector<std::int8_t> vesselLevels(const VascularTree& t, const std::vector<std::int32_t>& vessels, double h, const SurfaceOptions& o,
+                                      bool away_from_gaps = false) {
   std::vector<std::int8_t> level(std::size_t(t.nodeCount()), 0);
   if (!o.adaptive) return level;
   for (auto s : vessels) {
     double c = 2 * std::min(t.radius[s], t.startRadius(s)) / std::max(1, o.samples_across);
     if (o.max_cell_mm > 0) c = std::min(c, o.max_cell_mm);
-    if (std::size_t(s) < o.vessel_max_cell_mm.size() && o.vessel_max_cell_mm[std::size_t(s)] > 0) c = std::min(c, o.vessel_max_cell_mm[std::size_t(s)]);
+    if (std::size_t(s) < o.vessel_max_cell_mm.size() && o.vessel_max_cell_mm[std::size_t(s)] > 0 && !(away_from_gaps && hasGapPartners(o, s)))
+      c = std::min(c, o.vessel_max_cell_mm[std::size_t(s)]);
     if (c >= 2 * h) level[std::size_t(s)] = std::int8_t(std::min(kMaxSurfaceLevel, int(std::floor(std::log2(c / h) + 1e-9))));
   }
   return level;
@@ -439,11 +446,13 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
   if (!(o.voxel_mm > 0))
     for (auto c : o.vessel_max_cell_mm)
       if (c > 0) h = std::min(h, c);
-  const auto level = vesselLevels(t, vessels, h, o);
+  // `level`: the finest cells a vessel gets (and its fillet's width); `coarse`: those it gets
+  // away from a gap (the same without gap partners).
+  const auto level = vesselLevels(t, vessels, h, o), coarse = vesselLevels(t, vessels, h, o, true);
   std::vector<double> fillet(std::size_t(t.nodeCount()), 0.0);
   for (auto s : vessels) fillet[std::size_t(s)] = kFillet * h * double(std::int64_t(1) << level[std::size_t(s)]);
   int top = 0;
-  for (auto s : vessels) top = std::max<int>(top, level[std::size_t(s)]);
+  for (auto s : vessels) top = std::max<int>(top, coarse[std::size_t(s)]);
   const auto cellSize = [&](int l) { return h * double(std::int64_t(1) << l); };
   // Room around the vessels for the requested cells (up to two cells of their level beyond the
   // vessel) and the coarsest cells the balance adds around them (two of level top + 1); midpoints
@@ -465,10 +474,16 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
   VascularTree inflated = t;
   double area_over_cell2 = 0;
   for (auto s : vessels) {
-    const double c = cellSize(level[std::size_t(s)]), band = c + h, r = t.maxRadius(s);
+    const double c = cellSize(coarse[std::size_t(s)]), band = c + h, r = t.maxRadius(s);
     inflated.radius[s] += band;
     if (inflated.radius_start[s] >= 0) inflated.radius_start[s] += band;
     area_over_cell2 += (2 * std::numbers::pi * r * t.length[s] + 4 * std::numbers::pi * r * r) / (c * c);
+    // Near a gap: cells of the finest level over a strip where the walls are within a few of
+    // them (as wide as a chord of that sagitta), coarser ones around (as many again).
+    if (level[std::size_t(s)] < coarse[std::size_t(s)]) {
+      const double f = cellSize(level[std::size_t(s)]), strip = 2 * std::sqrt(2 * r * (kGapCells + 1) * f);
+      area_over_cell2 += 2 * (t.length[s] + 2 * r) * strip / (f * f);
+    }
   }
   lat.grid.spacing_mm = Vec3(h, h, h);
   lat.grid.origin_mm = lat.origin;
@@ -495,12 +510,22 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
       auto& out = local.local();
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
         const auto s = vessels[i];
-        const int l = level[std::size_t(s)];
+        const int l = level[std::size_t(s)], l_coarse = coarse[std::size_t(s)];
         const Capsule cap = capsuleOf(t, s);
+        std::vector<Capsule> partners;
+        if (hasGapPartners(o, s))
+          for (auto q : o.vessel_gap_partners[std::size_t(s)]) partners.push_back(capsuleOf(t, q));
+        // A cell of this vessel at level m is fine enough where it lies at least kGapCells of
+        // its size from every partner's surface (only near a gap are cells finer than l_coarse).
+        const auto clearOfGaps = [&](const Vec3& centre, double c) {
+          for (const auto& p : partners)
+            if (p.depth(centre) - 0.8660254037844387 * c < kGapCells * c) return false;
+          return true;
+        };
         // A cell the surface passes through has its centre within half a diagonal of it (the
         // distance is 1-Lipschitz); the cells around are the balance's and the top cells' job.
         // (The fillet stands off the vessel by at most a quarter of its width.)
-        const double margin = 1e-9 * cellSize(l) + fillet[std::size_t(s)] / 4, reach = t.maxRadius(s) + cellSize(l);
+        const double margin = 1e-9 * cellSize(l) + fillet[std::size_t(s)] / 4, reach = t.maxRadius(s) + cellSize(l_coarse);
         const Vec3 a = t.position[t.parent[s]], b = t.position[s];
         std::int64_t c0[3], c1[3];
         for (int ax = 0; ax < 3; ++ax) {
@@ -511,8 +536,8 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
           const double c = cellSize(m);
           const Vec3 centre = lat.origin + Vec3((double(x) + 0.5) * c, (double(y) + 0.5) * c, (double(z) + 0.5) * c);
           if (std::abs(cap.depth(centre)) > 0.8660254037844387 * c + margin) return;
-          if (m == l) {
-            out[std::size_t(l)].push_back(cellCode(x, y, z));
+          if (m == l || (m <= l_coarse && clearOfGaps(centre, c))) {
+            out[std::size_t(m)].push_back(cellCode(x, y, z));
             return;
           }
           for (int k = 0; k < 8; ++k) descend(m - 1, 2 * x + (k & 1), 2 * y + ((k >> 1) & 1), 2 * z + ((k >> 2) & 1));

@@ -27,6 +27,9 @@ struct SurfaceMesh {
 
 // Cells grow up to 2^kMaxSurfaceLevel finest steps.
 constexpr int kMaxSurfaceLevel = 10;
+// A gap between two vessels is contoured with cells of a third of its width: the fillet stays
+// inside it and no tetrahedron spans it.
+constexpr double kGapCells = 3;
 
 struct SurfaceOptions {
   double voxel_mm = 0;         // finest grid step; 0: the thinnest vessel's diameter / samples_across
@@ -35,6 +38,10 @@ struct SurfaceOptions {
   // Per segment id of the tree given (empty, or 0 for none): cells around that vessel no larger
   // than this (two vessels that come close without touching: cells that resolve their gap).
   std::vector<double> vessel_max_cell_mm;
+  // Per segment id (empty, or none): the vessels across its gap. Its cells are then that fine
+  // only near them: a cell of its own level or finer stays no larger than 1/kGapCells of its
+  // distance to their surface, so the cells grade down to the gap where it is thinnest.
+  std::vector<std::vector<std::int32_t>> vessel_gap_partners;
   bool adaptive = true;        // false: every vessel at the finest step
   // Move vertices off the surface by ¾ of their triangles' mean gap (a fraction of the chords'
   // sagitta) so the enclosed volume is the vessels'; false: every vertex on the surface.

@@ -196,6 +196,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"tube_triangles", tubes ? Json(tube_report.tube_triangles) : Json(nullptr)},
                     {"contoured_triangles", tubes ? Json(tube_report.contour_triangles) : Json(nullptr)},
                     {"tubes_given_up", tubes ? Json(tube_report.fallbacks) : Json(nullptr)},
+                    {"cuts_retried", tubes ? Json(tube_report.cut_retries) : Json(nullptr)},
                     {"wall_ends_joined", walls ? Json(wall_report.rings) : Json(nullptr)},
                     {"estimated_bytes", report.estimated_bytes},
                     {"enclosed_volume_mm3", topo.volume_mm3},
