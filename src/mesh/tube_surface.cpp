@@ -31,7 +31,9 @@ constexpr std::size_t kLargestGapPart = 64;
 constexpr double kShortestTube = 0.25;
 // A failed cut is tried again this many times, each this many radii further into its tube.
 constexpr int kCutRetries = 2;
-constexpr double kCutShift = 0.5, kLeastCutShift = 0.02;  // (or less where the tube is short, at least the second)
+constexpr double kCutShift = 0.5, kLeastCutShift = 0.02;
+// A failed cut made again in the same contour moves this far: within its overshoot (a radius).
+constexpr double kRecutShift = 0.5;  // (or less where the tube is short, at least the second)
 // Two vessels of a tree that come close without touching are contoured together, with cells of
 // a third of their gap (the fillet then stays in the gap and no tetrahedron spans it) along the
 // stretch of each where its wall comes within two of its own cells of the other's, unless that
@@ -520,30 +522,38 @@ class TubeMesher {
 
   // A part's surface; a stub whose cut fails (its loop in the plane is not star-shaped around
   // the axis: the node's other vessels or a slid vertex reach into it) is cut again further
-  // into its tube, up to kCutRetries times, while the tube keeps its length. Only this part is
-  // contoured again: giving the tube up would join its vessel to the part at its other end too.
+  // into its tube, while the tube keeps its length: first the same contour (its overshoot past
+  // the plane holds the new one), then, up to kCutRetries times, a contour of the part with
+  // its stub shortened. Only this part changes: giving the tube up would join its vessel to
+  // the part at its other end too.
   ClusterMesh meshCluster(const Cluster& c) const {
     std::vector<double> plane(c.stubs.size());
     for (std::size_t k = 0; k < c.stubs.size(); ++k) plane[k] = vessels_[std::size_t(c.stubs[k].vessel)].plane[c.stubs[k].side];
     for (int attempt = 0;; ++attempt) {
       ClusterMesh out = meshClusterAt(c, plane);
-      out.cut_retries = attempt;
+      out.cut_retries += attempt;
       bool again = false;
-      for (std::size_t k = 0; k < c.stubs.size() && attempt < kCutRetries; ++k) {
-        if (!out.loops[k].empty()) continue;
-        const auto& v = vessels_[std::size_t(c.stubs[k].vessel)];
-        // Each side may take half of the tube's spare length (the other side's part may move its cut too).
-        const double spare = 0.5 * (v.len - v.plane[0] - v.plane[1] - kShortestTube * v.rmax());
-        const double room = spare - (plane[k] - v.plane[c.stubs[k].side]);
-        if (room >= kLeastCutShift * v.rmax()) plane[k] += std::min(kCutShift * v.rmax(), room), again = true;
-      }
+      for (std::size_t k = 0; k < c.stubs.size() && attempt < kCutRetries; ++k)
+        if (out.loops[k].empty()) again = moveCut(c, k, kCutShift, plane) || again;
       if (!again) {
         out.planes = std::move(plane);
         return out;
       }
     }
   }
-  ClusterMesh meshClusterAt(const Cluster& c, const std::vector<double>& stub_planes) const {
+  // Moves stub k's cut further into its tube by `shift` radii (or what is left, at least
+  // kLeastCutShift): each side may take half of the tube's spare length (the part at the other
+  // side may move its cut too). False if there is no room.
+  bool moveCut(const Cluster& c, std::size_t k, double shift, std::vector<double>& plane) const {
+    const auto& v = vessels_[std::size_t(c.stubs[k].vessel)];
+    const double spare = 0.5 * (v.len - v.plane[0] - v.plane[1] - kShortestTube * v.rmax());
+    const double room = spare - (plane[k] - v.plane[c.stubs[k].side]);
+    if (!(room >= kLeastCutShift * v.rmax())) return false;
+    plane[k] += std::min(shift * v.rmax(), room);
+    return true;
+  }
+  // `stub_planes`: the cuts asked for, moved where a cut was made again in the same contour.
+  ClusterMesh meshClusterAt(const Cluster& c, std::vector<double>& stub_planes) const {
     ClusterMesh out;
     VascularTree sub;
     const auto piece = [&](const Vec3& a, const Vec3& b, double ra, double rb) {
@@ -612,7 +622,7 @@ class TubeMesher {
     // handles, else it is contoured again at twice (then four times) the samples across.
     const int base = std::max(1, o_.junction.samples_across);
     for (int refine = 0;; ++refine) {
-      contourCluster(c, sub, planes, base << refine, gap_cells, gap_partners, out);
+      contourCluster(c, sub, planes, stub_planes, base << refine, gap_cells, gap_partners, out);
       if (c.touching || !c.gap_spans.empty() || refine == kRefinements || isUnionShaped(out.mesh, planes, c.parts)) break;
       ++out.refinements;
       for (auto& g : gap_cells) g /= 2;
@@ -629,8 +639,8 @@ class TubeMesher {
     return components == parts && 2 * components - std::int64_t(boundaryLoops(m, verticesInPlanes(m, planes)).size()) == chi;
   }
   // The part's surface at `samples` across each vessel, cut at its planes, with its stubs' loops.
-  void contourCluster(const Cluster& c, const VascularTree& sub, const std::vector<VesselEnd>& planes, int samples, const std::vector<double>& gap_cells,
-                      const std::vector<std::vector<std::int32_t>>& gap_partners, ClusterMesh& out) const {
+  void contourCluster(const Cluster& c, const VascularTree& sub, std::vector<VesselEnd>& planes, std::vector<double>& stub_planes, int samples,
+                      const std::vector<double>& gap_cells, const std::vector<std::vector<std::int32_t>>& gap_partners, ClusterMesh& out) const {
     SurfaceReport sr;
     SurfaceOptions so = o_.junction;
     so.samples_across = samples;
@@ -639,8 +649,26 @@ class TubeMesher {
     EndCutReport cut;
     // Cut while the exact distance is at hand, then decimate (loops and caps stay where they are).
     out.decimation = DecimateReport();
+    const std::size_t ns = c.stubs.size();
     so.finish = [&](SurfaceMesh& mesh, const std::function<double(std::int32_t, const Vec3&)>& distance) {
-      cut = cutEnds(mesh, planes, o_.cap_ends);
+      // A stub whose loop fails is cut again once, within the contour's overshoot past its plane.
+      const SurfaceMesh uncut = ns > 0 ? mesh : SurfaceMesh();
+      std::vector<double> asked = stub_planes;
+      for (;;) {
+        cut = cutEnds(mesh, planes, o_.cap_ends);
+        SurfaceMesh probe = mesh;
+        const auto loops = starLoops(probe, planes, skipped(cut, ns, planes.size()));
+        bool moved = false;
+        for (std::size_t k = 0; k < ns; ++k) {
+          if (!loops[k].empty() || stub_planes[k] != asked[k] || !moveCut(c, k, kRecutShift, stub_planes)) continue;
+          const auto& st = c.stubs[k];
+          planes[k] = stubPlane(vessels_[std::size_t(st.vessel)], st.side, stub_planes[k]);
+          moved = true;
+        }
+        if (!moved) break;
+        mesh = uncut;
+        ++out.cut_retries;
+      }
       if (o_.decimate) out.decimation = decimate(mesh, o_.decimation, distance);
     };
     out.mesh = vesselSurface(sub, so, &sr);
@@ -649,7 +677,6 @@ class TubeMesher {
     out.cavities_removed = sr.cavities_removed;
     for (auto& tr : out.mesh.triangle_tree) tr = c.tree;
     // The CFD ends' part of the report, and their faces as options.ends numbers them.
-    const std::size_t ns = c.stubs.size();
     out.ends = EndCutReport();
     out.ends.cut = std::int64_t(out.end_ids.size());
     for (std::size_t k = 0; k < out.end_ids.size(); ++k) {
@@ -662,12 +689,7 @@ class TubeMesher {
       f = f > std::int32_t(ns) ? out.end_ids[std::size_t(f) - 1 - ns] + 1 : 0;
     // Each stub's loop: the boundary loop in its plane, near its axis, made star-shaped around it.
     out.loops.assign(ns, {});
-    std::vector<char> closed(ns, 0);
-    for (auto e : cut.left_closed)
-      if (std::size_t(e) < ns) closed[std::size_t(e)] = 1;
-    std::vector<char> skip(planes.size(), 1);
-    for (std::size_t k = 0; k < ns; ++k) skip[k] = closed[k];
-    auto loops = starLoops(out.mesh, planes, skip);
+    auto loops = starLoops(out.mesh, planes, skipped(cut, ns, planes.size()));
     for (std::size_t k = 0; k < ns; ++k) {
       // Counter-clockwise around the vessel's axis a → b (the plane's normal points into the tube).
       if (c.stubs[k].side == 1) std::reverse(loops[k].begin(), loops[k].end());
@@ -675,6 +697,14 @@ class TubeMesher {
     }
   }
 
+  // The planes starLoops skips: the CFD ends' (after the ns stubs') and the stubs' left closed.
+  static std::vector<char> skipped(const EndCutReport& cut, std::size_t ns, std::size_t planes) {
+    std::vector<char> skip(planes, 1);
+    for (std::size_t k = 0; k < ns; ++k) skip[k] = 0;
+    for (auto e : cut.left_closed)
+      if (std::size_t(e) < ns) skip[std::size_t(e)] = 1;
+    return skip;
+  }
   // A ring of n vertices around the axis at distance y from a: on the wall, or (restoring the
   // volume) where the polygon's area is the circle's.
   void ring(SurfaceMesh& m, const Vessel& v, double y, int n, std::vector<std::int32_t>& out) const {
