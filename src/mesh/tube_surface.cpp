@@ -650,14 +650,18 @@ class TubeMesher {
     // Cut while the exact distance is at hand, then decimate (loops and caps stay where they are).
     out.decimation = DecimateReport();
     const std::size_t ns = c.stubs.size();
+    std::vector<std::vector<std::int32_t>> loops;
     so.finish = [&](SurfaceMesh& mesh, const std::function<double(std::int32_t, const Vec3&)>& distance) {
       // A stub whose loop fails is cut again once, within the contour's overshoot past its plane.
       const SurfaceMesh uncut = ns > 0 ? mesh : SurfaceMesh();
       std::vector<double> asked = stub_planes;
       for (;;) {
         cut = cutEnds(mesh, planes, o_.cap_ends);
-        SurfaceMesh probe = mesh;
-        const auto loops = starLoops(probe, planes, skipped(cut, ns, planes.size()));
+        // The loops as final (decimation keeps them, but may change their triangles: then
+        // they are found again after it, and here on a copy).
+        SurfaceMesh probe;
+        if (o_.decimate) probe = mesh;
+        loops = starLoops(o_.decimate ? probe : mesh, planes, skipped(cut, ns, planes.size()));
         bool moved = false;
         for (std::size_t k = 0; k < ns; ++k) {
           if (!loops[k].empty() || stub_planes[k] != asked[k] || !moveCut(c, k, kRecutShift, stub_planes)) continue;
@@ -689,7 +693,7 @@ class TubeMesher {
       f = f > std::int32_t(ns) ? out.end_ids[std::size_t(f) - 1 - ns] + 1 : 0;
     // Each stub's loop: the boundary loop in its plane, near its axis, made star-shaped around it.
     out.loops.assign(ns, {});
-    auto loops = starLoops(out.mesh, planes, skipped(cut, ns, planes.size()));
+    if (o_.decimate || loops.size() != ns) loops = starLoops(out.mesh, planes, skipped(cut, ns, planes.size()));
     for (std::size_t k = 0; k < ns; ++k) {
       // Counter-clockwise around the vessel's axis a → b (the plane's normal points into the tube).
       if (c.stubs[k].side == 1) std::reverse(loops[k].begin(), loops[k].end());
