@@ -138,31 +138,49 @@ void frameOf(const Vec3& u, Vec3& e1, Vec3& e2) {
   e2 = cross(u, e1);
 }
 
+namespace {
+
+// A point lies in an end's plane: on it, within two radii of its centre.
+bool inPlane(const Vec3& p, const VesselEnd& e) { return std::abs(dot(p - e.centre, e.normal)) <= 1e-9 * e.radius && distance(p, e.centre) < 2 * e.radius; }
+
+// The planes binned on cubes of their largest diameter, each in the 27 around its centre: the
+// planes a point may lie in (inPlane) are those of its cube, in ascending order.
+class PlaneBins {
+ public:
+  explicit PlaneBins(const std::vector<VesselEnd>& planes) {
+    for (const auto& e : planes) g_ = std::max(g_, 2 * e.radius);
+    for (std::size_t k = 0; k < planes.size(); ++k)
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) bins_[key(planes[k].centre + Vec3(dx, dy, dz) * g_)].push_back(std::int32_t(k));
+  }
+  const std::vector<std::int32_t>* near(const Vec3& p) const {
+    const auto it = bins_.find(key(p));
+    return it == bins_.end() ? nullptr : &it->second;
+  }
+
+ private:
+  std::uint64_t key(const Vec3& p) const {
+    return (std::uint64_t(std::int64_t(std::floor(p.x / g_)) & 0x1fffff) << 42) | (std::uint64_t(std::int64_t(std::floor(p.y / g_)) & 0x1fffff) << 21) |
+           std::uint64_t(std::int64_t(std::floor(p.z / g_)) & 0x1fffff);
+  }
+  double g_ = 0;
+  std::unordered_map<std::uint64_t, std::vector<std::int32_t>> bins_;
+};
+
+}  // namespace
+
 std::vector<char> verticesInPlanes(const SurfaceMesh& m, const std::vector<VesselEnd>& planes) {
   std::vector<char> on(m.vertices.size(), 0);
   if (planes.empty()) return on;
-  double g = 0;
-  for (const auto& e : planes) g = std::max(g, 2 * e.radius);
-  const auto key = [g](const Vec3& p) {
-    return (std::uint64_t(std::int64_t(std::floor(p.x / g)) & 0x1fffff) << 42) | (std::uint64_t(std::int64_t(std::floor(p.y / g)) & 0x1fffff) << 21) |
-           std::uint64_t(std::int64_t(std::floor(p.z / g)) & 0x1fffff);
-  };
-  std::unordered_map<std::uint64_t, std::vector<std::int32_t>> bins;
-  for (std::size_t k = 0; k < planes.size(); ++k)
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) bins[key(planes[k].centre + Vec3(dx, dy, dz) * g)].push_back(std::int32_t(k));
-  for (std::size_t v = 0; v < m.vertices.size(); ++v) {
-    const auto it = bins.find(key(m.vertices[v]));
-    if (it == bins.end()) continue;
-    for (auto k : it->second) {
-      const auto& e = planes[std::size_t(k)];
-      if (std::abs(dot(m.vertices[v] - e.centre, e.normal)) <= 1e-9 * e.radius && distance(m.vertices[v], e.centre) < 2 * e.radius) {
-        on[v] = 1;
-        break;
-      }
-    }
-  }
+  const PlaneBins bins(planes);
+  for (std::size_t v = 0; v < m.vertices.size(); ++v)
+    if (const auto* near = bins.near(m.vertices[v]))
+      for (auto k : *near)
+        if (inPlane(m.vertices[v], planes[std::size_t(k)])) {
+          on[v] = 1;
+          break;
+        }
   return on;
 }
 
@@ -222,25 +240,32 @@ std::vector<std::vector<std::int32_t>> starLoops(SurfaceMesh& m, const std::vect
   for (std::size_t t = 0; t < m.triangles.size(); ++t)
     for (auto p : m.triangles[t])
       if (const auto it = around.find(p); it != around.end()) it->second.push_back(std::int32_t(t));
-  for (std::size_t k = 0; k < planes.size(); ++k) {
-    if (!skip.empty() && skip[k]) continue;
-    const auto& e = planes[k];
-    for (const auto& loop : loops) {
-      bool mine = true;
-      for (auto p : loop) {
-        const Vec3 q = m.vertices[std::size_t(p)];
-        mine = mine && std::abs(dot(q - e.centre, e.normal)) <= 1e-9 * e.radius && distance(q, e.centre) < 2 * e.radius;
+  // Each plane's loop: the first that lies in it (found through the bins of its first vertex).
+  std::vector<std::int32_t> loop_of(planes.size(), -1);
+  if (!planes.empty()) {
+    const PlaneBins bins(planes);
+    for (std::size_t l = 0; l < loops.size(); ++l) {
+      const auto* near = loops[l].empty() ? nullptr : bins.near(m.vertices[std::size_t(loops[l][0])]);
+      if (!near) continue;
+      for (auto k : *near) {
+        if (loop_of[std::size_t(k)] >= 0 || (!skip.empty() && skip[std::size_t(k)])) continue;
+        bool mine = true;
+        for (auto p : loops[l]) mine = mine && inPlane(m.vertices[std::size_t(p)], planes[std::size_t(k)]);
+        if (mine) loop_of[std::size_t(k)] = std::int32_t(l);
       }
-      if (!mine) continue;
-      double turn = 0;
-      for (std::size_t i = 0; i < loop.size(); ++i)
-        turn += dot(cross(m.vertices[std::size_t(loop[i])] - e.centre, m.vertices[std::size_t(loop[(i + 1) % loop.size()])] - e.centre), e.normal);
-      std::vector<std::int32_t> ccw = loop;
-      if (turn < 0) std::reverse(ccw.begin(), ccw.end());
-      if (makeStarShaped(m, ccw, around, keep, e.centre, e.normal, e.radius)) out[k] = std::move(ccw);
-      else if (bent) (*bent)[k] = std::move(ccw);
-      break;
     }
+  }
+  for (std::size_t k = 0; k < planes.size(); ++k) {
+    if (loop_of[k] < 0) continue;
+    const auto& e = planes[k];
+    const auto& loop = loops[std::size_t(loop_of[k])];
+    double turn = 0;
+    for (std::size_t i = 0; i < loop.size(); ++i)
+      turn += dot(cross(m.vertices[std::size_t(loop[i])] - e.centre, m.vertices[std::size_t(loop[(i + 1) % loop.size()])] - e.centre), e.normal);
+    std::vector<std::int32_t> ccw = loop;
+    if (turn < 0) std::reverse(ccw.begin(), ccw.end());
+    if (makeStarShaped(m, ccw, around, keep, e.centre, e.normal, e.radius)) out[k] = std::move(ccw);
+    else if (bent) (*bent)[k] = std::move(ccw);
   }
   // Drop what the repairs removed, and renumber the loops as keepTriangles does.
   std::vector<std::int32_t> renumber(m.vertices.size(), -1);
