@@ -7,12 +7,14 @@
 
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "io/graph_writers.hpp"
 #include "io/mesh_writers.hpp"
 #include "mesh/decimate.hpp"
+#include "mesh/ring_mesh.hpp"
 #include "mesh/tube_surface.hpp"
 #include "mesh/vessel_surface.hpp"
 #include "raster/vessel_capsule.hpp"
@@ -203,6 +205,63 @@ TEST(Mesh, VesselsJoinedByAShortVesselDoNotTouchAndKeepNoHandle) {
     EXPECT_EQ(topo.tree_components, std::vector<std::int64_t>({1})) << connector;
     EXPECT_EQ(topo.tree_euler, std::vector<std::int64_t>({2})) << connector;
   }
+}
+
+// A cut loop whose two neighbouring vertices lie closer than single precision resolves (a cut
+// point beside a vertex just off the plane): STL, OFF, PLY and OBJ would round them onto one
+// point, leaving a degenerate triangle on each side of the loop (vascusynth_like had 7 such
+// pairs, and 3 non-manifold edges in its STL). starLoops takes such an edge out.
+TEST(Mesh, CutLoopsKeepNoEdgeThatSinglePrecisionCollapses) {
+  // An open tube of radius 0.05 mm at (30, 30) mm, from z = 0 up, closed by a pole; its loop at
+  // z = 0 has a 17th vertex 10⁻⁸ mm around the circle from the first.
+  const double r = 0.05;
+  const Vec3 c(30, 30, 0), u(0, 0, 1);
+  SurfaceMesh m;
+  const auto ring = [&](double z, int n, bool extra) {
+    std::vector<std::int32_t> ids;
+    for (int k = 0; k < n; ++k) {
+      const double a = 2 * std::numbers::pi * k / n;
+      ids.push_back(std::int32_t(m.vertices.size()));
+      m.vertices.push_back(c + Vec3(std::cos(a), std::sin(a), 0) * r + u * z);
+      if (extra && k == 0) {
+        ids.push_back(std::int32_t(m.vertices.size()));
+        m.vertices.push_back(c + Vec3(std::cos(1e-8 / r), std::sin(1e-8 / r), 0) * r);
+      }
+    }
+    return ids;
+  };
+  const auto bottom = ring(0, 16, true), middle = ring(0.1, 16, false), top = ring(0.2, 16, false);
+  zipRings(m, c, u, bottom, middle, 0);
+  zipRings(m, c, u, middle, top, 0);
+  const auto pole = std::int32_t(m.vertices.size());
+  m.vertices.push_back(c + u * 0.25);
+  for (std::size_t k = 0; k < top.size(); ++k) {
+    m.triangles.push_back({top[k], top[(k + 1) % top.size()], pole});
+    m.triangle_tree.push_back(0);
+    m.triangle_face.push_back(0);
+  }
+  VesselEnd plane;
+  plane.centre = c, plane.normal = u, plane.radius = r;
+  const auto rounded = [&](std::int32_t v) {
+    const Vec3& p = m.vertices[std::size_t(v)];
+    return std::array<float, 3>{float(p.x), float(p.y), float(p.z)};
+  };
+  ASSERT_EQ(rounded(bottom[0]), rounded(bottom[1]));  // the case: one point in single precision
+  const auto loops = starLoops(m, {plane});
+  ASSERT_EQ(loops.size(), 1u);
+  ASSERT_EQ(loops[0].size(), 16u);
+  for (std::size_t k = 0; k < loops[0].size(); ++k)
+    EXPECT_NE(rounded(loops[0][k]), rounded(loops[0][(k + 1) % loops[0].size()])) << k;
+  // Every triangle keeps an area with its corners rounded to single precision, and the tube is
+  // still a surface with the loop as its one boundary.
+  for (const auto& t : m.triangles) {
+    const auto a = rounded(t[0]), b = rounded(t[1]), d = rounded(t[2]);
+    const Vec3 pa(a[0], a[1], a[2]), pb(b[0], b[1], b[2]), pd(d[0], d[1], d[2]);
+    EXPECT_GT(norm(cross(pb - pa, pd - pa)), 0.0);
+  }
+  const auto topo = meshTopology(m);
+  EXPECT_EQ(topo.boundary_edges, 16);
+  EXPECT_EQ(topo.nonmanifold_edges, 0);
 }
 
 TEST(Mesh, OneClosedOrientedSurfacePerTreeWithItsVerticesOnTheVessels) {

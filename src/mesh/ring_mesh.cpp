@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <unordered_map>
 
@@ -25,13 +26,14 @@ bool makeStarShaped(SurfaceMesh& m, std::vector<std::int32_t>& loop, std::unorde
                            std::vector<char>& keep, const Vec3& centre, const Vec3& u, double r) {
   constexpr double kHair = 0.05;
   const auto rises = [&](std::int32_t a, std::int32_t b) { return dot(cross(m.vertices[std::size_t(a)] - centre, m.vertices[std::size_t(b)] - centre), u) > 0; };
-  for (std::size_t i = 0; i < loop.size() && loop.size() >= 3;) {
+  // Loop edges shorter than this go too (where they can): single-precision formats would round
+  // their ends onto one point (8 of its units at the loop's coordinates, or 10⁻⁴ of the radius).
+  const double extent = std::max({std::abs(centre.x), std::abs(centre.y), std::abs(centre.z)}) + 2 * r;
+  const double shortest = std::max(1e-4 * r, 8 * double(std::numeric_limits<float>::epsilon()) * extent);
+  // Moves loop[i + 1] onto loop[i] (their triangle goes) where the link condition holds and no
+  // triangle turns over.
+  const auto collapse = [&](std::size_t i) {
     const auto p = loop[i], q = loop[(i + 1) % loop.size()];
-    if (rises(p, q)) {
-      ++i;
-      continue;
-    }
-    if (!(distance(m.vertices[std::size_t(p)], m.vertices[std::size_t(q)]) <= kHair * r)) return false;
     auto& tp = around[p];
     auto& tq = around[q];
     std::vector<std::int32_t> shared, others;
@@ -73,6 +75,22 @@ bool makeStarShaped(SurfaceMesh& m, std::vector<std::int32_t>& loop, std::unorde
       for (auto& x : m.triangles[std::size_t(t)])
         if (x == q) x = p;
       tp.push_back(t);
+    }
+    return true;
+  };
+  for (std::size_t i = 0; i < loop.size() && loop.size() >= 3;) {
+    const auto p = loop[i], q = loop[(i + 1) % loop.size()];
+    const double length = distance(m.vertices[std::size_t(p)], m.vertices[std::size_t(q)]);
+    const bool rising = rises(p, q);
+    if (rising && !(length < shortest)) {
+      ++i;
+      continue;
+    }
+    if (!rising && !(length <= kHair * r)) return false;
+    if (!collapse(i)) {
+      if (!rising) return false;
+      ++i;  // short, but it stays
+      continue;
     }
     loop.erase(loop.begin() + std::ptrdiff_t((i + 1) % loop.size()));
     if ((i + 1) % (loop.size() + 1) == 0 && i > 0) --i;  // q was the first: p moved down one
@@ -143,26 +161,31 @@ namespace {
 // A point lies in an end's plane: on it, within two radii of its centre.
 bool inPlane(const Vec3& p, const VesselEnd& e) { return std::abs(dot(p - e.centre, e.normal)) <= 1e-9 * e.radius && distance(p, e.centre) < 2 * e.radius; }
 
-// The planes binned on cubes of their largest diameter, each in the 27 around its centre: the
-// planes a point may lie in (inPlane) are those of its cube, in ascending order.
+// The planes binned on cubes of their largest diameter, each in the 27 around its centre's
+// (neighbours by index: cubes found from shifted points could skip one to rounding): the planes
+// a point may lie in (inPlane) are those of its cube, in ascending order.
 class PlaneBins {
  public:
   explicit PlaneBins(const std::vector<VesselEnd>& planes) {
     for (const auto& e : planes) g_ = std::max(g_, 2 * e.radius);
-    for (std::size_t k = 0; k < planes.size(); ++k)
+    for (std::size_t k = 0; k < planes.size(); ++k) {
+      const auto c = cube(planes[k].centre);
       for (int dz = -1; dz <= 1; ++dz)
         for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) bins_[key(planes[k].centre + Vec3(dx, dy, dz) * g_)].push_back(std::int32_t(k));
+          for (int dx = -1; dx <= 1; ++dx) bins_[key({c[0] + dx, c[1] + dy, c[2] + dz})].push_back(std::int32_t(k));
+    }
   }
   const std::vector<std::int32_t>* near(const Vec3& p) const {
-    const auto it = bins_.find(key(p));
+    const auto it = bins_.find(key(cube(p)));
     return it == bins_.end() ? nullptr : &it->second;
   }
 
  private:
-  std::uint64_t key(const Vec3& p) const {
-    return (std::uint64_t(std::int64_t(std::floor(p.x / g_)) & 0x1fffff) << 42) | (std::uint64_t(std::int64_t(std::floor(p.y / g_)) & 0x1fffff) << 21) |
-           std::uint64_t(std::int64_t(std::floor(p.z / g_)) & 0x1fffff);
+  std::array<std::int64_t, 3> cube(const Vec3& p) const {
+    return {std::int64_t(std::floor(p.x / g_)), std::int64_t(std::floor(p.y / g_)), std::int64_t(std::floor(p.z / g_))};
+  }
+  static std::uint64_t key(const std::array<std::int64_t, 3>& c) {
+    return (std::uint64_t(c[0] & 0x1fffff) << 42) | (std::uint64_t(c[1] & 0x1fffff) << 21) | std::uint64_t(c[2] & 0x1fffff);
   }
   double g_ = 0;
   std::unordered_map<std::uint64_t, std::vector<std::int32_t>> bins_;
