@@ -557,8 +557,13 @@ TEST(Mesh, HollowWallIsClosedOfGenusEndsLessOneWithItsThicknessAndVolume) {
     std::vector<std::string> f;
     std::istringstream cells(row);
     for (std::string c; std::getline(cells, c, ',');) f.push_back(c);
-    ASSERT_GT(f.size(), 5u);
+    ASSERT_GT(f.size(), 13u);
     open[std::size_t(std::stoi(f[2]))] += f[5] == "open";
+    // An open end's face is the flat ring from the outer side in to the lumen (its triangles
+    // labelled with the end's face id): the annulus of the wall's thickness around the radius.
+    if (f[5] != "open") continue;
+    const double r = std::stod(f[12]), ring = std::numbers::pi * ((r + 0.1) * (r + 0.1) - r * r);
+    EXPECT_NEAR(std::stod(f[13]) / ring, 1.0, 0.05) << row;
   }
   EXPECT_GE(open[0] + open[1], 24) << "at most two of the 26 ends stay closed";
   for (int k = 0; k < 2; ++k) EXPECT_EQ(st["tree_euler_characteristic"][std::size_t(k)], 2 - 2 * (open[std::size_t(k)] - 1)) << "tree " << k;

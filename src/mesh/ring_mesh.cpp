@@ -247,7 +247,7 @@ void zipRings(SurfaceMesh& m, const Vec3& axis, const Vec3& u, const std::vector
       ++j;
     }
     m.triangle_tree.push_back(tree);
-    m.triangle_face.push_back(0);
+    m.triangle_face.push_back(face);
   }
 }
 
