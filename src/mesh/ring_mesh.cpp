@@ -26,10 +26,12 @@ bool makeStarShaped(SurfaceMesh& m, std::vector<std::int32_t>& loop, std::unorde
                            std::vector<char>& keep, const Vec3& centre, const Vec3& u, double r) {
   constexpr double kHair = 0.05;
   const auto rises = [&](std::int32_t a, std::int32_t b) { return dot(cross(m.vertices[std::size_t(a)] - centre, m.vertices[std::size_t(b)] - centre), u) > 0; };
-  // Loop edges shorter than this go too (where they can): single-precision formats would round
-  // their ends onto one point (8 of its units at the loop's coordinates, or 10⁻⁴ of the radius).
+  // Loop edges shorter than this go too (where they can): the triangles on either side would be
+  // slivers (a cut point beside a vertex just off the plane), and single-precision formats
+  // could round their ends onto one point (8 of its units at the loop's coordinates).
+  constexpr double kShortLoopEdge = 0.02;  // radii: a tenth of a contoured loop's spacing at 3 samples across
   const double extent = std::max({std::abs(centre.x), std::abs(centre.y), std::abs(centre.z)}) + 2 * r;
-  const double shortest = std::max(1e-4 * r, 8 * double(std::numeric_limits<float>::epsilon()) * extent);
+  const double shortest = std::max(kShortLoopEdge * r, 8 * double(std::numeric_limits<float>::epsilon()) * extent);
   // Moves loop[i + 1] onto loop[i] (their triangle goes) where the link condition holds and no
   // triangle turns over.
   const auto collapse = [&](std::size_t i) {

@@ -29,6 +29,8 @@ constexpr int kRefinements = 2;
 constexpr std::size_t kLargestGapPart = 64;
 // A tube is at least this many radii long.
 constexpr double kShortestTube = 0.25;
+// A tube's first ring from a contoured loop stands this many radii from it (or a third of the tube).
+constexpr double kLoopBand = 0.5;
 // A failed cut is tried again this many times, each this many radii further into its tube.
 constexpr int kCutRetries = 2;
 constexpr double kCutShift = 0.5, kLeastCutShift = 0.02;
@@ -884,12 +886,22 @@ class TubeMesher {
         }
         rep.ends.cap_area_mm2[std::size_t(v.end[k])] = area;
       }
-      // Rings at most ring_spacing_radii radii apart.
+      // Rings at most ring_spacing_radii radii apart. A contoured loop has several times a
+      // ring's vertices: zipped to a ring two radii away, its band fans out into triangles of a
+      // few degrees (a quarter of the tube's triangles were under 5°), so the first ring stands
+      // kLoopBand radii from it.
+      std::vector<double> at;
+      double lo = y0, hi = y1;
+      if (!v.round[0] && v.end[0] < 0) lo = std::min(y0 + kLoopBand * v.radiusAt(y0), y0 + (y1 - y0) / 3), at.push_back(lo);
+      const bool band1 = !v.round[1] && v.end[1] < 0;
+      if (band1) hi = std::max(y1 - kLoopBand * v.radiusAt(y1), y1 - (y1 - y0) / 3);
       const double spacing = o_.ring_spacing_radii * 0.5 * (v.radiusAt(y0) + v.radiusAt(y1));
-      const int pieces = std::max(1, int(std::ceil((y1 - y0) / std::max(spacing, 1e-12))));
+      const int pieces = std::max(1, int(std::ceil((hi - lo) / std::max(spacing, 1e-12))));
+      for (int q = 1; q < pieces; ++q) at.push_back(lo + (hi - lo) * q / pieces);
+      if (band1) at.push_back(hi);
       A = loops[i][0];
-      for (int q = 1; q <= pieces; ++q) {
-        if (q < pieces) ring(m, v, y0 + (y1 - y0) * q / pieces, n_ring, B);
+      for (std::size_t q = 0; q <= at.size(); ++q) {
+        if (q < at.size()) ring(m, v, at[q], n_ring, B);
         else B = loops[i][1];
         zipRings(m, v.a, v.u, A, B, v.tree);
         A = B;
