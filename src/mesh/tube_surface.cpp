@@ -31,11 +31,12 @@ constexpr std::size_t kLargestGapPart = 64;
 constexpr double kShortestTube = 0.25;
 // A tube's first ring from a contoured loop stands this many radii from it (or a third of the tube).
 constexpr double kLoopBand = 0.5;
-// A failed cut is tried again this many times, each this many radii further into its tube.
+// A failed cut is tried again this many times, each this many radii further into its tube (or
+// what the tube has left, at least kLeastCutShift).
 constexpr int kCutRetries = 2;
 constexpr double kCutShift = 0.5, kLeastCutShift = 0.02;
 // A failed cut made again in the same contour moves this far: within its overshoot (a radius).
-constexpr double kRecutShift = 0.5;  // (or less where the tube is short, at least the second)
+constexpr double kRecutShift = 0.5;
 // Two vessels of a tree that come close without touching are contoured together, with cells of
 // a third of their gap (the fillet then stays in the gap and no tetrahedron spans it) along the
 // stretch of each where its wall comes within two of its own cells of the other's, unless that
