@@ -111,7 +111,14 @@ def faces_of(poly):
 
 
 def edge_counts(poly):
-    # One vtkFeatureEdges per kind (VTK 9.1 fails re-running one filter with other flags).
+    # One vtkFeatureEdges per kind (VTK 9.1 fails re-running one filter with other flags). On
+    # millions of triangles VTK 9.1's filter fails to allocate its point locator: there the
+    # edges are counted from the faces (numpy).
+    if poly.GetNumberOfCells() > 1_000_000:
+        faces = faces_of(poly)
+        edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+        _, uses = np.unique(edges, axis=0, return_counts=True)
+        return [int((uses == 1).sum()), int((uses > 2).sum())]
     counts = []
     for boundary in (True, False):
         fe = vtk.vtkFeatureEdges()
