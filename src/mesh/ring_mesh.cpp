@@ -274,9 +274,8 @@ std::vector<std::vector<std::int32_t>> starLoops(SurfaceMesh& m, const std::vect
       if (!near) continue;
       for (auto k : *near) {
         if (loop_of[std::size_t(k)] >= 0 || (!skip.empty() && skip[std::size_t(k)])) continue;
-        bool mine = true;
-        for (auto p : loops[l]) mine = mine && inPlane(m.vertices[std::size_t(p)], planes[std::size_t(k)]);
-        if (mine) loop_of[std::size_t(k)] = std::int32_t(l);
+        if (std::all_of(loops[l].begin(), loops[l].end(), [&](std::int32_t p) { return inPlane(m.vertices[std::size_t(p)], planes[std::size_t(k)]); }))
+          loop_of[std::size_t(k)] = std::int32_t(l);
       }
     }
   }

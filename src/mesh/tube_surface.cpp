@@ -172,6 +172,7 @@ class TubeMesher {
     rep.vessels = std::int64_t(vessels_.size());
     if (vessels_.empty()) return {};
     placeCuts();
+    findClosePairs();  // from the geometry alone: the same every round
     std::vector<char> give_up(vessels_.size(), 0);
     std::vector<ClusterMesh> meshes;
     std::vector<Cluster> clusters;
@@ -283,7 +284,6 @@ class TubeMesher {
   // closer than a tenth of their radii count as touching (rings and contours stand off the exact
   // wall by a few hundredths of a radius).
   void decideTubes(const std::vector<char>& give_up) {
-    findClosePairs();
     // Two vessels that come close only through a connector keep their tubes, cut past the
     // stretch where they are near each other: that stretch is contoured with the connector, in
     // the part of its two nodes (the cuts only move away from their nodes: the same every round).
@@ -387,9 +387,12 @@ class TubeMesher {
         const int other = m->node[0] == v.node[x] ? 1 : 0;
         for (int y = 0; y < 2; ++y) {
           if (m->node[other] != w.node[y]) continue;
-          side_v = x, side_w = y;
+          const auto found = [&] {
+            side_v = x, side_w = y;
+            return m;
+          };
           if (apart) {
-            if (distance(pi, v.nodeAt(x)) <= m->rmax() && distance(pj, w.nodeAt(y)) <= m->rmax()) return m;
+            if (distance(pi, v.nodeAt(x)) <= m->rmax() && distance(pj, w.nodeAt(y)) <= m->rmax()) return found();
             continue;
           }
           // The deepest point of the three along lines between their nearest points and the
@@ -406,7 +409,7 @@ class TubeMesher {
               if (outside(at(m1)) < outside(at(m2))) hi = m2;
               else lo = m1;
             }
-            if (outside(at(0.5 * (lo + hi))) < 0) return m;
+            if (outside(at(0.5 * (lo + hi))) < 0) return found();
           }
         }
       }
@@ -891,11 +894,11 @@ class TubeMesher {
       // ring's vertices: zipped to a ring two radii away, its band fans out into triangles of a
       // few degrees (a quarter of the tube's triangles were under 5°), so the first ring stands
       // kLoopBand radii from it.
+      const bool band0 = !v.round[0] && v.end[0] < 0, band1 = !v.round[1] && v.end[1] < 0;  // a contoured loop at that side
+      const double lo = band0 ? std::min(y0 + kLoopBand * v.radiusAt(y0), y0 + (y1 - y0) / 3) : y0;
+      const double hi = band1 ? std::max(y1 - kLoopBand * v.radiusAt(y1), y1 - (y1 - y0) / 3) : y1;
       std::vector<double> at;
-      double lo = y0, hi = y1;
-      if (!v.round[0] && v.end[0] < 0) lo = std::min(y0 + kLoopBand * v.radiusAt(y0), y0 + (y1 - y0) / 3), at.push_back(lo);
-      const bool band1 = !v.round[1] && v.end[1] < 0;
-      if (band1) hi = std::max(y1 - kLoopBand * v.radiusAt(y1), y1 - (y1 - y0) / 3);
+      if (band0) at.push_back(lo);
       const double spacing = o_.ring_spacing_radii * 0.5 * (v.radiusAt(y0) + v.radiusAt(y1));
       const int pieces = std::max(1, int(std::ceil((hi - lo) / std::max(spacing, 1e-12))));
       for (int q = 1; q < pieces; ++q) at.push_back(lo + (hi - lo) * q / pieces);
