@@ -99,7 +99,8 @@ struct Candidate {
 struct State {
   State(SurfaceMesh& mesh, const DecimateOptions& options, const std::function<double(std::int32_t, const Vec3&)>& dist)
       : m(mesh), o(options), distance(dist), around(mesh.vertices.size()), quadric(mesh.vertices.size()), version(mesh.vertices.size(), 0),
-        vertex_alive(mesh.vertices.size(), 1), locked(mesh.vertices.size(), 0), triangle_alive(mesh.triangles.size(), 1), block(mesh.vertices.size(), 0) {
+        vertex_alive(mesh.vertices.size(), 1), locked(mesh.vertices.size(), 0), triangle_alive(mesh.triangles.size(), 1), boundary(mesh.vertices.size(), 0), block(mesh.vertices.size(), 0),
+        visited(mesh.triangles.size(), 0) {
     for (std::size_t k = 0; k < m.triangles.size(); ++k) {
       const auto& t = m.triangles[k];
       const Vec3 n = cross(m.vertices[std::size_t(t[1])] - m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[2])] - m.vertices[std::size_t(t[0])]);
@@ -119,11 +120,11 @@ struct State {
         for (auto x : m.triangles[std::size_t(k)])
           if (x != std::int32_t(v)) ring.push_back(x);
       std::sort(ring.begin(), ring.end());
-      if (std::size_t(std::unique(ring.begin(), ring.end()) - ring.begin()) != around[v].size()) locked[v] = 1;
+      if (std::size_t(std::unique(ring.begin(), ring.end()) - ring.begin()) != around[v].size()) locked[v] = boundary[v] = 1;
     }
   }
 
-  void compact() { keepTriangles(m, triangle_alive); }
+  void compact(std::vector<std::int32_t>* renumber) { keepTriangles(m, triangle_alive, renumber); }
 
   SurfaceMesh& m;
   const DecimateOptions& o;
@@ -131,8 +132,14 @@ struct State {
   std::vector<std::vector<std::int32_t>> around;  // per vertex, its triangles
   std::vector<Quadric> quadric;
   std::vector<std::uint32_t> version;
-  std::vector<char> vertex_alive, locked, triangle_alive;
+  std::vector<char> vertex_alive, locked, triangle_alive, boundary;
   std::vector<std::int64_t> block;  // per vertex, the block of the current pass
+  // Sliver repair: when a vertex's neighbourhood last changed, and when a triangle's repair last
+  // failed (as (pass << 40) + the block's count of changes), so that a failed repair is tried
+  // again only once something near it has changed.
+  std::vector<std::uint64_t> changed, failed;
+  std::vector<std::uint64_t> visited;  // per triangle, the last search of the triangles near a change that met it
+  std::uint64_t pass = 0;
 };
 
 // One block's collapses or flips: only where everything read and written lies in the block, so
@@ -140,13 +147,13 @@ struct State {
 class Worker {
  public:
   Worker(State& s, std::int64_t block)
-      : m_(s.m), o_(s.o), distance_(s.distance), around_(s.around), quadric_(s.quadric), version_(s.version), vertex_alive_(s.vertex_alive),
+      : st_(s), m_(s.m), o_(s.o), distance_(s.distance), around_(s.around), quadric_(s.quadric), version_(s.version), vertex_alive_(s.vertex_alive),
         locked_(s.locked), triangle_alive_(s.triangle_alive), block_(s.block), mine_(block) {
     cos_turn_ = std::cos(o_.max_turn_deg * std::numbers::pi / 180);
     cos_min_angle_ = std::cos(o_.min_angle_deg * std::numbers::pi / 180);
   }
 
-  std::int64_t collapses = 0, flips = 0, removed = 0;
+  std::int64_t collapses = 0, flips = 0, moves = 0, removed = 0;
   double largest_error = 0;
 
   // Collapses among the edges of `triangles` (and those their collapses make) until none is allowed.
@@ -166,12 +173,34 @@ class Worker {
         continue;
       Vec3 w;
       double error = 0;
-      if (!allowed(c.u, c.v, w, error)) continue;
-      collapse(c.u, c.v, w);
+      auto [u, v] = survivorFirst(c.u, c.v);
+      if (!allowed(u, v, w, error)) continue;
+      collapse(u, v, w);
       largest_error = std::max(largest_error, error);
       ++collapses;
-      neighbours(c.u, ring);
-      for (auto x : ring) push(std::min(c.u, x), std::max(c.u, x));
+      neighbours(u, ring);
+      for (auto x : ring) push(std::min(u, x), std::max(u, x));
+    }
+  }
+
+  // Slivers among `triangles` (the cosine of the smallest angle above cos_sliver), in order,
+  // until a sweep changes nothing (or kSliverSweeps).
+  void sliverPass(const std::int32_t* first, const std::int32_t* last, double cos_sliver) {
+    joins_caps_ = true;
+    for (int sweep = 0; sweep < kSliverSweeps; ++sweep) {
+      bool changed = false;
+      for (auto k = first; k != last; ++k) {
+        if (!triangle_alive_[std::size_t(*k)]) continue;
+        const auto& t = m_.triangles[std::size_t(*k)];
+        const auto failed = st_.failed[std::size_t(*k)];
+        if (failed > 0 && std::none_of(t.begin(), t.end(), [&](std::int32_t v) { return st_.changed[std::size_t(v)] > failed; })) continue;
+        if (!(smallestAngleCosine(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]) > cos_sliver))
+          continue;
+        blocked_ = false;
+        if (repair(*k)) changed = true;
+        else if (!blocked_) st_.failed[std::size_t(*k)] = stamp();
+      }
+      if (!changed) break;
     }
   }
 
@@ -187,7 +216,128 @@ class Worker {
  private:
   static constexpr double kFlatFlip = 0.9848;  // cos 10°
 
-  bool mine(std::int32_t v) const { return block_[std::size_t(v)] == mine_; }
+  // The ends of an edge to collapse, the one that stays first: a locked vertex (it keeps its
+  // place, and its id: boundary loops are known by their vertex ids), else the lower id.
+  std::pair<std::int32_t, std::int32_t> survivorFirst(std::int32_t a, std::int32_t b) const {
+    if (a > b) std::swap(a, b);
+    if (locked_[std::size_t(b)] && !locked_[std::size_t(a)]) std::swap(a, b);
+    return {a, b};
+  }
+
+  static constexpr int kSliverSweeps = 8;
+  // A sliver's edge between two vertices of one cap, shorter than this share of their step, joins
+  // them (the survivor stays where it is, in the cap's plane): the cut made it, and a tetrahedral
+  // mesher would refine around it.
+  static constexpr double kCapJoin = 0.1;
+
+  bool joins_caps_ = false;  // in the sliver passes only
+  bool joinsCapVertices(std::int32_t u, std::int32_t v) const {
+    if (!joins_caps_ || st_.boundary[std::size_t(u)] || st_.boundary[std::size_t(v)] || m_.triangle_face.empty()) return false;
+    if (!(distance(m_.vertices[std::size_t(u)], m_.vertices[std::size_t(v)]) < kCapJoin * std::min(stepOf(u), stepOf(v)))) return false;
+    for (auto k : around_[std::size_t(u)]) {
+      const auto& t = m_.triangles[std::size_t(k)];
+      if (m_.triangle_face[std::size_t(k)] != 0 && (t[0] == v || t[1] == v || t[2] == v)) return true;
+    }
+    return false;
+  }
+
+  std::uint64_t stamp() { return (st_.pass << 40) + ++changes_; }
+  // x and its neighbours have changed.
+  void touch(std::int32_t x) {
+    const auto now = stamp();
+    st_.changed[std::size_t(x)] = now;
+    std::vector<std::int32_t> ring;
+    neighbours(x, ring);
+    for (auto y : ring) st_.changed[std::size_t(y)] = now;
+  }
+
+  // A sliver goes the first way the checks allow: one of its edges collapses, shortest first (a
+  // needle's short edge; a cap's apex onto the nearer end of its long edge); a cap's long edge
+  // flips; one of its corners moves to the middle of its neighbours, on the surface.
+  bool repair(std::int32_t k) {
+    const auto t = m_.triangles[std::size_t(k)];
+    const Vec3 p[3] = {m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]};
+    // Edge i runs from t[i] to t[i + 1].
+    double len[3];
+    for (int i = 0; i < 3; ++i) len[i] = distance(p[i], p[(i + 1) % 3]);
+    int order[3] = {0, 1, 2};
+    std::sort(order, order + 3, [&](int x, int y) { return len[x] < len[y] || (len[x] == len[y] && x < y); });
+    for (int e : order) {
+      const auto [u, v] = survivorFirst(t[std::size_t(e)], t[std::size_t((e + 1) % 3)]);
+      Vec3 w;
+      double error = 0;
+      if (!allowed(u, v, w, error)) continue;
+      collapse(u, v, w);
+      largest_error = std::max(largest_error, error);
+      ++collapses;
+      touch(u);
+      return true;
+    }
+    const int longest = order[2];
+    const double l1 = len[(longest + 1) % 3], l2 = len[(longest + 2) % 3];
+    if (len[longest] * len[longest] > l1 * l1 + l2 * l2 && flip(k, t[std::size_t(longest)], t[std::size_t((longest + 1) % 3)], true)) {
+      ++flips;
+      for (auto x : m_.triangles[std::size_t(k)]) touch(x);  // the flip's four vertices: k's new ones and the far end's
+      return true;
+    }
+    for (int i = 0; i < 3; ++i)
+      if (relax(t[std::size_t(i)], m_.triangle_tree[std::size_t(k)])) {
+        ++moves;
+        touch(t[std::size_t(i)]);
+        return true;
+      }
+    return false;
+  }
+
+  // Moves x to the mean of its neighbours, put back onto the surface along the distance's
+  // gradient, if that raises the smallest angle of its triangles and passes the checks of a
+  // collapse (turn, distance, nothing nearby cut).
+  bool relax(std::int32_t x, std::int32_t tree) {
+    if (locked_[std::size_t(x)]) return false;
+    neighbours(x, ring_u_);
+    if (ring_u_.empty() || !mine(ring_u_)) return false;
+    Vec3 c(0, 0, 0);
+    for (auto y : ring_u_) c += m_.vertices[std::size_t(y)];
+    c = c / double(ring_u_.size());
+    const double limit = o_.max_error * stepOf(x), h = 1e-3 * stepOf(x);
+    if (!std::isfinite(h)) return false;
+    for (int it = 0; it < 2; ++it) {
+      const double d = distance_(tree, c);
+      const Vec3 g((distance_(tree, c + Vec3(h, 0, 0)) - distance_(tree, c - Vec3(h, 0, 0))) / (2 * h),
+                   (distance_(tree, c + Vec3(0, h, 0)) - distance_(tree, c - Vec3(0, h, 0))) / (2 * h),
+                   (distance_(tree, c + Vec3(0, 0, h)) - distance_(tree, c - Vec3(0, 0, h))) / (2 * h));
+      if (!(dot(g, g) > 0)) return false;
+      c = c - g * (d / dot(g, g));
+    }
+    if (!(std::abs(distance_(tree, c)) <= limit)) return false;
+    double old_cos = -1, new_cos = -1;
+    moved_.clear();
+    for (auto k : around_[std::size_t(x)]) {
+      const auto& t = m_.triangles[std::size_t(k)];
+      Vec3 before[3], after[3];
+      for (int i = 0; i < 3; ++i) {
+        before[i] = m_.vertices[std::size_t(t[std::size_t(i)])];
+        after[i] = t[std::size_t(i)] == x ? c : before[i];
+      }
+      old_cos = std::max(old_cos, smallestAngleCosine(before[0], before[1], before[2]));
+      new_cos = std::max(new_cos, smallestAngleCosine(after[0], after[1], after[2]));
+      const Vec3 n0 = cross(before[1] - before[0], before[2] - before[0]), n1 = cross(after[1] - after[0], after[2] - after[0]);
+      if (!(norm(n1) > 0) || !(dot(n0, n1) >= cos_turn_ * norm(n0) * norm(n1))) return false;
+      if (!(std::abs(distance_(tree, (after[0] + after[1] + after[2]) / 3.0)) <= limit)) return false;
+      moved_.push_back({t, {after[0], after[1], after[2]}});
+    }
+    if (!(new_cos < old_cos - 1e-3)) return false;
+    if (cutsNear(ring_u_, [&](const std::array<std::int32_t, 3>& t, std::int32_t) { return t[0] == x || t[1] == x || t[2] == x; })) return false;
+    m_.vertices[std::size_t(x)] = c;
+    ++version_[std::size_t(x)];
+    return true;
+  }
+
+  bool mine(std::int32_t v) const {
+    const bool in = block_[std::size_t(v)] == mine_;
+    blocked_ |= !in;
+    return in;
+  }
   bool ringMine(std::int32_t v) const {
     for (auto k : around_[std::size_t(v)])
       for (auto x : m_.triangles[std::size_t(k)])
@@ -211,8 +361,10 @@ class Worker {
 
   // Flips edge a–b of triangle k = (a, b, c) and its neighbour (b, a, d) into (c, a, d) and
   // (d, b, c) if that raises their smallest angle, neither turns by more than the bound from
-  // either old one, the centroids stay near the surface and nothing nearby is cut.
-  bool flip(std::int32_t k1, std::int32_t a, std::int32_t b) {
+  // either old one, the centroids stay near the surface and nothing nearby is cut. A cap (k with
+  // c nearly on a–b) has no normal to speak of: its flip is judged against the neighbour's alone,
+  // and may cross a crease (the volume it moves is the cap's area times the crease's rise).
+  bool flip(std::int32_t k1, std::int32_t a, std::int32_t b, bool cap = false) {
     const std::int32_t k2 = across(k1, a, b);
     if (k2 < 0) return false;
     if (!m_.triangle_face.empty() && (m_.triangle_face[std::size_t(k1)] != 0 || m_.triangle_face[std::size_t(k2)] != 0)) return false;
@@ -231,24 +383,18 @@ class Worker {
     const Vec3 n1 = cross(pb - pa, pc - pa), n2 = cross(pa - pb, pd - pb), m1 = cross(pa - pc, pd - pc), m2 = cross(pb - pd, pc - pd);
     // Nearly flat pairs only: a flip across a crease moves the surface (and, on convex vessels,
     // always inwards: it would take volume).
-    if (!(dot(n1, n2) >= kFlatFlip * norm(n1) * norm(n2))) return false;
-    for (const Vec3& mnew : {m1, m2})
-      for (const Vec3& nold : {n1, n2})
-        if (!(dot(mnew, nold) >= cos_turn_ * norm(mnew) * norm(nold))) return false;
+    if (!cap && !(dot(n1, n2) >= kFlatFlip * norm(n1) * norm(n2))) return false;
+    const auto turns = [&](const Vec3& nold) {
+      return !(dot(m1, nold) >= cos_turn_ * norm(m1) * norm(nold)) || !(dot(m2, nold) >= cos_turn_ * norm(m2) * norm(nold));
+    };
+    if ((!cap && turns(n1)) || turns(n2)) return false;
     const std::int32_t tree = m_.triangle_tree[std::size_t(k1)];
     const double limit = o_.max_error * std::min({stepOf(a), stepOf(b), stepOf(c), stepOf(d)});
     if (!(std::abs(distance_(tree, (pc + pa + pd) / 3.0)) <= limit) || !(std::abs(distance_(tree, (pd + pb + pc) / 3.0)) <= limit)) return false;
     moved_.clear();
     moved_.push_back({{c, a, d}, {pc, pa, pd}});
     moved_.push_back({{d, b, c}, {pd, pb, pc}});
-    nearby_.clear();
-    for (auto x : {a, b, c, d})
-      for (auto k : around_[std::size_t(x)]) {
-        const auto& t = m_.triangles[std::size_t(k)];
-        if (!mine(t[0]) || !mine(t[1]) || !mine(t[2])) return false;
-        if (k != k1 && k != k2) nearby_.push_back(k);
-      }
-    if (cutsNearby()) return false;
+    if (cutsNear({a, b, c, d}, [&](const std::array<std::int32_t, 3>&, std::int32_t k) { return k == k1 || k == k2; })) return false;
     m_.triangles[std::size_t(k1)] = {c, a, d};
     m_.triangles[std::size_t(k2)] = {d, b, c};
     const auto drop = [&](std::int32_t x, std::int32_t k) {
@@ -312,7 +458,7 @@ class Worker {
 
   // The checks of a collapse of edge u–v into u at w; `error`: |distance| at w.
   bool allowed(std::int32_t u, std::int32_t v, Vec3& w, double& error) {
-    if (locked_[std::size_t(u)] && locked_[std::size_t(v)]) return false;
+    if (locked_[std::size_t(u)] && locked_[std::size_t(v)] && !joinsCapVertices(u, v)) return false;
     // The edge's two triangles and their third vertices.
     std::int32_t shared[2], opposite[2];
     int ns = 0;
@@ -325,7 +471,7 @@ class Worker {
     }
     if (ns != 2 || opposite[0] == opposite[1]) return false;
     for (auto o : opposite)
-      if (around_[std::size_t(o)].size() <= 3) return false;
+      if (around_[std::size_t(o)].size() <= (st_.boundary[std::size_t(o)] ? 1u : 3u)) return false;  // keeps a triangle; inside, three
     // Link condition: u and v have no other common neighbour.
     neighbours(u, ring_u_);
     neighbours(v, ring_v_);
@@ -373,28 +519,55 @@ class Worker {
           if (x == v) x = u;
         moved_.push_back({ids, {after[0], after[1], after[2]}});
       }
-    return !foldsIntoNeighbours(u, v);
+    seeds_ = ring_u_;
+    seeds_.insert(seeds_.end(), ring_v_.begin(), ring_v_.end());
+    const auto has = [](const std::array<std::int32_t, 3>& t, std::int32_t x) { return t[0] == x || t[1] == x || t[2] == x; };
+    return !cutsNear(seeds_, [&](const std::array<std::int32_t, 3>& t, std::int32_t) { return has(t, u) || has(t, v); });
   }
 
-  // The moved triangles (moved_, with v renamed u) against each other and against every other
-  // triangle at a vertex of the collapse's ring: a fold through the neighbourhood.
-  bool foldsIntoNeighbours(std::int32_t u, std::int32_t v) {
+  // Whether the moved triangles (moved_) cut each other or a triangle near them: every triangle
+  // at a seed vertex and, outwards from those across their vertices, every one whose box meets
+  // the moved ones' (a long moved triangle reaches past its ring); `replaced(t, k)` names the
+  // triangles the change takes away. Reaching out of the block counts as a cut: not in this pass.
+  template <class Replaced>
+  bool cutsNear(const std::vector<std::int32_t>& seeds, const Replaced& replaced) {
+    Vec3 lo = moved_[0].at[0], hi = lo;
+    for (const auto& mv : moved_)
+      for (const auto& p : mv.at) lo = componentMin(lo, p), hi = componentMax(hi, p);
+    const std::uint64_t mark = (st_.pass << 40) + ++visits_;
     nearby_.clear();
-    for (const auto* ring : {&ring_u_, &ring_v_})
-      for (auto x : *ring)
-        for (auto k : around_[std::size_t(x)]) {
-          const auto& t = m_.triangles[std::size_t(k)];
-          if (t[0] == u || t[1] == u || t[2] == u || t[0] == v || t[1] == v || t[2] == v) continue;
-          if (!mine(t[0]) || !mine(t[1]) || !mine(t[2])) return true;  // reaches out of the block: not in this pass
-          nearby_.push_back(k);
-        }
+    bool outside = false;
+    const auto visit = [&](std::int32_t x) {
+      for (auto k : around_[std::size_t(x)]) {
+        const auto& t = m_.triangles[std::size_t(k)];
+        if (st_.visited[std::size_t(k)] == mark || replaced(t, k)) continue;
+        if (!mine(t[0]) || !mine(t[1]) || !mine(t[2])) return outside = true, void();
+        st_.visited[std::size_t(k)] = mark;
+        nearby_.push_back(k);
+      }
+    };
+    for (auto x : seeds)
+      if (visit(x), outside) return true;
+    for (std::size_t i = 0; i < nearby_.size(); ++i) {
+      const auto t = m_.triangles[std::size_t(nearby_[i])];
+      bool apart = false;
+      for (int ax = 0; ax < 3 && !apart; ++ax) {
+        const double a = m_.vertices[std::size_t(t[0])][ax], b = m_.vertices[std::size_t(t[1])][ax], c = m_.vertices[std::size_t(t[2])][ax];
+        apart = std::max({a, b, c}) < lo[ax] || std::min({a, b, c}) > hi[ax];
+      }
+      if (apart) continue;
+      for (auto x : t)
+        if (visit(x), outside) return true;
+    }
     return cutsNearby();
+  }
+  bool cutsNear(std::initializer_list<std::int32_t> seeds, const auto& replaced) {
+    seeds_.assign(seeds.begin(), seeds.end());
+    return cutsNear(seeds_, replaced);
   }
 
   // moved_ against each other and against nearby_ (boxes first).
   bool cutsNearby() {
-    std::sort(nearby_.begin(), nearby_.end());
-    nearby_.erase(std::unique(nearby_.begin(), nearby_.end()), nearby_.end());
     for (std::size_t i = 0; i < moved_.size(); ++i) {
       const Vec3 lo = componentMin(componentMin(moved_[i].at[0], moved_[i].at[1]), moved_[i].at[2]);
       const Vec3 hi = componentMax(componentMax(moved_[i].at[0], moved_[i].at[1]), moved_[i].at[2]);
@@ -442,6 +615,7 @@ class Worker {
     ++version_[std::size_t(v)];
   }
 
+  State& st_;
   SurfaceMesh& m_;
   const DecimateOptions& o_;
   const std::function<double(std::int32_t, const Vec3&)>& distance_;
@@ -451,8 +625,11 @@ class Worker {
   std::vector<char>&vertex_alive_, &locked_, &triangle_alive_;
   const std::vector<std::int64_t>& block_;
   const std::int64_t mine_;
+  std::uint64_t changes_ = 0;
+  mutable bool blocked_ = false;  // a check reached out of the block
   std::priority_queue<Candidate> queue_;
-  std::vector<std::int32_t> ring_u_, ring_v_, nearby_;
+  std::vector<std::int32_t> ring_u_, ring_v_, nearby_, seeds_;
+  std::uint64_t visits_ = 0;
   struct Moved {
     std::array<std::int32_t, 3> ids;
     Vec3 at[3];
@@ -467,8 +644,8 @@ constexpr double kBlockSteps = 128;
 constexpr int kRounds = 4;
 
 // Alive triangles with all three vertices in one block, grouped by block (blocks and triangles
-// in ascending order).
-std::vector<std::vector<std::int32_t>> partition(State& st, double size, double shift) {
+// in ascending order); with cos_sliver ≤ 1, only those whose smallest angle lies below it.
+std::vector<std::vector<std::int32_t>> partition(State& st, double size, double shift, double cos_sliver) {
   const auto& m = st.m;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m.vertices.size(), 8192), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t v = r.begin(); v != r.end(); ++v) {
@@ -482,7 +659,11 @@ std::vector<std::vector<std::int32_t>> partition(State& st, double size, double 
     if (!st.triangle_alive[k]) continue;
     const auto& t = m.triangles[k];
     const auto b = st.block[std::size_t(t[0])];
-    if (st.block[std::size_t(t[1])] == b && st.block[std::size_t(t[2])] == b) keyed.emplace_back(b, std::int32_t(k));
+    if (st.block[std::size_t(t[1])] != b || st.block[std::size_t(t[2])] != b) continue;
+    if (cos_sliver <= 1 &&
+        !(smallestAngleCosine(m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[1])], m.vertices[std::size_t(t[2])]) > cos_sliver))
+      continue;
+    keyed.emplace_back(b, std::int32_t(k));
   }
   tbb::parallel_sort(keyed.begin(), keyed.end());
   std::vector<std::vector<std::int32_t>> blocks;
@@ -493,51 +674,79 @@ std::vector<std::vector<std::int32_t>> partition(State& st, double size, double 
   return blocks;
 }
 
+enum class Pass { collapse, flip, sliver };
+
+// One pass of `kind` over blocks of `size` mm shifted by `shift` blocks, its blocks in parallel;
+// the collapses and flips it made.
+std::int64_t runPass(State& st, DecimateReport& rep, double size, double shift, Pass kind) {
+  const double cos_sliver = kind == Pass::sliver ? std::cos(st.o.sliver_deg * std::numbers::pi / 180) : 2.0;
+  const auto blocks = partition(st, size, shift, cos_sliver);
+  ++st.pass;
+  if (kind == Pass::sliver && st.changed.empty()) st.changed.assign(st.m.vertices.size(), 0), st.failed.assign(st.m.triangles.size(), 0);
+  std::vector<Worker> workers;
+  workers.reserve(blocks.size());
+  for (const auto& b : blocks) workers.emplace_back(st, st.block[std::size_t(st.m.triangles[std::size_t(b.front())][0])]);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const auto* first = blocks[i].data();
+      const auto* last = first + blocks[i].size();
+      if (kind == Pass::flip) workers[i].flipPass(first, last);
+      else if (kind == Pass::collapse) workers[i].collapsePass(first, last);
+      else workers[i].sliverPass(first, last, cos_sliver);
+    }
+  });
+  std::int64_t made = 0;
+  for (const auto& w : workers) {
+    made += w.collapses + w.flips + w.moves;
+    rep.collapses += w.collapses, rep.flips += w.flips, rep.moves += w.moves, rep.after -= w.removed;
+    rep.largest_error_mm = std::max(rep.largest_error_mm, w.largest_error);
+  }
+  return made;
+}
+
+// Blocks of kBlockSteps median steps (an eighth of the mesh's extent without steps).
+double blockSize(const SurfaceMesh& m) {
+  std::vector<float> steps = m.vertex_step;
+  if (!steps.empty()) {
+    std::nth_element(steps.begin(), steps.begin() + std::ptrdiff_t(steps.size() / 2), steps.end());
+    return kBlockSteps * double(steps[steps.size() / 2]);
+  }
+  Vec3 lo = m.vertices[0], hi = lo;
+  for (const auto& p : m.vertices) lo = componentMin(lo, p), hi = componentMax(hi, p);
+  return std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, 1e-9}) / 8;
+}
+
 }  // namespace
 
-DecimateReport decimate(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance) {
+DecimateReport decimate(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance,
+                        std::vector<std::int32_t>* renumber) {
   DecimateReport rep;
   rep.before = rep.after = std::int64_t(m.triangles.size());
   if (m.triangles.empty()) return rep;
   State st(m, o, distance);
-  std::vector<float> steps = m.vertex_step;
-  double size = 1;
-  if (!steps.empty()) {
-    std::nth_element(steps.begin(), steps.begin() + std::ptrdiff_t(steps.size() / 2), steps.end());
-    size = kBlockSteps * double(steps[steps.size() / 2]);
-  } else {
-    Vec3 lo = m.vertices[0], hi = lo;
-    for (const auto& p : m.vertices) lo = componentMin(lo, p), hi = componentMax(hi, p);
-    size = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, 1e-9}) / 8;
-  }
-  // Collapses in both partitions, then flips; rounds until a round collapses nothing.
-  const auto pass = [&](double shift, bool flips) {
-    const auto blocks = partition(st, size, shift);
-    std::vector<Worker> workers;
-    workers.reserve(blocks.size());
-    for (const auto& b : blocks) workers.emplace_back(st, st.block[std::size_t(m.triangles[std::size_t(b.front())][0])]);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) {
-        const auto* first = blocks[i].data();
-        if (flips) workers[i].flipPass(first, first + blocks[i].size());
-        else workers[i].collapsePass(first, first + blocks[i].size());
-      }
-    });
-    std::int64_t made = 0;
-    for (const auto& w : workers) {
-      made += w.collapses + w.flips;
-      rep.collapses += w.collapses, rep.flips += w.flips, rep.after -= w.removed;
-      rep.largest_error_mm = std::max(rep.largest_error_mm, w.largest_error);
-    }
-    return made;
-  };
+  const double size = blockSize(m);
+  // Collapses in both partitions, then flips; rounds until a round collapses nothing; then the
+  // slivers left.
   for (int round = 0; round < kRounds; ++round) {
     std::int64_t collapsed = 0;
-    for (double shift : {0.0, 0.5}) collapsed += pass(shift, false);
+    for (double shift : {0.0, 0.5}) collapsed += runPass(st, rep, size, shift, Pass::collapse);
     if (round > 0 && collapsed == 0) break;
-    pass(round % 2 ? 0.5 : 0.0, true);
+    runPass(st, rep, size, round % 2 ? 0.5 : 0.0, Pass::flip);
   }
-  st.compact();
+  for (double shift : {0.0, 0.5}) runPass(st, rep, size, shift, Pass::sliver);
+  st.compact(renumber);
+  return rep;
+}
+
+DecimateReport repairSlivers(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance,
+                             std::vector<std::int32_t>* renumber) {
+  DecimateReport rep;
+  rep.before = rep.after = std::int64_t(m.triangles.size());
+  if (m.triangles.empty()) return rep;
+  State st(m, o, distance);
+  const double size = blockSize(m);
+  for (double shift : {0.0, 0.5}) runPass(st, rep, size, shift, Pass::sliver);
+  st.compact(renumber);
   return rep;
 }
 

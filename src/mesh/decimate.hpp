@@ -8,6 +8,7 @@
 // well, so most of them go. Blocks of space are decimated in parallel, each in the order (cost,
 // vertex ids) and only where all it reads lies inside it, so the result does not depend on the
 // thread count.
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -20,16 +21,31 @@ struct DecimateOptions {
   double max_error = 0.1;         // share of the local step: largest distance of a new vertex or centroid from the surface
   double min_angle_deg = 15;      // a new triangle's angles stay above this (or above the smallest they replace)
   double max_turn_deg = 45;       // largest turn of a triangle's normal by one collapse
+  double sliver_deg = 10;         // a triangle with an angle below this is repaired where the checks allow
 };
 
 struct DecimateReport {
-  std::int64_t before = 0, after = 0, collapses = 0, flips = 0;
+  std::int64_t before = 0, after = 0, collapses = 0, flips = 0, moves = 0;
   double largest_error_mm = 0;  // largest |distance| of a vertex placed
+
+  DecimateReport& operator+=(const DecimateReport& o) {
+    after = o.after, collapses += o.collapses, flips += o.flips, moves += o.moves;
+    largest_error_mm = std::max(largest_error_mm, o.largest_error_mm);
+    return *this;
+  }
 };
 
 // `distance(tree, p)`: signed distance (mm, negative inside) from p to the surface of tree
-// `tree`. Vertices of cap faces (triangle_face ≠ 0) and of boundary loops do not move. Vertices
-// the collapses remove are dropped (the others keep their order).
-DecimateReport decimate(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance);
+// `tree`. Vertices of cap faces (triangle_face ≠ 0) and of boundary loops do not move (and
+// boundary loops keep their vertices in order). Vertices the collapses remove are dropped (the
+// others keep their order; `renumber`: old vertex → new, −1 for dropped).
+DecimateReport decimate(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance,
+                        std::vector<std::int32_t>* renumber = nullptr);
+
+// Slivers only (a triangle with an angle below o.sliver_deg): a needle's shortest edge collapses,
+// else a cap's longest edge flips, under the checks of decimation. Marching tetrahedra leave
+// them where the surface passes near a grid point, and a tetrahedral mesher refines around each.
+DecimateReport repairSlivers(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance,
+                             std::vector<std::int32_t>* renumber = nullptr);
 
 }  // namespace angiosynth

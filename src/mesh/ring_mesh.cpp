@@ -316,27 +316,36 @@ std::vector<std::array<int, 3>> earClip(const std::vector<Vec3>& polygon, const 
     return (x[std::size_t(b)] - x[std::size_t(a)]) * (y[std::size_t(c)] - y[std::size_t(a)]) -
            (y[std::size_t(b)] - y[std::size_t(a)]) * (x[std::size_t(c)] - x[std::size_t(a)]);
   };
+  const auto length2 = [&](int a, int b) {
+    const double dx = x[std::size_t(b)] - x[std::size_t(a)], dy = y[std::size_t(b)] - y[std::size_t(a)];
+    return dx * dx + dy * dy;
+  };
   std::vector<int> ring(polygon.size());
   for (int i = 0; i < n; ++i) ring[std::size_t(i)] = i;
+  // An ear's shape: 2√3·(twice its area) / Σ edge², 1 when equilateral, 0 when flat; −1 for no ear.
+  const auto ear = [&](std::size_t i) {
+    const std::size_t k = ring.size();
+    const int a = ring[(i + k - 1) % k], b = ring[i], c = ring[(i + 1) % k];
+    const double twice = orient(a, b, c);
+    if (!(twice > 0)) return -1.0;
+    for (const int p : ring)
+      if (p != a && p != b && p != c && orient(a, b, p) >= 0 && orient(b, c, p) >= 0 && orient(c, a, p) >= 0) return -1.0;
+    return 2 * std::sqrt(3.0) * twice / (length2(a, b) + length2(b, c) + length2(c, a));
+  };
+  // The roundest ear first, so that nearly straight runs of the loop are not clipped into slivers.
+  std::vector<double> shape(ring.size());
+  for (std::size_t i = 0; i < ring.size(); ++i) shape[i] = ear(i);
   std::vector<std::array<int, 3>> out;
   while (ring.size() > 3) {
-    bool clipped = false;
     const std::size_t k = ring.size();
-    for (std::size_t i = 0; i < k && !clipped; ++i) {
-      const int a = ring[(i + k - 1) % k], b = ring[i], c = ring[(i + 1) % k];
-      if (!(orient(a, b, c) > 0)) continue;
-      bool empty = true;
-      for (std::size_t j = 0; j < k && empty; ++j) {
-        const int p = ring[j];
-        if (p == a || p == b || p == c) continue;
-        empty = !(orient(a, b, p) >= 0 && orient(b, c, p) >= 0 && orient(c, a, p) >= 0);
-      }
-      if (!empty) continue;
-      out.push_back({a, b, c});
-      ring.erase(ring.begin() + std::ptrdiff_t(i));
-      clipped = true;
-    }
-    if (!clipped) return {};
+    const std::size_t i = std::size_t(std::max_element(shape.begin(), shape.end()) - shape.begin());
+    if (!(shape[i] >= 0)) return {};
+    out.push_back({ring[(i + k - 1) % k], ring[i], ring[(i + 1) % k]});
+    ring.erase(ring.begin() + std::ptrdiff_t(i));
+    shape.erase(shape.begin() + std::ptrdiff_t(i));
+    const std::size_t before = (i + k - 2) % (k - 1), after = i % (k - 1);
+    shape[before] = ear(before);
+    shape[after] = ear(after);
   }
   if (!(orient(ring[0], ring[1], ring[2]) > 0)) return {};
   out.push_back({ring[0], ring[1], ring[2]});

@@ -157,7 +157,7 @@ struct ClusterMesh {
   EndCutReport ends;                     // for those, in that order
   double estimated_bytes = 0, step = 0;
   std::int64_t cavities_removed = 0;
-  DecimateReport decimation;
+  DecimateReport decimation, slivers;
   int refinements = 0;                   // contoured again, finer, to lose a handle
   std::vector<double> planes;            // each stub's cut distance from its node, as made
   int cut_retries = 0;                   // contoured again with cuts further into their tubes
@@ -658,16 +658,16 @@ class TubeMesher {
     const std::size_t ns = c.stubs.size();
     std::vector<std::vector<std::int32_t>> loops;
     so.finish = [&](SurfaceMesh& mesh, const std::function<double(std::int32_t, const Vec3&)>& distance) {
+      // Slivers go first, while no cut holds their vertices: marching tetrahedra leave a fan of
+      // them where the surface passes by a grid point, and a cut through the fan would keep its
+      // edges of a hundredth of a step in the loop (TetGen stops at such features).
+      out.slivers = repairSlivers(mesh, o_.decimation, distance);
       // A stub whose loop fails is cut again once, within the contour's overshoot past its plane.
       const SurfaceMesh uncut = ns > 0 ? mesh : SurfaceMesh();
       std::vector<double> asked = stub_planes;
       for (;;) {
         cut = cutEnds(mesh, planes, o_.cap_ends);
-        // The loops as final (decimation keeps them, but may change their triangles: then
-        // they are found again after it, and here on a copy).
-        SurfaceMesh probe;
-        if (o_.decimate) probe = mesh;
-        loops = starLoops(o_.decimate ? probe : mesh, planes, skipped(cut, ns, planes.size()));
+        loops = starLoops(mesh, planes, skipped(cut, ns, planes.size()));
         bool moved = false;
         for (std::size_t k = 0; k < ns; ++k) {
           if (!loops[k].empty() || stub_planes[k] != asked[k] || !moveCut(c, k, kRecutShift, stub_planes)) continue;
@@ -679,7 +679,12 @@ class TubeMesher {
         mesh = uncut;
         ++out.cut_retries;
       }
-      if (o_.decimate) out.decimation = decimate(mesh, o_.decimation, distance);
+      // Decimated, or only its slivers repaired: the loops keep their vertices, renumbered.
+      std::vector<std::int32_t> renumber;
+      if (o_.decimate) out.decimation = decimate(mesh, o_.decimation, distance, &renumber);
+      else out.slivers += repairSlivers(mesh, o_.decimation, distance, &renumber);
+      for (auto& loop : loops)
+        for (auto& p : loop) p = renumber[std::size_t(p)];
     };
     out.mesh = vesselSurface(sub, so, &sr);
     out.estimated_bytes = sr.estimated_bytes;
@@ -699,7 +704,7 @@ class TubeMesher {
       f = f > std::int32_t(ns) ? out.end_ids[std::size_t(f) - 1 - ns] + 1 : 0;
     // Each stub's loop: the boundary loop in its plane, near its axis, made star-shaped around it.
     out.loops.assign(ns, {});
-    if (o_.decimate || loops.size() != ns) loops = starLoops(out.mesh, planes, skipped(cut, ns, planes.size()));
+    if (loops.size() != ns) loops = starLoops(out.mesh, planes, skipped(cut, ns, planes.size()));
     for (std::size_t k = 0; k < ns; ++k) {
       // Counter-clockwise around the vessel's axis a → b (the plane's normal points into the tube).
       if (c.stubs[k].side == 1) std::reverse(loops[k].begin(), loops[k].end());
@@ -830,6 +835,7 @@ class TubeMesher {
       rep.cut_retries += cm.cut_retries;
       rep.triangles_before_decimation += cm.decimation.before;
       rep.decimation_collapses += cm.decimation.collapses;
+      rep.slivers_repaired += cm.slivers.collapses + cm.slivers.flips + cm.slivers.moves;
       rep.decimation_largest_error_mm = std::max(rep.decimation_largest_error_mm, cm.decimation.largest_error_mm);
       rep.estimated_bytes = std::max(rep.estimated_bytes, cm.estimated_bytes);
       rep.finest_step_mm = rep.finest_step_mm > 0 ? std::min(rep.finest_step_mm, cm.step) : cm.step;

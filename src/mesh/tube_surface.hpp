@@ -41,6 +41,7 @@ struct TubeSurfaceReport {
   double estimated_bytes = 0, finest_step_mm = 0;
   std::int64_t cavities_removed = 0;
   std::int64_t triangles_before_decimation = 0, decimation_collapses = 0;
+  std::int64_t slivers_repaired = 0;  // collapses, flips and moves that repaired the contour's slivers
   double decimation_largest_error_mm = 0;
   EndCutReport ends;                // per options.ends
 };

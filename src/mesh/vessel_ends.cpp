@@ -20,9 +20,11 @@ namespace {
 // radius from the prolongation's round tip (longer ones merge with more neighbours).
 constexpr double kOvershootRadii = 1;
 
-// A vertex this close to a plane (share of the radius) is moved onto it: cut points never fall
-// next to a vertex, so no sliver triangles.
-constexpr double kSnap = 1e-6;
+// A vertex this close to a plane (share of the radius; or of its step, where that moves it by
+// less than a quarter of its height over the far edge of each of its triangles, so none turns
+// far or over) is moved onto it: cut points never fall next to a vertex, so no slivers and no
+// loop edges of a hundredth of a step, which the cap (its vertices stay) would keep.
+constexpr double kSnap = 1e-6, kSnapSteps = 0.05, kSnapHeight = 0.25;
 
 std::uint64_t pairKey(std::int32_t a, std::int32_t b) {
   if (a > b) std::swap(a, b);
@@ -194,7 +196,16 @@ EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool ca
     const Vec3 tip = reg.c + reg.n * ((kOvershootRadii + 1) * reg.r);
     for (auto v : local) {
       double s = dot(m.vertices[std::size_t(v)] - reg.c, reg.n);
-      if (std::abs(s) < kSnap * reg.r) {
+      double snap = m.vertex_step.empty() ? 0.0 : kSnapSteps * double(m.vertex_step[std::size_t(v)]);
+      if (std::abs(s) < snap)
+        for (auto q = first[std::size_t(v)]; q < first[std::size_t(v) + 1]; ++q) {
+          const auto& tri = m.triangles[std::size_t(incident[q])];
+          const int i = tri[0] == v ? 0 : tri[1] == v ? 1 : 2;
+          const Vec3 p = m.vertices[std::size_t(v)], a = m.vertices[std::size_t(tri[std::size_t((i + 1) % 3)])],
+                     b = m.vertices[std::size_t(tri[std::size_t((i + 2) % 3)])];
+          snap = std::min(snap, kSnapHeight * norm(cross(a - p, b - p)) / std::max(norm(b - a), 1e-300));
+        }
+      if (std::abs(s) < std::max(snap, kSnap * reg.r)) {
         m.vertices[std::size_t(v)] = m.vertices[std::size_t(v)] - reg.n * s;
         s = 0;
       }

@@ -77,13 +77,15 @@ constexpr double kFillet = 2.0;
 // a gap) and fades to nothing at 107° (the creases of every junction keep their volume). The
 // fillet stands at most k/4 off the union, outside it. The order of the solids is fixed, so
 // every unit gets the same value.
-double unionDistance(const std::vector<Solid>& solids, const Vec3& p) {
+double unionDistance(const std::vector<Solid>& solids, const Vec3& p, double* plain = nullptr) {
   double best = std::numeric_limits<double>::infinity(), k_min = std::numeric_limits<double>::infinity();
+  if (plain) *plain = std::numeric_limits<double>::infinity();
   Vec3 n_best(0, 0, 0);
   for (const auto& s : solids) k_min = std::min(k_min, s.k);
   for (const auto& s : solids) {
     const Capsule& c = s.c;
     const double d = c.depth(p);
+    if (plain) *plain = std::min(*plain, d);
     // The direction away from the solid (from the nearest point of its axis).
     const double t = c.inv_len2 > 0 ? std::clamp(dot(p - c.a, c.d) * c.inv_len2, 0.0, 1.0) : 0.0;
     const Vec3 off = p - (c.a + c.d * t);
@@ -625,28 +627,38 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
   });
   std::vector<Solid> solids(std::size_t(t.nodeCount()));
   for (auto s : vessels) solids[std::size_t(s)] = {capsuleOf(t, s), fillet[std::size_t(s)]};
-  const std::function<double(std::int32_t, const Vec3&)> distance = [&](std::int32_t tree, const Vec3& p) {
-    // The bin of the point, as the units sample it.
+  // The solids of a tree in the bin of a point, as the units sample it.
+  const auto solidsAt = [&](std::int32_t tree, const Vec3& p) -> const std::vector<Solid>& {
     const Vec3 half = (p - lat.origin) / (0.5 * lat.h);
     thread_local std::vector<Solid> here;
     here.clear();
     if (const auto* segs = lat.segmentsIn(Lattice::binOf(half.x), Lattice::binOf(half.y), Lattice::binOf(half.z)))
       for (auto s : *segs)
         if ((t.tree.empty() ? 0 : t.tree[s]) == tree) here.push_back(solids[std::size_t(s)]);
-    return unionDistance(here, p);
+    return here;
   };
+  const std::function<double(std::int32_t, const Vec3&)> distance = [&](std::int32_t tree, const Vec3& p) { return unionDistance(solidsAt(tree, p), p); };
   if (o.restore_volume) {
     const double moved = restoreVolume(mesh, along, on_edge, distance);
     if (report) report->largest_volume_move_mm = moved;
   }
   const auto removed = removeCavities(mesh);
   if (report) report->cavities_removed = removed;
-  if (o.finish) o.finish(mesh, distance);
+  // What changes the surface afterwards (decimation, sliver repair) measures its error from the
+  // union and the fillets alike (the larger), so that a fillet's offset never adds to it.
+  const std::function<double(std::int32_t, const Vec3&)> strict = [&](std::int32_t tree, const Vec3& p) {
+    double plain = 0;
+    const double filleted = unionDistance(solidsAt(tree, p), p, &plain);
+    return std::abs(plain) > std::abs(filleted) ? plain : filleted;
+  };
+  if (o.finish) o.finish(mesh, strict);
   return mesh;
 }
 
-void keepTriangles(SurfaceMesh& m, const std::vector<char>& keep) {
-  std::vector<std::int32_t> renumber(m.vertices.size(), -1);
+void keepTriangles(SurfaceMesh& m, const std::vector<char>& keep, std::vector<std::int32_t>* renumber_out) {
+  std::vector<std::int32_t> own;
+  std::vector<std::int32_t>& renumber = renumber_out ? *renumber_out : own;
+  renumber.assign(m.vertices.size(), -1);
   std::size_t nt = 0;
   for (std::size_t k = 0; k < m.triangles.size(); ++k) {
     if (!keep[k]) continue;

@@ -67,8 +67,8 @@ SurfaceMesh vesselSurface(const VascularTree& forest, const SurfaceOptions& opti
                           const std::function<void(std::int64_t done, std::int64_t total)>& progress = {});
 
 // Keeps the triangles flagged in `keep` (with their tree and face labels) and the vertices they
-// use, both in their order.
-void keepTriangles(SurfaceMesh& m, const std::vector<char>& keep);
+// use, both in their order; `renumber`: old vertex → new (−1 for dropped).
+void keepTriangles(SurfaceMesh& m, const std::vector<char>& keep, std::vector<std::int32_t>* renumber = nullptr);
 
 // The area of m's triangle t (mm²).
 inline double triangleArea(const SurfaceMesh& m, const std::array<std::int32_t, 3>& t) {

@@ -1,5 +1,7 @@
 #include "pipeline/mesh_outputs.hpp"
 
+#include <algorithm>
+#include <array>
 #include <fstream>
 #include <stdexcept>
 
@@ -56,15 +58,27 @@ void writeFaces(std::ostream& os, const std::vector<VesselEnd>& ends, const EndC
   }
 }
 
-// The area of each end's face (labels 1 … n), and optionally its triangle count.
-std::vector<double> endFaceAreas(const SurfaceMesh& m, std::size_t n, std::vector<std::int32_t>* triangles = nullptr) {
+// The area of each end's face (labels 1 … n), and optionally the vertices of its loops (the
+// edges its triangles use once).
+std::vector<double> endFaceAreas(const SurfaceMesh& m, std::size_t n, std::vector<std::int32_t>* loop_vertices = nullptr) {
   std::vector<double> area(n, 0.0);
-  if (triangles) triangles->assign(n, 0);
+  std::vector<std::array<std::int32_t, 3>> edges;  // (face, lower vertex, higher vertex)
   for (std::size_t k = 0; k < m.triangles.size(); ++k) {
     const auto f = m.triangle_face[k];
     if (f <= 0 || std::size_t(f) > n) continue;
-    area[std::size_t(f - 1)] += triangleArea(m, m.triangles[k]);
-    if (triangles) ++(*triangles)[std::size_t(f - 1)];
+    const auto& t = m.triangles[k];
+    area[std::size_t(f - 1)] += triangleArea(m, t);
+    for (int i = 0; i < 3; ++i) edges.push_back({f, std::min(t[std::size_t(i)], t[std::size_t((i + 1) % 3)]), std::max(t[std::size_t(i)], t[std::size_t((i + 1) % 3)])});
+  }
+  if (loop_vertices) {
+    loop_vertices->assign(n, 0);
+    std::sort(edges.begin(), edges.end());
+    for (std::size_t i = 0; i < edges.size();) {
+      std::size_t j = i + 1;
+      while (j < edges.size() && edges[j] == edges[i]) ++j;
+      if (j - i == 1) ++(*loop_vertices)[std::size_t(edges[i][0] - 1)];
+      i = j;
+    }
   }
   return area;
 }
@@ -90,7 +104,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   const bool cut_ends = p.ends != "closed" || walls;  // a hollow wall's ends are open
   const auto ends = cut_ends ? openEnds(tree, p.flow_extension) : std::vector<VesselEnd>{};
   EndCutReport cut;
-  DecimateReport reduced;
+  DecimateReport reduced, slivers;
   DecimateOptions d;
   d.max_error = p.max_error;
   TubeSurfaceReport tube_report;
@@ -109,7 +123,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
     report.estimated_bytes = std::max(wall_report.outer.estimated_bytes, wall_report.lumen.estimated_bytes);
     cut.cut = wall_report.rings;
     cut.left_closed = wall_report.not_joined;
-    // A ring's triangles: its two loops' vertices together.
+    // A ring's loop vertices: its two loops' together.
     cut.cap_area_mm2 = endFaceAreas(mesh, ends.size(), &cut.loop_vertices);
   } else if (tubes) {
     TubeSurfaceOptions to;
@@ -128,11 +142,16 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
     reduced.largest_error_mm = tube_report.decimation_largest_error_mm;
   } else {
     o.finish = [&](SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
+      // Slivers before the cut too (tube_surface.cpp says why).
+      slivers = repairSlivers(m, d, distance);
       if (cut_ends) cut = cutEnds(m, ends, p.ends == "capped");
       if (p.decimate) reduced = decimate(m, d, distance);
+      else slivers += repairSlivers(m, d, distance);
     };
     mesh = vesselSurface(cut_ends ? prolongEnds(tree, ends) : tree, o, &report, progress);
   }
+  // The caps as made: the sliver repair may join two of a cap's loop vertices.
+  if (p.ends == "capped" && !walls) cut.cap_area_mm2 = endFaceAreas(mesh, ends.size(), &cut.loop_vertices);
   BoxClipReport clipped;
   if (!p.clip_box.empty()) {
     const auto& b = p.clip_box;
@@ -208,6 +227,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"triangles_before_decimation", p.decimate ? Json(reduced.before) : Json(nullptr)},
                     {"decimation_collapses", reduced.collapses},
                     {"decimation_largest_error_mm", reduced.largest_error_mm},
+                    {"slivers_repaired", tubes ? tube_report.slivers_repaired : slivers.collapses + slivers.flips + slivers.moves},
                     {"ends", ends.size()},
                     {"ends_cut", cut.cut},
                     {"ends_left_closed", cut.left_closed.size()},
