@@ -140,6 +140,7 @@ struct State {
   std::vector<std::uint64_t> changed, failed;
   std::vector<std::uint64_t> visited;  // per triangle, the last search of the triangles near a change that met it
   std::uint64_t pass = 0;
+  bool at_fixed_only = false;  // sliver repair: only triangles with a fixed vertex
 };
 
 // One block's collapses or flips: only where everything read and written lies in the block, so
@@ -187,20 +188,19 @@ class Worker {
   // until a sweep changes nothing (or kSliverSweeps).
   void sliverPass(const std::int32_t* first, const std::int32_t* last, double cos_sliver) {
     joins_caps_ = true;
-    for (int sweep = 0; sweep < kSliverSweeps; ++sweep) {
-      bool changed = false;
-      for (auto k = first; k != last; ++k) {
-        if (!triangle_alive_[std::size_t(*k)]) continue;
-        const auto& t = m_.triangles[std::size_t(*k)];
-        const auto failed = st_.failed[std::size_t(*k)];
-        if (failed > 0 && std::none_of(t.begin(), t.end(), [&](std::int32_t v) { return st_.changed[std::size_t(v)] > failed; })) continue;
-        if (!(smallestAngleCosine(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]) > cos_sliver))
-          continue;
-        blocked_ = false;
-        if (repair(*k)) changed = true;
-        else if (!blocked_) st_.failed[std::size_t(*k)] = stamp();
-      }
-      if (!changed) break;
+    work_.assign(first, last);
+    // Each repair queues the triangles it changed; a bound on the work, against cycles of moves.
+    const std::size_t budget = kSliverWork * work_.size() + 64;
+    for (std::size_t next = 0; next < work_.size() && next < budget; ++next) {
+      const auto k = work_[next];
+      if (!triangle_alive_[std::size_t(k)]) continue;
+      const auto& t = m_.triangles[std::size_t(k)];
+      const auto failed = st_.failed[std::size_t(k)];
+      if (failed > 0 && std::none_of(t.begin(), t.end(), [&](std::int32_t v) { return st_.changed[std::size_t(v)] > failed; })) continue;
+      if (!(smallestAngleCosine(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]) > cos_sliver))
+        continue;
+      blocked_ = false;
+      if (!repair(k) && !blocked_) st_.failed[std::size_t(k)] = stamp();
     }
   }
 
@@ -224,7 +224,7 @@ class Worker {
     return {a, b};
   }
 
-  static constexpr int kSliverSweeps = 8;
+  static constexpr std::size_t kSliverWork = 8;
   // A sliver's edge between two vertices of one cap, shorter than this share of their step, joins
   // them (the survivor stays where it is, in the cap's plane): the cut made it, and a tetrahedral
   // mesher would refine around it.
@@ -242,13 +242,16 @@ class Worker {
   }
 
   std::uint64_t stamp() { return (st_.pass << 40) + ++changes_; }
-  // x and its neighbours have changed.
+  // x and its neighbours have changed; x's triangles are queued for the sliver pass.
   void touch(std::int32_t x) {
     const auto now = stamp();
     st_.changed[std::size_t(x)] = now;
-    std::vector<std::int32_t> ring;
-    neighbours(x, ring);
-    for (auto y : ring) st_.changed[std::size_t(y)] = now;
+    neighbours(x, touched_);
+    for (auto y : touched_) st_.changed[std::size_t(y)] = now;
+    for (auto k : around_[std::size_t(x)]) {
+      const auto& t = m_.triangles[std::size_t(k)];
+      if (block_[std::size_t(t[0])] == mine_ && block_[std::size_t(t[1])] == mine_ && block_[std::size_t(t[2])] == mine_) work_.push_back(k);
+    }
   }
 
   // A sliver goes the first way the checks allow: one of its edges collapses, shortest first (a
@@ -277,7 +280,8 @@ class Worker {
     const double l1 = len[(longest + 1) % 3], l2 = len[(longest + 2) % 3];
     if (len[longest] * len[longest] > l1 * l1 + l2 * l2 && flip(k, t[std::size_t(longest)], t[std::size_t((longest + 1) % 3)], true)) {
       ++flips;
-      for (auto x : m_.triangles[std::size_t(k)]) touch(x);  // the flip's four vertices: k's new ones and the far end's
+      for (auto x : {t[0], t[1], t[2]}) touch(x);
+      for (auto x : m_.triangles[std::size_t(k)]) touch(x);  // the far vertex among them
       return true;
     }
     for (int i = 0; i < 3; ++i)
@@ -628,7 +632,7 @@ class Worker {
   std::uint64_t changes_ = 0;
   mutable bool blocked_ = false;  // a check reached out of the block
   std::priority_queue<Candidate> queue_;
-  std::vector<std::int32_t> ring_u_, ring_v_, nearby_, seeds_;
+  std::vector<std::int32_t> ring_u_, ring_v_, nearby_, seeds_, touched_, work_;
   std::uint64_t visits_ = 0;
   struct Moved {
     std::array<std::int32_t, 3> ids;
@@ -661,7 +665,8 @@ std::vector<std::vector<std::int32_t>> partition(State& st, double size, double 
     const auto b = st.block[std::size_t(t[0])];
     if (st.block[std::size_t(t[1])] != b || st.block[std::size_t(t[2])] != b) continue;
     if (cos_sliver <= 1 &&
-        !(smallestAngleCosine(m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[1])], m.vertices[std::size_t(t[2])]) > cos_sliver))
+        (!(smallestAngleCosine(m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[1])], m.vertices[std::size_t(t[2])]) > cos_sliver) ||
+         (st.at_fixed_only && !st.locked[std::size_t(t[0])] && !st.locked[std::size_t(t[1])] && !st.locked[std::size_t(t[2])])))
       continue;
     keyed.emplace_back(b, std::int32_t(k));
   }
@@ -739,11 +744,12 @@ DecimateReport decimate(SurfaceMesh& m, const DecimateOptions& o, const std::fun
 }
 
 DecimateReport repairSlivers(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance,
-                             std::vector<std::int32_t>* renumber) {
+                             std::vector<std::int32_t>* renumber, bool at_fixed_only) {
   DecimateReport rep;
   rep.before = rep.after = std::int64_t(m.triangles.size());
   if (m.triangles.empty()) return rep;
   State st(m, o, distance);
+  st.at_fixed_only = at_fixed_only;
   const double size = blockSize(m);
   for (double shift : {0.0, 0.5}) runPass(st, rep, size, shift, Pass::sliver);
   st.compact(renumber);

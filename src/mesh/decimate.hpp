@@ -42,10 +42,12 @@ struct DecimateReport {
 DecimateReport decimate(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance,
                         std::vector<std::int32_t>* renumber = nullptr);
 
-// Slivers only (a triangle with an angle below o.sliver_deg): a needle's shortest edge collapses,
-// else a cap's longest edge flips, under the checks of decimation. Marching tetrahedra leave
-// them where the surface passes near a grid point, and a tetrahedral mesher refines around each.
+// Slivers only (a triangle with an angle below o.sliver_deg), under the checks of decimation: an
+// edge collapses (the shortest first), else a cap's longest edge flips, else a corner moves to
+// the middle of its neighbours on the surface. Marching tetrahedra leave them where the surface
+// passes near a grid point, and a tetrahedral mesher refines around each. `at_fixed_only`: only
+// slivers with a fixed vertex (a cap's or a boundary loop's: what a cut made).
 DecimateReport repairSlivers(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance,
-                             std::vector<std::int32_t>* renumber = nullptr);
+                             std::vector<std::int32_t>* renumber = nullptr, bool at_fixed_only = false);
 
 }  // namespace angiosynth

@@ -682,7 +682,7 @@ class TubeMesher {
       // Decimated, or only its slivers repaired: the loops keep their vertices, renumbered.
       std::vector<std::int32_t> renumber;
       if (o_.decimate) out.decimation = decimate(mesh, o_.decimation, distance, &renumber);
-      else out.slivers += repairSlivers(mesh, o_.decimation, distance, &renumber);
+      else out.slivers += repairSlivers(mesh, o_.decimation, distance, &renumber, true);
       for (auto& loop : loops)
         for (auto& p : loop) p = renumber[std::size_t(p)];
     };

@@ -146,7 +146,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
       slivers = repairSlivers(m, d, distance);
       if (cut_ends) cut = cutEnds(m, ends, p.ends == "capped");
       if (p.decimate) reduced = decimate(m, d, distance);
-      else slivers += repairSlivers(m, d, distance);
+      else slivers += repairSlivers(m, d, distance, nullptr, true);
     };
     mesh = vesselSurface(cut_ends ? prolongEnds(tree, ends) : tree, o, &report, progress);
   }
