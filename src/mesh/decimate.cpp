@@ -152,6 +152,7 @@ class Worker {
         locked_(s.locked), triangle_alive_(s.triangle_alive), block_(s.block), mine_(block) {
     cos_turn_ = std::cos(o_.max_turn_deg * std::numbers::pi / 180);
     cos_min_angle_ = std::cos(o_.min_angle_deg * std::numbers::pi / 180);
+    cos_sliver_ = std::cos(o_.sliver_deg * std::numbers::pi / 180);
   }
 
   std::int64_t collapses = 0, flips = 0, moves = 0, removed = 0;
@@ -315,6 +316,7 @@ class Worker {
     }
     if (!(std::abs(distance_(tree, c)) <= limit)) return false;
     double old_cos = -1, new_cos = -1;
+    const Vec3 star = starNormal(x, x);
     moved_.clear();
     for (auto k : around_[std::size_t(x)]) {
       const auto& t = m_.triangles[std::size_t(k)];
@@ -325,8 +327,7 @@ class Worker {
       }
       old_cos = std::max(old_cos, smallestAngleCosine(before[0], before[1], before[2]));
       new_cos = std::max(new_cos, smallestAngleCosine(after[0], after[1], after[2]));
-      const Vec3 n0 = cross(before[1] - before[0], before[2] - before[0]), n1 = cross(after[1] - after[0], after[2] - after[0]);
-      if (!(norm(n1) > 0) || !(dot(n0, n1) >= cos_turn_ * norm(n0) * norm(n1))) return false;
+      if (turnsOver(before, after, star)) return false;
       if (!(std::abs(distance_(tree, (after[0] + after[1] + after[2]) / 3.0)) <= limit)) return false;
       moved_.push_back({t, {after[0], after[1], after[2]}});
     }
@@ -335,6 +336,25 @@ class Worker {
     m_.vertices[std::size_t(x)] = c;
     ++version_[std::size_t(x)];
     return true;
+  }
+
+  // The area-weighted normal of the triangles around a and b.
+  Vec3 starNormal(std::int32_t a, std::int32_t b) const {
+    Vec3 n(0, 0, 0);
+    for (const std::int32_t end : {a, b})
+      for (auto k : around_[std::size_t(end)]) {
+        const auto& t = m_.triangles[std::size_t(k)];
+        if (end == b && a != b && (t[0] == a || t[1] == a || t[2] == a)) continue;  // counted from a
+        n += cross(m_.vertices[std::size_t(t[1])] - m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[2])] - m_.vertices[std::size_t(t[0])]);
+      }
+    return n;
+  }
+  // A moved triangle degenerates or turns by more than the bound from its normal before; a
+  // sliver's normal is noise, so it is held to its star's instead.
+  bool turnsOver(const Vec3* before, const Vec3* after, const Vec3& star) const {
+    const Vec3 n1 = cross(after[1] - after[0], after[2] - after[0]);
+    const Vec3 n0 = smallestAngleCosine(before[0], before[1], before[2]) > cos_sliver_ ? star : cross(before[1] - before[0], before[2] - before[0]);
+    return !(norm(n1) > 0) || !(dot(n0, n1) >= cos_turn_ * norm(n0) * norm(n1));
   }
 
   bool mine(std::int32_t v) const {
@@ -503,6 +523,7 @@ class Worker {
         old_cos = std::max(old_cos, smallestAngleCosine(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]));
       }
     const double floor = std::max(cos_min_angle_, old_cos);  // as a cosine
+    const Vec3 star = starNormal(u, v);
     moved_.clear();
     for (const std::int32_t end : {u, v})
       for (auto k : around_[std::size_t(end)]) {
@@ -513,9 +534,7 @@ class Worker {
           before[i] = m_.vertices[std::size_t(t[std::size_t(i)])];
           after[i] = t[std::size_t(i)] == u || t[std::size_t(i)] == v ? w : before[i];
         }
-        const Vec3 n0 = cross(before[1] - before[0], before[2] - before[0]), n1 = cross(after[1] - after[0], after[2] - after[0]);
-        const double l0 = norm(n0), l1 = norm(n1);
-        if (!(l1 > 0) || !(dot(n0, n1) >= cos_turn_ * l0 * l1)) return false;
+        if (turnsOver(before, after, star)) return false;
         if (!(smallestAngleCosine(after[0], after[1], after[2]) <= floor)) return false;
         if (!(std::abs(distance_(tree, (after[0] + after[1] + after[2]) / 3.0)) <= limit)) return false;
         std::array<std::int32_t, 3> ids = t;
@@ -639,7 +658,7 @@ class Worker {
     Vec3 at[3];
   };
   std::vector<Moved> moved_;
-  double cos_turn_ = 0, cos_min_angle_ = 1;
+  double cos_turn_ = 0, cos_min_angle_ = 1, cos_sliver_ = 1;
 };
 
 // Blocks: cubes of kBlockSteps median steps, shifted by half a block in odd passes so that what
