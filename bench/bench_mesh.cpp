@@ -1,8 +1,9 @@
 // Surface meshing (issue 15): the forest of each parameter file grown once, then its closed
 // surface (src/mesh): tubes joined to contoured junctions (--tubes 1, the default; --samples N
 // across each vessel where vessels meet, default 3) or contoured whole (--tubes 0; 4 samples
-// across), optionally decimated (--decimate 1), at the automatic step or --voxel MM:
-//   bench_mesh FILE.toml ... [--tubes 0|1] [--samples N] [--decimate 0|1] [--voxel MM] [--threads T]
+// across), optionally decimated (--decimate 1) or with the contour's slivers repaired
+// (--slivers DEG: angles below DEG; 0, the default for closed ends, none), at the automatic step or --voxel MM:
+//   bench_mesh FILE.toml ... [--tubes 0|1] [--samples N] [--decimate 0|1] [--slivers DEG] [--voxel MM] [--threads T]
 // Prints the step, the time, triangles in all and per segment, and the peak memory.
 // Targets (issue 15): 10k segments ≤ 10 s, ≤ 4 GB, ≤ 500 triangles per segment; 100k ≤ 2 min.
 #include <cstdio>
@@ -26,7 +27,9 @@ int main(int argc, char** argv) {
   const int samples = int(bench::takeOption(int(rest2.size()), rest2.data(), "--samples", 3, rest3));
   std::vector<char*> rest4;
   const bool decimated = bench::takeOption(int(rest3.size()), rest3.data(), "--decimate", 0, rest4) != 0;
-  const auto args = bench::parseFileArgs(int(rest4.size()), rest4.data());
+  std::vector<char*> rest5;
+  const double slivers = bench::takeOption(int(rest4.size()), rest4.data(), "--slivers", 0, rest5);
+  const auto args = bench::parseFileArgs(int(rest5.size()), rest5.data());
   std::printf("%-34s %9s %9s %10s %12s %10s %8s %9s\n", "file", "segments", "step mm", "mesh s", "triangles", "tri/seg", "genus0", "peak MiB");
   for (const auto& f : args.files) {
     const auto sc = readTomlParameters(f);
@@ -47,6 +50,7 @@ int main(int argc, char** argv) {
       to.junction = o;
       to.junction.samples_across = samples;
       to.decimate = decimated;
+      to.decimation.sliver_deg = slivers;
       m = tubeSurface(t, to, &trep);
       rep.voxel_mm = trep.finest_step_mm;
     } else {
@@ -69,6 +73,7 @@ int main(int argc, char** argv) {
       std::printf("\n  tubes %lld of %lld vessels, clusters %lld (largest %lld vessels), contour %lld + tube %lld triangles, fallbacks %lld, parts cut again %lld",
                   (long long)trep.tubes, (long long)trep.vessels, (long long)trep.clusters, (long long)trep.largest_cluster_vessels,
                   (long long)trep.contour_triangles, (long long)trep.tube_triangles, (long long)trep.fallbacks, (long long)trep.cut_retries);
+    if (tubes && slivers > 0) std::printf(", slivers repaired %lld", (long long)trep.slivers_repaired);
     if (tubes) std::printf(", rounds %lld (largest part meshed again: %lld vessels)", (long long)trep.rounds, (long long)trep.largest_remeshed);
     std::printf("\n");
   }

@@ -498,6 +498,17 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
     const auto faces = readText(dir / "capped/surface_faces.csv");
     EXPECT_EQ(faces.substr(0, faces.find('\n')), "face_id,kind,tree,vessel,end,state,centre_x,centre_y,centre_z,normal_x,normal_y,normal_z,radius,cap_area,loop_vertices");
   }
+  // Capped, the contour's slivers are repaired by default, and TetGen meshes the volume with
+  // quality (radius–edge ratio 1.414) at its default tolerance, undecimated.
+  EXPECT_GT(st["slivers_repaired"].get<int>(), 100);
+  const std::string tetgen_fine = "cd '" + (dir / "capped").string() + "' && tetgen -pq1.414 -Q surface.off > tetgen.log 2>&1";
+  EXPECT_EQ(std::system(tetgen_fine.c_str()), 0) << readText(dir / "capped/tetgen.log");
+  EXPECT_TRUE(std::filesystem::exists(dir / "capped/surface.1.ele"));
+  for (const char* bad : {"--sliver-angle 40", "--sliver-angle -1"}) {
+    const auto refused = run(std::string("mesh sample --out bad --ends capped ") + bad + " --quiet", dir);
+    EXPECT_EQ(refused.code, 2) << bad;
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad")) << bad;
+  }
 
   const auto open = run("mesh sample --out open --format vtp --ends open --flow-extension 3 --samples-across 2 --quiet", dir);
   ASSERT_EQ(open.code, 0) << open.err;

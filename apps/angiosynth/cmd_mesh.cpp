@@ -58,6 +58,10 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
   c->add_option("--max-error", a.max_error, "with --decimate: largest distance of a moved vertex or a new triangle's centroid from the "
                                              "vessels' surface, as a share of the local grid step (default 0.1)")
       ->check(finiteIn(0, 1));
+  c->add_option("--sliver-angle", a.sliver_angle,
+                "repair contoured triangles with an angle below this many degrees (collapse, flip or move under the checks of "
+                "--decimate), as TetGen needs; 0: none (default 10 with --ends capped, else 0)")
+      ->check(finiteIn(0, 30));
   c->add_option("--clip-box", a.clip_box,
                 "X0,Y0,Z0,X1,Y1,Z1: clip the closed surface to this box (mm), each side's section filled flat (a hollow wall's lumen "
                 "stays open there: the printed block of seed 004)")
@@ -101,6 +105,7 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   p.flow_extension = a.flow_extension;
   p.decimate = a.decimate;
   p.max_error = a.max_error;
+  p.sliver_angle = a.sliver_angle;
   if (p.ends == "closed" && p.flow_extension > 0) throw InputError("", 0, "--flow-extension needs --ends open or capped");
   p.clip_box = a.clip_box;
   if (const auto why = clipBoxProblem(p); !why.empty()) throw InputError("", 0, why);

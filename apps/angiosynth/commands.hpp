@@ -86,6 +86,7 @@ struct MeshArgs {
   double flow_extension = 0;
   bool decimate = false;
   double max_error = 0.1;
+  double sliver_angle = -1;
   std::vector<double> clip_box;
   std::vector<std::string> formats;
   bool force = false;

@@ -60,6 +60,9 @@ const std::vector<MethodParam>& commonParams() {
        "45 degrees, no new angle falls below 15 degrees (unless one already was), and every moved vertex and new triangle stays within "
        "max_error of the vessels"},
       {"mesh", "max_error", "share of the local step", "0.1", "with decimate: the largest distance from the vessels' surface, (0, 1]"},
+      {"mesh", "sliver_angle", "degrees", "10 with capped ends, else 0",
+       "contoured triangles with an angle below this are repaired (an edge collapsed, a cap's edge flipped, a corner moved) under "
+       "decimation's checks, as a tetrahedral mesher needs; 0: none, [0, 30]"},
       {"mesh", "flow_extension", "radii", "0", "open/capped: each end prolonged straight by this many radii of its vessel before the cut (0 … 100)"},
       {"mesh", "clip_box", "[mm × 6]", "none",
        "[x0, y0, z0, x1, y1, z1]: the closed surface (closed or capped ends, or a hollow wall) clipped to this box, each side's section "

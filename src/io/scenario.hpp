@@ -55,6 +55,8 @@ struct MeshParameters {
   double flow_extension = 0;                // open/capped: straight extension of each end, in radii of its vessel
   bool decimate = false;                    // edge-collapse decimation within max_error of the surface
   double max_error = 0.1;                   // share of the local step
+  double sliver_angle = -1;                 // degrees: contoured triangles with a smaller angle are repaired; −1: 10 with capped ends, else 0 (none)
+  double sliverAngle() const { return sliver_angle >= 0 ? sliver_angle : ends == "capped" ? 10 : 0; }
   // mm: x0, y0, z0, x1, y1, z1 of a box the closed surface is clipped to, each side's section
   // filled (a hollow wall's lumen open there); empty: none
   std::vector<double> clip_box;

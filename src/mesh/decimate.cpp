@@ -757,7 +757,8 @@ DecimateReport decimate(SurfaceMesh& m, const DecimateOptions& o, const std::fun
     if (round > 0 && collapsed == 0) break;
     runPass(st, rep, size, round % 2 ? 0.5 : 0.0, Pass::flip);
   }
-  for (double shift : {0.0, 0.5}) runPass(st, rep, size, shift, Pass::sliver);
+  if (o.sliver_deg > 0)
+    for (double shift : {0.0, 0.5}) runPass(st, rep, size, shift, Pass::sliver);
   st.compact(renumber);
   return rep;
 }

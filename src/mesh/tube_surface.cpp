@@ -661,7 +661,8 @@ class TubeMesher {
       // Slivers go first, while no cut holds their vertices: marching tetrahedra leave a fan of
       // them where the surface passes by a grid point, and a cut through the fan would keep its
       // edges of a hundredth of a step in the loop (TetGen stops at such features).
-      out.slivers = repairSlivers(mesh, o_.decimation, distance);
+      const bool repair = o_.decimation.sliver_deg > 0;
+      if (repair) out.slivers = repairSlivers(mesh, o_.decimation, distance);
       // A stub whose loop fails is cut again once, within the contour's overshoot past its plane.
       const SurfaceMesh uncut = ns > 0 ? mesh : SurfaceMesh();
       std::vector<double> asked = stub_planes;
@@ -682,9 +683,10 @@ class TubeMesher {
       // Decimated, or only its slivers repaired: the loops keep their vertices, renumbered.
       std::vector<std::int32_t> renumber;
       if (o_.decimate) out.decimation = decimate(mesh, o_.decimation, distance, &renumber);
-      else out.slivers += repairSlivers(mesh, o_.decimation, distance, &renumber, true);
-      for (auto& loop : loops)
-        for (auto& p : loop) p = renumber[std::size_t(p)];
+      else if (repair) out.slivers += repairSlivers(mesh, o_.decimation, distance, &renumber, true);
+      if (!renumber.empty())
+        for (auto& loop : loops)
+          for (auto& p : loop) p = renumber[std::size_t(p)];
     };
     out.mesh = vesselSurface(sub, so, &sr);
     out.estimated_bytes = sr.estimated_bytes;

@@ -107,6 +107,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   DecimateReport reduced, slivers;
   DecimateOptions d;
   d.max_error = p.max_error;
+  d.sliver_deg = p.sliverAngle();
   TubeSurfaceReport tube_report;
   HollowWallReport wall_report;
   SurfaceMesh mesh;
@@ -143,10 +144,10 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   } else {
     o.finish = [&](SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
       // Slivers before the cut too (tube_surface.cpp says why).
-      slivers = repairSlivers(m, d, distance);
+      if (d.sliver_deg > 0) slivers = repairSlivers(m, d, distance);
       if (cut_ends) cut = cutEnds(m, ends, p.ends == "capped");
       if (p.decimate) reduced = decimate(m, d, distance);
-      else slivers += repairSlivers(m, d, distance, nullptr, true);
+      else if (d.sliver_deg > 0) slivers += repairSlivers(m, d, distance, nullptr, true);
     };
     mesh = vesselSurface(cut_ends ? prolongEnds(tree, ends) : tree, o, &report, progress);
   }
@@ -193,6 +194,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"clip_box_mm", p.clip_box.empty() ? Json(nullptr) : Json(p.clip_box)},
                     {"decimate", p.decimate},
                     {"max_error_steps", p.max_error},
+                    {"sliver_angle_deg", p.sliverAngle()},
                     {"description", tubes ? "each vessel's free middle a tube of rings on its exact wall (at most ring_spacing_radii radii "
                                             "apart); where vessels meet, marching tetrahedra of the signed distance to the union of their "
                                             "capsules and round cones (2:1-balanced octree of cells sized to each vessel's radius), cut by "
