@@ -673,6 +673,31 @@ TEST(Mesh, HollowWallClippedToABoxStaysClosedWithOpenLumensAndTheWallsVolume) {
   std::filesystem::remove_all(dir);
 }
 
+// The test forest contoured whole, and again with `finish` applied to the contour; a change of
+// its triangles keeps the topology (components and Euler characteristic per tree), closed,
+// manifold and outward.
+struct Finished {
+  SurfaceMesh fine, m;
+  MeshTopology before, topo;
+};
+Finished contouredWith(const std::function<void(SurfaceMesh&, const std::function<double(std::int32_t, const Vec3&)>&)>& finish) {
+  const auto& t = forest().forest.vessels;
+  SurfaceOptions o;
+  Finished f;
+  f.fine = vesselSurface(t, o);
+  f.before = meshTopology(f.fine);
+  o.finish = finish;
+  f.m = vesselSurface(t, o);
+  f.topo = meshTopology(f.m);
+  EXPECT_EQ(f.topo.boundary_edges, 0);
+  EXPECT_EQ(f.topo.nonmanifold_edges, 0);
+  EXPECT_EQ(f.topo.misoriented_edges, 0);
+  EXPECT_EQ(f.topo.degenerate_triangles, 0);
+  EXPECT_EQ(f.topo.tree_components, f.before.tree_components);
+  EXPECT_EQ(f.topo.tree_euler, f.before.tree_euler);
+  return f;
+}
+
 // Decimation keeps what the marching-tetrahedra surface guarantees and changes its triangles
 // only: the same components and Euler characteristics per tree (the link condition), closed,
 // manifold and outward, the enclosed volume (to 0.2 %), every vertex it places
@@ -680,23 +705,13 @@ TEST(Mesh, HollowWallClippedToABoxStaysClosedWithOpenLumensAndTheWallsVolume) {
 // bins), and TetGen's exact test finds no intersecting faces; a tenth of the triangles or fewer.
 TEST(Mesh, DecimationKeepsTopologyVolumeAndSurface) {
   const auto& t = forest().forest.vessels;
-  SurfaceOptions o;
-  const auto fine = vesselSurface(t, o);
-  const auto before = meshTopology(fine);
   DecimateReport rep;
   DecimateOptions d;
-  o.finish = [&](SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) { rep = decimate(m, d, distance); };
-  const auto m = vesselSurface(t, o);
-  const auto topo = meshTopology(m);
+  const auto [fine, m, before, topo] =
+      contouredWith([&](SurfaceMesh& s, const std::function<double(std::int32_t, const Vec3&)>& distance) { rep = decimate(s, d, distance); });
   EXPECT_EQ(rep.before, std::int64_t(fine.triangles.size()));
   EXPECT_EQ(rep.after, std::int64_t(m.triangles.size()));
   EXPECT_LT(m.triangles.size() * 10, fine.triangles.size());
-  EXPECT_EQ(topo.boundary_edges, 0);
-  EXPECT_EQ(topo.nonmanifold_edges, 0);
-  EXPECT_EQ(topo.misoriented_edges, 0);
-  EXPECT_EQ(topo.degenerate_triangles, 0);
-  EXPECT_EQ(topo.tree_components, before.tree_components);
-  EXPECT_EQ(topo.tree_euler, before.tree_euler);
   // Collapses keep the volume; flips of nearly flat pairs change it a little (the undecimated
   // volume is within 0.05 % of the union's, WrittenFilesReadBackClosedByVtkWithTheUnionsVolume).
   EXPECT_NEAR(topo.volume_mm3, before.volume_mm3, 2e-3 * before.volume_mm3);
@@ -727,14 +742,10 @@ TEST(Mesh, DecimationKeepsTopologyVolumeAndSurface) {
 // vertices within max_error steps of the vessels, and no intersecting faces (TetGen's test).
 TEST(Mesh, SliverRepairKeepsTopologyVolumeAndSurface) {
   const auto& t = forest().forest.vessels;
-  SurfaceOptions o;
-  const auto fine = vesselSurface(t, o);
-  const auto before = meshTopology(fine);
   DecimateReport rep;
   DecimateOptions d;
-  o.finish = [&](SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) { rep = repairSlivers(m, d, distance); };
-  const auto m = vesselSurface(t, o);
-  const auto topo = meshTopology(m);
+  const auto [fine, m, before, topo] =
+      contouredWith([&](SurfaceMesh& s, const std::function<double(std::int32_t, const Vec3&)>& distance) { rep = repairSlivers(s, d, distance); });
   const auto slivers = [](const SurfaceMesh& s, double degrees) {
     std::int64_t n = 0;
     for (const auto& tri : s.triangles) {
@@ -754,12 +765,6 @@ TEST(Mesh, SliverRepairKeepsTopologyVolumeAndSurface) {
   EXPECT_LT(after_5 * 2, before_5);
   EXPECT_GT(rep.collapses + rep.flips + rep.moves, before_1);
   EXPECT_EQ(rep.after, std::int64_t(m.triangles.size()));
-  EXPECT_EQ(topo.boundary_edges, 0);
-  EXPECT_EQ(topo.nonmanifold_edges, 0);
-  EXPECT_EQ(topo.misoriented_edges, 0);
-  EXPECT_EQ(topo.degenerate_triangles, 0);
-  EXPECT_EQ(topo.tree_components, before.tree_components);
-  EXPECT_EQ(topo.tree_euler, before.tree_euler);
   EXPECT_NEAR(topo.volume_mm3, before.volume_mm3, 5e-4 * before.volume_mm3);
   EXPECT_LE(largestDistanceOverStep(t, m), std::max(largestDistanceOverStep(t, fine), d.max_error) * (1 + 1e-9));
   const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_slivers_" + std::to_string(::getpid()));

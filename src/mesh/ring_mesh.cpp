@@ -291,15 +291,9 @@ std::vector<std::vector<std::int32_t>> starLoops(SurfaceMesh& m, const std::vect
     if (makeStarShaped(m, ccw, around, keep, e.centre, e.normal, e.radius)) out[k] = std::move(ccw);
     else if (bent) (*bent)[k] = std::move(ccw);
   }
-  // Drop what the repairs removed, and renumber the loops as keepTriangles does.
-  std::vector<std::int32_t> renumber(m.vertices.size(), -1);
-  for (std::size_t t = 0; t < keep.size(); ++t)
-    if (keep[t])
-      for (auto p : m.triangles[t]) renumber[std::size_t(p)] = 0;
-  std::int32_t used = 0;
-  for (auto& r : renumber)
-    if (r == 0) r = used++;
-  keepTriangles(m, keep);
+  // Drop what the repairs removed, and renumber the loops.
+  std::vector<std::int32_t> renumber;
+  keepTriangles(m, keep, &renumber);
   for (auto& l : out)
     for (auto& p : l) p = renumber[std::size_t(p)];
   if (bent)
