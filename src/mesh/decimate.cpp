@@ -185,12 +185,13 @@ class Worker {
     }
   }
 
-  // Slivers among `triangles` (the cosine of the smallest angle above cos_sliver), in order,
-  // until a sweep changes nothing (or kSliverSweeps).
-  void sliverPass(const std::int32_t* first, const std::int32_t* last, double cos_sliver) {
+  // Slivers among `triangles` (the cosine of the smallest angle above cos_sliver_), from a work
+  // list: each repair queues the triangles it changed, and a failed one is tried again only once
+  // something near it has changed.
+  void sliverPass(const std::int32_t* first, const std::int32_t* last) {
     joins_caps_ = true;
     work_.assign(first, last);
-    // Each repair queues the triangles it changed; a bound on the work, against cycles of moves.
+    // A bound on the work, against cycles of moves.
     const std::size_t budget = kSliverWork * work_.size() + 64;
     for (std::size_t next = 0; next < work_.size() && next < budget; ++next) {
       const auto k = work_[next];
@@ -198,7 +199,7 @@ class Worker {
       const auto& t = m_.triangles[std::size_t(k)];
       const auto failed = st_.failed[std::size_t(k)];
       if (failed > 0 && std::none_of(t.begin(), t.end(), [&](std::int32_t v) { return st_.changed[std::size_t(v)] > failed; })) continue;
-      if (!(smallestAngleCosine(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]) > cos_sliver))
+      if (!(smallestAngleCosine(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]) > cos_sliver_))
         continue;
       blocked_ = false;
       if (!repair(k) && !blocked_) st_.failed[std::size_t(k)] = stamp();
@@ -242,6 +243,7 @@ class Worker {
     return false;
   }
 
+  // The worker's clock: unique within the pass, rising, and above every earlier pass's.
   std::uint64_t stamp() { return (st_.pass << 40) + ++changes_; }
   // x and its neighbours have changed; x's triangles are queued for the sliver pass.
   void touch(std::int32_t x) {
@@ -557,7 +559,7 @@ class Worker {
     Vec3 lo = moved_[0].at[0], hi = lo;
     for (const auto& mv : moved_)
       for (const auto& p : mv.at) lo = componentMin(lo, p), hi = componentMax(hi, p);
-    const std::uint64_t mark = (st_.pass << 40) + ++visits_;
+    const std::uint64_t mark = stamp();
     nearby_.clear();
     bool outside = false;
     const auto visit = [&](std::int32_t x) {
@@ -652,7 +654,6 @@ class Worker {
   mutable bool blocked_ = false;  // a check reached out of the block
   std::priority_queue<Candidate> queue_;
   std::vector<std::int32_t> ring_u_, ring_v_, nearby_, seeds_, touched_, work_;
-  std::uint64_t visits_ = 0;
   struct Moved {
     std::array<std::int32_t, 3> ids;
     Vec3 at[3];
@@ -716,7 +717,7 @@ std::int64_t runPass(State& st, DecimateReport& rep, double size, double shift, 
       const auto* last = first + blocks[i].size();
       if (kind == Pass::flip) workers[i].flipPass(first, last);
       else if (kind == Pass::collapse) workers[i].collapsePass(first, last);
-      else workers[i].sliverPass(first, last, cos_sliver);
+      else workers[i].sliverPass(first, last);
     }
   });
   std::int64_t made = 0;

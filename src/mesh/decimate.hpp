@@ -28,6 +28,8 @@ struct DecimateReport {
   std::int64_t before = 0, after = 0, collapses = 0, flips = 0, moves = 0;
   double largest_error_mm = 0;  // largest |distance| of a vertex placed
 
+  std::int64_t changes() const { return collapses + flips + moves; }
+  // Another pass over the same mesh: its changes added, its count of triangles the last.
   DecimateReport& operator+=(const DecimateReport& o) {
     after = o.after, collapses += o.collapses, flips += o.flips, moves += o.moves;
     largest_error_mm = std::max(largest_error_mm, o.largest_error_mm);

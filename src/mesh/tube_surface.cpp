@@ -837,7 +837,7 @@ class TubeMesher {
       rep.cut_retries += cm.cut_retries;
       rep.triangles_before_decimation += cm.decimation.before;
       rep.decimation_collapses += cm.decimation.collapses;
-      rep.slivers_repaired += cm.slivers.collapses + cm.slivers.flips + cm.slivers.moves;
+      rep.slivers_repaired += cm.slivers.changes();
       rep.decimation_largest_error_mm = std::max(rep.decimation_largest_error_mm, cm.decimation.largest_error_mm);
       rep.estimated_bytes = std::max(rep.estimated_bytes, cm.estimated_bytes);
       rep.finest_step_mm = rep.finest_step_mm > 0 ? std::min(rep.finest_step_mm, cm.step) : cm.step;

@@ -229,7 +229,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"triangles_before_decimation", p.decimate ? Json(reduced.before) : Json(nullptr)},
                     {"decimation_collapses", reduced.collapses},
                     {"decimation_largest_error_mm", reduced.largest_error_mm},
-                    {"slivers_repaired", tubes ? tube_report.slivers_repaired : slivers.collapses + slivers.flips + slivers.moves},
+                    {"slivers_repaired", tubes ? tube_report.slivers_repaired : slivers.changes()},
                     {"ends", ends.size()},
                     {"ends_cut", cut.cut},
                     {"ends_left_closed", cut.left_closed.size()},
