@@ -253,7 +253,8 @@ TEST_F(SafeDataset, MalformedAndEscapingManifestLinesAreReportedAndBlockNothing)
        << R"({"index": 2, "status": 7})" << "\n"                                             // wrong type
        << R"({"index": 2, "status": "ok", "finished_unix": 1e300, "files": [{"path": "../../../../etc/hostname", "size": 3, "sha256": ")"
        << std::string(64, 'a') << "\"}]}\n"
-       << "[1, 2, 3]\n";
+       << "[1, 2, 3]\n"
+       << R"({"index":0,"status":"ok","files":8,"status":"failed","error":"x"})" << "\n";  // found by fuzz_manifest
   part.close();
   const auto v = run("dataset verify raw/" + name_, dir_);
   EXPECT_EQ(v.code, 0) << v.err;  // the good entries still vouch for every sample
@@ -264,6 +265,7 @@ TEST_F(SafeDataset, MalformedAndEscapingManifestLinesAreReportedAndBlockNothing)
   EXPECT_NE(v.err.find("evil.jsonl:5: status is missing or not a string"), std::string::npos) << v.err;
   EXPECT_NE(v.err.find("evil.jsonl:6: file path '../../../../etc/hostname' leaves the dataset"), std::string::npos) << v.err;
   EXPECT_NE(v.err.find("evil.jsonl:7: not a JSON object"), std::string::npos) << v.err;
+  EXPECT_NE(v.err.find("evil.jsonl:8: files is not a list"), std::string::npos) << v.err;
   EXPECT_EQ(run("dataset finalize raw/" + name_, dir_).code, 0);
   EXPECT_EQ(run("dataset spec.toml --out raw --resume --quiet", dir_).code, 0);
   // Damaged directories are input errors, not internal ones.

@@ -97,9 +97,11 @@ std::string manifestEntryProblem(const nlohmann::json& j, std::int64_t samples) 
   if (j.contains("finished_unix") && !j["finished_unix"].is_number()) return "finished_unix is not a number";
   for (const char* key : {"id", "profile", "error", "part", "sample_sha256"})
     if (j.contains(key) && !j[key].is_string()) return std::string(key) + " is not a string";
-  if (status == "failed") return "";
-  if (status != "ok") return "status '" + status + "'; allowed: ok, failed";
-  if (!j.contains("files") || !j["files"].is_array() || j["files"].empty()) return "files is missing or empty";
+  if (status != "ok" && status != "failed") return "status '" + status + "'; allowed: ok, failed";
+  // A failed entry may still list files (a sample that failed late); they are checked the same way.
+  if (status == "failed" && !j.contains("files")) return "";
+  if (!j.contains("files") || !j["files"].is_array() || (status == "ok" && j["files"].empty()))
+    return status == "ok" ? "files is missing or empty" : "files is not a list";
   for (const auto& f : j["files"]) {
     if (!f.is_object() || !f.contains("path") || !f["path"].is_string() || !f.contains("size") ||
         !f["size"].is_number_unsigned() || !f.contains("sha256") || !f["sha256"].is_string())
