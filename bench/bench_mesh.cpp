@@ -2,8 +2,9 @@
 // surface (src/mesh): tubes joined to contoured junctions (--tubes 1, the default; --samples N
 // across each vessel where vessels meet, default 3) or contoured whole (--tubes 0; 4 samples
 // across), optionally decimated (--decimate 1) or with the contour's slivers repaired
-// (--slivers DEG: angles below DEG; 0, the default for closed ends, none), at the automatic step or --voxel MM:
-//   bench_mesh FILE.toml ... [--tubes 0|1] [--samples N] [--decimate 0|1] [--slivers DEG] [--voxel MM] [--threads T]
+// (--slivers DEG: angles below DEG or edges under 0.35 of the step; 0, the default for closed ends, none; with
+// --max-angle DEG, angles above DEG improved: 90 is the default with capped ends), at the automatic step or --voxel MM:
+//   bench_mesh FILE.toml ... [--tubes 0|1] [--samples N] [--decimate 0|1] [--slivers DEG] [--max-angle DEG] [--voxel MM] [--threads T]
 // Prints the step, the time, triangles in all and per segment, and the peak memory.
 // Targets (issue 15): 10k segments ≤ 10 s, ≤ 4 GB, ≤ 500 triangles per segment; 100k ≤ 2 min.
 #include <cstdio>
@@ -29,7 +30,9 @@ int main(int argc, char** argv) {
   const bool decimated = bench::takeOption(int(rest3.size()), rest3.data(), "--decimate", 0, rest4) != 0;
   std::vector<char*> rest5;
   const double slivers = bench::takeOption(int(rest4.size()), rest4.data(), "--slivers", 0, rest5);
-  const auto args = bench::parseFileArgs(int(rest5.size()), rest5.data());
+  std::vector<char*> rest6;
+  const double max_angle = bench::takeOption(int(rest5.size()), rest5.data(), "--max-angle", 0, rest6);
+  const auto args = bench::parseFileArgs(int(rest6.size()), rest6.data());
   std::printf("%-34s %9s %9s %10s %12s %10s %8s %9s\n", "file", "segments", "step mm", "mesh s", "triangles", "tri/seg", "genus0", "peak MiB");
   for (const auto& f : args.files) {
     const auto sc = readTomlParameters(f);
@@ -51,6 +54,7 @@ int main(int argc, char** argv) {
       to.junction.samples_across = samples;
       to.decimate = decimated;
       to.decimation.sliver_deg = slivers;
+      to.decimation.obtuse_deg = max_angle;
       m = tubeSurface(t, to, &trep);
       rep.voxel_mm = trep.finest_step_mm;
     } else {

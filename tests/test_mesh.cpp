@@ -491,7 +491,9 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
     EXPECT_EQ(caps["boundary_loops"], 0) << method;
     EXPECT_LT(caps["max_cap_plane_distance"].get<double>(), 1e-9) << method;  // share of the radius
     EXPECT_GT(caps["min_cap_area_ratio"].get<double>(), 0.95) << method;  // at two samples across a loop can have 12 vertices (0.955 πr²)
-    EXPECT_LT(caps["max_cap_area_ratio"].get<double>(), 1.01) << method;
+    // (the contour's loop runs through vertices the volume restoration moved out and the repair
+    // moved along: at two samples across, up to 1.4 % over)
+    EXPECT_LT(caps["max_cap_area_ratio"].get<double>(), 1.02) << method;
     EXPECT_GT(caps["min_cap_normal_cosine"].get<double>(), 0.999999) << method;
     const auto tetgen = check("capped", "--self-intersections");
     for (const auto& [ext, pairs] : tetgen.items()) EXPECT_EQ(pairs, 0) << method << ", " << ext << ": intersecting face pairs";
@@ -504,7 +506,7 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
   const std::string tetgen_fine = "cd '" + (dir / "capped").string() + "' && tetgen -pq1.414 -Q surface.off > tetgen.log 2>&1";
   EXPECT_EQ(std::system(tetgen_fine.c_str()), 0) << readText(dir / "capped/tetgen.log");
   EXPECT_TRUE(std::filesystem::exists(dir / "capped/surface.1.ele"));
-  for (const char* bad : {"--sliver-angle 40", "--sliver-angle -1"}) {
+  for (const char* bad : {"--sliver-angle 40", "--sliver-angle -1", "--max-angle 60", "--max-angle 180"}) {
     const auto refused = run(std::string("mesh sample --out bad --ends capped ") + bad + " --quiet", dir);
     EXPECT_EQ(refused.code, 2) << bad;
     EXPECT_FALSE(std::filesystem::exists(dir / "bad")) << bad;
@@ -528,10 +530,10 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
   EXPECT_EQ(sc["boundary_edges"], 0);
   EXPECT_EQ(sc["nonmanifold_edges"], 0);
   EXPECT_EQ(sc["tree_euler_characteristic"], nlohmann::json::array({2, 2}));
-  // The tubes are economical already (and the sliver repair thins the contour a little):
-  // decimation thins the contoured parts.
-  EXPECT_LT(sc["contoured_triangles"].get<double>() * 3, st["contoured_triangles"].get<double>());
-  EXPECT_LT(sc["triangles"].get<double>(), 0.6 * st["triangles"].get<double>());
+  // The tubes are economical already (capped, their rings 1.5 vertex spacings apart), and the
+  // sliver repair's short-edge collapses thin the contour: decimation halves the contoured parts.
+  EXPECT_LT(sc["contoured_triangles"].get<double>() * 2, st["contoured_triangles"].get<double>());
+  EXPECT_LT(sc["triangles"].get<double>(), 0.8 * st["triangles"].get<double>());
   const auto coarse_caps = check("coarse", "--ends");
   EXPECT_EQ(coarse_caps["caps"], 26);
   EXPECT_LT(coarse_caps["max_cap_plane_distance"].get<double>(), 1e-9);
@@ -738,12 +740,15 @@ TEST(Mesh, DecimationKeepsTopologyVolumeAndSurface) {
 
 // The sliver repair (run on every contour) removes most triangles with an angle under 1° —
 // marching tetrahedra leave them where the surface passes by a grid point, and TetGen refines
-// around each — and keeps what decimation keeps: topology, closedness, the volume (to 0.05 %),
+// around each — and most edges under a fifth of the step; with max_angle 90 (the capped
+// default) it removes most triangles with an angle over 100° (TetGen splits the edge an obtuse
+// angle faces). It keeps what decimation keeps: topology, closedness, the volume (to 0.05 %),
 // vertices within max_error steps of the vessels, and no intersecting faces (TetGen's test).
 TEST(Mesh, SliverRepairKeepsTopologyVolumeAndSurface) {
   const auto& t = forest().forest.vessels;
   DecimateReport rep;
   DecimateOptions d;
+  d.obtuse_deg = 90;
   const auto [fine, m, before, topo] =
       contouredWith([&](SurfaceMesh& s, const std::function<double(std::int32_t, const Vec3&)>& distance) { rep = repairSlivers(s, d, distance); });
   const auto slivers = [](const SurfaceMesh& s, double degrees) {
@@ -760,6 +765,28 @@ TEST(Mesh, SliverRepairKeepsTopologyVolumeAndSurface) {
     return n;
   };
   const auto before_1 = slivers(fine, 1), after_1 = slivers(m, 1), before_5 = slivers(fine, 5), after_5 = slivers(m, 5);
+  // Triangles with an angle over 100°, and with an edge under a fifth of the smallest step at its ends.
+  const auto obtuse = [](const SurfaceMesh& s) {
+    std::int64_t n = 0;
+    for (const auto& tri : s.triangles) {
+      const Vec3 p[3] = {s.vertices[std::size_t(tri[0])], s.vertices[std::size_t(tri[1])], s.vertices[std::size_t(tri[2])]};
+      for (int i = 0; i < 3; ++i) n += dot(p[(i + 1) % 3] - p[i], p[(i + 2) % 3] - p[i]) < std::cos(100 * std::numbers::pi / 180) *
+                                                                                          norm(p[(i + 1) % 3] - p[i]) * norm(p[(i + 2) % 3] - p[i]);
+    }
+    return n;
+  };
+  const auto short_edges = [](const SurfaceMesh& s) {
+    std::int64_t n = 0;
+    for (const auto& tri : s.triangles)
+      for (int i = 0; i < 3; ++i) {
+        const auto a = std::size_t(tri[std::size_t(i)]), b = std::size_t(tri[std::size_t((i + 1) % 3)]);
+        n += a < b && norm(s.vertices[a] - s.vertices[b]) < 0.2 * std::min(s.vertex_step[a], s.vertex_step[b]);
+      }
+    return n;
+  };
+  const auto obtuse_before = obtuse(fine), obtuse_after = obtuse(m), short_before = short_edges(fine), short_after = short_edges(m);
+  EXPECT_LT(obtuse_after * 5, obtuse_before);
+  EXPECT_LT(short_after * 10, short_before);
   EXPECT_GT(before_1, 100);
   EXPECT_LT(after_1 * 4, before_1);
   EXPECT_LT(after_5 * 2, before_5);
@@ -777,7 +804,8 @@ TEST(Mesh, SliverRepairKeepsTopologyVolumeAndSurface) {
                           "' off > '" + (dir / "tetgen.json").string() + "'";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   EXPECT_EQ(nlohmann::json::parse(readText(dir / "tetgen.json"))["off"], 0) << "intersecting face pairs";
-  std::cout << "under 1 degree " << before_1 << " -> " << after_1 << ", under 5 degrees " << before_5 << " -> " << after_5 << "; " << rep.collapses
+  std::cout << "under 1 degree " << before_1 << " -> " << after_1 << ", under 5 degrees " << before_5 << " -> " << after_5 << ", over 100 degrees "
+            << obtuse_before << " -> " << obtuse_after << ", edges under 0.2 steps " << short_before << " -> " << short_after << "; " << rep.collapses
             << " collapses, " << rep.flips << " flips, " << rep.moves << " moves; volume " << before.volume_mm3 << " -> " << topo.volume_mm3 << "\n";
   std::filesystem::remove_all(dir);
 }

@@ -28,7 +28,8 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
                 "tubes: each vessel's free middle a tube of rings on its wall, the parts where vessels meet contoured and joined to "
                 "them (default); contour: the whole surface contoured from the signed distance")
       ->check(CLI::IsMember({"tubes", "contour"}));
-  c->add_option("--ring-spacing", a.ring_spacing, "tubes: rings at most this many radii apart (default 2)")->check(finiteIn(0.1, 100));
+  c->add_option("--ring-spacing", a.ring_spacing, "tubes: rings at most this many radii apart (default 2; with --ends capped 1.5 times the rings' vertex spacing, "
+                                          "about 0.9 radii at 3 samples across, which TetGen's -q1.414 leaves unsplit)")->check(finiteIn(0.1, 100));
   c->add_option("--wall-thickness", a.wall_thickness,
                 "a hollow wall of this thickness in mm around each vessel's lumen (seed 004): the wall's surface, outer side, lumen "
                 "and a flat ring at each open end")
@@ -62,6 +63,11 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
                 "repair contoured triangles with an angle below this many degrees (collapse, flip or move under the checks of "
                 "--decimate), as TetGen needs; 0: none (default 10 with --ends capped, else 0)")
       ->check(finiteIn(0, 30));
+  c->add_option("--max-angle", a.max_angle,
+                "with the sliver repair: improve contoured triangles with an angle above this many degrees (Delaunay flip or a corner "
+                "moved, under the same checks): TetGen splits every edge an obtuse angle faces; 0: none, else 90 ... 180 (default 90 "
+                "with --ends capped, else 0)")
+      ->check(finiteIn(0, 180));
   c->add_option("--clip-box", a.clip_box,
                 "X0,Y0,Z0,X1,Y1,Z1: clip the closed surface to this box (mm), each side's section filled flat (a hollow wall's lumen "
                 "stays open there: the printed block of seed 004)")
@@ -106,6 +112,9 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   p.decimate = a.decimate;
   p.max_error = a.max_error;
   p.sliver_angle = a.sliver_angle;
+  p.max_angle = a.max_angle;
+  if (p.max_angle > 0 && !(p.max_angle >= 90 && p.max_angle < 180))
+    throw InputError("", 0, "--max-angle is out of range; allowed: 0 (none) or [90, 180) degrees");
   if (p.ends == "closed" && p.flow_extension > 0) throw InputError("", 0, "--flow-extension needs --ends open or capped");
   p.clip_box = a.clip_box;
   if (const auto why = clipBoxProblem(p); !why.empty()) throw InputError("", 0, why);

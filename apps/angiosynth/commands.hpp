@@ -78,7 +78,7 @@ struct MeshArgs {
   std::string method = "tubes";
   double voxel_mm = 0;
   int samples_across = 0;
-  double ring_spacing = 2;
+  double ring_spacing = -1;
   double wall_thickness = 0, wall_ratio = 0;
   bool wall_from_graph = false;
   bool uniform = false, on_surface = false;
@@ -87,6 +87,7 @@ struct MeshArgs {
   bool decimate = false;
   double max_error = 0.1;
   double sliver_angle = -1;
+  double max_angle = -1;
   std::vector<double> clip_box;
   std::vector<std::string> formats;
   bool force = false;

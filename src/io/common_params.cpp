@@ -43,7 +43,8 @@ const std::vector<MethodParam>& commonParams() {
       {"mesh", "voxel_size", "mm", "the thinnest vessel's diameter / samples_across", "the finest grid step"},
       {"mesh", "samples_across", "count", "3 (tubes), 4 (contour)",
        "grid steps across each vessel's thinnest end where it is contoured (1 … 64); thicker vessels get coarser cells"},
-      {"mesh", "ring_spacing", "radii", "2", "tubes: rings at most this many radii of the vessel apart (0.1 … 100)"},
+      {"mesh", "ring_spacing", "radii", "2; with capped ends 1.5 times the rings' vertex spacing",
+       "tubes: rings at most this many radii of the vessel apart (0.1 … 100); successive rings are turned by half a vertex spacing"},
       {"mesh", "wall_thickness", "mm", "0 (no wall)",
        "a hollow wall of this thickness around each vessel's lumen (seed 004): the surface bounds the wall (outer side, lumen, a flat "
        "ring at each end, all ends open); one of wall_thickness, wall_ratio, wall_from_graph"},
@@ -62,7 +63,10 @@ const std::vector<MethodParam>& commonParams() {
       {"mesh", "max_error", "share of the local step", "0.1", "with decimate: the largest distance from the vessels' surface, (0, 1]"},
       {"mesh", "sliver_angle", "degrees", "10 with capped ends, else 0",
        "contoured triangles with an angle below this are repaired (an edge collapsed, a cap's edge flipped, a corner moved) under "
-       "decimation's checks, as a tetrahedral mesher needs; 0: none, [0, 30]"},
+       "decimation's checks, as a tetrahedral mesher needs; so are those with an edge shorter than 0.35 of the local step; 0: none, [0, 30]"},
+      {"mesh", "max_angle", "degrees", "90 with capped ends, else 0",
+       "with the sliver repair: contoured triangles with an angle above this are improved (the long edge flipped, a corner moved) under "
+       "the same checks: a tetrahedral mesher splits the edge an obtuse angle faces; 0: none, else [90, 180)"},
       {"mesh", "flow_extension", "radii", "0", "open/capped: each end prolonged straight by this many radii of its vessel before the cut (0 … 100)"},
       {"mesh", "clip_box", "[mm × 6]", "none",
        "[x0, y0, z0, x1, y1, z1]: the closed surface (closed or capped ends, or a hollow wall) clipped to this box, each side's section "

@@ -45,7 +45,8 @@ struct MeshParameters {
   std::string method = "tubes";             // tubes (rings along free vessels, contoured junctions) or contour (all contoured)
   double voxel_mm = 0;                      // finest step; 0: the thinnest vessel's diameter / samples_across
   int samples_across = 0;                   // 0: the method's (contour 4, tubes 3)
-  double ring_spacing = 2;                  // tubes: rings at most this many radii apart
+  double ring_spacing = -1;                 // tubes: rings at most this many radii apart; −1: 2, with capped ends 1.5 ring vertex spacings (0)
+  double ringSpacing() const { return ring_spacing > 0 ? ring_spacing : ends == "capped" ? 0 : 2; }
   double wall_thickness = 0;                // mm: a hollow wall of this thickness (0: none), or
   double wall_ratio = 0;                    // of this share of each vessel's radius, or
   bool wall_from_graph = false;             // of each vessel's own wall (a graph's wall thickness)
@@ -57,6 +58,8 @@ struct MeshParameters {
   double max_error = 0.1;                   // share of the local step
   double sliver_angle = -1;                 // degrees: contoured triangles with a smaller angle are repaired; −1: 10 with capped ends, else 0 (none)
   double sliverAngle() const { return sliver_angle >= 0 ? sliver_angle : ends == "capped" ? 10 : 0; }
+  double max_angle = -1;                    // degrees: with the sliver repair, contoured triangles with a larger angle are improved; −1: 90 with capped ends, else 0 (none)
+  double maxAngle() const { return max_angle >= 0 ? max_angle : ends == "capped" ? 90 : 0; }
   // mm: x0, y0, z0, x1, y1, z1 of a box the closed surface is clipped to, each side's section
   // filled (a hollow wall's lumen open there); empty: none
   std::vector<double> clip_box;

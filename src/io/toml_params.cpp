@@ -147,7 +147,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
 
   // [mesh]: the vessels' surface beside the graphs (src/mesh); the table's presence enables it.
   const auto& me = r.table("mesh", {"enabled", "method", "formats", "voxel_size", "samples_across", "ring_spacing", "uniform", "on_surface", "ends",
-                                    "flow_extension", "decimate", "max_error", "sliver_angle", "wall_thickness", "wall_ratio", "wall_from_graph", "clip_box"});
+                                    "flow_extension", "decimate", "max_error", "sliver_angle", "max_angle", "wall_thickness", "wall_ratio", "wall_from_graph", "clip_box"});
   if (const auto* n = root.get("mesh")) {
     auto& mp = sc.mesh;
     sc.mesh_line = r.lineOf(n);
@@ -183,6 +183,10 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     if (me.get("sliver_angle")) {
       mp.sliver_angle = r.number(me, "mesh", "sliver_angle");
       checkRange(mp.sliver_angle, 0, false, 30, false, r.at(me, "sliver_angle"), "sliver_angle (degrees)");
+    }
+    if (me.get("max_angle")) {
+      mp.max_angle = r.number(me, "mesh", "max_angle");
+      if (mp.max_angle != 0) checkRange(mp.max_angle, 90, false, 180, true, r.at(me, "max_angle"), "max_angle (degrees; 0: none)");
     }
     if (me.get("wall_thickness")) {
       mp.wall_thickness = r.quantity(me, "mesh", "wall_thickness", Dimension::Length, voxel_mm);

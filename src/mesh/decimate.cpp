@@ -50,6 +50,28 @@ double smallestAngleCosine(const Vec3& a, const Vec3& b, const Vec3& c) {
   return std::isfinite(m) ? m : 1.0;
 }
 
+// The cosine of a triangle's largest angle (the smallest of its corners' cosines), and the corner.
+double largestAngleCosine(const Vec3& a, const Vec3& b, const Vec3& c, int* corner = nullptr) {
+  const Vec3 ab = b - a, bc = c - b, ca = a - c;
+  const double lab = dot(ab, ab), lbc = dot(bc, bc), lca = dot(ca, ca);
+  const double at[3] = {-dot(ab, ca) / std::sqrt(lab * lca), -dot(bc, ab) / std::sqrt(lbc * lab), -dot(ca, bc) / std::sqrt(lca * lbc)};
+  const int i = at[0] <= at[1] && at[0] <= at[2] ? 0 : at[1] <= at[2] ? 1 : 2;
+  if (corner) *corner = i;
+  return std::isfinite(at[i]) ? at[i] : -1.0;
+}
+
+// A sliver: an angle below the bound, or an edge shorter than kShortEdge of its ends' step (a
+// tetrahedral mesher grades its elements down to the shortest edge near it).
+constexpr double kShortEdge = 0.35;
+bool isSliver(const SurfaceMesh& m, const std::array<std::int32_t, 3>& t, double cos_sliver) {
+  const Vec3 p0 = m.vertices[std::size_t(t[0])], p1 = m.vertices[std::size_t(t[1])], p2 = m.vertices[std::size_t(t[2])];
+  if (smallestAngleCosine(p0, p1, p2) > cos_sliver) return true;
+  if (m.vertex_step.empty()) return false;
+  const double step = std::min({m.vertex_step[std::size_t(t[0])], m.vertex_step[std::size_t(t[1])], m.vertex_step[std::size_t(t[2])]});
+  const double shortest2 = std::min({dot(p1 - p0, p1 - p0), dot(p2 - p1, p2 - p1), dot(p0 - p2, p0 - p2)});
+  return shortest2 < kShortEdge * kShortEdge * step * step;
+}
+
 double orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) { return dot(b - a, cross(c - a, d - a)); }
 
 // Segment p–q passes through the inside of triangle abc (touching counts as not: vertices
@@ -153,6 +175,7 @@ class Worker {
     cos_turn_ = std::cos(o_.max_turn_deg * std::numbers::pi / 180);
     cos_min_angle_ = std::cos(o_.min_angle_deg * std::numbers::pi / 180);
     cos_sliver_ = std::cos(o_.sliver_deg * std::numbers::pi / 180);
+    cos_obtuse_ = std::cos(o_.obtuse_deg * std::numbers::pi / 180);
   }
 
   std::int64_t collapses = 0, flips = 0, moves = 0, removed = 0;
@@ -188,8 +211,8 @@ class Worker {
   // Slivers among `triangles` (the cosine of the smallest angle above cos_sliver_), from a work
   // list: each repair queues the triangles it changed, and a failed one is tried again only once
   // something near it has changed.
-  void sliverPass(const std::int32_t* first, const std::int32_t* last) {
-    joins_caps_ = true;
+  void sliverPass(const std::int32_t* first, const std::int32_t* last, bool obtuse = false) {
+    joins_caps_ = !obtuse;
     work_.assign(first, last);
     // A bound on the work, against cycles of moves.
     const std::size_t budget = kSliverWork * work_.size() + 64;
@@ -199,10 +222,10 @@ class Worker {
       const auto& t = m_.triangles[std::size_t(k)];
       const auto failed = st_.failed[std::size_t(k)];
       if (failed > 0 && std::none_of(t.begin(), t.end(), [&](std::int32_t v) { return st_.changed[std::size_t(v)] > failed; })) continue;
-      if (!(smallestAngleCosine(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]) > cos_sliver_))
-        continue;
+      const Vec3 p0 = m_.vertices[std::size_t(t[0])], p1 = m_.vertices[std::size_t(t[1])], p2 = m_.vertices[std::size_t(t[2])];
+      if (obtuse ? !(largestAngleCosine(p0, p1, p2) < cos_obtuse_) : !isSliver(m_, t, cos_sliver_)) continue;
       blocked_ = false;
-      if (!repair(k) && !blocked_) st_.failed[std::size_t(k)] = stamp();
+      if (!(obtuse ? repairObtuse(k) : repair(k)) && !blocked_) st_.failed[std::size_t(k)] = stamp();
     }
   }
 
@@ -296,28 +319,55 @@ class Worker {
     return false;
   }
 
-  // Moves x to the mean of its neighbours, put back onto the surface along the distance's
-  // gradient, if that raises the smallest angle of its triangles and passes the checks of a
-  // collapse (turn, distance, nothing nearby cut).
-  bool relax(std::int32_t x, std::int32_t tree) {
+  // An obtuse triangle's long edge encroaches on its opposite corner: a tetrahedral mesher
+  // splits it, and the split's neighbours in turn. Its long edge flips (a Delaunay flip), else
+  // its corners move to the middle of their neighbours, on the surface, where that lowers the
+  // largest angle around them.
+  bool repairObtuse(std::int32_t k) {
+    const auto t = m_.triangles[std::size_t(k)];
+    int c = 0;
+    largestAngleCosine(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])], &c);
+    if (flip(k, t[std::size_t((c + 1) % 3)], t[std::size_t((c + 2) % 3)])) {
+      ++flips;
+      for (auto x : {t[0], t[1], t[2]}) touch(x);
+      for (auto x : m_.triangles[std::size_t(k)]) touch(x);
+      return true;
+    }
+    for (int i = 0; i < 3; ++i)
+      if (relax(t[std::size_t((c + i) % 3)], m_.triangle_tree[std::size_t(k)], Aim::largest)) {
+        ++moves;
+        touch(t[std::size_t((c + i) % 3)]);
+        return true;
+      }
+    return false;
+  }
+
+  // Moves x to the mean of its neighbours, then along its star's normal to where the star keeps
+  // its volume (the volume is linear in x's position), if that raises the smallest angle of its
+  // triangles (Aim::largest: lowers the largest, the smallest staying above the floor or where it
+  // was) and passes the checks of a collapse (turn, distance, nothing nearby cut). Put onto the
+  // surface instead, the corners moved lost 0.12 % of the test forest's volume; kept at their
+  // offset from it, they gained 0.09 %.
+  enum class Aim { smallest, largest };
+  bool relax(std::int32_t x, std::int32_t tree, Aim aim = Aim::smallest) {
     if (locked_[std::size_t(x)]) return false;
     neighbours(x, ring_u_);
     if (ring_u_.empty() || !mine(ring_u_)) return false;
     Vec3 c(0, 0, 0);
     for (auto y : ring_u_) c += m_.vertices[std::size_t(y)];
     c = c / double(ring_u_.size());
-    const double limit = o_.max_error * stepOf(x), h = 1e-3 * stepOf(x);
-    if (!std::isfinite(h)) return false;
-    for (int it = 0; it < 2; ++it) {
-      const double d = distance_(tree, c);
-      const Vec3 g((distance_(tree, c + Vec3(h, 0, 0)) - distance_(tree, c - Vec3(h, 0, 0))) / (2 * h),
-                   (distance_(tree, c + Vec3(0, h, 0)) - distance_(tree, c - Vec3(0, h, 0))) / (2 * h),
-                   (distance_(tree, c + Vec3(0, 0, h)) - distance_(tree, c - Vec3(0, 0, h))) / (2 * h));
-      if (!(dot(g, g) > 0)) return false;
-      c = c - g * (d / dot(g, g));
+    // 6 × the star's volume as cones from the origin is x · g.
+    Vec3 g(0, 0, 0);
+    for (auto k : around_[std::size_t(x)]) {
+      const auto& t = m_.triangles[std::size_t(k)];
+      const int i = t[0] == x ? 0 : t[1] == x ? 1 : 2;
+      g += cross(m_.vertices[std::size_t(t[std::size_t((i + 1) % 3)])], m_.vertices[std::size_t(t[std::size_t((i + 2) % 3)])]);
     }
+    if (!(dot(g, g) > 0)) return false;
+    c = c + g * (dot(m_.vertices[std::size_t(x)] - c, g) / dot(g, g));
+    const double limit = o_.max_error * stepOf(x);
     if (!(std::abs(distance_(tree, c)) <= limit)) return false;
-    double old_cos = -1, new_cos = -1;
+    double old_cos = -1, new_cos = -1, old_big = 1, new_big = 1;
     const Vec3 star = starNormal(x, x);
     moved_.clear();
     for (auto k : around_[std::size_t(x)]) {
@@ -329,11 +379,14 @@ class Worker {
       }
       old_cos = std::max(old_cos, smallestAngleCosine(before[0], before[1], before[2]));
       new_cos = std::max(new_cos, smallestAngleCosine(after[0], after[1], after[2]));
+      old_big = std::min(old_big, largestAngleCosine(before[0], before[1], before[2]));
+      new_big = std::min(new_big, largestAngleCosine(after[0], after[1], after[2]));
       if (turnsOver(before, after, star)) return false;
       if (!(std::abs(distance_(tree, (after[0] + after[1] + after[2]) / 3.0)) <= limit)) return false;
       moved_.push_back({t, {after[0], after[1], after[2]}});
     }
-    if (!(new_cos < old_cos - 1e-3)) return false;
+    const bool better = aim == Aim::smallest ? new_cos < old_cos - 1e-3 : new_big > old_big + 1e-3 && new_cos <= std::max(cos_min_angle_, old_cos);
+    if (!better) return false;
     if (cutsNear(ring_u_, [&](const std::array<std::int32_t, 3>& t, std::int32_t) { return t[0] == x || t[1] == x || t[2] == x; })) return false;
     m_.vertices[std::size_t(x)] = c;
     ++version_[std::size_t(x)];
@@ -659,7 +712,7 @@ class Worker {
     Vec3 at[3];
   };
   std::vector<Moved> moved_;
-  double cos_turn_ = 0, cos_min_angle_ = 1, cos_sliver_ = 1;
+  double cos_turn_ = 0, cos_min_angle_ = 1, cos_sliver_ = 1, cos_obtuse_ = -1;
 };
 
 // Blocks: cubes of kBlockSteps median steps, shifted by half a block in odd passes so that what
@@ -669,7 +722,7 @@ constexpr int kRounds = 4;
 
 // Alive triangles with all three vertices in one block, grouped by block (blocks and triangles
 // in ascending order); with cos_sliver ≤ 1, only those whose smallest angle lies below it.
-std::vector<std::vector<std::int32_t>> partition(State& st, double size, double shift, double cos_sliver) {
+std::vector<std::vector<std::int32_t>> partition(State& st, double size, double shift, double cos_sliver, double cos_obtuse) {
   const auto& m = st.m;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m.vertices.size(), 8192), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t v = r.begin(); v != r.end(); ++v) {
@@ -684,8 +737,10 @@ std::vector<std::vector<std::int32_t>> partition(State& st, double size, double 
     const auto& t = m.triangles[k];
     const auto b = st.block[std::size_t(t[0])];
     if (st.block[std::size_t(t[1])] != b || st.block[std::size_t(t[2])] != b) continue;
+    const Vec3 p0 = m.vertices[std::size_t(t[0])], p1 = m.vertices[std::size_t(t[1])], p2 = m.vertices[std::size_t(t[2])];
+    if (cos_obtuse >= -1 && !(largestAngleCosine(p0, p1, p2) < cos_obtuse)) continue;
     if (cos_sliver <= 1 &&
-        (!(smallestAngleCosine(m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[1])], m.vertices[std::size_t(t[2])]) > cos_sliver) ||
+        (!isSliver(m, t, cos_sliver) ||
          (st.at_fixed_only && !st.locked[std::size_t(t[0])] && !st.locked[std::size_t(t[1])] && !st.locked[std::size_t(t[2])])))
       continue;
     keyed.emplace_back(b, std::int32_t(k));
@@ -699,15 +754,16 @@ std::vector<std::vector<std::int32_t>> partition(State& st, double size, double 
   return blocks;
 }
 
-enum class Pass { collapse, flip, sliver };
+enum class Pass { collapse, flip, sliver, obtuse };
 
 // One pass of `kind` over blocks of `size` mm shifted by `shift` blocks, its blocks in parallel;
 // the collapses and flips it made.
 std::int64_t runPass(State& st, DecimateReport& rep, double size, double shift, Pass kind) {
   const double cos_sliver = kind == Pass::sliver ? std::cos(st.o.sliver_deg * std::numbers::pi / 180) : 2.0;
-  const auto blocks = partition(st, size, shift, cos_sliver);
+  const double cos_obtuse = kind == Pass::obtuse ? std::cos(st.o.obtuse_deg * std::numbers::pi / 180) : -2.0;
+  const auto blocks = partition(st, size, shift, cos_sliver, cos_obtuse);
   ++st.pass;
-  if (kind == Pass::sliver && st.changed.empty()) st.changed.assign(st.m.vertices.size(), 0), st.failed.assign(st.m.triangles.size(), 0);
+  if ((kind == Pass::sliver || kind == Pass::obtuse) && st.changed.empty()) st.changed.assign(st.m.vertices.size(), 0), st.failed.assign(st.m.triangles.size(), 0);
   std::vector<Worker> workers;
   workers.reserve(blocks.size());
   for (const auto& b : blocks) workers.emplace_back(st, st.block[std::size_t(st.m.triangles[std::size_t(b.front())][0])]);
@@ -717,7 +773,7 @@ std::int64_t runPass(State& st, DecimateReport& rep, double size, double shift, 
       const auto* last = first + blocks[i].size();
       if (kind == Pass::flip) workers[i].flipPass(first, last);
       else if (kind == Pass::collapse) workers[i].collapsePass(first, last);
-      else workers[i].sliverPass(first, last);
+      else workers[i].sliverPass(first, last, kind == Pass::obtuse);
     }
   });
   std::int64_t made = 0;
@@ -759,7 +815,9 @@ DecimateReport decimate(SurfaceMesh& m, const DecimateOptions& o, const std::fun
     runPass(st, rep, size, round % 2 ? 0.5 : 0.0, Pass::flip);
   }
   if (o.sliver_deg > 0)
-    for (double shift : {0.0, 0.5}) runPass(st, rep, size, shift, Pass::sliver);
+    for (const Pass kind : {Pass::sliver, Pass::obtuse})
+      if (kind == Pass::sliver || o.obtuse_deg > 0)
+        for (double shift : {0.0, 0.5}) runPass(st, rep, size, shift, kind);
   st.compact(renumber);
   return rep;
 }
@@ -773,6 +831,8 @@ DecimateReport repairSlivers(SurfaceMesh& m, const DecimateOptions& o, const std
   st.at_fixed_only = at_fixed_only;
   const double size = blockSize(m);
   for (double shift : {0.0, 0.5}) runPass(st, rep, size, shift, Pass::sliver);
+  if (o.obtuse_deg > 0)
+    for (double shift : {0.0, 0.5}) runPass(st, rep, size, shift, Pass::obtuse);
   st.compact(renumber);
   return rep;
 }

@@ -722,17 +722,29 @@ class TubeMesher {
       if (std::size_t(e) < ns) skip[std::size_t(e)] = 1;
     return skip;
   }
-  // A ring of n vertices around the axis at distance y from a: on the wall, or (restoring the
-  // volume) where the polygon's area is the circle's.
-  void ring(SurfaceMesh& m, const Vessel& v, double y, int n, std::vector<std::int32_t>& out) const {
+  // A ring's radius over its vessel's: 1 on the wall; restoring the volume, what gives the bands
+  // between rings the circle's area per length. Successive rings are turned by half a step
+  // (`phase` 0 or ½), so the bands' triangles are acute (on aligned rings they were right-angled,
+  // and a tetrahedral mesher splits the long edge of every such pair); such a band is a
+  // prismatoid whose middle section is the 2n-gon of radius cos(π/2n), so it holds
+  // (1 + 2 cos²(π/2n) / cos(π/n)) / 3 of its rings' polygon area per length.
+  // `face`: a CFD end's ring, whose polygon (its cap) has the circle's area.
+  double ringScale(int n, bool face = false) const {
+    if (!o_.junction.restore_volume) return 1.0;
+    const double step = kTwoPi / n, polygon = std::sin(step) / step;  // the n-gon's area over its circle's
+    const double middle = std::pow(std::cos(step / 4), 2) / std::cos(step / 2);
+    return 1 / std::sqrt(polygon * (face ? 1.0 : (1 + 2 * middle) / 3));
+  }
+  // A ring of n vertices around the axis at distance y from a, its first at `phase` steps.
+  void ring(SurfaceMesh& m, const Vessel& v, double y, int n, double phase, std::vector<std::int32_t>& out, bool face = false) const {
     Vec3 e1, e2;
     frameOf(v.u, e1, e2);
     const double r = v.radiusAt(y), step = kTwoPi / n;
-    const double R = o_.junction.restore_volume ? r * std::sqrt(step / std::sin(step)) : r;
+    const double R = r * ringScale(n, face);
     const Vec3 c = v.a + v.u * y;
     out.clear();
     for (int k = 0; k < n; ++k) {
-      const double phi = step * k;
+      const double phi = step * (k + phase);
       out.push_back(std::int32_t(m.vertices.size()));
       m.vertices.push_back(c + (e1 * std::cos(phi) + e2 * std::sin(phi)) * R);
       m.vertex_step.push_back(float(step * R));
@@ -742,10 +754,10 @@ class TubeMesher {
   // A round end of rings: latitude rings on the sphere of the end's radius around its node, and
   // its pole. The rings' polygons keep the tube's area correction, and the whole cap is scaled
   // so its volume is the hemisphere's (on_surface: every vertex on the sphere).
-  void roundCap(SurfaceMesh& m, const Vessel& v, int k, const std::vector<std::int32_t>& base, int n) const {
+  void roundCap(SurfaceMesh& m, const Vessel& v, int k, const std::vector<std::int32_t>& base, int n, double phase) const {
     const int bands = std::max(2, int(std::lround(n / 4.0)));
     const bool restore = o_.junction.restore_volume;
-    const double step = kTwoPi / n, area = restore ? std::sqrt(step / std::sin(step)) : 1.0;
+    const double step = kTwoPi / n, area = ringScale(n);
     const double f = restore ? capScale(n, bands, area) : 1.0;
     const double r = v.radiusAt(k == 0 ? 0.0 : v.len);
     const Vec3 node = v.nodeAt(k), out = v.into(k) * -1.0;
@@ -756,7 +768,7 @@ class TubeMesher {
       const double phi = std::numbers::pi / 2 * j / bands;
       std::vector<std::int32_t> ring;
       for (int q = 0; q < n; ++q) {
-        const double a = step * q;
+        const double a = step * (q + phase);
         ring.push_back(std::int32_t(m.vertices.size()));
         m.vertices.push_back(node + out * (f * r * std::sin(phi)) + (e1 * std::cos(a) + e2 * std::sin(a)) * (f * area * r * std::cos(phi)));
         m.vertex_step.push_back(float(step * r));
@@ -869,16 +881,32 @@ class TubeMesher {
       // A chord of a ring of n stands r (1 − cos π/n) inside the wall at its middle.
       if (o_.ring_tolerance_mm > 0 && o_.ring_tolerance_mm < v.rmax())
         n_ring = std::max(n_ring, int(std::ceil(std::numbers::pi / std::acos(1 - o_.ring_tolerance_mm / v.rmax()))));
+      // Rings at most ring_spacing_radii radii apart. A contoured loop has several times a
+      // ring's vertices: zipped to a ring two radii away, its band fans out into triangles of a
+      // few degrees (a quarter of the tube's triangles were under 5°), so the first ring stands
+      // kLoopBand radii from it.
+      const bool band0 = !v.round[0] && v.end[0] < 0, band1 = !v.round[1] && v.end[1] < 0;  // a contoured loop at that side
+      const double lo = band0 ? std::min(y0 + kLoopBand * v.radiusAt(y0), y0 + (y1 - y0) / 3) : y0;
+      const double hi = band1 ? std::max(y1 - kLoopBand * v.radiusAt(y1), y1 - (y1 - y0) / 3) : y1;
+      std::vector<double> at;
+      if (band0) at.push_back(lo);
+      const double spacing = (o_.ring_spacing_radii > 0 ? o_.ring_spacing_radii : kCfdRingSpacing * kTwoPi / n_ring) * 0.5 * (v.radiusAt(y0) + v.radiusAt(y1));
+      const int pieces = std::max(1, int(std::ceil((hi - lo) / std::max(spacing, 1e-12))));
+      for (int q = 1; q < pieces; ++q) at.push_back(lo + (hi - lo) * q / pieces);
+      if (band1) at.push_back(hi);
+      // Ring j of the tube (0 at y0, at.size() + 1 at y1) turned by j half steps.
+      const auto phase = [](std::size_t j) { return j % 2 ? 0.5 : 0.0; };
       for (int k = 0; k < 2; ++k) {
         auto& l = loops[i][std::size_t(k)];
+        const double turn = phase(k == 0 ? 0 : at.size() + 1);
         if (v.round[k]) {
-          ring(m, v, k == 0 ? y0 : y1, n_ring, l);
-          roundCap(m, v, k, l, n_ring);
+          ring(m, v, k == 0 ? y0 : y1, n_ring, turn, l);
+          roundCap(m, v, k, l, n_ring, turn);
           continue;
         }
         if (v.end[k] < 0) continue;
         // A CFD end: its ring in its plane, open or capped.
-        ring(m, v, k == 0 ? y0 : y1, n_ring, l);
+        ring(m, v, k == 0 ? y0 : y1, n_ring, turn, l, true);
         const auto& e = o_.ends[std::size_t(v.end[k])];
         ++rep.ends.cut;
         rep.ends.loop_vertices[std::size_t(v.end[k])] = std::int32_t(l.size());
@@ -898,22 +926,9 @@ class TubeMesher {
         }
         rep.ends.cap_area_mm2[std::size_t(v.end[k])] = area;
       }
-      // Rings at most ring_spacing_radii radii apart. A contoured loop has several times a
-      // ring's vertices: zipped to a ring two radii away, its band fans out into triangles of a
-      // few degrees (a quarter of the tube's triangles were under 5°), so the first ring stands
-      // kLoopBand radii from it.
-      const bool band0 = !v.round[0] && v.end[0] < 0, band1 = !v.round[1] && v.end[1] < 0;  // a contoured loop at that side
-      const double lo = band0 ? std::min(y0 + kLoopBand * v.radiusAt(y0), y0 + (y1 - y0) / 3) : y0;
-      const double hi = band1 ? std::max(y1 - kLoopBand * v.radiusAt(y1), y1 - (y1 - y0) / 3) : y1;
-      std::vector<double> at;
-      if (band0) at.push_back(lo);
-      const double spacing = o_.ring_spacing_radii * 0.5 * (v.radiusAt(y0) + v.radiusAt(y1));
-      const int pieces = std::max(1, int(std::ceil((hi - lo) / std::max(spacing, 1e-12))));
-      for (int q = 1; q < pieces; ++q) at.push_back(lo + (hi - lo) * q / pieces);
-      if (band1) at.push_back(hi);
       A = loops[i][0];
       for (std::size_t q = 0; q <= at.size(); ++q) {
-        if (q < at.size()) ring(m, v, at[q], n_ring, B);
+        if (q < at.size()) ring(m, v, at[q], n_ring, phase(q + 1), B);
         else B = loops[i][1];
         zipRings(m, v.a, v.u, A, B, v.tree);
         A = B;

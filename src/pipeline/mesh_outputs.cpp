@@ -108,13 +108,14 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   DecimateOptions d;
   d.max_error = p.max_error;
   d.sliver_deg = p.sliverAngle();
+  d.obtuse_deg = p.maxAngle();
   TubeSurfaceReport tube_report;
   HollowWallReport wall_report;
   SurfaceMesh mesh;
   if (walls) {
     TubeSurfaceOptions to;
     to.junction = o;
-    to.ring_spacing_radii = p.ring_spacing;
+    to.ring_spacing_radii = p.ringSpacing();
     to.ends = ends;
     to.decimate = p.decimate;
     to.decimation = d;
@@ -129,7 +130,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   } else if (tubes) {
     TubeSurfaceOptions to;
     to.junction = o;
-    to.ring_spacing_radii = p.ring_spacing;
+    to.ring_spacing_radii = p.ringSpacing();
     to.ends = ends;
     to.cap_ends = p.ends == "capped";
     to.decimate = p.decimate;
@@ -182,7 +183,8 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"method", p.method},
                     {"voxel_mm", p.voxel_mm > 0 ? Json(p.voxel_mm) : Json(nullptr)},
                     {"samples_across", o.samples_across},
-                    {"ring_spacing_radii", tubes ? Json(p.ring_spacing) : Json(nullptr)},
+                    {"ring_spacing_radii", tubes && p.ringSpacing() > 0 ? Json(p.ringSpacing()) : Json(nullptr)},
+                    {"ring_spacing_vertex_spacings", tubes && p.ringSpacing() == 0 ? Json(kCfdRingSpacing) : Json(nullptr)},
                     {"wall", !walls ? Json(nullptr)
                                     : p.wall_thickness > 0 ? Json({{"thickness_mm", p.wall_thickness}})
                                     : p.wall_ratio > 0     ? Json({{"ratio_of_radius", p.wall_ratio}})
@@ -195,6 +197,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"decimate", p.decimate},
                     {"max_error_steps", p.max_error},
                     {"sliver_angle_deg", p.sliverAngle()},
+                    {"max_angle_deg", p.maxAngle()},
                     {"description", tubes ? "each vessel's free middle a tube of rings on its exact wall (at most ring_spacing_radii radii "
                                             "apart); where vessels meet, marching tetrahedra of the signed distance to the union of their "
                                             "capsules and round cones (2:1-balanced octree of cells sized to each vessel's radius), cut by "
