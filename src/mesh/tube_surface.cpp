@@ -728,7 +728,7 @@ class TubeMesher {
   // and a tetrahedral mesher splits the long edge of every such pair); such a band is a
   // prismatoid whose middle section is the 2n-gon of radius cos(π/2n), so it holds
   // (1 + 2 cos²(π/2n) / cos(π/n)) / 3 of its rings' polygon area per length.
-  // `face`: a CFD end's ring, whose polygon (its cap) has the circle's area.
+  // `face`: a ring whose polygon has the circle's area (a CFD end's: its cap).
   double ringScale(int n, bool face = false) const {
     if (!o_.junction.restore_volume) return 1.0;
     const double step = kTwoPi / n, polygon = std::sin(step) / step;  // the n-gon's area over its circle's
@@ -928,7 +928,8 @@ class TubeMesher {
       }
       A = loops[i][0];
       for (std::size_t q = 0; q <= at.size(); ++q) {
-        if (q < at.size()) ring(m, v, at[q], n_ring, phase(q + 1), B);
+        // A ring next to a contoured loop has the circle's area itself: their band is no prismatoid.
+        if (q < at.size()) ring(m, v, at[q], n_ring, phase(q + 1), B, (band0 && q == 0) || (band1 && q + 1 == at.size()));
         else B = loops[i][1];
         zipRings(m, v.a, v.u, A, B, v.tree);
         A = B;
