@@ -124,6 +124,40 @@ TEST(Mesh, TubesJoinContouredJunctionsIntoOneSurfaceOfGenusZeroPerTree) {
   EXPECT_EQ(m1.vertices, m.vertices);
 }
 
+// A lone straight vessel is one tube with round ends: its rings are turned by half a vertex
+// spacing against each other, so every triangle along it is acute (on aligned rings they were
+// right-angled, and TetGen splits the long edge of each such pair), and the rings' radius and the
+// caps' scale give it the capsule's volume (the band between staggered rings is a prismatoid,
+// the divergence theorem counts it exactly). Capped at 1.5 vertex spacings, likewise.
+TEST(Mesh, StaggeredRingsMakeAcuteTrianglesAndKeepTheCapsulesVolume) {
+  VascularTree t;
+  const auto root = t.addNode({0, 0, 0}, -1), leaf = t.addNode({20, 3, 4}, root);
+  t.radius[root] = t.radius[leaf] = 0.8;
+  const double length = norm(Vec3(20, 3, 4)), exact = std::numbers::pi * 0.64 * length + 4.0 / 3 * std::numbers::pi * 0.512;
+  for (const double spacing : {2.0, 0.0}) {
+    TubeSurfaceOptions o;
+    o.junction.samples_across = 3;
+    o.ring_spacing_radii = spacing;
+    TubeSurfaceReport rep;
+    const auto m = tubeSurface(t, o, &rep);
+    EXPECT_EQ(rep.tubes, 1);
+    const auto topo = meshTopology(m);
+    EXPECT_EQ(topo.tree_euler, std::vector<std::int64_t>({2}));
+    EXPECT_NEAR(topo.volume_mm3, exact, 1e-3 * exact) << spacing;
+    // Along the tube (away from the round ends' latitude rings), no angle reaches 90°.
+    std::int64_t along = 0, right_or_obtuse = 0;
+    for (const auto& tri : m.triangles) {
+      const Vec3 p[3] = {m.vertices[std::size_t(tri[0])], m.vertices[std::size_t(tri[1])], m.vertices[std::size_t(tri[2])]};
+      const double x = dot((p[0] + p[1] + p[2]) / 3.0, Vec3(20, 3, 4)) / length;
+      if (x < 1 || x > length - 1) continue;
+      ++along;
+      for (int i = 0; i < 3; ++i) right_or_obtuse += dot(p[(i + 1) % 3] - p[i], p[(i + 2) % 3] - p[i]) <= 1e-9 * dot(p[(i + 1) % 3] - p[i], p[(i + 1) % 3] - p[i]);
+    }
+    EXPECT_GT(along, 40) << spacing;
+    EXPECT_EQ(right_or_obtuse, 0) << spacing;
+  }
+}
+
 // Two vessels of a tree that come within a tenth of their radii without touching are contoured
 // together; the gap between them stays open (cells of a third of it along the close stretch), so
 // the loop the tree closes through them is no handle: one closed surface of genus 0. A U of
