@@ -626,14 +626,16 @@ class Worker {
     };
     for (auto x : seeds)
       if (visit(x), outside) return true;
+    close_.clear();
     for (std::size_t i = 0; i < nearby_.size(); ++i) {
       const auto t = m_.triangles[std::size_t(nearby_[i])];
+      const Vec3 a = m_.vertices[std::size_t(t[0])], b = m_.vertices[std::size_t(t[1])], c = m_.vertices[std::size_t(t[2])];
+      const Vec3 tlo = componentMin(componentMin(a, b), c), thi = componentMax(componentMax(a, b), c);
       bool apart = false;
-      for (int ax = 0; ax < 3 && !apart; ++ax) {
-        const double a = m_.vertices[std::size_t(t[0])][ax], b = m_.vertices[std::size_t(t[1])][ax], c = m_.vertices[std::size_t(t[2])][ax];
-        apart = std::max({a, b, c}) < lo[ax] || std::min({a, b, c}) > hi[ax];
-      }
+      for (int ax = 0; ax < 3 && !apart; ++ax) apart = thi[ax] < lo[ax] || tlo[ax] > hi[ax];
       if (apart) continue;
+      // Only these can meet a moved triangle (each moved one lies in that box).
+      close_.push_back({nearby_[i], tlo, thi});
       for (auto x : t)
         if (visit(x), outside) return true;
     }
@@ -644,20 +646,20 @@ class Worker {
     return cutsNear(seeds_, replaced);
   }
 
-  // moved_ against each other and against nearby_ (boxes first).
+  // moved_ against each other and against close_ (boxes first).
   bool cutsNearby() {
     for (std::size_t i = 0; i < moved_.size(); ++i) {
       const Vec3 lo = componentMin(componentMin(moved_[i].at[0], moved_[i].at[1]), moved_[i].at[2]);
       const Vec3 hi = componentMax(componentMax(moved_[i].at[0], moved_[i].at[1]), moved_[i].at[2]);
       for (std::size_t j = i + 1; j < moved_.size(); ++j)
         if (intersect(moved_[i].ids, moved_[i].at, moved_[j].ids, moved_[j].at)) return true;
-      for (auto k : nearby_) {
-        const auto& t = m_.triangles[std::size_t(k)];
-        const Vec3 at[3] = {m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]};
+      for (const auto& c : close_) {
         bool apart = false;
-        for (int ax = 0; ax < 3 && !apart; ++ax)
-          apart = std::max({at[0][ax], at[1][ax], at[2][ax]}) < lo[ax] || std::min({at[0][ax], at[1][ax], at[2][ax]}) > hi[ax];
-        if (!apart && intersect(moved_[i].ids, moved_[i].at, t, at)) return true;
+        for (int ax = 0; ax < 3 && !apart; ++ax) apart = c.hi[ax] < lo[ax] || c.lo[ax] > hi[ax];
+        if (apart) continue;
+        const auto& t = m_.triangles[std::size_t(c.k)];
+        const Vec3 at[3] = {m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]};
+        if (intersect(moved_[i].ids, moved_[i].at, t, at)) return true;
       }
     }
     return false;
@@ -712,6 +714,11 @@ class Worker {
     Vec3 at[3];
   };
   std::vector<Moved> moved_;
+  struct Boxed {
+    std::int32_t k;
+    Vec3 lo, hi;
+  };
+  std::vector<Boxed> close_;  // the nearby triangles whose box meets the box of the moved ones
   double cos_turn_ = 0, cos_min_angle_ = 1, cos_sliver_ = 1, cos_obtuse_ = -1;
 };
 
