@@ -40,21 +40,24 @@ struct Quadric {
   }
 };
 
-// The cosine of a triangle's smallest angle (the largest of its corners' cosines): angles
-// compare as their cosines do, reversed, without an arc function.
-double smallestAngleCosine(const Vec3& a, const Vec3& b, const Vec3& c) {
+// The cosines of a triangle's angles at a, b and c: angles compare as their cosines do,
+// reversed, without an arc function.
+std::array<double, 3> cornerCosines(const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 ab = b - a, bc = c - b, ca = a - c;
   const double lab = dot(ab, ab), lbc = dot(bc, bc), lca = dot(ca, ca);
-  const double at_a = -dot(ab, ca) / std::sqrt(lab * lca), at_b = -dot(bc, ab) / std::sqrt(lbc * lab), at_c = -dot(ca, bc) / std::sqrt(lca * lbc);
-  const double m = std::max({at_a, at_b, at_c});
+  return {-dot(ab, ca) / std::sqrt(lab * lca), -dot(bc, ab) / std::sqrt(lbc * lab), -dot(ca, bc) / std::sqrt(lca * lbc)};
+}
+
+// The cosine of a triangle's smallest angle (the largest of its corners' cosines).
+double smallestAngleCosine(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const auto at = cornerCosines(a, b, c);
+  const double m = std::max({at[0], at[1], at[2]});
   return std::isfinite(m) ? m : 1.0;
 }
 
 // The cosine of a triangle's largest angle (the smallest of its corners' cosines), and the corner.
 double largestAngleCosine(const Vec3& a, const Vec3& b, const Vec3& c, int* corner = nullptr) {
-  const Vec3 ab = b - a, bc = c - b, ca = a - c;
-  const double lab = dot(ab, ab), lbc = dot(bc, bc), lca = dot(ca, ca);
-  const double at[3] = {-dot(ab, ca) / std::sqrt(lab * lca), -dot(bc, ab) / std::sqrt(lbc * lab), -dot(ca, bc) / std::sqrt(lca * lbc)};
+  const auto at = cornerCosines(a, b, c);
   const int i = at[0] <= at[1] && at[0] <= at[2] ? 0 : at[1] <= at[2] ? 1 : 2;
   if (corner) *corner = i;
   return std::isfinite(at[i]) ? at[i] : -1.0;
@@ -70,6 +73,16 @@ bool isSliver(const SurfaceMesh& m, const std::array<std::int32_t, 3>& t, double
   const double step = std::min({m.vertex_step[std::size_t(t[0])], m.vertex_step[std::size_t(t[1])], m.vertex_step[std::size_t(t[2])]});
   const double shortest2 = std::min({dot(p1 - p0, p1 - p0), dot(p2 - p1, p2 - p1), dot(p0 - p2, p0 - p2)});
   return shortest2 < kShortEdge * kShortEdge * step * step;
+}
+
+// What a pass does; the repair passes (sliver, obtuse) take on only the triangles needsRepair names.
+enum class Pass { collapse, flip, sliver, obtuse };
+
+// A triangle the repair pass `kind` takes on: a sliver (cos_bound: the cosine of sliver_deg), or
+// one with an angle above obtuse_deg (cos_bound: its cosine).
+bool needsRepair(const SurfaceMesh& m, const std::array<std::int32_t, 3>& t, Pass kind, double cos_bound) {
+  if (kind == Pass::sliver) return isSliver(m, t, cos_bound);
+  return largestAngleCosine(m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[1])], m.vertices[std::size_t(t[2])]) < cos_bound;
 }
 
 // Component-wise min and max of finite points, inlined (std::fmin and fmax are calls into libm,
@@ -213,10 +226,12 @@ class Worker {
     }
   }
 
-  // Slivers among `triangles` (the cosine of the smallest angle above cos_sliver_), from a work
-  // list: each repair queues the triangles it changed, and a failed one is tried again only once
-  // something near it has changed.
-  void sliverPass(const std::int32_t* first, const std::int32_t* last, bool obtuse = false) {
+  // Slivers or obtuse triangles (`kind`) among `triangles`, from a work list: each repair queues
+  // the triangles it changed, and a failed one is tried again only once something near it has
+  // changed.
+  void repairPass(const std::int32_t* first, const std::int32_t* last, Pass kind) {
+    const bool obtuse = kind == Pass::obtuse;
+    const double cos_bound = obtuse ? cos_obtuse_ : cos_sliver_;
     joins_caps_ = !obtuse;
     work_.assign(first, last);
     // A bound on the work, against cycles of moves.
@@ -227,8 +242,7 @@ class Worker {
       const auto& t = m_.triangles[std::size_t(k)];
       const auto failed = st_.failed[std::size_t(k)];
       if (failed > 0 && std::none_of(t.begin(), t.end(), [&](std::int32_t v) { return st_.changed[std::size_t(v)] > failed; })) continue;
-      const Vec3 p0 = m_.vertices[std::size_t(t[0])], p1 = m_.vertices[std::size_t(t[1])], p2 = m_.vertices[std::size_t(t[2])];
-      if (obtuse ? !(largestAngleCosine(p0, p1, p2) < cos_obtuse_) : !isSliver(m_, t, cos_sliver_)) continue;
+      if (!needsRepair(m_, t, kind, cos_bound)) continue;
       blocked_ = false;
       if (!(obtuse ? repairObtuse(k) : repair(k)) && !blocked_) st_.failed[std::size_t(k)] = stamp();
     }
@@ -245,6 +259,7 @@ class Worker {
 
  private:
   static constexpr double kFlatFlip = 0.9848;  // cos 10°
+  enum class Aim { smallest, largest };  // what a corner's move must improve: the smallest angle, or the largest
 
   // The ends of an edge to collapse, the one that stays first: a locked vertex (it keeps its
   // place, and its id: boundary loops are known by their vertex ids), else the lower id.
@@ -287,7 +302,7 @@ class Worker {
 
   // A sliver goes the first way the checks allow: one of its edges collapses, shortest first (a
   // needle's short edge; a cap's apex onto the nearer end of its long edge); a cap's long edge
-  // flips; one of its corners moves to the middle of its neighbours, on the surface.
+  // flips; one of its corners moves (relax).
   bool repair(std::int32_t k) {
     const auto t = m_.triangles[std::size_t(k)];
     const Vec3 p[3] = {m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]};
@@ -309,41 +324,39 @@ class Worker {
     }
     const int longest = order[2];
     const double l1 = len[(longest + 1) % 3], l2 = len[(longest + 2) % 3];
-    if (len[longest] * len[longest] > l1 * l1 + l2 * l2 && flip(k, t[std::size_t(longest)], t[std::size_t((longest + 1) % 3)], true)) {
-      ++flips;
-      for (auto x : {t[0], t[1], t[2]}) touch(x);
-      for (auto x : m_.triangles[std::size_t(k)]) touch(x);  // the far vertex among them
-      return true;
-    }
+    if (len[longest] * len[longest] > l1 * l1 + l2 * l2 && flipped(k, longest, true)) return true;
     for (int i = 0; i < 3; ++i)
-      if (relax(t[std::size_t(i)], m_.triangle_tree[std::size_t(k)])) {
-        ++moves;
-        touch(t[std::size_t(i)]);
-        return true;
-      }
+      if (relaxed(k, i, Aim::smallest)) return true;
     return false;
+  }
+  // Edge i of triangle k (from t[i] to t[i + 1]) flipped; its four vertices' triangles queued.
+  bool flipped(std::int32_t k, int i, bool cap) {
+    const auto t = m_.triangles[std::size_t(k)];
+    if (!flip(k, t[std::size_t(i)], t[std::size_t((i + 1) % 3)], cap)) return false;
+    ++flips;
+    for (auto x : {t[0], t[1], t[2]}) touch(x);
+    for (auto x : m_.triangles[std::size_t(k)]) touch(x);  // the far vertex among them
+    return true;
+  }
+  // Corner i of triangle k moved (relax); its triangles queued.
+  bool relaxed(std::int32_t k, int i, Aim aim) {
+    const auto x = m_.triangles[std::size_t(k)][std::size_t(i)];
+    if (!relax(x, m_.triangle_tree[std::size_t(k)], aim)) return false;
+    ++moves;
+    touch(x);
+    return true;
   }
 
   // An obtuse triangle's long edge encroaches on its opposite corner: a tetrahedral mesher
   // splits it, and the split's neighbours in turn. Its long edge flips (a Delaunay flip), else
-  // its corners move to the middle of their neighbours, on the surface, where that lowers the
-  // largest angle around them.
+  // one of its corners moves (relax) where that lowers the largest angle around it.
   bool repairObtuse(std::int32_t k) {
     const auto t = m_.triangles[std::size_t(k)];
     int c = 0;
     largestAngleCosine(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])], &c);
-    if (flip(k, t[std::size_t((c + 1) % 3)], t[std::size_t((c + 2) % 3)])) {
-      ++flips;
-      for (auto x : {t[0], t[1], t[2]}) touch(x);
-      for (auto x : m_.triangles[std::size_t(k)]) touch(x);
-      return true;
-    }
+    if (flipped(k, (c + 1) % 3, false)) return true;
     for (int i = 0; i < 3; ++i)
-      if (relax(t[std::size_t((c + i) % 3)], m_.triangle_tree[std::size_t(k)], Aim::largest)) {
-        ++moves;
-        touch(t[std::size_t((c + i) % 3)]);
-        return true;
-      }
+      if (relaxed(k, (c + i) % 3, Aim::largest)) return true;
     return false;
   }
 
@@ -353,7 +366,6 @@ class Worker {
   // was) and passes the checks of a collapse (turn, distance, nothing nearby cut). Put onto the
   // surface instead, the corners moved lost 0.12 % of the test forest's volume; kept at their
   // offset from it, they gained 0.09 %.
-  enum class Aim { smallest, largest };
   bool relax(std::int32_t x, std::int32_t tree, Aim aim = Aim::smallest) {
     if (locked_[std::size_t(x)]) return false;
     neighbours(x, ring_u_);
@@ -733,8 +745,9 @@ constexpr double kBlockSteps = 128;
 constexpr int kRounds = 4;
 
 // Alive triangles with all three vertices in one block, grouped by block (blocks and triangles
-// in ascending order); with cos_sliver ≤ 1, only those whose smallest angle lies below it.
-std::vector<std::vector<std::int32_t>> partition(State& st, double size, double shift, double cos_sliver, double cos_obtuse) {
+// in ascending order); for a repair pass, only those it takes on (needsRepair; a sliver pass
+// with at_fixed_only, only those with a fixed vertex).
+std::vector<std::vector<std::int32_t>> partition(State& st, double size, double shift, Pass kind, double cos_bound) {
   const auto& m = st.m;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m.vertices.size(), 8192), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t v = r.begin(); v != r.end(); ++v) {
@@ -749,11 +762,8 @@ std::vector<std::vector<std::int32_t>> partition(State& st, double size, double 
     const auto& t = m.triangles[k];
     const auto b = st.block[std::size_t(t[0])];
     if (st.block[std::size_t(t[1])] != b || st.block[std::size_t(t[2])] != b) continue;
-    const Vec3 p0 = m.vertices[std::size_t(t[0])], p1 = m.vertices[std::size_t(t[1])], p2 = m.vertices[std::size_t(t[2])];
-    if (cos_obtuse >= -1 && !(largestAngleCosine(p0, p1, p2) < cos_obtuse)) continue;
-    if (cos_sliver <= 1 &&
-        (!isSliver(m, t, cos_sliver) ||
-         (st.at_fixed_only && !st.locked[std::size_t(t[0])] && !st.locked[std::size_t(t[1])] && !st.locked[std::size_t(t[2])])))
+    if ((kind == Pass::sliver || kind == Pass::obtuse) && !needsRepair(m, t, kind, cos_bound)) continue;
+    if (kind == Pass::sliver && st.at_fixed_only && !st.locked[std::size_t(t[0])] && !st.locked[std::size_t(t[1])] && !st.locked[std::size_t(t[2])])
       continue;
     keyed.emplace_back(b, std::int32_t(k));
   }
@@ -766,14 +776,11 @@ std::vector<std::vector<std::int32_t>> partition(State& st, double size, double 
   return blocks;
 }
 
-enum class Pass { collapse, flip, sliver, obtuse };
-
 // One pass of `kind` over blocks of `size` mm shifted by `shift` blocks, its blocks in parallel;
 // the collapses and flips it made.
 std::int64_t runPass(State& st, DecimateReport& rep, double size, double shift, Pass kind) {
-  const double cos_sliver = kind == Pass::sliver ? std::cos(st.o.sliver_deg * std::numbers::pi / 180) : 2.0;
-  const double cos_obtuse = kind == Pass::obtuse ? std::cos(st.o.obtuse_deg * std::numbers::pi / 180) : -2.0;
-  const auto blocks = partition(st, size, shift, cos_sliver, cos_obtuse);
+  const double cos_bound = std::cos((kind == Pass::obtuse ? st.o.obtuse_deg : st.o.sliver_deg) * std::numbers::pi / 180);
+  const auto blocks = partition(st, size, shift, kind, cos_bound);
   ++st.pass;
   if ((kind == Pass::sliver || kind == Pass::obtuse) && st.changed.empty()) st.changed.assign(st.m.vertices.size(), 0), st.failed.assign(st.m.triangles.size(), 0);
   std::vector<Worker> workers;
@@ -785,7 +792,7 @@ std::int64_t runPass(State& st, DecimateReport& rep, double size, double shift, 
       const auto* last = first + blocks[i].size();
       if (kind == Pass::flip) workers[i].flipPass(first, last);
       else if (kind == Pass::collapse) workers[i].collapsePass(first, last);
-      else workers[i].sliverPass(first, last, kind == Pass::obtuse);
+      else workers[i].repairPass(first, last, kind);
     }
   });
   std::int64_t made = 0;
@@ -795,6 +802,13 @@ std::int64_t runPass(State& st, DecimateReport& rep, double size, double shift, 
     rep.largest_error_mm = std::max(rep.largest_error_mm, w.largest_error);
   }
   return made;
+}
+
+// The slivers' passes, then (with obtuse_deg) the obtuse triangles', each in both partitions.
+void repairPasses(State& st, DecimateReport& rep, double size) {
+  for (const Pass kind : {Pass::sliver, Pass::obtuse})
+    if (kind == Pass::sliver || st.o.obtuse_deg > 0)
+      for (double shift : {0.0, 0.5}) runPass(st, rep, size, shift, kind);
 }
 
 // Blocks of kBlockSteps median steps (an eighth of the mesh's extent without steps).
@@ -826,10 +840,7 @@ DecimateReport decimate(SurfaceMesh& m, const DecimateOptions& o, const std::fun
     if (round > 0 && collapsed == 0) break;
     runPass(st, rep, size, round % 2 ? 0.5 : 0.0, Pass::flip);
   }
-  if (o.sliver_deg > 0)
-    for (const Pass kind : {Pass::sliver, Pass::obtuse})
-      if (kind == Pass::sliver || o.obtuse_deg > 0)
-        for (double shift : {0.0, 0.5}) runPass(st, rep, size, shift, kind);
+  if (o.sliver_deg > 0) repairPasses(st, rep, size);
   st.compact(renumber);
   return rep;
 }
@@ -842,9 +853,7 @@ DecimateReport repairSlivers(SurfaceMesh& m, const DecimateOptions& o, const std
   State st(m, o, distance);
   st.at_fixed_only = at_fixed_only;
   const double size = blockSize(m);
-  for (double shift : {0.0, 0.5}) runPass(st, rep, size, shift, Pass::sliver);
-  if (o.obtuse_deg > 0)
-    for (double shift : {0.0, 0.5}) runPass(st, rep, size, shift, Pass::obtuse);
+  repairPasses(st, rep, size);
   st.compact(renumber);
   return rep;
 }
