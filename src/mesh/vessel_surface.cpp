@@ -38,7 +38,6 @@ struct EdgeVertex {
 };
 
 struct KeyedTriangle {
-  std::int32_t tree;
   std::int64_t edge[3];
 };
 
@@ -65,6 +64,19 @@ constexpr int kUnitLevel = 3;
 struct Solid {
   Capsule c;
   double k;
+  Vec3 centre;         // a ball that holds the solid: its distance bounds the solid's from below
+  double bound = 0;
+  Solid() = default;
+  Solid(const Capsule& capsule, double fillet) : c(capsule), k(fillet), centre(capsule.a + capsule.d * 0.5) {
+    bound = 0.5 * norm(capsule.d) + capsule.r;
+  }
+  // The direction away from the solid at p (from the nearest point of its axis).
+  Vec3 away(const Vec3& p) const {
+    const double t = c.inv_len2 > 0 ? std::clamp(dot(p - c.a, c.d) * c.inv_len2, 0.0, 1.0) : 0.0;
+    const Vec3 off = p - (c.a + c.d * t);
+    const double len = norm(off);
+    return len > 0 ? off / len : Vec3(0, 0, 0);
+  }
 };
 constexpr double kFillet = 2.0;
 
@@ -80,24 +92,37 @@ constexpr double kFillet = 2.0;
 double unionDistance(const std::vector<Solid>& solids, const Vec3& p, double* plain = nullptr) {
   double best = std::numeric_limits<double>::infinity(), k_min = std::numeric_limits<double>::infinity();
   if (plain) *plain = std::numeric_limits<double>::infinity();
-  Vec3 n_best(0, 0, 0);
   for (const auto& s : solids) k_min = std::min(k_min, s.k);
+  // The solid nearest so far, and its direction at p once a fillet needed it.
+  const Solid* nearest = nullptr;
+  Vec3 n_best(0, 0, 0);
+  bool have_n_best = false;
   for (const auto& s : solids) {
-    const Capsule& c = s.c;
-    const double d = c.depth(p);
+    // A solid whose ball lies k_min beyond the best neither lowers it nor fillets it (h = 0
+    // below): skipped, unless the plain minimum is asked for as well.
+    if (!plain && nearest) {
+      const Vec3 q = p - s.centre;
+      const double reach = best + k_min + s.bound * (1 + 1e-9);
+      if (reach > 0 && dot(q, q) >= reach * reach) continue;
+    }
+    const double d = s.c.depth(p);
     if (plain) *plain = std::min(*plain, d);
-    // The direction away from the solid (from the nearest point of its axis).
-    const double t = c.inv_len2 > 0 ? std::clamp(dot(p - c.a, c.d) * c.inv_len2, 0.0, 1.0) : 0.0;
-    const Vec3 off = p - (c.a + c.d * t);
-    const double len = norm(off);
-    const Vec3 n = len > 0 ? off / len : Vec3(0, 0, 0);
-    if (!std::isfinite(best)) {
-      best = d, n_best = n;
+    if (!nearest) {
+      best = d, nearest = &s;
       continue;
     }
-    const double facing = std::clamp((-dot(n, n_best) - 0.3) * 2, 0.0, 1.0);
-    const double k = k_min * facing, h = k > 0 ? std::max(0.0, 1 - std::abs(best - d) / k) : 0.0;
-    if (d < best) n_best = n;
+    // Only where the two are within k_min of each other can the fillet (k ≤ k_min) act.
+    const double gap = std::abs(best - d);
+    double h = 0, k = 0;
+    Vec3 n(0, 0, 0);
+    const bool near = gap < k_min;
+    if (near) {
+      n = s.away(p);
+      if (!have_n_best) n_best = nearest->away(p), have_n_best = true;
+      const double facing = std::clamp((-dot(n, n_best) - 0.3) * 2, 0.0, 1.0);
+      k = k_min * facing, h = k > 0 ? std::max(0.0, 1 - gap / k) : 0.0;
+    }
+    if (d < best) nearest = &s, n_best = n, have_n_best = near;
     best = std::min(best, d) - h * h * k / 4;
   }
   return best;
@@ -165,19 +190,8 @@ class UnitMesher {
         }
     std::sort(trees.begin(), trees.end());
     trees.erase(std::unique(trees.begin(), trees.end()), trees.end());
-    keyed_.clear();
+    // Trees in order, each's vertices in edge order: the unit's vertices are in key order.
     for (auto tree : trees) meshTree(tree, out);
-    // Vertices in key order (trees apart), triangles by their index in the unit.
-    std::sort(out.vertices.begin(), out.vertices.end(), [](const EdgeVertex& x, const EdgeVertex& y) { return x.key < y.key; });
-    const auto local = [&](std::int32_t tree, std::int64_t edge) {
-      const EdgeKey key{tree, edge};
-      return std::int32_t(std::lower_bound(out.vertices.begin(), out.vertices.end(), key, [](const EdgeVertex& v, const EdgeKey& k) { return v.key < k; }) -
-                          out.vertices.begin());
-    };
-    for (const auto& k : keyed_) {
-      out.triangles.push_back({local(k.tree, k.edge[0]), local(k.tree, k.edge[1]), local(k.tree, k.edge[2])});
-      out.triangle_tree.push_back(k.tree);
-    }
   }
 
  private:
@@ -248,6 +262,7 @@ class UnitMesher {
     if (stamp_.size() < points) stamp_.resize(points, 0), f_.resize(points);
     ++generation_;
     crossings_.clear();
+    keyed_.clear();
     for (const auto& tet : tets_) {
       double v[4];
       int in[4], outside[4], ni = 0, no = 0;
@@ -264,22 +279,31 @@ class UnitMesher {
       const Vec3 outward = c_out - c_in;
       const auto edge = [&](int a, int b) { return Crossing{v[a], v[b], p[a], p[b]}; };
       if (ni == 1) {
-        triangle(tree, edge(in[0], outside[0]), edge(in[0], outside[1]), edge(in[0], outside[2]), outward);
+        triangle(edge(in[0], outside[0]), edge(in[0], outside[1]), edge(in[0], outside[2]), outward);
       } else if (ni == 3) {
-        triangle(tree, edge(in[0], outside[0]), edge(in[1], outside[0]), edge(in[2], outside[0]), outward);
+        triangle(edge(in[0], outside[0]), edge(in[1], outside[0]), edge(in[2], outside[0]), outward);
       } else {  // a quadrilateral, in its cyclic order, as two triangles
-        triangle(tree, edge(in[0], outside[0]), edge(in[0], outside[1]), edge(in[1], outside[1]), outward);
-        triangle(tree, edge(in[0], outside[0]), edge(in[1], outside[1]), edge(in[1], outside[0]), outward);
+        triangle(edge(in[0], outside[0]), edge(in[0], outside[1]), edge(in[1], outside[1]), outward);
+        triangle(edge(in[0], outside[0]), edge(in[1], outside[1]), edge(in[1], outside[0]), outward);
       }
     }
     // One vertex per crossed edge, on the surface.
     std::sort(crossings_.begin(), crossings_.end(), [](const Crossing& x, const Crossing& y) { return x.key < y.key; });
     crossings_.erase(std::unique(crossings_.begin(), crossings_.end(), [](const Crossing& x, const Crossing& y) { return x.key == y.key; }),
                      crossings_.end());
+    const auto base = std::int32_t(out.vertices.size());
+    keys_.clear();
     for (const auto& c : crossings_) {
       const double t = std::clamp(zeroOnEdge(asVec(c.pa), asVec(c.pb), c.fa, c.fb), kEdgeMargin, 1 - kEdgeMargin);
       const Vec3 pa = lat_.position(c.pa), pb = lat_.position(c.pb);
       out.vertices.push_back({{tree, c.key}, pa + (pb - pa) * t, pb - pa, t});
+      keys_.push_back(c.key);
+    }
+    // Triangles by their vertices' index in the unit.
+    const auto local = [&](std::int64_t edge) { return base + std::int32_t(std::lower_bound(keys_.begin(), keys_.end(), edge) - keys_.begin()); };
+    for (const auto& k : keyed_) {
+      out.triangles.push_back({local(k.edge[0]), local(k.edge[1]), local(k.edge[2])});
+      out.triangle_tree.push_back(tree);
     }
   }
 
@@ -295,10 +319,10 @@ class UnitMesher {
 
   // The triangle's turn is that of the edges' midpoints (exact in half steps): a vertex moves
   // along its edge's open interior, where the triangle never degenerates, so the turn holds.
-  void triangle(std::int32_t tree, const Crossing& e0, const Crossing& e1, const Crossing& e2, const Vec3& outward) {
+  void triangle(const Crossing& e0, const Crossing& e1, const Crossing& e2, const Vec3& outward) {
     const Vec3 m0 = asVec(e0.pa) + asVec(e0.pb), m1 = asVec(e1.pa) + asVec(e1.pb), m2 = asVec(e2.pa) + asVec(e2.pb);
     const bool flip = dot(cross(m1 - m0, m2 - m0), outward) < 0;
-    keyed_.push_back({tree, {e0.key, flip ? e2.key : e1.key, flip ? e1.key : e2.key}});
+    keyed_.push_back({{e0.key, flip ? e2.key : e1.key, flip ? e1.key : e2.key}});
     crossings_.push_back(e0);
     crossings_.push_back(e1);
     crossings_.push_back(e2);
@@ -320,7 +344,8 @@ class UnitMesher {
   std::vector<double> f_;
   std::uint32_t generation_ = 0;
   std::vector<Crossing> crossings_;
-  std::vector<KeyedTriangle> keyed_;
+  std::vector<KeyedTriangle> keyed_;  // the current tree's, by their edges
+  std::vector<std::int64_t> keys_;    // the current tree's crossed edges, in order
 };
 
 // The connected surface of each vertex (through shared triangles), as one representative vertex.
