@@ -74,9 +74,9 @@ int main(int argc, char** argv) {
                 (long long)topo.nonmanifold_edges, (long long)topo.misoriented_edges, (long long)topo.degenerate_triangles, topo.volume_mm3);
     for (auto e : topo.tree_euler) std::printf(" %lld", (long long)e);
     if (tubes)
-      std::printf("\n  tubes %lld of %lld vessels, clusters %lld (largest %lld vessels), contour %lld + tube %lld triangles, fallbacks %lld, parts cut again %lld",
+      std::printf("\n  tubes %lld of %lld vessels, clusters %lld (largest %lld vessels), contour %lld (of %lld contoured) + tube %lld triangles, fallbacks %lld, parts cut again %lld",
                   (long long)trep.tubes, (long long)trep.vessels, (long long)trep.clusters, (long long)trep.largest_cluster_vessels,
-                  (long long)trep.contour_triangles, (long long)trep.tube_triangles, (long long)trep.fallbacks, (long long)trep.cut_retries);
+                  (long long)trep.contour_triangles, (long long)trep.contoured_triangles, (long long)trep.tube_triangles, (long long)trep.fallbacks, (long long)trep.cut_retries);
     if (tubes && slivers > 0) std::printf(", slivers repaired %lld", (long long)trep.slivers_repaired);
     if (tubes) std::printf(", rounds %lld (largest part meshed again: %lld vessels)", (long long)trep.rounds, (long long)trep.largest_remeshed);
     std::printf("\n");

@@ -158,6 +158,7 @@ struct ClusterMesh {
   double estimated_bytes = 0, step = 0;
   std::int64_t cavities_removed = 0;
   DecimateReport decimation, slivers;
+  std::int64_t contoured = 0;            // triangles contoured, with those cut away and contours made again
   int refinements = 0;                   // contoured again, finer, to lose a handle
   std::vector<double> planes;            // each stub's cut distance from its node, as made
   int cut_retries = 0;                   // contoured again with cuts further into their tubes
@@ -665,6 +666,7 @@ class TubeMesher {
       if (repair) out.slivers = repairSlivers(mesh, o_.decimation, distance);
       // A stub whose loop fails is cut again once, within the contour's overshoot past its plane.
       const SurfaceMesh uncut = ns > 0 ? mesh : SurfaceMesh();
+      out.contoured += std::int64_t(mesh.triangles.size());
       std::vector<double> asked = stub_planes;
       for (;;) {
         cut = cutEnds(mesh, planes, o_.cap_ends);
@@ -844,6 +846,7 @@ class TubeMesher {
       m.triangle_tree.insert(m.triangle_tree.end(), cm.mesh.triangle_tree.begin(), cm.mesh.triangle_tree.end());
       m.triangle_face.insert(m.triangle_face.end(), cm.mesh.triangle_face.begin(), cm.mesh.triangle_face.end());
       rep.contour_triangles += std::int64_t(cm.mesh.triangles.size());
+      rep.contoured_triangles += cm.contoured;
       rep.cavities_removed += cm.cavities_removed;
       rep.refinements += cm.refinements;
       rep.cut_retries += cm.cut_retries;

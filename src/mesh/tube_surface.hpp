@@ -38,6 +38,9 @@ struct TubeSurfaceReport {
   std::int64_t vessels = 0, tubes = 0, clusters = 0;  // vessels with a tube; contoured parts
   std::int64_t largest_cluster_vessels = 0;
   std::int64_t contour_triangles = 0, tube_triangles = 0;
+  // Triangles marching tetrahedra made, with the prolongations past the cuts (cut away) and the
+  // contours made again (finer, or with cuts moved) of the parts kept: the contouring's work.
+  std::int64_t contoured_triangles = 0;
   std::int64_t fallbacks = 0;       // tubes given up because their cut failed (their vessel contoured whole)
   std::int64_t cut_retries = 0;     // parts contoured again with a failed cut further into its tube
   std::int64_t refinements = 0;     // parts contoured again, finer, to lose a handle a tree's union does not have
