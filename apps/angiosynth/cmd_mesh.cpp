@@ -113,8 +113,8 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   p.max_error = a.max_error;
   p.sliver_angle = a.sliver_angle;
   p.max_angle = a.max_angle;
-  if (p.max_angle > 0 && !(p.max_angle >= 90 && p.max_angle < 180))
-    throw InputError("", 0, "--max-angle is out of range; allowed: 0 (none) or [90, 180) degrees");
+  if (p.max_angle >= 0)  // given
+    if (const auto why = maxAngleProblem(p.max_angle); !why.empty()) throw InputError("", 0, "--max-angle: " + why);
   if (p.ends == "closed" && p.flow_extension > 0) throw InputError("", 0, "--flow-extension needs --ends open or capped");
   p.clip_box = a.clip_box;
   if (const auto why = clipBoxProblem(p); !why.empty()) throw InputError("", 0, why);

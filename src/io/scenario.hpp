@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/units.hpp"
+#include "io/param_checks.hpp"
 #include "grow/common/curved_vessels.hpp"
 #include "grow/method.hpp"
 #include "raster/label_policy.hpp"
@@ -65,6 +66,12 @@ struct MeshParameters {
   std::vector<double> clip_box;
   bool hollowWall() const { return wall_thickness > 0 || wall_ratio > 0 || wall_from_graph; }
 };
+
+// Why a max_angle given is refused, or empty: 0 (none) or an obtuse bound below 180°.
+inline std::string maxAngleProblem(double degrees) {
+  if (degrees == 0 || (degrees >= 90 && degrees < 180)) return {};
+  return "max_angle = " + show(degrees) + " degrees is out of range; allowed: 0 (none) or [90, 180)";
+}
 
 // Why p's clip box is refused, or empty: six numbers, each lower bound below its upper one, and
 // a closed surface to clip (closed or capped ends, or a hollow wall, whose ends are joined).

@@ -186,7 +186,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     }
     if (me.get("max_angle")) {
       mp.max_angle = r.number(me, "mesh", "max_angle");
-      if (mp.max_angle != 0) checkRange(mp.max_angle, 90, false, 180, true, r.at(me, "max_angle"), "max_angle (degrees; 0: none)");
+      if (const auto why = maxAngleProblem(mp.max_angle); !why.empty()) throw InputError(file, r.lineOf(me.get("max_angle")), why);
     }
     if (me.get("wall_thickness")) {
       mp.wall_thickness = r.quantity(me, "mesh", "wall_thickness", Dimension::Length, voxel_mm);

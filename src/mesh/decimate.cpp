@@ -49,18 +49,20 @@ std::array<double, 3> cornerCosines(const Vec3& a, const Vec3& b, const Vec3& c)
 }
 
 // The cosine of a triangle's smallest angle (the largest of its corners' cosines).
-double smallestAngleCosine(const Vec3& a, const Vec3& b, const Vec3& c) {
-  const auto at = cornerCosines(a, b, c);
+double smallestAngleCosine(const std::array<double, 3>& at) {
   const double m = std::max({at[0], at[1], at[2]});
   return std::isfinite(m) ? m : 1.0;
 }
+double smallestAngleCosine(const Vec3& a, const Vec3& b, const Vec3& c) { return smallestAngleCosine(cornerCosines(a, b, c)); }
 
 // The cosine of a triangle's largest angle (the smallest of its corners' cosines), and the corner.
-double largestAngleCosine(const Vec3& a, const Vec3& b, const Vec3& c, int* corner = nullptr) {
-  const auto at = cornerCosines(a, b, c);
+double largestAngleCosine(const std::array<double, 3>& at, int* corner = nullptr) {
   const int i = at[0] <= at[1] && at[0] <= at[2] ? 0 : at[1] <= at[2] ? 1 : 2;
   if (corner) *corner = i;
   return std::isfinite(at[i]) ? at[i] : -1.0;
+}
+double largestAngleCosine(const Vec3& a, const Vec3& b, const Vec3& c, int* corner = nullptr) {
+  return largestAngleCosine(cornerCosines(a, b, c), corner);
 }
 
 // A sliver: an angle below the bound, or an edge shorter than kShortEdge of its ends' step (a
@@ -394,10 +396,11 @@ class Worker {
         before[i] = m_.vertices[std::size_t(t[std::size_t(i)])];
         after[i] = t[std::size_t(i)] == x ? c : before[i];
       }
-      old_cos = std::max(old_cos, smallestAngleCosine(before[0], before[1], before[2]));
-      new_cos = std::max(new_cos, smallestAngleCosine(after[0], after[1], after[2]));
-      old_big = std::min(old_big, largestAngleCosine(before[0], before[1], before[2]));
-      new_big = std::min(new_big, largestAngleCosine(after[0], after[1], after[2]));
+      const auto cos_before = cornerCosines(before[0], before[1], before[2]), cos_after = cornerCosines(after[0], after[1], after[2]);
+      old_cos = std::max(old_cos, smallestAngleCosine(cos_before));
+      new_cos = std::max(new_cos, smallestAngleCosine(cos_after));
+      old_big = std::min(old_big, largestAngleCosine(cos_before));
+      new_big = std::min(new_big, largestAngleCosine(cos_after));
       if (turnsOver(before, after, star)) return false;
       if (!(std::abs(distance_(tree, (after[0] + after[1] + after[2]) / 3.0)) <= limit)) return false;
       moved_.push_back({t, {after[0], after[1], after[2]}});
