@@ -6,7 +6,7 @@ set -euo pipefail
 pkgs=(build-essential cmake pkg-config ccache
       libtbb-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libtinyxml2-dev
       zlib1g-dev libzip-dev libnifti2-dev libtiff-dev libpng-dev libjpeg-dev
-      libopenvdb-dev libboost-iostreams-dev libssl-dev libceres-dev libcgal-dev)
+      libopenvdb-dev libboost-iostreams-dev libssl-dev libceres-dev libcgal-dev libjemalloc-dev)
 if [ "${1:-all}" != program ]; then
   pkgs+=(libgtest-dev libbenchmark-dev
          libopenimageio-dev python3-nibabel python3-networkx python3-scipy python3-skimage python3-vtk9 tetgen  # independent readers and references
