@@ -91,6 +91,13 @@ bool needsRepair(const SurfaceMesh& m, const std::array<std::int32_t, 3>& t, Pas
 // 4 % of the repair's time).
 Vec3 lower(const Vec3& a, const Vec3& b) { return {a.x < b.x ? a.x : b.x, a.y < b.y ? a.y : b.y, a.z < b.z ? a.z : b.z}; }
 Vec3 upper(const Vec3& a, const Vec3& b) { return {a.x > b.x ? a.x : b.x, a.y > b.y ? a.y : b.y, a.z > b.z ? a.z : b.z}; }
+// A triangle's bounding box, and whether two boxes are apart on some axis.
+void triangleBox(const Vec3& a, const Vec3& b, const Vec3& c, Vec3& lo, Vec3& hi) { lo = lower(lower(a, b), c), hi = upper(upper(a, b), c); }
+bool boxesApart(const Vec3& lo1, const Vec3& hi1, const Vec3& lo2, const Vec3& hi2) {
+  for (int ax = 0; ax < 3; ++ax)
+    if (hi1[ax] < lo2[ax] || lo1[ax] > hi2[ax]) return true;
+  return false;
+}
 
 double orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) { return dot(b - a, cross(c - a, d - a)); }
 
@@ -649,11 +656,9 @@ class Worker {
     close_.clear();
     for (std::size_t i = 0; i < nearby_.size(); ++i) {
       const auto t = m_.triangles[std::size_t(nearby_[i])];
-      const Vec3 a = m_.vertices[std::size_t(t[0])], b = m_.vertices[std::size_t(t[1])], c = m_.vertices[std::size_t(t[2])];
-      const Vec3 tlo = lower(lower(a, b), c), thi = upper(upper(a, b), c);
-      bool apart = false;
-      for (int ax = 0; ax < 3 && !apart; ++ax) apart = thi[ax] < lo[ax] || tlo[ax] > hi[ax];
-      if (apart) continue;
+      Vec3 tlo, thi;
+      triangleBox(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])], tlo, thi);
+      if (boxesApart(tlo, thi, lo, hi)) continue;
       // Only these can meet a moved triangle (each moved one lies in that box).
       close_.push_back({nearby_[i], tlo, thi});
       for (auto x : t)
@@ -669,14 +674,12 @@ class Worker {
   // moved_ against each other and against close_ (boxes first).
   bool cutsNearby() {
     for (std::size_t i = 0; i < moved_.size(); ++i) {
-      const Vec3 lo = lower(lower(moved_[i].at[0], moved_[i].at[1]), moved_[i].at[2]);
-      const Vec3 hi = upper(upper(moved_[i].at[0], moved_[i].at[1]), moved_[i].at[2]);
+      Vec3 lo, hi;
+      triangleBox(moved_[i].at[0], moved_[i].at[1], moved_[i].at[2], lo, hi);
       for (std::size_t j = i + 1; j < moved_.size(); ++j)
         if (intersect(moved_[i].ids, moved_[i].at, moved_[j].ids, moved_[j].at)) return true;
       for (const auto& c : close_) {
-        bool apart = false;
-        for (int ax = 0; ax < 3 && !apart; ++ax) apart = c.hi[ax] < lo[ax] || c.lo[ax] > hi[ax];
-        if (apart) continue;
+        if (boxesApart(c.lo, c.hi, lo, hi)) continue;
         const auto& t = m_.triangles[std::size_t(c.k)];
         const Vec3 at[3] = {m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]};
         if (intersect(moved_[i].ids, moved_[i].at, t, at)) return true;
