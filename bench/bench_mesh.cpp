@@ -4,7 +4,7 @@
 // across), optionally decimated (--decimate 1) or with the contour's slivers repaired
 // (--slivers DEG: angles below DEG or edges under 0.35 of the step; 0, the default for closed ends, none; with
 // --max-angle DEG, angles above DEG improved: 90 is the default with capped ends), at the automatic step or --voxel MM:
-//   bench_mesh FILE.toml ... [--tubes 0|1] [--samples N] [--decimate 0|1] [--slivers DEG] [--max-angle DEG] [--voxel MM] [--threads T]
+//   bench_mesh FILE.toml ... [--tubes 0|1] [--samples N] [--decimate 0|1] [--slivers DEG] [--max-angle DEG] [--nets 0|1] [--voxel MM] [--threads T]
 // Prints the step, the time, triangles in all and per segment, and the peak memory.
 // Targets (issue 15): 10k segments ≤ 10 s, ≤ 4 GB, ≤ 500 triangles per segment; 100k ≤ 2 min.
 #include <cstdio>
@@ -32,7 +32,9 @@ int main(int argc, char** argv) {
   const double slivers = bench::takeOption(int(rest4.size()), rest4.data(), "--slivers", 0, rest5);
   std::vector<char*> rest6;
   const double max_angle = bench::takeOption(int(rest5.size()), rest5.data(), "--max-angle", 0, rest6);
-  const auto args = bench::parseFileArgs(int(rest6.size()), rest6.data());
+  std::vector<char*> rest7;
+  const bool nets = bench::takeOption(int(rest6.size()), rest6.data(), "--nets", 1, rest7) != 0;
+  const auto args = bench::parseFileArgs(int(rest7.size()), rest7.data());
   std::printf("%-34s %9s %9s %10s %12s %10s %8s %9s\n", "file", "segments", "step mm", "mesh s", "triangles", "tri/seg", "genus0", "peak MiB");
   for (const auto& f : args.files) {
     const auto sc = readTomlParameters(f);
@@ -55,6 +57,7 @@ int main(int argc, char** argv) {
       to.decimate = decimated;
       to.decimation.sliver_deg = slivers;
       to.decimation.obtuse_deg = max_angle;
+      to.nets = nets;
       m = tubeSurface(t, to, &trep);
       rep.voxel_mm = trep.finest_step_mm;
     } else {
@@ -77,6 +80,7 @@ int main(int argc, char** argv) {
       std::printf("\n  tubes %lld of %lld vessels, clusters %lld (largest %lld vessels), contour %lld (of %lld contoured) + tube %lld triangles, fallbacks %lld, parts cut again %lld",
                   (long long)trep.tubes, (long long)trep.vessels, (long long)trep.clusters, (long long)trep.largest_cluster_vessels,
                   (long long)trep.contour_triangles, (long long)trep.contoured_triangles, (long long)trep.tube_triangles, (long long)trep.fallbacks, (long long)trep.cut_retries);
+    if (tubes) std::printf(", netted parts %lld", (long long)trep.netted);
     if (tubes && slivers > 0) std::printf(", slivers repaired %lld", (long long)trep.slivers_repaired);
     if (tubes) std::printf(", rounds %lld (largest part meshed again: %lld vessels)", (long long)trep.rounds, (long long)trep.largest_remeshed);
     std::printf("\n");

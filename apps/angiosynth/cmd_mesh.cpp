@@ -28,6 +28,11 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
                 "tubes: each vessel's free middle a tube of rings on its wall, the parts where vessels meet contoured and joined to "
                 "them (default); contour: the whole surface contoured from the signed distance")
       ->check(CLI::IsMember({"tubes", "contour"}));
+  c->add_option("--junctions", a.junctions,
+                "tubes: contour the parts where vessels meet by surface nets where they pass their checks (closed, manifold, no "
+                "self-intersection, the union's shape; about a third of the triangles), else by marching tetrahedra (nets, the "
+                "default); or by marching tetrahedra only (tetrahedra)")
+      ->check(CLI::IsMember({"nets", "tetrahedra"}));
   c->add_option("--ring-spacing", a.ring_spacing, "tubes: rings at most this many radii apart (default 2; with --ends capped 1.5 times the rings' vertex spacing, "
                                           "about 0.9 radii at 3 samples across, which TetGen's -q1.414 leaves unsplit)")->check(finiteIn(0.1, 100));
   c->add_option("--wall-thickness", a.wall_thickness,
@@ -94,6 +99,7 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   MeshParameters p;
   p.method = a.method;
   p.ring_spacing = a.ring_spacing;
+  p.junctions = a.junctions;
   p.wall_thickness = a.wall_thickness;
   p.wall_ratio = a.wall_ratio;
   p.wall_from_graph = a.wall_from_graph;

@@ -76,6 +76,7 @@ int runScore(const ScoreArgs& a);
 struct MeshArgs {
   std::string input, out;
   std::string method = "tubes";
+  std::string junctions = "nets";
   double voxel_mm = 0;
   int samples_across = 0;
   double ring_spacing = -1;

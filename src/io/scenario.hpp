@@ -44,6 +44,7 @@ struct MeshParameters {
   bool enabled = false;
   std::vector<std::string> formats{"stl"};  // stl, obj, ply, off, vtp
   std::string method = "tubes";             // tubes (rings along free vessels, contoured junctions) or contour (all contoured)
+  std::string junctions = "nets";           // tubes: parts contoured by surface nets where they pass their checks, or by tetrahedra only
   double voxel_mm = 0;                      // finest step; 0: the thinnest vessel's diameter / samples_across
   int samples_across = 0;                   // 0: the method's (contour 4, tubes 3)
   double ring_spacing = -1;                 // tubes: rings at most this many radii apart; −1: 2, with capped ends 1.5 ring vertex spacings (0)

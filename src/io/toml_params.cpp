@@ -146,7 +146,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   if (im.get("graph_formats")) ip.graph_formats = stringsOf(im, "graph_formats", {"csv", "vtp", "swc", "graphml", "cco"});
 
   // [mesh]: the vessels' surface beside the graphs (src/mesh); the table's presence enables it.
-  const auto& me = r.table("mesh", {"enabled", "method", "formats", "voxel_size", "samples_across", "ring_spacing", "uniform", "on_surface", "ends",
+  const auto& me = r.table("mesh", {"enabled", "method", "formats", "voxel_size", "junctions", "samples_across", "ring_spacing", "uniform", "on_surface", "ends",
                                     "flow_extension", "decimate", "max_error", "sliver_angle", "max_angle", "wall_thickness", "wall_ratio", "wall_from_graph", "clip_box"});
   if (const auto* n = root.get("mesh")) {
     auto& mp = sc.mesh;
@@ -162,6 +162,11 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
       mp.method = r.string(me, "mesh", "method");
       if (mp.method != "tubes" && mp.method != "contour")
         throw InputError(file, r.lineOf(me.get("method")), "method '" + mp.method + "'; allowed: tubes, contour");
+    }
+    if (me.get("junctions")) {
+      mp.junctions = r.string(me, "mesh", "junctions");
+      if (mp.junctions != "nets" && mp.junctions != "tetrahedra")
+        throw InputError(file, r.lineOf(me.get("junctions")), "junctions '" + mp.junctions + "'; allowed: nets, tetrahedra");
     }
     if (me.get("samples_across")) mp.samples_across = r.smallInteger(me, "mesh", "samples_across", 1, 64);
     if (me.get("ring_spacing")) {

@@ -14,6 +14,7 @@
 #include "core/union_find.hpp"
 #include "grow/common/segment_index.hpp"
 #include "mesh/decimate.hpp"
+#include "mesh/net_surface.hpp"
 #include "mesh/ring_mesh.hpp"
 #include "raster/vessel_capsule.hpp"
 
@@ -162,6 +163,7 @@ struct ClusterMesh {
   int refinements = 0;                   // contoured again, finer, to lose a handle
   std::vector<double> planes;            // each stub's cut distance from its node, as made
   int cut_retries = 0;                   // contoured again with cuts further into their tubes
+  bool netted = false;                   // by surface nets (net_surface.hpp), else marching tetrahedra
 };
 
 class TubeMesher {
@@ -690,7 +692,18 @@ class TubeMesher {
         for (auto& loop : loops)
           for (auto& p : loop) p = renumber[std::size_t(p)];
     };
-    out.mesh = vesselSurface(sub, so, &sr);
+    // Surface nets where the part allows (about a third of the triangles), checked; else, or
+    // when the net's cut part is not the union's shape, marching tetrahedra.
+    std::optional<SurfaceMesh> net;
+    if (o_.nets && !c.touching) {
+      const auto planes_asked = planes;
+      const auto stubs_asked = stub_planes;
+      net = netSurface(sub, so, &sr);
+      if (net && !isUnionShaped(*net, planes, c.parts)) net.reset();
+      if (!net) planes = planes_asked, stub_planes = stubs_asked;
+    }
+    out.netted = net.has_value();
+    out.mesh = net ? std::move(*net) : vesselSurface(sub, so, &sr);
     out.estimated_bytes = sr.estimated_bytes;
     out.step = sr.voxel_mm;
     out.cavities_removed = sr.cavities_removed;
@@ -847,6 +860,7 @@ class TubeMesher {
       m.triangle_face.insert(m.triangle_face.end(), cm.mesh.triangle_face.begin(), cm.mesh.triangle_face.end());
       rep.contour_triangles += std::int64_t(cm.mesh.triangles.size());
       rep.contoured_triangles += cm.contoured;
+      rep.netted += cm.netted;
       rep.cavities_removed += cm.cavities_removed;
       rep.refinements += cm.refinements;
       rep.cut_retries += cm.cut_retries;

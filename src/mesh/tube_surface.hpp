@@ -31,6 +31,7 @@ struct TubeSurfaceOptions {
   std::vector<VesselEnd> ends;      // CFD ends (openEnds): each cut by its plane; empty: round ends
   bool cap_ends = false;            // fill each end's loop with a planar cap (else left open)
   bool decimate = false;            // decimate each contoured part (its cut loops stay)
+  bool nets = true;                 // contour parts by surface nets where they pass their checks (net_surface.hpp)
   DecimateOptions decimation;
 };
 
@@ -41,6 +42,7 @@ struct TubeSurfaceReport {
   // Triangles marching tetrahedra made, with the prolongations past the cuts (cut away) and the
   // contours made again (finer, or with cuts moved) of the parts kept: the contouring's work.
   std::int64_t contoured_triangles = 0;
+  std::int64_t netted = 0;          // parts contoured by surface nets (the others by marching tetrahedra)
   std::int64_t fallbacks = 0;       // tubes given up because their cut failed (their vessel contoured whole)
   std::int64_t cut_retries = 0;     // parts contoured again with a failed cut further into its tube
   std::int64_t refinements = 0;     // parts contoured again, finer, to lose a handle a tree's union does not have

@@ -55,6 +55,7 @@ Json describeParameters(const Scenario& sc) {
   if (sc.mesh.enabled)
     j["mesh"] = Json{{"formats", sc.mesh.formats},
                      {"voxel_size", sc.mesh.voxel_mm > 0 ? quantityJson(sc.mesh.voxel_mm, "mm") : Json(nullptr)},
+                     {"junctions", sc.mesh.junctions},
                      {"samples_across", sc.mesh.samples_across},
                      {"uniform", sc.mesh.uniform},
                      {"on_surface", sc.mesh.on_surface}};

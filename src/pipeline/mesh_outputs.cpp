@@ -119,6 +119,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
     to.ends = ends;
     to.decimate = p.decimate;
     to.decimation = d;
+    to.nets = p.junctions == "nets";
     mesh = hollowWall(tree, to, wall, &wall_report, progress);
     tube_report = wall_report.outer;
     report.voxel_mm = std::min(wall_report.outer.finest_step_mm, wall_report.lumen.finest_step_mm);
@@ -135,6 +136,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
     to.cap_ends = p.ends == "capped";
     to.decimate = p.decimate;
     to.decimation = d;
+    to.nets = p.junctions == "nets";
     mesh = tubeSurface(tree, to, &tube_report, progress);
     cut = tube_report.ends;
     report.voxel_mm = tube_report.finest_step_mm;
@@ -181,6 +183,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   for (std::int32_t i = 0; i < tree.nodeCount(); ++i) trees += tree.isRoot(i), segments += !tree.isRoot(i) && !tree.isLink(i);
   out.parameters = {{"formats", p.formats},
                     {"method", p.method},
+                    {"junctions", tubes ? Json(p.junctions) : Json(nullptr)},
                     {"voxel_mm", p.voxel_mm > 0 ? Json(p.voxel_mm) : Json(nullptr)},
                     {"samples_across", o.samples_across},
                     {"ring_spacing_radii", tubes && p.ringSpacing() > 0 ? Json(p.ringSpacing()) : Json(nullptr)},
@@ -199,8 +202,9 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"sliver_angle_deg", p.sliverAngle()},
                     {"max_angle_deg", p.maxAngle()},
                     {"description", tubes ? "each vessel's free middle a tube of rings on its exact wall (at most ring_spacing_radii radii "
-                                            "apart); where vessels meet, marching tetrahedra of the signed distance to the union of their "
-                                            "capsules and round cones (2:1-balanced octree of cells sized to each vessel's radius), cut by "
+                                            "apart); where vessels meet, the signed distance to the union of their capsules and round cones "
+                                            "contoured by surface nets on a uniform grid (junctions = nets, where the part passes its checks) or "
+                                            "by marching tetrahedra (2:1-balanced octree of cells sized to each vessel's radius), cut by "
                                             "planes across the tubes and joined to their rings"
                                           : "marching tetrahedra of the signed distance to the union of each tree's capsules and round cones, on a "
                                             "2:1-balanced octree of cells sized to each vessel's radius, split into conforming tetrahedra"}};
@@ -216,6 +220,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"largest_volume_move_mm", tubes ? Json(nullptr) : Json(report.largest_volume_move_mm)},
                     {"tubes", tubes ? Json(tube_report.tubes) : Json(nullptr)},
                     {"contoured_parts", tubes ? Json(tube_report.clusters) : Json(nullptr)},
+                    {"parts_by_nets", tubes ? Json(tube_report.netted) : Json(nullptr)},
                     {"largest_contoured_part_vessels", tubes ? Json(tube_report.largest_cluster_vessels) : Json(nullptr)},
                     {"tube_triangles", tubes ? Json(tube_report.tube_triangles) : Json(nullptr)},
                     {"contoured_triangles", tubes ? Json(tube_report.contour_triangles) : Json(nullptr)},

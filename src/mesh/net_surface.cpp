@@ -1,0 +1,401 @@
+#include "mesh/net_surface.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <numeric>
+#include <vector>
+
+#include "mesh/union_distance.hpp"
+
+namespace angiosynth {
+namespace {
+
+// Cell corners are numbered by their offsets: bit a set is +1 along axis a. Edge e runs along
+// axis e / 4 from the corner whose other two bits are those of e % 4 (axis a + 1 in bit 0, a + 2 in bit 1).
+int edgeId(int axis, int low_corner) {
+  return 4 * axis + ((low_corner >> ((axis + 1) % 3)) & 1) + 2 * ((low_corner >> ((axis + 2) % 3)) & 1);
+}
+int edgeLow(int e) {
+  const int a = e / 4, r = e % 4;
+  return ((r & 1) << ((a + 1) % 3)) | (((r >> 1) & 1) << ((a + 2) % 3));
+}
+
+// A face's corners in cyclic order (axes a + 1, a + 2 as x, y: 00, 10, 11, 01), and its edges
+// from corner k to k + 1.
+struct Face {
+  int corner[4];
+  int edge[4];
+};
+std::array<Face, 6> makeFaces() {
+  std::array<Face, 6> faces{};
+  for (int a = 0; a < 3; ++a)
+    for (int s = 0; s < 2; ++s) {
+      Face& f = faces[std::size_t(2 * a + s)];
+      const int b = (a + 1) % 3, c = (a + 2) % 3;
+      const int uv[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+      for (int k = 0; k < 4; ++k) f.corner[k] = (s << a) | (uv[k][0] << b) | (uv[k][1] << c);
+      for (int k = 0; k < 4; ++k) {
+        const int p = f.corner[k], q = f.corner[(k + 1) % 4], axis = (p ^ q) == (1 << b) ? b : c;
+        f.edge[k] = edgeId(axis, std::min(p, q));
+      }
+    }
+  return faces;
+}
+const std::array<Face, 6> kFaces = makeFaces();
+
+struct UnionFind12 {
+  int parent[12];
+  UnionFind12() { std::iota(parent, parent + 12, 0); }
+  int find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void join(int x, int y) { parent[find(x)] = find(y); }
+};
+
+// A cell the surface passes through: its first vertex, and each crossed edge's sheet.
+struct NetCell {
+  std::int32_t first_vertex;
+  std::int8_t sheet[12];
+};
+
+double orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) { return dot(cross(b - a, c - a), d - a); }
+
+// Whether segment pq meets triangle abc (touching counts).
+bool segmentMeetsTriangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double o1 = orient(a, b, c, p), o2 = orient(a, b, c, q);
+  if ((o1 > 0 && o2 > 0) || (o1 < 0 && o2 < 0) || (o1 == 0 && o2 == 0)) return false;
+  const double s1 = orient(p, q, a, b), s2 = orient(p, q, b, c), s3 = orient(p, q, c, a);
+  return (s1 >= 0 && s2 >= 0 && s3 >= 0) || (s1 <= 0 && s2 <= 0 && s3 <= 0);
+}
+
+// Two triangles of a closed mesh that cross or overlap beyond what they share.
+bool trianglesCross(const SurfaceMesh& m, const std::array<std::int32_t, 3>& s, const std::array<std::int32_t, 3>& t) {
+  int shared = 0, si = -1, ti = -1;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (s[std::size_t(i)] == t[std::size_t(j)]) ++shared, si = i, ti = j;
+  const auto P = [&](const std::array<std::int32_t, 3>& x, int i) -> const Vec3& { return m.vertices[std::size_t(x[std::size_t(i)])]; };
+  if (shared == 3) return true;
+  if (shared == 2) {  // folded onto each other across their edge
+    const Vec3 n1 = cross(P(s, 1) - P(s, 0), P(s, 2) - P(s, 0)), n2 = cross(P(t, 1) - P(t, 0), P(t, 2) - P(t, 0));
+    return dot(n1, n2) < -0.99 * norm(n1) * norm(n2);
+  }
+  if (shared == 1)
+    return segmentMeetsTriangle(P(s, (si + 1) % 3), P(s, (si + 2) % 3), P(t, 0), P(t, 1), P(t, 2)) ||
+           segmentMeetsTriangle(P(t, (ti + 1) % 3), P(t, (ti + 2) % 3), P(s, 0), P(s, 1), P(s, 2));
+  for (int i = 0; i < 3; ++i) {
+    if (segmentMeetsTriangle(P(s, i), P(s, (i + 1) % 3), P(t, 0), P(t, 1), P(t, 2))) return true;
+    if (segmentMeetsTriangle(P(t, i), P(t, (i + 1) % 3), P(s, 0), P(s, 1), P(s, 2))) return true;
+  }
+  return false;
+}
+
+// Every vertex's triangles form one fan closed around it, each edge used once each way (so:
+// closed, manifold at edges and vertices, consistently oriented), and no triangle is degenerate.
+bool closedManifold(const SurfaceMesh& m) {
+  const std::size_t nv = m.vertices.size();
+  std::vector<std::int32_t> start(nv + 1, 0);
+  for (const auto& t : m.triangles) {
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || !(triangleArea(m, t) > 0)) return false;
+    for (auto v : t) ++start[std::size_t(v) + 1];
+  }
+  for (std::size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
+  std::vector<std::pair<std::int32_t, std::int32_t>> link(static_cast<std::size_t>(start[nv]));
+  std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) link[std::size_t(fill[std::size_t(t[std::size_t(k)])]++)] = {t[std::size_t((k + 1) % 3)], t[std::size_t((k + 2) % 3)]};
+  for (std::size_t v = 0; v < nv; ++v) {
+    const auto first = link.begin() + start[v], last = link.begin() + start[v + 1];
+    const auto n = last - first;
+    if (n == 0) continue;
+    if (n < 3) return false;
+    std::sort(first, last);
+    for (auto it = first + 1; it != last; ++it)
+      if (it->first == (it - 1)->first) return false;
+    std::int32_t at = first->second;
+    std::ptrdiff_t steps = 1;
+    while (at != first->first) {
+      const auto it = std::lower_bound(first, last, std::make_pair(at, std::int32_t(-1)));
+      if (it == last || it->first != at || ++steps > n) return false;
+      at = it->second;
+    }
+    if (steps != n) return false;
+  }
+  return true;
+}
+
+// No two triangles cross: pairs binned together by their boxes (cells of `cell`) are tested.
+bool freeOfCrossings(const SurfaceMesh& m, const Vec3& origin, double cell) {
+  std::vector<std::pair<std::uint64_t, std::int32_t>> binned;
+  std::vector<Vec3> box_lo(m.triangles.size()), box_hi(m.triangles.size());
+  for (std::size_t k = 0; k < m.triangles.size(); ++k) {
+    Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
+    for (auto v : m.triangles[k]) lo = componentMin(lo, m.vertices[std::size_t(v)]), hi = componentMax(hi, m.vertices[std::size_t(v)]);
+    box_lo[k] = lo, box_hi[k] = hi;
+    std::int64_t b0[3], b1[3];
+    for (int a = 0; a < 3; ++a) {
+      b0[a] = std::int64_t(std::floor((lo[a] - origin[a]) / cell));
+      b1[a] = std::int64_t(std::floor((hi[a] - origin[a]) / cell));
+    }
+    for (auto z = b0[2]; z <= b1[2]; ++z)
+      for (auto y = b0[1]; y <= b1[1]; ++y)
+        for (auto x = b0[0]; x <= b1[0]; ++x)
+          binned.emplace_back(std::uint64_t(x + 1) | (std::uint64_t(y + 1) << 21) | (std::uint64_t(z + 1) << 42), std::int32_t(k));
+  }
+  std::sort(binned.begin(), binned.end());
+  for (std::size_t i = 0; i < binned.size();) {
+    std::size_t j = i;
+    while (j < binned.size() && binned[j].first == binned[i].first) ++j;
+    for (std::size_t p = i; p < j; ++p)
+      for (std::size_t q = p + 1; q < j; ++q) {
+        const auto a = std::size_t(binned[p].second), b = std::size_t(binned[q].second);
+        if (!(box_hi[a].x < box_lo[b].x || box_hi[b].x < box_lo[a].x || box_hi[a].y < box_lo[b].y || box_hi[b].y < box_lo[a].y ||
+              box_hi[a].z < box_lo[b].z || box_hi[b].z < box_lo[a].z) &&
+            trianglesCross(m, m.triangles[a], m.triangles[b]))
+          return false;
+      }
+    i = j;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<SurfaceMesh> netSurface(const VascularTree& t, const SurfaceOptions& o, SurfaceReport* report, NetReport* net) {
+  const auto refuse = [&](const char* why) -> std::optional<SurfaceMesh> {
+    if (net) net->refused = why;
+    return std::nullopt;
+  };
+  if (net) net->refused = nullptr;
+  for (auto c : o.vessel_max_cell_mm)
+    if (c > 0) return refuse("gaps to resolve");
+  std::vector<std::int32_t> vessels;
+  double r_min = INFINITY, r_max = 0;
+  for (std::int32_t s = 0; s < t.nodeCount(); ++s) {
+    if (t.isRoot(s) || t.isLink(s)) continue;
+    if (!t.tree.empty() && t.tree[s] != t.tree[vessels.empty() ? s : vessels.front()]) return refuse("several trees");
+    vessels.push_back(s);
+    r_min = std::min({r_min, t.radius[s], t.startRadius(s)});
+    r_max = std::max(r_max, t.maxRadius(s));
+  }
+  if (vessels.empty()) return SurfaceMesh();
+  if (vessels.size() > kNetMaxVessels) return refuse("too many vessels");
+  if (!(r_min > 0)) return refuse("a vessel of radius 0");
+  // vesselSurface's finest step and the fillet of its cells there.
+  const int across = std::max(1, o.samples_across);
+  double h = o.voxel_mm > 0 ? o.voxel_mm : 2 * r_min / across;
+  if (o.max_cell_mm > 0 && !(o.voxel_mm > 0)) h = std::min(h, o.max_cell_mm);
+  // One step for all: thick vessels get more triangles than marching tetrahedra give them at
+  // their own coarser level; nets only where that costs less in all (per area: kNetTriangles per
+  // step², marching tetrahedra kTetTriangles per step² of each vessel's level).
+  double net_cost = 0, tet_cost = 0;
+  for (auto s : vessels) {
+    const double r = std::min(t.radius[s], t.startRadius(s)), area = 2 * std::numbers::pi * t.maxRadius(s) * (t.length[s] + 2 * r);
+    double c = 2 * r / across;
+    if (o.max_cell_mm > 0) c = std::min(c, o.max_cell_mm);
+    const int level = c >= 2 * h ? int(std::floor(std::log2(c / h) + 1e-9)) : 0;
+    net_cost += kNetTriangles * area;
+    tet_cost += kTetTriangles * area / double(std::int64_t(1) << (2 * std::min(level, 20)));
+  }
+  if (net_cost > tet_cost) return refuse("marching tetrahedra make fewer triangles");
+  std::vector<Solid> solids;
+  Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
+  for (auto s : vessels) {
+    solids.emplace_back(capsuleOf(t, s), kFillet * h);
+    const double r = t.maxRadius(s);
+    for (const Vec3& p : {t.position[t.parent[s]], t.position[s]})
+      lo = componentMin(lo, p - Vec3(r, r, r)), hi = componentMax(hi, p + Vec3(r, r, r));
+  }
+  // Two steps of room (and the fillet's stand-off) keep the surface off the grid's border.
+  const double room = 2 * h + kFillet * h;
+  const Vec3 origin = lo - Vec3(room, room, room);
+  std::int64_t n[3];
+  for (int a = 0; a < 3; ++a) n[a] = std::int64_t(std::ceil((hi[a] - lo[a] + 2 * room) / h)) + 1;
+  if (n[0] * n[1] * n[2] > kNetMaxPoints) return refuse("grid too large");
+  const auto index = [&](std::int64_t x, std::int64_t y, std::int64_t z) { return x + n[0] * (y + n[1] * z); };
+  const auto point = [&](std::int64_t x, std::int64_t y, std::int64_t z) { return origin + Vec3(double(x), double(y), double(z)) * h; };
+  const auto distance = [&](const Vec3& p) { return unionDistance(solids, p); };
+  // The distance near the solids (within two steps of their boxes: every corner of a cell the
+  // surface passes through); further out the points are outside, far.
+  constexpr double kFar = 1e30;
+  std::vector<double> f(std::size_t(n[0] * n[1] * n[2]), kFar);
+  std::vector<char> near(f.size(), 0);
+  for (const auto& sol : solids) {
+    std::int64_t b0[3], b1[3];
+    const double reach = sol.bound + kFillet * h + 2 * h;
+    for (int a = 0; a < 3; ++a) {
+      b0[a] = std::max<std::int64_t>(0, std::int64_t(std::floor((sol.centre[a] - reach - origin[a]) / h)));
+      b1[a] = std::min<std::int64_t>(n[a] - 1, std::int64_t(std::ceil((sol.centre[a] + reach - origin[a]) / h)));
+    }
+    const Capsule& cap = sol.c;
+    for (std::int64_t z = b0[2]; z <= b1[2]; ++z)
+      for (std::int64_t y = b0[1]; y <= b1[1]; ++y)
+        for (std::int64_t x = b0[0]; x <= b1[0]; ++x)
+          if (cap.depth(point(x, y, z)) < kFillet * h + 2 * h) near[std::size_t(index(x, y, z))] = 1;
+  }
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (!near[i]) continue;
+    const auto x = std::int64_t(i) % n[0], y = (std::int64_t(i) / n[0]) % n[1], z = std::int64_t(i) / (n[0] * n[1]);
+    double v = distance(point(x, y, z));
+    if (v == 0) v = std::numeric_limits<double>::min();  // on the surface counts as outside
+    f[i] = v;
+  }
+  if (report) report->voxel_mm = h, report->coarsest_mm = h, report->levels = 1, report->estimated_bytes = double(f.size()) * 12;
+
+  // Cells: the sheets of each crossed cell, one vertex each.
+  SurfaceMesh mesh;
+  const std::int64_t cx = n[0] - 1, cy = n[1] - 1, cz = n[2] - 1;
+  std::vector<std::int32_t> cell_of(std::size_t(cx * cy * cz), -1);
+  std::vector<NetCell> cells;
+  const double margin = 1e-3 * h;
+  for (std::int64_t z = 0; z < cz; ++z)
+    for (std::int64_t y = 0; y < cy; ++y)
+      for (std::int64_t x = 0; x < cx; ++x) {
+        double v[8];
+        int inside = 0;
+        for (int c = 0; c < 8; ++c) {
+          v[c] = f[std::size_t(index(x + (c & 1), y + ((c >> 1) & 1), z + ((c >> 2) & 1)))];
+          inside |= int(v[c] < 0) << c;
+        }
+        if (inside == 0 || inside == 255) continue;
+        const auto crossed = [&](int e) {
+          const int p = edgeLow(e), q = p | (1 << (e / 4));
+          return ((inside >> p) & 1) != ((inside >> q) & 1);
+        };
+        UnionFind12 sheets;
+        for (const auto& face : kFaces) {
+          int ce[4], nc = 0;
+          for (int k = 0; k < 4; ++k)
+            if (crossed(face.edge[k])) ce[nc++] = k;
+          if (nc == 2) {
+            sheets.join(face.edge[ce[0]], face.edge[ce[1]]);
+          } else if (nc == 4) {
+            // Corners 0 and 2 share a sign: joined across the face where the bilinear saddle has it.
+            const double a = v[face.corner[0]], b = v[face.corner[1]], c = v[face.corner[2]], d = v[face.corner[3]];
+            const double den = a + c - b - d, saddle = den != 0 ? (a * c - b * d) / den : -1.0;
+            if ((saddle < 0) == (a < 0)) {  // 0 and 2 joined: corners 1 and 3 cut off
+              sheets.join(face.edge[0], face.edge[1]), sheets.join(face.edge[2], face.edge[3]);
+            } else {
+              sheets.join(face.edge[3], face.edge[0]), sheets.join(face.edge[1], face.edge[2]);
+            }
+          }
+        }
+        NetCell cell;
+        cell.first_vertex = std::int32_t(mesh.vertices.size());
+        int root_sheet[12];
+        std::fill(root_sheet, root_sheet + 12, -1);
+        Vec3 sum[4];
+        int count[4] = {0, 0, 0, 0}, sheets_n = 0;
+        const Vec3 corner0 = point(x, y, z);
+        for (int e = 0; e < 12; ++e) {
+          cell.sheet[e] = -1;
+          if (!crossed(e)) continue;
+          const int r = sheets.find(e);
+          if (root_sheet[r] < 0) root_sheet[r] = sheets_n, sum[sheets_n] = Vec3(0, 0, 0), ++sheets_n;
+          const int k = root_sheet[r];
+          cell.sheet[e] = std::int8_t(k);
+          const int p = edgeLow(e), q = p | (1 << (e / 4));
+          const double tt = v[p] / (v[p] - v[q]);
+          const Vec3 cp(double(p & 1), double((p >> 1) & 1), double((p >> 2) & 1)), cq(double(q & 1), double((q >> 1) & 1), double((q >> 2) & 1));
+          sum[k] += corner0 + (cp + (cq - cp) * tt) * h;
+          ++count[k];
+        }
+        for (int k = 0; k < sheets_n; ++k) {
+          // The sheet's crossings' mean, taken onto the surface by Newton steps, kept in the cell.
+          Vec3 p = sum[k] / double(count[k]);
+          for (int it = 0; it < 3; ++it) {
+            const double d = distance(p);
+            if (std::abs(d) < 1e-6 * h) break;
+            const double e = 1e-3 * h;
+            const Vec3 g((distance(p + Vec3(e, 0, 0)) - distance(p - Vec3(e, 0, 0))) / (2 * e),
+                         (distance(p + Vec3(0, e, 0)) - distance(p - Vec3(0, e, 0))) / (2 * e),
+                         (distance(p + Vec3(0, 0, e)) - distance(p - Vec3(0, 0, e))) / (2 * e));
+            const double g2 = dot(g, g);
+            if (!(g2 > 1e-12)) break;
+            p = p - g * (d / g2);
+          }
+          p = componentMin(componentMax(p, corner0 + Vec3(margin, margin, margin)), corner0 + Vec3(h - margin, h - margin, h - margin));
+          mesh.vertices.push_back(p);
+          mesh.vertex_step.push_back(float(h));
+        }
+        cell_of[std::size_t(x + cx * (y + cy * z))] = std::int32_t(cells.size());
+        cells.push_back(cell);
+      }
+
+  // A quadrilateral around each crossed edge, from the four cells around it (counter-clockwise
+  // seen from the outside), split along the diagonal that folds it least.
+  for (std::int64_t z = 1; z < cz; ++z)
+    for (std::int64_t y = 1; y < cy; ++y)
+      for (std::int64_t x = 1; x < cx; ++x) {
+        const std::int64_t pt[3] = {x, y, z};
+        const bool in0 = f[std::size_t(index(x, y, z))] < 0;
+        for (int a = 0; a < 3; ++a) {
+          std::int64_t q[3] = {x, y, z};
+          ++q[a];
+          if ((f[std::size_t(index(q[0], q[1], q[2]))] < 0) == in0) continue;
+          const int b = (a + 1) % 3, c = (a + 2) % 3;
+          const int off[4][2] = {{-1, -1}, {0, -1}, {0, 0}, {-1, 0}};
+          std::int32_t quad[4];
+          for (int k = 0; k < 4; ++k) {
+            std::int64_t cc[3] = {pt[0], pt[1], pt[2]};
+            cc[b] += off[k][0], cc[c] += off[k][1];
+            const auto id = cell_of[std::size_t(cc[0] + cx * (cc[1] + cy * cc[2]))];
+            // The edge in that cell: along a, from the corner at −off.
+            const int low = ((-off[k][0]) << b) | ((-off[k][1]) << c);
+            const auto& cell = cells[std::size_t(id)];
+            quad[k] = cell.first_vertex + cell.sheet[edgeId(a, low)];
+          }
+          if (!in0) std::swap(quad[1], quad[3]);  // outward is −a
+          const auto P = [&](int k) -> const Vec3& { return mesh.vertices[std::size_t(quad[k])]; };
+          const auto fold = [&](int i) {  // cosine between the halves split along i – i + 2
+            const Vec3 n1 = cross(P((i + 1) % 4) - P(i), P((i + 2) % 4) - P(i)), n2 = cross(P((i + 2) % 4) - P(i), P((i + 3) % 4) - P(i));
+            const double l = norm(n1) * norm(n2);
+            return l > 0 ? dot(n1, n2) / l : -2.0;
+          };
+          const int i = fold(0) >= fold(1) ? 0 : 1;
+          mesh.triangles.push_back({quad[i], quad[(i + 1) % 4], quad[(i + 2) % 4]});
+          mesh.triangles.push_back({quad[i], quad[(i + 2) % 4], quad[(i + 3) % 4]});
+        }
+      }
+  mesh.triangle_tree.assign(mesh.triangles.size(), t.tree.empty() ? 0 : t.tree[vessels.front()]);
+  if (report) report->cells = std::int64_t(cells.size()), report->units = 1;
+
+  // The flat triangles lie inside the convex wall (chords): each vertex moves out along its
+  // normal by ¾ of its triangles' area-weighted gap at their centroids (vesselSurface's rule).
+  if (o.restore_volume) {
+    std::vector<Vec3> normal(mesh.vertices.size(), Vec3(0, 0, 0));
+    std::vector<double> weighted(mesh.vertices.size(), 0.0), area(mesh.vertices.size(), 0.0);
+    for (const auto& tr : mesh.triangles) {
+      const Vec3& a = mesh.vertices[std::size_t(tr[0])];
+      const Vec3 nn = cross(mesh.vertices[std::size_t(tr[1])] - a, mesh.vertices[std::size_t(tr[2])] - a);
+      const double ar = norm(nn);
+      const double d = distance((a + mesh.vertices[std::size_t(tr[1])] + mesh.vertices[std::size_t(tr[2])]) / 3.0);
+      for (auto v : tr) normal[std::size_t(v)] += nn, weighted[std::size_t(v)] += ar * (-0.75 * d), area[std::size_t(v)] += ar;
+    }
+    double largest = 0;
+    for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+      if (!(area[v] > 0)) continue;
+      const double move = std::clamp(weighted[v] / area[v], -0.2 * h, 0.2 * h);
+      mesh.vertices[v] += unit(normal[v]) * move;
+      largest = std::max(largest, std::abs(move));
+    }
+    if (report) report->largest_volume_move_mm = largest;
+  }
+  if (!closedManifold(mesh)) return refuse("not a closed manifold");
+  if (!freeOfCrossings(mesh, origin, h)) return refuse("self-intersecting");
+  if (o.finish) {
+    const std::function<double(std::int32_t, const Vec3&)> strict = [&](std::int32_t, const Vec3& p) {
+      double plain = 0;
+      const double filleted = unionDistance(solids, p, &plain);
+      return std::abs(plain) > std::abs(filleted) ? plain : filleted;
+    };
+    o.finish(mesh, strict);
+  }
+  return mesh;
+}
+
+}  // namespace angiosynth
