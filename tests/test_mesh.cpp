@@ -182,7 +182,49 @@ TEST(Mesh, SurfaceNetsContourAJunctionClosedOnTheVesselsWithFewerTriangles) {
   thin.radius[fork] = 3.0;
   thin.radius[right] = 0.2;
   EXPECT_FALSE(netSurface(thin, o, nullptr, &why).has_value());
-  EXPECT_STREQ(why.refused, "marching tetrahedra make fewer triangles");
+  EXPECT_EQ(why.refused, kNetCostlier);
+}
+
+// Where radii lie far apart, the nets are made on the octree instead (each vessel at its own
+// step; the dual of its leaves): the same checks pass, the triangles are a third of marching
+// tetrahedra's on the same cells, the volume theirs within 0.3 %, the mesh the same on one thread.
+TEST(Mesh, DualContourOnTheOctreeKeepsEachVesselsStep) {
+  VascularTree t;
+  const auto root = t.addNode({0, 0, 0}, -1), fork = t.addNode({12, 0, 0}, root);
+  const auto thick = t.addNode({24, 3, 0}, fork), thin = t.addNode({18, -5, 2}, fork);
+  t.radius[fork] = 2.0, t.radius[thick] = 1.8, t.radius[thin] = 0.25;
+  SurfaceOptions o;
+  o.samples_across = 3;
+  o.dual = true;
+  SurfaceReport rep;
+  const auto dual = vesselSurface(t, o, &rep);
+  ASSERT_TRUE(rep.dual) << rep.dual_refused;
+  EXPECT_GE(rep.levels, 3);
+  const auto topo = meshTopology(dual);
+  EXPECT_EQ(topo.boundary_edges, 0);
+  EXPECT_EQ(topo.nonmanifold_edges, 0);
+  EXPECT_EQ(topo.misoriented_edges, 0);
+  EXPECT_EQ(topo.degenerate_triangles, 0);
+  EXPECT_EQ(topo.tree_euler, std::vector<std::int64_t>({2}));
+  double worst = 0;
+  for (std::size_t v = 0; v < dual.vertices.size(); ++v) {
+    double d = INFINITY;
+    for (auto s : {fork, thick, thin}) d = std::min(d, capsuleOf(t, s).depth(dual.vertices[v]));
+    worst = std::max(worst, std::abs(d) / dual.vertex_step[v]);
+  }
+  EXPECT_LT(worst, 0.25);
+  SurfaceOptions tet = o;
+  tet.dual = false;
+  const auto mt = vesselSurface(t, tet);
+  const double v_tet = meshTopology(mt).volume_mm3;
+  EXPECT_NEAR(topo.volume_mm3, v_tet, 3e-3 * v_tet);
+  EXPECT_LT(dual.triangles.size() * 2, mt.triangles.size());
+  std::cout << dual.triangles.size() << " triangles on the octree's dual, " << mt.triangles.size() << " by marching tetrahedra; volume "
+            << topo.volume_mm3 << " against " << v_tet << " mm^3; largest distance / step " << worst << "; " << rep.levels << " levels\n";
+  tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+  const auto d1 = vesselSurface(t, o);
+  EXPECT_EQ(d1.triangles, dual.triangles);
+  EXPECT_EQ(d1.vertices, dual.vertices);
 }
 
 // A lone straight vessel is one tube with round ends: its rings are turned by half a vertex

@@ -41,9 +41,10 @@ const std::vector<MethodParam>& commonParams() {
        "meet (bifurcations, round ends, vessels that touch) contoured and joined to the tubes ring to ring; contour: the whole surface "
        "contoured from the signed distance"},
       {"mesh", "junctions", "nets/tetrahedra", "nets",
-       "tubes: how the parts where vessels meet are contoured: nets (surface nets on a uniform grid, about a third of the "
-       "triangles, where the part's radii are alike and the result is a closed manifold without self-intersections and of the "
-       "union's shape; else marching tetrahedra) or tetrahedra (marching tetrahedra everywhere: manifold by construction)"},
+       "tubes: how the parts where vessels meet are contoured: nets (surface nets, about a third of the triangles: on a uniform "
+       "grid where the part's radii are alike, else on the octree, where the result is a closed manifold without "
+       "self-intersections and of the union's shape; else marching tetrahedra) or tetrahedra (marching tetrahedra everywhere: "
+       "manifold by construction)"},
       {"mesh", "voxel_size", "mm", "the thinnest vessel's diameter / samples_across", "the finest grid step"},
       {"mesh", "samples_across", "count", "3 (tubes), 4 (contour)",
        "grid steps across each vessel's thinnest end where it is contoured (1 … 64); thicker vessels get coarser cells"},

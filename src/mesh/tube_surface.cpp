@@ -692,15 +692,23 @@ class TubeMesher {
         for (auto& loop : loops)
           for (auto& p : loop) p = renumber[std::size_t(p)];
     };
-    // Surface nets where the part allows (about a third of the triangles), checked; else, or
-    // when the net's cut part is not the union's shape, marching tetrahedra.
+    // Surface nets where the part allows (about a third of the triangles), checked: on one
+    // uniform grid where its radii are alike, else on the octree (vesselSurface's dual
+    // contour); else, or when the net's cut part is not the union's shape, marching tetrahedra.
     std::optional<SurfaceMesh> net;
     if (o_.nets && !c.touching) {
       const auto planes_asked = planes;
       const auto stubs_asked = stub_planes;
-      net = netSurface(sub, so, &sr);
-      if (net && !isUnionShaped(*net, planes, c.parts)) net.reset();
-      if (!net) planes = planes_asked, stub_planes = stubs_asked;
+      const auto shaped = [&](const std::optional<SurfaceMesh>& m) { return m && isUnionShaped(*m, planes, c.parts); };
+      NetReport nr;
+      net = netSurface(sub, so, &sr, &nr);
+      if (!shaped(net)) net.reset(), planes = planes_asked, stub_planes = stubs_asked;
+      if (!net && nr.refused == kNetCostlier) {
+        so.dual = true;
+        net = vesselSurface(sub, so, &sr);
+        so.dual = false;
+        if (!sr.dual || !shaped(net)) net.reset(), planes = planes_asked, stub_planes = stubs_asked;
+      }
     }
     out.netted = net.has_value();
     out.mesh = net ? std::move(*net) : vesselSurface(sub, so, &sr);

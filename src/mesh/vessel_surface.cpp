@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -16,6 +17,7 @@
 #include "core/error.hpp"
 #include "core/memory.hpp"
 #include "mesh/balanced_octree.hpp"
+#include "mesh/surface_checks.hpp"
 #include "mesh/union_distance.hpp"
 #include "raster/capsule_rasterizer.hpp"
 #include "raster/vessel_capsule.hpp"
@@ -40,6 +42,21 @@ struct EdgeVertex {
 
 struct KeyedTriangle {
   std::int64_t edge[3];
+};
+
+// A unit's dual contour: its leaves' sheet vertices, and for each grid edge of a leaf's boundary
+// the surface crosses, the leaf's sheet there and the leaf's direction around the edge.
+struct DualRecord {
+  std::int32_t tree;
+  std::int64_t edge;   // the edge's midpoint in quarter steps, packed
+  double angle;        // of the leaf's centre around the edge (counter-clockwise about its axis)
+  std::int32_t vertex; // in the unit
+  bool low_inside;     // the edge's lower end lies inside
+};
+struct DualUnit {
+  std::vector<Vec3> vertices;
+  std::vector<float> steps;  // mm: the leaf's size
+  std::vector<DualRecord> records;
 };
 
 struct UnitMesh {
@@ -89,6 +106,32 @@ class UnitMesher {
       : t_(t), lat_(lat), splitter_(splitter), fillet_(fillet) {}
 
   void mesh(int level, const std::array<std::int64_t, 3>& cell, const OctreeLeaf* first, const OctreeLeaf* last, UnitMesh& out) {
+    tets_.clear();
+    scratch_.clear();
+    for (auto* l = first; l != last; ++l) splitter_.tetrahedra(*l, scratch_);
+    const auto trees = prepare(level, cell, first, last);
+    for (const auto& tet : scratch_) {
+      std::array<std::int32_t, 4> local;
+      for (int q = 0; q < 4; ++q) local[std::size_t(q)] = localIndex(tet[std::size_t(q)]);
+      tets_.push_back(local);
+    }
+    // Trees in order, each's vertices in edge order: the unit's vertices are in key order.
+    for (auto tree : trees) meshTree(tree, out);
+  }
+
+  // The unit's dual contour (surface nets on the octree): per leaf, the sheets of the surface
+  // through it and, for each grid edge of its boundary the surface crosses, the sheet there.
+  void dual(int level, const std::array<std::int64_t, 3>& cell, const OctreeLeaf* first, const OctreeLeaf* last, DualUnit& out) {
+    const auto trees = prepare(level, cell, first, last);
+    for (auto tree : trees) {
+      loadTree(tree);
+      for (auto* l = first; l != last; ++l) dualLeaf(*l, tree, out);
+    }
+  }
+
+ private:
+  // The unit's lattice and bins; the trees with vessels there, in order.
+  std::vector<std::int32_t> prepare(int level, const std::array<std::int64_t, 3>& cell, const OctreeLeaf* first, const OctreeLeaf* last) {
     // The unit's lattice: its points are those of its finest leaves' faces (balance: at most one
     // level finer), so steps of 2^(finest − 1) half steps (1 at level 0).
     int finest = level;
@@ -97,14 +140,6 @@ class UnitMesher {
     const std::int64_t span = std::int64_t(2) << level;
     n_ = (span >> shift_) + 1;
     for (int a = 0; a < 3; ++a) base_[std::size_t(a)] = cell[std::size_t(a)] * span;
-    tets_.clear();
-    scratch_.clear();
-    for (auto* l = first; l != last; ++l) splitter_.tetrahedra(*l, scratch_);
-    for (const auto& tet : scratch_) {
-      std::array<std::int32_t, 4> local;
-      for (int q = 0; q < 4; ++q) local[std::size_t(q)] = localIndex(tet[std::size_t(q)]);
-      tets_.push_back(local);
-    }
     // The bins the unit's points fall in, and the trees with vessels there.
     for (int a = 0; a < 3; ++a) {
       bin_lo_[std::size_t(a)] = Lattice::binOf(double(base_[std::size_t(a)]));
@@ -122,11 +157,9 @@ class UnitMesher {
         }
     std::sort(trees.begin(), trees.end());
     trees.erase(std::unique(trees.begin(), trees.end()), trees.end());
-    // Trees in order, each's vertices in edge order: the unit's vertices are in key order.
-    for (auto tree : trees) meshTree(tree, out);
+    return trees;
   }
 
- private:
   std::int32_t treeOf(std::int32_t s) const { return t_.tree.empty() ? 0 : t_.tree[s]; }
 
   std::int32_t localIndex(const HalfPoint& q) const {
@@ -184,7 +217,8 @@ class UnitMesher {
     return next();
   }
 
-  void meshTree(std::int32_t tree, UnitMesh& out) {
+  // The tree's solids per bin, and no lattice value known yet.
+  void loadTree(std::int32_t tree) {
     caps_.assign(unit_bins_.size(), {});
     for (std::size_t b = 0; b < unit_bins_.size(); ++b)
       if (unit_bins_[b])
@@ -193,6 +227,107 @@ class UnitMesher {
     const std::size_t points = std::size_t(n_ * n_ * n_);
     if (stamp_.size() < points) stamp_.resize(points, 0), f_.resize(points);
     ++generation_;
+  }
+
+  // One leaf of the dual contour. Its boundary is triangulated as the conforming tetrahedra's
+  // faces there (the same triangles as each neighbour's): each boundary triangle the surface
+  // crosses joins its two crossed edges, so a leaf's sheets are the loops of crossings around
+  // its boundary, alike in both leaves of every face. A sheet's vertex is the mean of its
+  // crossings, moved onto the surface by Newton steps and kept inside the leaf.
+  void dualLeaf(const OctreeLeaf& leaf, std::int32_t tree, DualUnit& out) {
+    const std::int64_t size = std::int64_t(2) << leaf.level;
+    const HalfPoint o{leaf.cell[0] * size, leaf.cell[1] * size, leaf.cell[2] * size};
+    const HalfPoint centre{o[0] + size / 2, o[1] + size / 2, o[2] + size / 2};
+    boundary_.clear();
+    scratch_.clear();
+    splitter_.tetrahedra(leaf, scratch_);
+    if (scratch_.front()[0] == centre) {  // coned from its centre: the cones' bases
+      for (const auto& tet : scratch_) boundary_.push_back({tet[1], tet[2], tet[3]});
+    } else {  // Freudenthal: each face split by its diagonal from the lowest to the highest corner
+      for (int a = 0; a < 3; ++a)
+        for (std::int64_t side = 0; side < 2; ++side) {
+          const int b = (a + 1) % 3, c = (a + 2) % 3;
+          HalfPoint q[4] = {o, o, o, o};
+          for (auto& p : q) p[std::size_t(a)] += side * size;
+          q[1][std::size_t(b)] += size, q[2][std::size_t(b)] += size, q[2][std::size_t(c)] += size, q[3][std::size_t(c)] += size;
+          boundary_.push_back({q[0], q[1], q[2]});
+          boundary_.push_back({q[0], q[2], q[3]});
+        }
+    }
+    edges_.clear();
+    const auto edgeOf = [&](const HalfPoint& a, const HalfPoint& b, double fa, double fb) {
+      const auto key = std::int64_t(cellCode(a[0] + b[0], a[1] + b[1], a[2] + b[2]));
+      for (std::size_t k = 0; k < edges_.size(); ++k)
+        if (edges_[k].key == key) return std::int32_t(k);
+      edges_.push_back({key, a, b, fa, fb, std::int32_t(edges_.size())});
+      return std::int32_t(edges_.size() - 1);
+    };
+    const auto root = [&](std::int32_t k) {
+      while (edges_[std::size_t(k)].parent != k) k = edges_[std::size_t(k)].parent = edges_[std::size_t(edges_[std::size_t(k)].parent)].parent;
+      return k;
+    };
+    for (const auto& tri : boundary_) {
+      double v[3];
+      for (int q = 0; q < 3; ++q) v[q] = value(localIndex(tri[std::size_t(q)]));
+      std::int32_t crossed[2], nc = 0;
+      for (int q = 0; q < 3; ++q) {
+        const int r = (q + 1) % 3;
+        if ((v[q] < 0) != (v[r] < 0)) crossed[nc++] = edgeOf(tri[std::size_t(q)], tri[std::size_t(r)], v[q], v[r]);
+      }
+      if (nc == 2) edges_[std::size_t(root(crossed[0]))].parent = root(crossed[1]);
+    }
+    if (edges_.empty()) return;
+    // Vertices, one per sheet, in the order of the sheets' first edges.
+    const auto first_vertex = std::int32_t(out.vertices.size());
+    sheet_of_.assign(edges_.size(), -1);
+    sums_.clear();
+    for (std::size_t k = 0; k < edges_.size(); ++k) {
+      const auto r = std::size_t(root(std::int32_t(k)));
+      if (sheet_of_[r] < 0) sheet_of_[r] = std::int32_t(sums_.size()), sums_.push_back({Vec3(0, 0, 0), 0});
+      const auto& e = edges_[k];
+      const double t = e.fa / (e.fa - e.fb);
+      sums_[std::size_t(sheet_of_[r])].first += asVec(e.pa) + (asVec(e.pb) - asVec(e.pa)) * t;
+      sums_[std::size_t(sheet_of_[r])].second += 1;
+    }
+    // Kept off the leaf's faces by more than the gradient's step: its samples stay in the unit's bins.
+    const double margin = 2e-3 * double(size);
+    const auto inLeaf = [&](const Vec3& q) {
+      return componentMin(componentMax(q, asVec(o) + Vec3(margin, margin, margin)),
+                          asVec(o) + Vec3(double(size) - margin, double(size) - margin, double(size) - margin));
+    };
+    for (const auto& [sum, count] : sums_) {
+      Vec3 q = inLeaf(sum / double(count));
+      for (int it = 0; it < 3; ++it) {
+        const double d = distance(q);
+        if (!std::isfinite(d) || std::abs(d) < 1e-7 * lat_.h) break;
+        const double e = 1e-3;  // half steps
+        const Vec3 g((distance(q + Vec3(e, 0, 0)) - distance(q - Vec3(e, 0, 0))) / (2 * e),
+                     (distance(q + Vec3(0, e, 0)) - distance(q - Vec3(0, e, 0))) / (2 * e),
+                     (distance(q + Vec3(0, 0, e)) - distance(q - Vec3(0, 0, e))) / (2 * e));
+        const double g2 = dot(g, g);
+        if (!(g2 > 1e-24) || !std::isfinite(g2)) break;
+        q = inLeaf(q - g * (d / g2));
+      }
+      out.vertices.push_back(lat_.origin + q * (0.5 * lat_.h));
+      out.steps.push_back(float(double(size) * 0.5 * lat_.h));
+    }
+    // The grid edges among them (one axis): the dual polygons are made around those.
+    for (std::size_t k = 0; k < edges_.size(); ++k) {
+      const auto& e = edges_[k];
+      int axis = -1, differ = 0;
+      for (int a = 0; a < 3; ++a)
+        if (e.pa[std::size_t(a)] != e.pb[std::size_t(a)]) axis = a, ++differ;
+      if (differ != 1) continue;
+      const int b = (axis + 1) % 3, c = (axis + 2) % 3;
+      const double db = double(2 * centre[std::size_t(b)] - e.pa[std::size_t(b)] - e.pb[std::size_t(b)]);
+      const double dc = double(2 * centre[std::size_t(c)] - e.pa[std::size_t(c)] - e.pb[std::size_t(c)]);
+      const bool low_inside = (e.pa[std::size_t(axis)] < e.pb[std::size_t(axis)]) == (e.fa < 0);
+      out.records.push_back({tree, e.key, std::atan2(dc, db), first_vertex + sheet_of_[std::size_t(root(std::int32_t(k)))], low_inside});
+    }
+  }
+
+  void meshTree(std::int32_t tree, UnitMesh& out) {
+    loadTree(tree);
     crossings_.clear();
     keyed_.clear();
     for (const auto& tet : tets_) {
@@ -278,6 +413,17 @@ class UnitMesher {
   std::vector<Crossing> crossings_;
   std::vector<KeyedTriangle> keyed_;  // the current tree's, by their edges
   std::vector<std::int64_t> keys_;    // the current tree's crossed edges, in order
+  // The dual contour's per-leaf scratch.
+  struct LeafEdge {
+    std::int64_t key;
+    HalfPoint pa, pb;
+    double fa, fb;
+    std::int32_t parent;  // union-find: edges joined across the boundary's triangles
+  };
+  std::vector<std::array<HalfPoint, 3>> boundary_;
+  std::vector<LeafEdge> edges_;
+  std::vector<std::int32_t> sheet_of_;
+  std::vector<std::pair<Vec3, int>> sums_;
 };
 
 // The connected surface of each vertex (through shared triangles), as one representative vertex.
@@ -344,7 +490,9 @@ std::vector<std::int8_t> vesselLevels(const VascularTree& t, const std::vector<s
 // own edge of the tetrahedra (by the move over the edge's outward component, within the edge's
 // inner 98 % and at most a fifth of it): every triangle stays inside its tetrahedron, so the surface keeps free of
 // self-intersections. The move is a fraction of the chord's sagitta. Returns the largest.
-constexpr double kLargestSlide = 0.2;  // share of the edge: a grazing edge would carry the vertex far from the surface
+constexpr double kLargestSlide = 0.2;
+// Rounds of relax() for the dual contour's folds.
+constexpr int kRelaxRounds = 4;  // share of the edge: a grazing edge would carry the vertex far from the surface
 
 double restoreVolume(SurfaceMesh& m, const std::vector<Vec3>& along, std::vector<double>& on_edge,
                      const std::function<double(std::int32_t, const Vec3&)>& distance) {
@@ -380,6 +528,196 @@ double restoreVolume(SurfaceMesh& m, const std::vector<Vec3>& along, std::vector
   return largest;
 }
 
+
+// Each vertex moves out along its normal by ¾ of its triangles' area-weighted gap (restoreVolume's
+// rule, for vertices that lie on no edge: the dual contour's). Returns the largest move.
+double restoreVolumeAlongNormals(SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
+  const std::size_t nt = m.triangles.size();
+  std::vector<double> gap(nt, 0.0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k != r.end(); ++k) {
+      const auto& t = m.triangles[k];
+      const Vec3 c = (m.vertices[std::size_t(t[0])] + m.vertices[std::size_t(t[1])] + m.vertices[std::size_t(t[2])]) / 3.0;
+      const double d = distance(m.triangle_tree[k], c);
+      gap[k] = std::isfinite(d) ? -0.75 * d : 0.0;
+    }
+  });
+  std::vector<Vec3> normal(m.vertices.size(), Vec3(0, 0, 0));
+  std::vector<double> weighted(m.vertices.size(), 0.0), area(m.vertices.size(), 0.0);
+  for (std::size_t k = 0; k < nt; ++k) {
+    const auto& t = m.triangles[k];
+    const Vec3 n = cross(m.vertices[std::size_t(t[1])] - m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[2])] - m.vertices[std::size_t(t[0])]);
+    const double a = norm(n);
+    for (auto v : t) normal[std::size_t(v)] += n, weighted[std::size_t(v)] += a * gap[k], area[std::size_t(v)] += a;
+  }
+  double largest = 0;
+  for (std::size_t v = 0; v < m.vertices.size(); ++v) {
+    if (!(area[v] > 0)) continue;
+    const double step = m.vertex_step[v], move = std::clamp(weighted[v] / area[v], -kLargestSlide * step, kLargestSlide * step);
+    m.vertices[v] += unit(normal[v]) * move;
+    largest = std::max(largest, std::abs(move));
+  }
+  return largest;
+}
+
+// Where a coarse leaf meets finer ones, or the surface grazes a face, a sheet's vertex may lie
+// so far round the surface that a triangle folds back over its neighbours. The corners of the
+// triangles marked (facing against the summed normal at one of their corners, or found crossing
+// another) move to the mean of their neighbours and back onto the surface (Newton steps on the
+// distance). Returns the vertices moved.
+std::int64_t relax(SurfaceMesh& m, const std::vector<std::int32_t>& tree_of, const std::vector<std::int32_t>& marked_triangles,
+                   const std::function<double(std::int32_t, const Vec3&)>& distance) {
+  const std::size_t nv = m.vertices.size(), nt = m.triangles.size();
+  std::vector<char> bad(nv, 0);
+  for (auto k : marked_triangles)
+    for (auto w : m.triangles[std::size_t(k)]) bad[std::size_t(w)] = 1;
+  {
+    std::vector<Vec3> normal(nv, Vec3(0, 0, 0)), face(nt);
+    for (std::size_t k = 0; k < nt; ++k) {
+      const auto& t = m.triangles[k];
+      face[k] = cross(m.vertices[std::size_t(t[1])] - m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[2])] - m.vertices[std::size_t(t[0])]);
+      for (auto v : t) normal[std::size_t(v)] += face[k];
+    }
+    for (std::size_t k = 0; k < nt; ++k)
+      for (auto v : m.triangles[k])
+        if (dot(face[k], normal[std::size_t(v)]) <= 0) {
+          for (auto w : m.triangles[k]) bad[std::size_t(w)] = 1;
+          break;
+        }
+  }
+  std::vector<Vec3> sum(nv, Vec3(0, 0, 0));
+  std::vector<int> count(nv, 0);
+  for (const auto& t : m.triangles)
+    for (int q = 0; q < 3; ++q)
+      if (bad[std::size_t(t[std::size_t(q)])])
+        for (int r = 1; r < 3; ++r) sum[std::size_t(t[std::size_t(q)])] += m.vertices[std::size_t(t[std::size_t((q + r) % 3)])], ++count[std::size_t(t[std::size_t(q)])];
+  std::int64_t moved = 0;
+  for (std::size_t v = 0; v < nv; ++v) {
+    if (!bad[v] || count[v] == 0) continue;
+    Vec3 p = sum[v] / double(count[v]);
+    const double e = 1e-3 * m.vertex_step[v];
+    for (int it = 0; it < 3; ++it) {
+      const double d = distance(tree_of[v], p);
+      if (!std::isfinite(d) || std::abs(d) < 1e-6 * m.vertex_step[v]) break;
+      const Vec3 g((distance(tree_of[v], p + Vec3(e, 0, 0)) - distance(tree_of[v], p - Vec3(e, 0, 0))) / (2 * e),
+                   (distance(tree_of[v], p + Vec3(0, e, 0)) - distance(tree_of[v], p - Vec3(0, e, 0))) / (2 * e),
+                   (distance(tree_of[v], p + Vec3(0, 0, e)) - distance(tree_of[v], p - Vec3(0, 0, e))) / (2 * e));
+      const double g2 = dot(g, g);
+      if (!(g2 > 1e-12) || !std::isfinite(g2)) break;
+      p = p - g * (d / g2);
+    }
+    m.vertices[v] = p;
+    ++moved;
+  }
+  return moved;
+}
+
+// A sheet whose loop crosses only two grid edges gets a vertex of two triangles on the same
+// three vertices, back to back: a flat pillow. Both go (with the vertex); the surface around
+// them closes over their shared edge. Repeated while removing one makes another.
+void removePillows(SurfaceMesh& m) {
+  for (;;) {
+    std::vector<std::int32_t> degree(m.vertices.size(), 0), any(m.vertices.size(), -1);
+    for (std::size_t k = 0; k < m.triangles.size(); ++k)
+      for (auto v : m.triangles[k]) ++degree[std::size_t(v)], any[std::size_t(v)] = std::int32_t(k);
+    std::vector<char> keep(m.triangles.size(), 1);
+    std::vector<std::array<std::int32_t, 3>> sorted(m.triangles.size());
+    for (std::size_t k = 0; k < m.triangles.size(); ++k) {
+      sorted[k] = m.triangles[k];
+      std::sort(sorted[k].begin(), sorted[k].end());
+    }
+    bool removed = false;
+    // The two triangles of a degree-2 vertex: the last one found and the other.
+    std::vector<std::int32_t> second(m.vertices.size(), -1);
+    for (std::size_t k = 0; k < m.triangles.size(); ++k)
+      for (auto v : m.triangles[k])
+        if (degree[std::size_t(v)] == 2 && any[std::size_t(v)] != std::int32_t(k)) second[std::size_t(v)] = std::int32_t(k);
+    for (std::size_t v = 0; v < m.vertices.size(); ++v) {
+      if (degree[v] != 2 || second[v] < 0) continue;
+      const auto a = std::size_t(any[v]), b = std::size_t(second[v]);
+      if (!keep[a] || !keep[b] || sorted[a] != sorted[b]) continue;
+      keep[a] = keep[b] = 0;
+      removed = true;
+    }
+    if (!removed) return;
+    keepTriangles(m, keep);
+  }
+}
+
+// The dual contour of the octree's leaves (surface nets): a vertex per sheet of each leaf, a
+// triangle or quadrilateral around each grid edge the surface crosses from the 3 or 4 leaves
+// around it (a coarser leaf spans two of its quadrants), counter-clockwise seen from outside,
+// a quadrilateral split along the diagonal that folds it least. Null (and why) where an edge's
+// leaves do not close around it.
+std::optional<SurfaceMesh> dualContour(const VascularTree& t, const Lattice& lat, const BalancedOctree& octree, const std::vector<OctreeLeaf>& units,
+                                       const std::vector<double>& fillet, const char*& refused,
+                                       const std::function<void(std::int64_t, std::int64_t)>& progress) {
+  const std::int64_t nu = std::int64_t(units.size());
+  std::vector<DualUnit> duals(units.size());
+  const std::int64_t batch = 4096;
+  for (std::int64_t first = 0; first < nu; first += batch) {
+    const std::int64_t last = std::min(nu, first + batch);
+    tbb::parallel_for(tbb::blocked_range<std::int64_t>(first, last, 4), [&](const tbb::blocked_range<std::int64_t>& r) {
+      LeafSplitter splitter(octree);
+      UnitMesher mesher(t, lat, splitter, fillet);
+      std::vector<OctreeLeaf> leaves;
+      for (std::int64_t u = r.begin(); u != r.end(); ++u) {
+        const auto& unit = units[std::size_t(u)];
+        splitter.leaves(unit, leaves);
+        mesher.dual(unit.level, unit.cell, leaves.data(), leaves.data() + leaves.size(), duals[std::size_t(u)]);
+      }
+    });
+    if (progress) progress(last, nu);
+  }
+  SurfaceMesh mesh;
+  std::vector<DualRecord> records;
+  for (auto& d : duals) {
+    const auto base = std::int32_t(mesh.vertices.size());
+    mesh.vertices.insert(mesh.vertices.end(), d.vertices.begin(), d.vertices.end());
+    mesh.vertex_step.insert(mesh.vertex_step.end(), d.steps.begin(), d.steps.end());
+    for (auto r : d.records) r.vertex += base, records.push_back(r);
+    DualUnit().records.swap(d.records);
+  }
+  tbb::parallel_sort(records.begin(), records.end(), [](const DualRecord& a, const DualRecord& b) {
+    return std::tie(a.tree, a.edge, a.angle) < std::tie(b.tree, b.edge, b.angle);
+  });
+  for (std::size_t i = 0; i < records.size();) {
+    std::size_t j = i;
+    while (j < records.size() && records[j].tree == records[i].tree && records[j].edge == records[i].edge) ++j;
+    const std::size_t n = j - i;
+    if (n == 2) {  // an edge inside a face (a fan's spoke): no polygon
+      i = j;
+      continue;
+    }
+    if (n != 3 && n != 4) {
+      refused = "an edge without 3 or 4 leaves around it";
+      return std::nullopt;
+    }
+    std::int32_t poly[4];
+    for (std::size_t k = 0; k < n; ++k) poly[k] = records[i + k].vertex;
+    if (!records[i].low_inside) std::reverse(poly, poly + n);  // outward is down the edge's axis
+    const auto tree = records[i].tree;
+    if (n == 3) {
+      mesh.triangles.push_back({poly[0], poly[1], poly[2]});
+      mesh.triangle_tree.push_back(tree);
+    } else {
+      const auto P = [&](int k) -> const Vec3& { return mesh.vertices[std::size_t(poly[k])]; };
+      const auto fold = [&](int d) {  // cosine between the halves split along d – d + 2
+        const Vec3 n1 = cross(P((d + 1) % 4) - P(d), P((d + 2) % 4) - P(d)), n2 = cross(P((d + 2) % 4) - P(d), P((d + 3) % 4) - P(d));
+        const double l = norm(n1) * norm(n2);
+        return l > 0 ? dot(n1, n2) / l : -2.0;
+      };
+      const int d = fold(0) >= fold(1) ? 0 : 1;
+      mesh.triangles.push_back({poly[d], poly[(d + 1) % 4], poly[(d + 2) % 4]});
+      mesh.triangles.push_back({poly[d], poly[(d + 2) % 4], poly[(d + 3) % 4]});
+      mesh.triangle_tree.push_back(tree);
+      mesh.triangle_tree.push_back(tree);
+    }
+    i = j;
+  }
+  removePillows(mesh);
+  return mesh;
+}
 }  // namespace
 
 SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, SurfaceReport* report,
@@ -516,6 +854,59 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
   const BalancedOctree octree(top, std::move(requests));
   // Units: the level-3 nodes (8³ finest cells) with their leaves, and the coarser leaves alone.
   const std::vector<OctreeLeaf> units = octree.units(kUnitLevel);
+  std::vector<Solid> solids(std::size_t(t.nodeCount()));
+  for (auto s : vessels) solids[std::size_t(s)] = {capsuleOf(t, s), fillet[std::size_t(s)]};
+  // The solids of a tree in the bin of a point, as the units sample it.
+  const auto solidsAt = [&](std::int32_t tree, const Vec3& p) -> const std::vector<Solid>& {
+    const Vec3 half = (p - lat.origin) / (0.5 * lat.h);
+    thread_local std::vector<Solid> here;
+    here.clear();
+    if (const auto* segs = lat.segmentsIn(Lattice::binOf(half.x), Lattice::binOf(half.y), Lattice::binOf(half.z)))
+      for (auto s : *segs)
+        if ((t.tree.empty() ? 0 : t.tree[s]) == tree) here.push_back(solids[std::size_t(s)]);
+    return here;
+  };
+  const std::function<double(std::int32_t, const Vec3&)> distance = [&](std::int32_t tree, const Vec3& p) { return unionDistance(solidsAt(tree, p), p); };
+  // What changes the surface afterwards (decimation, sliver repair) measures its error from the
+  // union and the fillets alike (the larger), so that a fillet's offset never adds to it.
+  const std::function<double(std::int32_t, const Vec3&)> strict = [&](std::int32_t tree, const Vec3& p) {
+    double plain = 0;
+    const double filleted = unionDistance(solidsAt(tree, p), p, &plain);
+    return std::abs(plain) > std::abs(filleted) ? plain : filleted;
+  };
+  if (o.dual) {
+    const char* refused = nullptr;
+    if (auto dual = dualContour(t, lat, octree, units, fillet, refused, progress)) {
+      if (o.restore_volume) {
+        const double moved = restoreVolumeAlongNormals(*dual, distance);
+        if (report) report->largest_volume_move_mm = moved;
+      }
+      const auto removed = removeCavities(*dual);
+      if (!closedManifold(*dual)) {
+        refused = "not a closed manifold";
+      } else {
+        // Folds relaxed until no two triangles cross (the moved vertices back on the surface).
+        std::vector<std::int32_t> tree_of(dual->vertices.size(), 0);
+        for (std::size_t k = 0; k < dual->triangles.size(); ++k)
+          for (auto v : dual->triangles[k]) tree_of[std::size_t(v)] = dual->triangle_tree[k];
+        std::vector<std::int32_t> crossing;
+        for (int round = 0; round < kRelaxRounds; ++round) {
+          relax(*dual, tree_of, crossing, distance);
+          crossing = crossingTriangles(*dual, lat.origin, h);
+          if (crossing.empty()) break;
+        }
+        if (!crossing.empty()) refused = "self-intersecting";
+      }
+      if (!refused) {
+        if (report)
+          report->dual = true, report->cavities_removed = removed, report->cells = std::int64_t(dual->vertices.size()),
+          report->units = std::int64_t(units.size()), report->levels = top + 1;
+        if (o.finish) o.finish(*dual, strict);
+        return std::move(*dual);
+      }
+    }
+    if (report) report->dual_refused = refused;
+  }
   std::atomic<std::int64_t> cells{0};
   const std::int64_t nu = std::int64_t(units.size());
   std::vector<UnitMesh> meshes(units.size());
@@ -582,32 +973,12 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
       UnitMesh().vertices.swap(meshes[u].vertices);
     }
   });
-  std::vector<Solid> solids(std::size_t(t.nodeCount()));
-  for (auto s : vessels) solids[std::size_t(s)] = {capsuleOf(t, s), fillet[std::size_t(s)]};
-  // The solids of a tree in the bin of a point, as the units sample it.
-  const auto solidsAt = [&](std::int32_t tree, const Vec3& p) -> const std::vector<Solid>& {
-    const Vec3 half = (p - lat.origin) / (0.5 * lat.h);
-    thread_local std::vector<Solid> here;
-    here.clear();
-    if (const auto* segs = lat.segmentsIn(Lattice::binOf(half.x), Lattice::binOf(half.y), Lattice::binOf(half.z)))
-      for (auto s : *segs)
-        if ((t.tree.empty() ? 0 : t.tree[s]) == tree) here.push_back(solids[std::size_t(s)]);
-    return here;
-  };
-  const std::function<double(std::int32_t, const Vec3&)> distance = [&](std::int32_t tree, const Vec3& p) { return unionDistance(solidsAt(tree, p), p); };
   if (o.restore_volume) {
     const double moved = restoreVolume(mesh, along, on_edge, distance);
     if (report) report->largest_volume_move_mm = moved;
   }
   const auto removed = removeCavities(mesh);
   if (report) report->cavities_removed = removed;
-  // What changes the surface afterwards (decimation, sliver repair) measures its error from the
-  // union and the fillets alike (the larger), so that a fillet's offset never adds to it.
-  const std::function<double(std::int32_t, const Vec3&)> strict = [&](std::int32_t tree, const Vec3& p) {
-    double plain = 0;
-    const double filleted = unionDistance(solidsAt(tree, p), p, &plain);
-    return std::abs(plain) > std::abs(filleted) ? plain : filleted;
-  };
   if (o.finish) o.finish(mesh, strict);
   return mesh;
 }

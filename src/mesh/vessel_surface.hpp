@@ -46,6 +46,9 @@ struct SurfaceOptions {
   // Move vertices off the surface by ¾ of their triangles' mean gap (a fraction of the chords'
   // sagitta) so the enclosed volume is the vessels'; false: every vertex on the surface.
   bool restore_volume = true;
+  // Contour by surface nets on the octree (the dual of the cells: about a third of the triangles)
+  // where the result is a closed manifold free of self-intersections; else marching tetrahedra.
+  bool dual = false;
   std::uint64_t memory_limit = 0;  // bytes; 0: no limit
   // Called on the finished mesh while the exact signed distance to each tree's surface is at
   // hand (distance(tree, p), mm): cutting ends, decimation.
@@ -60,6 +63,8 @@ struct SurfaceReport {
   double estimated_bytes = 0;
   std::int64_t cavities_removed = 0;
   double largest_volume_move_mm = 0;  // closed pockets of outside space below the grid's resolution
+  bool dual = false;                  // contoured by surface nets (options.dual and its checks passed)
+  const char* dual_refused = nullptr; // options.dual, but marching tetrahedra: why
 };
 
 // Throws InputError (no file) when the grid would exceed the memory limit or the index range.
