@@ -66,6 +66,19 @@ double largestDistanceOverStep(const VascularTree& t, const SurfaceMesh& m) {
   return worst;
 }
 
+// A mesh of one tree: closed, manifold, consistently oriented, without degenerate triangles,
+// one surface of genus 0 (Euler characteristic 2).
+MeshTopology expectOneSurfaceOfGenusZero(const SurfaceMesh& m) {
+  const auto topo = meshTopology(m);
+  EXPECT_EQ(topo.boundary_edges, 0);
+  EXPECT_EQ(topo.nonmanifold_edges, 0);
+  EXPECT_EQ(topo.misoriented_edges, 0);
+  EXPECT_EQ(topo.degenerate_triangles, 0);
+  EXPECT_EQ(topo.tree_components, std::vector<std::int64_t>({1}));
+  EXPECT_EQ(topo.tree_euler, std::vector<std::int64_t>({2}));
+  return topo;
+}
+
 // mesh.json's own account of a closed surface: no boundary, non-manifold or misoriented edge,
 // no degenerate triangle.
 void expectClosedInMeshJson(const nlohmann::json& statistics, const std::string& what = {}) {
@@ -153,19 +166,8 @@ TEST(Mesh, SurfaceNetsContourAJunctionClosedOnTheVesselsWithFewerTriangles) {
   NetReport why;
   const auto net = netSurface(t, o, &rep, &why);
   ASSERT_TRUE(net.has_value()) << why.refused;
-  const auto topo = meshTopology(*net);
-  EXPECT_EQ(topo.boundary_edges, 0);
-  EXPECT_EQ(topo.nonmanifold_edges, 0);
-  EXPECT_EQ(topo.misoriented_edges, 0);
-  EXPECT_EQ(topo.degenerate_triangles, 0);
-  EXPECT_EQ(topo.tree_components, std::vector<std::int64_t>({1}));
-  EXPECT_EQ(topo.tree_euler, std::vector<std::int64_t>({2}));
-  double worst = 0;
-  for (const auto& p : net->vertices) {
-    double d = INFINITY;
-    for (auto s : {fork, left, right}) d = std::min(d, capsuleOf(t, s).depth(p));
-    worst = std::max(worst, std::abs(d) / rep.voxel_mm);
-  }
+  const auto topo = expectOneSurfaceOfGenusZero(*net);
+  const double worst = largestDistanceOverStep(t, *net);
   EXPECT_LT(worst, 0.25);
   const auto tet = vesselSurface(t, o);
   const double v_tet = meshTopology(tet).volume_mm3;
@@ -200,18 +202,8 @@ TEST(Mesh, DualContourOnTheOctreeKeepsEachVesselsStep) {
   const auto dual = vesselSurface(t, o, &rep);
   ASSERT_TRUE(rep.dual) << rep.dual_refused;
   EXPECT_GE(rep.levels, 3);
-  const auto topo = meshTopology(dual);
-  EXPECT_EQ(topo.boundary_edges, 0);
-  EXPECT_EQ(topo.nonmanifold_edges, 0);
-  EXPECT_EQ(topo.misoriented_edges, 0);
-  EXPECT_EQ(topo.degenerate_triangles, 0);
-  EXPECT_EQ(topo.tree_euler, std::vector<std::int64_t>({2}));
-  double worst = 0;
-  for (std::size_t v = 0; v < dual.vertices.size(); ++v) {
-    double d = INFINITY;
-    for (auto s : {fork, thick, thin}) d = std::min(d, capsuleOf(t, s).depth(dual.vertices[v]));
-    worst = std::max(worst, std::abs(d) / dual.vertex_step[v]);
-  }
+  const auto topo = expectOneSurfaceOfGenusZero(dual);
+  const double worst = largestDistanceOverStep(t, dual);
   EXPECT_LT(worst, 0.25);
   SurfaceOptions tet = o;
   tet.dual = false;

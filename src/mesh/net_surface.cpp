@@ -8,6 +8,7 @@
 #include <numeric>
 #include <vector>
 
+#include "mesh/dual_geometry.hpp"
 #include "mesh/surface_checks.hpp"
 #include "mesh/union_distance.hpp"
 
@@ -206,19 +207,9 @@ std::optional<SurfaceMesh> netSurface(const VascularTree& t, const SurfaceOption
         }
         for (int k = 0; k < sheets_n; ++k) {
           // The sheet's crossings' mean, taken onto the surface by Newton steps, kept in the cell.
-          Vec3 p = sum[k] / double(count[k]);
-          for (int it = 0; it < 3; ++it) {
-            const double d = distance(p);
-            if (std::abs(d) < 1e-6 * h) break;
-            const double e = 1e-3 * h;
-            const Vec3 g((distance(p + Vec3(e, 0, 0)) - distance(p - Vec3(e, 0, 0))) / (2 * e),
-                         (distance(p + Vec3(0, e, 0)) - distance(p - Vec3(0, e, 0))) / (2 * e),
-                         (distance(p + Vec3(0, 0, e)) - distance(p - Vec3(0, 0, e))) / (2 * e));
-            const double g2 = dot(g, g);
-            if (!(g2 > 1e-12)) break;
-            p = p - g * (d / g2);
-          }
-          p = componentMin(componentMax(p, corner0 + Vec3(margin, margin, margin)), corner0 + Vec3(h - margin, h - margin, h - margin));
+          const Vec3 lo_c = corner0 + Vec3(margin, margin, margin), hi_c = corner0 + Vec3(h - margin, h - margin, h - margin);
+          const Vec3 p = ontoSurface(sum[k] / double(count[k]), distance, 1e-3 * h, 1e-6 * h,
+                                     [&](const Vec3& q) { return componentMin(componentMax(q, lo_c), hi_c); });
           mesh.vertices.push_back(p);
           mesh.vertex_step.push_back(float(h));
         }
@@ -227,7 +218,7 @@ std::optional<SurfaceMesh> netSurface(const VascularTree& t, const SurfaceOption
       }
 
   // A quadrilateral around each crossed edge, from the four cells around it (counter-clockwise
-  // seen from the outside), split along the diagonal that folds it least.
+  // seen from the outside).
   for (std::int64_t z = 1; z < cz; ++z)
     for (std::int64_t y = 1; y < cy; ++y)
       for (std::int64_t x = 1; x < cx; ++x) {
@@ -250,15 +241,7 @@ std::optional<SurfaceMesh> netSurface(const VascularTree& t, const SurfaceOption
             quad[k] = cell.first_vertex + cell.sheet[edgeId(a, low)];
           }
           if (!in0) std::swap(quad[1], quad[3]);  // outward is −a
-          const auto P = [&](int k) -> const Vec3& { return mesh.vertices[std::size_t(quad[k])]; };
-          const auto fold = [&](int i) {  // cosine between the halves split along i – i + 2
-            const Vec3 n1 = cross(P((i + 1) % 4) - P(i), P((i + 2) % 4) - P(i)), n2 = cross(P((i + 2) % 4) - P(i), P((i + 3) % 4) - P(i));
-            const double l = norm(n1) * norm(n2);
-            return l > 0 ? dot(n1, n2) / l : -2.0;
-          };
-          const int i = fold(0) >= fold(1) ? 0 : 1;
-          mesh.triangles.push_back({quad[i], quad[(i + 1) % 4], quad[(i + 2) % 4]});
-          mesh.triangles.push_back({quad[i], quad[(i + 2) % 4], quad[(i + 3) % 4]});
+          appendQuad(mesh, quad);
         }
       }
   mesh.triangle_tree.assign(mesh.triangles.size(), t.tree.empty() ? 0 : t.tree[vessels.front()]);

@@ -17,6 +17,7 @@
 #include "core/error.hpp"
 #include "core/memory.hpp"
 #include "mesh/balanced_octree.hpp"
+#include "mesh/dual_geometry.hpp"
 #include "mesh/surface_checks.hpp"
 #include "mesh/union_distance.hpp"
 #include "raster/capsule_rasterizer.hpp"
@@ -296,18 +297,7 @@ class UnitMesher {
                           asVec(o) + Vec3(double(size) - margin, double(size) - margin, double(size) - margin));
     };
     for (const auto& [sum, count] : sums_) {
-      Vec3 q = inLeaf(sum / double(count));
-      for (int it = 0; it < 3; ++it) {
-        const double d = distance(q);
-        if (!std::isfinite(d) || std::abs(d) < 1e-7 * lat_.h) break;
-        const double e = 1e-3;  // half steps
-        const Vec3 g((distance(q + Vec3(e, 0, 0)) - distance(q - Vec3(e, 0, 0))) / (2 * e),
-                     (distance(q + Vec3(0, e, 0)) - distance(q - Vec3(0, e, 0))) / (2 * e),
-                     (distance(q + Vec3(0, 0, e)) - distance(q - Vec3(0, 0, e))) / (2 * e));
-        const double g2 = dot(g, g);
-        if (!(g2 > 1e-24) || !std::isfinite(g2)) break;
-        q = inLeaf(q - g * (d / g2));
-      }
+      const Vec3 q = ontoSurface(sum / double(count), [&](const Vec3& x) { return distance(x); }, 1e-3, 1e-7 * lat_.h, inLeaf);
       out.vertices.push_back(lat_.origin + q * (0.5 * lat_.h));
       out.steps.push_back(float(double(size) * 0.5 * lat_.h));
     }
@@ -529,6 +519,27 @@ double restoreVolume(SurfaceMesh& m, const std::vector<Vec3>& along, std::vector
 }
 
 
+// Runs fn(mesher, unit index, the unit's leaves) over the units in parallel, in batches so that
+// progress is reported from the calling thread.
+template <class F>
+void forEachUnit(const VascularTree& t, const Lattice& lat, const BalancedOctree& octree, const std::vector<OctreeLeaf>& units,
+                 const std::vector<double>& fillet, const std::function<void(std::int64_t, std::int64_t)>& progress, const F& fn) {
+  const std::int64_t nu = std::int64_t(units.size()), batch = 4096;
+  for (std::int64_t first = 0; first < nu; first += batch) {
+    const std::int64_t last = std::min(nu, first + batch);
+    tbb::parallel_for(tbb::blocked_range<std::int64_t>(first, last, 4), [&](const tbb::blocked_range<std::int64_t>& r) {
+      LeafSplitter splitter(octree);
+      UnitMesher mesher(t, lat, splitter, fillet);
+      std::vector<OctreeLeaf> leaves;
+      for (std::int64_t u = r.begin(); u != r.end(); ++u) {
+        splitter.leaves(units[std::size_t(u)], leaves);
+        fn(mesher, std::size_t(u), leaves);
+      }
+    });
+    if (progress) progress(last, nu);
+  }
+}
+
 // Each vertex moves out along its normal by ¾ of its triangles' area-weighted gap (restoreVolume's
 // rule, for vertices that lie on no edge: the dual contour's). Returns the largest move.
 double restoreVolumeAlongNormals(SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
@@ -594,18 +605,9 @@ std::int64_t relax(SurfaceMesh& m, const std::vector<std::int32_t>& tree_of, con
   std::int64_t moved = 0;
   for (std::size_t v = 0; v < nv; ++v) {
     if (!bad[v] || count[v] == 0) continue;
-    Vec3 p = sum[v] / double(count[v]);
-    const double e = 1e-3 * m.vertex_step[v];
-    for (int it = 0; it < 3; ++it) {
-      const double d = distance(tree_of[v], p);
-      if (!std::isfinite(d) || std::abs(d) < 1e-6 * m.vertex_step[v]) break;
-      const Vec3 g((distance(tree_of[v], p + Vec3(e, 0, 0)) - distance(tree_of[v], p - Vec3(e, 0, 0))) / (2 * e),
-                   (distance(tree_of[v], p + Vec3(0, e, 0)) - distance(tree_of[v], p - Vec3(0, e, 0))) / (2 * e),
-                   (distance(tree_of[v], p + Vec3(0, 0, e)) - distance(tree_of[v], p - Vec3(0, 0, e))) / (2 * e));
-      const double g2 = dot(g, g);
-      if (!(g2 > 1e-12) || !std::isfinite(g2)) break;
-      p = p - g * (d / g2);
-    }
+    const auto tree = tree_of[v];
+    const Vec3 p = ontoSurface(sum[v] / double(count[v]), [&](const Vec3& x) { return distance(tree, x); }, 1e-3 * m.vertex_step[v],
+                               1e-6 * m.vertex_step[v], [](const Vec3& x) { return x; });
     m.vertices[v] = p;
     ++moved;
   }
@@ -652,23 +654,10 @@ void removePillows(SurfaceMesh& m) {
 std::optional<SurfaceMesh> dualContour(const VascularTree& t, const Lattice& lat, const BalancedOctree& octree, const std::vector<OctreeLeaf>& units,
                                        const std::vector<double>& fillet, const char*& refused,
                                        const std::function<void(std::int64_t, std::int64_t)>& progress) {
-  const std::int64_t nu = std::int64_t(units.size());
   std::vector<DualUnit> duals(units.size());
-  const std::int64_t batch = 4096;
-  for (std::int64_t first = 0; first < nu; first += batch) {
-    const std::int64_t last = std::min(nu, first + batch);
-    tbb::parallel_for(tbb::blocked_range<std::int64_t>(first, last, 4), [&](const tbb::blocked_range<std::int64_t>& r) {
-      LeafSplitter splitter(octree);
-      UnitMesher mesher(t, lat, splitter, fillet);
-      std::vector<OctreeLeaf> leaves;
-      for (std::int64_t u = r.begin(); u != r.end(); ++u) {
-        const auto& unit = units[std::size_t(u)];
-        splitter.leaves(unit, leaves);
-        mesher.dual(unit.level, unit.cell, leaves.data(), leaves.data() + leaves.size(), duals[std::size_t(u)]);
-      }
-    });
-    if (progress) progress(last, nu);
-  }
+  forEachUnit(t, lat, octree, units, fillet, progress, [&](UnitMesher& mesher, std::size_t u, const std::vector<OctreeLeaf>& leaves) {
+    mesher.dual(units[u].level, units[u].cell, leaves.data(), leaves.data() + leaves.size(), duals[u]);
+  });
   SurfaceMesh mesh;
   std::vector<DualRecord> records;
   for (auto& d : duals) {
@@ -701,15 +690,7 @@ std::optional<SurfaceMesh> dualContour(const VascularTree& t, const Lattice& lat
       mesh.triangles.push_back({poly[0], poly[1], poly[2]});
       mesh.triangle_tree.push_back(tree);
     } else {
-      const auto P = [&](int k) -> const Vec3& { return mesh.vertices[std::size_t(poly[k])]; };
-      const auto fold = [&](int d) {  // cosine between the halves split along d – d + 2
-        const Vec3 n1 = cross(P((d + 1) % 4) - P(d), P((d + 2) % 4) - P(d)), n2 = cross(P((d + 2) % 4) - P(d), P((d + 3) % 4) - P(d));
-        const double l = norm(n1) * norm(n2);
-        return l > 0 ? dot(n1, n2) / l : -2.0;
-      };
-      const int d = fold(0) >= fold(1) ? 0 : 1;
-      mesh.triangles.push_back({poly[d], poly[(d + 1) % 4], poly[(d + 2) % 4]});
-      mesh.triangles.push_back({poly[d], poly[(d + 2) % 4], poly[(d + 3) % 4]});
+      appendQuad(mesh, poly);
       mesh.triangle_tree.push_back(tree);
       mesh.triangle_tree.push_back(tree);
     }
@@ -908,30 +889,16 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
     if (report) report->dual_refused = refused;
   }
   std::atomic<std::int64_t> cells{0};
-  const std::int64_t nu = std::int64_t(units.size());
   std::vector<UnitMesh> meshes(units.size());
-  // In batches, so progress is reported from this thread.
-  const std::int64_t batch = 4096;
-  for (std::int64_t first = 0; first < nu; first += batch) {
-    const std::int64_t last = std::min(nu, first + batch);
-    tbb::parallel_for(tbb::blocked_range<std::int64_t>(first, last, 4), [&](const tbb::blocked_range<std::int64_t>& r) {
-      LeafSplitter splitter(octree);
-      UnitMesher mesher(t, lat, splitter, fillet);
-      std::vector<OctreeLeaf> leaves;
-      for (std::int64_t u = r.begin(); u != r.end(); ++u) {
-        const auto& unit = units[std::size_t(u)];
-        auto& out = meshes[std::size_t(u)];
-        splitter.leaves(unit, leaves);
-        cells += std::int64_t(leaves.size());
-        mesher.mesh(unit.level, unit.cell, leaves.data(), leaves.data() + leaves.size(), out);
-        out.vertices.shrink_to_fit();
-        out.triangles.shrink_to_fit();
-        out.triangle_tree.shrink_to_fit();
-      }
-    });
-    if (progress) progress(last, nu);
-  }
-  if (report) report->cells = cells, report->units = nu, report->levels = top + 1;
+  forEachUnit(t, lat, octree, units, fillet, progress, [&](UnitMesher& mesher, std::size_t u, const std::vector<OctreeLeaf>& leaves) {
+    auto& out = meshes[u];
+    cells += std::int64_t(leaves.size());
+    mesher.mesh(units[u].level, units[u].cell, leaves.data(), leaves.data() + leaves.size(), out);
+    out.vertices.shrink_to_fit();
+    out.triangles.shrink_to_fit();
+    out.triangle_tree.shrink_to_fit();
+  });
+  if (report) report->cells = cells, report->units = std::int64_t(units.size()), report->levels = top + 1;
   // Weld: one vertex per (tree, edge), numbered in key order; triangles in unit order. Units
   // that share an edge computed the same vertex, so the first copy stands for all.
   struct Copy {
