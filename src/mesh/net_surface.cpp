@@ -71,7 +71,7 @@ std::optional<SurfaceMesh> netSurface(const VascularTree& t, const SurfaceOption
     if (net) net->refused = why;
     return std::nullopt;
   };
-  if (net) net->refused = nullptr;
+  if (net) *net = NetReport();
   for (auto c : o.vessel_max_cell_mm)
     if (c > 0) return refuse("gaps to resolve");
   std::vector<std::int32_t> vessels;
@@ -102,7 +102,10 @@ std::optional<SurfaceMesh> netSurface(const VascularTree& t, const SurfaceOption
     net_cost += kNetTriangles * area;
     tet_cost += kTetTriangles * area / double(std::int64_t(1) << (2 * std::min(level, 20)));
   }
-  if (net_cost > tet_cost) return refuse(kNetCostlier);
+  if (net_cost > tet_cost) {
+    if (net) net->costlier = true;
+    return refuse("marching tetrahedra make fewer triangles");
+  }
   std::vector<Solid> solids;
   Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
   for (auto s : vessels) {

@@ -15,9 +15,8 @@ namespace angiosynth {
 
 struct NetReport {
   const char* refused = nullptr;  // why no mesh was returned (nullptr: it was)
+  bool costlier = false;          // refused because the part's radii lie too far apart for one step
 };
-// The reason given where the part's radii lie too far apart for one step.
-inline constexpr const char* kNetCostlier = "marching tetrahedra make fewer triangles";
 
 // The distance, step and fillets are vesselSurface's at its finest level for the same options;
 // options.finish is called on a mesh that passed the checks. Parts with gaps to resolve

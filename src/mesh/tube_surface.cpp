@@ -703,7 +703,7 @@ class TubeMesher {
       NetReport nr;
       net = netSurface(sub, so, &sr, &nr);
       if (!shaped(net)) net.reset(), planes = planes_asked, stub_planes = stubs_asked;
-      if (!net && nr.refused == kNetCostlier) {
+      if (!net && nr.costlier) {
         so.dual = true;
         net = vesselSurface(sub, so, &sr);
         so.dual = false;
