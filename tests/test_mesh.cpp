@@ -79,6 +79,15 @@ MeshTopology expectOneSurfaceOfGenusZero(const SurfaceMesh& m) {
   return topo;
 }
 
+// A parent vessel from the origin to `fork` and two daughters from it; radii parent, a, b.
+VascularTree bifurcation(const Vec3& fork, const Vec3& a, const Vec3& b, const std::array<double, 3>& radii) {
+  VascularTree t;
+  const auto root = t.addNode({0, 0, 0}, -1), f = t.addNode(fork, root);
+  const auto da = t.addNode(a, f), db = t.addNode(b, f);
+  t.radius[f] = radii[0], t.radius[da] = radii[1], t.radius[db] = radii[2];
+  return t;
+}
+
 // mesh.json's own account of a closed surface: no boundary, non-manifold or misoriented edge,
 // no degenerate triangle.
 void expectClosedInMeshJson(const nlohmann::json& statistics, const std::string& what = {}) {
@@ -156,10 +165,8 @@ TEST(Mesh, TubesJoinContouredJunctionsIntoOneSurfaceOfGenusZeroPerTree) {
 // at the same step within 0.3 %, and under half their triangles. Parts it cannot serve are refused:
 // gaps to resolve, and radii so far apart that one step for all costs more than the octree.
 TEST(Mesh, SurfaceNetsContourAJunctionClosedOnTheVesselsWithFewerTriangles) {
-  VascularTree t;
-  const auto root = t.addNode({0, 0, 0}, -1), fork = t.addNode({10, 0, 0}, root);
-  const auto left = t.addNode({18, 4, 0}, fork), right = t.addNode({17, -4, 1.5}, fork);
-  t.radius[fork] = 1.0, t.radius[left] = 0.8, t.radius[right] = 0.75;
+  const VascularTree t = bifurcation({10, 0, 0}, {18, 4, 0}, {17, -4, 1.5}, {1.0, 0.8, 0.75});
+  const std::int32_t fork = 1, left = 2, right = 3;  // bifurcation()'s nodes after the root
   SurfaceOptions o;
   o.samples_across = 3;
   SurfaceReport rep;
@@ -192,10 +199,7 @@ TEST(Mesh, SurfaceNetsContourAJunctionClosedOnTheVesselsWithFewerTriangles) {
 // step; the dual of its leaves): the same checks pass, the triangles are a third of marching
 // tetrahedra's on the same cells, the volume theirs within 0.3 %, the mesh the same on one thread.
 TEST(Mesh, DualContourOnTheOctreeKeepsEachVesselsStep) {
-  VascularTree t;
-  const auto root = t.addNode({0, 0, 0}, -1), fork = t.addNode({12, 0, 0}, root);
-  const auto thick = t.addNode({24, 3, 0}, fork), thin = t.addNode({18, -5, 2}, fork);
-  t.radius[fork] = 2.0, t.radius[thick] = 1.8, t.radius[thin] = 0.25;
+  const VascularTree t = bifurcation({12, 0, 0}, {24, 3, 0}, {18, -5, 2}, {2.0, 1.8, 0.25});
   SurfaceOptions o;
   o.samples_across = 3;
   o.dual = true;

@@ -471,6 +471,34 @@ std::vector<std::int8_t> vesselLevels(const VascularTree& t, const std::vector<s
   return level;
 }
 
+// Per vertex, over its triangles: the area-weighted normal (× 2), the area, and the area-weighted
+// gap of the triangles' centroids (¾ of their distance inside: what flat chords lose).
+struct ChordGaps {
+  std::vector<Vec3> normal;
+  std::vector<double> weighted, area;
+};
+ChordGaps chordGaps(const SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
+  const std::size_t nt = m.triangles.size();
+  std::vector<double> gap(nt, 0.0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k != r.end(); ++k) {
+      const auto& t = m.triangles[k];
+      const Vec3 c = (m.vertices[std::size_t(t[0])] + m.vertices[std::size_t(t[1])] + m.vertices[std::size_t(t[2])]) / 3.0;
+      const double d = distance(m.triangle_tree[k], c);
+      gap[k] = std::isfinite(d) ? -0.75 * d : 0.0;
+    }
+  });
+  ChordGaps g{std::vector<Vec3>(m.vertices.size(), Vec3(0, 0, 0)), std::vector<double>(m.vertices.size(), 0.0),
+              std::vector<double>(m.vertices.size(), 0.0)};
+  for (std::size_t k = 0; k < nt; ++k) {
+    const auto& t = m.triangles[k];
+    const Vec3 n = cross(m.vertices[std::size_t(t[1])] - m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[2])] - m.vertices[std::size_t(t[0])]);
+    const double a = norm(n);
+    for (auto v : t) g.normal[std::size_t(v)] += n, g.weighted[std::size_t(v)] += a * gap[k], g.area[std::size_t(v)] += a;
+  }
+  return g;
+}
+
 // Flat triangles through points of a vessel's surface lie inside it where it is convex (chords)
 // and lose volume: about c²/(12 r²) of a vessel sampled by cells of size c (more where cells are
 // coarse); at creases they stand out. Each triangle's gap is measured at its centroid with the
@@ -486,24 +514,7 @@ constexpr int kRelaxRounds = 4;  // share of the edge: a grazing edge would carr
 
 double restoreVolume(SurfaceMesh& m, const std::vector<Vec3>& along, std::vector<double>& on_edge,
                      const std::function<double(std::int32_t, const Vec3&)>& distance) {
-  const std::size_t nt = m.triangles.size();
-  std::vector<double> gap(nt, 0.0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t k = r.begin(); k != r.end(); ++k) {
-      const auto& t = m.triangles[k];
-      const Vec3 c = (m.vertices[std::size_t(t[0])] + m.vertices[std::size_t(t[1])] + m.vertices[std::size_t(t[2])]) / 3.0;
-      const double d = distance(m.triangle_tree[k], c);
-      gap[k] = std::isfinite(d) ? -0.75 * d : 0.0;
-    }
-  });
-  std::vector<Vec3> normal(m.vertices.size(), Vec3(0, 0, 0));  // area-weighted (× 2)
-  std::vector<double> weighted(m.vertices.size(), 0.0), area(m.vertices.size(), 0.0);
-  for (std::size_t k = 0; k < nt; ++k) {
-    const auto& t = m.triangles[k];
-    const Vec3 n = cross(m.vertices[std::size_t(t[1])] - m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[2])] - m.vertices[std::size_t(t[0])]);
-    const double a = norm(n);
-    for (auto v : t) normal[std::size_t(v)] += n, weighted[std::size_t(v)] += a * gap[k], area[std::size_t(v)] += a;
-  }
+  const auto [normal, weighted, area] = chordGaps(m, distance);
   double largest = 0;
   for (std::size_t v = 0; v < m.vertices.size(); ++v) {
     const double outward = dot(along[v], unit(normal[v]));
@@ -543,24 +554,7 @@ void forEachUnit(const VascularTree& t, const Lattice& lat, const BalancedOctree
 // Each vertex moves out along its normal by ¾ of its triangles' area-weighted gap (restoreVolume's
 // rule, for vertices that lie on no edge: the dual contour's). Returns the largest move.
 double restoreVolumeAlongNormals(SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
-  const std::size_t nt = m.triangles.size();
-  std::vector<double> gap(nt, 0.0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t k = r.begin(); k != r.end(); ++k) {
-      const auto& t = m.triangles[k];
-      const Vec3 c = (m.vertices[std::size_t(t[0])] + m.vertices[std::size_t(t[1])] + m.vertices[std::size_t(t[2])]) / 3.0;
-      const double d = distance(m.triangle_tree[k], c);
-      gap[k] = std::isfinite(d) ? -0.75 * d : 0.0;
-    }
-  });
-  std::vector<Vec3> normal(m.vertices.size(), Vec3(0, 0, 0));
-  std::vector<double> weighted(m.vertices.size(), 0.0), area(m.vertices.size(), 0.0);
-  for (std::size_t k = 0; k < nt; ++k) {
-    const auto& t = m.triangles[k];
-    const Vec3 n = cross(m.vertices[std::size_t(t[1])] - m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[2])] - m.vertices[std::size_t(t[0])]);
-    const double a = norm(n);
-    for (auto v : t) normal[std::size_t(v)] += n, weighted[std::size_t(v)] += a * gap[k], area[std::size_t(v)] += a;
-  }
+  const auto [normal, weighted, area] = chordGaps(m, distance);
   double largest = 0;
   for (std::size_t v = 0; v < m.vertices.size(); ++v) {
     if (!(area[v] > 0)) continue;
