@@ -95,10 +95,12 @@ void expectClosedInMeshJson(const nlohmann::json& statistics, const std::string&
     EXPECT_EQ(statistics[key], 0) << key << " " << what;
 }
 
-// The tube mesher's surface at `samples` across where vessels meet.
-SurfaceMesh tubeMesh(const VascularTree& t, int samples, TubeSurfaceReport* rep = nullptr) {
+// The tube mesher's surface at `samples` across where vessels meet (by surface nets where they
+// pass, or by marching tetrahedra only).
+SurfaceMesh tubeMesh(const VascularTree& t, int samples, TubeSurfaceReport* rep = nullptr, bool nets = true) {
   TubeSurfaceOptions o;
   o.junction.samples_across = samples;
+  o.nets = nets;
   return tubeSurface(t, o, rep);
 }
 
@@ -143,11 +145,8 @@ TEST(Mesh, TubesJoinContouredJunctionsIntoOneSurfaceOfGenusZeroPerTree) {
   std::cout << rep.tubes << " tubes of " << rep.vessels << " vessels, " << rep.clusters << " contoured parts, " << m.triangles.size()
             << " triangles (contour " << contour.triangles.size() << "), given up " << rep.fallbacks << ", volume " << topo.volume_mm3 << " mm^3\n";
   // Marching tetrahedra in every part: the same topology and volume, more triangles.
-  TubeSurfaceOptions tet;
-  tet.junction.samples_across = 3;
-  tet.nets = false;
   TubeSurfaceReport tet_rep;
-  const auto mt = tubeSurface(t, tet, &tet_rep);
+  const auto mt = tubeMesh(t, 3, &tet_rep, false);
   EXPECT_EQ(tet_rep.netted, 0);
   EXPECT_EQ(meshTopology(mt).tree_euler, topo.tree_euler);
   EXPECT_NEAR(meshTopology(mt).volume_mm3, topo.volume_mm3, 1e-3 * topo.volume_mm3);

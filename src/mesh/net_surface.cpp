@@ -251,35 +251,15 @@ std::optional<SurfaceMesh> netSurface(const VascularTree& t, const SurfaceOption
   if (report) report->cells = std::int64_t(cells.size()), report->units = 1;
 
   // The flat triangles lie inside the convex wall (chords): each vertex moves out along its
-  // normal by ¾ of its triangles' area-weighted gap at their centroids (vesselSurface's rule).
+  // normal by ¾ of its triangles' area-weighted gap at their centroids.
   if (o.restore_volume) {
-    std::vector<Vec3> normal(mesh.vertices.size(), Vec3(0, 0, 0));
-    std::vector<double> weighted(mesh.vertices.size(), 0.0), area(mesh.vertices.size(), 0.0);
-    for (const auto& tr : mesh.triangles) {
-      const Vec3& a = mesh.vertices[std::size_t(tr[0])];
-      const Vec3 nn = cross(mesh.vertices[std::size_t(tr[1])] - a, mesh.vertices[std::size_t(tr[2])] - a);
-      const double ar = norm(nn);
-      const double d = distance((a + mesh.vertices[std::size_t(tr[1])] + mesh.vertices[std::size_t(tr[2])]) / 3.0);
-      for (auto v : tr) normal[std::size_t(v)] += nn, weighted[std::size_t(v)] += ar * (-0.75 * d), area[std::size_t(v)] += ar;
-    }
-    double largest = 0;
-    for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
-      if (!(area[v] > 0)) continue;
-      const double move = std::clamp(weighted[v] / area[v], -0.2 * h, 0.2 * h);
-      mesh.vertices[v] += unit(normal[v]) * move;
-      largest = std::max(largest, std::abs(move));
-    }
-    if (report) report->largest_volume_move_mm = largest;
+    const double moved = restoreVolumeAlongNormals(mesh, [&](std::int32_t, const Vec3& p) { return distance(p); });
+    if (report) report->largest_volume_move_mm = moved;
   }
   if (!closedManifold(mesh)) return refuse("not a closed manifold");
   if (!freeOfCrossings(mesh, origin, h)) return refuse("self-intersecting");
   if (o.finish) {
-    const std::function<double(std::int32_t, const Vec3&)> strict = [&](std::int32_t, const Vec3& p) {
-      double plain = 0;
-      const double filleted = unionDistance(solids, p, &plain);
-      return std::abs(plain) > std::abs(filleted) ? plain : filleted;
-    };
-    o.finish(mesh, strict);
+    o.finish(mesh, [&](std::int32_t, const Vec3& p) { return strictDistance(solids, p); });
   }
   return mesh;
 }

@@ -695,23 +695,33 @@ class TubeMesher {
     // Surface nets where the part allows (about a third of the triangles), checked: on one
     // uniform grid where its radii are alike, else on the octree (vesselSurface's dual
     // contour); else, or when the net's cut part is not the union's shape, marching tetrahedra.
-    std::optional<SurfaceMesh> net;
+    std::optional<SurfaceMesh> net, tetrahedra;
     if (o_.nets && !c.touching) {
       const auto planes_asked = planes;
       const auto stubs_asked = stub_planes;
-      const auto shaped = [&](const std::optional<SurfaceMesh>& m) { return m && isUnionShaped(*m, planes, c.parts); };
+      // A net whose cut part is not the union's shape is dropped with the cuts it moved.
+      const auto keepIfShaped = [&](std::optional<SurfaceMesh>& m) {
+        if (m && isUnionShaped(*m, planes, c.parts)) return;
+        m.reset();
+        planes = planes_asked, stub_planes = stubs_asked;
+      };
       NetReport nr;
       net = netSurface(sub, so, &sr, &nr);
-      if (!shaped(net)) net.reset(), planes = planes_asked, stub_planes = stubs_asked;
+      keepIfShaped(net);
       if (!net && nr.costlier) {
         so.dual = true;
-        net = vesselSurface(sub, so, &sr);
+        auto m = vesselSurface(sub, so, &sr);
         so.dual = false;
-        if (!sr.dual || !shaped(net)) net.reset(), planes = planes_asked, stub_planes = stubs_asked;
+        if (sr.dual) {
+          net = std::move(m);
+          keepIfShaped(net);
+        } else {
+          tetrahedra = std::move(m);  // the dual refused: vesselSurface contoured it by tetrahedra already
+        }
       }
     }
     out.netted = net.has_value();
-    out.mesh = net ? std::move(*net) : vesselSurface(sub, so, &sr);
+    out.mesh = net ? std::move(*net) : tetrahedra ? std::move(*tetrahedra) : vesselSurface(sub, so, &sr);
     out.estimated_bytes = sr.estimated_bytes;
     out.step = sr.voxel_mm;
     out.cavities_removed = sr.cavities_removed;

@@ -79,4 +79,12 @@ inline double unionDistance(const std::vector<Solid>& solids, const Vec3& p, dou
   return best;
 }
 
+// What changes the surface after contouring (decimation, sliver repair) measures its error from
+// the union and the fillets alike (the larger), so that a fillet's offset never adds to it.
+inline double strictDistance(const std::vector<Solid>& solids, const Vec3& p) {
+  double plain = 0;
+  const double filleted = unionDistance(solids, p, &plain);
+  return std::abs(plain) > std::abs(filleted) ? plain : filleted;
+}
+
 }  // namespace angiosynth

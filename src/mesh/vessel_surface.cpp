@@ -551,20 +551,6 @@ void forEachUnit(const VascularTree& t, const Lattice& lat, const BalancedOctree
   }
 }
 
-// Each vertex moves out along its normal by ¾ of its triangles' area-weighted gap (restoreVolume's
-// rule, for vertices that lie on no edge: the dual contour's). Returns the largest move.
-double restoreVolumeAlongNormals(SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
-  const auto [normal, weighted, area] = chordGaps(m, distance);
-  double largest = 0;
-  for (std::size_t v = 0; v < m.vertices.size(); ++v) {
-    if (!(area[v] > 0)) continue;
-    const double step = m.vertex_step[v], move = std::clamp(weighted[v] / area[v], -kLargestSlide * step, kLargestSlide * step);
-    m.vertices[v] += unit(normal[v]) * move;
-    largest = std::max(largest, std::abs(move));
-  }
-  return largest;
-}
-
 // Where a coarse leaf meets finer ones, or the surface grazes a face, a sheet's vertex may lie
 // so far round the surface that a triangle folds back over its neighbours. The corners of the
 // triangles marked (facing against the summed normal at one of their corners, or found crossing
@@ -694,6 +680,18 @@ std::optional<SurfaceMesh> dualContour(const VascularTree& t, const Lattice& lat
   return mesh;
 }
 }  // namespace
+
+double restoreVolumeAlongNormals(SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
+  const auto [normal, weighted, area] = chordGaps(m, distance);
+  double largest = 0;
+  for (std::size_t v = 0; v < m.vertices.size(); ++v) {
+    if (!(area[v] > 0)) continue;
+    const double step = m.vertex_step[v], move = std::clamp(weighted[v] / area[v], -kLargestSlide * step, kLargestSlide * step);
+    m.vertices[v] += unit(normal[v]) * move;
+    largest = std::max(largest, std::abs(move));
+  }
+  return largest;
+}
 
 SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, SurfaceReport* report,
                           const std::function<void(std::int64_t, std::int64_t)>& progress) {
@@ -842,13 +840,7 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
     return here;
   };
   const std::function<double(std::int32_t, const Vec3&)> distance = [&](std::int32_t tree, const Vec3& p) { return unionDistance(solidsAt(tree, p), p); };
-  // What changes the surface afterwards (decimation, sliver repair) measures its error from the
-  // union and the fillets alike (the larger), so that a fillet's offset never adds to it.
-  const std::function<double(std::int32_t, const Vec3&)> strict = [&](std::int32_t tree, const Vec3& p) {
-    double plain = 0;
-    const double filleted = unionDistance(solidsAt(tree, p), p, &plain);
-    return std::abs(plain) > std::abs(filleted) ? plain : filleted;
-  };
+  const std::function<double(std::int32_t, const Vec3&)> strict = [&](std::int32_t tree, const Vec3& p) { return strictDistance(solidsAt(tree, p), p); };
   if (o.dual) {
     const char* refused = nullptr;
     if (auto dual = dualContour(t, lat, octree, units, fillet, refused, progress)) {

@@ -71,6 +71,12 @@ struct SurfaceReport {
 SurfaceMesh vesselSurface(const VascularTree& forest, const SurfaceOptions& options, SurfaceReport* report = nullptr,
                           const std::function<void(std::int64_t done, std::int64_t total)>& progress = {});
 
+// Flat triangles through points of a convex wall are chords and lose volume: each vertex moves
+// out along its normal by ¾ of its triangles' area-weighted gap at their centroids (by `distance`,
+// at most a fifth of its vertex_step), for meshes whose vertices lie on no grid edge (surface
+// nets). Returns the largest move (mm).
+double restoreVolumeAlongNormals(SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance);
+
 // Keeps the triangles flagged in `keep` (with their tree and face labels) and the vertices they
 // use, both in their order; `renumber`: old vertex → new (−1 for dropped).
 void keepTriangles(SurfaceMesh& m, const std::vector<char>& keep, std::vector<std::int32_t>* renumber = nullptr);

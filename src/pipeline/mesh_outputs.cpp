@@ -112,14 +112,16 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   TubeSurfaceReport tube_report;
   HollowWallReport wall_report;
   SurfaceMesh mesh;
+  // The tubes' options, for the tube surface and a hollow wall's two (whose ends are open).
+  TubeSurfaceOptions to;
+  to.junction = o;
+  to.ring_spacing_radii = p.ringSpacing();
+  to.ends = ends;
+  to.cap_ends = !walls && p.ends == "capped";
+  to.decimate = p.decimate;
+  to.decimation = d;
+  to.nets = p.junctions == "nets";
   if (walls) {
-    TubeSurfaceOptions to;
-    to.junction = o;
-    to.ring_spacing_radii = p.ringSpacing();
-    to.ends = ends;
-    to.decimate = p.decimate;
-    to.decimation = d;
-    to.nets = p.junctions == "nets";
     mesh = hollowWall(tree, to, wall, &wall_report, progress);
     tube_report = wall_report.outer;
     report.voxel_mm = std::min(wall_report.outer.finest_step_mm, wall_report.lumen.finest_step_mm);
@@ -129,14 +131,6 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
     // A ring's loop vertices: its two loops' together.
     cut.cap_area_mm2 = endFaceAreas(mesh, ends.size(), &cut.loop_vertices);
   } else if (tubes) {
-    TubeSurfaceOptions to;
-    to.junction = o;
-    to.ring_spacing_radii = p.ringSpacing();
-    to.ends = ends;
-    to.cap_ends = p.ends == "capped";
-    to.decimate = p.decimate;
-    to.decimation = d;
-    to.nets = p.junctions == "nets";
     mesh = tubeSurface(tree, to, &tube_report, progress);
     cut = tube_report.ends;
     report.voxel_mm = tube_report.finest_step_mm;
