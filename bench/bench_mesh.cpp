@@ -3,8 +3,9 @@
 // across each vessel where vessels meet, default 3) or contoured whole (--tubes 0; 4 samples
 // across), optionally decimated (--decimate 1) or with the contour's slivers repaired
 // (--slivers DEG: angles below DEG or edges under 0.35 of the step; 0, the default for closed ends, none; with
-// --max-angle DEG, angles above DEG improved: 90 is the default with capped ends), at the automatic step or --voxel MM:
-//   bench_mesh FILE.toml ... [--tubes 0|1] [--samples N] [--decimate 0|1] [--slivers DEG] [--max-angle DEG] [--nets 0|1] [--voxel MM] [--threads T]
+// --max-angle DEG, angles above DEG improved: 90 is the default with capped ends), the tubes' rings at
+// most --ring-spacing R radii apart (default 8; 0: capped ends' 1.5 vertex spacings, staggered), at the automatic step or --voxel MM:
+//   bench_mesh FILE.toml ... [--tubes 0|1] [--samples N] [--decimate 0|1] [--slivers DEG] [--max-angle DEG] [--nets 0|1] [--ring-spacing R] [--voxel MM] [--threads T]
 // Prints the step, the time, triangles in all and per segment, and the peak memory.
 // Targets (issue 15): 10k segments ≤ 10 s, ≤ 4 GB, ≤ 500 triangles per segment; 100k ≤ 2 min.
 #include <cstdio>
@@ -34,7 +35,9 @@ int main(int argc, char** argv) {
   const double max_angle = bench::takeOption(int(rest5.size()), rest5.data(), "--max-angle", 0, rest6);
   std::vector<char*> rest7;
   const bool nets = bench::takeOption(int(rest6.size()), rest6.data(), "--nets", 1, rest7) != 0;
-  const auto args = bench::parseFileArgs(int(rest7.size()), rest7.data());
+  std::vector<char*> rest8;
+  const double ring_spacing = bench::takeOption(int(rest7.size()), rest7.data(), "--ring-spacing", 8, rest8);
+  const auto args = bench::parseFileArgs(int(rest8.size()), rest8.data());
   std::printf("%-34s %9s %9s %10s %12s %10s %8s %9s\n", "file", "segments", "step mm", "mesh s", "triangles", "tri/seg", "genus0", "peak MiB");
   for (const auto& f : args.files) {
     const auto sc = readTomlParameters(f);
@@ -58,6 +61,7 @@ int main(int argc, char** argv) {
       to.decimation.sliver_deg = slivers;
       to.decimation.obtuse_deg = max_angle;
       to.nets = nets;
+      to.ring_spacing_radii = ring_spacing;
       m = tubeSurface(t, to, &trep);
       rep.voxel_mm = trep.finest_step_mm;
     } else {

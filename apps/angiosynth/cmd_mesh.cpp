@@ -33,8 +33,8 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
                 "self-intersection, the union's shape; about a third of the triangles), else by marching tetrahedra (nets, the "
                 "default); or by marching tetrahedra only (tetrahedra)")
       ->check(CLI::IsMember({"nets", "tetrahedra"}));
-  c->add_option("--ring-spacing", a.ring_spacing, "tubes: rings at most this many radii apart (default 2; with --ends capped 1.5 times the rings' vertex spacing, "
-                                          "about 0.9 radii at 3 samples across, which TetGen's -q1.414 leaves unsplit)")->check(finiteIn(0.1, 100));
+  c->add_option("--ring-spacing", a.ring_spacing, "tubes: rings at most this many radii apart, aligned (default 8; with --ends capped 1.5 times the rings' vertex spacing, "
+                                          "about 0.9 radii at 3 samples across, turned by half of it, which TetGen's -q1.414 leaves unsplit)")->check(finiteIn(0.1, 100));
   c->add_option("--wall-thickness", a.wall_thickness,
                 "a hollow wall of this thickness in mm around each vessel's lumen (seed 004): the wall's surface, outer side, lumen "
                 "and a flat ring at each open end")

@@ -48,7 +48,7 @@ const std::vector<MethodParam>& commonParams() {
       {"mesh", "voxel_size", "mm", "the thinnest vessel's diameter / samples_across", "the finest grid step"},
       {"mesh", "samples_across", "count", "3 (tubes), 4 (contour)",
        "grid steps across each vessel's thinnest end where it is contoured (1 … 64); thicker vessels get coarser cells"},
-      {"mesh", "ring_spacing", "radii", "2; with capped ends 1.5 times the rings' vertex spacing",
+      {"mesh", "ring_spacing", "radii", "8; with capped ends 1.5 times the rings' vertex spacing (turned by half of it)",
        "tubes: rings at most this many radii of the vessel apart (0.1 … 100); successive rings are turned by half a vertex spacing"},
       {"mesh", "wall_thickness", "mm", "0 (no wall)",
        "a hollow wall of this thickness around each vessel's lumen (seed 004): the surface bounds the wall (outer side, lumen, a flat "

@@ -47,8 +47,8 @@ struct MeshParameters {
   std::string junctions = "nets";           // tubes: parts contoured by surface nets where they pass their checks, or by tetrahedra only
   double voxel_mm = 0;                      // finest step; 0: the thinnest vessel's diameter / samples_across
   int samples_across = 0;                   // 0: the method's (contour 4, tubes 3)
-  double ring_spacing = -1;                 // tubes: rings at most this many radii apart; −1: 2, with capped ends 1.5 ring vertex spacings (0)
-  double ringSpacing() const { return ring_spacing > 0 ? ring_spacing : ends == "capped" ? 0 : 2; }
+  double ring_spacing = -1;                 // tubes: rings at most this many radii apart; −1: 8, with capped ends 1.5 ring vertex spacings (0)
+  double ringSpacing() const { return ring_spacing > 0 ? ring_spacing : ends == "capped" ? 0 : 8; }
   double wall_thickness = 0;                // mm: a hollow wall of this thickness (0: none), or
   double wall_ratio = 0;                    // of this share of each vessel's radius, or
   bool wall_from_graph = false;             // of each vessel's own wall (a graph's wall thickness)

@@ -756,17 +756,22 @@ class TubeMesher {
     return skip;
   }
   // A ring's radius over its vessel's: 1 on the wall; restoring the volume, what gives the bands
-  // between rings the circle's area per length. Successive rings are turned by half a step
-  // (`phase` 0 or ½), so the bands' triangles are acute (on aligned rings they were right-angled,
-  // and a tetrahedral mesher splits the long edge of every such pair); such a band is a
-  // prismatoid whose middle section is the 2n-gon of radius cos(π/2n), so it holds
-  // (1 + 2 cos²(π/2n) / cos(π/n)) / 3 of its rings' polygon area per length.
+  // between rings the circle's area per length. At the CFD spacing (rings about as far apart as
+  // their vertices) successive rings are turned by half a step (`phase` 0 or ½), so the bands'
+  // triangles are acute (on aligned rings they were right-angled, and a tetrahedral mesher
+  // splits the long edge of every such pair); such a band is a prismatoid whose middle section
+  // is the 2n-gon of radius cos(π/2n), so it holds (1 + 2 cos²(π/2n) / cos(π/n)) / 3 of its
+  // rings' polygon area per length. Rings radii apart are aligned: their triangles are long
+  // whatever their turn, and a band between aligned rings is a frustum of a pyramid, its volume
+  // exact for any length however far the ring next to it is turned or scaled.
   // `face`: a ring whose polygon has the circle's area (a CFD end's: its cap).
+  bool staggered() const { return o_.ring_spacing_radii <= 0; }
+  double ringPhase(std::size_t j) const { return staggered() && j % 2 ? 0.5 : 0.0; }
   double ringScale(int n, bool face = false) const {
     if (!o_.junction.restore_volume) return 1.0;
     const double step = kTwoPi / n, polygon = std::sin(step) / step;  // the n-gon's area over its circle's
     const double middle = std::pow(std::cos(step / 4), 2) / std::cos(step / 2);
-    return 1 / std::sqrt(polygon * (face ? 1.0 : (1 + 2 * middle) / 3));
+    return 1 / std::sqrt(polygon * (face || !staggered() ? 1.0 : (1 + 2 * middle) / 3));
   }
   // A ring of n vertices around the axis at distance y from a, its first at `phase` steps.
   void ring(SurfaceMesh& m, const Vessel& v, double y, int n, double phase, std::vector<std::int32_t>& out, bool face = false) const {
@@ -929,8 +934,8 @@ class TubeMesher {
       const int pieces = std::max(1, int(std::ceil((hi - lo) / std::max(spacing, 1e-12))));
       for (int q = 1; q < pieces; ++q) at.push_back(lo + (hi - lo) * q / pieces);
       if (band1) at.push_back(hi);
-      // Ring j of the tube (0 at y0, at.size() + 1 at y1) turned by j half steps.
-      const auto phase = [](std::size_t j) { return j % 2 ? 0.5 : 0.0; };
+      // Ring j of the tube (0 at y0, at.size() + 1 at y1), turned by j half steps if staggered.
+      const auto phase = [this](std::size_t j) { return ringPhase(j); };
       for (int k = 0; k < 2; ++k) {
         auto& l = loops[i][std::size_t(k)];
         const double turn = phase(k == 0 ? 0 : at.size() + 1);

@@ -24,7 +24,7 @@ constexpr double kCfdRingSpacing = 1.5;
 
 struct TubeSurfaceOptions {
   SurfaceOptions junction;          // how the meeting parts are contoured (samples across, volume)
-  double ring_spacing_radii = 2;    // tube rings at most this many radii apart; 0: kCfdRingSpacing times the ring's vertex spacing
+  double ring_spacing_radii = 8;    // tube rings at most this many radii apart, aligned; 0: kCfdRingSpacing times the ring's vertex spacing, staggered
   int min_ring_vertices = 8;        // and at least this many around
   int ring_vertices = 0;            // that many around (0: π × junction samples across, at least min_ring_vertices)
   double ring_tolerance_mm = 0;     // and more where a ring's chords would stand further than this inside the wall
