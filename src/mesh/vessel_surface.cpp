@@ -54,10 +54,22 @@ struct DualRecord {
   std::int32_t vertex; // in the unit
   bool low_inside;     // the edge's lower end lies inside
 };
+// Where one leaf's sheet crosses one of its faces in two or more separate arcs, each arc: the two
+// grid edges it ends on (keys, lo < hi) and a point of it on the surface. If the leaf across the
+// face has them in one sheet too, one vertex per sheet would give that pair of vertices one edge
+// for both arcs (used by four triangles); a vertex on each arc keeps the surface a manifold.
+struct ArcRecord {
+  std::int32_t tree;
+  std::int64_t lo, hi;
+  std::int64_t plane;  // the face's: axis + 3 × its coordinate in half steps
+  Vec3 position;  // mm
+  float step;     // mm: the leaf's size
+};
 struct DualUnit {
   std::vector<Vec3> vertices;
   std::vector<float> steps;  // mm: the leaf's size
   std::vector<DualRecord> records;
+  std::vector<ArcRecord> arcs;
 };
 
 struct UnitMesh {
@@ -267,6 +279,7 @@ class UnitMesher {
       while (edges_[std::size_t(k)].parent != k) k = edges_[std::size_t(k)].parent = edges_[std::size_t(edges_[std::size_t(k)].parent)].parent;
       return k;
     };
+    segments_.clear();
     for (const auto& tri : boundary_) {
       double v[3];
       for (int q = 0; q < 3; ++q) v[q] = value(localIndex(tri[std::size_t(q)]));
@@ -275,7 +288,13 @@ class UnitMesher {
         const int r = (q + 1) % 3;
         if ((v[q] < 0) != (v[r] < 0)) crossed[nc++] = edgeOf(tri[std::size_t(q)], tri[std::size_t(r)], v[q], v[r]);
       }
-      if (nc == 2) edges_[std::size_t(root(crossed[0]))].parent = root(crossed[1]);
+      if (nc != 2) continue;
+      edges_[std::size_t(root(crossed[0]))].parent = root(crossed[1]);
+      int face = -1;
+      for (int a = 0; a < 3 && face < 0; ++a)
+        if (tri[0][std::size_t(a)] == tri[1][std::size_t(a)] && tri[1][std::size_t(a)] == tri[2][std::size_t(a)])
+          face = 2 * a + (tri[0][std::size_t(a)] != o[std::size_t(a)]);
+      segments_.push_back({face, crossed[0], crossed[1]});
     }
     if (edges_.empty()) return;
     // Vertices, one per sheet, in the order of the sheets' first edges.
@@ -301,6 +320,7 @@ class UnitMesher {
       out.vertices.push_back(lat_.origin + q * (0.5 * lat_.h));
       out.steps.push_back(float(double(size) * 0.5 * lat_.h));
     }
+    faceArcs(o, size, tree, out);
     // The grid edges among them (one axis): the dual polygons are made around those.
     for (std::size_t k = 0; k < edges_.size(); ++k) {
       const auto& e = edges_[k];
@@ -313,6 +333,66 @@ class UnitMesher {
       const double dc = double(2 * centre[std::size_t(c)] - e.pa[std::size_t(c)] - e.pb[std::size_t(c)]);
       const bool low_inside = (e.pa[std::size_t(axis)] < e.pb[std::size_t(axis)]) == (e.fa < 0);
       out.records.push_back({tree, e.key, std::atan2(dc, db), first_vertex + sheet_of_[std::size_t(root(std::int32_t(k)))], low_inside});
+    }
+  }
+
+  // The arcs of each face of the leaf (its segments joined within the face), where a sheet
+  // crosses the face in more than one: an ArcRecord per arc, its point the mean of its crossings
+  // moved onto the surface within the face.
+  void faceArcs(const HalfPoint& o, std::int64_t size, std::int32_t tree, DualUnit& out) {
+    const auto rootOf = [&](std::int32_t k) {
+      while (edges_[std::size_t(k)].parent != k) k = edges_[std::size_t(k)].parent;
+      return k;
+    };
+    const double margin = 2e-3 * double(size);
+    for (int face = 0; face < 6; ++face) {
+      arc_parent_.assign(edges_.size(), -1);
+      arc_degree_.assign(edges_.size(), 0);
+      int count = 0;
+      for (const auto& sg : segments_) {
+        if (sg.face != face) continue;
+        ++count;
+        for (auto e : {sg.a, sg.b}) {
+          if (arc_parent_[std::size_t(e)] < 0) arc_parent_[std::size_t(e)] = e;
+          ++arc_degree_[std::size_t(e)];
+        }
+      }
+      if (count < 2) continue;
+      const auto find = [&](std::int32_t k) {
+        while (arc_parent_[std::size_t(k)] != k) k = arc_parent_[std::size_t(k)] = arc_parent_[std::size_t(arc_parent_[std::size_t(k)])];
+        return k;
+      };
+      for (const auto& sg : segments_)
+        if (sg.face == face) arc_parent_[std::size_t(find(sg.a))] = find(sg.b);
+      // Arcs (paths: two ends of degree 1) by their root; a sheet with two or more is recorded.
+      arcs_.clear();
+      for (std::size_t k = 0; k < edges_.size(); ++k) {
+        if (arc_parent_[k] < 0) continue;
+        const auto r = find(std::int32_t(k));
+        auto it = std::find_if(arcs_.begin(), arcs_.end(), [&](const LeafArc& x) { return x.root == r; });
+        if (it == arcs_.end()) arcs_.push_back({r, rootOf(std::int32_t(k)), {}, 0, Vec3(0, 0, 0), 0}), it = arcs_.end() - 1;
+        const auto& e = edges_[k];
+        it->sum += asVec(e.pa) + (asVec(e.pb) - asVec(e.pa)) * (e.fa / (e.fa - e.fb));
+        ++it->crossings;
+        if (arc_degree_[k] == 1 && it->ends < 2) it->end[it->ends] = e.key;
+        it->ends += arc_degree_[k] == 1;
+      }
+      for (const auto& arc : arcs_) {
+        if (arc.ends != 2) continue;
+        const auto shared = std::count_if(arcs_.begin(), arcs_.end(), [&](const LeafArc& x) { return x.sheet == arc.sheet && x.ends == 2; });
+        if (shared < 2) continue;
+        const int a = face / 2;
+        const auto inFace = [&](const Vec3& q) {
+          Vec3 c = componentMin(componentMax(q, asVec(o) + Vec3(margin, margin, margin)),
+                                asVec(o) + Vec3(double(size) - margin, double(size) - margin, double(size) - margin));
+          (a == 0 ? c.x : a == 1 ? c.y : c.z) = double(o[std::size_t(a)] + (face % 2) * size);
+          return c;
+        };
+        const Vec3 q = ontoSurface(arc.sum / double(arc.crossings), [&](const Vec3& x) { return distance(x); }, 1e-3, 1e-7 * lat_.h, inFace);
+        out.arcs.push_back({tree, std::min(arc.end[0], arc.end[1]), std::max(arc.end[0], arc.end[1]),
+                            a + 3 * (o[std::size_t(a)] + (face % 2) * size), lat_.origin + q * (0.5 * lat_.h),
+                            float(double(size) * 0.5 * lat_.h)});
+      }
     }
   }
 
@@ -410,8 +490,22 @@ class UnitMesher {
     double fa, fb;
     std::int32_t parent;  // union-find: edges joined across the boundary's triangles
   };
+  struct Segment {
+    int face;                // 2 × axis + side
+    std::int32_t a, b;       // its crossed edges
+  };
+  struct LeafArc {
+    std::int32_t root, sheet;  // in the face's union-find; the leaf's sheet
+    std::int64_t end[2];
+    int ends;
+    Vec3 sum;
+    int crossings;
+  };
   std::vector<std::array<HalfPoint, 3>> boundary_;
   std::vector<LeafEdge> edges_;
+  std::vector<Segment> segments_;
+  std::vector<std::int32_t> arc_parent_, arc_degree_;
+  std::vector<LeafArc> arcs_;
   std::vector<std::int32_t> sheet_of_;
   std::vector<std::pair<Vec3, int>> sums_;
 };
@@ -626,6 +720,132 @@ void removePillows(SurfaceMesh& m) {
   }
 }
 
+// A polygon of the dual contour: the leaves' vertices around a crossed grid edge, counter-clockwise
+// seen from outside, and maybe an arc's vertex.
+struct DualPolygon {
+  std::int32_t v[5];
+  int n;
+  std::int32_t tree;
+  std::int64_t edge;
+};
+
+// A triangle, or a quadrilateral split along the diagonal that folds it least.
+void appendPolygon(SurfaceMesh& mesh, const DualPolygon& p) {
+  if (p.n == 3) {
+    mesh.triangles.push_back({p.v[0], p.v[1], p.v[2]});
+  } else {
+    const std::int32_t q[4] = {p.v[0], p.v[1], p.v[2], p.v[3]};
+    appendQuad(mesh, q);
+    mesh.triangle_tree.push_back(p.tree);
+  }
+  mesh.triangle_tree.push_back(p.tree);
+}
+
+// The polygons around grid edges arcs end on. Two of them that run across the same pair of
+// vertices the same way hold two arcs of one face between the same two sheets: each arc's vertex
+// goes between the pair in the two polygons at its ends (which run across it opposite ways), and
+// such a polygon is a fan from it, so each new edge has two triangles and the pair none. False
+// (and why) where the arcs cannot be told apart.
+bool splitSharedPairs(SurfaceMesh& mesh, std::vector<DualPolygon>& held, const std::vector<ArcRecord>& arcs, const char*& refused) {
+  struct Use {
+    std::int32_t a, b;
+    std::int32_t polygon, at;
+  };
+  std::vector<Use> uses;
+  for (std::size_t p = 0; p < held.size(); ++p)
+    for (int k = 0; k < held[p].n; ++k) uses.push_back({held[p].v[k], held[p].v[(k + 1) % held[p].n], std::int32_t(p), k});
+  std::sort(uses.begin(), uses.end(), [](const Use& x, const Use& y) { return std::tie(x.a, x.b, x.polygon) < std::tie(y.a, y.b, y.polygon); });
+  const auto range = [&](std::int32_t a, std::int32_t b) {
+    const auto lo = std::lower_bound(uses.begin(), uses.end(), std::make_pair(a, b), [](const Use& u, const std::pair<std::int32_t, std::int32_t>& k) {
+      return std::tie(u.a, u.b) < std::tie(k.first, k.second);
+    });
+    auto hi = lo;
+    while (hi != uses.end() && hi->a == a && hi->b == b) ++hi;
+    return std::make_pair(lo, hi);
+  };
+  // The arcs (of any face) between grid edges e and f.
+  const auto arcsOf = [&](std::int32_t tree, std::int64_t e, std::int64_t f) {
+    const auto key = std::make_tuple(tree, std::min(e, f), std::max(e, f));
+    const auto cmp = [](const ArcRecord& r, const std::tuple<std::int32_t, std::int64_t, std::int64_t>& k) { return std::tie(r.tree, r.lo, r.hi) < k; };
+    auto lo = std::lower_bound(arcs.begin(), arcs.end(), key, cmp), hi = lo;
+    while (hi != arcs.end() && std::tie(hi->tree, hi->lo, hi->hi) == key) ++hi;
+    return std::make_pair(lo, hi);
+  };
+  std::vector<std::vector<std::pair<std::int32_t, std::int32_t>>> split(held.size());  // per polygon: (at, arc vertex)
+  for (auto it = uses.begin(); it != uses.end();) {
+    const auto [first, last] = range(it->a, it->b);
+    it = last;
+    if (last - first < 2 || first->a > first->b) continue;
+    const auto [rfirst, rlast] = range(first->b, first->a);
+    if (last - first != 2 || rlast - rfirst != 2) {
+      refused = "more than two arcs between two sheets";
+      return false;
+    }
+    // The face's plane: the one in which each forward polygon's edge has an arc to one backward
+    // polygon's edge, a different one for each (an edge also ends arcs on the other faces
+    // through it, and two edges on one line end arcs on two faces).
+    const auto edgeOf = [&](const Use& u) { return held[std::size_t(u.polygon)].edge; };
+    const std::int32_t tree = held[std::size_t(first->polygon)].tree;
+    std::vector<std::int64_t> planes;
+    for (int f = 0; f < 2; ++f)
+      for (int g = 0; g < 2; ++g)
+        for (auto [lo, hi] = arcsOf(tree, edgeOf(first[f]), edgeOf(rfirst[g])); lo != hi; ++lo) planes.push_back(lo->plane);
+    std::sort(planes.begin(), planes.end());
+    planes.erase(std::unique(planes.begin(), planes.end()), planes.end());
+    const ArcRecord* chosen[2] = {nullptr, nullptr};
+    int matched[2] = {-1, -1}, faces = 0;
+    for (auto plane : planes) {
+      const auto inPlane = [&](int f, int g) -> const ArcRecord* {
+        for (auto [lo, hi] = arcsOf(tree, edgeOf(first[f]), edgeOf(rfirst[g])); lo != hi; ++lo)
+          if (lo->plane == plane) return &*lo;
+        return nullptr;
+      };
+      for (int g = 0; g < 2; ++g) {
+        const auto *x = inPlane(0, g), *y = inPlane(1, 1 - g);
+        if (!x || !y || inPlane(0, 1 - g) || inPlane(1, g)) continue;
+        chosen[0] = x, chosen[1] = y, matched[0] = g, matched[1] = 1 - g, ++faces;
+      }
+    }
+    if (faces != 1) {
+      refused = "two arcs between two sheets not told apart";
+      return false;
+    }
+    for (int f = 0; f < 2; ++f) {
+      const ArcRecord* arc = chosen[f];
+      const int match = matched[f];
+      const auto m = std::int32_t(mesh.vertices.size());
+      mesh.vertices.push_back(arc->position);
+      mesh.vertex_step.push_back(arc->step);
+      for (const Use* u : {&first[f], &rfirst[match]}) split[std::size_t(u->polygon)].push_back({u->at, m});
+    }
+  }
+  std::vector<std::int32_t> ring;
+  for (std::size_t p = 0; p < held.size(); ++p) {
+    const auto& poly = held[p];
+    if (split[p].empty()) {
+      appendPolygon(mesh, poly);
+      continue;
+    }
+    // The polygon with its arcs' vertices, each after vertex `at`, as a fan from the first of
+    // them (the others on its rim, their edges each in two triangles).
+    std::sort(split[p].begin(), split[p].end());
+    ring.clear();
+    std::size_t next = 0, apex = 0;
+    for (int k = 0; k < poly.n; ++k) {
+      ring.push_back(poly.v[k]);
+      if (next < split[p].size() && split[p][next].first == k) {
+        if (next == 0) apex = ring.size();
+        ring.push_back(split[p][next++].second);
+      }
+    }
+    for (std::size_t k = 1; k + 1 < ring.size(); ++k) {
+      mesh.triangles.push_back({ring[apex], ring[(apex + k) % ring.size()], ring[(apex + k + 1) % ring.size()]});
+      mesh.triangle_tree.push_back(poly.tree);
+    }
+  }
+  return true;
+}
+
 // The dual contour of the octree's leaves (surface nets): a vertex per sheet of each leaf, a
 // triangle or quadrilateral around each grid edge the surface crosses from the 3 or 4 leaves
 // around it (a coarser leaf spans two of its quadrants), counter-clockwise seen from outside,
@@ -640,16 +860,30 @@ std::optional<SurfaceMesh> dualContour(const VascularTree& t, const Lattice& lat
   });
   SurfaceMesh mesh;
   std::vector<DualRecord> records;
+  std::vector<ArcRecord> arcs;
   for (auto& d : duals) {
     const auto base = std::int32_t(mesh.vertices.size());
     mesh.vertices.insert(mesh.vertices.end(), d.vertices.begin(), d.vertices.end());
     mesh.vertex_step.insert(mesh.vertex_step.end(), d.steps.begin(), d.steps.end());
     for (auto r : d.records) r.vertex += base, records.push_back(r);
+    arcs.insert(arcs.end(), d.arcs.begin(), d.arcs.end());
     DualUnit().records.swap(d.records);
   }
   tbb::parallel_sort(records.begin(), records.end(), [](const DualRecord& a, const DualRecord& b) {
     return std::tie(a.tree, a.edge, a.angle) < std::tie(b.tree, b.edge, b.angle);
   });
+  // Each arc once (both leaves of its face may record it; the first by position, whatever the
+  // units' order), and the grid edges arcs end on: only polygons around those can share a pair.
+  const auto arcKey = [](const ArcRecord& a) { return std::tie(a.tree, a.lo, a.hi, a.plane); };
+  std::sort(arcs.begin(), arcs.end(), [&](const ArcRecord& a, const ArcRecord& b) {
+    return std::tie(a.tree, a.lo, a.hi, a.plane, a.position.x, a.position.y, a.position.z) <
+           std::tie(b.tree, b.lo, b.hi, b.plane, b.position.x, b.position.y, b.position.z);
+  });
+  arcs.erase(std::unique(arcs.begin(), arcs.end(), [&](const ArcRecord& a, const ArcRecord& b) { return arcKey(a) == arcKey(b); }), arcs.end());
+  std::vector<std::pair<std::int32_t, std::int64_t>> arc_ends;
+  for (const auto& a : arcs) arc_ends.push_back({a.tree, a.lo}), arc_ends.push_back({a.tree, a.hi});
+  std::sort(arc_ends.begin(), arc_ends.end());
+  std::vector<DualPolygon> held;  // polygons around an arc's end: made last
   for (std::size_t i = 0; i < records.size();) {
     std::size_t j = i;
     while (j < records.size() && records[j].tree == records[i].tree && records[j].edge == records[i].edge) ++j;
@@ -662,20 +896,17 @@ std::optional<SurfaceMesh> dualContour(const VascularTree& t, const Lattice& lat
       refused = "an edge without 3 or 4 leaves around it";
       return std::nullopt;
     }
-    std::int32_t poly[4];
-    for (std::size_t k = 0; k < n; ++k) poly[k] = records[i + k].vertex;
-    if (!records[i].low_inside) std::reverse(poly, poly + n);  // outward is down the edge's axis
-    const auto tree = records[i].tree;
-    if (n == 3) {
-      mesh.triangles.push_back({poly[0], poly[1], poly[2]});
-      mesh.triangle_tree.push_back(tree);
-    } else {
-      appendQuad(mesh, poly);
-      mesh.triangle_tree.push_back(tree);
-      mesh.triangle_tree.push_back(tree);
-    }
+    DualPolygon poly{{}, int(n), records[i].tree, records[i].edge};
+    for (std::size_t k = 0; k < n; ++k) poly.v[k] = records[i + k].vertex;
+    if (!records[i].low_inside) std::reverse(poly.v, poly.v + n);  // outward is down the edge's axis
     i = j;
+    if (std::binary_search(arc_ends.begin(), arc_ends.end(), std::make_pair(poly.tree, poly.edge))) {
+      held.push_back(poly);
+      continue;
+    }
+    appendPolygon(mesh, poly);
   }
+  if (!splitSharedPairs(mesh, held, arcs, refused)) return std::nullopt;
   removePillows(mesh);
   return mesh;
 }
