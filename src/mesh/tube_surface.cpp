@@ -699,9 +699,10 @@ class TubeMesher {
           for (auto& p : loop) p = renumber[std::size_t(p)];
     };
     // Surface nets where the part allows (about a third of the triangles), checked: on one
-    // uniform grid where its radii are alike and no vessels touch, else on the octree
-    // (vesselSurface's dual contour); else, or when the net's cut part is not the union's
-    // shape, marching tetrahedra.
+    // uniform grid where its radii are alike and no vessels touch, else (radii far apart, gaps
+    // to resolve, too large for one grid, or that net refused) on the octree (vesselSurface's
+    // dual contour, each vessel at its own step); else, or when the net's cut part is not the
+    // union's shape, marching tetrahedra.
     std::optional<SurfaceMesh> net, tetrahedra;
     if (o_.nets && (!c.touching || c.whole.size() + c.stubs.size() <= kLargestDualTouchingPart)) {
       const auto planes_asked = planes;
@@ -717,7 +718,7 @@ class TubeMesher {
         net = netSurface(sub, so, &sr, &nr);
         keepIfShaped(net);
       }
-      if (!net && (c.touching || nr.costlier)) {
+      if (!net) {
         so.dual = true;
         auto m = vesselSurface(sub, so, &sr);
         so.dual = false;
