@@ -773,10 +773,13 @@ bool splitSharedPairs(SurfaceMesh& mesh, std::vector<DualPolygon>& held, const s
   };
   std::vector<std::vector<std::pair<std::int32_t, std::int32_t>>> split(held.size());  // per polygon: (at, arc vertex)
   for (auto it = uses.begin(); it != uses.end();) {
-    const auto [first, last] = range(it->a, it->b);
+    // (Iterators, not a structured binding: the lambdas below capture them.)
+    const auto forward = range(it->a, it->b);
+    const auto first = forward.first, last = forward.second;
     it = last;
     if (last - first < 2 || first->a > first->b) continue;
-    const auto [rfirst, rlast] = range(first->b, first->a);
+    const auto backward = range(first->b, first->a);
+    const auto rfirst = backward.first, rlast = backward.second;
     if (last - first != 2 || rlast - rfirst != 2) {
       refused = "more than two arcs between two sheets";
       return false;
