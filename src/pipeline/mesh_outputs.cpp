@@ -196,7 +196,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"sliver_angle_deg", p.sliverAngle()},
                     {"max_angle_deg", p.maxAngle()},
                     {"description", tubes ? "each vessel's free middle a tube of rings on its exact wall (at most ring_spacing_radii radii "
-                                            "apart); where vessels meet, the signed distance to the union of their capsules and round cones "
+                                            "apart, aligned; or ring_spacing_vertex_spacings apart, each turned by half a vertex spacing); where vessels meet, the signed distance to the union of their capsules and round cones "
                                             "contoured by surface nets on a uniform grid or on the octree (junctions = nets, where the part passes its checks) or "
                                             "by marching tetrahedra (2:1-balanced octree of cells sized to each vessel's radius), cut by "
                                             "planes across the tubes and joined to their rings"
