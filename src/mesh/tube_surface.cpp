@@ -36,6 +36,9 @@ constexpr std::size_t kLargestGapPart = 64;
 constexpr std::size_t kLargestDualTouchingPart = 64;
 // A tube is at least this many radii long.
 constexpr double kShortestTube = 0.25;
+// A stub is prolonged this many radii past its cut (vessel_ends' overshoot), and ends there in a
+// round tip of its radius.
+constexpr double kStubOvershoot = 1;
 // A tube's first ring from a contoured loop stands this many radii from it (or a third of the tube).
 constexpr double kLoopBand = 0.5;
 // A failed cut is tried again this many times, each this many radii further into its tube (or
@@ -65,6 +68,7 @@ struct Vessel {
   int end[2] = {-1, -1};            // the CFD end (options.ends index) at each side, or -1
   bool round[2] = {false, false};   // a round end of the tree (no other vessel at that node)
   bool tube = false;
+  bool looped = false;              // its tube runs from a contoured part back to the same part
 
   double rmax() const { return std::max(ra, rb); }
   // How far side k's CFD end prolongs the axis beyond its node (0 without one), and the distance
@@ -317,6 +321,38 @@ class TubeMesher {
       if (p.via >= 0) vessels_[std::size_t(p.via)].tube = false;  // the connector joins the two cuts' nodes into one part
       if (!cutPastEachOther(p)) vessels_[std::size_t(p.i)].tube = vessels_[std::size_t(p.j)].tube = false;
     }
+    // Unless both its ends lie in one part: there each cut would find the other stub's wall in
+    // the region it reads past its plane (its prolongation and round tip reach towards it), and
+    // fail however far it moves, so a tube too short to keep the two apart is contoured whole
+    // with that part (which it joins to nothing new: the parts stay as they are).
+    UnionFind parts = partNodes();
+    for (auto& v : vessels_) {
+      v.looped = v.tube && parts.find(v.node[0]) == parts.find(v.node[1]);
+      if (v.looped && v.len - v.plane[0] - v.plane[1] < loopedTubeLength(v)) v.tube = false;
+    }
+  }
+  // The free length a looped tube needs: each cut's region past its plane clear of the other
+  // stub, which reaches its overshoot and tip past its own plane.
+  double loopedTubeLength(const Vessel& v) const {
+    const double r = v.rmax();
+    return endCutExtent(r, stepNear(r, o_.junction), true).beyond + (kStubOvershoot + 1) * r;
+  }
+  // Nodes joined into one contoured part: by vessels without a tube and by close pairs (through
+  // a connector: the nodes at its ends, where the two are cut); `joined` (if given): only by the
+  // vessels and the pairs that touch or overlap (the components of the part's union).
+  UnionFind partNodes(UnionFind* joined = nullptr) const {
+    UnionFind g(std::size_t(t_.nodeCount()));
+    for (const auto& v : vessels_)
+      if (!v.tube) {
+        g.unite(v.node[0], v.node[1]);
+        if (joined) joined->unite(v.node[0], v.node[1]);
+      }
+    for (const auto& pr : close_pairs_) {
+      const auto ni = vessels_[std::size_t(pr.i)].node[pr.side_i], nj = vessels_[std::size_t(pr.j)].node[pr.side_j];
+      g.unite(ni, nj);
+      if (joined && (pr.touching || pr.overlapping)) joined->unite(ni, nj);
+    }
+    return g;
   }
   // Pairs of vessels of a tree that share no node and come close (close_pairs_).
   void findClosePairs() {
@@ -455,15 +491,8 @@ class TubeMesher {
   // smallest node, so the mesh does not depend on the thread count. A part's union has as many
   // components as its nodes have when only the vessels and the touching pairs join them.
   std::vector<Cluster> buildClusters() {
-    UnionFind g(std::size_t(t_.nodeCount())), joined(std::size_t(t_.nodeCount()));
-    for (const auto& v : vessels_)
-      if (!v.tube) g.unite(v.node[0], v.node[1]), joined.unite(v.node[0], v.node[1]);
-    for (const auto& pr : close_pairs_) {
-      // Through a connector: the nodes at its ends (where the two are cut).
-      const auto ni = vessels_[std::size_t(pr.i)].node[pr.side_i], nj = vessels_[std::size_t(pr.j)].node[pr.side_j];
-      g.unite(ni, nj);
-      if (pr.touching || pr.overlapping) joined.unite(ni, nj);
-    }
+    UnionFind joined(std::size_t(t_.nodeCount()));
+    UnionFind g = partNodes(&joined);
     std::vector<char> touching_root(std::size_t(t_.nodeCount()), 0);
     for (const auto& pr : close_pairs_)
       if (pr.touching) touching_root[std::size_t(g.find(vessels_[std::size_t(pr.i)].node[0]))] = 1;
@@ -561,7 +590,7 @@ class TubeMesher {
   // side may move its cut too). False if there is no room.
   bool moveCut(const Cluster& c, std::size_t k, double shift, std::vector<double>& plane) const {
     const auto& v = vessels_[std::size_t(c.stubs[k].vessel)];
-    const double spare = 0.5 * (v.len - v.plane[0] - v.plane[1] - kShortestTube * v.rmax());
+    const double spare = 0.5 * (v.len - v.plane[0] - v.plane[1] - (v.looped ? loopedTubeLength(v) : kShortestTube * v.rmax()));
     const double room = spare - (plane[k] - v.plane[c.stubs[k].side]);
     if (!(room >= kLeastCutShift * v.rmax())) return false;
     plane[k] += std::min(shift * v.rmax(), room);
@@ -583,8 +612,8 @@ class TubeMesher {
       const auto& st = c.stubs[k];
       const auto& v = vessels_[std::size_t(st.vessel)];
       const auto e = stubPlane(v, st.side, stub_planes[k]);
-      // Prolonged a radius past the plane (the cut's overshoot), then cut away again.
-      const double d = stub_planes[k] + e.radius;
+      // Prolonged past the plane (the cut's overshoot), then cut away again.
+      const double d = stub_planes[k] + kStubOvershoot * e.radius;
       piece(e.node, e.node + e.normal * d, v.radiusAt(v.fromA(st.side, 0)), v.radiusAt(v.fromA(st.side, d)));
       planes.push_back(e);
     }
