@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <numeric>
 #include <limits>
 #include <numbers>
 #include <optional>
@@ -1125,28 +1126,48 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
     EdgeKey key;
     std::uint32_t unit, local;
   };
-  std::vector<Copy> copies;
-  std::vector<Vec3> along;  // per vertex, its edge
-  std::vector<double> on_edge;
-  std::vector<std::size_t> offset(meshes.size() + 1, 0);
+  std::vector<std::size_t> offset(meshes.size() + 1, 0), first_copy(meshes.size() + 1, 0);
   for (std::size_t u = 0; u < meshes.size(); ++u) {
-    for (std::size_t v = 0; v < meshes[u].vertices.size(); ++v) copies.push_back({meshes[u].vertices[v].key, std::uint32_t(u), std::uint32_t(v)});
+    first_copy[u + 1] = first_copy[u] + meshes[u].vertices.size();
     offset[u + 1] = offset[u] + meshes[u].triangles.size();
   }
-  tbb::parallel_sort(copies.begin(), copies.end(), [](const Copy& a, const Copy& b) { return std::tie(a.key, a.unit, a.local) < std::tie(b.key, b.unit, b.local); });
+  std::vector<Copy> copies(first_copy.back());
   std::vector<std::vector<std::int32_t>> global(meshes.size());
-  for (std::size_t u = 0; u < meshes.size(); ++u) global[u].resize(meshes[u].vertices.size());
-  for (std::size_t i = 0; i < copies.size(); ++i) {
-    const auto& c = copies[i];
-    if (i == 0 || !(copies[i - 1].key == c.key)) {
-      const auto& v = meshes[c.unit].vertices[c.local];
-      mesh.vertices.push_back(v.position);
-      mesh.vertex_step.push_back(float(norm(v.along)));
-      along.push_back(v.along);
-      on_edge.push_back(v.t);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, meshes.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t u = r.begin(); u != r.end(); ++u) {
+      global[u].resize(meshes[u].vertices.size());
+      for (std::size_t v = 0; v < meshes[u].vertices.size(); ++v) copies[first_copy[u] + v] = {meshes[u].vertices[v].key, std::uint32_t(u), std::uint32_t(v)};
     }
-    global[c.unit][c.local] = std::int32_t(mesh.vertices.size() - 1);
-  }
+  });
+  tbb::parallel_sort(copies.begin(), copies.end(), [](const Copy& a, const Copy& b) { return std::tie(a.key, a.unit, a.local) < std::tie(b.key, b.unit, b.local); });
+  // The first copy of each key is the vertex, numbered in key order (by a running count; the
+  // rest in parallel: on a part of 20 M triangles this loop was a sixth of its time).
+  const auto leads = [&](std::size_t i) { return i == 0 || !(copies[i - 1].key == copies[i].key); };
+  std::vector<std::int32_t> id(copies.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, copies.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) id[i] = leads(i) ? 1 : 0;
+  });
+  std::inclusive_scan(id.begin(), id.end(), id.begin());
+  const std::size_t nv = id.empty() ? 0 : std::size_t(id.back());
+  mesh.vertices.resize(nv);
+  mesh.vertex_step.resize(nv);
+  std::vector<Vec3> along(nv);  // per vertex, its edge
+  std::vector<double> on_edge(nv);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, copies.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const auto& c = copies[i];
+      const auto k = std::size_t(id[i] - 1);
+      if (leads(i)) {
+        const auto& v = meshes[c.unit].vertices[c.local];
+        mesh.vertices[k] = v.position;
+        mesh.vertex_step[k] = float(norm(v.along));
+        along[k] = v.along;
+        on_edge[k] = v.t;
+      }
+      global[c.unit][c.local] = std::int32_t(k);
+    }
+  });
+  std::vector<std::int32_t>().swap(id);
   std::vector<Copy>().swap(copies);
   mesh.triangles.resize(offset.back());
   mesh.triangle_tree.resize(offset.back());
