@@ -415,6 +415,36 @@ TEST(Mesh, VesselsJoinedByAShortVesselDoNotTouchAndKeepNoHandle) {
   }
 }
 
+// A tube whose two ends lie in one contoured part (its sibling at one end overlaps a child at the
+// other, so the loop they close is one part): its cuts' regions would each hold the other stub's
+// wall, and both cuts fail however far they move. Too short to keep them apart, it is contoured
+// whole from the start: one round, no tube given up, and the union's one handle.
+TEST(Mesh, ATubeFromAPartBackToItselfTooShortForTwoCutsIsContouredWhole) {
+  VascularTree t;
+  const auto add = [&](const Vec3& p, std::int32_t parent) {
+    const auto id = t.addNode(p, parent);
+    t.radius[id] = 0.2;
+    return id;
+  };
+  const auto root = add({0, 0, 0}, -1), a = add({5, 0, 0}, root);
+  const auto b = add({7, 0, 0}, a);                               // the short vessel
+  add({5 + 3 * std::cos(std::numbers::pi / 3), 3 * std::sin(std::numbers::pi / 3), 0}, a);  // its sibling, ending at (6.5, 2.6)
+  add({6.5, 2.6 - 0.3, 0}, b);                                    // a child overlapping the sibling's end
+  add({10, 0, 0}, b);
+  TubeSurfaceReport rep;
+  const auto m = tubeMesh(t, 3, &rep);
+  EXPECT_EQ(rep.fallbacks, 0);
+  EXPECT_EQ(rep.rounds, 1);
+  EXPECT_EQ(rep.tubes, 2);  // the trunk and the continuing child
+  const auto topo = meshTopology(m);
+  EXPECT_EQ(topo.boundary_edges, 0);
+  EXPECT_EQ(topo.nonmanifold_edges, 0);
+  EXPECT_EQ(topo.misoriented_edges, 0);
+  EXPECT_EQ(topo.tree_components, std::vector<std::int64_t>({1}));
+  EXPECT_EQ(topo.tree_euler, std::vector<std::int64_t>({0}));  // the loop a → sibling → child → b → a
+  EXPECT_LE(largestDistanceOverStep(t, m), 0.5);
+}
+
 // A cut loop whose two neighbouring vertices lie closer than single precision resolves (a cut
 // point beside a vertex just off the plane): STL, OFF, PLY and OBJ would round them onto one
 // point, leaving a degenerate triangle on each side of the loop (vascusynth_like had 7 such
