@@ -79,6 +79,13 @@ MeshTopology expectOneSurfaceOfGenusZero(const SurfaceMesh& m) {
   return topo;
 }
 
+// Node p under `parent`, its vessel of radius r.
+std::int32_t addVessel(VascularTree& t, const Vec3& p, std::int32_t parent, double r) {
+  const auto id = t.addNode(p, parent);
+  t.radius[id] = r;
+  return id;
+}
+
 // A parent vessel from the origin to `fork` and two daughters from it; radii parent, a, b.
 VascularTree bifurcation(const Vec3& fork, const Vec3& a, const Vec3& b, const std::array<double, 3>& radii) {
   VascularTree t;
@@ -336,11 +343,7 @@ TEST(Mesh, StaggeredRingsMakeAcuteTrianglesAndKeepTheCapsulesVolume) {
 // vessels of radius 0.5 whose leaf ends 0.085 mm from the root vessel's wall.
 TEST(Mesh, VesselsCloseAcrossAGapStayApartAndTheSurfaceKeepsGenusZero) {
   VascularTree t;
-  const auto add = [&](const Vec3& p, std::int32_t parent) {
-    const auto id = t.addNode(p, parent);
-    t.radius[id] = 0.5;
-    return id;
-  };
+  const auto add = [&](const Vec3& p, std::int32_t parent) { return addVessel(t, p, parent, 0.5); };
   const auto root = add({0, 0, 0}, -1), a = add({10, 0, 0}, root);
   const auto b = add({10, 10, 0}, a);
   add({14, -3, 0}, a);
@@ -379,11 +382,7 @@ TEST(Mesh, VesselsCloseAcrossAGapStayApartAndTheSurfaceKeepsGenusZero) {
 // moved with n2): below 0.95 the vessels on either side of it overlap, through it.
 VascularTree zigzag(double connector) {
   VascularTree t;
-  const auto add = [&](const Vec3& p, std::int32_t parent, double r) {
-    const auto id = t.addNode(p, parent);
-    t.radius[id] = r;
-    return id;
-  };
+  const auto add = [&](const Vec3& p, std::int32_t parent, double r) { return addVessel(t, p, parent, r); };
   const auto root = add({24.4, 57.75, 29.4}, -1, 0);
   const auto n1 = add({23.3181, 54.6138, 28.5927}, root, 0.993377);
   const Vec3 shift = (Vec3(24.3689, 52.8999, 29.0966) - Vec3(23.3181, 54.6138, 28.5927)) * (connector - 1);
@@ -421,11 +420,7 @@ TEST(Mesh, VesselsJoinedByAShortVesselDoNotTouchAndKeepNoHandle) {
 // whole from the start: one round, no tube given up, and the union's one handle.
 TEST(Mesh, ATubeFromAPartBackToItselfTooShortForTwoCutsIsContouredWhole) {
   VascularTree t;
-  const auto add = [&](const Vec3& p, std::int32_t parent) {
-    const auto id = t.addNode(p, parent);
-    t.radius[id] = 0.2;
-    return id;
-  };
+  const auto add = [&](const Vec3& p, std::int32_t parent) { return addVessel(t, p, parent, 0.2); };
   const auto root = add({0, 0, 0}, -1), a = add({5, 0, 0}, root);
   const auto b = add({7, 0, 0}, a);                               // the short vessel
   add({5 + 3 * std::cos(std::numbers::pi / 3), 3 * std::sin(std::numbers::pi / 3), 0}, a);  // its sibling, ending at (6.5, 2.6)
