@@ -440,6 +440,55 @@ TEST(Mesh, ATubeFromAPartBackToItselfTooShortForTwoCutsIsContouredWhole) {
   EXPECT_LE(largestDistanceOverStep(t, m), 0.5);
 }
 
+// A cut loop that steps back by a hair (q a twentieth of a degree behind p) where moving q onto p
+// would turn a triangle of q's over, but moving p onto q turns none: the loop is made star-shaped
+// by the second collapse (the 100k tree's largest part lost a tube, and was contoured again, for
+// want of it). An open tube of radius 1 whose loop lies in z = 0, unrolled as (degrees, z).
+TEST(Mesh, ACutLoopSteppingBackIsCollapsedIntoWhicheverEndTurnsNoTriangleOver) {
+  SurfaceMesh m;
+  const auto at = [&](double deg, double z) {
+    const double a = deg * std::numbers::pi / 180;
+    m.vertices.push_back({std::cos(a), std::sin(a), z});
+    m.vertex_step.push_back(0.5f);
+    return std::int32_t(m.vertices.size() - 1);
+  };
+  std::vector<std::int32_t> L, U;
+  for (int k = 0; k < 12; ++k) L.push_back(at(30 * k, 0));
+  for (int k = 0; k < 12; ++k) U.push_back(at(15 + 30 * k, 0.6));
+  const auto p = L[1], q = at(29.9, 0), w = at(29.95, 0.3), x = at(29.95, 0.6);
+  const auto tri = [&](std::int32_t a, std::int32_t b, std::int32_t c) {
+    m.triangles.push_back({a, b, c});
+    m.triangle_tree.push_back(0);
+  };
+  for (int k = 0; k < 12; ++k) {
+    if (k != 1) tri(L[std::size_t(k)], L[std::size_t((k + 1) % 12)], U[std::size_t(k)]);
+    if (k != 1 && k != 2) tri(U[std::size_t((k + 11) % 12)], L[std::size_t(k)], U[std::size_t(k)]);
+  }
+  tri(p, x, U[0]);
+  tri(p, q, x);  // on the edge that steps back: folded
+  tri(q, w, x);  // turns over if q moves onto p
+  tri(q, L[2], w);
+  tri(w, L[2], U[1]);
+  tri(w, U[1], x);
+  tri(U[1], L[2], U[2]);
+  VesselEnd plane;
+  plane.centre = {0, 0, 0}, plane.normal = {0, 0, 1}, plane.radius = 1;
+  const auto loops = starLoops(m, {plane});
+  ASSERT_EQ(loops.size(), 1u);
+  ASSERT_EQ(loops[0].size(), 12u);  // p went onto q
+  for (std::size_t k = 0; k < 12; ++k) {
+    const Vec3 a = m.vertices[std::size_t(loops[0][k])], b = m.vertices[std::size_t(loops[0][(k + 1) % 12])];
+    EXPECT_GT(cross(a, b).z, 0) << k;  // rising all the way round
+  }
+  // No triangle left facing inwards, and the surface still a manifold with one boundary in the plane.
+  for (const auto& t : m.triangles) {
+    const Vec3 a = m.vertices[std::size_t(t[0])], b = m.vertices[std::size_t(t[1])], c = m.vertices[std::size_t(t[2])];
+    const Vec3 centroid = (a + b + c) / 3.0;
+    EXPECT_GT(dot(cross(b - a, c - a), Vec3(centroid.x, centroid.y, 0)), 0);
+  }
+  EXPECT_EQ(meshTopology(m).nonmanifold_edges, 0);
+}
+
 // A cut loop whose two neighbouring vertices lie closer than single precision resolves (a cut
 // point beside a vertex just off the plane): STL, OFF, PLY and OBJ would round them onto one
 // point, leaving a degenerate triangle on each side of the loop (vascusynth_like had 7 such

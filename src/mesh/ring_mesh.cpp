@@ -21,7 +21,8 @@ double angleAround(const Vec3& p, const Vec3& c, const Vec3& e1, const Vec3& e2)
 // point next to a vertex the volume restoration slid); the tube's triangle on that edge would
 // face inwards. Such an edge, at most kHair of the radius long, is collapsed into its first
 // vertex (the one contour triangle on it goes) when that keeps the surface a manifold and turns
-// no triangle over. True when the loop's angles then rise all the way round.
+// no triangle over, else into its second (both lie in the plane). True when the loop's angles
+// then rise all the way round.
 bool makeStarShaped(SurfaceMesh& m, std::vector<std::int32_t>& loop, std::unordered_map<std::int32_t, std::vector<std::int32_t>>& around,
                            std::vector<char>& keep, const Vec3& centre, const Vec3& u, double r) {
   constexpr double kHair = 0.05;
@@ -32,10 +33,9 @@ bool makeStarShaped(SurfaceMesh& m, std::vector<std::int32_t>& loop, std::unorde
   constexpr double kShortLoopEdge = 0.02;  // radii: a tenth of a contoured loop's spacing at 3 samples across
   const double extent = std::max({std::abs(centre.x), std::abs(centre.y), std::abs(centre.z)}) + 2 * r;
   const double shortest = std::max(kShortLoopEdge * r, 8 * double(std::numeric_limits<float>::epsilon()) * extent);
-  // Moves loop[i + 1] onto loop[i] (their triangle goes) where the link condition holds and no
-  // triangle turns over.
-  const auto collapse = [&](std::size_t i) {
-    const auto p = loop[i], q = loop[(i + 1) % loop.size()];
+  // Moves loop vertex q onto its neighbour p (their triangle goes) where the link condition
+  // holds and no triangle turns over.
+  const auto collapse = [&](std::int32_t q, std::int32_t p) {
     auto& tp = around[p];
     auto& tq = around[q];
     std::vector<std::int32_t> shared, others;
@@ -89,14 +89,18 @@ bool makeStarShaped(SurfaceMesh& m, std::vector<std::int32_t>& loop, std::unorde
       continue;
     }
     if (!rising && !(length <= kHair * r)) return false;
-    if (!collapse(i)) {
-      if (!rising) return false;
-      ++i;  // short, but it stays
-      continue;
+    std::size_t gone = (i + 1) % loop.size(), kept = i;
+    if (!collapse(q, p)) {
+      if (rising) {
+        ++i;  // short, but it stays
+        continue;
+      }
+      if (!collapse(p, q)) return false;
+      std::swap(gone, kept);
     }
-    loop.erase(loop.begin() + std::ptrdiff_t((i + 1) % loop.size()));
-    if ((i + 1) % (loop.size() + 1) == 0 && i > 0) --i;  // q was the first: p moved down one
-    i = i > 0 ? i - 1 : 0;                               // the step before p may have changed
+    loop.erase(loop.begin() + std::ptrdiff_t(gone));
+    if (kept > gone) --kept;  // the survivor moved down one
+    i = kept > 0 ? kept - 1 : 0;  // the step before it may have changed
   }
   for (std::size_t i = 0; i < loop.size(); ++i)
     if (!rises(loop[i], loop[(i + 1) % loop.size()])) return false;

@@ -25,7 +25,7 @@ std::vector<char> verticesInPlanes(const SurfaceMesh& m, const std::vector<Vesse
 // cut loop may step back by a hair where two of its vertices sit at one angle (a cut point next
 // to a vertex the volume restoration slid); such an edge, at most a twentieth of the radius
 // long, is collapsed into its first vertex when that keeps the surface a manifold and turns no
-// triangle over; so is (where it can be) an edge so short that single-precision formats would
+// triangle over (else into its second, where that does); so is (where it can be) an edge so short that single-precision formats would
 // round its ends onto one point. m loses the triangles the collapses removed (and the vertices only they used);
 // the loops are numbered after that.
 // `bent`, if given, gets the loops that stay bent (counter-clockwise, else empty).
