@@ -2,8 +2,10 @@
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -52,6 +54,8 @@ constexpr double kRecutShift = 0.5;
 // stretch of each where its wall comes within two of its own cells of the other's, unless that
 // is more than this many times finer than their own cells: then they count as touching.
 constexpr double kFinestGapCells = 16;  // (kGapCells: vessel_surface.hpp)
+// Parts of more vessels than this are large: meshed on a task of their own.
+constexpr std::size_t kLargePart = 256;
 
 // A vessel as the mesher sees it: its two junction nodes (links merged), its axis and radii, and
 // where its tube starts and ends.
@@ -208,15 +212,30 @@ class TubeMesher {
       const std::int64_t total = std::int64_t(todo.size());
       ++rep.rounds;
       for (auto c : todo) rep.largest_remeshed = std::max<std::int64_t>(rep.largest_remeshed, std::int64_t(clusters[c].whole.size()));
-      // In batches, so progress is reported from this thread.
-      for (std::int64_t first = 0; first < total; first += 1024) {
-        const std::int64_t last = std::min(total, first + 1024);
-        tbb::parallel_for(first, last, [&](std::int64_t i) {
-          const auto c = todo[std::size_t(i)];
+      // A large part (the 100k tree's largest holds 13 k vessels) starts first, on its own task:
+      // its serial steps (welding, cutting its stubs) then overlap the small parts' work instead
+      // of holding a batch of them. The small parts go in batches, so progress is reported from
+      // this thread.
+      std::vector<std::size_t> small;
+      tbb::task_group large;
+      std::atomic<std::int64_t> large_done{0};
+      for (auto c : todo) {
+        if (clusters[c].whole.size() + clusters[c].stubs.size() <= kLargePart) {
+          small.push_back(c);
+          continue;
+        }
+        large.run([&, c] {
           meshes[c] = meshCluster(clusters[c]);
+          ++large_done;
         });
-        if (progress) progress(last, total);
       }
+      for (std::size_t first = 0; first < small.size(); first += 1024) {
+        const std::size_t last = std::min(small.size(), first + 1024);
+        tbb::parallel_for(first, last, [&](std::size_t i) { meshes[small[i]] = meshCluster(clusters[small[i]]); });
+        if (progress) progress(std::int64_t(last) + large_done, total);
+      }
+      large.wait();
+      if (progress) progress(total, total);
       // Where each part cut its tubes (a retried cut lies further in), for the tubes' rings.
       for (auto c : todo)
         for (std::size_t k = 0; k < clusters[c].stubs.size(); ++k)
