@@ -30,12 +30,11 @@ constexpr double kTouching = 1.1;
 constexpr int kRefinements = 2;
 // Gaps are not resolved in parts of more vessels (a gap's step multiplies their grid).
 constexpr std::size_t kLargestGapPart = 64;
-// Where vessels touch, parts of up to this many are contoured by surface nets on the octree
-// (where those pass their checks); larger ones by tetrahedra at once. The 10k tree's largest
-// (1,237 vessels) gave a closed manifold net of 614 k triangles (2.03 M by tetrahedra), but 27
-// crossing triangles stayed after relaxing its folds, and the try cost 1.5 s; its 11 smaller
-// ones (7–15 vessels) pass but for 3.
-constexpr std::size_t kLargestDualTouchingPart = 64;
+// Where vessels touch, parts of up to this many are tried by surface nets on the octree (their
+// crossings untangled, each contact closed or not: isUnionShaped); larger ones go by tetrahedra
+// at once. The 10k tree's largest (1,237 vessels) passes: 614 k triangles against 2.03 M; the
+// 100k tree's (13,411) kept 3 crossing triangles at one knot, and the failed try cost 30 s.
+constexpr std::size_t kLargestDualTouchingPart = 4096;
 // A tube is at least this many radii long.
 constexpr double kShortestTube = 0.25;
 // A stub is prolonged this many radii past its cut (vessel_ends' overshoot), and ends there in a
@@ -159,6 +158,10 @@ struct Cluster {
   std::vector<Stub> stubs;          // tubes cut at this cluster's side
   bool touching = false;            // holds vessels that touch without sharing a node (its union may have handles)
   std::int32_t parts = 1;           // components of its union (vessels close across a gap stay apart)
+  // Where vessels touch without overlapping (walls a hair apart), a contour may close the gap or
+  // not: its union then has from `parts` to `parts_apart` components, each contact that closes
+  // joining two of them or making a handle.
+  std::int32_t parts_apart = 1, contacts = 0;
   std::vector<GapSpan> gap_spans;   // whole vessels that need finer cells along a stretch
 };
 
@@ -543,19 +546,43 @@ class TubeMesher {
       gs.push_back({pr.i, pr.gap_cell, pr.span_i[0], pr.span_i[1], {pr.j}});
       gs.push_back({pr.j, pr.gap_cell, pr.span_j[0], pr.span_j[1], {pr.i}});
     }
-    for (auto& c : out) {
-      // A large part's grid at a gap's step costs more than its handle: its close pairs touch.
+    // Components of each part's union: joined by its vessels and the pairs that overlap, and by
+    // its contacts (pairs that touch without overlapping; in a large part the gaps too) or not.
+    for (auto& c : out)
       if (c.whole.size() > kLargestGapPart && !c.gap_spans.empty()) {
+        // A large part's grid at a gap's step costs more than its handle: its close pairs touch.
         c.gap_spans.clear();
         c.touching = true;
-        continue;
       }
+    UnionFind apart(std::size_t(t_.nodeCount()));
+    for (const auto& v : vessels_)
+      if (!v.tube) apart.unite(v.node[0], v.node[1]);
+    std::vector<std::vector<std::pair<std::int32_t, std::int32_t>>> contacts(out.size());
+    for (const auto& pr : close_pairs_) {
+      const auto ni = vessels_[std::size_t(pr.i)].node[pr.side_i], nj = vessels_[std::size_t(pr.j)].node[pr.side_j];
+      if (pr.overlapping) apart.unite(ni, nj);
+    }
+    for (const auto& pr : close_pairs_) {
+      const auto ni = vessels_[std::size_t(pr.i)].node[pr.side_i], nj = vessels_[std::size_t(pr.j)].node[pr.side_j];
+      const auto c = slot[std::size_t(g.find(ni))];
+      if (c < 0 || pr.overlapping || pr.via >= 0 || (!pr.touching && !out[std::size_t(c)].touching)) continue;
+      contacts[std::size_t(c)].emplace_back(apart.find(ni), apart.find(nj));
+    }
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      auto& c = out[k];
       std::vector<std::int32_t> roots;
       for (auto i : c.whole)
-        for (auto n : vessels_[std::size_t(i)].node) roots.push_back(joined.find(n));
-      for (const auto& st : c.stubs) roots.push_back(joined.find(vessels_[std::size_t(st.vessel)].node[st.side]));
+        for (auto n : vessels_[std::size_t(i)].node) roots.push_back(apart.find(n));
+      for (const auto& st : c.stubs) roots.push_back(apart.find(vessels_[std::size_t(st.vessel)].node[st.side]));
       std::sort(roots.begin(), roots.end());
-      c.parts = std::int32_t(std::unique(roots.begin(), roots.end()) - roots.begin());
+      roots.erase(std::unique(roots.begin(), roots.end()), roots.end());
+      c.parts_apart = std::int32_t(roots.size());
+      c.contacts = std::int32_t(contacts[k].size());
+      UnionFind local(roots.size());
+      const auto at = [&](std::int32_t r) { return std::int32_t(std::lower_bound(roots.begin(), roots.end(), r) - roots.begin()); };
+      c.parts = c.parts_apart;
+      for (const auto& [a, b] : contacts[k])
+        if (local.find(at(a)) != local.find(at(b))) local.unite(at(a), at(b)), --c.parts;
     }
     return out;
   }
@@ -686,7 +713,7 @@ class TubeMesher {
     const int base = std::max(1, o_.junction.samples_across);
     for (int refine = 0;; ++refine) {
       contourCluster(c, sub, planes, stub_planes, base << refine, gap_cells, gap_partners, out);
-      if (c.touching || !c.gap_spans.empty() || refine == kRefinements || isUnionShaped(out.mesh, planes, c.parts)) break;
+      if (c.touching || !c.gap_spans.empty() || refine == kRefinements || isUnionShaped(out.mesh, planes, c)) break;
       ++out.refinements;
       for (auto& g : gap_cells) g /= 2;
     }
@@ -694,12 +721,18 @@ class TubeMesher {
   }
 
   // A contoured part of genus 0 with `parts` components: 2 × components − boundary loops = V − E + F.
-  static bool isUnionShaped(const SurfaceMesh& m, const std::vector<VesselEnd>& planes, std::int32_t parts) {
+  // Where vessels touch, each contact the contour closes joins two components or makes a handle:
+  // from parts_apart components, k closed contacts (0 ≤ k ≤ contacts) leave c components and
+  // k − (parts_apart − c) handles.
+  static bool isUnionShaped(const SurfaceMesh& m, const std::vector<VesselEnd>& planes, const Cluster& c) {
     const auto topo = meshTopology(m);
     std::int64_t chi = 0, components = 0;
     for (auto e : topo.tree_euler) chi += e;
     for (auto k : topo.tree_components) components += k;
-    return components == parts && 2 * components - std::int64_t(boundaryLoops(m, verticesInPlanes(m, planes)).size()) == chi;
+    const std::int64_t twice_handles = 2 * components - std::int64_t(boundaryLoops(m, verticesInPlanes(m, planes)).size()) - chi;
+    if (twice_handles < 0 || twice_handles % 2 || components < c.parts || components > c.parts_apart) return false;
+    const std::int64_t closed = twice_handles / 2 + c.parts_apart - components;
+    return closed <= c.contacts;
   }
   // The part's surface at `samples` across each vessel, cut at its planes, with its stubs' loops.
   void contourCluster(const Cluster& c, const VascularTree& sub, std::vector<VesselEnd>& planes, std::vector<double>& stub_planes, int samples,
@@ -757,7 +790,7 @@ class TubeMesher {
       const auto stubs_asked = stub_planes;
       // A net whose cut part is not the union's shape is dropped with the cuts it moved.
       const auto keepIfShaped = [&](std::optional<SurfaceMesh>& m) {
-        if (m && isUnionShaped(*m, planes, c.parts)) return;
+        if (m && isUnionShaped(*m, planes, c)) return;
         m.reset();
         planes = planes_asked, stub_planes = stubs_asked;
       };

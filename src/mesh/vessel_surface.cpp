@@ -689,6 +689,97 @@ std::int64_t relax(SurfaceMesh& m, const std::vector<std::int32_t>& tree_of, con
   return moved;
 }
 
+// A corner of a crossing triangle with only three triangles round it (a knot of vertices a
+// hundredth of a step apart, which Laplace steps hardly move) goes: its three triangles become the
+// one of their outer corners (the Euler characteristic stays), unless that triangle is there
+// already. The vertices stay, unused (keepTriangles drops them). True if any went.
+bool removeThreeFans(SurfaceMesh& m, const std::vector<std::int32_t>& crossing) {
+  std::vector<std::vector<std::int32_t>> around(m.vertices.size());
+  for (std::size_t k = 0; k < m.triangles.size(); ++k)
+    for (auto v : m.triangles[k]) around[std::size_t(v)].push_back(std::int32_t(k));
+  std::vector<char> keep(m.triangles.size(), 1);
+  const auto same = [](std::array<std::int32_t, 3> x, std::array<std::int32_t, 3> y) {
+    std::sort(x.begin(), x.end());
+    std::sort(y.begin(), y.end());
+    return x == y;
+  };
+  bool any = false;
+  for (auto k : crossing)
+    for (auto v : m.triangles[std::size_t(k)]) {
+      const auto& fan = around[std::size_t(v)];
+      if (fan.size() != 3 || !keep[std::size_t(fan[0])] || !keep[std::size_t(fan[1])] || !keep[std::size_t(fan[2])]) continue;
+      // The link: each triangle (v, x, y) gives x → y.
+      std::int32_t next_of[3][2];
+      for (int q = 0; q < 3; ++q) {
+        const auto& t = m.triangles[std::size_t(fan[std::size_t(q)])];
+        const int at = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+        next_of[q][0] = t[std::size_t((at + 1) % 3)], next_of[q][1] = t[std::size_t((at + 2) % 3)];
+      }
+      const std::int32_t a = next_of[0][0], b = next_of[0][1];
+      std::int32_t c = -1;
+      for (int q = 1; q < 3; ++q)
+        if (next_of[q][0] == b) c = next_of[q][1];
+      if (c < 0 || c == a) continue;
+      const std::array<std::int32_t, 3> cap{a, b, c};
+      bool there = false;
+      for (auto t : around[std::size_t(a)]) there = there || (keep[std::size_t(t)] && same(m.triangles[std::size_t(t)], cap));
+      if (there) continue;
+      for (auto t : fan) keep[std::size_t(t)] = 0;
+      m.triangles.push_back(cap);
+      m.triangle_tree.push_back(m.triangle_tree[std::size_t(fan[0])]);
+      keep.push_back(1);
+      for (auto x : cap) around[std::size_t(x)].push_back(std::int32_t(m.triangles.size() - 1));
+      any = true;
+    }
+  if (any) keepTriangles(m, keep);
+  return any;
+}
+
+// Rounds of untangle() after relax, and how far off the surface it may leave a vertex (of its step;
+// the issue asks every vertex within half a step).
+constexpr int kUntangleRounds = 4;
+constexpr double kUntangleOffset = 0.4;
+
+// Where folds cross at creases and thin gaps closer than a fifth of a step, moving the corners
+// back onto the surface (relax) makes the same crossing again. The corners of the crossing
+// triangles and `rings` rings of vertices around them move three times to the mean of their
+// neighbours (Laplace steps untangle a fold) and, where that leaves one more than
+// kUntangleOffset of its step off the surface, back to that offset (Newton steps on the distance
+// less the offset).
+void untangle(SurfaceMesh& m, const std::vector<std::int32_t>& tree_of, const std::vector<std::int32_t>& crossing, int rings,
+              const std::function<double(std::int32_t, const Vec3&)>& distance) {
+  std::vector<std::vector<std::int32_t>> next_to(m.vertices.size());
+  for (const auto& t : m.triangles)
+    for (int q = 0; q < 3; ++q) next_to[std::size_t(t[std::size_t(q)])].push_back(t[std::size_t((q + 1) % 3)]);
+  std::vector<char> in(m.vertices.size(), 0);
+  std::vector<std::int32_t> moving;
+  for (auto k : crossing)
+    for (auto v : m.triangles[std::size_t(k)])
+      if (!in[std::size_t(v)]) in[std::size_t(v)] = 1, moving.push_back(v);
+  for (int r = 0; r < rings; ++r)
+    for (std::size_t i = 0, n = moving.size(); i < n; ++i)
+      for (auto w : next_to[std::size_t(moving[i])])
+        if (!in[std::size_t(w)]) in[std::size_t(w)] = 1, moving.push_back(w);
+  std::vector<Vec3> to(moving.size());
+  for (int step = 0; step < 3; ++step) {
+    for (std::size_t i = 0; i < moving.size(); ++i) {
+      Vec3 sum(0, 0, 0);
+      for (auto w : next_to[std::size_t(moving[i])]) sum += m.vertices[std::size_t(w)];
+      to[i] = sum / double(next_to[std::size_t(moving[i])].size());
+    }
+    for (std::size_t i = 0; i < moving.size(); ++i) {
+      const auto v = std::size_t(moving[i]);
+      const auto tree = tree_of[v];
+      const double h = m.vertex_step[v], most = kUntangleOffset * h, d = distance(tree, to[i]);
+      if (std::abs(d) > most) {
+        const double offset = d > 0 ? most : -most;
+        to[i] = ontoSurface(to[i], [&](const Vec3& x) { return distance(tree, x) - offset; }, 1e-3 * h, 1e-3 * h, [](const Vec3& x) { return x; });
+      }
+      m.vertices[v] = to[i];
+    }
+  }
+}
+
 // A sheet whose loop crosses only two grid edges gets a vertex of two triangles on the same
 // three vertices, back to back: a flat pillow. Both go (with the vertex); the surface around
 // them closes over their shared edge. Repeated while removing one makes another.
@@ -1096,6 +1187,19 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
           relax(*dual, tree_of, crossing, distance);
           crossing = crossingTriangles(*dual, lat.origin, h);
           if (crossing.empty()) break;
+        }
+        // Tangles relax cannot undo (sheets a fifth of a step apart at creases and thin gaps):
+        // smoothed off the surface, within kUntangleOffset of a step.
+        for (int round = 0; round < kUntangleRounds && !crossing.empty(); ++round) {
+          if (removeThreeFans(*dual, crossing)) {
+            tree_of.assign(dual->vertices.size(), 0);
+            for (std::size_t k = 0; k < dual->triangles.size(); ++k)
+              for (auto v : dual->triangles[k]) tree_of[std::size_t(v)] = dual->triangle_tree[k];
+            crossing = crossingTriangles(*dual, lat.origin, h);
+            if (crossing.empty()) break;
+          }
+          untangle(*dual, tree_of, crossing, round + 1, distance);
+          crossing = crossingTriangles(*dual, lat.origin, h);
         }
         if (!crossing.empty()) refused = "self-intersecting";
       }
