@@ -18,6 +18,7 @@
 #include "mesh/decimate.hpp"
 #include "mesh/net_surface.hpp"
 #include "mesh/ring_mesh.hpp"
+#include "mesh/surface_checks.hpp"
 #include "mesh/tube_surface.hpp"
 #include "mesh/vessel_surface.hpp"
 #include "raster/vessel_capsule.hpp"
@@ -1115,4 +1116,102 @@ TEST(Mesh, SliverRepairKeepsTopologyVolumeAndSurface) {
             << obtuse_before << " -> " << obtuse_after << ", edges under 0.2 steps " << short_before << " -> " << short_after << "; " << rep.collapses
             << " collapses, " << rep.flips << " flips, " << rep.moves << " moves; volume " << before.volume_mm3 << " -> " << topo.volume_mm3 << "\n";
   std::filesystem::remove_all(dir);
+}
+
+namespace {
+
+// A UV sphere: `rings` bands of `around` quadrilaterals (triangles at the poles), outward.
+void addSphere(SurfaceMesh& m, const Vec3& centre, double radius, int rings, int around) {
+  const auto first = std::int32_t(m.vertices.size());
+  m.vertices.push_back(centre + Vec3(0, 0, radius));
+  for (int i = 1; i < rings; ++i)
+    for (int j = 0; j < around; ++j) {
+      const double th = std::numbers::pi * i / rings, ph = 2 * std::numbers::pi * (j + 0.37 * i) / around;
+      m.vertices.push_back(centre + Vec3(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)) * radius);
+    }
+  m.vertices.push_back(centre - Vec3(0, 0, radius));
+  const auto at = [&](int i, int j) { return first + 1 + (i - 1) * around + (j % around); };
+  const auto south = std::int32_t(m.vertices.size() - 1);
+  for (int j = 0; j < around; ++j) {
+    m.triangles.push_back({first, at(1, j), at(1, j + 1)});
+    for (int i = 1; i + 1 < rings; ++i) {
+      m.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      m.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+    m.triangles.push_back({at(rings - 1, j), south, at(rings - 1, j + 1)});
+  }
+}
+
+// Whether two triangles with no common corner meet: an edge of one through the other (by its
+// plane's crossing and barycentric coordinates; the test's own arithmetic).
+bool edgesPierce(const std::array<Vec3, 3>& s, const std::array<Vec3, 3>& t) {
+  const Vec3 n = cross(t[1] - t[0], t[2] - t[0]);
+  for (int i = 0; i < 3; ++i) {
+    const Vec3 p = s[std::size_t(i)], q = s[std::size_t((i + 1) % 3)];
+    const double dp = dot(n, p - t[0]), dq = dot(n, q - t[0]);
+    if (dp * dq > 0 || dp == dq) continue;
+    const Vec3 x = p + (q - p) * (dp / (dp - dq));
+    const double a = dot(n, cross(t[1] - x, t[2] - x)), b = dot(n, cross(t[2] - x, t[0] - x)), c = dot(n, cross(t[0] - x, t[1] - x));
+    if ((a >= 0 && b >= 0 && c >= 0) || (a <= 0 && b <= 0 && c <= 0)) return true;
+  }
+  return false;
+}
+
+std::vector<std::int32_t> crossingByAllPairs(const SurfaceMesh& m) {
+  std::vector<std::int32_t> found;
+  const auto corners = [&](std::size_t k) {
+    const auto& t = m.triangles[k];
+    return std::array<Vec3, 3>{m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[1])], m.vertices[std::size_t(t[2])]};
+  };
+  for (std::size_t a = 0; a < m.triangles.size(); ++a)
+    for (std::size_t b = a + 1; b < m.triangles.size(); ++b) {
+      bool shared = false;
+      for (auto u : m.triangles[a])
+        for (auto w : m.triangles[b]) shared = shared || u == w;
+      if (shared) continue;
+      const auto s = corners(a), t = corners(b);
+      if (edgesPierce(s, t) || edgesPierce(t, s)) found.push_back(std::int32_t(a)), found.push_back(std::int32_t(b));
+    }
+  std::sort(found.begin(), found.end());
+  found.erase(std::unique(found.begin(), found.end()), found.end());
+  return found;
+}
+
+}  // namespace
+
+// The crossing check bins triangles by size and tests each pair in one bin only, and after a
+// move only pairs with a triangle that moved or crossed: checked against every pair tested.
+TEST(Mesh, CrossingTrianglesAreFoundAcrossSizesAndAgainOnlyWhereVerticesMoved) {
+  SurfaceMesh m;
+  addSphere(m, Vec3(0, 0, 0), 1.0, 10, 20);         // triangles about 0.3 across
+  addSphere(m, Vec3(0.55, 0.1, 0.2), 0.7, 40, 80);  // about 0.05: bins of other levels
+  addSphere(m, Vec3(3, 0, 0), 0.5, 12, 24);         // apart from both
+  const double cell = 0.02;
+  const Vec3 origin(-2.3, -1.1, -1.2);  // below every box, as a lattice's origin is
+  const auto expected = crossingByAllPairs(m);
+  ASSERT_GT(expected.size(), 300u);
+  EXPECT_EQ(crossingTriangles(m, origin, cell), expected);
+  const auto first = crossingTriangles(m, origin, cell, true);
+  ASSERT_EQ(first.size(), 2u);
+  EXPECT_TRUE(std::binary_search(expected.begin(), expected.end(), first[0]) && std::binary_search(expected.begin(), expected.end(), first[1]));
+
+  // The small sphere's cap above z = 0.5 pushed out through the large one, the far sphere moved
+  // into its other side (finer triangles, dirty, through coarser ones that are not): crossings go
+  // and come.
+  const std::size_t small_first = 1 + 9 * 20 + 1, far_first = small_first + 1 + 39 * 80 + 1;
+  const auto before = m.vertices;
+  for (std::size_t v = small_first; v < far_first; ++v)
+    if (m.vertices[v].z > 0.5) m.vertices[v] = m.vertices[v] + Vec3(0.4, 0, 0.3);
+  for (std::size_t v = far_first; v < m.vertices.size(); ++v) m.vertices[v] = m.vertices[v] - Vec3(4.1, 0, 0);
+  std::vector<char> dirty(m.triangles.size(), 0);
+  for (auto k : expected) dirty[std::size_t(k)] = 1;
+  std::size_t moved = 0;
+  for (std::size_t k = 0; k < m.triangles.size(); ++k)
+    for (auto v : m.triangles[k])
+      if (m.vertices[std::size_t(v)].x != before[std::size_t(v)].x) dirty[k] = 1, ++moved;
+  ASSERT_GT(moved, 0u);
+  const auto after = crossingByAllPairs(m);
+  ASSERT_NE(after, expected);
+  EXPECT_EQ(crossingTriangles(m, origin, cell), after);
+  EXPECT_EQ(crossingTriangles(m, origin, cell, false, &dirty), after);
 }

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <vector>
 
 namespace angiosynth {
@@ -75,9 +76,13 @@ bool closedManifold(const SurfaceMesh& m) {
   return true;
 }
 
-std::vector<std::int32_t> crossingTriangles(const SurfaceMesh& m, const Vec3& origin, double cell, bool first_only) {
+std::vector<std::int32_t> crossingTriangles(const SurfaceMesh& m, const Vec3& origin, double cell, bool first_only,
+                                             const std::vector<char>* dirty) {
   // Each triangle has a level: the bins of cell × 2^level hold its box in at most 2 per axis. A
-  // pair is tested in the bins of the coarser one's level, which hold the finer one too.
+  // pair is tested in the bins of the coarser one's level (which hold the finer one too), and
+  // only in the bin of its boxes' overlap's low corner: the one where, along each axis, one of
+  // the two starts. Finer triangles are binned only where a coarser one is (or, with `dirty`,
+  // where a coarser one and a dirty one are).
   const std::size_t nt = m.triangles.size();
   std::vector<Vec3> box_lo(nt), box_hi(nt);
   std::vector<int> level(nt, 0);
@@ -90,45 +95,84 @@ std::vector<std::int32_t> crossingTriangles(const SurfaceMesh& m, const Vec3& or
     while (level[k] < 40 && cell * double(std::int64_t(1) << level[k]) < extent) ++level[k];
     top = std::max(top, level[k]);
   }
+  const auto isDirty = [&](std::size_t k) { return !dirty || (*dirty)[k] != 0; };
+  struct Entry {
+    std::uint64_t key;
+    std::int32_t triangle;
+    std::uint8_t starts;  // bit a: the triangle's box starts in this bin along axis a
+    bool operator<(const Entry& o) const { return key != o.key ? key < o.key : triangle < o.triangle; }
+  };
+  // The bins of triangle k at bin size `size`, passed to fn(key, starts).
+  const auto forBins = [&](std::size_t k, double size, const auto& fn) {
+    std::int64_t b0[3], b1[3];
+    for (int a = 0; a < 3; ++a) {
+      b0[a] = std::int64_t(std::floor((box_lo[k][a] - origin[a]) / size));
+      b1[a] = std::int64_t(std::floor((box_hi[k][a] - origin[a]) / size));
+    }
+    for (auto z = b0[2]; z <= b1[2]; ++z)
+      for (auto y = b0[1]; y <= b1[1]; ++y)
+        for (auto x = b0[0]; x <= b1[0]; ++x)
+          fn(std::uint64_t(x + 1) | (std::uint64_t(y + 1) << 21) | (std::uint64_t(z + 1) << 42),
+             std::uint8_t((x == b0[0] ? 1 : 0) | (y == b0[1] ? 2 : 0) | (z == b0[2] ? 4 : 0)));
+  };
+  const auto keysOf = [](const std::vector<Entry>& entries) {
+    std::vector<std::uint64_t> keys;
+    for (const auto& e : entries)
+      if (keys.empty() || keys.back() != e.key) keys.push_back(e.key);
+    return keys;
+  };
   std::vector<std::int32_t> found;
-  std::vector<std::pair<std::uint64_t, std::int32_t>> binned;
+  std::vector<Entry> coarse, fine;
+  std::vector<std::uint64_t> dirty_keys;
   for (int l = 0; l <= top; ++l) {
     const double size = cell * double(std::int64_t(1) << l);
-    binned.clear();
-    bool any = false;
-    for (std::size_t k = 0; k < nt; ++k) {
-      if (level[k] > l) continue;
-      any = any || level[k] == l;
-      std::int64_t b0[3], b1[3];
-      for (int a = 0; a < 3; ++a) {
-        b0[a] = std::int64_t(std::floor((box_lo[k][a] - origin[a]) / size));
-        b1[a] = std::int64_t(std::floor((box_hi[k][a] - origin[a]) / size));
-      }
-      for (auto z = b0[2]; z <= b1[2]; ++z)
-        for (auto y = b0[1]; y <= b1[1]; ++y)
-          for (auto x = b0[0]; x <= b1[0]; ++x)
-            binned.emplace_back(std::uint64_t(x + 1) | (std::uint64_t(y + 1) << 21) | (std::uint64_t(z + 1) << 42), std::int32_t(k));
+    coarse.clear(), fine.clear();
+    for (std::size_t k = 0; k < nt; ++k)
+      if (level[k] == l) forBins(k, size, [&](std::uint64_t key, std::uint8_t starts) { coarse.push_back({key, std::int32_t(k), starts}); });
+    if (coarse.empty()) continue;
+    std::sort(coarse.begin(), coarse.end());
+    std::vector<std::uint64_t> keys = keysOf(coarse);
+    if (dirty) {  // only bins that hold a dirty triangle can hold a pair to test
+      std::vector<Entry> marks;
+      for (std::size_t k = 0; k < nt; ++k)
+        if (level[k] <= l && (*dirty)[k]) forBins(k, size, [&](std::uint64_t key, std::uint8_t) { marks.push_back({key, 0, 0}); });
+      std::sort(marks.begin(), marks.end());
+      dirty_keys = keysOf(marks);
+      std::vector<std::uint64_t> both;
+      std::set_intersection(keys.begin(), keys.end(), dirty_keys.begin(), dirty_keys.end(), std::back_inserter(both));
+      keys.swap(both);
+      if (keys.empty()) continue;
     }
-    if (!any) continue;
-    std::sort(binned.begin(), binned.end());
-    for (std::size_t i = 0; i < binned.size();) {
+    for (std::size_t k = 0; k < nt; ++k)
+      if (level[k] < l)
+        forBins(k, size, [&](std::uint64_t key, std::uint8_t starts) {
+          if (std::binary_search(keys.begin(), keys.end(), key)) fine.push_back({key, std::int32_t(k), starts});
+        });
+    std::sort(fine.begin(), fine.end());
+    const auto test = [&](std::size_t a, std::size_t b, std::uint8_t starts) {
+      if (starts != 7 || !(isDirty(a) || isDirty(b))) return false;
+      if (box_hi[a].x < box_lo[b].x || box_hi[b].x < box_lo[a].x || box_hi[a].y < box_lo[b].y || box_hi[b].y < box_lo[a].y ||
+          box_hi[a].z < box_lo[b].z || box_hi[b].z < box_lo[a].z || !trianglesCross(m, m.triangles[a], m.triangles[b]))
+        return false;
+      found.push_back(std::int32_t(a)), found.push_back(std::int32_t(b));
+      return first_only;
+    };
+    std::size_t i = 0, f = 0;
+    for (const auto key : keys) {
+      while (coarse[i].key != key) ++i;
       std::size_t j = i;
-      while (j < binned.size() && binned[j].first == binned[i].first) ++j;
+      while (j < coarse.size() && coarse[j].key == key) ++j;
+      while (f < fine.size() && fine[f].key < key) ++f;
+      std::size_t g = f;
+      while (g < fine.size() && fine[g].key == key) ++g;
       for (std::size_t p = i; p < j; ++p) {
-        const auto a = std::size_t(binned[p].second);
-        if (level[a] != l) continue;
-        for (std::size_t q = i; q < j; ++q) {
-          const auto b = std::size_t(binned[q].second);
-          if (b == a || (level[b] == l && b < a)) continue;  // a pair of this level once (per bin)
-          if (!(box_hi[a].x < box_lo[b].x || box_hi[b].x < box_lo[a].x || box_hi[a].y < box_lo[b].y || box_hi[b].y < box_lo[a].y ||
-                box_hi[a].z < box_lo[b].z || box_hi[b].z < box_lo[a].z) &&
-              trianglesCross(m, m.triangles[a], m.triangles[b])) {
-            found.push_back(std::int32_t(a)), found.push_back(std::int32_t(b));
-            if (first_only) return found;
-          }
-        }
+        const auto a = std::size_t(coarse[p].triangle);
+        for (std::size_t q = p + 1; q < j; ++q)
+          if (test(a, std::size_t(coarse[q].triangle), coarse[p].starts | coarse[q].starts)) return found;
+        for (std::size_t q = f; q < g; ++q)
+          if (test(a, std::size_t(fine[q].triangle), coarse[p].starts | fine[q].starts)) return found;
       }
-      i = j;
+      i = j, f = g;
     }
   }
   std::sort(found.begin(), found.end());

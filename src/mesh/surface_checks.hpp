@@ -15,7 +15,10 @@ bool closedManifold(const SurfaceMesh& m);
 // No two triangles cross or overlap beyond what they share: each pair whose boxes meet in the
 // bins of `cell` (mm, from `origin`) is tested with orientation predicates (touching counts).
 bool freeOfCrossings(const SurfaceMesh& m, const Vec3& origin, double cell);
-// The triangles of such pairs, in order (only the first pair's with first_only).
-std::vector<std::int32_t> crossingTriangles(const SurfaceMesh& m, const Vec3& origin, double cell, bool first_only = false);
+// The triangles of such pairs, in order (only the first pair's with first_only); with `dirty`
+// (a flag per triangle), only of pairs with a dirty triangle: after moving some vertices, the
+// triangles at them and those that crossed before are dirty, and the rest's pairs stand.
+std::vector<std::int32_t> crossingTriangles(const SurfaceMesh& m, const Vec3& origin, double cell, bool first_only = false,
+                                             const std::vector<char>* dirty = nullptr);
 
 }  // namespace angiosynth

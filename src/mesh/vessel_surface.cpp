@@ -1183,9 +1183,27 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
         for (std::size_t k = 0; k < dual->triangles.size(); ++k)
           for (auto v : dual->triangles[k]) tree_of[std::size_t(v)] = dual->triangle_tree[k];
         std::vector<std::int32_t> crossing;
+        // Checked again after a move only where it moved: the triangles at moved vertices and
+        // those that crossed are dirty, the other pairs did not cross and stand.
+        std::vector<Vec3> before;
+        std::vector<char> dirty;
+        const auto recheck = [&] {
+          dirty.assign(dual->triangles.size(), 0);
+          for (auto k : crossing) dirty[std::size_t(k)] = 1;
+          for (std::size_t k = 0; k < dual->triangles.size(); ++k)
+            for (auto v : dual->triangles[k]) {
+              const Vec3 &p = dual->vertices[std::size_t(v)], &q = before[std::size_t(v)];
+              if (p.x != q.x || p.y != q.y || p.z != q.z) dirty[k] = 1;
+            }
+          crossing = crossingTriangles(*dual, lat.origin, h, false, &dirty);
+        };
         for (int round = 0; round < kRelaxRounds; ++round) {
+          before = dual->vertices;
           relax(*dual, tree_of, crossing, distance);
-          crossing = crossingTriangles(*dual, lat.origin, h);
+          if (round == 0)
+            crossing = crossingTriangles(*dual, lat.origin, h);
+          else
+            recheck();
           if (crossing.empty()) break;
         }
         // Tangles relax cannot undo (sheets a fifth of a step apart at creases and thin gaps):
@@ -1198,8 +1216,9 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
             crossing = crossingTriangles(*dual, lat.origin, h);
             if (crossing.empty()) break;
           }
+          before = dual->vertices;
           untangle(*dual, tree_of, crossing, round + 1, distance);
-          crossing = crossingTriangles(*dual, lat.origin, h);
+          recheck();
         }
         if (!crossing.empty()) refused = "self-intersecting";
       }
