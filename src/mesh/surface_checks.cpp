@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <iterator>
 #include <vector>
 
 namespace angiosynth {
@@ -121,32 +120,61 @@ std::vector<std::int32_t> crossingTriangles(const SurfaceMesh& m, const Vec3& or
       if (keys.empty() || keys.back() != e.key) keys.push_back(e.key);
     return keys;
   };
+  // With `dirty`, the triangles that can be in a pair to test: the dirty ones and those whose
+  // box reaches a bin of a dirty one's, at the triangle's own level or the dirty ones' coarsest.
+  std::vector<std::int32_t> candidates;
+  if (dirty) {
+    int dirty_top = -1;
+    std::vector<std::size_t> dirty_list;
+    for (std::size_t k = 0; k < nt; ++k)
+      if ((*dirty)[k]) dirty_top = std::max(dirty_top, level[k]), dirty_list.push_back(k);
+    if (dirty_list.empty()) return {};
+    std::vector<std::vector<std::uint64_t>> near(std::size_t(top + 1));
+    for (int l = dirty_top; l <= top; ++l) {
+      std::vector<Entry> marks;
+      for (const auto k : dirty_list) forBins(k, cell * double(std::int64_t(1) << l), [&](std::uint64_t key, std::uint8_t) { marks.push_back({key, 0, 0}); });
+      std::sort(marks.begin(), marks.end());
+      near[std::size_t(l)] = keysOf(marks);
+    }
+    for (std::size_t k = 0; k < nt; ++k) {
+      bool take = (*dirty)[k] != 0;
+      const int l = std::max(dirty_top, level[k]);
+      const auto& keys = near[std::size_t(l)];
+      if (!take) forBins(k, cell * double(std::int64_t(1) << l), [&](std::uint64_t key, std::uint8_t) { take = take || std::binary_search(keys.begin(), keys.end(), key); });
+      if (take) candidates.push_back(std::int32_t(k));
+    }
+  } else {
+    candidates.resize(nt);
+    for (std::size_t k = 0; k < nt; ++k) candidates[k] = std::int32_t(k);
+  }
   std::vector<std::int32_t> found;
   std::vector<Entry> coarse, fine;
   std::vector<std::uint64_t> dirty_keys;
   for (int l = 0; l <= top; ++l) {
     const double size = cell * double(std::int64_t(1) << l);
     coarse.clear(), fine.clear();
-    for (std::size_t k = 0; k < nt; ++k)
-      if (level[k] == l) forBins(k, size, [&](std::uint64_t key, std::uint8_t starts) { coarse.push_back({key, std::int32_t(k), starts}); });
-    if (coarse.empty()) continue;
-    std::sort(coarse.begin(), coarse.end());
-    std::vector<std::uint64_t> keys = keysOf(coarse);
     if (dirty) {  // only bins that hold a dirty triangle can hold a pair to test
       std::vector<Entry> marks;
-      for (std::size_t k = 0; k < nt; ++k)
+      for (const auto c : candidates) {
+        const auto k = std::size_t(c);
         if (level[k] <= l && (*dirty)[k]) forBins(k, size, [&](std::uint64_t key, std::uint8_t) { marks.push_back({key, 0, 0}); });
+      }
+      if (marks.empty()) continue;
       std::sort(marks.begin(), marks.end());
       dirty_keys = keysOf(marks);
-      std::vector<std::uint64_t> both;
-      std::set_intersection(keys.begin(), keys.end(), dirty_keys.begin(), dirty_keys.end(), std::back_inserter(both));
-      keys.swap(both);
-      if (keys.empty()) continue;
     }
-    for (std::size_t k = 0; k < nt; ++k)
-      if (level[k] < l)
-        forBins(k, size, [&](std::uint64_t key, std::uint8_t starts) {
-          if (std::binary_search(keys.begin(), keys.end(), key)) fine.push_back({key, std::int32_t(k), starts});
+    for (const auto c : candidates)
+      if (level[std::size_t(c)] == l)
+        forBins(std::size_t(c), size, [&](std::uint64_t key, std::uint8_t starts) {
+          if (!dirty || std::binary_search(dirty_keys.begin(), dirty_keys.end(), key)) coarse.push_back({key, c, starts});
+        });
+    if (coarse.empty()) continue;
+    std::sort(coarse.begin(), coarse.end());
+    const std::vector<std::uint64_t> keys = keysOf(coarse);
+    for (const auto c : candidates)
+      if (level[std::size_t(c)] < l)
+        forBins(std::size_t(c), size, [&](std::uint64_t key, std::uint8_t starts) {
+          if (std::binary_search(keys.begin(), keys.end(), key)) fine.push_back({key, c, starts});
         });
     std::sort(fine.begin(), fine.end());
     const auto test = [&](std::size_t a, std::size_t b, std::uint8_t starts) {

@@ -692,12 +692,28 @@ std::int64_t relax(SurfaceMesh& m, const std::vector<std::int32_t>& tree_of, con
 // A corner of a crossing triangle with only three triangles round it (a knot of vertices a
 // hundredth of a step apart, which Laplace steps hardly move) goes: its three triangles become the
 // one of their outer corners (the Euler characteristic stays), unless that triangle is there
-// already. The vertices stay, unused (keepTriangles drops them). True if any went.
-bool removeThreeFans(SurfaceMesh& m, const std::vector<std::int32_t>& crossing) {
-  std::vector<std::vector<std::int32_t>> around(m.vertices.size());
+// already. The vertices stay, unused (keepTriangles drops them). True if any went; then `dirty`
+// flags, in the new numbering, the crossing triangles that stayed and the new ones (the rest did
+// not change, so their pairs need no second check).
+bool removeThreeFans(SurfaceMesh& m, const std::vector<std::int32_t>& crossing, std::vector<char>& dirty) {
+  // The triangles around the crossing triangles' corners and their neighbours only.
+  std::vector<std::int32_t> slot(m.vertices.size(), -1);
+  std::vector<std::vector<std::int32_t>> around;
+  const auto watch = [&](std::int32_t v) {
+    if (slot[std::size_t(v)] < 0) slot[std::size_t(v)] = std::int32_t(around.size()), around.emplace_back();
+  };
+  std::vector<char> corner(m.vertices.size(), 0);
+  for (auto k : crossing)
+    for (auto v : m.triangles[std::size_t(k)]) corner[std::size_t(v)] = 1;
+  for (const auto& t : m.triangles)
+    if (corner[std::size_t(t[0])] || corner[std::size_t(t[1])] || corner[std::size_t(t[2])])
+      for (auto v : t) watch(v);
   for (std::size_t k = 0; k < m.triangles.size(); ++k)
-    for (auto v : m.triangles[k]) around[std::size_t(v)].push_back(std::int32_t(k));
-  std::vector<char> keep(m.triangles.size(), 1);
+    for (auto v : m.triangles[k])
+      if (slot[std::size_t(v)] >= 0) around[std::size_t(slot[std::size_t(v)])].push_back(std::int32_t(k));
+  const auto fanOf = [&](std::int32_t v) -> const std::vector<std::int32_t>& { return around[std::size_t(slot[std::size_t(v)])]; };
+  const std::size_t first_added = m.triangles.size();
+  std::vector<char> keep(first_added, 1);
   const auto same = [](std::array<std::int32_t, 3> x, std::array<std::int32_t, 3> y) {
     std::sort(x.begin(), x.end());
     std::sort(y.begin(), y.end());
@@ -706,7 +722,7 @@ bool removeThreeFans(SurfaceMesh& m, const std::vector<std::int32_t>& crossing) 
   bool any = false;
   for (auto k : crossing)
     for (auto v : m.triangles[std::size_t(k)]) {
-      const auto& fan = around[std::size_t(v)];
+      const auto& fan = fanOf(v);
       if (fan.size() != 3 || !keep[std::size_t(fan[0])] || !keep[std::size_t(fan[1])] || !keep[std::size_t(fan[2])]) continue;
       // The link: each triangle (v, x, y) gives x → y.
       std::int32_t next_of[3][2];
@@ -722,17 +738,23 @@ bool removeThreeFans(SurfaceMesh& m, const std::vector<std::int32_t>& crossing) 
       if (c < 0 || c == a) continue;
       const std::array<std::int32_t, 3> cap{a, b, c};
       bool there = false;
-      for (auto t : around[std::size_t(a)]) there = there || (keep[std::size_t(t)] && same(m.triangles[std::size_t(t)], cap));
+      for (auto t : fanOf(a)) there = there || (keep[std::size_t(t)] && same(m.triangles[std::size_t(t)], cap));
       if (there) continue;
       for (auto t : fan) keep[std::size_t(t)] = 0;
       m.triangles.push_back(cap);
       m.triangle_tree.push_back(m.triangle_tree[std::size_t(fan[0])]);
       keep.push_back(1);
-      for (auto x : cap) around[std::size_t(x)].push_back(std::int32_t(m.triangles.size() - 1));
+      for (auto x : cap) around[std::size_t(slot[std::size_t(x)])].push_back(std::int32_t(m.triangles.size() - 1));
       any = true;
     }
-  if (any) keepTriangles(m, keep);
-  return any;
+  if (!any) return false;
+  std::vector<char> was(first_added, 0);
+  for (auto k : crossing) was[std::size_t(k)] = 1;
+  dirty.clear();
+  for (std::size_t k = 0; k < keep.size(); ++k)
+    if (keep[k]) dirty.push_back(k < first_added ? was[k] : 1);
+  keepTriangles(m, keep);
+  return true;
 }
 
 // Rounds of untangle() after relax, and how far off the surface it may leave a vertex (of its step;
@@ -1209,11 +1231,11 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
         // Tangles relax cannot undo (sheets a fifth of a step apart at creases and thin gaps):
         // smoothed off the surface, within kUntangleOffset of a step.
         for (int round = 0; round < kUntangleRounds && !crossing.empty(); ++round) {
-          if (removeThreeFans(*dual, crossing)) {
+          if (removeThreeFans(*dual, crossing, dirty)) {
             tree_of.assign(dual->vertices.size(), 0);
             for (std::size_t k = 0; k < dual->triangles.size(); ++k)
               for (auto v : dual->triangles[k]) tree_of[std::size_t(v)] = dual->triangle_tree[k];
-            crossing = crossingTriangles(*dual, lat.origin, h);
+            crossing = crossingTriangles(*dual, lat.origin, h, false, &dirty);
             if (crossing.empty()) break;
           }
           before = dual->vertices;
