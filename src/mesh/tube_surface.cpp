@@ -30,11 +30,6 @@ constexpr double kTouching = 1.1;
 constexpr int kRefinements = 2;
 // Gaps are not resolved in parts of more vessels (a gap's step multiplies their grid).
 constexpr std::size_t kLargestGapPart = 64;
-// Where vessels touch, parts of up to this many are tried by surface nets on the octree (their
-// crossings untangled, each contact closed or not: isUnionShaped); larger ones go by tetrahedra
-// at once. The 10k tree's largest (1,237 vessels) passes: 614 k triangles against 2.03 M; the
-// 100k tree's (13,411) kept 3 crossing triangles at one knot, and the failed try cost 30 s.
-constexpr std::size_t kLargestDualTouchingPart = 4096;
 // A tube is at least this many radii long.
 constexpr double kShortestTube = 0.25;
 // A stub is prolonged this many radii past its cut (vessel_ends' overshoot), and ends there in a
@@ -785,7 +780,7 @@ class TubeMesher {
     // dual contour, each vessel at its own step); else, or when the net's cut part is not the
     // union's shape, marching tetrahedra.
     std::optional<SurfaceMesh> net, tetrahedra;
-    if (o_.nets && (!c.touching || c.whole.size() + c.stubs.size() <= kLargestDualTouchingPart)) {
+    if (o_.nets) {
       const auto planes_asked = planes;
       const auto stubs_asked = stub_planes;
       // A net whose cut part is not the union's shape is dropped with the cuts it moved.
