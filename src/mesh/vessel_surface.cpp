@@ -1030,6 +1030,38 @@ std::optional<SurfaceMesh> dualContour(const VascularTree& t, const Lattice& lat
 }
 }  // namespace
 
+constexpr double kSpeckSteps = 0.25;
+
+std::int64_t removeSpecks(SurfaceMesh& m) {
+  if (m.vertex_step.size() != m.vertices.size()) return 0;
+  const auto component = componentOf(m);
+  const std::size_t nv = m.vertices.size();
+  std::vector<Vec3> lo(nv, Vec3(INFINITY, INFINITY, INFINITY)), hi(nv, Vec3(-INFINITY, -INFINITY, -INFINITY));
+  std::vector<double> step(nv, INFINITY);
+  std::vector<char> used(nv, 0);
+  for (const auto& t : m.triangles)
+    for (auto v : t) used[std::size_t(v)] = 1;
+  for (std::size_t v = 0; v < nv; ++v) {
+    if (!used[v]) continue;
+    const auto c = std::size_t(component[v]);
+    lo[c] = componentMin(lo[c], m.vertices[v]), hi[c] = componentMax(hi[c], m.vertices[v]);
+    step[c] = std::min(step[c], double(m.vertex_step[v]));
+  }
+  std::vector<char> speck(nv, 0);
+  std::int64_t removed = 0;
+  for (std::size_t c = 0; c < nv; ++c)
+    if (used[c] && component[c] == std::int32_t(c)) {
+      const Vec3 extent = hi[c] - lo[c];
+      speck[c] = std::max({extent.x, extent.y, extent.z}) < kSpeckSteps * step[c];
+      removed += speck[c];
+    }
+  if (removed == 0) return 0;
+  std::vector<char> keep(m.triangles.size());
+  for (std::size_t k = 0; k < m.triangles.size(); ++k) keep[k] = !speck[std::size_t(component[std::size_t(m.triangles[k][0])])];
+  keepTriangles(m, keep);
+  return removed;
+}
+
 double restoreVolumeAlongNormals(SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
   const auto [normal, weighted, area] = chordGaps(m, distance);
   double largest = 0;
@@ -1197,7 +1229,7 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
         const double moved = restoreVolumeAlongNormals(*dual, distance);
         if (report) report->largest_volume_move_mm = moved;
       }
-      const auto removed = removeCavities(*dual);
+      auto removed = removeCavities(*dual);
       if (!closedManifold(*dual)) {
         refused = "not a closed manifold";
       } else {
@@ -1244,6 +1276,7 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
           recheck();
         }
         if (!crossing.empty()) refused = "self-intersecting";
+        removed += removeSpecks(*dual);
       }
       if (!refused) {
         if (report)

@@ -81,6 +81,11 @@ double restoreVolumeAlongNormals(SurfaceMesh& m, const std::function<double(std:
 // use, both in their order; `renumber`: old vertex → new (−1 for dropped).
 void keepTriangles(SurfaceMesh& m, const std::vector<char>& keep, std::vector<std::int32_t>* renumber = nullptr);
 
+// Drops the closed components whose box is under a quarter of their finest vertex step across
+// (the union has no feature that small: every vessel is sampled at least once across): what
+// untangling leaves of a knot, its vertices drawn onto one point. Returns how many.
+std::int64_t removeSpecks(SurfaceMesh& m);
+
 // The area of m's triangle t (mm²).
 inline double triangleArea(const SurfaceMesh& m, const std::array<std::int32_t, 3>& t) {
   const Vec3& a = m.vertices[std::size_t(t[0])];
