@@ -120,26 +120,28 @@ std::vector<std::int32_t> crossingTriangles(const SurfaceMesh& m, const Vec3& or
       if (keys.empty() || keys.back() != e.key) keys.push_back(e.key);
     return keys;
   };
-  // With `dirty`, the triangles that can be in a pair to test: the dirty ones and those whose
-  // box reaches a bin of a dirty one's, at the triangle's own level or the dirty ones' coarsest.
+  // With `dirty`: per level l, the bins at l of the dirty triangles of level l or finer (only
+  // there can a pair to test lie); and the triangles that can be in one: the dirty ones and those
+  // whose box reaches such a bin, at their own level or the dirty ones' coarsest.
   std::vector<std::int32_t> candidates;
+  std::vector<std::vector<std::uint64_t>> dirty_keys(std::size_t(top + 1));
   if (dirty) {
     int dirty_top = -1;
     std::vector<std::size_t> dirty_list;
     for (std::size_t k = 0; k < nt; ++k)
       if ((*dirty)[k]) dirty_top = std::max(dirty_top, level[k]), dirty_list.push_back(k);
     if (dirty_list.empty()) return {};
-    std::vector<std::vector<std::uint64_t>> near(std::size_t(top + 1));
-    for (int l = dirty_top; l <= top; ++l) {
-      std::vector<Entry> marks;
-      for (const auto k : dirty_list) forBins(k, cell * double(std::int64_t(1) << l), [&](std::uint64_t key, std::uint8_t) { marks.push_back({key, 0, 0}); });
-      std::sort(marks.begin(), marks.end());
-      near[std::size_t(l)] = keysOf(marks);
+    for (int l = 0; l <= top; ++l) {
+      auto& keys = dirty_keys[std::size_t(l)];
+      for (const auto k : dirty_list)
+        if (level[k] <= l) forBins(k, cell * double(std::int64_t(1) << l), [&](std::uint64_t key, std::uint8_t) { keys.push_back(key); });
+      std::sort(keys.begin(), keys.end());
+      keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
     }
     for (std::size_t k = 0; k < nt; ++k) {
       bool take = (*dirty)[k] != 0;
       const int l = std::max(dirty_top, level[k]);
-      const auto& keys = near[std::size_t(l)];
+      const auto& keys = dirty_keys[std::size_t(l)];
       if (!take) forBins(k, cell * double(std::int64_t(1) << l), [&](std::uint64_t key, std::uint8_t) { take = take || std::binary_search(keys.begin(), keys.end(), key); });
       if (take) candidates.push_back(std::int32_t(k));
     }
@@ -149,24 +151,15 @@ std::vector<std::int32_t> crossingTriangles(const SurfaceMesh& m, const Vec3& or
   }
   std::vector<std::int32_t> found;
   std::vector<Entry> coarse, fine;
-  std::vector<std::uint64_t> dirty_keys;
   for (int l = 0; l <= top; ++l) {
     const double size = cell * double(std::int64_t(1) << l);
+    const auto& near = dirty_keys[std::size_t(l)];
+    if (dirty && near.empty()) continue;
     coarse.clear(), fine.clear();
-    if (dirty) {  // only bins that hold a dirty triangle can hold a pair to test
-      std::vector<Entry> marks;
-      for (const auto c : candidates) {
-        const auto k = std::size_t(c);
-        if (level[k] <= l && (*dirty)[k]) forBins(k, size, [&](std::uint64_t key, std::uint8_t) { marks.push_back({key, 0, 0}); });
-      }
-      if (marks.empty()) continue;
-      std::sort(marks.begin(), marks.end());
-      dirty_keys = keysOf(marks);
-    }
     for (const auto c : candidates)
       if (level[std::size_t(c)] == l)
         forBins(std::size_t(c), size, [&](std::uint64_t key, std::uint8_t starts) {
-          if (!dirty || std::binary_search(dirty_keys.begin(), dirty_keys.end(), key)) coarse.push_back({key, c, starts});
+          if (!dirty || std::binary_search(near.begin(), near.end(), key)) coarse.push_back({key, c, starts});
         });
     if (coarse.empty()) continue;
     std::sort(coarse.begin(), coarse.end());

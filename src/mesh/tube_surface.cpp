@@ -355,19 +355,19 @@ class TubeMesher {
     return endCutExtent(r, stepNear(r, o_.junction), true).beyond + (kStubOvershoot + 1) * r;
   }
   // Nodes joined into one contoured part: by vessels without a tube and by close pairs (through
-  // a connector: the nodes at its ends, where the two are cut); `joined` (if given): only by the
-  // vessels and the pairs that touch or overlap (the components of the part's union).
-  UnionFind partNodes(UnionFind* joined = nullptr) const {
+  // a connector: the nodes at its ends, where the two are cut); `apart` (if given): only by the
+  // vessels and the pairs that overlap (the components of the part's union, its contacts open).
+  UnionFind partNodes(UnionFind* apart = nullptr) const {
     UnionFind g(std::size_t(t_.nodeCount()));
     for (const auto& v : vessels_)
       if (!v.tube) {
         g.unite(v.node[0], v.node[1]);
-        if (joined) joined->unite(v.node[0], v.node[1]);
+        if (apart) apart->unite(v.node[0], v.node[1]);
       }
     for (const auto& pr : close_pairs_) {
       const auto ni = vessels_[std::size_t(pr.i)].node[pr.side_i], nj = vessels_[std::size_t(pr.j)].node[pr.side_j];
       g.unite(ni, nj);
-      if (joined && (pr.touching || pr.overlapping)) joined->unite(ni, nj);
+      if (apart && pr.overlapping) apart->unite(ni, nj);
     }
     return g;
   }
@@ -506,10 +506,11 @@ class TubeMesher {
 
   // Clusters: nodes joined by vessels without a tube and by close pairs; in the order of their
   // smallest node, so the mesh does not depend on the thread count. A part's union has as many
-  // components as its nodes have when only the vessels and the touching pairs join them.
+  // components as its nodes have when its vessels, its overlapping pairs and the contacts it
+  // closes join them (parts … parts_apart).
   std::vector<Cluster> buildClusters() {
-    UnionFind joined(std::size_t(t_.nodeCount()));
-    UnionFind g = partNodes(&joined);
+    UnionFind apart(std::size_t(t_.nodeCount()));
+    UnionFind g = partNodes(&apart);
     std::vector<char> touching_root(std::size_t(t_.nodeCount()), 0);
     for (const auto& pr : close_pairs_)
       if (pr.touching) touching_root[std::size_t(g.find(vessels_[std::size_t(pr.i)].node[0]))] = 1;
@@ -549,14 +550,7 @@ class TubeMesher {
         c.gap_spans.clear();
         c.touching = true;
       }
-    UnionFind apart(std::size_t(t_.nodeCount()));
-    for (const auto& v : vessels_)
-      if (!v.tube) apart.unite(v.node[0], v.node[1]);
     std::vector<std::vector<std::pair<std::int32_t, std::int32_t>>> contacts(out.size());
-    for (const auto& pr : close_pairs_) {
-      const auto ni = vessels_[std::size_t(pr.i)].node[pr.side_i], nj = vessels_[std::size_t(pr.j)].node[pr.side_j];
-      if (pr.overlapping) apart.unite(ni, nj);
-    }
     for (const auto& pr : close_pairs_) {
       const auto ni = vessels_[std::size_t(pr.i)].node[pr.side_i], nj = vessels_[std::size_t(pr.j)].node[pr.side_j];
       const auto c = slot[std::size_t(g.find(ni))];

@@ -528,6 +528,17 @@ std::vector<std::int32_t> componentOf(const SurfaceMesh& m) {
   return parent;
 }
 
+// Drops the components whose representative vertex (componentOf) is flagged in `drop`. Returns
+// how many.
+std::int64_t dropComponents(SurfaceMesh& m, const std::vector<std::int32_t>& component, const std::vector<char>& drop) {
+  const auto removed = std::int64_t(std::count(drop.begin(), drop.end(), 1));
+  if (removed == 0) return 0;
+  std::vector<char> keep(m.triangles.size());
+  for (std::size_t k = 0; k < m.triangles.size(); ++k) keep[k] = !drop[std::size_t(component[std::size_t(m.triangles[k][0])])];
+  keepTriangles(m, keep);
+  return removed;
+}
+
 // Drops the closed components that enclose a negative volume: pockets of outside space the grid
 // cannot resolve (a wedge between two vessels closed off between grid points), which the union
 // of a tree's vessels does not have. Returns how many.
@@ -535,13 +546,9 @@ std::int64_t removeCavities(SurfaceMesh& m) {
   const auto component = componentOf(m);
   std::vector<double> volume(m.vertices.size(), 0.0);  // per component representative: 6 × its signed volume
   for (const auto& t : m.triangles) volume[std::size_t(component[std::size_t(t[0])])] += dot(m.vertices[t[0]], cross(m.vertices[t[1]], m.vertices[t[2]]));
-  std::int64_t removed = 0;
-  for (std::size_t v = 0; v < volume.size(); ++v) removed += component[v] == std::int32_t(v) && volume[v] < 0;
-  if (removed == 0) return 0;
-  std::vector<char> keep(m.triangles.size());
-  for (std::size_t k = 0; k < m.triangles.size(); ++k) keep[k] = !(volume[std::size_t(component[std::size_t(m.triangles[k][0])])] < 0);
-  keepTriangles(m, keep);
-  return removed;
+  std::vector<char> drop(volume.size(), 0);
+  for (std::size_t v = 0; v < volume.size(); ++v) drop[v] = component[v] == std::int32_t(v) && volume[v] < 0;
+  return dropComponents(m, component, drop);
 }
 
 bool hasGapPartners(const SurfaceOptions& o, std::int32_t s) {
@@ -1048,18 +1055,12 @@ std::int64_t removeSpecks(SurfaceMesh& m) {
     step[c] = std::min(step[c], double(m.vertex_step[v]));
   }
   std::vector<char> speck(nv, 0);
-  std::int64_t removed = 0;
   for (std::size_t c = 0; c < nv; ++c)
     if (used[c] && component[c] == std::int32_t(c)) {
       const Vec3 extent = hi[c] - lo[c];
       speck[c] = std::max({extent.x, extent.y, extent.z}) < kSpeckSteps * step[c];
-      removed += speck[c];
     }
-  if (removed == 0) return 0;
-  std::vector<char> keep(m.triangles.size());
-  for (std::size_t k = 0; k < m.triangles.size(); ++k) keep[k] = !speck[std::size_t(component[std::size_t(m.triangles[k][0])])];
-  keepTriangles(m, keep);
-  return removed;
+  return dropComponents(m, component, speck);
 }
 
 double restoreVolumeAlongNormals(SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
@@ -1234,9 +1235,13 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
         refused = "not a closed manifold";
       } else {
         // Folds relaxed until no two triangles cross (the moved vertices back on the surface).
-        std::vector<std::int32_t> tree_of(dual->vertices.size(), 0);
-        for (std::size_t k = 0; k < dual->triangles.size(); ++k)
-          for (auto v : dual->triangles[k]) tree_of[std::size_t(v)] = dual->triangle_tree[k];
+        std::vector<std::int32_t> tree_of;
+        const auto treesOfVertices = [&] {
+          tree_of.assign(dual->vertices.size(), 0);
+          for (std::size_t k = 0; k < dual->triangles.size(); ++k)
+            for (auto v : dual->triangles[k]) tree_of[std::size_t(v)] = dual->triangle_tree[k];
+        };
+        treesOfVertices();
         std::vector<std::int32_t> crossing;
         // Checked again after a move only where it moved: the triangles at moved vertices and
         // those that crossed are dirty, the other pairs did not cross and stand.
@@ -1253,7 +1258,7 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
           crossing = crossingTriangles(*dual, lat.origin, h, false, &dirty);
         };
         for (int round = 0; round < kRelaxRounds; ++round) {
-          before = dual->vertices;
+          if (round > 0) before = dual->vertices;
           relax(*dual, tree_of, crossing, distance);
           if (round == 0)
             crossing = crossingTriangles(*dual, lat.origin, h);
@@ -1265,9 +1270,7 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
         // smoothed off the surface, within kUntangleOffset of a step.
         for (int round = 0; round < kUntangleRounds && !crossing.empty(); ++round) {
           if (removeThreeFans(*dual, crossing, dirty)) {
-            tree_of.assign(dual->vertices.size(), 0);
-            for (std::size_t k = 0; k < dual->triangles.size(); ++k)
-              for (auto v : dual->triangles[k]) tree_of[std::size_t(v)] = dual->triangle_tree[k];
+            treesOfVertices();
             crossing = crossingTriangles(*dual, lat.origin, h, false, &dirty);
             if (crossing.empty()) break;
           }
@@ -1276,7 +1279,7 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
           recheck();
         }
         if (!crossing.empty()) refused = "self-intersecting";
-        removed += removeSpecks(*dual);
+        else removed += removeSpecks(*dual);
       }
       if (!refused) {
         if (report)
