@@ -26,13 +26,13 @@ struct DecimateOptions {
 };
 
 struct DecimateReport {
-  std::int64_t before = 0, after = 0, collapses = 0, flips = 0, moves = 0;
+  std::int64_t before = 0, after = 0, collapses = 0, flips = 0, moves = 0, splits = 0;
   double largest_error_mm = 0;  // largest |distance| of a vertex placed
 
-  std::int64_t changes() const { return collapses + flips + moves; }
+  std::int64_t changes() const { return collapses + flips + moves + splits; }
   // Another pass over the same mesh: its changes added, its count of triangles the last.
   DecimateReport& operator+=(const DecimateReport& o) {
-    after = o.after, collapses += o.collapses, flips += o.flips, moves += o.moves;
+    after = o.after, collapses += o.collapses, flips += o.flips, moves += o.moves, splits += o.splits;
     largest_error_mm = std::max(largest_error_mm, o.largest_error_mm);
     return *this;
   }
@@ -44,6 +44,26 @@ struct DecimateReport {
 // others keep their order; `renumber`: old vertex → new, −1 for dropped).
 DecimateReport decimate(SurfaceMesh& m, const DecimateOptions& o, const std::function<double(std::int32_t, const Vec3&)>& distance,
                         std::vector<std::int32_t>* renumber = nullptr);
+
+// Remeshing's defaults: edges of this many steps (triangles of the nets' quads' area: a net's
+// vertex stands for a square of its step, an equilateral triangle's for √3/2 of its edge
+// squared), in this many rounds.
+constexpr double kRemeshTarget = 1.07;
+constexpr int kRemeshRounds = 5;
+
+// Isotropic remeshing (Botsch and Kobbelt 2004) of the wall's free vertices, `rounds` times:
+// edges longer than 4/3 of `target` × their ends' step split, shorter than 4/5 collapse, flips
+// that raise the smallest angle and flips towards valence 6, vertices moved towards their
+// neighbours' mean where that betters the worst triangle around them; every change under the
+// checks of decimation; then (o.sliver_deg) the slivers' and obtuse triangles' repair. The
+// surface nets' quads make pairs of right-angled triangles whose corners lie on each other's
+// circumsphere: TetGen's quality refinement splits nearly all of them, and every split costs it
+// a traversal of its queues. Boundary loops keep their order, their short edges collapsing into
+// the survivor, which stays. One worker (a contoured part at a time; the caller runs parts in
+// parallel). Appends the new vertices; `renumber` as for decimate (−1 for a loop's vertex that
+// went too).
+DecimateReport remeshIsotropic(SurfaceMesh& m, const DecimateOptions& o, double target, int rounds,
+                               const std::function<double(std::int32_t, const Vec3&)>& distance, std::vector<std::int32_t>* renumber = nullptr);
 
 // Slivers only (a triangle with an angle below o.sliver_deg), under the checks of decimation: an
 // edge collapses (the shortest first), else a cap's longest edge flips, else a corner moves to
