@@ -73,6 +73,11 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
                 "moved, under the same checks): TetGen splits every edge an obtuse angle faces; 0: none, else 90 ... 180 (default 90 "
                 "with --ends capped, else 0)")
       ->check(finiteIn(0, 180));
+  c->add_option("--remesh", a.remesh,
+                "1: remesh each contoured part isotropically to its local step (edges split, collapsed, flipped, vertices moved, under "
+                "the checks of --decimate), so TetGen's quality refinement leaves the surface whole; 0: not (default 1 with --ends capped "
+                "and without --decimate, else 0)")
+      ->check(CLI::IsMember({0, 1}));
   c->add_option("--clip-box", a.clip_box,
                 "X0,Y0,Z0,X1,Y1,Z1: clip the closed surface to this box (mm), each side's section filled flat (a hollow wall's lumen "
                 "stays open there: the printed block of seed 004)")
@@ -119,6 +124,7 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   p.max_error = a.max_error;
   p.sliver_angle = a.sliver_angle;
   p.max_angle = a.max_angle;
+  p.remesh = a.remesh;
   if (p.max_angle >= 0)  // given
     if (const auto why = maxAngleProblem(p.max_angle); !why.empty()) throw InputError("", 0, "--max-angle: " + why);
   if (p.ends == "closed" && p.flow_extension > 0) throw InputError("", 0, "--flow-extension needs --ends open or capped");

@@ -89,6 +89,7 @@ struct MeshArgs {
   double max_error = 0.1;
   double sliver_angle = -1;
   double max_angle = -1;
+  int remesh = -1;
   std::vector<double> clip_box;
   std::vector<std::string> formats;
   bool force = false;

@@ -72,6 +72,9 @@ const std::vector<MethodParam>& commonParams() {
       {"mesh", "max_angle", "degrees", "90 with capped ends, else 0",
        "with the sliver repair: contoured triangles with an angle above this are improved (the long edge flipped, a corner moved) under "
        "the same checks: a tetrahedral mesher splits the edge an obtuse angle faces; 0: none, else [90, 180)"},
+      {"mesh", "remesh", "true/false", "true with capped ends (without decimate), else false",
+       "tubes: each contoured part remeshed isotropically to its local step (long edges split, short ones collapsed, flips, moves, "
+       "under decimation's checks): the nets' right-angled triangle pairs are what TetGen's quality refinement splits"},
       {"mesh", "flow_extension", "radii", "0", "open/capped: each end prolonged straight by this many radii of its vessel before the cut (0 … 100)"},
       {"mesh", "clip_box", "[mm × 6]", "none",
        "[x0, y0, z0, x1, y1, z1]: the closed surface (closed or capped ends, or a hollow wall) clipped to this box, each side's section "

@@ -62,6 +62,8 @@ struct MeshParameters {
   double sliverAngle() const { return sliver_angle >= 0 ? sliver_angle : ends == "capped" ? 10 : 0; }
   double max_angle = -1;                    // degrees: with the sliver repair, contoured triangles with a larger angle are improved; −1: 90 with capped ends, else 0 (none)
   double maxAngle() const { return max_angle >= 0 ? max_angle : ends == "capped" ? 90 : 0; }
+  int remesh = -1;                          // tubes: contoured parts remeshed isotropically (1) or not (0); −1: with capped ends and without decimate
+  bool remeshes() const { return remesh >= 0 ? remesh == 1 : ends == "capped" && !decimate; }
   // mm: x0, y0, z0, x1, y1, z1 of a box the closed surface is clipped to, each side's section
   // filled (a hollow wall's lumen open there); empty: none
   std::vector<double> clip_box;

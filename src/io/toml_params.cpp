@@ -147,7 +147,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
 
   // [mesh]: the vessels' surface beside the graphs (src/mesh); the table's presence enables it.
   const auto& me = r.table("mesh", {"enabled", "method", "formats", "voxel_size", "junctions", "samples_across", "ring_spacing", "uniform", "on_surface", "ends",
-                                    "flow_extension", "decimate", "max_error", "sliver_angle", "max_angle", "wall_thickness", "wall_ratio", "wall_from_graph", "clip_box"});
+                                    "flow_extension", "decimate", "max_error", "sliver_angle", "max_angle", "remesh", "wall_thickness", "wall_ratio", "wall_from_graph", "clip_box"});
   if (const auto* n = root.get("mesh")) {
     auto& mp = sc.mesh;
     sc.mesh_line = r.lineOf(n);
@@ -193,6 +193,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
       mp.max_angle = r.number(me, "mesh", "max_angle");
       if (const auto why = maxAngleProblem(mp.max_angle); !why.empty()) throw InputError(file, r.lineOf(me.get("max_angle")), why);
     }
+    if (me.get("remesh")) mp.remesh = r.boolean(me, "remesh", false) ? 1 : 0;
     if (me.get("wall_thickness")) {
       mp.wall_thickness = r.quantity(me, "mesh", "wall_thickness", Dimension::Length, voxel_mm);
       checkRange(mp.wall_thickness, 0, false, 1e6, false, r.at(me, "wall_thickness"), "wall_thickness (mm)");

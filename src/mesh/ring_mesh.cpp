@@ -214,7 +214,7 @@ std::vector<char> verticesInPlanes(const SurfaceMesh& m, const std::vector<Vesse
 }
 
 void zipRings(SurfaceMesh& m, const Vec3& axis, const Vec3& u, const std::vector<std::int32_t>& A, const std::vector<std::int32_t>& B,
-              std::int32_t tree, std::int32_t face) {
+              std::int32_t tree, std::int32_t face, bool by_shape) {
   Vec3 e1, e2;
   frameOf(u, e1, e2);
   // Angles around the axis (not the ring's centroid: a contoured loop is star-shaped around the
@@ -244,7 +244,14 @@ void zipRings(SurfaceMesh& m, const Vec3& axis, const Vec3& u, const std::vector
   const auto b = [&](std::size_t j) { return B[(fb + j) % q]; };
   std::size_t i = 0, j = 0;
   while (i < p || j < q) {
-    const bool advance_a = j == q || (i < p && aa[i + 1] <= ab[j + 1]);
+    bool advance_a = j == q || (i < p && aa[i + 1] <= ab[j + 1]);
+    if (by_shape && i < p && j < q) {
+      // Either way the strip stays a strip (the diagonals a(i)–b(j) never cross): the shorter
+      // diagonal (Christiansen and Sederberg).
+      const double da = distance(m.vertices[std::size_t(a(i + 1))], m.vertices[std::size_t(b(j))]);
+      const double db = distance(m.vertices[std::size_t(a(i))], m.vertices[std::size_t(b(j + 1))]);
+      if (da != db) advance_a = da < db;
+    }
     if (advance_a) {
       m.triangles.push_back({a(i), a(i + 1), b(j)});
       ++i;

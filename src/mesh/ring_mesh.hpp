@@ -43,8 +43,9 @@ void frameOf(const Vec3& u, Vec3& e1, Vec3& e2);
 // and star-shaped around it: A nearer −u (or, in one plane, the outer one), B the other. From
 // the vertex of each at the smallest angle, always advancing on the ring whose next vertex comes
 // first around the axis; the triangles face away from the axis (in one plane: along u). Each
-// gets `tree` and `face`.
+// gets `tree` and `face`. `by_shape`: at each step the triangle whose largest angle is the
+// smaller (a contoured loop's irregular spacing makes obtuse triangles by the angles' order).
 void zipRings(SurfaceMesh& m, const Vec3& c, const Vec3& u, const std::vector<std::int32_t>& A, const std::vector<std::int32_t>& B,
-              std::int32_t tree, std::int32_t face = 0);
+              std::int32_t tree, std::int32_t face = 0, bool by_shape = false);
 
 }  // namespace angiosynth

@@ -170,7 +170,7 @@ struct ClusterMesh {
   EndCutReport ends;                     // for those, in that order
   double estimated_bytes = 0, step = 0;
   std::int64_t cavities_removed = 0;
-  DecimateReport decimation, slivers;
+  DecimateReport decimation, slivers, remeshing;
   std::int64_t contoured = 0;            // triangles contoured, with those cut away and contours made again
   int refinements = 0;                   // contoured again, finer, to lose a handle
   std::vector<double> planes;            // each stub's cut distance from its node, as made
@@ -733,7 +733,7 @@ class TubeMesher {
     so.vessel_gap_partners = gap_partners;
     EndCutReport cut;
     // Cut while the exact distance is at hand, then decimate (loops and caps stay where they are).
-    out.decimation = DecimateReport();
+    out.decimation = out.remeshing = DecimateReport();
     const std::size_t ns = c.stubs.size();
     std::vector<std::vector<std::int32_t>> loops;
     so.finish = [&](SurfaceMesh& mesh, const std::function<double(std::int32_t, const Vec3&)>& distance) {
@@ -763,10 +763,13 @@ class TubeMesher {
       // Decimated, or only its slivers repaired: the loops keep their vertices, renumbered.
       std::vector<std::int32_t> renumber;
       if (o_.decimate) out.decimation = decimate(mesh, o_.decimation, distance, &renumber);
+      else if (o_.remesh) out.remeshing = remeshIsotropic(mesh, o_.decimation, kRemeshTarget, kRemeshRounds, distance, &renumber);
       else if (repair) out.slivers += repairSlivers(mesh, o_.decimation, distance, &renumber, true);
       if (!renumber.empty())
-        for (auto& loop : loops)
+        for (auto& loop : loops) {
           for (auto& p : loop) p = renumber[std::size_t(p)];
+          std::erase(loop, -1);  // remeshing collapses the loops' short edges
+        }
     };
     // Surface nets where the part allows (about a third of the triangles), checked: on one
     // uniform grid where its radii are alike and no vessels touch, else (radii far apart, gaps
@@ -853,6 +856,25 @@ class TubeMesher {
     const double middle = std::pow(std::cos(step / 4), 2) / std::cos(step / 2);
     return 1 / std::sqrt(polygon * (face || !staggered() ? 1.0 : (1 + 2 * middle) / 3));
   }
+  // Rings from a contoured loop of `n_loop` vertices at y = `from` towards `n_ring`: each about
+  // 1.5 times fewer, an equilateral triangle's height of their mean spacing apart, the last one
+  // of n_ring; at most `room` (signed: the direction) from the loop; empty when the loop has not
+  // 1.3 times the ring's vertices or there is no room.
+  std::vector<std::pair<double, int>> graded(const Vessel& v, int n_loop, int n_ring, double from, double room) const {
+    std::vector<std::pair<double, int>> out;
+    if (n_loop <= 1.3 * n_ring) return out;
+    const double dir = room < 0 ? -1 : 1;
+    double y = from;
+    for (int n = n_loop; n != n_ring;) {
+      const int next = n > 1.3 * n_ring ? std::max(n_ring, int(std::lround(n / 1.5))) : n_ring;
+      y += dir * 0.5 * std::sqrt(3.0) * std::numbers::pi * v.radiusAt(y) * (1.0 / n + 1.0 / next);
+      if ((y - from) * dir > std::abs(room)) return {};
+      out.emplace_back(y, next);
+      n = next;
+    }
+    return out;
+  }
+
   // A ring of n vertices around the axis at distance y from a, its first at `phase` steps.
   void ring(SurfaceMesh& m, const Vessel& v, double y, int n, double phase, std::vector<std::int32_t>& out, bool face = false) const {
     Vec3 e1, e2;
@@ -970,6 +992,7 @@ class TubeMesher {
       rep.triangles_before_decimation += cm.decimation.before;
       rep.decimation_collapses += cm.decimation.collapses;
       rep.slivers_repaired += cm.slivers.changes();
+      rep.remesh_splits += cm.remeshing.splits, rep.remesh_changes += cm.remeshing.changes();
       rep.decimation_largest_error_mm = std::max(rep.decimation_largest_error_mm, cm.decimation.largest_error_mm);
       rep.estimated_bytes = std::max(rep.estimated_bytes, cm.estimated_bytes);
       rep.finest_step_mm = rep.finest_step_mm > 0 ? std::min(rep.finest_step_mm, cm.step) : cm.step;
@@ -1006,14 +1029,24 @@ class TubeMesher {
       // few degrees (a quarter of the tube's triangles were under 5°), so the first ring stands
       // kLoopBand radii from it.
       const bool band0 = !v.round[0] && v.end[0] < 0, band1 = !v.round[1] && v.end[1] < 0;  // a contoured loop at that side
-      const double lo = band0 ? std::min(y0 + kLoopBand * v.radiusAt(y0), y0 + (y1 - y0) / 3) : y0;
-      const double hi = band1 ? std::max(y1 - kLoopBand * v.radiusAt(y1), y1 - (y1 - y0) / 3) : y1;
+      // Remeshing, the loop's vertices thin out to the ring's over rings of fewer and fewer
+      // (graded()): fanned onto one ring, half its band's triangles were obtuse.
+      std::vector<std::pair<double, int>> graded0, graded1;  // (position, vertices) from the loop inwards
+      if (o_.remesh && band0) graded0 = graded(v, int(loops[i][0].size()), n_ring, y0, (y1 - y0) / 3);
+      if (o_.remesh && band1) graded1 = graded(v, int(loops[i][1].size()), n_ring, y1, -(y1 - y0) / 3);
+      const double lo = !band0 ? y0 : !graded0.empty() ? graded0.back().first : std::min(y0 + kLoopBand * v.radiusAt(y0), y0 + (y1 - y0) / 3);
+      const double hi = !band1 ? y1 : !graded1.empty() ? graded1.back().first : std::max(y1 - kLoopBand * v.radiusAt(y1), y1 - (y1 - y0) / 3);
       std::vector<double> at;
-      if (band0) at.push_back(lo);
+      std::vector<int> count;  // each ring's vertices
+      for (const auto& [y, n] : graded0) at.push_back(y), count.push_back(n);
+      if (band0 && graded0.empty()) at.push_back(lo), count.push_back(n_ring);
+      const std::size_t first_regular = at.size();
       const double spacing = (o_.ring_spacing_radii > 0 ? o_.ring_spacing_radii : kCfdRingSpacing * kTwoPi / n_ring) * 0.5 * (v.radiusAt(y0) + v.radiusAt(y1));
       const int pieces = std::max(1, int(std::ceil((hi - lo) / std::max(spacing, 1e-12))));
-      for (int q = 1; q < pieces; ++q) at.push_back(lo + (hi - lo) * q / pieces);
-      if (band1) at.push_back(hi);
+      for (int q = 1; q < pieces; ++q) at.push_back(lo + (hi - lo) * q / pieces), count.push_back(n_ring);
+      const std::size_t last_regular = at.size();
+      if (band1 && graded1.empty()) at.push_back(hi), count.push_back(n_ring);
+      for (auto g = graded1.rbegin(); g != graded1.rend(); ++g) at.push_back(g->first), count.push_back(g->second);
       // Ring j of the tube (0 at y0, at.size() + 1 at y1), turned by j half steps if staggered.
       const auto phase = [this](std::size_t j) { return ringPhase(j); };
       for (int k = 0; k < 2; ++k) {
@@ -1048,10 +1081,13 @@ class TubeMesher {
       }
       A = loops[i][0];
       for (std::size_t q = 0; q <= at.size(); ++q) {
-        // A ring next to a contoured loop has the circle's area itself: their band is no prismatoid.
-        if (q < at.size()) ring(m, v, at[q], n_ring, phase(q + 1), B, (band0 && q == 0) || (band1 && q + 1 == at.size()));
+        // A ring next to a contoured loop, and a graded one, has the circle's area itself: their
+        // bands are no prismatoids.
+        const bool graded_ring = q < first_regular ? !graded0.empty() : q >= last_regular && !graded1.empty();
+        if (q < at.size()) ring(m, v, at[q], count[q], phase(q + 1), B, (band0 && q == 0) || (band1 && q + 1 == at.size()) || graded_ring);
         else B = loops[i][1];
-        zipRings(m, v.a, v.u, A, B, v.tree);
+        const bool at_loop = (band0 && q == 0) || (band1 && q == at.size());
+        zipRings(m, v.a, v.u, A, B, v.tree, 0, o_.remesh && at_loop);
         A = B;
       }
     }

@@ -32,6 +32,7 @@ struct TubeSurfaceOptions {
   bool cap_ends = false;            // fill each end's loop with a planar cap (else left open)
   bool decimate = false;            // decimate each contoured part (its cut loops stay)
   bool nets = true;                 // contour parts by surface nets where they pass their checks (net_surface.hpp)
+  bool remesh = false;              // remesh each contoured part isotropically to its step (its cut loops stay; not with decimate)
   DecimateOptions decimation;
 };
 
@@ -52,6 +53,7 @@ struct TubeSurfaceReport {
   std::int64_t cavities_removed = 0;
   std::int64_t triangles_before_decimation = 0, decimation_collapses = 0;
   std::int64_t slivers_repaired = 0;  // collapses, flips and moves that repaired the contour's slivers
+  std::int64_t remesh_splits = 0, remesh_changes = 0;  // the remeshing's splits, and all its changes
   double decimation_largest_error_mm = 0;
   EndCutReport ends;                // per options.ends
 };

@@ -121,6 +121,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   to.decimate = p.decimate;
   to.decimation = d;
   to.nets = p.junctions == "nets";
+  to.remesh = p.remeshes();
   if (walls) {
     mesh = hollowWall(tree, to, wall, &wall_report, progress);
     tube_report = wall_report.outer;
@@ -195,6 +196,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"max_error_steps", p.max_error},
                     {"sliver_angle_deg", p.sliverAngle()},
                     {"max_angle_deg", p.maxAngle()},
+                    {"remesh", tubes && p.remeshes()},
                     {"description", tubes ? "each vessel's free middle a tube of rings on its exact wall (at most ring_spacing_radii radii "
                                             "apart, aligned; or ring_spacing_vertex_spacings apart, each turned by half a vertex spacing); where vessels meet, the signed distance to the union of their capsules and round cones "
                                             "contoured by surface nets on a uniform grid or on the octree (junctions = nets, where the part passes its checks) or "
@@ -232,6 +234,8 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                     {"decimation_collapses", reduced.collapses},
                     {"decimation_largest_error_mm", reduced.largest_error_mm},
                     {"slivers_repaired", tubes ? tube_report.slivers_repaired : slivers.changes()},
+                    {"remesh_splits", tube_report.remesh_splits},
+                    {"remesh_changes", tube_report.remesh_changes},
                     {"ends", ends.size()},
                     {"ends_cut", cut.cut},
                     {"ends_left_closed", cut.left_closed.size()},
