@@ -4,8 +4,10 @@
 // across), optionally decimated (--decimate 1) or with the contour's slivers repaired
 // (--slivers DEG: angles below DEG or edges under 0.35 of the step; 0, the default for closed ends, none; with
 // --max-angle DEG, angles above DEG improved: 90 is the default with capped ends), the tubes' rings at
-// most --ring-spacing R radii apart (default 8; 0: capped ends' 1.5 vertex spacings, staggered), at the automatic step or --voxel MM:
-//   bench_mesh FILE.toml ... [--tubes 0|1] [--samples N] [--decimate 0|1] [--slivers DEG] [--max-angle DEG] [--nets 0|1] [--ring-spacing R] [--voxel MM] [--threads T]
+// most --ring-spacing R radii apart (default 8; 0: capped ends' 1.5 vertex spacings, staggered), the contoured
+// parts remeshed isotropically (--remesh 1, the default with capped ends), at the automatic step or --voxel MM:
+//   bench_mesh FILE.toml ... [--tubes 0|1] [--samples N] [--decimate 0|1] [--slivers DEG] [--max-angle DEG] [--nets 0|1] [--ring-spacing R]
+//              [--remesh 0|1] [--voxel MM] [--threads T]
 // Prints the step, the time, triangles in all and per segment, and the peak memory.
 // Targets (issue 15): 10k segments ≤ 10 s, ≤ 4 GB, ≤ 500 triangles per segment; 100k ≤ 2 min.
 #include <cstdio>
@@ -37,7 +39,9 @@ int main(int argc, char** argv) {
   const bool nets = bench::takeOption(int(rest6.size()), rest6.data(), "--nets", 1, rest7) != 0;
   std::vector<char*> rest8;
   const double ring_spacing = bench::takeOption(int(rest7.size()), rest7.data(), "--ring-spacing", 8, rest8);
-  const auto args = bench::parseFileArgs(int(rest8.size()), rest8.data());
+  std::vector<char*> rest9;
+  const bool remesh = bench::takeOption(int(rest8.size()), rest8.data(), "--remesh", 0, rest9) != 0;
+  const auto args = bench::parseFileArgs(int(rest9.size()), rest9.data());
   std::printf("%-34s %9s %9s %10s %12s %10s %8s %9s\n", "file", "segments", "step mm", "mesh s", "triangles", "tri/seg", "genus0", "peak MiB");
   for (const auto& f : args.files) {
     const auto sc = readTomlParameters(f);
@@ -62,6 +66,7 @@ int main(int argc, char** argv) {
       to.decimation.obtuse_deg = max_angle;
       to.nets = nets;
       to.ring_spacing_radii = ring_spacing;
+      to.remesh = remesh;
       m = tubeSurface(t, to, &trep);
       rep.voxel_mm = trep.finest_step_mm;
     } else {
@@ -86,6 +91,7 @@ int main(int argc, char** argv) {
                   (long long)trep.contour_triangles, (long long)trep.contoured_triangles, (long long)trep.tube_triangles, (long long)trep.fallbacks, (long long)trep.cut_retries);
     if (tubes) std::printf(", netted parts %lld", (long long)trep.netted);
     if (tubes && slivers > 0) std::printf(", slivers repaired %lld", (long long)trep.slivers_repaired);
+    if (tubes && remesh) std::printf(", remeshed: %lld splits, %lld changes", (long long)trep.remesh_splits, (long long)trep.remesh_changes);
     if (tubes) std::printf(", rounds %lld (largest part meshed again: %lld vessels)", (long long)trep.rounds, (long long)trep.largest_remeshed);
     std::printf("\n");
   }
