@@ -20,6 +20,14 @@ struct Quadric {
     yy += w * n.y * n.y, yz += w * n.y * n.z, yw += w * n.y * d;
     zz += w * n.z * n.z, zw += w * n.z * d, ww += w * d * d;
   }
+  // Triangle abc's plane, weighted by its area (nothing for a degenerate one).
+  void addTriangle(const Vec3& a, const Vec3& b, const Vec3& c) {
+    const Vec3 n = cross(b - a, c - a);
+    const double area2 = norm(n);
+    if (!(area2 > 0)) return;
+    const Vec3 u = n / area2;
+    addPlane(u, -dot(u, a), 0.5 * area2);
+  }
   Quadric& operator+=(const Quadric& q) {
     xx += q.xx, xy += q.xy, xz += q.xz, xw += q.xw, yy += q.yy, yz += q.yz, yw += q.yw, zz += q.zz, zw += q.zw, ww += q.ww;
     return *this;
@@ -168,14 +176,12 @@ struct State {
         visited(mesh.triangles.size(), 0) {
     for (std::size_t k = 0; k < m.triangles.size(); ++k) {
       const auto& t = m.triangles[k];
-      const Vec3 n = cross(m.vertices[std::size_t(t[1])] - m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[2])] - m.vertices[std::size_t(t[0])]);
-      const double area2 = norm(n);
       for (auto v : t) around[std::size_t(v)].push_back(std::int32_t(k));
       if (!m.triangle_face.empty() && m.triangle_face[k] != 0)
         for (auto v : t) locked[std::size_t(v)] = 1;
-      if (!(area2 > 0)) continue;
-      const Vec3 u = n / area2;
-      for (auto v : t) quadric[std::size_t(v)].addPlane(u, -dot(u, m.vertices[std::size_t(t[0])]), 0.5 * area2);
+      Quadric q;
+      q.addTriangle(m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[1])], m.vertices[std::size_t(t[2])]);
+      for (auto v : t) quadric[std::size_t(v)] += q;
     }
     // A vertex on a boundary loop has one more neighbour than triangles.
     std::vector<std::int32_t> ring;
@@ -190,6 +196,31 @@ struct State {
   }
 
   void compact(std::vector<std::int32_t>* renumber) { keepTriangles(m, triangle_alive, renumber); }
+
+  // A new free vertex (remeshing's split), with every per-vertex record; its id.
+  std::int32_t addVertex(const Vec3& p, float step, std::int64_t in_block, std::vector<std::int32_t> triangles, const Quadric& q) {
+    m.vertices.push_back(p);
+    if (!m.vertex_step.empty()) m.vertex_step.push_back(step);
+    around.push_back(std::move(triangles));
+    quadric.push_back(q);
+    version.push_back(0);
+    vertex_alive.push_back(1);
+    locked.push_back(0);
+    boundary.push_back(0);
+    block.push_back(in_block);
+    if (!changed.empty()) changed.push_back(0);
+    return std::int32_t(m.vertices.size() - 1);
+  }
+  // A new wall triangle, with every per-triangle record; its id (the caller links its vertices).
+  std::int32_t addTriangle(const std::array<std::int32_t, 3>& t, std::int32_t tree) {
+    m.triangles.push_back(t);
+    m.triangle_tree.push_back(tree);
+    if (!m.triangle_face.empty()) m.triangle_face.push_back(0);
+    triangle_alive.push_back(1);
+    visited.push_back(0);
+    if (!failed.empty()) failed.push_back(0);
+    return std::int32_t(m.triangles.size() - 1);
+  }
 
   SurfaceMesh& m;
   const DecimateOptions& o;
@@ -277,10 +308,9 @@ class Worker {
   // step: edges longer than 4/3 of it split (longest first), edges shorter than 4/5 collapse
   // (shortest first, no edge left longer than 4/3; a boundary loop's too, into the survivor),
   // flips that raise the smallest angle, then flips towards valence 6, and every free vertex
-  // whose star changed moved towards its neighbours' mean where that betters its star's worst
-  // triangle. Each change under the checks of decimation. Serial: the caller's one block.
+  // moved towards its neighbours' mean where that betters its star's worst triangle. Each change
+  // under the checks of decimation. Serial: the caller's one block.
   void remeshRound(double target) {
-    active_.resize(m_.vertices.size(), 1);
     for (const bool split_pass : {true, false}) {
       edges_.clear();
       for (std::size_t k = 0; k < m_.triangles.size(); ++k) {
@@ -297,10 +327,7 @@ class Worker {
       for (const auto& e : edges_) {
         if (!vertex_alive_[std::size_t(e.a)] || !vertex_alive_[std::size_t(e.b)]) continue;
         if (split_pass) {
-          if (split(e.a, e.b)) {
-            ++splits;
-            for (auto k : around_.back()) activate(m_.triangles[std::size_t(k)]);
-          }
+          splits += split(e.a, e.b);
           continue;
         }
         const double len = distance(m_.vertices[std::size_t(e.a)], m_.vertices[std::size_t(e.b)]);
@@ -312,42 +339,20 @@ class Worker {
         collapse(u, v, w);
         largest_error = std::max(largest_error, error);
         ++collapses;
-        activateStar(u);
       }
     }
     // Flips that raise the smallest angle, then those that bring the valences nearer 6 (the nets'
     // and their splits' lattices of squares are fixed points of the angles' flips and of the
     // moves: only a change of valence breaks them).
-    for (const bool valence : {false, true}) {
-      valence_flip_ = valence;
+    for (const bool valence : {false, true})
       for (std::size_t k = 0; k < m_.triangles.size(); ++k)
         for (int i = 0; i < 3 && triangle_alive_[k]; ++i) {
           const auto a = m_.triangles[k][std::size_t(i)], b = m_.triangles[k][std::size_t((i + 1) % 3)];
           if (a > b || (valence && !betterValences(std::int32_t(k), a, b))) continue;
-          if (!flip(std::int32_t(k), a, b)) continue;
-          ++flips;
-          active_[std::size_t(a)] = active_[std::size_t(b)] = 1;
-          activate(m_.triangles[k]);
+          flips += flip(std::int32_t(k), a, b, false, valence);
         }
-      valence_flip_ = false;
-    }
-    // A vertex whose star has not changed since its move last failed would fail again.
-    for (std::size_t x = 0; x < m_.vertices.size(); ++x) {
-      if (!active_[x] || !vertex_alive_[x] || around_[x].empty()) continue;
-      active_[x] = 0;
-      if (!relax(std::int32_t(x), m_.triangle_tree[std::size_t(around_[x][0])], Aim::quality)) continue;
-      ++moves;
-      activateStar(std::int32_t(x));
-    }
-  }
-  // Remeshing: the vertices whose star changed since their last move was tried (a new vertex is).
-  std::vector<char> active_;
-  void activate(const std::array<std::int32_t, 3>& t) {
-    if (active_.size() < m_.vertices.size()) active_.resize(m_.vertices.size(), 1);
-    for (auto v : t) active_[std::size_t(v)] = 1;
-  }
-  void activateStar(std::int32_t v) {
-    for (auto k : around_[std::size_t(v)]) activate(m_.triangles[std::size_t(k)]);
+    for (std::size_t x = 0; x < m_.vertices.size(); ++x)
+      if (vertex_alive_[x] && !around_[x].empty() && relax(std::int32_t(x), m_.triangle_tree[std::size_t(around_[x][0])], Aim::quality)) ++moves;
   }
   std::int64_t splits = 0;
 
@@ -573,7 +578,6 @@ class Worker {
     bool operator<(const Edge& o) const { return key != o.key ? key < o.key : a != o.a ? a < o.a : b < o.b; }
   };
   std::vector<Edge> edges_;
-  bool valence_flip_ = false;     // flip(): judged by the caller's valences, not by the angles
   // The valence a vertex's triangles have in a regular mesh: 6 inside, 4 on a boundary loop.
   int valenceExcess(std::int32_t v, int change) const {
     return std::abs(int(around_[std::size_t(v)].size()) + (st_.boundary[std::size_t(v)] ? 1 : 0) + change - (st_.boundary[std::size_t(v)] ? 4 : 6));
@@ -622,41 +626,19 @@ class Worker {
     }
     if (cutsNear({a, b, c, d}, [&](const std::array<std::int32_t, 3>&, std::int32_t k) { return k == k1 || k == k2; })) return false;
     // x, and the triangles (x, b, c) and (x, a, d) after k1 = (a, x, c) and k2 = (b, x, d).
-    m_.vertices.push_back(x);
-    if (!m_.vertex_step.empty()) m_.vertex_step.push_back(float(step));
-    const std::int32_t k3 = std::int32_t(m_.triangles.size()), k4 = k3 + 1;
+    const std::int32_t k3 = st_.addTriangle(ids[1], tree), k4 = st_.addTriangle(ids[3], tree);
     for (auto& v : m_.triangles[std::size_t(k1)])
       if (v == b) v = xi;
     for (auto& v : m_.triangles[std::size_t(k2)])
       if (v == a) v = xi;
-    m_.triangles.push_back(ids[1]);
-    m_.triangles.push_back(ids[3]);
-    for (int i = 0; i < 2; ++i) {
-      m_.triangle_tree.push_back(tree);
-      if (!m_.triangle_face.empty()) m_.triangle_face.push_back(0);
-      triangle_alive_.push_back(1);
-      st_.visited.push_back(0);
-      if (!st_.failed.empty()) st_.failed.push_back(0);
-    }
+    Quadric q;
+    for (const auto& t : after) q.addTriangle(t[0], t[1], t[2]);
+    st_.addVertex(x, float(step), mine_, {k1, k3, k2, k4}, q);
     dropTriangle(a, k2), dropTriangle(b, k1);
     around_[std::size_t(a)].push_back(k4);
     around_[std::size_t(b)].push_back(k3);
     around_[std::size_t(c)].push_back(k3);
     around_[std::size_t(d)].push_back(k4);
-    around_.push_back({k1, k3, k2, k4});
-    Quadric q;
-    for (int i = 0; i < 4; ++i) {
-      const Vec3 ni = cross(after[i][1] - after[i][0], after[i][2] - after[i][0]);
-      const double area2 = norm(ni);
-      q.addPlane(ni / area2, -dot(ni / area2, after[i][0]), 0.5 * area2);
-    }
-    quadric_.push_back(q);
-    version_.push_back(0);
-    vertex_alive_.push_back(1);
-    locked_.push_back(0);
-    st_.boundary.push_back(0);
-    st_.block.push_back(mine_);
-    if (!st_.changed.empty()) st_.changed.push_back(0);
     largest_error = std::max(largest_error, error);
     return true;
   }
@@ -686,7 +668,9 @@ class Worker {
   // either old one, the centroids stay near the surface and nothing nearby is cut. A cap (k with
   // c nearly on a–b) has no normal to speak of: its flip is judged against the neighbour's alone,
   // and may cross a crease (the volume it moves is the cap's area times the crease's rise).
-  bool flip(std::int32_t k1, std::int32_t a, std::int32_t b, bool cap = false) {
+  // `by_valence` (remeshing; the caller judged the valences): the smallest angle need only stay
+  // above the floor or where it was.
+  bool flip(std::int32_t k1, std::int32_t a, std::int32_t b, bool cap = false, bool by_valence = false) {
     const std::int32_t k2 = across(k1, a, b);
     if (k2 < 0) return false;
     if (!m_.triangle_face.empty() && (m_.triangle_face[std::size_t(k1)] != 0 || m_.triangle_face[std::size_t(k2)] != 0)) return false;
@@ -697,8 +681,7 @@ class Worker {
     // The smallest angle must grow (by a margin: no flipping back and forth).
     const double old_cos = std::max(smallestAngleCosine(pa, pb, pc), smallestAngleCosine(pb, pa, pd));
     const double new_cos = std::max(smallestAngleCosine(pc, pa, pd), smallestAngleCosine(pd, pb, pc));
-    // (A remeshing's valence flip: the smallest angle stays above the floor or where it was.)
-    if (valence_flip_ ? !(new_cos <= std::max(cos_min_angle_, old_cos)) : !(new_cos < old_cos - 1e-3)) return false;
+    if (by_valence ? !(new_cos <= std::max(cos_min_angle_, old_cos)) : !(new_cos < old_cos - 1e-3)) return false;
     const Vec3 n1 = cross(pb - pa, pc - pa), n2 = cross(pa - pb, pd - pb), m1 = cross(pa - pc, pd - pc), m2 = cross(pb - pd, pc - pd);
     // Nearly flat pairs only: a flip across a crease moves the surface (and, on convex vessels,
     // always inwards: it would take volume).

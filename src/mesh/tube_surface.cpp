@@ -1036,17 +1036,21 @@ class TubeMesher {
       if (o_.remesh && band1) graded1 = graded(v, int(loops[i][1].size()), n_ring, y1, -(y1 - y0) / 3);
       const double lo = !band0 ? y0 : !graded0.empty() ? graded0.back().first : std::min(y0 + kLoopBand * v.radiusAt(y0), y0 + (y1 - y0) / 3);
       const double hi = !band1 ? y1 : !graded1.empty() ? graded1.back().first : std::max(y1 - kLoopBand * v.radiusAt(y1), y1 - (y1 - y0) / 3);
-      std::vector<double> at;
-      std::vector<int> count;  // each ring's vertices
-      for (const auto& [y, n] : graded0) at.push_back(y), count.push_back(n);
-      if (band0 && graded0.empty()) at.push_back(lo), count.push_back(n_ring);
-      const std::size_t first_regular = at.size();
+      // The rings between the ends: where, how many vertices, and whether the ring has the
+      // circle's area itself (next to a contoured loop, and graded: their bands are no prismatoids).
+      struct RingAt {
+        double y;
+        int n;
+        bool exact;
+      };
+      std::vector<RingAt> at;
+      for (const auto& [y, n] : graded0) at.push_back({y, n, true});
+      if (band0 && graded0.empty()) at.push_back({lo, n_ring, true});
       const double spacing = (o_.ring_spacing_radii > 0 ? o_.ring_spacing_radii : kCfdRingSpacing * kTwoPi / n_ring) * 0.5 * (v.radiusAt(y0) + v.radiusAt(y1));
       const int pieces = std::max(1, int(std::ceil((hi - lo) / std::max(spacing, 1e-12))));
-      for (int q = 1; q < pieces; ++q) at.push_back(lo + (hi - lo) * q / pieces), count.push_back(n_ring);
-      const std::size_t last_regular = at.size();
-      if (band1 && graded1.empty()) at.push_back(hi), count.push_back(n_ring);
-      for (auto g = graded1.rbegin(); g != graded1.rend(); ++g) at.push_back(g->first), count.push_back(g->second);
+      for (int q = 1; q < pieces; ++q) at.push_back({lo + (hi - lo) * q / pieces, n_ring, false});
+      if (band1 && graded1.empty()) at.push_back({hi, n_ring, true});
+      for (auto g = graded1.rbegin(); g != graded1.rend(); ++g) at.push_back({g->first, g->second, true});
       // Ring j of the tube (0 at y0, at.size() + 1 at y1), turned by j half steps if staggered.
       const auto phase = [this](std::size_t j) { return ringPhase(j); };
       for (int k = 0; k < 2; ++k) {
@@ -1081,10 +1085,7 @@ class TubeMesher {
       }
       A = loops[i][0];
       for (std::size_t q = 0; q <= at.size(); ++q) {
-        // A ring next to a contoured loop, and a graded one, has the circle's area itself: their
-        // bands are no prismatoids.
-        const bool graded_ring = q < first_regular ? !graded0.empty() : q >= last_regular && !graded1.empty();
-        if (q < at.size()) ring(m, v, at[q], count[q], phase(q + 1), B, (band0 && q == 0) || (band1 && q + 1 == at.size()) || graded_ring);
+        if (q < at.size()) ring(m, v, at[q].y, at[q].n, phase(q + 1), B, at[q].exact);
         else B = loops[i][1];
         const bool at_loop = (band0 && q == 0) || (band1 && q == at.size());
         zipRings(m, v.a, v.u, A, B, v.tree, 0, o_.remesh && at_loop);
