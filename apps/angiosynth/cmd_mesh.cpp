@@ -9,6 +9,7 @@
 #include "angiosynth/version.hpp"
 #include "commands.hpp"
 #include "core/error.hpp"
+#include "core/physical_ranges.hpp"
 #include "io/network_files.hpp"
 #include "io/staged_directory.hpp"
 #include "pipeline/mesh_outputs.hpp"
@@ -38,11 +39,11 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
   c->add_option("--wall-thickness", a.wall_thickness,
                 "a hollow wall of this thickness in mm around each vessel's lumen (seed 004): the wall's surface, outer side, lumen "
                 "and a flat ring at each open end")
-      ->check(finiteIn(0, 1e6));
+      ->check(finiteIn(0, physical::kMaxRadiusMm));
   c->add_option("--wall-ratio", a.wall_ratio, "a hollow wall of this share of each vessel's radius")->check(finiteIn(0, 100));
   c->add_flag("--wall-from-graph", a.wall_from_graph, "a hollow wall of each vessel's own thickness (the graph file's wall values)");
   c->add_option("--voxel", a.voxel_mm, "finest grid step in mm (default: the thinnest vessel's diameter / --samples-across)")
-      ->check(finiteIn(0, 1e6));
+      ->check(finiteIn(0, physical::kMaxStepMm));
   c->add_option("--samples-across", a.samples_across,
                 "grid steps across each vessel's thinnest end where it is contoured: each vessel is sampled at the coarsest step (the "
                 "finest times a power of 2) that keeps this many (default 3 with --method tubes, 4 with contour)")
@@ -98,8 +99,13 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   if (!fs::exists(in)) throw InputError(a.input, 0, "no such sample directory or graph file");
   const fs::path graph = fs::is_directory(in) ? in / "edges.csv" : in;
   if (!fs::exists(graph)) throw InputError(graph.string(), 0, "no such file: a sample directory holds the nodes.csv and edges.csv angiosynth generate writes");
-  const auto net = readNetwork(graph);
-  const fs::path out = a.out.empty() ? fs::path(in.lexically_normal().string() + "_mesh") : fs::path(a.out);
+  const auto net = readNetwork(graph, 1, memoryLimit(a.common));
+  refuseLargeJunctions(net, graph.string(), "mesh takes");
+  // By default beside the input, named after it: never inside it, whatever the path ends with
+  // ("sample/", "sample/.", ".").
+  fs::path named = fs::absolute(in).lexically_normal();
+  if (!named.has_filename()) named = named.parent_path();
+  const fs::path out = a.out.empty() ? named.parent_path() / (named.filename().string() + "_mesh") : fs::path(a.out);
   StagedDirectory dir(out, a.force ? ExistingOutput::ReplaceOwn : ExistingOutput::Refuse, {in});
   MeshParameters p;
   p.method = a.method;
@@ -114,6 +120,9 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
     throw InputError("", 0, "a hollow wall is built on the tubes; allowed: --method tubes");
   if (p.hollowWall() && a.ends == "capped")
     throw InputError("", 0, "a hollow wall keeps its ends open (the lumen runs through); allowed: --ends open (or closed, which opens them)");
+  if (a.voxel_mm > 0 && a.voxel_mm < physical::kMinStepMm)
+    throw InputError("", 0, "--voxel " + physical::shown(a.voxel_mm) + " mm is out of range; allowed: " + physical::shown(physical::kMinStepMm) + " to " +
+                                physical::shown(physical::kMaxStepMm) + " mm (0: the default)");
   p.voxel_mm = a.voxel_mm;
   p.samples_across = a.samples_across;
   p.uniform = a.uniform;

@@ -8,6 +8,8 @@
 
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "core/memory.hpp"
+#include "core/physical_ranges.hpp"
 #include "core/vessel_roles.hpp"
 #include "io/network_rows.hpp"
 #include "io/param_checks.hpp"
@@ -60,6 +62,18 @@ ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, 
   std::map<std::string, std::size_t> at;
   for (std::size_t k = 0; k < rows.size(); ++k)
     if (!at.emplace(rows[k].id, k).second) throw InputError(file, rows[k].line, "id " + rows[k].id + " is defined twice");
+  for (const auto& r : rows) {
+    const std::string of = (swc ? "sample " : "vessel ") + r.id;
+    if (!swc)
+      for (int a = 0; a < 3; ++a) physical::checkCoordinate(r.prox[a] * unit_mm, file, r.line, of + ": start coordinate");
+    for (int a = 0; a < 3; ++a) physical::checkCoordinate(r.dist[a] * unit_mm, file, r.line, of + (swc ? ": coordinate" : ": end coordinate"));
+    physical::checkRadius(r.radius * unit_mm, file, r.line, of + ": its radius", true);
+    if (r.radius_start != -1) physical::checkRadius(r.radius_start * unit_mm, file, r.line, of + ": its radius at the start", true);
+    for (const double w : {r.wall_start, r.wall})
+      if (!(w * unit_mm >= 0 && w * unit_mm <= physical::kMaxRadiusMm))
+        throw InputError(file, r.line, of + ": a wall thickness of " + physical::shown(w * unit_mm) + " mm is out of range; allowed: 0 (none) to " +
+                                           physical::shown(physical::kMaxRadiusMm) + " mm");
+  }
   std::vector<std::vector<std::size_t>> kids(rows.size());
   std::vector<std::size_t> roots;
   for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -80,6 +94,8 @@ ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, 
     t.radius[node] = r.radius * unit_mm;
     // A tapered vessel keeps its proximal radius (a cylinder's equals its radius: none).
     if (r.radius_start >= 0 && r.radius_start != r.radius) t.radius_start[node] = r.radius_start * unit_mm;
+    t.wall_start[node] = r.wall_start * unit_mm;
+    t.wall[node] = r.wall * unit_mm;
     t.outflow[node] = r.outflow;
     t.stage[node] = r.stage;
     t.role[node] = r.role;
@@ -137,6 +153,8 @@ ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, 
       if (node[k] < 0) throw InputError(file, rows[k].line, rows[k].id + " is not connected to a root: its parents form a cycle");
   for (std::int32_t i = 0; i < t.nodeCount(); ++i)
     if (!t.isRoot(i) && !(t.length[i] > 0) && !net.ids[i].empty()) throw InputError(file, net.lines[i], net.ids[i] + " has zero length");
+  if (t.segmentCount() == 0)
+    throw InputError(file, rows.front().line, "no vessel; allowed: a network of at least one vessel (two connected nodes)");
   return net;
 }
 
@@ -297,7 +315,6 @@ ExistingNetwork readSwc(const std::string& file, double unit_mm) {
     r.id = std::to_string(whole(file, l, 0, "sample id"));
     r.dist = Vec3(number(file, l, 2, "x"), number(file, l, 3, "y"), number(file, l, 4, "z"));
     r.radius = number(file, l, 5, "radius");
-    if (!(r.radius >= 0)) throw InputError(file, l.number, "radius must not be negative");
     const auto parent = whole(file, l, 6, "parent id");
     if (parent != -1) r.parent = std::to_string(parent);
     rows.push_back(r);
@@ -325,15 +342,49 @@ int vitaFunction(std::uint8_t r) {
 }  // namespace
 }  // namespace network_detail
 
-ExistingNetwork readNetwork(const std::filesystem::path& file, double unit_mm) {
+void refuseLargeJunctions(const ExistingNetwork& net, const std::string& file, const std::string& use) {
+  const auto& t = net.tree;
+  std::vector<std::int32_t> kids;
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    // Only the first node of a junction: its links follow it (a bifurcation has none).
+    if (t.isLink(i) || t.child1[i] < 0 || !(t.isLink(t.child0[i]) || t.isLink(t.child1[i]))) continue;
+    kids.clear();
+    t.junctionChildren(i, kids);
+    if (kids.size() > std::size_t(physical::kMaxJunctionChildren))
+      throw InputError(file, net.lines[std::size_t(i)], "node " + (net.ids[std::size_t(i)].empty() ? std::to_string(i) : net.ids[std::size_t(i)]) +
+                                                           " has " + std::to_string(kids.size()) + " children; " + use + " at most " +
+                                                           std::to_string(physical::kMaxJunctionChildren) +
+                                                           " (a vascular junction has two to four; a node of many is a skeletonisation artefact: split it)");
+  }
+}
+
+ExistingNetwork readNetwork(const std::filesystem::path& file, double unit_mm, std::uint64_t memory_limit) {
   auto ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   using namespace network_detail;
+  if (memory_limit == 0) memory_limit = defaultMemoryLimitBytes();
+  if (ext != ".vtp") {
+    // A text row of a vessel takes 16 bytes or more (a CSV pair: both files).
+    std::error_code ec;
+    std::uint64_t bytes = std::filesystem::file_size(file, ec);
+    if (ext == ".csv") {
+      const std::string name = file.filename().string();
+      for (const auto& [from, to] : {std::pair{"nodes", "edges"}, {"edges", "nodes"}})
+        if (const auto at = name.rfind(from); at != std::string::npos) {
+          bytes += std::filesystem::file_size(file.parent_path() / (name.substr(0, at) + to + name.substr(at + 5)), ec);
+          break;
+        }
+    }
+    const std::uint64_t need = (bytes / 16 + 1) * kNetworkBytesPerVessel;
+    if (!ec && need > memory_limit)
+      throw InputError(file.string(), 0, "a network file of " + formatBytes(bytes) + " needs up to " + formatBytes(need) +
+                                             " to read, more than the limit of " + formatBytes(memory_limit) + "; raise --memory-limit");
+  }
   if (ext == ".cco") return readCco(file.string(), unit_mm);
   if (ext == ".swc") return readSwc(file.string(), unit_mm);
   if (ext == ".gxl") return readGxl(file.string(), unit_mm);
   if (ext == ".csv") return readCsv(file.string(), unit_mm);
-  if (ext == ".vtp") return readVtp(file.string(), unit_mm);
+  if (ext == ".vtp") return readVtp(file.string(), unit_mm, memory_limit);
   throw InputError(file.string(), 0, "unknown network format '" + ext + "'; allowed: .cco (VItA), .swc, .gxl, .csv (nodes and edges), .vtp");
 }
 

@@ -20,11 +20,23 @@ struct ExistingNetwork {
   double flow = 0, reference_pressure = 0, root_radius = 0;
 };
 
-// Reads `file` by its extension (.cco, .swc); lengths are multiplied by `unit_mm`. Throws
-// InputError (file:line) for malformed rows, unknown ids, cycles and vessels that do not start
-// where their parent ends. A node of m ≥ 3 children becomes a chain of m − 2 links at its point
-// (VascularTree::isLink).
-ExistingNetwork readNetwork(const std::filesystem::path& file, double unit_mm = 1);
+// Reads `file` by its extension (.cco, .swc, .gxl, .csv, .vtp); lengths are multiplied by
+// `unit_mm`. Throws InputError (file:line) for malformed rows, unknown ids, cycles, vessels that
+// do not start where their parent ends and values beyond the physical ranges. A node of m ≥ 3
+// children becomes a chain of m − 2 links at its point (VascularTree::isLink). The network's
+// memory is estimated from the file's size (or a VTP's declared counts, before any array is
+// decoded) and refused beyond `memory_limit` bytes (0: 75 % of physical memory).
+ExistingNetwork readNetwork(const std::filesystem::path& file, double unit_mm = 1, std::uint64_t memory_limit = 0);
+
+// Throws InputError (file:line of the node) for a node of more than kMaxJunctionChildren
+// children (core/physical_ranges.hpp). The readers take any; what walks a junction's chain of
+// links for each of its vessels (growth from an [initial] network, meshing) refuses them up
+// front. `use` begins the allowed part ("growth from an initial network takes").
+void refuseLargeJunctions(const ExistingNetwork& net, const std::string& file, const std::string& use);
+
+// What one vessel of a network costs while it is read and assembled (its row, its id, the
+// tree's arrays), in bytes: the readers' memory estimates multiply this.
+inline constexpr std::uint64_t kNetworkBytesPerVessel = 1024;
 
 // VItA's .cco layout: *Tree (root point, inflow, 0, pressure drop, terminals, terminal pressure,
 // vessels, root radius, viscosity tolerance), *Vessels (one row per segment: id, proximal and

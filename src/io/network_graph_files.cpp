@@ -74,7 +74,9 @@ ExistingNetwork readGxl(const std::string& file, double unit_mm) {
     const auto* radius = gxlAttr(e, "radius");
     if (!radius) throw InputError(file, s.row.line, "edge " + s.row.id + " has no 'radius' attribute (mm)");
     s.row.radius = finite(file, radius->GetLineNum(), radius->GetText(), "radius");
-    if (!(s.row.radius >= 0)) throw InputError(file, radius->GetLineNum(), "radius must not be negative");
+    // A tapered vessel and its wall, as angiosynth writes them.
+    for (const auto& [name, to] : {std::pair{"radius_start", &s.row.radius_start}, {"wall_start", &s.row.wall_start}, {"wall", &s.row.wall}})
+      if (const auto* a = gxlAttr(e, name)) *to = finite(file, a->GetLineNum(), a->GetText(), name);
     if (const auto* st = gxlAttr(e, "stage")) {
       const double v = finite(file, st->GetLineNum(), st->GetText(), "stage");
       if (v != std::floor(v) || v < -1 || v > 30000) throw InputError(file, st->GetLineNum(), "stage must be an integer in [-1, 30000]");
@@ -154,7 +156,8 @@ ExistingNetwork readCsv(const std::string& file, double unit_mm) {
   }
   const int eid = edges.column("id", false), from = edges.column("node1id", true), to = edges.column("node2id", true),
             radius = edges.column("radius", true), stage = edges.column("stage", false), role = edges.column("role", false),
-            branching = edges.column("branching", false), radius_start = edges.column("radius_start", false);
+            branching = edges.column("branching", false), radius_start = edges.column("radius_start", false),
+            wall_start = edges.column("wall_start", false), wall = edges.column("wall", false);
   std::vector<PointSegment> segments;
   for (const auto& [line, c] : edges.rows) {
     const auto& f = edges.file;
@@ -167,11 +170,9 @@ ExistingNetwork readCsv(const std::string& file, double unit_mm) {
       *at = p->second;
     }
     s.row.radius = finite(f, line, c[radius].c_str(), "radius");
-    if (!(s.row.radius >= 0)) throw InputError(f, line, "radius must not be negative");
-    if (radius_start >= 0) {
-      s.row.radius_start = finite(f, line, c[radius_start].c_str(), "radius_start");
-      if (!(s.row.radius_start >= 0)) throw InputError(f, line, "radius_start must not be negative");
-    }
+    if (radius_start >= 0) s.row.radius_start = finite(f, line, c[radius_start].c_str(), "radius_start");
+    if (wall_start >= 0) s.row.wall_start = finite(f, line, c[wall_start].c_str(), "wall_start");
+    if (wall >= 0) s.row.wall = finite(f, line, c[wall].c_str(), "wall");
     if (stage >= 0) {
       const double v = finite(f, line, c[stage].c_str(), "stage");
       if (v != std::floor(v) || v < -1 || v > 30000) throw InputError(f, line, "stage must be an integer in [-1, 30000]");

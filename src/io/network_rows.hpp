@@ -15,13 +15,16 @@ struct Row {
   Vec3 prox, dist;     // .cco: both ends; SWC: dist only
   double radius = 0, outflow = 0;
   double radius_start = -1;  // a tapered vessel's radius at its proximal end (CSV column radius_start); -1: none
+  double wall_start = 0, wall = 0;  // its wall thickness at the proximal and distal end (0: none given)
   std::int16_t stage = -1;
   std::uint8_t role = 0, branching = 0;
   int line = 0;
 };
 
 // Builds the tree breadth-first from the roots in file order. `swc`: a root row is a root node
-// (no segment); else a root row is a root vessel whose proximal point is the root node.
+// (no segment); else a root row is a root vessel whose proximal point is the root node. Every
+// reader's values meet the physical ranges here (core/physical_ranges.hpp), in mm: coordinates,
+// radii (0: not given), walls, and at most kMaxJunctionChildren children per node.
 ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, bool swc, double unit_mm);
 
 // A vessel of a graph file (GXL, CSV, VTP): the indices of its end points, proximal first, and
@@ -44,6 +47,6 @@ std::uint8_t branchingFromVita(const std::string& file, int line, long long code
 
 ExistingNetwork readGxl(const std::string& file, double unit_mm);
 ExistingNetwork readCsv(const std::string& file, double unit_mm);
-ExistingNetwork readVtp(const std::string& file, double unit_mm);
+ExistingNetwork readVtp(const std::string& file, double unit_mm, std::uint64_t memory_limit);
 
 }  // namespace angiosynth::network_detail

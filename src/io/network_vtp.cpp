@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/memory.hpp"
 #include "io/network_rows.hpp"
 
 namespace angiosynth::network_detail {
@@ -274,13 +275,23 @@ class VtpFile {
 
 }  // namespace
 
-ExistingNetwork readVtp(const std::string& file, double unit_mm) {
+ExistingNetwork readVtp(const std::string& file, double unit_mm, std::uint64_t memory_limit) {
   const VtpFile vtp(file);
   const auto* piece = vtp.piece();
   const auto points_n = piece->Unsigned64Attribute("NumberOfPoints", 0), lines_n = piece->Unsigned64Attribute("NumberOfLines", 0);
   if (lines_n == 0) throw InputError(file, piece->GetLineNum(), "no lines: a network is the Piece's Lines");
   if (points_n > 50'000'000 || lines_n > 50'000'000)
     throw InputError(file, piece->GetLineNum(), "more than 5e7 points or lines; allowed: up to 5e7 (a vascular network, not a mesh)");
+  // Compressed arrays expand up to a thousandfold: the counts the Piece declares are checked
+  // against the limit before any array is decoded (a point: its coordinates, its node; a line: a
+  // vessel at least).
+  const auto refuseBeyondLimit = [&](std::uint64_t need) {
+    if (need > memory_limit)
+      throw InputError(file, piece->GetLineNum(), "the Piece declares " + std::to_string(points_n) + " points and " + std::to_string(lines_n) +
+                                                      " lines, which need about " + formatBytes(need) + " to read, more than the limit of " +
+                                                      formatBytes(memory_limit) + "; raise --memory-limit");
+  };
+  refuseBeyondLimit(points_n * 256 + lines_n * (kNetworkBytesPerVessel + 64));
   const auto* pts = vtp.array("Points", nullptr);
   if (!pts) throw InputError(file, piece->GetLineNum(), "no <Points> array");
   const auto xyz = vtp.values(pts, 3 * points_n);
@@ -291,6 +302,7 @@ ExistingNetwork readVtp(const std::string& file, double unit_mm) {
   const double ends = offsets.back();
   if (!(ends >= 2 && ends <= 2.0 * double(points_n) + 2 * double(lines_n) && ends == std::floor(ends)))
     throw InputError(file, offs->GetLineNum(), "the last offset must be the connectivity's length: a whole number, at most one point per line and point");
+  refuseBeyondLimit(points_n * 256 + lines_n * 64 + std::uint64_t(ends) * (kNetworkBytesPerVessel + 8));
   const auto connectivity = vtp.values(conn, std::size_t(ends));
   // Coincident points are one node (VItA writes each vessel's own two points).
   std::map<std::array<double, 3>, std::size_t> node_of;
@@ -322,6 +334,9 @@ ExistingNetwork readVtp(const std::string& file, double unit_mm) {
   const auto [role, role_name] = cellArray({"Role", "vesselFunction"});
   const auto [branching, branching_name] = cellArray({"Branching", "branchingType"});
   const auto [vessel_id, id_name] = cellArray({"ID_Vessel"});
+  const auto [radius_start, radius_start_name] = cellArray({"RadiusStart"});
+  const auto [wall_start, wall_start_name] = cellArray({"WallStart"});
+  const auto [wall, wall_name] = cellArray({"Wall"});
   const int line = conn->GetLineNum();
   const auto whole = [&](double v, const char* what, std::size_t c) {
     if (v != std::floor(v) || std::abs(v) > 1e15)
@@ -361,6 +376,9 @@ ExistingNetwork readVtp(const std::string& file, double unit_mm) {
       }
     }
     const auto last = std::size_t(end);
+    if (last - begin > 2 && (radius_start_name || wall_start_name))
+      throw InputError(file, line, "line " + std::to_string(c) + " has " + std::to_string(last - begin) +
+                                       " points and a RadiusStart or WallStart: a tapered vessel is a line of two points");
     for (std::size_t k = begin; k + 1 < last; ++k) {
       const double a = connectivity[k], b = connectivity[k + 1];
       if (!(a >= 0 && b >= 0 && a < double(points_n) && b < double(points_n)))
@@ -368,7 +386,9 @@ ExistingNetwork readVtp(const std::string& file, double unit_mm) {
       s.from = node[std::size_t(a)];
       s.to = node[std::size_t(b)];
       s.row.radius = radius_name ? radius[c] : point_radius[std::size_t(b)];
-      if (!(s.row.radius >= 0)) throw InputError(file, line, "line " + std::to_string(c) + ": radius must not be negative");
+      if (radius_start_name) s.row.radius_start = radius_start[c];
+      if (wall_start_name) s.row.wall_start = wall_start[c];
+      if (wall_name) s.row.wall = wall[c];
       s.row.id = last - begin == 2 ? base : base + "." + std::to_string(k - begin);
       segments.push_back(s);
     }

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/physical_ranges.hpp"
 #include "core/vec3.hpp"
 
 namespace angiosynth {
@@ -31,6 +32,15 @@ inline void checkRange(double v, double lo, bool lo_open, double hi, bool hi_ope
                          (std::isinf(hi) ? "inf" : show(hi)) + (hi_open ? ")" : "]"));
 }
 
+// A name the program writes into graph files, file names and tables (a tree's id or kind): 1 to
+// 60 letters, digits, '_', '-' and '.', so GXL, GraphML, DOT and CSV take it as it is. Returns
+// what is wrong, or "".
+inline std::string nameProblem(const std::string& name, const std::string& what) {
+  static const char* kAllowed = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.";
+  if (!name.empty() && name.size() <= 60 && name.find_first_not_of(kAllowed) == std::string::npos) return {};
+  return what + " '" + name + "'; allowed: 1 to 60 letters, digits, '_', '-' and '.' (it names the tree in graph files)";
+}
+
 // The growth and physics limits, in one place for both formats.
 struct Limits {
   static constexpr double kMaxTerminals = 5e6;
@@ -39,8 +49,9 @@ struct Limits {
   static constexpr double kMaxCostExponent = 10;                // λ, μ in [0, 10]
   // Finite, physically generous bounds: far beyond any vessel, small enough that no product of
   // them overflows a double or a grid index.
-  static constexpr double kMinVoxel = 1e-4, kMaxVoxel = 1e4;    // mm: 0.1 µm to 10 m
-  static constexpr double kMaxLength = 1e6;                     // mm: lengths, distances, fields of view
+  static constexpr double kMinVoxel = physical::kMinStepMm, kMaxVoxel = physical::kMaxStepMm;  // mm
+  static constexpr double kMaxLength = physical::kMaxLengthMm;  // mm: lengths, distances, fields of view
+  static constexpr double kMinRadius = physical::kMinRadiusMm, kMaxRadius = physical::kMaxRadiusMm;  // mm
   static constexpr double kMaxVoxelsPerAxis = 1e5;
   static constexpr double kMinViscosity = 1e-6, kMaxViscosity = 1e3;  // Pa*s (blood: 3.6e-3)
   static constexpr double kMaxPressure = 1e8;                   // Pa (1000 bar)

@@ -196,7 +196,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     if (me.get("remesh")) mp.remesh = r.boolean(me, "remesh", false) ? 1 : 0;
     if (me.get("wall_thickness")) {
       mp.wall_thickness = r.quantity(me, "mesh", "wall_thickness", Dimension::Length, voxel_mm);
-      checkRange(mp.wall_thickness, 0, false, 1e6, false, r.at(me, "wall_thickness"), "wall_thickness (mm)");
+      checkRange(mp.wall_thickness, 0, false, Limits::kMaxRadius, false, r.at(me, "wall_thickness"), "wall_thickness (mm)");
     }
     if (me.get("wall_ratio")) {
       mp.wall_ratio = r.number(me, "mesh", "wall_ratio");

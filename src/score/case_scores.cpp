@@ -355,7 +355,7 @@ Json scoreCase(const std::filesystem::path& pred_file, const TruthFiles& files, 
   }
   j["calibre"] = calibreRecall(p, t, centre.values, radius.values, opt.bins_voxels, voxel, "voxels");
   if (!opt.bins_mm.empty()) j["calibre_mm"] = calibreRecall(p, t, centre.values, radius.values, opt.bins_mm, 1.0, "mm");
-  if (!files.edges.empty()) j["vessels"] = vesselDetection(p, readNetwork(files.edges).tree);
+  if (!files.edges.empty()) j["vessels"] = vesselDetection(p, readNetwork(files.edges, 1, opt.memory_limit).tree);
   if (!files.classes.empty() && files.legend.size() >= 2) {
     const NiftiVolume cls = readNiftiVolume(files.classes, opt.memory_limit, kBytesPerVoxel, "the truth classes");
     checkSameGrid(cls, truth, files.classes.string(), mask_file.string());

@@ -92,7 +92,7 @@ std::vector<RegionSpec> readRegions(const TomlReader& r, const GrowthMethod& m, 
   return out;
 }
 
-InitialNetwork readInitialNetwork(const TomlReader& r, const GrowthMethod& m, const toml::node& node) {
+InitialNetwork readInitialNetwork(const TomlReader& r, const GrowthMethod& m, const toml::node& node, bool flat) {
   const auto* t = node.as_table();
   if (!t) throw InputError(r.file(), r.lineOf(&node), "initial must be a table: [initial] file = \"tree.swc\"");
   checkMethodKeys(r, m, *t, "initial");
@@ -101,6 +101,17 @@ InitialNetwork readInitialNetwork(const TomlReader& r, const GrowthMethod& m, co
   const auto unit = choice<double>(r, *t, "initial", "unit", 1.0, {{"mm", 1.0}, {"cm", 10.0}, {"m", 1000.0}, {"um", 1e-3}});
   in.from_corner = choice<bool>(r, *t, "initial", "origin", false, {{"centre", false}, {"corner", true}});
   in.network = readNetwork(in.file, unit);
+  refuseLargeJunctions(in.network, in.file.string(), "growth from an initial network takes");
+  if (flat) {
+    const auto& t = in.network.tree;
+    const double z0 = t.position.front().z;
+    for (std::int32_t i = 0; i < t.nodeCount(); ++i)
+      if (std::abs(t.position[i].z - z0) > 1e-9 * (1 + std::abs(z0)))
+        throw InputError(in.file.string(), in.network.lines[std::size_t(i)],
+                         "node " + (in.network.ids[std::size_t(i)].empty() ? std::to_string(i) : in.network.ids[std::size_t(i)]) + " has z = " +
+                             show(t.position[i].z) + " mm where the first has " + show(z0) +
+                             " mm; a 2D domain takes a network in one plane: allowed: every node at the same z");
+  }
   return in;
 }
 

@@ -24,7 +24,8 @@ struct InitialNetwork {
   ExistingNetwork network;
   bool from_corner = false;
 };
-InitialNetwork readInitialNetwork(const TomlReader& r, const GrowthMethod& m, const toml::node& node);
+// `flat`: the domain is 2D, so the network must lie in one plane (its common z is dropped).
+InitialNetwork readInitialNetwork(const TomlReader& r, const GrowthMethod& m, const toml::node& node, bool flat);
 
 // The [[region]] declarations (`used_by` says which keys name regions), appended to `rows`.
 std::vector<MethodParam> withRegionParams(std::vector<MethodParam> rows, const char* used_by);

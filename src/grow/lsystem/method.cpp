@@ -131,7 +131,7 @@ void readGrammar(const TomlReader& r, const GrowthMethod& m, const toml::table& 
   g.iterations = declaredCount(r, m, tree, "tree", "iterations", 0, 20);
   if (tree.get("root_diameter")) {
     s.root_diameter_mm = r.quantity(tree, "tree", "root_diameter", Dimension::Length, s.voxel_mm);
-    checkRange(s.root_diameter_mm, 0, true, Limits::kMaxLength, false, r.at(tree, "root_diameter"), "root_diameter (mm)");
+    checkRange(s.root_diameter_mm, 2 * Limits::kMinRadius, false, 2 * Limits::kMaxRadius, false, r.at(tree, "root_diameter"), "root_diameter (mm)");
   }
   const auto number = [&](const char* key, double lo, bool lo_open, double hi, bool hi_open) {
     const double v = declaredNumber(r, m, tree, "tree", key);
