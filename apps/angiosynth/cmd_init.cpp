@@ -1,11 +1,11 @@
 // `angiosynth params [METHOD]` and `angiosynth init [METHOD] FILE`: the key reference and a
 // template that runs as it is, from the program itself.
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 
 #include "commands.hpp"
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 #include "io/common_params.hpp"
 
 namespace angiosynth::cli {
@@ -18,19 +18,13 @@ const GrowthMethod& methodNamed(const std::string& name) {
   return *m;
 }
 
-// Never replaces a file: a template is a starting point, not an output to refresh.
+// Never replaces a file: a template is a starting point, not an output to refresh. Written
+// whole through an exclusively created temporary, and moved into place only if the name is
+// still free then.
 void writeNew(const std::filesystem::path& file, const std::string& text) {
-  if (std::filesystem::exists(file)) throw InputError(file.string(), 0, "exists; init writes new files only (choose another name)");
-  const std::filesystem::path tmp = file.string() + ".tmp-angiosynth";
-  {
-    std::ofstream o(tmp, std::ios::binary);
-    o << text;
-    if (!o.flush()) {
-      std::filesystem::remove(tmp);
-      throw InputError(file.string(), 0, "cannot write");
-    }
-  }
-  std::filesystem::rename(tmp, file);
+  if (std::filesystem::exists(std::filesystem::symlink_status(file)))
+    throw InputError(file.string(), 0, "exists; init writes new files only (choose another name)");
+  writeFileAtomically(file, text, /*replace=*/false);
 }
 
 }  // namespace
@@ -57,6 +51,8 @@ CLI::App* addInit(CLI::App& app, InitArgs& a) {
 int runInit(const InitArgs& a) {
   const std::string method = a.args.size() == 2 ? a.args[0] : "cco";
   const std::filesystem::path file = a.args.back();
+  if (file.empty() || !file.has_filename() || std::filesystem::is_directory(file))
+    throw InputError("", 0, "FILE '" + file.string() + "' is not a file name; give the parameter file to write, such as my_tree.toml");
   const GrowthMethod& m = methodNamed(method);
   std::string data_file, data;
   const std::string text = parameterTemplate(m, file.stem().string(), data_file, data);

@@ -6,7 +6,8 @@
 
 #include "commands.hpp"
 #include "core/error.hpp"
-#include "io/text_file.hpp"
+#include "io/atomic_file.hpp"
+#include "io/output_guard.hpp"
 #include "score/case_scores.hpp"
 #include "score/calibre_plot.hpp"
 #include "score/dataset_scores.hpp"
@@ -19,18 +20,15 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
-// Output files are new files, or --force; never an input.
-void checkOutput(const std::string& out, const ScoreArgs& a) {
-  if (out.empty()) return;
-  const fs::path o = fs::weakly_canonical(out);
-  for (const std::string& in : {a.prediction, a.sample, a.dataset, a.predictions}) {
-    if (in.empty()) continue;
-    const fs::path i = fs::weakly_canonical(in);
-    const auto rel = o.lexically_relative(i);
-    if (o == i || (!rel.empty() && *rel.begin() != ".."))
-      throw InputError(out, 0, "is an input or lies inside one (" + in + "); allowed: a file elsewhere");
-  }
-  if (fs::exists(o) && !a.force) throw InputError(out, 0, "exists; give --force to replace it");
+// Output files: each its own, never an input, new unless --force; written whole or not at all.
+void checkOutputs(const ScoreArgs& a) {
+  checkOutputFiles({{a.out, "--out"}, {a.csv, "--csv"}, {a.plot, "--plot"}}, {a.prediction, a.sample, a.dataset, a.predictions}, a.force);
+}
+
+void writePngAtomically(const fs::path& file, const Image8& image) {
+  AtomicFile f(file);
+  writePng(f.stream(), file, image);
+  f.commit();
 }
 
 }  // namespace
@@ -57,9 +55,7 @@ CLI::App* addScore(CLI::App& app, ScoreArgs& a) {
 
 int runScore(const ScoreArgs& a) {
   const auto guard = limitThreads(a.common.threads);
-  checkOutput(a.out, a);
-  checkOutput(a.csv, a);
-  checkOutput(a.plot, a);
+  checkOutputs(a);
   ScoreOptions opt;
   opt.tolerance_mm = a.tolerance_mm;
   opt.topcow = a.topcow;
@@ -82,9 +78,9 @@ int runScore(const ScoreArgs& a) {
     csv = scoreCsvHeader() + scoreCsvRow(a.prediction, j);
   }
   if (a.out.empty()) std::cout << j.dump(2) << "\n";
-  else writeTextFile(a.out, [&](std::ostream& o) { o << j.dump(2) << "\n"; });
-  if (!a.csv.empty()) writeTextFile(a.csv, [&](std::ostream& o) { o << csv; });
-  if (!a.plot.empty()) writePng(a.plot, plotCalibreCurves({calibreCurve(j)}));
+  else writeFileAtomically(a.out, j.dump(2) + "\n");
+  if (!a.csv.empty()) writeFileAtomically(a.csv, csv);
+  if (!a.plot.empty()) writePngAtomically(a.plot, plotCalibreCurves({calibreCurve(j, "")}));
   if (!a.common.quiet) {
     const Json& s = dataset ? j["summary"] : j;
     const auto show = [&](const char* pointer) {
@@ -111,18 +107,19 @@ CLI::App* addPlotCalibre(CLI::App& app, PlotCalibreArgs& a) {
 }
 
 int runPlotCalibre(const PlotCalibreArgs& a) {
-  if (fs::exists(a.out) && !a.force) throw InputError(a.out, 0, "exists; give --force to replace it");
+  checkOutputFiles({{a.out, "OUT"}}, {a.scores.begin(), a.scores.end()}, a.force);
   std::vector<CalibreCurve> curves;
   for (const auto& f : a.scores) {
     std::ifstream in(f);
+    if (!in) throw InputError(f, 0, "cannot read this file");
     const Json j = Json::parse(in, nullptr, /*allow_exceptions=*/false);
     if (j.is_discarded() || !j.is_object()) throw InputError(f, 0, "is not a score result (JSON of angiosynth score)");
-    const CalibreCurve c = calibreCurve(j);
+    const CalibreCurve c = calibreCurve(j, f);
     if (c.lower.empty()) throw InputError(f, 0, "holds no calibre bins; allowed: the JSON angiosynth score writes");
     if (!curves.empty() && c.lower != curves.front().lower) throw InputError(f, 0, "has other calibre bins than " + a.scores.front());
     curves.push_back(c);
   }
-  writePng(a.out, plotCalibreCurves(curves));
+  writePngAtomically(a.out, plotCalibreCurves(curves));
   for (std::size_t k = 0; k < a.scores.size(); ++k) std::cerr << "curve " << k + 1 << ": " << a.scores[k] << "\n";
   return 0;
 }

@@ -17,6 +17,7 @@
 #include "dataset/manifest.hpp"
 #include "degrade/profile.hpp"
 #include "core/interrupt_cleanup.hpp"
+#include "io/atomic_file.hpp"
 #include "io/output_guard.hpp"
 #include "io/text_file.hpp"
 #include "pipeline/generate_sample.hpp"
@@ -56,11 +57,7 @@ Json readSpecRecord(const fs::path& dir) {
   return j;
 }
 
-void writeJsonAtomically(const fs::path& p, const Json& j) {
-  const fs::path tmp = p.string() + ".tmp" + std::to_string(::getpid());
-  writeTextFile(tmp, [&](std::ostream& o) { o << j.dump(2) << "\n"; });
-  fs::rename(tmp, p);
-}
+void writeJsonAtomically(const fs::path& p, const Json& j) { writeFileAtomically(p, j.dump(2) + "\n"); }
 
 Scenario scenarioOf(const DatasetSpec& spec, const ResolvedSample& r) {
   Scenario sc = readTomlParameters(*r.table, spec.file);
@@ -364,12 +361,10 @@ DatasetCheck finalizeDataset(const fs::path& dir) {
   Json info;
   DatasetCheck c = checkDataset(dir, /*rehash=*/false, entries, info);
   // manifest.jsonl: every sample's last entry, in index order.
-  const fs::path tmp = dir / ("manifest.jsonl.tmp" + std::to_string(::getpid()));
-  writeTextFile(tmp, [&](std::ostream& o) {
-    for (const auto& [i, e] : entries)
-      if (i < c.samples) o << e.dump() << "\n";
-  });
-  fs::rename(tmp, dir / "manifest.jsonl");
+  std::string manifest;
+  for (const auto& [i, e] : entries)
+    if (i < c.samples) manifest += e.dump() + "\n";
+  writeFileAtomically(dir / "manifest.jsonl", manifest);
   // nnU-Net's dataset.json; "CT" makes nnU-Net use its CT (global percentile) normalisation.
   std::string channel = info.contains("channel_name") && info["channel_name"].is_string() ? info["channel_name"].get<std::string>() : "";
   if (channel.empty()) {

@@ -84,6 +84,10 @@ void writeTiff(const std::filesystem::path& file, const VolumeView& v) {
 
 void writePng(const std::filesystem::path& file, const Image8& image) {
   File f = openForWriting(file);
+  writePng(f.get(), file, image);
+}
+
+void writePng(std::FILE* out, const std::filesystem::path& file, const Image8& image) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!info) {
@@ -94,7 +98,7 @@ void writePng(const std::filesystem::path& file, const Image8& image) {
     png_destroy_write_struct(&png, &info);
     fail(file, "libpng failed (disk full?)");
   }
-  png_init_io(png, f.get());
+  png_init_io(png, out);
   png_set_IHDR(png, info, png_uint_32(image.width), png_uint_32(image.height), 8, image.channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY,
                PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
@@ -102,7 +106,7 @@ void writePng(const std::filesystem::path& file, const Image8& image) {
   for (int y = 0; y < image.height; ++y) png_write_row(png, image.pixels.data() + std::size_t(y) * stride);
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
-  if (std::fflush(f.get()) != 0 || std::ferror(f.get())) fail(file, "write error (disk full?)");
+  if (std::fflush(out) != 0 || std::ferror(out)) fail(file, "write error (disk full?)");
 }
 
 namespace {

@@ -42,6 +42,29 @@ bool isConfinedRelativePath(const std::string& rel) {
   return true;
 }
 
+void checkOutputFiles(const std::vector<OutputFile>& outputs, const std::vector<fs::path>& inputs, bool replace) {
+  std::error_code ec;
+  for (std::size_t k = 0; k < outputs.size(); ++k) {
+    const auto& [out, what] = outputs[k];
+    if (out.empty()) continue;
+    const std::string shown = out.string();
+    if (!out.has_filename() || fs::is_directory(out, ec))
+      throw InputError(what, 0, "'" + shown + "' is a directory; give a file name");
+    for (const auto& in : inputs) {
+      if (in.empty()) continue;
+      const bool same = isWithin(out, in) || (fs::exists(out, ec) && fs::exists(in, ec) && fs::equivalent(out, in, ec));
+      if (same) throw InputError(what, 0, "'" + shown + "' is the input " + in.string() + " or lies inside it; allowed: a file elsewhere");
+    }
+    for (std::size_t j = 0; j < k; ++j) {
+      const auto& other = outputs[j];
+      if (other.path.empty()) continue;
+      const bool same = isWithin(out, other.path) || (fs::exists(out, ec) && fs::exists(other.path, ec) && fs::equivalent(out, other.path, ec));
+      if (same) throw InputError(what, 0, "'" + shown + "' is also " + other.what + "; allowed: a file of its own for each output");
+    }
+    if (fs::exists(fs::symlink_status(out, ec)) && !replace) throw InputError(what, 0, "'" + shown + "' exists; give --force to replace it");
+  }
+}
+
 void checkOutputPath(const fs::path& out, const std::vector<fs::path>& inputs, const std::string& what) {
   const std::string shown = out.string();
   if (out.empty()) throw InputError(what, 0, "the output directory is empty; give a directory name");

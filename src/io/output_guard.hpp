@@ -13,6 +13,17 @@ namespace angiosynth {
 void checkOutputPath(const std::filesystem::path& out, const std::vector<std::filesystem::path>& inputs,
                      const std::string& what);
 
+// One output file of a command (--out, --csv, --plot, OUT) and the option that names it.
+struct OutputFile {
+  std::filesystem::path path;
+  std::string what;
+};
+
+// Throws InputError (exit 2, nothing written) when an output file (an empty path: not asked for)
+// is a directory, is one of the `inputs` or lies inside an input directory, is the same file as
+// another output, or exists while `replace` (--force) is false.
+void checkOutputFiles(const std::vector<OutputFile>& outputs, const std::vector<std::filesystem::path>& inputs, bool replace);
+
 // Whether `inner` is `outer` or lies beneath it (both made absolute and normalised, symlinks of
 // existing parts resolved).
 bool isWithin(const std::filesystem::path& inner, const std::filesystem::path& outer);

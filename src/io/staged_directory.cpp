@@ -87,11 +87,22 @@ StagedDirectory::StagedDirectory(fs::path target, ExistingOutput existing, const
   prefix += target_.filename().string();
   prefix += ".tmp-";
   removeStaleStaging(parent, prefix);
-  staging_ = parent / (prefix + stagingSuffix());
-  fs::remove_all(staging_, ec);  // our own pid's: a leftover of a process that had this pid
-  ec.clear();
-  if (!fs::create_directory(staging_, ec) || ec)
-    throw InputError(parent.string(), 0, "cannot create an output directory here: " + ec.message());
+  // A new directory of our own: a leftover of a process that had this pid is ours to remove
+  // (it has the marker); anything else of that name is left alone and another name taken.
+  for (int k = 0;; ++k) {
+    std::string name = prefix + stagingSuffix();
+    if (k > 0) name += '-', name += std::to_string(k);
+    staging_ = parent / name;
+    const auto status = fs::symlink_status(staging_, ec);
+    if (fs::exists(status)) {
+      if (k == 0 && fs::is_directory(status) && fs::exists(staging_ / kStagingMarker, ec)) fs::remove_all(staging_, ec);
+      else continue;
+    }
+    ec.clear();
+    if (fs::create_directory(staging_, ec)) break;
+    if (ec != std::errc::file_exists || k > 64)
+      throw InputError(parent.string(), 0, "cannot create an output directory here: " + ec.message());
+  }
   registerStaging(staging_);
   std::ofstream(staging_ / kStagingMarker).put('\n');
 }

@@ -6,6 +6,7 @@
 //   the same physical geometry in every viewer.
 // Every writer throws InputError(path, 0, …) when the file cannot be written.
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -71,6 +72,8 @@ Image8 maximumProjection(const Volume<float>& v, const Volume<std::uint8_t>& lab
 Image8 sliceZ(const Volume<float>& v, std::int32_t z, double lo, double hi);
 // Lossless 8-bit PNG through libpng.
 void writePng(const std::filesystem::path& file, const Image8& image);
+// The same into an open stream (an AtomicFile's); `file` names it in errors.
+void writePng(std::FILE* out, const std::filesystem::path& file, const Image8& image);
 // Baseline JPEG through libjpeg (lossy: VascuSynth's slice format, kept for its users' scripts).
 void writeJpeg(const std::filesystem::path& file, const Image8& image, int quality = 95);
 

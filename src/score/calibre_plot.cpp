@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <map>
 
+#include "core/error.hpp"
+
 namespace angiosynth {
 namespace {
 
@@ -77,28 +79,66 @@ std::string label(double v) {
 
 }  // namespace
 
-CalibreCurve calibreCurve(const Json& scores) {
+namespace {
+
+// One case's bins, checked: an array of at most 64 objects, each with radius_voxels (an array
+// whose first value is a finite, non-negative lower edge, increasing from bin to bin) and recall
+// (a number in [0, 1], or null where the bin holds no voxel).
+CalibreCurve checkedBins(const Json& bins, const std::string& file, const std::string& where) {
+  const auto bad = [&](const std::string& why) -> InputError {
+    return InputError(file, 0, where + why + "; allowed: the JSON angiosynth score writes");
+  };
+  if (!bins.is_array()) throw bad("\"calibre\" is not an array");
+  if (bins.size() > 64) throw bad("\"calibre\" has " + std::to_string(bins.size()) + " bins, more than 64");
   CalibreCurve c;
-  if (scores.contains("calibre")) {
-    for (const auto& b : scores["calibre"]) {
-      c.lower.push_back(b["radius_voxels"][0].get<double>());
-      c.recall.push_back(b["recall"].is_number() ? b["recall"].get<double>() : NAN);
-    }
-    return c;
+  for (std::size_t b = 0; b < bins.size(); ++b) {
+    const auto& bin = bins[b];
+    const std::string at = "bin " + std::to_string(b);
+    if (!bin.is_object()) throw bad(at + " is not an object");
+    const auto edges = bin.find("radius_voxels");
+    if (edges == bin.end() || !edges->is_array() || edges->empty() || !(*edges)[0].is_number())
+      throw bad(at + " has no radius_voxels (an array of its lower and upper edge)");
+    const double lower = (*edges)[0].get<double>();
+    if (!std::isfinite(lower) || lower < 0 || (!c.lower.empty() && !(lower > c.lower.back())))
+      throw bad(at + "'s lower edge " + std::to_string(lower) + " is not finite, non-negative and above the last bin's");
+    const auto recall = bin.find("recall");
+    if (recall == bin.end() || !(recall->is_null() || recall->is_number())) throw bad(at + " has no recall (a number, or null)");
+    const double r = recall->is_number() ? recall->get<double>() : NAN;
+    if (recall->is_number() && !(r >= 0 && r <= 1)) throw bad(at + "'s recall " + std::to_string(r) + " is not in [0, 1]");
+    c.lower.push_back(lower);
+    c.recall.push_back(r);
   }
+  return c;
+}
+
+}  // namespace
+
+CalibreCurve calibreCurve(const Json& scores, const std::string& file) {
+  if (!scores.is_object()) throw InputError(file, 0, "is not a score result (a JSON object of angiosynth score)");
+  if (scores.contains("calibre")) return checkedBins(scores["calibre"], file, "");
   // A dataset: the mean per bin over the cases where the bin holds voxels.
-  if (scores.contains("per_case") && !scores["per_case"].empty()) {
-    const auto& first = scores["per_case"][0]["calibre"];
-    std::vector<double> sum(first.size(), 0);
-    std::vector<int> n(first.size(), 0);
-    for (const auto& cs : scores["per_case"])
-      for (std::size_t b = 0; b < std::min(first.size(), cs["calibre"].size()); ++b)
-        if (cs["calibre"][b]["recall"].is_number()) sum[b] += cs["calibre"][b]["recall"].get<double>(), ++n[b];
-    for (std::size_t b = 0; b < first.size(); ++b) {
-      c.lower.push_back(first[b]["radius_voxels"][0].get<double>());
-      c.recall.push_back(n[b] ? sum[b] / n[b] : NAN);
+  CalibreCurve c;
+  if (!scores.contains("per_case")) return c;
+  const auto& cases = scores["per_case"];
+  if (!cases.is_array()) throw InputError(file, 0, "\"per_case\" is not an array; allowed: the JSON angiosynth score writes");
+  std::vector<double> sum;
+  std::vector<int> n;
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const std::string where = "case " + std::to_string(k) + ": ";
+    if (!cases[k].is_object() || !cases[k].contains("calibre"))
+      throw InputError(file, 0, where + "has no \"calibre\"; allowed: the JSON angiosynth score writes");
+    const CalibreCurve one = checkedBins(cases[k]["calibre"], file, where);
+    if (k == 0) {
+      c.lower = one.lower;
+      sum.assign(one.lower.size(), 0);
+      n.assign(one.lower.size(), 0);
+    } else if (one.lower != c.lower) {
+      throw InputError(file, 0, where + "has other calibre bins than case 0; allowed: one set of bins per dataset");
     }
+    for (std::size_t b = 0; b < one.recall.size(); ++b)
+      if (!std::isnan(one.recall[b])) sum[b] += one.recall[b], ++n[b];
   }
+  for (std::size_t b = 0; b < c.lower.size(); ++b) c.recall.push_back(n[b] ? sum[b] / n[b] : NAN);
   return c;
 }
 

@@ -15,8 +15,9 @@ struct CalibreCurve {
 };
 
 // The curve of a score result (`angiosynth score` JSON: its "calibre", or a dataset's mean per
-// bin over the cases where it is defined).
-CalibreCurve calibreCurve(const nlohmann::ordered_json& scores);
+// bin over the cases where it is defined). Throws InputError naming `file` when the JSON is not
+// of that shape (wrong types, bins not increasing, recall outside [0, 1], cases with other bins).
+CalibreCurve calibreCurve(const nlohmann::ordered_json& scores, const std::string& file);
 
 // Recall (0 … 1) against the bins' lower edges, equally spaced; curve k in colour k (the legend:
 // numbers 1, 2, … beside the curves' colours); axes labelled "radius voxels" and "recall".
