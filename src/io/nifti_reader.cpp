@@ -3,7 +3,9 @@
 #include <nifti/nifti1_io.h>
 
 #include <cmath>
+#include <cstring>
 #include <memory>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/memory.hpp"
@@ -44,8 +46,24 @@ NiftiVolume readNiftiVolume(const std::filesystem::path& file, std::uint64_t lim
   if (need > limit)
     throw InputError(f, 0, std::string(what) + " of " + std::to_string(g.voxelCount()) + " voxels needs " + formatBytes(need) +
                                ", more than the limit of " + formatBytes(limit) + "; raise --memory-limit");
-  std::unique_ptr<nifti_image, decltype(&nifti_image_free)> img(nifti_image_read(f.c_str(), 1), &nifti_image_free);
-  if (!img || !img->data) throw InputError(f, 0, "cannot read the voxels of this NIfTI image");
+  // The voxels read here, not by nifti_image_read: on a file that ends early it fills the missing
+  // voxels with 0 and carries on, which would score a truncated prediction as if it were whole.
+  nifti_image* opened = nullptr;
+  znzFile fp = nifti_image_open(f.c_str(), const_cast<char*>("rb"), &opened);
+  std::unique_ptr<nifti_image, decltype(&nifti_image_free)> img(opened, &nifti_image_free);
+  if (znz_isnull(fp) || !img) throw InputError(f, 0, "cannot read the voxels of this NIfTI image");
+  if (img->iname_offset < 0 || znzseek(fp, long(img->iname_offset), SEEK_SET) < 0) {
+    znzclose(fp);
+    throw InputError(f, 0, "the voxel data's offset " + std::to_string(img->iname_offset) + " lies beyond the file (a truncated file)");
+  }
+  const std::size_t bytes = nifti_get_volsize(img.get());
+  std::vector<unsigned char> raw(bytes);
+  const std::size_t got = znzread(raw.data(), 1, bytes, fp);
+  znzclose(fp);
+  if (got != bytes)
+    throw InputError(f, 0, "the voxel data ends after " + std::to_string(got == std::size_t(-1) ? 0 : got) + " of its " + std::to_string(bytes) +
+                               " bytes (a truncated file); allowed: a complete NIfTI image");
+  if (img->swapsize > 1 && img->byteorder != nifti_short_order()) nifti_swap_Nbytes(bytes / std::size_t(img->swapsize), img->swapsize, raw.data());
   const mat44& m = img->sform_code > 0 ? img->sto_xyz : img->qto_xyz;
   NiftiVolume out;
   for (int r = 0; r < 3; ++r)
@@ -54,18 +72,23 @@ NiftiVolume readNiftiVolume(const std::filesystem::path& file, std::uint64_t lim
   out.values = Volume<float>(g);
   const auto n = static_cast<std::size_t>(g.voxelCount());
   auto& v = out.values.data;
-  const auto convert = [&](auto* p) {
-    for (std::size_t i = 0; i < n; ++i) v[i] = static_cast<float>(p[i]);
+  const auto convert = [&](auto type) {
+    using T = decltype(type);
+    for (std::size_t i = 0; i < n; ++i) {
+      T x;
+      std::memcpy(&x, raw.data() + i * sizeof(T), sizeof(T));
+      v[i] = static_cast<float>(x);
+    }
   };
   switch (img->datatype) {
-    case DT_UINT8: convert(static_cast<const std::uint8_t*>(img->data)); break;
-    case DT_INT8: convert(static_cast<const std::int8_t*>(img->data)); break;
-    case DT_INT16: convert(static_cast<const std::int16_t*>(img->data)); break;
-    case DT_UINT16: convert(static_cast<const std::uint16_t*>(img->data)); break;
-    case DT_INT32: convert(static_cast<const std::int32_t*>(img->data)); break;
-    case DT_UINT32: convert(static_cast<const std::uint32_t*>(img->data)); break;
-    case DT_FLOAT32: convert(static_cast<const float*>(img->data)); break;
-    case DT_FLOAT64: convert(static_cast<const double*>(img->data)); break;
+    case DT_UINT8: convert(std::uint8_t()); break;
+    case DT_INT8: convert(std::int8_t()); break;
+    case DT_INT16: convert(std::int16_t()); break;
+    case DT_UINT16: convert(std::uint16_t()); break;
+    case DT_INT32: convert(std::int32_t()); break;
+    case DT_UINT32: convert(std::uint32_t()); break;
+    case DT_FLOAT32: convert(float()); break;
+    case DT_FLOAT64: convert(double()); break;
     default: throw InputError(f, 0, "unsupported NIfTI data type");
   }
   if (img->scl_slope != 0 && (img->scl_slope != 1 || img->scl_inter != 0))
