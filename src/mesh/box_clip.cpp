@@ -355,9 +355,25 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
 
 }  // namespace
 
-BoxClipReport clipToBox(SurfaceMesh& m, const Vec3& lo, const Vec3& hi, std::int32_t first_face) {
+BoxClipReport clipToBox(SurfaceMesh& m, const Vec3& box_lo, const Vec3& box_hi, std::int32_t first_face) {
   BoxClipReport rep;
   if (m.triangle_face.empty()) m.triangle_face.assign(m.triangles.size(), 0);
+  // A side beyond the surface cuts nothing: it is moved to just outside the surface, so that the
+  // snapping tolerance follows the surface's size, not a box of 1e10 mm (which snapped every
+  // vertex within millimetres onto its planes).
+  Vec3 lo = box_lo, hi = box_hi;
+  if (!m.vertices.empty()) {
+    Vec3 mlo = m.vertices.front(), mhi = m.vertices.front();
+    for (const auto& v : m.vertices) mlo = componentMin(mlo, v), mhi = componentMax(mhi, v);
+    const double margin = 1e-3 * std::max({mhi.x - mlo.x, mhi.y - mlo.y, mhi.z - mlo.z, 1e-6}) + 1e-6;
+    lo = componentMax(lo, mlo - Vec3(margin, margin, margin));
+    hi = componentMin(hi, mhi + Vec3(margin, margin, margin));
+    // A box that misses the surface altogether keeps nothing.
+    if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) {
+      keepTriangles(m, std::vector<char>(m.triangles.size(), 0));
+      return rep;
+    }
+  }
   const double snap = 1e-9 * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, 1e-300});
   for (int side = 0; side < 6; ++side) {
     const int axis = side / 2;

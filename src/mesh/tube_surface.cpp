@@ -13,6 +13,7 @@
 #include <unordered_map>
 
 #include "core/error.hpp"
+#include "core/memory.hpp"
 #include "core/union_find.hpp"
 #include "grow/common/segment_index.hpp"
 #include "mesh/decimate.hpp"
@@ -186,6 +187,7 @@ class TubeMesher {
     collectVessels();
     rep.vessels = std::int64_t(vessels_.size());
     if (vessels_.empty()) return {};
+    refuseTubesBeyondLimit();
     placeCuts();
     findClosePairs();  // from the geometry alone: the same every round
     std::vector<char> give_up(vessels_.size(), 0);
@@ -250,6 +252,34 @@ class TubeMesher {
 
  private:
   std::int32_t treeOf(std::int32_t s) const { return t_.tree.empty() ? 0 : t_.tree[s]; }
+
+  // Vertices of a vessel's rings.
+  int ringVertices(const Vessel& v) const {
+    int n = o_.ring_vertices > 0 ? o_.ring_vertices : std::max(o_.min_ring_vertices, int(std::ceil(std::numbers::pi * std::max(1, o_.junction.samples_across))));
+    // A chord of a ring of n stands r (1 − cos π/n) inside the wall at its middle.
+    if (o_.ring_tolerance_mm > 0 && o_.ring_tolerance_mm < v.rmax())
+      n = std::max(n, int(std::ceil(std::numbers::pi / std::acos(1 - o_.ring_tolerance_mm / v.rmax()))));
+    return n;
+  }
+
+  // Every vessel as one tube, before anything is meshed: an upper bound of the tubes' triangles
+  // (the contoured parts take some vessels, and have an estimate of their own). A kilometre of a
+  // thin vessel is a million rings.
+  void refuseTubesBeyondLimit() const {
+    if (o_.junction.memory_limit == 0) return;
+    constexpr double kBytesPerTriangle = 64;  // the mesh's arrays, their copies while parts are joined, the writer's
+    double triangles = 0;
+    for (const auto& v : vessels_) {
+      const int n = ringVertices(v);
+      const double spacing = (o_.ring_spacing_radii > 0 ? o_.ring_spacing_radii : kCfdRingSpacing * kTwoPi / n) * 0.5 * (v.ra + v.rb);
+      triangles += 2.0 * n * (std::ceil(v.len / spacing) + 4);
+    }
+    const double bytes = triangles * kBytesPerTriangle;
+    if (bytes > double(o_.junction.memory_limit))
+      throw InputError("", 0, "the vessels' tubes make about " + std::to_string(std::llround(triangles)) + " triangles, which need about " +
+                                  formatBytes(std::uint64_t(bytes)) + " of memory, more than the limit of " + formatBytes(o_.junction.memory_limit) +
+                                  "; allowed: rings further apart (--ring-spacing), fewer --samples-across, or a larger --memory-limit");
+  }
 
   void collectVessels() {
     for (std::int32_t s = 0; s < t_.nodeCount(); ++s) {
@@ -1019,11 +1049,7 @@ class TubeMesher {
       if (!v.tube) continue;
       ++rep.tubes;
       const double y0 = v.plane[0], y1 = v.len - v.plane[1];
-      int n_ring = o_.ring_vertices > 0 ? o_.ring_vertices
-                                        : std::max(o_.min_ring_vertices, int(std::ceil(std::numbers::pi * std::max(1, o_.junction.samples_across))));
-      // A chord of a ring of n stands r (1 − cos π/n) inside the wall at its middle.
-      if (o_.ring_tolerance_mm > 0 && o_.ring_tolerance_mm < v.rmax())
-        n_ring = std::max(n_ring, int(std::ceil(std::numbers::pi / std::acos(1 - o_.ring_tolerance_mm / v.rmax()))));
+      const int n_ring = ringVertices(v);
       // Rings at most ring_spacing_radii radii apart. A contoured loop has several times a
       // ring's vertices: zipped to a ring two radii away, its band fans out into triangles of a
       // few degrees (a quarter of the tube's triangles were under 5°), so the first ring stands

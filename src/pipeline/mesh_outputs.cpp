@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <fstream>
 #include <stdexcept>
 
+#include "core/error.hpp"
 #include "io/mesh_writers.hpp"
 #include "core/format.hpp"
 #include "mesh/box_clip.hpp"
@@ -89,6 +91,16 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
                                const std::function<void(std::int64_t, std::int64_t)>& progress, const std::vector<std::string>& tree_kinds,
                                const std::vector<std::string>& vessel_ids) {
   const bool tubes = p.method == "tubes";
+  // At least two grid steps across the thinnest vessel: coarser, its surface falls between the
+  // samples and comes out empty, or its volume wrong by a tenth and more.
+  if (p.voxel_mm > 0) {
+    double thinnest = INFINITY;
+    for (std::int32_t i = 0; i < tree.nodeCount(); ++i)
+      if (!tree.isRoot(i) && !tree.isLink(i)) thinnest = std::min({thinnest, tree.radius[i], tree.startRadius(i)});
+    if (p.voxel_mm > thinnest)
+      throw InputError("", 0, "a mesh voxel of " + exactNumber(p.voxel_mm) + " mm is coarser than half the thinnest vessel's diameter (" +
+                                  exactNumber(2 * thinnest) + " mm); allowed: at most " + exactNumber(thinnest) + " mm, two steps across it");
+  }
   WallThickness wall;
   wall.constant_mm = p.wall_thickness;
   wall.ratio = p.wall_ratio;
@@ -158,6 +170,8 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
     // What is left of each end's face (a box side may cut it; outside the box it is gone).
     if (cut_ends) cut.cap_area_mm2 = endFaceAreas(mesh, ends.size());
   }
+  if (mesh.triangles.empty() && p.clip_box.empty())
+    throw std::logic_error("the surface of a tree with vessels came out empty");
   const auto topo = meshTopology(mesh);
   SurfaceFiles out;
   out.files = Json::object();
