@@ -13,7 +13,7 @@ const std::vector<MethodParam>& commonParams() {
       {"curves", "tortuosity_sd", "", "0", "normal spread of the target between vessels (0 … 1)"},
       {"curves", "wavelength", "mm", "40 × the vessel's radius", "the curve's wavelength (or wavelength_radii, multiples of each vessel's radius)"},
       {"curves", "wavelength_radii", "", "40", "the curve's wavelength in multiples of each vessel's radius (≥ 2)"},
-      {"curves", "piece_length", "mm", "1 voxel", "the longest straight piece a curve is drawn with"},
+      {"curves", "piece_length", "mm", "1 voxel", "the longest straight piece a curve is drawn with (none shorter than an eighth of its vessel's radius)"},
       {"curves", "wall_clearance", "mm", "0 mm", "kept beyond the radius (and wall) from the domain's wall"},
       {"curves", "avoid_overlaps", "true/false", "true", "flatten a curve that would touch another vessel"},
       {"image", "enabled", "true/false", "true", "write volumes at all"},

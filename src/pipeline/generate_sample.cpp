@@ -1,6 +1,7 @@
 #include "pipeline/generate_sample.hpp"
 #include "pipeline/mesh_outputs.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -147,6 +148,11 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   try {
     forest = ps.growth->grow(req.seed, req.sample, report, req.progress);
     if (!req.class_kinds.empty()) assignClassLabels(forest.trees, req.class_kinds);
+    // A sample without a vessel has no truth to label: a method whose parameters leave nothing to
+    // grow (a step that leaves the domain, drains that all die) says so instead of writing one.
+    const auto& grown = forest.vessels;
+    if (std::none_of(grown.parent.begin(), grown.parent.end(), [](std::int32_t p) { return p >= 0; }))
+      throw GrowthError("the growth made no vessel: check the method's lengths against the domain (its step, its spacing) and its counts");
   } catch (const GrowthError& e) {
     throw InputError(sc.parameter_file, 0, e.what());
   }
@@ -154,7 +160,11 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   CurveReport curves;
   if (sc.curves.enabled) {
     t0 = Clock::now();
-    forest.vessels = curveVessels(forest.vessels, sc.curves, domain, map, req.seed, req.sample, curves);
+    try {
+      forest.vessels = curveVessels(forest.vessels, sc.curves, domain, map, req.seed, req.sample, curves, req.memory_limit);
+    } catch (const InputError& e) {
+      throw InputError(sc.parameter_file, sc.curves_line, e.what());
+    }
     timing["curves"] = seconds(t0);
   }
   const VascularTree& tree = forest.vessels;

@@ -200,8 +200,7 @@ void readInlets(const TomlReader& r, const GrowthMethod& m, const toml::table& t
     in.id = per_kind[in.kind] == 1 ? in.kind : in.kind + "_" + std::to_string(nth);
     if (t.get("id")) {
       in.id = r.string(t, "tree.inlet", "id");
-      if (in.id.empty() || in.id.size() > 60)
-        throw InputError(r.file(), r.lineOf(t.get("id")), "id must hold 1 to 60 characters");
+      if (const auto why = nameProblem(in.id, "id"); !why.empty()) throw InputError(r.file(), r.lineOf(t.get("id")), why);
     }
     if (!ids.insert(in.id).second)
       throw InputError(r.file(), r.lineOf(t.get("id") ? t.get("id") : &t), "a second inlet with id '" + in.id + "'; ids must be unique");

@@ -55,6 +55,17 @@ class PreparedColonisation final : public PreparedGrowth {
         }
         st.drains = drains_.back().get();
       }
+      // Lengths the domain can hold: a step beyond half its diameter leaves it at once, a step
+      // of 0 never moves; a leaf a hundredth of the domain across already makes a root of a
+      // fifth of it at a few thousand leaves (Murray's law).
+      const auto where = [&](const char* key) { return spec.lines.count(key) ? spec.lines.at(key) : spec.line; };
+      if (!(st.step >= physical::kMinStepMm && st.step <= diameter / 2))
+        throw InputError(s.parameter_file, where("step"), "stage '" + st.name + "': step " + show(st.step) + " mm is out of range; allowed: " +
+                                                          show(physical::kMinStepMm) + " mm to half the domain's diameter (" + show(diameter / 2) + " mm)");
+      if (!(st.terminal_radius >= physical::kMinRadiusMm && st.terminal_radius <= diameter / 100))
+        throw InputError(s.parameter_file, where("terminal_radius"), "stage '" + st.name + "': terminal_radius " + show(st.terminal_radius) +
+                                                                     " mm is out of range; allowed: " + show(physical::kMinRadiusMm) +
+                                                                     " mm to a hundredth of the domain's diameter (" + show(diameter / 100) + " mm)");
       if (!(st.perception_distance > st.satisfaction_distance))
         throw InputError(s.parameter_file, spec.line, "stage '" + st.name + "': perception_distance (" + show(st.perception_distance) +
                                                           " mm) must exceed satisfaction_distance (" + show(st.satisfaction_distance) +
@@ -277,6 +288,8 @@ ColonisationStageSpec readStage(const TomlReader& r, const GrowthMethod& m, cons
                                       {{"sd", SpreadStatistic::StandardDeviation}, {"rms", SpreadStatistic::RootMeanSquare}});
   st.lateral = r.boolean(t, "lateral", true);
   st.source = choice<DrainSource>(r, t, "stage", "source", DrainSource::Volume, {{"volume", DrainSource::Volume}, {"surface", DrainSource::Surface}});
+  for (const char* key : {"step", "terminal_radius"})
+    if (t.get(key)) spec.lines[key] = r.lineOf(t.get(key));
   spec.step = readLength(r, m, t, "step");
   spec.perception_distance = readLength(r, m, t, "perception_distance");
   spec.satisfaction_distance = readLength(r, m, t, "satisfaction_distance");
@@ -342,7 +355,10 @@ void readRoots(const TomlReader& r, const GrowthMethod& m, const toml::table& tr
     auto& rs = s.roots[i];
     const int nth = ++seen[rs.kind];
     rs.id = per_kind[rs.kind] == 1 ? rs.kind : rs.kind + "_" + std::to_string(nth);
-    if (t.get("id")) rs.id = r.string(t, "tree.inlet", "id");
+    if (t.get("id")) {
+      rs.id = r.string(t, "tree.inlet", "id");
+      if (const auto why = nameProblem(rs.id, "id"); !why.empty()) throw InputError(r.file(), r.lineOf(t.get("id")), why);
+    }
     if (rs.id.empty() || rs.id.size() > 60 || !ids.insert(rs.id).second)
       throw InputError(r.file(), rs.line, "root id '" + rs.id + "' is empty, longer than 60 characters or used twice");
   }
@@ -363,7 +379,7 @@ std::shared_ptr<const GrowthSetup> readColonisationToml(const TomlReader& r, con
   o.sigma0 = declaredNumber(r, m, tree, "tree", "sigma0");
   checkRange(o.sigma0, 0, true, 1e6, false, r.at(tree, "sigma0"), "sigma0");
   if (const auto* node = r.root().get("initial")) {
-    auto in = readInitialNetwork(r, m, *node);
+    auto in = readInitialNetwork(r, m, *node, flat);
     s->initial_file = in.file;
     s->initial = std::move(in.network);
     s->initial_from_corner = in.from_corner;

@@ -2,6 +2,7 @@
 // Method "colonisation": space colonisation of arterial and venous trees (seed 003) in an
 // analytic shape or a mask, in stages with their own parameters and regions.
 #include <filesystem>
+#include <map>
 #include <memory>
 
 #include "grow/colonisation/grower.hpp"
@@ -24,6 +25,7 @@ struct ColonisationStageSpec {
   DomainLength step, perception_distance, satisfaction_distance, co2_distance, drain_spacing, terminal_radius, surface_depth;
   std::vector<std::string> domain;  // regions its drains come from (empty: the whole domain)
   int line = 0;
+  std::map<std::string, int> lines;  // the lines of keys checked against the domain once it is loaded
 };
 
 struct ColonisationRootSpec {

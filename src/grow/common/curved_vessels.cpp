@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
+#include "core/error.hpp"
+#include "core/memory.hpp"
 #include "core/rng.hpp"
 #include "domain/growth_domain.hpp"
 #include "grow/common/intersections.hpp"
@@ -132,6 +135,12 @@ struct Bounds {
   }
 };
 
+// The pieces' length along a vessel of `length` mm, `knots` knot intervals and largest radius r:
+// the longest piece asked for, and each knot interval at least 8 pieces so the curve is resolved
+// as well as the voxels; never under an eighth of the radius, where a finer curve changes nothing
+// and every piece would be checked against the hundreds beside it on its own vessel.
+double pieceStep(double piece, double length, int knots, double r) { return std::max(std::min(piece, length / (8.0 * knots)), r / 8); }
+
 // Vessels that overlap where their straight forms did not; pairs of pieces near a shared end (or
 // near each other along one vessel) touch by construction and are not counted.
 struct PieceOverlaps {
@@ -206,7 +215,7 @@ struct PieceOverlaps {
 }  // namespace
 
 VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const GrowthDomain* domain, const DemandMap& frame,
-                          std::uint64_t seed, std::uint64_t sample, CurveReport& rep) {
+                          std::uint64_t seed, std::uint64_t sample, CurveReport& rep, std::uint64_t memory_limit) {
   rep = CurveReport{};
   rep.nodes_before = t.nodeCount();
   const auto paths = vesselPaths(t);
@@ -214,6 +223,31 @@ VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const Gr
   const bool flat = frame.dims[2] == 1;
   const double piece = o.piece_mm > 0 ? o.piece_mm : frame.voxel_mm;
   const Bounds bounds{domain, frame, o.wall_clearance_mm};
+
+  // The pieces before anything is drawn (each knot interval gets at least 8, as below): a piece
+  // length far below the vessels makes millions of nodes, drawn some ninety times each while the
+  // amplitude is sought.
+  double pieces = 0;
+  for (const auto& path : paths) {
+    double length = 0, r = 0;
+    std::int32_t prev = path.start;
+    std::vector<double> arcs;
+    for (auto seg : path.segments) {
+      arcs.push_back(distance(t.position[prev], t.position[seg]));
+      length += arcs.back();
+      r = std::max(r, t.maxRadius(seg));
+      prev = seg;
+    }
+    const double wavelength = o.wavelength_mm > 0 ? o.wavelength_mm : o.wavelength_radii * r;
+    const int m = std::clamp(int(std::lround(2 * length / std::max(wavelength, 1e-12))), 2, 4096);
+    const double step = pieceStep(piece, length, m, r);
+    for (double a : arcs) pieces += std::max(1.0, std::ceil(a / std::max(step, 1e-12) - 1e-9));
+  }
+  constexpr double kBytesPerPiece = 400;  // its points (curve, straight copy, overlap index) and its node in the tree
+  if (pieces > double(std::numeric_limits<std::int32_t>::max() / 2) || (memory_limit > 0 && pieces * kBytesPerPiece > double(memory_limit)))
+    throw InputError("", 0, "[curves] piece_length " + std::to_string(piece) + " mm draws the vessels in about " + std::to_string(std::llround(pieces)) +
+                                " pieces, which need about " + formatBytes(std::uint64_t(pieces * kBytesPerPiece)) + ", more than the limit of " +
+                                formatBytes(memory_limit) + "; allowed: a longer piece_length (default: one voxel) or a larger --memory-limit");
 
   std::vector<VesselCurve> curves(paths.size());
   const auto build = [&](VesselCurve& c) {
@@ -238,8 +272,7 @@ VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const Gr
     c.target = std::max(1.0, o.tortuosity + o.tortuosity_sd * rng.normal());
     const double wavelength = o.wavelength_mm > 0 ? o.wavelength_mm : o.wavelength_radii * r;
     const int m = std::clamp(int(std::lround(2 * c.length() / std::max(wavelength, 1e-12))), 2, 4096);
-    // Each knot interval gets at least 8 pieces, so the curve is resolved as well as the voxels.
-    const double step = std::min(piece, c.length() / (8.0 * m));
+    const double step = pieceStep(piece, c.length(), m, r);
     for (std::size_t j = 0; j + 1 < c.base.size(); ++j)
       c.pieces.push_back(std::max(1, int(std::ceil((c.arc[j + 1] - c.arc[j]) / std::max(step, 1e-12) - 1e-9))));
     c.knot.assign(std::size_t(m) + 1, Vec3(0, 0, 0));

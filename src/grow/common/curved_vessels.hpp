@@ -44,8 +44,9 @@ struct CurveReport {
 // The curved tree (roots, bifurcations and terminals where they were; a forest's tree ids kept).
 // Random draws come from (seed, sample, Stage::Curves, the vessel's first segment id), so the
 // result does not depend on thread count. `domain` may be null (the frame's box then bounds it).
+// Throws InputError, before drawing, when the pieces would need more than `memory_limit` bytes.
 VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const GrowthDomain* domain, const DemandMap& frame,
-                          std::uint64_t seed, std::uint64_t sample, CurveReport& report);
+                          std::uint64_t seed, std::uint64_t sample, CurveReport& report, std::uint64_t memory_limit = 0);
 
 // Arc length over chord of every vessel of a tree (chains of continuation nodes joined).
 struct VesselPath {

@@ -24,6 +24,33 @@ bool withinTwoSegments(const VascularTree& t, std::int32_t x, std::int32_t y) {
   return std::find(near.begin(), near.end(), a) != near.end() || std::find(near.begin(), near.end(), b) != near.end();
 }
 
+bool joinedAlongVessel(const VascularTree& t, std::int32_t x, std::int32_t y, double reach, double from_prox, double from_dist) {
+  const auto continues = [&](std::int32_t v) { return !t.isRoot(v) && t.child0[v] >= 0 && t.child1[v] < 0; };
+  int budget = 4096;
+  // Down the pieces from c (reached at `at` from the start), while their nodes continue.
+  const auto down = [&](std::int32_t c, double at) {
+    for (; c >= 0 && at <= reach && budget-- > 0; at += t.length[c], c = continues(c) ? t.child0[c] : -1)
+      if (c == y) return true;
+    return false;
+  };
+  const std::int32_t p = t.parent[x];
+  if (p >= 0) {
+    // Up: the piece ending at x's proximal node, and on while the nodes above continue.
+    double at = from_prox;
+    for (std::int32_t v = p; !t.isRoot(v) && at <= reach && budget-- > 0; at += t.length[v], v = t.parent[v]) {
+      if (v == y) return true;
+      if (!continues(t.parent[v])) break;
+    }
+    // Across: x's siblings at its proximal node, and down their pieces.
+    for (std::int32_t c : {t.child0[p], t.child1[p]})
+      if (c >= 0 && c != x && down(c, from_prox)) return true;
+  }
+  // Down: the pieces leaving x's distal node.
+  for (std::int32_t c : {t.child0[x], t.child1[x]})
+    if (c >= 0 && down(c, from_dist)) return true;
+  return false;
+}
+
 bool crossInPlane(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const auto side = [](const Vec3& o, const Vec3& u, const Vec3& v) { return (u.x - o.x) * (v.y - o.y) - (u.y - o.y) * (v.x - o.x); };
   const double s1 = side(a, b, c), s2 = side(a, b, d), s3 = side(c, d, a), s4 = side(c, d, b);

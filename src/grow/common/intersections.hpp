@@ -13,6 +13,13 @@ namespace angiosynth {
 // True if segments x and y share a node or one segment lies between them.
 bool withinTwoSegments(const VascularTree& tree, std::int32_t x, std::int32_t y);
 
+// True if y is a piece of the vessel x lies on (or branches from) within `reach` mm: reached from
+// x's ends along the tree through nodes of one child only (a vessel given as a polyline, whose
+// pieces overlap at every bend once they are shorter than their radius). The nodes at x's own
+// ends may be junctions. `from_prox` and `from_dist`: how far the point the walk starts from lies
+// from x's proximal and distal node (x's ends: 0, 0). At most 4096 pieces are walked.
+bool joinedAlongVessel(const VascularTree& tree, std::int32_t x, std::int32_t y, double reach, double from_prox = 0, double from_dist = 0);
+
 inline bool capsulesOverlap(const Vec3& a0, const Vec3& a1, double ra, const Vec3& b0, const Vec3& b1, double rb) {
   return segmentSegmentDistance(a0, a1, b0, b1) < ra + rb;
 }

@@ -17,12 +17,15 @@ class SegmentGrid {
  public:
   // `cell`: the edge wanted; coarser when the box would need more than 2M cells. `flat`: one layer.
   SegmentGrid(const Vec3& lo, const Vec3& hi, double cell, bool flat) : lo_(lo), cell_(std::max(cell, 1e-9)) {
-    const auto count = [&](double extent) { return std::max<std::int64_t>(1, std::int64_t(std::ceil(extent / cell_)) + 1); };
+    // Counts in double: a cell far below the box (a root diameter of 1e-6 mm in a 20 mm domain)
+    // gives 2e10 cells per axis, whose integer product wraps round to a small number.
+    const auto count = [&](double extent) { return std::max(1.0, std::ceil(extent / cell_) + 1); };
     for (;;) {
-      n_[0] = count(hi.x - lo.x);
-      n_[1] = count(hi.y - lo.y);
-      n_[2] = flat ? 1 : count(hi.z - lo.z);
-      if (n_[0] * n_[1] * n_[2] <= (std::int64_t(1) << 21)) break;
+      const double nx = count(hi.x - lo.x), ny = count(hi.y - lo.y), nz = flat ? 1.0 : count(hi.z - lo.z);
+      if (nx * ny * nz <= double(std::int64_t(1) << 21)) {
+        n_[0] = std::int64_t(nx), n_[1] = std::int64_t(ny), n_[2] = std::int64_t(nz);
+        break;
+      }
       cell_ *= 1.25;
     }
     inv_ = 1 / cell_;

@@ -8,6 +8,7 @@
 #include <span>
 
 #include "core/rng.hpp"
+#include "core/physical_ranges.hpp"
 #include "grow/common/intersections.hpp"
 #include "grow/common/segment_index.hpp"
 #include "grow/dcco/lattice.hpp"
@@ -30,6 +31,8 @@ constexpr double kThickReach = 0.25, kThickList = 0.2;
 // The repair sheds at most this share of a stage's terminals from below one vessel while that
 // fixes something (more only when a violation would otherwise stay).
 constexpr double kMaxShedShare = 0.05;
+// Draws from a stage's Gaussians that may miss its terminal region in a row before growth stops.
+constexpr std::int64_t kGaussianMisses = 10'000'000;
 
 // Characteristic length of a domain (eq. 13): the radius of the disc or ball of its measure.
 double characteristicLength(const GrowthDomain& d) {
@@ -98,7 +101,25 @@ class DccoGrower {
       solve();
       checked_ = t_.radius;
       index_.refresh(t_, true);
+      refuseUnbranchableNetwork();
     }
+  }
+
+  // A branch leaves a vessel between its ends, clear of the pieces beside it. A network whose
+  // every vessel that may branch is drawn in pieces shorter than its radius (a polyline sampled
+  // finely) gives no draw a place to connect: refused here, before millions of draws find none.
+  void refuseUnbranchableNetwork() const {
+    std::int32_t shortest = -1;
+    for (std::int32_t i = 0; i < t_.nodeCount(); ++i) {
+      if (t_.isRoot(i) || t_.isLink(i) || !mayBranch(i)) continue;
+      if (t_.length[i] >= t_.radius[i]) return;
+      if (shortest < 0 || t_.length[i] / t_.radius[i] < t_.length[shortest] / t_.radius[shortest]) shortest = i;
+    }
+    if (shortest < 0) return;  // nothing may branch: the stages' own checks say so
+    const std::string name = std::size_t(shortest) < o_.initial_names.size() ? o_.initial_names[std::size_t(shortest)] : "vessel " + std::to_string(shortest);
+    throw GrowthError("no vessel of the initial network can take a branch: each one that may is shorter than its radius at the flow it "
+                      "carries (" + name + ": " + physical::shown(t_.length[shortest]) + " mm long, radius " + physical::shown(t_.radius[shortest]) +
+                      " mm); allowed: pieces at least as long as their radius (join a polyline's samples)");
   }
 
   VascularTree run(const ProgressFn& progress) {
@@ -169,7 +190,12 @@ class DccoGrower {
     if (st.pdf != TerminalPdf::Gaussian) return d.sample(rng_);
     double total = 0;
     for (const auto& g : st.gaussians) total += g.weight;
-    for (;;) {
+    // prepare() refused mixtures with under a thousandth of their mass inside: a miss this many
+    // times in a row is a region the Gaussians barely reach (a relaxation of nothing).
+    for (std::int64_t misses = 0;; ++misses) {
+      if (misses >= kGaussianMisses)
+        throw GrowthError("stage '" + st.name + "': " + std::to_string(kGaussianMisses) + " points drawn in a row from its Gaussians fell outside its terminal region; "
+                          "move their means into it or widen them");
       double u = rng_.uniform() * total;
       const GaussianComponent* g = &st.gaussians.back();
       for (const auto& c : st.gaussians)
@@ -384,18 +410,22 @@ class DccoGrower {
   // them: their capsules may touch at the joint, their centrelines may not come within half
   // the thinner radius; the lattice's bifurcation points can fold a branch over its sibling).
   bool overlaps(std::int32_t x, const Vec3& a, const Vec3& e, double r) {
-    return hitsVessel(a, e, r, [&](std::int32_t y) {
-      return y == x || sharesNode(x, y) ? Neighbour::Meets : withinTwoSegments(t_, x, y) ? Neighbour::Near : Neighbour::Apart;
-    });
+    return hitsVessel(
+        a, e, r,
+        [&](std::int32_t y) {
+          return y == x || sharesNode(x, y) ? Neighbour::Meets : withinTwoSegments(t_, x, y) ? Neighbour::Near : Neighbour::Apart;
+        },
+        [&](std::int32_t y, double reach) { return joinedAlongVessel(t_, x, y, reach); });
   }
 
   enum class Neighbour { Meets, Near, Apart };
   // True if the capsule a–e of radius r overlaps a vessel y that `kind(y)` calls Apart, or runs
-  // its centreline within half the thinner radius of one it calls Near (Meets: exempt). The grid
-  // as far as thin vessels reach; the few thick ones from their list, so the search does not
-  // widen with the root radius.
-  template <class Kind>
-  bool hitsVessel(const Vec3& a, const Vec3& e, double r, Kind&& kind) {
+  // its centreline within half the thinner radius of one it calls Near (Meets: exempt). An Apart
+  // vessel that `along(y, reach)` finds within reach along the same vessel (the pieces of a
+  // polyline in an initial network) is held to the Near rule. The grid as far as thin vessels
+  // reach; the few thick ones from their list, so the search does not widen with the root radius.
+  template <class Kind, class Along>
+  bool hitsVessel(const Vec3& a, const Vec3& e, double r, Kind&& kind, Along&& along) {
     bool hit = false;
     const auto test = [&](std::int32_t y) {
       // A link lies inside the cap of the vessel that ends at its junction: that vessel stands for it.
@@ -407,7 +437,7 @@ class DccoGrower {
       if (ya == a || ya == e || ye == a || ye == e) return;
       const double d = segmentSegmentDistance(a, e, t_.position[t_.parent[y]], t_.position[y]);
       const double ry = kMargin * radiusOf(y);
-      hit = k == Neighbour::Near ? d < 0.5 * std::min(r, ry) : d < r + ry;
+      hit = k == Neighbour::Near || (d < r + ry && along(y, r + ry)) ? d < 0.5 * std::min(r, ry) : d < r + ry;
     };
     index_.forEachNearSegment(a, e, r + kMargin * kThickReach * o_.root_radius, test);
     for (auto y : thick_)
@@ -432,6 +462,8 @@ class DccoGrower {
   bool trialHits(const Trial& tr, const Vec3& x) {
     const auto s = tr.s, q = t_.parent[s];
     const auto& T = t_;
+    // Where b lies on s: its distances to s's proximal and distal node.
+    const double to_prox = distance(tr.b, T.position[q]), to_dist = distance(tr.b, T.position[s]);
     const std::int32_t sib = T.sibling(s), c0 = T.child0[s], c1 = T.child1[s];
     const auto kids = [&](std::int32_t y, std::int32_t* out, int& n) {
       if (y > 0 && T.child0[y] >= 0) out[n++] = T.child0[y];
@@ -442,12 +474,12 @@ class DccoGrower {
       std::int32_t near[6] = {T.parent[q] >= 0 ? q : -1, sib};
       int n = 2;
       kids(c0, near, n);
-      return capsuleHits(tr.b, x, kMargin * tr.r[2], s, {share, share + 2}, {near, near + n});
+      return capsuleHits(tr.b, x, kMargin * tr.r[2], s, {share, share + 2}, {near, near + n}, to_prox, to_dist);
     }
     // The new vessel b→x: next to s's parent and sibling (through the proximal part) and s's children.
     {
       const std::int32_t near[4] = {q, sib, c0, c1};
-      if (capsuleHits(tr.b, x, kMargin * tr.r[2], s, {}, {near, near + 4})) return true;
+      if (capsuleHits(tr.b, x, kMargin * tr.r[2], s, {}, {near, near + 4}, to_prox, to_dist)) return true;
     }
     // The distal part b→xd: shares xd with s's children; next to s's parent, sibling, grandchildren.
     {
@@ -456,7 +488,7 @@ class DccoGrower {
       int n = 2;
       kids(c0, near, n);
       kids(c1, near, n);
-      if (capsuleHits(tr.b, T.position[s], kMargin * tr.r[1], s, {share, share + 2}, {near, near + n})) return true;
+      if (capsuleHits(tr.b, T.position[s], kMargin * tr.r[1], s, {share, share + 2}, {near, near + n}, to_prox, 0)) return true;
     }
     // The proximal part q→b: shares q with s's parent and sibling; next to their neighbours and s's children.
     {
@@ -468,7 +500,7 @@ class DccoGrower {
         near[n++] = T.parent[T.parent[q]] >= 0 ? T.sibling(q) : -1;
       }
       kids(sib, near, n);
-      if (capsuleHits(T.position[q], tr.b, kMargin * tr.r[0], s, {share, share + 2}, {near, near + n})) return true;
+      if (capsuleHits(T.position[q], tr.b, kMargin * tr.r[0], s, {share, share + 2}, {near, near + n}, 0, to_dist)) return true;
     }
     return false;
   }
@@ -476,11 +508,12 @@ class DccoGrower {
   // True if the capsule a–e of radius r overlaps a vessel other than `skip` and `share` (which
   // meet it), with `near` (one segment away) held only to the rule for near neighbours.
   bool capsuleHits(const Vec3& a, const Vec3& e, double r, std::int32_t skip, std::span<const std::int32_t> share,
-                   std::span<const std::int32_t> near) {
+                   std::span<const std::int32_t> near, double from_prox, double from_dist) {
     const auto in = [](std::span<const std::int32_t> list, std::int32_t y) { return std::find(list.begin(), list.end(), y) != list.end(); };
-    return hitsVessel(a, e, r, [&](std::int32_t y) {
-      return y == skip || in(share, y) ? Neighbour::Meets : in(near, y) ? Neighbour::Near : Neighbour::Apart;
-    });
+    return hitsVessel(
+        a, e, r,
+        [&](std::int32_t y) { return y == skip || in(share, y) ? Neighbour::Meets : in(near, y) ? Neighbour::Near : Neighbour::Apart; },
+        [&](std::int32_t y, double reach) { return joinedAlongVessel(t_, skip, y, reach, from_prox, from_dist); });
   }
 
   // The vessels of the last commit (proximal part, distal part s, new vessel) against the tree.
@@ -762,6 +795,12 @@ class DccoGrower {
     report_.intersecting_pairs = std::int64_t(pairs.size());
     for (const auto& [x, y] : pairs) {
       if (T.stage[x] < 0 && T.stage[y] < 0 && given_ > 0) {  // the initial network as it was given
+        --report_.intersecting_pairs;
+        continue;
+      }
+      // Pieces of one vessel of the initial network, and a branch off it, within reach along it
+      // (the rule growth held them to).
+      if (given_ > 0 && joinedAlongVessel(T, x, y, kMargin * (T.radius[x] + T.radius[y]))) {
         --report_.intersecting_pairs;
         continue;
       }

@@ -76,6 +76,7 @@ struct DccoOptions {
   // take stage -1; each of its roots is an inlet with the fixed radius root_radii[tree] (empty:
   // root_radius), all inlets share Q by the terminals they feed.
   const VascularTree* initial = nullptr;
+  std::vector<std::string> initial_names;  // per node of `initial`: how errors name it (its file, line and id)
   std::vector<double> root_radii;
   std::vector<DccoStage> stages;
   std::uint64_t seed = 1, sample = 0;

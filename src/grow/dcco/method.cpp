@@ -1,6 +1,7 @@
 // Method "dcco": its parameters, TOML reader, description, domains and grow function.
 #include <cmath>
 #include <map>
+#include <random>
 #include <set>
 
 #include "core/error.hpp"
@@ -87,6 +88,7 @@ class PreparedDcco final : public PreparedGrowth {
                          "stage '" + st.stage.name + "' brings the tree to " + std::to_string(total) + " terminals, more than the " +
                              std::to_string(inside) + " voxels of its terminal region; use fewer terminals or a finer voxel_size");
     }
+    checkGaussians();
     const double r = setup_.options.root_radius;
     if (!setup_.initial_file.empty()) return;
     if (!(world_.depth(root_) > -1e-6 * world_.frame().voxel_mm))
@@ -94,6 +96,44 @@ class PreparedDcco final : public PreparedGrowth {
     if (!(2 * r < 0.5 * std::min({world_.hi().x, world_.hi().y, world_.dimension() == 2 ? world_.hi().x : world_.hi().z})))
       throw InputError(setup_.parameter_file, setup_.root.root_line,
                        "root_radius " + show(r) + " mm is too large for the domain (its frame is " + show3(world_.hi()) + " mm)");
+  }
+  // The share of each stage's Gaussians inside its terminal region, by draws of their own (the
+  // growth's draws are not touched): a mixture whose mass lies outside would have every terminal
+  // drawn again and again.
+  void checkGaussians() const {
+    constexpr int kDraws = 20000;
+    constexpr double kLeast = 1e-3;
+    for (std::size_t k = 0; k < setup_.stages.size(); ++k) {
+      const auto& st = setup_.stages[k].stage;
+      if (st.pdf != TerminalPdf::Gaussian || st.gaussians.empty()) continue;
+      const GrowthDomain& d = *domains_[k].terminals;
+      double total = 0;
+      for (const auto& g : st.gaussians) total += g.weight;
+      std::mt19937_64 pick(0x9a05517);
+      std::normal_distribution<double> normal;
+      std::uniform_real_distribution<double> uniform;
+      int inside = 0;
+      for (int n = 0; n < kDraws; ++n) {
+        double u = uniform(pick) * total;
+        const GaussianComponent* g = &st.gaussians.back();
+        for (const auto& c : st.gaussians)
+          if ((u -= c.weight) < 0) {
+            g = &c;
+            break;
+          }
+        Vec3 p = world_.center() + g->mean;
+        p.x += g->sigma.x * normal(pick);
+        p.y += g->sigma.y * normal(pick);
+        if (d.dimension() == 3) p.z += g->sigma.z * normal(pick);
+        else p.z = d.planeZ();
+        inside += d.depth(p) > 0;
+      }
+      if (double(inside) < kLeast * kDraws)
+        throw InputError(setup_.parameter_file, setup_.stages[k].line,
+                         "stage '" + st.name + "': its Gaussians put " + show(100.0 * inside / kDraws) + " % of their mass inside its terminal region (" +
+                             std::to_string(inside) + " of " + std::to_string(kDraws) + " draws); allowed: at least " + show(100 * kLeast) +
+                             " % (means inside the region, relative to the domain's centre, or wider sigmas)");
+    }
   }
   Forest grow(std::uint64_t seed, std::uint64_t sample, GrowthReport& report, const ProgressFn& progress) const override {
     DccoOptions o = setup_.options;
@@ -104,6 +144,8 @@ class PreparedDcco final : public PreparedGrowth {
     if (!setup_.initial_file.empty()) {
       o.initial = &initial_;
       o.root_radii = setup_.root_radii;
+      for (std::size_t i = 0; i < setup_.initial.ids.size(); ++i)
+        o.initial_names.push_back(setup_.initial_file.string() + ":" + std::to_string(setup_.initial.lines[i]) + ": vessel " + setup_.initial.ids[i]);
     }
     o.stages.clear();
     for (std::size_t k = 0; k < setup_.stages.size(); ++k) {
@@ -244,7 +286,7 @@ void readInitial(const TomlReader& r, const GrowthMethod& m, DccoSetup& s, bool 
     if (!root_radius) throw InputError(r.file(), 0, "[tree] root_radius is required (the fixed radius of the root vessel)");
     return;
   }
-  auto in = readInitialNetwork(r, m, *node);
+  auto in = readInitialNetwork(r, m, *node, flat);
   const auto* t = node->as_table();
   s.initial_file = in.file;
   s.initial = std::move(in.network);
@@ -271,11 +313,15 @@ void readInitial(const TomlReader& r, const GrowthMethod& m, DccoSetup& s, bool 
   if (const auto* list = t->get("vessel")) {
     const auto* arr = list->as_array();
     if (!arr || !arr->is_array_of_tables()) throw InputError(r.file(), r.lineOf(list), "vessel must be an array of tables: write each as [[initial.vessel]]");
+    std::map<std::string, int> given;  // id → the line of its [[initial.vessel]]
     for (const auto& v : *arr) {
       const auto& vt = *v.as_table();
       checkMethodKeys(r, m, vt, "initial.vessel");
       const auto* idn = r.need(vt, "initial.vessel", "id");
       const std::string id = idn->is_integer() ? std::to_string(*idn->value<std::int64_t>()) : r.string(vt, "initial.vessel", "id");
+      if (const auto [at, added] = given.emplace(id, r.lineOf(idn)); !added)
+        throw InputError(r.file(), r.lineOf(idn), "vessel id " + id + " is set again (first on line " + std::to_string(at->second) +
+                                                      "); allowed: one [[initial.vessel]] per vessel");
       const auto it = by_id.find(id);
       if (it == by_id.end())
         throw InputError(r.file(), r.lineOf(idn), "vessel id " + id + " is not a vessel of " + s.initial_file.string() +
@@ -313,7 +359,7 @@ void readInitial(const TomlReader& r, const GrowthMethod& m, DccoSetup& s, bool 
     s.root_radii.push_back(radius);
   }
   s.options.root_radius = *std::max_element(s.root_radii.begin(), s.root_radii.end());
-  if (flat)
+  if (flat)  // one plane (readInitialNetwork checked): the domain's
     for (auto& p : tree.position) p.z = 0;
 }
 
@@ -326,10 +372,13 @@ std::shared_ptr<const GrowthSetup> readDccoToml(const TomlReader& r, const Growt
   auto& o = s->options;
   if (tree.get("root_radius")) {
     o.root_radius = r.quantity(tree, "tree", "root_radius", Dimension::Length);
-    checkRange(o.root_radius, 0, true, Limits::kMaxLength, false, r.at(tree, "root_radius"), "root_radius (mm)");
+    checkRange(o.root_radius, Limits::kMinRadius, false, Limits::kMaxRadius, false, r.at(tree, "root_radius"), "root_radius (mm)");
   }
   readInitial(r, m, *s, flat, tree.get("root_radius") ? &tree : nullptr);
-  if (tree.get("kind")) s->kind = r.string(tree, "tree", "kind");
+  if (tree.get("kind")) {
+    s->kind = r.string(tree, "tree", "kind");
+    if (const auto why = nameProblem(s->kind, "kind"); !why.empty()) throw InputError(r.file(), r.lineOf(tree.get("kind")), why);
+  }
   // [physics]: viscosity "pries" or a quantity.
   if (const auto* v = ph.get("viscosity"); v && v->is_string() && *v->value<std::string>() == "pries") {
     o.viscosity.model = ViscosityModel::Pries;
