@@ -15,13 +15,37 @@ root=$(pwd)
 corpus=build-san/fuzz-corpus
 findings=build-san/fuzz-findings
 mkdir -p "$findings"
-for t in toml_params vascusynth_params box_map noise_file profile dataset_spec manifest nifti_mask network_file; do mkdir -p "$corpus/fuzz_$t"; done
+for t in toml_params vascusynth_params box_map noise_file profile dataset_spec manifest nifti_mask network_file \
+         graph_mesh initial_network method_params mesh_options score plot_calibre; do mkdir -p "$corpus/fuzz_$t"; done
 cp examples/*.toml "$corpus/fuzz_toml_params/" 2>/dev/null || true
 for f in examples/vascusynth/param*.txt; do cp "$f" "$corpus/fuzz_vascusynth_params/"; done
 for f in demand_maps/vascusynth_rods_100.txt demand_maps/supply_100.txt tests/data/*.txt; do [ -f "$f" ] && cp "$f" "$corpus/fuzz_box_map/" || true; done
 for f in noise_profiles/*.txt tests/data/*noise*; do [ -f "$f" ] && cp "$f" "$corpus/fuzz_noise_file/" || true; done
 cp noise_profiles/*.toml "$corpus/fuzz_profile/"
 cp examples/*.swc examples/*.cco tests/data/network/*.vtp "$corpus/fuzz_network_file/" 2>/dev/null || true
+# Graphs for mesh and [initial]: the shipped networks (the initial-network target's first byte
+# picks the method: even DCCO, odd colonisation).
+cp examples/*.swc examples/*.cco tests/data/network/*.vtp "$corpus/fuzz_graph_mesh/" 2>/dev/null || true
+for f in examples/*.swc tests/data/network/*.vtp; do
+  { printf 'D'; cat "$f"; } > "$corpus/fuzz_initial_network/dcco_$(basename "$f")"
+  { printf 'C'; cat "$f"; } > "$corpus/fuzz_initial_network/colonisation_$(basename "$f")"
+done
+# Method parameters: the first byte picks the method (its value mod 5), the rest is a fragment of
+# keys; the shipped examples' tables are the fragments.
+for f in examples/*.toml; do
+  for m in 0 1 2 3 4; do { printf "\\x3$m"; grep -v '^\s*\(demand_map\|file\|mask\) *=' "$f"; } > "$corpus/fuzz_method_params/$m-$(basename "$f")"; done
+done
+# Mesh options: the [mesh] tables of the parameter reference and a few hand-made ones.
+printf 'ends = "capped"\nflow_extension = 2\nremesh = true\n' > "$corpus/fuzz_mesh_options/capped.toml"
+printf 'wall_from_graph = true\nends = "open"\nclip_box = [1, -2, -2, 8, 2, 2]\n' > "$corpus/fuzz_mesh_options/wall.toml"
+printf 'method = "contour"\ndecimate = true\nmax_error = 0.2\nsamples_across = 2\n' > "$corpus/fuzz_mesh_options/contour.toml"
+printf 'junctions = "tetrahedra"\nsliver_angle = 12\nmax_angle = 100\nring_spacing = 3\nvoxel_size = "0.1 mm"\n' > "$corpus/fuzz_mesh_options/tetra.toml"
+# Score results for plot-calibre: one case and a dataset.
+printf '%s' '{"calibre":[{"radius_voxels":[0,0.5],"recall":0.2},{"radius_voxels":[0.5,1],"recall":0.6},{"radius_voxels":[1,null],"recall":null}]}' \
+  > "$corpus/fuzz_plot_calibre/case.json"
+printf '%s' '{"per_case":[{"calibre":[{"radius_voxels":[0,1],"recall":0.5}]},{"calibre":[{"radius_voxels":[0,1],"recall":1}]}]}' \
+  > "$corpus/fuzz_plot_calibre/dataset.json"
+# Predictions (fuzz_score): the target writes its sample's own mask into its corpus on start.
 for f in examples/dataset_*.toml tests/data/dataset_*.toml; do cp "$f" "$corpus/fuzz_dataset_spec/"; done
 printf '%s\n' '{"index":0,"status":"ok","files":[{"path":"imagesTr/F_0000_0000.nii.gz","size":5,"sha256":"6105d6cc76af400325e94d588ce511be5bfdbb73b437dc51eca43917d7a43e3d"}]}' \
   '{"index":1,"status":"failed","error":"x"}' > "$corpus/fuzz_manifest/two_lines.jsonl"
@@ -36,7 +60,8 @@ fi
 # Inputs that once failed, kept so every run tries them first.
 for d in fuzz/regressions/*/; do cp "$d"* "$corpus/$(basename "$d")/" 2>/dev/null || true; done
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_toml_params fuzz_vascusynth_params fuzz_box_map fuzz_noise_file fuzz_profile fuzz_dataset_spec fuzz_manifest fuzz_nifti_mask fuzz_network_file)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_toml_params fuzz_vascusynth_params fuzz_box_map fuzz_noise_file fuzz_profile fuzz_dataset_spec fuzz_manifest fuzz_nifti_mask fuzz_network_file
+                                     fuzz_graph_mesh fuzz_initial_network fuzz_method_params fuzz_mesh_options fuzz_score fuzz_plot_calibre)
 export ASAN_OPTIONS="detect_leaks=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/sanitizer/ubsan.supp"
 status=0

@@ -1,0 +1,23 @@
+// Graph files through `mesh`: the same bytes read as each of the five formats (VItA's .cco,
+// SWC, GXL, VTP, the CSV pair), then meshed with the default tubes under a small memory limit
+// (the surface is built in full, no file is written).
+#include "fuzz_support.hpp"
+#include "io/network_files.hpp"
+#include "pipeline/mesh_outputs.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  using namespace angiosynth;
+  const auto out = fuzz::scratchDir() / "mesh";
+  std::filesystem::create_directories(out);
+  for (const char* name : {"tree.cco", "tree.swc", "tree.gxl", "tree.vtp", "tree_nodes.csv"}) {
+    const auto file = fuzz::writeInput(data, size, name);
+    if (std::string(name) == "tree_nodes.csv") fuzz::writeInput(data, size, "tree_edges.csv");
+    fuzz::expectOnlyInputErrors([&] {
+      const auto net = readNetwork(file, 1, fuzz::kMemoryLimit);
+      MeshParameters p;
+      p.formats = {};
+      writeSurfaceFiles(net.tree, p, fuzz::kMemoryLimit, out, {}, {}, net.ids);
+    });
+  }
+  return 0;
+}

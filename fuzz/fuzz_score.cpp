@@ -1,0 +1,72 @@
+// Predictions as `score` reads them: the bytes as a NIfTI file (plain, and gzip-compressed as
+// .nii.gz, so truncated and corrupt streams are both tried) scored against a small sample's
+// truth (16^3 voxels, 24 terminals), with TopCoW's conventions on odd first bytes.
+#include <zlib.h>
+
+#include "fuzz_support.hpp"
+#include "io/scenario.hpp"
+#include "pipeline/generate_sample.hpp"
+#include "score/case_scores.hpp"
+
+namespace {
+
+const std::filesystem::path& sampleDir() {
+  static const std::filesystem::path dir = [] {
+    using namespace angiosynth;
+    const auto root = fuzz::scratchDir();
+    const auto map = root / "score_map16.txt";
+    std::ofstream(map) << "16 16 16\n0 0 0 16 16 16\n1\n";
+    const auto params = root / "score_sample.toml";
+    std::ofstream(params) << "seed = 3\n[domain]\ndemand_map = \"" << map.string()
+                          << "\"\nvoxel_size = \"1 mm\"\n[tree]\nterminals = 24\nroot_voxel = [0, 8, 8]\n"
+                             "[physics]\nviscosity = \"3.6 mPa*s\"\nperfusion_pressure = \"13300 Pa\"\n"
+                             "terminal_pressure = \"8300 Pa\"\nperfusion_flow = \"100 mm3/s\"\n"
+                             "[image]\nformats = [\"nifti\"]\ngraph_formats = [\"csv\"]\n";
+    const Scenario sc = readTomlParameters(params);
+    const auto out = root / "score_sample";
+    std::filesystem::remove_all(out);
+    std::filesystem::create_directories(out);
+    SampleRequest req;
+    req.scenario = &sc;
+    req.memory_limit = fuzz::kMemoryLimit;
+    req.profiles = std::vector<Profile>{};
+    generateSample(req, out);
+    return out;
+  }();
+  return dir;
+}
+
+}  // namespace
+
+// The sample's own mask, uncompressed, joins the corpus (the last argument naming a directory):
+// mutations of a prediction on the right grid reach past the header checks.
+extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
+  for (int k = *argc - 1; k > 0; --k) {
+    const std::filesystem::path corpus((*argv)[k]);
+    if ((*argv)[k][0] == '-' || !std::filesystem::is_directory(corpus)) continue;
+    if (gzFile g = gzopen((sampleDir() / "mask.nii.gz").c_str(), "rb")) {
+      std::ofstream seed(corpus / "sample_mask.nii", std::ios::binary);
+      char buf[65536];
+      for (int n; (n = gzread(g, buf, sizeof buf)) > 0;) seed.write(buf, n);
+      gzclose(g);
+    }
+    break;
+  }
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  using namespace angiosynth;
+  const auto truth = sampleTruth(sampleDir());
+  ScoreOptions opt;
+  opt.memory_limit = fuzz::kMemoryLimit;
+  opt.topcow = size > 0 && data[0] % 2 == 1;
+  const auto plain = fuzz::writeInput(data, size, "pred.nii");
+  fuzz::expectOnlyInputErrors([&] { scoreCase(plain, truth, opt); });
+  const auto packed = fuzz::scratchDir() / "pred.nii.gz";
+  if (gzFile g = gzopen(packed.c_str(), "wb")) {
+    if (size > 0) gzwrite(g, data, unsigned(size));
+    gzclose(g);
+  }
+  return fuzz::expectOnlyInputErrors([&] { scoreCase(packed, truth, opt); });
+}
