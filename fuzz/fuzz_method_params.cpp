@@ -6,9 +6,7 @@
 
 #include <sstream>
 
-#include "fuzz_support.hpp"
-#include "io/scenario.hpp"
-#include "pipeline/generate_sample.hpp"
+#include "fuzz_sample.hpp"
 
 namespace {
 
@@ -75,14 +73,5 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto params = fuzz::scratchDir() / "method.toml";
   std::ofstream(params) << base;
   const auto out = fuzz::scratchDir() / "method";
-  return fuzz::expectOnlyInputErrors([&] {
-    std::filesystem::remove_all(out);
-    std::filesystem::create_directories(out);
-    const Scenario sc = readTomlParameters(params);
-    SampleRequest req;
-    req.scenario = &sc;
-    req.memory_limit = fuzz::kMemoryLimit;
-    req.no_image = true;
-    generateSample(req, out);
-  });
+  return fuzz::expectOnlyInputErrors([&] { fuzz::growParameterFile(params, out); });
 }

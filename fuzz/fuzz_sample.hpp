@@ -29,4 +29,17 @@ inline void degradeSmallSample(const Profile& profile) {
   generateSample(req, out);
 }
 
+// A parameter file grown into a fresh `out` (its graphs only, no image), as `generate
+// --no-image` writes it.
+inline void growParameterFile(const std::filesystem::path& params, const std::filesystem::path& out) {
+  std::filesystem::remove_all(out);
+  std::filesystem::create_directories(out);
+  const Scenario sc = readTomlParameters(params);
+  SampleRequest req;
+  req.scenario = &sc;
+  req.memory_limit = kMemoryLimit;
+  req.no_image = true;
+  generateSample(req, out);
+}
+
 }  // namespace angiosynth::fuzz

@@ -285,23 +285,46 @@ TEST_F(Robustness, DccoChainsGrowWhereAPieceCanBranchAndAreRefusedAtOnceWhereNon
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 30.0);
 }
 
-TEST_F(Robustness, DccoGaussiansOutsideTheirStageAreRefusedBeforeGrowth) {
-  std::string t = slurp(test::sourceDir() / "examples/dcco_pdf_gaussian_2d.toml");
-  replaceOnce(t, "mean = [0, 0]", "mean = [500, 500]");
-  replaceOnce(t, "sigma = [6, 6]", "sigma = [1, 1]");
+// A shipped example with `edits` made (each once) and no volume formats, written as `name`.
+void writeExample(const fs::path& dir, const std::string& example, const std::string& name,
+                  const std::vector<std::pair<std::string, std::string>>& edits) {
+  std::string t = slurp(test::sourceDir() / "examples" / example);
+  for (const auto& [from, to] : edits) replaceOnce(t, from, to);
   replaceOnce(t, "formats = [\"nifti\", \"png\"]", "formats = []");
-  write("g.toml", t);
+  std::ofstream(dir / name) << t;
+}
+
+TEST_F(Robustness, DccoRepairKeepsTheTerminalCountsOfAPolylineNetwork) {
+  // VItA's tree with tortuous vessels as polylines (nodes of one child): the repair's removal of
+  // subtrees added a continuation's missing second child, terminals[-1] (fuzz_initial_network).
+  fs::copy_file(test::sourceDir() / "tests/data/network/tree_vita_polylines.vtp", dir_ / "p.vtp");
+  write("p.toml", "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.2 mm\"\n[tree]\nmethod = \"dcco\"\n"
+                  "root_radius = \"0.2 mm\"\n[initial]\nfile = \"p.vtp\"\nbranching = \"versatile\"\nrole = \"distribution\"\n"
+                  "[physics]\nperfusion_flow = \"0.3 mL/min\"\n[[stage]]\nterminals = 12\n[image]\nformats = []\n");
+  GrowthReport report;
+  const auto g = test::growFile(dir_ / "p.toml", 1, &report);
+  const auto& t = g.forest.vessels;
+  ASSERT_GT(report.repair_rounds, 0) << "the repair did not run: the case no longer tests it";
+  std::vector<std::int64_t> below(std::size_t(t.nodeCount()), 0);
+  const auto order = t.topDownOrder();
+  for (auto it = order.rbegin(); it != order.rend(); ++it) {
+    const auto i = *it;
+    if (t.isRoot(i)) continue;
+    below[std::size_t(i)] = t.child0[i] < 0 ? 1 : below[std::size_t(t.child0[i])] + (t.child1[i] >= 0 ? below[std::size_t(t.child1[i])] : 0);
+    EXPECT_EQ(t.terminals[i], below[std::size_t(i)]) << "segment " << i;
+  }
+}
+
+TEST_F(Robustness, DccoGaussiansOutsideTheirStageAreRefusedBeforeGrowth) {
+  writeExample(dir_, "dcco_pdf_gaussian_2d.toml", "g.toml", {{"mean = [0, 0]", "mean = [500, 500]"}, {"sigma = [6, 6]", "sigma = [1, 1]"}});
   const auto r = run("generate g.toml --out o --no-image", dir_);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("its Gaussians put 0 % of their mass inside its terminal region"), std::string::npos) << r.err;
 }
 
 TEST_F(Robustness, CurvePiecesFarBelowTheVesselsStayFew) {
-  std::string t = slurp(test::sourceDir() / "examples/cco_sphere_curved_3d.toml");
-  replaceOnce(t, "terminals = 4000", "terminals = 50");
-  replaceOnce(t, "wall_clearance", "piece_length = \"1e-4 mm\"\nwall_clearance");
-  replaceOnce(t, "formats = [\"nifti\", \"png\"]", "formats = []");
-  write("c.toml", t);
+  writeExample(dir_, "cco_sphere_curved_3d.toml", "c.toml",
+               {{"terminals = 4000", "terminals = 50"}, {"wall_clearance", "piece_length = \"1e-4 mm\"\nwall_clearance"}});
   const auto r = run("generate c.toml --out o --no-image --quiet", dir_);
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream in(dir_ / "o" / "sample.json");

@@ -252,7 +252,8 @@ void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments, con
     out.depth[i] = out.depth[out.parent[i]] + 1;
   }
   for (auto it = order.rbegin(); it != order.rend(); ++it)
-    if (out.parent[*it] >= 0 && out.child0[*it] >= 0) out.terminals[*it] = out.terminals[out.child0[*it]] + out.terminals[out.child1[*it]];
+    if (out.parent[*it] >= 0 && out.child0[*it] >= 0)  // a continuation (a polyline's node) has one child
+      out.terminals[*it] = out.terminals[out.child0[*it]] + (out.child1[*it] >= 0 ? out.terminals[out.child1[*it]] : 0);
   *this = std::move(out);
 }
 
