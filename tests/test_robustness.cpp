@@ -222,6 +222,16 @@ TEST_F(Robustness, EveryGraphReaderHoldsValuesToThePhysicalRanges) {
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 10.0);
 }
 
+TEST(RobustnessFiles, AJunctionsLinksAreReadWhereverTheNodesArrayMoves) {
+  // A link was added at its junction's position by reference, which the push_back of the link
+  // itself could move (heap-use-after-free under the sanitizers; found by fuzz_graph_mesh).
+  const auto net = readNetwork(test::sourceDir() / "fuzz/regressions/fuzz_graph_mesh/junction-link-position-moved.swc");
+  const auto& t = net.tree;
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i)
+    if (t.isLink(i)) EXPECT_EQ(t.length[i], 0.0) << "link " << i;
+  EXPECT_EQ(t.roots().size(), 1u);
+}
+
 TEST_F(Robustness, ClipBoxesAreBoundedAndBeyondTheSurfaceCutNothing) {
   write("v.swc", "1 1 0 0 0 0.5 -1\n2 3 20 0 0 0.5 1\n");
   const auto volume = [&](const std::string& box) {

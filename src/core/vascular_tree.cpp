@@ -84,7 +84,9 @@ void VascularTree::setPieceOf(const VascularTree& t, std::int32_t n, int q, int 
   depth[id] = t.depth[n];
 }
 
-std::int32_t VascularTree::addNode(const Vec3& p, std::int32_t parent_node, std::int32_t tree_id) {
+std::int32_t VascularTree::addNode(const Vec3& at, std::int32_t parent_node, std::int32_t tree_id) {
+  // A copy: `at` may be a node's own position (a link at its junction), which push_back moves.
+  const Vec3 p = at;
   const auto id = nodeCount();
   position.push_back(p);
   parent.push_back(parent_node);
