@@ -3,6 +3,8 @@
 // is one defect that was seen: a lost file, a crash, a hang or nonsense with exit 0.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -108,6 +110,37 @@ TEST_F(Robustness, AtomicFilesAreCreatedExclusivelyAndLeaveNoTemporary) {
   EXPECT_EQ(slurp(dir_ / "kept.txt"), "new\n");
   EXPECT_THROW(writeFileAtomically(dir_ / "no_such_dir" / "x.json", "{}"), InputError);
   EXPECT_EQ(files(dir_), "kept.txt\n");
+}
+
+// A SIGKILL leaves an AtomicFile's temporary behind (a killed dataset run left manifest.jsonl's):
+// the next writer of that file, or a dataset run in that directory, removes those of processes
+// that are gone, and nothing else.
+TEST_F(Robustness, TemporariesOfKilledProcessesAreRemovedAndNoOtherFile) {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ASSERT_GT(child, 0);
+  ::waitpid(child, nullptr, 0);
+  const std::string self = stagingSuffix();
+  const std::string host = self.substr(0, self.rfind('-'));
+  const std::string gone = host + "-" + std::to_string(child) + "-0123456789abcdef";
+  write(".kept.txt.tmp-angiosynth-" + gone, "killed\n");
+  write(".other.txt.tmp-angiosynth-" + gone, "killed\n");
+  write(".kept.txt.tmp-angiosynth-" + self + "-0123456789abcdef", "this process is writing it\n");
+  write(".kept.txt.tmp-angiosynth-elsewhere-1-0123456789abcdef", "another machine may still be writing it\n");
+  write(".kept.txt.tmp-angiosynth-notes", "the user's own\n");
+  write("target.txt", "a file a link points to\n");
+  fs::create_symlink(dir_ / "target.txt", dir_ / (".link.txt.tmp-angiosynth-" + gone));
+  writeFileAtomically(dir_ / "kept.txt", "new\n");
+  EXPECT_FALSE(fs::exists(dir_ / (".kept.txt.tmp-angiosynth-" + gone)));
+  EXPECT_TRUE(fs::exists(dir_ / (".other.txt.tmp-angiosynth-" + gone))) << "only the temporaries of the file written";
+  EXPECT_EQ(removeAbandonedTemporaries(dir_), 1);
+  for (const std::string& kept : {".kept.txt.tmp-angiosynth-" + self + "-0123456789abcdef",
+                                   std::string(".kept.txt.tmp-angiosynth-elsewhere-1-0123456789abcdef"),
+                                   std::string(".kept.txt.tmp-angiosynth-notes"), ".link.txt.tmp-angiosynth-" + gone,
+                                   std::string("kept.txt"), std::string("target.txt")})
+    EXPECT_TRUE(fs::exists(fs::symlink_status(dir_ / kept))) << kept;
+  EXPECT_FALSE(fs::exists(dir_ / (".other.txt.tmp-angiosynth-" + gone)));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 6);
 }
 
 TEST_F(Robustness, PlotCalibreNeverWritesOverItsInput) {

@@ -251,6 +251,8 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
   checkExistingDataset(spec, dir, todo, opt, spec_changed);
   for (const char* sub : {"imagesTr", "labelsTr", "groundtruth", "manifest"}) fs::create_directories(dir / sub);
   const fs::path staging = processStaging(dir);
+  // Files of a run that was killed while writing them (SIGKILL cannot be caught).
+  for (const fs::path& d : {dir, dir / "manifest"}) removeAbandonedTemporaries(d);
   // The same content from every process, so concurrent shards may all write it.
   Json spec_record{{"name", spec.name},
                    {"id", spec.id},

@@ -35,7 +35,34 @@ bool renameNoReplace(const fs::path& from, const fs::path& to, int& error) {
   return true;
 }
 
+constexpr std::string_view kTemporaryMarker = ".tmp-angiosynth-";
+
+// The owner of a temporary's name ".NAME.tmp-angiosynth-HOST-PID-RANDOM", as "HOST-PID".
+std::string temporaryOwner(const std::string& name) {
+  const auto marker = name.rfind(kTemporaryMarker);
+  const auto last_dash = name.rfind('-');
+  if (name.empty() || name[0] != '.' || marker == std::string::npos || last_dash == std::string::npos) return {};
+  const auto owner_at = marker + kTemporaryMarker.size();
+  if (last_dash <= owner_at) return {};
+  return name.substr(owner_at, last_dash - owner_at);
+}
+
 }  // namespace
+
+int removeAbandonedTemporaries(const fs::path& dir, const std::string& target_name) {
+  int removed = 0;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (!target_name.empty() && name.rfind("." + target_name + std::string(kTemporaryMarker), 0) != 0) continue;
+    const std::string owner = temporaryOwner(name);
+    std::error_code type_ec;
+    if (owner.empty() || !e.is_regular_file(type_ec) || e.is_symlink(type_ec) || !stagingOwnerIsGone(owner)) continue;
+    std::error_code rm;
+    if (fs::remove(e.path(), rm)) ++removed;
+  }
+  return removed;
+}
 
 AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
   if (target_.empty() || !target_.has_filename())
@@ -43,6 +70,7 @@ AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
   const fs::path dir = target_.has_parent_path() ? target_.parent_path() : fs::path(".");
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw InputError(target_.string(), 0, "its directory " + dir.string() + " does not exist; create it first");
+  removeAbandonedTemporaries(dir, target_.filename().string());
   std::random_device entropy;
   std::mt19937_64 pick((std::uint64_t(entropy()) << 32) ^ entropy() ^ std::uint64_t(::getpid()));
   for (int attempt = 0; attempt < 64; ++attempt) {
@@ -51,7 +79,9 @@ AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
     // Built by appending: GCC 12 misreads `"." + std::string` as an overlapping copy (-Wrestrict).
     std::string name(1, '.');
     name += target_.filename().string();
-    name += ".tmp-angiosynth-";
+    name += kTemporaryMarker;
+    name += stagingSuffix();
+    name += '-';
     name += suffix;
     temporary_ = dir / name;
     const int fd = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
