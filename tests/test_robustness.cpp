@@ -260,8 +260,11 @@ TEST(RobustnessFiles, AJunctionsLinksAreReadWhereverTheNodesArrayMoves) {
   // itself could move (heap-use-after-free under the sanitizers; found by fuzz_graph_mesh).
   const auto net = readNetwork(test::sourceDir() / "fuzz/regressions/fuzz_graph_mesh/junction-link-position-moved.swc");
   const auto& t = net.tree;
-  for (std::int32_t i = 0; i < t.nodeCount(); ++i)
-    if (t.isLink(i)) EXPECT_EQ(t.length[i], 0.0) << "link " << i;
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    if (t.isLink(i)) {
+      EXPECT_EQ(t.length[i], 0.0) << "link " << i;
+    }
+  }
   EXPECT_EQ(t.roots().size(), 1u);
 }
 
@@ -363,6 +366,22 @@ TEST_F(Robustness, DccoGaussiansOutsideTheirStageAreRefusedBeforeGrowth) {
   const auto r = run("generate g.toml --out o --no-image", dir_);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("its Gaussians put 0 % of their mass inside its terminal region"), std::string::npos) << r.err;
+}
+
+TEST_F(Robustness, DccoRootOutsideItsFirstStagesDomainIsRefusedBeforeDrawing) {
+  // The root sits on the 21 mm disc's border, 1 mm outside the ring its first stage distributes
+  // in: a million draws (14 s) were refused one by one before the growth gave up.
+  write("r.toml", "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"21 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"dcco\"\n"
+                  "root_radius = \"0.6 mm\"\n[physics]\nperfusion_flow = \"4 mL/min\"\n[[region]]\nname = \"ring\"\nshape = \"annulus\"\n"
+                  "inner_radius = \"12 mm\"\nouter_radius = \"20 mm\"\n[[stage]]\nname = \"ring\"\nterminals = 30\ndomain = [\"ring\"]\n"
+                  "[image]\nformats = []\n");
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto r = run("generate r.toml --out o --no-image", dir_);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("lies 1 mm outside the stage's domain"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("allowed: a root at most 0.612 mm"), std::string::npos) << r.err;
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
 }
 
 TEST_F(Robustness, CurvePiecesFarBelowTheVesselsStayFew) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <span>
 
@@ -217,10 +218,28 @@ class DccoGrower {
     return lc_ * std::pow(stage().nu / double(terminalCount() + 1), 1.0 / D);
   }
 
+  // A distributing stage's root vessel lies inside the stage's domain (at depth r) from 2 r past
+  // the root on. Depth changes by at most the distance moved, so a root more than r (and a
+  // voxel of the region's map) outside that domain can never be joined: every draw would fail.
+  void refuseRootOutsideItsStage() const {
+    const auto& st = stage();
+    if (st.role != VesselRole::Distribution || !st.vessels) return;
+    const double r = kMargin * o_.root_radius;
+    const double outside = -st.vessels->depth(o_.root_mm);
+    if (outside <= r + st.vessels->frame().voxel_mm) return;
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "stage '%s': the root at (%.6g, %.6g, %.6g) mm lies %.6g mm outside the stage's domain, where its vessels "
+                  "must run; allowed: a root at most %.6g mm (the root vessel's radius) outside it; move the root or widen the domain",
+                  st.name.c_str(), o_.root_mm.x, o_.root_mm.y, o_.root_mm.z, outside, r);
+    throw GrowthError(text);
+  }
+
   // The root segment (Algorithm 2, line 1): a drawn point far enough from the root, with l > 2 r.
   void plantRoot() {
     double lim = limitLength();
     const auto& st = stage();
+    refuseRootOutsideItsStage();
     for (std::int64_t draws = 1; draws <= o_.max_draws; ++draws) {
       ++report_.candidates;
       const Vec3 p = draw();
