@@ -121,8 +121,8 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   if (p.hollowWall() && a.ends == "capped")
     throw InputError("", 0, "a hollow wall keeps its ends open (the lumen runs through); allowed: --ends open (or closed, which opens them)");
   if (a.voxel_mm > 0 && a.voxel_mm < physical::kMinStepMm)
-    throw InputError("", 0, "--voxel " + physical::shown(a.voxel_mm) + " mm is out of range; allowed: " + physical::shown(physical::kMinStepMm) + " to " +
-                                physical::shown(physical::kMaxStepMm) + " mm (0: the default)");
+    throw InputError("", 0, "--voxel " + show(a.voxel_mm) + " mm is out of range; allowed: " + show(physical::kMinStepMm) + " to " +
+                                show(physical::kMaxStepMm) + " mm (0: the default)");
   p.voxel_mm = a.voxel_mm;
   p.samples_across = a.samples_across;
   p.uniform = a.uniform;

@@ -4,10 +4,10 @@
 // on what a vessel can be. Generous beyond any vasculature, and small enough that no product of
 // them overflows a double, a grid index or a triangle count.
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 #include "core/error.hpp"
+#include "core/format.hpp"
 
 namespace angiosynth::physical {
 
@@ -22,32 +22,26 @@ inline constexpr double kMaxStepMm = 1e4;        // … 10 m
 // length every walk through the tree pays.
 inline constexpr int kMaxJunctionChildren = 64;
 
-inline std::string shown(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
 // A radius: in [kMinRadiusMm, kMaxRadiusMm], or 0 where `zero_means_unset` (a graph file may
 // leave radii to the growth that continues it).
 inline void checkRadius(double r_mm, const std::string& file, int line, const std::string& what, bool zero_means_unset = false) {
   if (zero_means_unset && r_mm == 0) return;
   if (!(r_mm >= kMinRadiusMm && r_mm <= kMaxRadiusMm))
-    throw InputError(file, line, what + " " + shown(r_mm) + " mm is out of range; allowed: " + shown(kMinRadiusMm) + " to " +
-                                     shown(kMaxRadiusMm) + " mm" + (zero_means_unset ? " (or 0: not given)" : ""));
+    throw InputError(file, line, what + " " + show(r_mm) + " mm is out of range; allowed: " + show(kMinRadiusMm) + " to " +
+                                     show(kMaxRadiusMm) + " mm" + (zero_means_unset ? " (or 0: not given)" : ""));
 }
 
 inline void checkCoordinate(double v_mm, const std::string& file, int line, const std::string& what) {
   if (!(std::abs(v_mm) <= kMaxCoordinateMm))
-    throw InputError(file, line, what + " " + shown(v_mm) + " mm is out of range; allowed: -" + shown(kMaxCoordinateMm) + " to " +
-                                     shown(kMaxCoordinateMm) + " mm");
+    throw InputError(file, line, what + " " + show(v_mm) + " mm is out of range; allowed: -" + show(kMaxCoordinateMm) + " to " +
+                                     show(kMaxCoordinateMm) + " mm");
 }
 
 // A length or distance in (0, kMaxLengthMm] (or [0, …] with `zero_allowed`).
 inline void checkLength(double v_mm, const std::string& file, int line, const std::string& what, bool zero_allowed = false) {
   if (!((zero_allowed ? v_mm >= 0 : v_mm > 0) && v_mm <= kMaxLengthMm))
-    throw InputError(file, line, what + " " + shown(v_mm) + " mm is out of range; allowed: " + (zero_allowed ? "0" : "more than 0") +
-                                     " to " + shown(kMaxLengthMm) + " mm");
+    throw InputError(file, line, what + " " + show(v_mm) + " mm is out of range; allowed: " + (zero_allowed ? "0" : "more than 0") +
+                                     " to " + show(kMaxLengthMm) + " mm");
 }
 
 }  // namespace angiosynth::physical

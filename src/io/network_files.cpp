@@ -71,8 +71,8 @@ ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, 
     if (r.radius_start != -1) physical::checkRadius(r.radius_start * unit_mm, file, r.line, of + ": its radius at the start", true);
     for (const double w : {r.wall_start, r.wall})
       if (!(w * unit_mm >= 0 && w * unit_mm <= physical::kMaxRadiusMm))
-        throw InputError(file, r.line, of + ": a wall thickness of " + physical::shown(w * unit_mm) + " mm is out of range; allowed: 0 (none) to " +
-                                           physical::shown(physical::kMaxRadiusMm) + " mm");
+        throw InputError(file, r.line, of + ": a wall thickness of " + show(w * unit_mm) + " mm is out of range; allowed: 0 (none) to " +
+                                           show(physical::kMaxRadiusMm) + " mm");
   }
   std::vector<std::vector<std::size_t>> kids(rows.size());
   std::vector<std::size_t> roots;

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/physical_ranges.hpp"
 #include "core/vec3.hpp"
 
@@ -13,12 +14,6 @@ struct Where {
   std::string file;
   int line;
 };
-
-inline std::string show(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
 
 inline std::string show3(const Vec3& v) { return show(v.x) + " " + show(v.y) + " " + show(v.z); }
 

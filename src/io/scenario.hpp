@@ -83,8 +83,8 @@ inline std::string clipBoxProblem(const MeshParameters& p) {
   if (p.clip_box.size() != 6) return "clip_box must hold 6 numbers (mm): x0, y0, z0, x1, y1, z1";
   for (double c : p.clip_box)
     if (!(std::abs(c) <= physical::kMaxCoordinateMm))
-      return "clip_box corner coordinate " + physical::shown(c) + " mm is out of range; allowed: -" + physical::shown(physical::kMaxCoordinateMm) +
-             " to " + physical::shown(physical::kMaxCoordinateMm) + " mm";
+      return "clip_box corner coordinate " + show(c) + " mm is out of range; allowed: -" + show(physical::kMaxCoordinateMm) +
+             " to " + show(physical::kMaxCoordinateMm) + " mm";
   for (int k = 0; k < 3; ++k)
     if (!(p.clip_box[std::size_t(k)] < p.clip_box[std::size_t(k + 3)]))
       return "clip_box's lower corner must lie below its upper one on every axis; allowed: x0 < x1, y0 < y1, z0 < z1 (mm)";

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <numbers>
 #include <span>
 
@@ -119,7 +118,7 @@ class DccoGrower {
     if (shortest < 0) return;  // nothing may branch: the stages' own checks say so
     const std::string name = std::size_t(shortest) < o_.initial_names.size() ? o_.initial_names[std::size_t(shortest)] : "vessel " + std::to_string(shortest);
     throw GrowthError("no vessel of the initial network can take a branch: each one that may is shorter than its radius at the flow it "
-                      "carries (" + name + ": " + physical::shown(t_.length[shortest]) + " mm long, radius " + physical::shown(t_.radius[shortest]) +
+                      "carries (" + name + ": " + show(t_.length[shortest]) + " mm long, radius " + show(t_.radius[shortest]) +
                       " mm); allowed: pieces at least as long as their radius (join a polyline's samples)");
   }
 
@@ -227,12 +226,10 @@ class DccoGrower {
     const double r = kMargin * o_.root_radius;
     const double outside = -st.vessels->depth(o_.root_mm);
     if (outside <= r + st.vessels->frame().voxel_mm) return;
-    char text[320];
-    std::snprintf(text, sizeof text,
-                  "stage '%s': the root at (%.6g, %.6g, %.6g) mm lies %.6g mm outside the stage's domain, where its vessels "
-                  "must run; allowed: a root at most %.6g mm (the root vessel's radius) outside it; move the root or widen the domain",
-                  st.name.c_str(), o_.root_mm.x, o_.root_mm.y, o_.root_mm.z, outside, r);
-    throw GrowthError(text);
+    throw GrowthError("stage '" + st.name + "': the root at (" + show(o_.root_mm.x) + ", " + show(o_.root_mm.y) + ", " +
+                      show(o_.root_mm.z) + ") mm lies " + show(outside) +
+                      " mm outside the stage's domain, where its vessels must run; allowed: a root at most " + show(r) +
+                      " mm (the root vessel's radius) outside it; move the root or widen the domain");
   }
 
   // The root segment (Algorithm 2, line 1): a drawn point far enough from the root, with l > 2 r.
