@@ -123,17 +123,16 @@ class DccoGrower {
   }
 
   VascularTree run(const ProgressFn& progress) {
-    std::int64_t total = 0, before = 0;
+    std::int64_t total = 0;
     for (const auto& st : o_.stages) total += st.terminal_count;
     for (std::size_t k = 0; k < o_.stages.size(); ++k) {
       stage_ = int(k);
       const auto& st = o_.stages[k];
       made_ = 0;
       lc_ = characteristicLength(*st.terminals);
-      growStage(progress, before, total);
-      repairStage(progress, before, total);
+      growStage(progress, total);
+      repairStage(progress, total);
       dr_.stage_terminals.push_back(made_);
-      before += made_;
     }
     dr_.viscosity_iterations = solve();
     finalCounts();
@@ -232,12 +231,21 @@ class DccoGrower {
                       " mm (the root vessel's radius) outside it; move the root or widen the domain");
   }
 
+  // Failed draws in a row before a stage gives up. After this many relaxations the spacing limit
+  // is f_r^100 of itself (3e-5 at the usual 0.9, far below any vessel's radius): what still fails
+  // is geometry that more draws do not change, and a hopeless stage is refused in a second.
+  std::int64_t drawBudget() const {
+    constexpr std::int64_t kRelaxationsBeforeGivingUp = 100;
+    return std::min(o_.max_draws, kRelaxationsBeforeGivingUp * std::int64_t(stage().draws_before_relaxing));
+  }
+
   // The root segment (Algorithm 2, line 1): a drawn point far enough from the root, with l > 2 r.
   void plantRoot() {
     double lim = limitLength();
     const auto& st = stage();
     refuseRootOutsideItsStage();
-    for (std::int64_t draws = 1; draws <= o_.max_draws; ++draws) {
+    const std::int64_t budget = drawBudget();
+    for (std::int64_t draws = 1; draws <= budget; ++draws) {
       ++report_.candidates;
       const Vec3 p = draw();
       const double l = distance(o_.root_mm, p);
@@ -769,7 +777,7 @@ class DccoGrower {
     return false;
   }
 
-  void growStage(const ProgressFn& progress, std::int64_t before, std::int64_t total) {
+  void growStage(const ProgressFn& progress, std::int64_t total) {
     const auto& st = stage();
     std::int64_t next_report = 0;
     if (t_.nodeCount() < 2) plantRoot();
@@ -779,10 +787,11 @@ class DccoGrower {
         next_report = terminalCount() + std::max<std::int64_t>(1, total / 200);
       }
       double lim = limitLength();
+      const std::int64_t budget = drawBudget();
       for (std::int64_t failures = 1;; ++failures) {
-        if (failures > o_.max_draws)
-          throw GrowthError("stage '" + st.name + "' placed " + std::to_string(terminalCount() - before) + " of its " +
-                            std::to_string(st.terminal_count) + " terminals: " + std::to_string(o_.max_draws) +
+        if (failures > budget)
+          throw GrowthError("stage '" + st.name + "' placed " + std::to_string(made_) + " of its " + std::to_string(st.terminal_count) +
+                            " terminals: " + std::to_string(budget) +
                             " points in a row found no admissible connection; lower its terminals, relax its angle or symmetry limits, "
                             "or enlarge its domain");
         const Vec3 x = draw();
@@ -945,7 +954,7 @@ class DccoGrower {
 
   // The stage's exact tree is checked; vessels of this stage that break a constraint are removed
   // and regrown in the stage, until none is left (older vessels are never removed).
-  void repairStage(const ProgressFn& progress, std::int64_t before, std::int64_t total) {
+  void repairStage(const ProgressFn& progress, std::int64_t total) {
     for (int round = 0;; ++round) {
       solve();
       const auto moved = moved_;
@@ -986,7 +995,7 @@ class DccoGrower {
       made_ = stageTerminals();
       checked_ = t_.radius;
       index_.refresh(t_, true);
-      growStage(progress, before, total);
+      growStage(progress, total);
     }
   }
 
