@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 
 namespace angiosynth::bench {
 

@@ -8,7 +8,7 @@
 
 #include "fuzz_support.hpp"
 #include "io/network_files.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 #include "pipeline/mesh_outputs.hpp"
 
 namespace {

@@ -2,7 +2,7 @@
 // A small sample (24 terminals, 16^3 voxels) through the whole pipeline with a fuzzed profile;
 // no volume files are written (formats = []), the degradation itself runs in full.
 #include "fuzz_support.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 #include "pipeline/generate_sample.hpp"
 
 namespace angiosynth::fuzz {

@@ -4,7 +4,7 @@
 #include <zlib.h>
 
 #include "fuzz_support.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 #include "pipeline/generate_sample.hpp"
 #include "score/case_scores.hpp"
 

@@ -1,6 +1,6 @@
 // TOML parameter files: parsed, then every input they name read and checked as before growth.
 #include "fuzz_support.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 #include "pipeline/generate_sample.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -1,6 +1,6 @@
 // VascuSynth parameter files (KEY: value lines).
 #include "fuzz_support.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 #include "pipeline/generate_sample.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "grow/dcco/setup.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 
 namespace angiosynth::test {
 

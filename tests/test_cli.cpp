@@ -10,7 +10,7 @@
 
 #include "cli_run.hpp"
 #include "grow/method.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 
 using Json = nlohmann::json;
 namespace fs = std::filesystem;

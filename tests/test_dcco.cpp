@@ -19,7 +19,7 @@
 #include "grow/dcco/setup.hpp"
 #include "io/graph_writers.hpp"
 #include "io/network_files.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 #include "physics/viscosity.hpp"
 #include "grow_file.hpp"
 #include "test_support.hpp"

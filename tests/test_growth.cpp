@@ -11,7 +11,7 @@
 #include "domain/demand_sampler.hpp"
 #include "grow/common/bifurcation_optimizer.hpp"
 #include "grow/common/intersections.hpp"
-#include "grow/common/segment_index.hpp"
+#include "core/segment_index.hpp"
 #include "physics/hemodynamics.hpp"
 #include "test_support.hpp"
 #include "tree_checks.hpp"

@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "grow/vascusynth/setup.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 
 namespace {
 const angiosynth::GrowthOptions& vsGrowth(const angiosynth::Scenario& s) {

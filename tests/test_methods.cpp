@@ -10,7 +10,7 @@
 #include "grow/cco/setup.hpp"
 #include "grow/common/method_tables.hpp"
 #include "grow/method.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 #include "test_support.hpp"
 
 namespace angiosynth {

@@ -11,7 +11,7 @@
 #include "grow/vascusynth/grower.hpp"
 #include "grow/vascusynth/setup.hpp"
 #include "io/map_files.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 
 namespace angiosynth::test {
 

@@ -1,5 +1,5 @@
 // Volume and graph files as other tools read them: NIfTI through nibabel, GraphML through
-// NetworkX, PNG/TIFF through OpenImageIO, NRRD by its header.
+// NetworkX, PNG/TIFF through OpenImageIO, MetaImage through VTK, NRRD by its header.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -76,6 +76,40 @@ TEST_F(VolumeFiles, NrrdHeaderDescribesTheSameGeometryInLps) {
   EXPECT_NE(header.find("space directions: (-0.5,0,0) (0,-0.25,0) (0,0,2)"), std::string::npos) << header;
   EXPECT_NE(header.find("space origin: (3,-1.5,10)"), std::string::npos) << header;
   EXPECT_NE(header.find("sizes: 7 5 3"), std::string::npos) << header;
+}
+
+TEST_F(VolumeFiles, MetaImageReadByVtkHoldsTheNiftisVoxelsAndItsHeaderTheSameGeometryInLps) {
+  Volume<std::uint32_t> labels(grid_);
+  for (std::size_t v = 0; v < labels.data.size(); ++v) labels.data[v] = static_cast<std::uint32_t>(v * 40503u + 7u);
+  Volume<float> image(grid_);
+  for (std::size_t v = 0; v < image.data.size(); ++v) image.data[v] = 0.125f * float(v);
+  for (const char* stem : {"labels", "image"}) {
+    const bool label = std::string(stem) == "labels";
+    const auto view = label ? viewOf(labels, true, stem) : viewOf(image, false, stem);
+    writeNifti(dir_ / (std::string(stem) + ".nii.gz"), view);
+    writeMetaImage(dir_ / (std::string(stem) + ".mha"), view);
+  }
+  // VTK's reader takes spacing, origin and voxels (not the direction, which the header states).
+  const std::string out = python(R"(
+import vtk, nibabel as nib, numpy as np
+from vtk.util.numpy_support import vtk_to_numpy
+d = ')" + dir_.string() + R"('
+for stem in ('labels', 'image'):
+    r = vtk.vtkMetaImageReader(); r.SetFileName(d + '/' + stem + '.mha'); r.Update()
+    im = r.GetOutput(); dims = im.GetDimensions()
+    a = vtk_to_numpy(im.GetPointData().GetScalars()).reshape(dims[::-1]).transpose(2, 1, 0)
+    b = np.asanyarray(nib.load(d + '/' + stem + '.nii.gz').dataobj)
+    print(stem, dims, im.GetSpacing(), im.GetOrigin(), a.dtype == b.dtype, np.array_equal(a, b))
+)");
+  EXPECT_NE(out.find("labels (7, 5, 3) (0.5, 0.25, 2.0) (3.0, -1.5, 10.0) True True"), std::string::npos) << out;
+  EXPECT_NE(out.find("image (7, 5, 3) (0.5, 0.25, 2.0) (3.0, -1.5, 10.0) True True"), std::string::npos) << out;
+  std::ifstream in(dir_ / "labels.mha", std::ios::binary);
+  std::string header, line;
+  while (std::getline(in, line) && line.rfind("ElementDataFile", 0) != 0) header += line + "\n";
+  // RAS x and y negated: the direction's first two axes point to LPS -x and -y.
+  EXPECT_NE(header.find("TransformMatrix = -1 0 0 0 -1 0 0 0 1\n"), std::string::npos) << header;
+  EXPECT_NE(header.find("Offset = 3 -1.5 10\n"), std::string::npos) << header;
+  EXPECT_NE(header.find("ElementType = MET_UINT\n"), std::string::npos) << header;
 }
 
 TEST(GraphFiles, GraphmlLoadsInNetworkxAndMatchesTheTree) {

@@ -3,7 +3,8 @@
 
 #include "commands.hpp"
 #include "core/error.hpp"
-#include "io/staged_directory.hpp"
+#include "files/staged_directory.hpp"
+#include "io/volume_formats.hpp"
 #include "pipeline/generate_sample.hpp"
 
 namespace angiosynth::cli {
@@ -16,9 +17,9 @@ CLI::App* addGenerate(CLI::App& app, GenerateArgs& a) {
       ->check(CLI::Range(std::uint64_t(0), std::uint64_t(INT64_MAX)));  // as TOML seeds: int64 >= 0
   c->add_option("--gxl-dialect", a.gxl_dialect, "gxl: valid GXL 1.0 (default); vascusynth: VascuSynth 2011's dialect")
       ->check(CLI::IsMember({"gxl", "vascusynth"}));
-  c->add_option("--format", a.formats, "volume formats, overriding [image] formats: nifti, nrrd, tiff, png (MIPs), vdb (sparse)")
+  c->add_option("--format", a.formats, "volume formats, overriding [image] formats: " + volumeFormatSummary())
       ->delimiter(',')
-      ->check(CLI::IsMember({"nifti", "nrrd", "tiff", "png", "vdb"}));
+      ->check(CLI::IsMember(volumeFormatNames()));
   c->add_flag("--no-image", a.no_image, "grow and write graphs only, no volumes");
   c->add_option("--profile", a.profiles,
                 "degradation profiles, overriding [degrade] profiles: shipped names (clean, vascusynth, cta, tof_mra, "

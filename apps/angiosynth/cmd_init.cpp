@@ -5,8 +5,8 @@
 
 #include "commands.hpp"
 #include "core/error.hpp"
-#include "io/atomic_file.hpp"
-#include "io/common_params.hpp"
+#include "files/atomic_file.hpp"
+#include "config/common_params.hpp"
 
 namespace angiosynth::cli {
 

@@ -11,7 +11,7 @@
 #include "core/error.hpp"
 #include "core/physical_ranges.hpp"
 #include "io/network_files.hpp"
-#include "io/staged_directory.hpp"
+#include "files/staged_directory.hpp"
 #include "pipeline/mesh_outputs.hpp"
 
 namespace angiosynth::cli {

@@ -6,8 +6,8 @@
 
 #include "commands.hpp"
 #include "core/error.hpp"
-#include "io/atomic_file.hpp"
-#include "io/output_guard.hpp"
+#include "files/atomic_file.hpp"
+#include "files/output_guard.hpp"
 #include "score/case_scores.hpp"
 #include "score/calibre_plot.hpp"
 #include "score/dataset_scores.hpp"

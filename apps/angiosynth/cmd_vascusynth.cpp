@@ -4,10 +4,10 @@
 
 #include "commands.hpp"
 #include "core/error.hpp"
-#include "io/output_guard.hpp"
-#include "io/param_checks.hpp"
-#include "io/staged_directory.hpp"
-#include "io/text_lines.hpp"
+#include "files/output_guard.hpp"
+#include "settings/param_checks.hpp"
+#include "files/staged_directory.hpp"
+#include "files/text_lines.hpp"
 #include "pipeline/generate_sample.hpp"
 
 namespace angiosynth::cli {

@@ -11,7 +11,7 @@
 #include <memory>
 
 #include "core/error.hpp"
-#include "io/output_guard.hpp"
+#include "files/output_guard.hpp"
 
 namespace angiosynth {
 

@@ -16,7 +16,7 @@
 #include "dataset/manifest.hpp"
 #include "degrade/profile.hpp"
 #include "grow/method.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 
 namespace angiosynth {
 namespace {

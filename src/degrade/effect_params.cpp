@@ -7,7 +7,7 @@
 
 #include "core/error.hpp"
 #include "core/units.hpp"
-#include "io/param_checks.hpp"
+#include "settings/param_checks.hpp"
 
 namespace angiosynth {
 namespace {

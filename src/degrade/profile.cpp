@@ -1,6 +1,6 @@
 #include "degrade/profile.hpp"
 
-#include "io/toml_file.hpp"
+#include "files/toml_file.hpp"
 
 #include <cstdlib>
 #include <set>
@@ -8,8 +8,8 @@
 #include <unistd.h>
 
 #include "core/error.hpp"
-#include "io/scenario.hpp"
-#include "io/text_lines.hpp"
+#include "settings/input_paths.hpp"
+#include "files/text_lines.hpp"
 
 namespace angiosynth {
 namespace {

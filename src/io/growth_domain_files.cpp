@@ -7,7 +7,7 @@
 #include "core/memory.hpp"
 #include "io/map_files.hpp"
 #include "io/nifti_reader.hpp"
-#include "io/param_checks.hpp"
+#include "settings/param_checks.hpp"
 
 namespace angiosynth {
 namespace {

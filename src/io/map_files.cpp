@@ -5,8 +5,8 @@
 #include "core/error.hpp"
 #include "core/memory.hpp"
 #include "domain/demand_sampler.hpp"
-#include "io/param_checks.hpp"
-#include "io/text_lines.hpp"
+#include "settings/param_checks.hpp"
+#include "files/text_lines.hpp"
 
 namespace angiosynth {
 namespace {

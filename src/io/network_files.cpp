@@ -12,7 +12,7 @@
 #include "core/physical_ranges.hpp"
 #include "core/vessel_roles.hpp"
 #include "io/network_rows.hpp"
-#include "io/param_checks.hpp"
+#include "settings/param_checks.hpp"
 
 namespace angiosynth {
 namespace network_detail {

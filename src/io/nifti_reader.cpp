@@ -9,7 +9,7 @@
 
 #include "core/error.hpp"
 #include "core/memory.hpp"
-#include "io/param_checks.hpp"
+#include "settings/param_checks.hpp"
 
 namespace angiosynth {
 

@@ -1,12 +1,11 @@
 // NRRD 4 with gzip encoding. NRRD's usual space is LPS, so RAS axes x and y are negated.
-#include <zlib.h>
-
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "io/deflate_stream.hpp"
 #include "io/volume_writers.hpp"
 
 namespace angiosynth {
@@ -27,28 +26,7 @@ void writeNrrd(const std::filesystem::path& file, const VolumeView& v) {
   h << "\n";
   std::ofstream out(file, std::ios::binary);
   out << h.str();
-  z_stream zs{};
-  if (deflateInit2(&zs, 6, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK)
-    throw InputError(file.string(), 0, "cannot start gzip compression");
-  const auto* in = static_cast<const unsigned char*>(v.data);
-  std::size_t left = static_cast<std::size_t>(g.voxelCount()) * voxelBytes(v.type);
-  std::vector<unsigned char> buf(1 << 20);
-  int flush = Z_NO_FLUSH;
-  do {
-    const std::size_t chunk = std::min<std::size_t>(left, 1u << 30);
-    zs.next_in = const_cast<unsigned char*>(in);
-    zs.avail_in = static_cast<uInt>(chunk);
-    in += chunk;
-    left -= chunk;
-    flush = left == 0 ? Z_FINISH : Z_NO_FLUSH;
-    do {
-      zs.next_out = buf.data();
-      zs.avail_out = static_cast<uInt>(buf.size());
-      deflate(&zs, flush);
-      out.write(reinterpret_cast<const char*>(buf.data()), static_cast<std::streamsize>(buf.size() - zs.avail_out));
-    } while (zs.avail_out == 0);
-  } while (flush != Z_FINISH);
-  deflateEnd(&zs);
+  deflateInto(out, v.data, static_cast<std::size_t>(g.voxelCount()) * voxelBytes(v.type), DeflateFraming::Gzip, file);
   out.flush();
   if (!out) throw InputError(file.string(), 0, "writing failed (disk full?)");
 }

@@ -45,6 +45,8 @@ std::size_t voxelBytes(VoxelType t);
 void writeNifti(const std::filesystem::path& file, const VolumeView& v);
 // NRRD with gzip encoding, space left-posterior-superior.
 void writeNrrd(const std::filesystem::path& file, const VolumeView& v);
+// MetaImage (.mha), zlib-compressed, in ITK's LPS space.
+void writeMetaImage(const std::filesystem::path& file, const VolumeView& v);
 
 }  // namespace angiosynth
 

@@ -15,7 +15,7 @@
 #include "core/error.hpp"
 #include "core/memory.hpp"
 #include "core/union_find.hpp"
-#include "grow/common/segment_index.hpp"
+#include "core/segment_index.hpp"
 #include "mesh/decimate.hpp"
 #include "mesh/net_surface.hpp"
 #include "mesh/ring_mesh.hpp"

@@ -4,7 +4,7 @@
 
 #include "degrade/degrade.hpp"
 #include "io/graph_writers.hpp"
-#include "io/text_file.hpp"
+#include "files/text_file.hpp"
 #include "pipeline/label_outputs.hpp"
 #include "pipeline/volume_files.hpp"
 

@@ -12,7 +12,7 @@
 #include "domain/growth_domain.hpp"
 #include "io/graph_writers.hpp"
 #include "io/svg_writer.hpp"
-#include "io/text_file.hpp"
+#include "files/text_file.hpp"
 #include "pipeline/volume_files.hpp"
 #include "pipeline/volume_outputs.hpp"
 #include "physics/hemodynamics.hpp"

@@ -9,7 +9,7 @@
 
 #include "degrade/profile.hpp"
 #include "grow/common/growth_report.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 
 namespace angiosynth {
 

@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/vascular_tree.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 
 namespace angiosynth {
 

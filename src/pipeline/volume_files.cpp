@@ -8,7 +8,8 @@
 #include "degrade/effect.hpp"
 #include "io/graph_writers.hpp"
 #include "io/network_files.hpp"
-#include "io/text_file.hpp"
+#include "io/volume_formats.hpp"
+#include "files/text_file.hpp"
 
 namespace angiosynth {
 namespace {
@@ -61,15 +62,13 @@ std::vector<Channel> labelChannels(const GroundTruthVolumes& gt, const std::stri
 void writeChannels(const std::vector<Channel>& channels, const std::vector<std::string>& formats,
                    const std::filesystem::path& dir, Json& files) {
   bool first = true;
-  for (const auto& fmt : formats) {
-    if (fmt == "vdb" || fmt == "png") continue;
-    const std::string ext = fmt == "nifti" ? ".nii.gz" : (fmt == "nrrd" ? ".nrrd" : ".tif");
+  for (const auto& name : formats) {
+    const VolumeFormat* format = findVolumeFormat(name);
+    if (!format || format->kind != VolumeFormatKind::PerChannel) continue;
     for (const auto& c : channels) {
-      const std::string name = c.role + ext;
-      if (fmt == "nifti") writeNifti(dir / name, c.view);
-      else if (fmt == "nrrd") writeNrrd(dir / name, c.view);
-      else writeTiff(dir / name, c.view);
-      files[first ? c.role : c.role + "_" + fmt] = name;
+      const std::string file = c.role + std::string(format->extension);
+      format->write(dir / file, c.view);
+      files[first ? c.role : c.role + "_" + name] = file;
     }
     first = false;
   }

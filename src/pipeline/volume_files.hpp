@@ -36,7 +36,7 @@ struct Channel {
 // appended to each role ("" or "_<profile>").
 std::vector<Channel> labelChannels(const GroundTruthVolumes& gt, const std::string& suffix);
 
-// Writes the channels in each volume format (nifti, nrrd, tiff; png and vdb are skipped).
+// Writes the channels in each per-channel volume format (projections and sparse grids are written elsewhere).
 void writeChannels(const std::vector<Channel>& channels, const std::vector<std::string>& formats,
                    const std::filesystem::path& dir, nlohmann::ordered_json& files);
 // Maximum-intensity projections along x, y, z as mip_<axis><suffix>.png, [lo, hi] → [0, 255]; in

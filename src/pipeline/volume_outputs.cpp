@@ -7,13 +7,13 @@
 #include "core/format.hpp"
 #include "core/memory.hpp"
 #include "io/graph_writers.hpp"
-#include "io/text_file.hpp"
+#include "files/text_file.hpp"
 #include "io/vdb_writer.hpp"
 #include "io/volume_writers.hpp"
 #include "pipeline/degraded_outputs.hpp"
 #include "pipeline/label_outputs.hpp"
 #include "pipeline/volume_files.hpp"
-#include "io/param_checks.hpp"
+#include "settings/param_checks.hpp"
 #include "raster/ground_truth.hpp"
 
 namespace angiosynth {

@@ -10,7 +10,7 @@
 #include "domain/demand_map.hpp"
 #include "core/forest.hpp"
 #include "io/graph_writers.hpp"
-#include "io/scenario.hpp"
+#include "config/scenario.hpp"
 #include "raster/label_policy.hpp"
 #include "raster/volume.hpp"
 

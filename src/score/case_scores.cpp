@@ -11,7 +11,7 @@
 #include "core/error.hpp"
 #include "io/network_files.hpp"
 #include "io/nifti_reader.hpp"
-#include "io/param_checks.hpp"
+#include "settings/param_checks.hpp"
 #include "score/betti.hpp"
 #include "score/keypoints.hpp"
 #include "score/skeleton.hpp"

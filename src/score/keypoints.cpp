@@ -6,7 +6,7 @@
 #include <tuple>
 
 #include "core/error.hpp"
-#include "io/text_lines.hpp"
+#include "files/text_lines.hpp"
 #include "score/case_scores.hpp"
 
 namespace angiosynth {

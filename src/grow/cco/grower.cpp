@@ -13,7 +13,7 @@
 #include "grow/common/intersections.hpp"
 #include "grow/common/kamiya.hpp"
 #include "grow/common/point_hash.hpp"
-#include "grow/common/segment_index.hpp"
+#include "core/segment_index.hpp"
 
 namespace angiosynth {
 namespace {

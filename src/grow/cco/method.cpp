@@ -10,7 +10,7 @@
 #include "grow/common/method_tables.hpp"
 #include "io/growth_domain_files.hpp"
 #include "io/map_files.hpp"
-#include "io/scenario.hpp"
+#include "settings/input_paths.hpp"
 
 namespace angiosynth {
 namespace {

@@ -14,8 +14,8 @@
 #include "grow/common/region_tables.hpp"
 #include "io/growth_domain_files.hpp"
 #include "io/network_files.hpp"
-#include "io/param_checks.hpp"
-#include "io/scenario.hpp"
+#include "settings/param_checks.hpp"
+#include "settings/input_paths.hpp"
 
 namespace angiosynth {
 namespace {

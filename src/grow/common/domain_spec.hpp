@@ -10,7 +10,7 @@
 
 #include "domain/growth_domain.hpp"
 #include "grow/method.hpp"
-#include "io/toml_reader.hpp"
+#include "settings/toml_reader.hpp"
 
 namespace angiosynth {
 

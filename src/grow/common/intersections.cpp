@@ -5,7 +5,7 @@
 
 #include <algorithm>
 
-#include "grow/common/segment_index.hpp"
+#include "core/segment_index.hpp"
 
 namespace angiosynth {
 

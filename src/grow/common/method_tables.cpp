@@ -1,7 +1,7 @@
 #include "grow/common/method_tables.hpp"
 
 #include "core/quantity_json.hpp"
-#include "io/param_checks.hpp"
+#include "settings/param_checks.hpp"
 
 namespace angiosynth {
 

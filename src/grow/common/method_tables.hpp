@@ -10,7 +10,7 @@
 #include "core/error.hpp"
 #include "core/units.hpp"
 #include "grow/method.hpp"
-#include "io/toml_reader.hpp"
+#include "settings/toml_reader.hpp"
 
 namespace angiosynth {
 

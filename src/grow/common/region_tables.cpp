@@ -1,7 +1,7 @@
 #include "grow/common/region_tables.hpp"
 
-#include "io/param_checks.hpp"
-#include "io/scenario.hpp"
+#include "settings/param_checks.hpp"
+#include "settings/input_paths.hpp"
 
 namespace angiosynth {
 

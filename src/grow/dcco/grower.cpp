@@ -10,7 +10,7 @@
 #include "core/rng.hpp"
 #include "core/physical_ranges.hpp"
 #include "grow/common/intersections.hpp"
-#include "grow/common/segment_index.hpp"
+#include "core/segment_index.hpp"
 #include "grow/dcco/lattice.hpp"
 #include "physics/hemodynamics.hpp"
 

@@ -10,7 +10,7 @@
 #include "grow/common/method_tables.hpp"
 #include "grow/common/region_tables.hpp"
 #include "grow/lsystem/setup.hpp"
-#include "io/param_checks.hpp"
+#include "settings/param_checks.hpp"
 
 namespace angiosynth {
 namespace {

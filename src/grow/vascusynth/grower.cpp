@@ -14,7 +14,7 @@
 #include "grow/common/bifurcation_optimizer.hpp"
 #include "grow/common/connection_commit.hpp"
 #include "grow/common/intersections.hpp"
-#include "grow/common/segment_index.hpp"
+#include "core/segment_index.hpp"
 
 namespace angiosynth {
 namespace {

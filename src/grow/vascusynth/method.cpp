@@ -6,7 +6,7 @@
 #include "grow/common/feasibility.hpp"
 #include "grow/common/method_tables.hpp"
 #include "grow/vascusynth/setup.hpp"
-#include "io/scenario.hpp"
+#include "settings/input_paths.hpp"
 
 namespace angiosynth {
 namespace {

@@ -6,10 +6,10 @@
 #include <set>
 
 #include "core/error.hpp"
-#include "io/param_checks.hpp"
+#include "settings/param_checks.hpp"
 #include "grow/vascusynth/setup.hpp"
-#include "io/scenario.hpp"
-#include "io/text_lines.hpp"
+#include "config/scenario.hpp"
+#include "files/text_lines.hpp"
 
 namespace angiosynth {
 namespace {

@@ -1,4 +1,4 @@
-#include "io/staged_directory.hpp"
+#include "files/staged_directory.hpp"
 
 #include <algorithm>
 #include <fstream>
@@ -8,8 +8,8 @@
 
 #include "core/error.hpp"
 #include "core/interrupt_cleanup.hpp"
-#include "io/output_guard.hpp"
-#include "io/text_file.hpp"
+#include "files/output_guard.hpp"
+#include "files/text_file.hpp"
 
 namespace angiosynth {
 

@@ -1,12 +1,14 @@
-#include "io/common_params.hpp"
+#include "config/common_params.hpp"
 
 #include <sstream>
 
 #include "angiosynth/templates.hpp"
+#include "io/volume_formats.hpp"
 
 namespace angiosynth {
 
 const std::vector<MethodParam>& commonParams() {
+  static const std::string volume_formats = "any of " + volumeFormatSummary();
   static const std::vector<MethodParam> p{
       {"", "seed", "integer ≥ 0", "fresh, recorded in sample.json", "the random seed: same seed and parameters, same bytes"},
       {"curves", "tortuosity", "", "1.2", "with a [curves] table, every vessel becomes a smooth curve whose arc length over chord is this (1 … 3)"},
@@ -24,7 +26,7 @@ const std::vector<MethodParam>& commonParams() {
       {"image", "background", "", "0", "image intensity outside vessels"},
       {"image", "vessel", "", "255", "image intensity inside vessels (image = background + (vessel − background) × partial volume)"},
       {"image", "dtype", "text", "uint8", "uint8, uint16, int16 or float32"},
-      {"image", "formats", "[text]", "[\"nifti\", \"png\"]", "any of nifti, nrrd, tiff, png (MIPs), vdb"},
+      {"image", "formats", "[text]", "[\"nifti\", \"png\"]", volume_formats.c_str()},
       {"image", "graph_formats", "[text]", "[\"csv\", \"vtp\", \"swc\", \"graphml\"]", "any of csv, vtp, swc, graphml, cco (GXL and DOT are always written)"},
       {"image", "label_policy", "text", "binary",
        "the training label (label.nii.gz; the mask stays as it is): binary (the mask), threshold, visible, soft or ignore"},

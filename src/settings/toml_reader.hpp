@@ -1,7 +1,7 @@
 #pragma once
 // Reading checked values from a parsed TOML table: every error names file and line, and the
 // allowed values. Shared by the parameter reader and the growth methods' readers.
-#include "io/toml_file.hpp"
+#include "files/toml_file.hpp"
 
 #include <cmath>
 #include <cstdint>
@@ -12,7 +12,7 @@
 #include "core/error.hpp"
 #include "core/units.hpp"
 #include "core/vec3.hpp"
-#include "io/param_checks.hpp"
+#include "settings/param_checks.hpp"
 
 namespace angiosynth {
 

@@ -1,4 +1,4 @@
-#include "io/text_lines.hpp"
+#include "files/text_lines.hpp"
 
 #include <charconv>
 #include <cmath>

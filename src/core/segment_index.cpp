@@ -1,4 +1,4 @@
-#include "grow/common/segment_index.hpp"
+#include "core/segment_index.hpp"
 
 #include <algorithm>
 #include <cmath>

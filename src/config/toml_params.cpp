@@ -5,10 +5,11 @@
 
 #include "core/error.hpp"
 #include "core/format.hpp"
-#include "io/param_checks.hpp"
+#include "settings/param_checks.hpp"
 #include "grow/method.hpp"
-#include "io/scenario.hpp"
-#include "io/toml_reader.hpp"
+#include "config/scenario.hpp"
+#include "settings/toml_reader.hpp"
+#include "io/volume_formats.hpp"
 
 namespace angiosynth {
 namespace {
@@ -142,7 +143,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     return out;
   };
   readLabelPolicy(r, im, ip);
-  if (im.get("formats")) ip.formats = stringsOf(im, "formats", {"nifti", "nrrd", "tiff", "png", "vdb"});
+  if (im.get("formats")) ip.formats = stringsOf(im, "formats", volumeFormatNames());
   if (im.get("graph_formats")) ip.graph_formats = stringsOf(im, "graph_formats", {"csv", "vtp", "swc", "graphml", "cco"});
 
   // [mesh]: the vessels' surface beside the graphs (src/mesh); the table's presence enables it.

@@ -1,4 +1,4 @@
-#include "io/output_guard.hpp"
+#include "files/output_guard.hpp"
 
 #include "core/error.hpp"
 

@@ -11,7 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/units.hpp"
-#include "io/param_checks.hpp"
+#include "settings/input_paths.hpp"
+#include "settings/param_checks.hpp"
 #include "grow/common/curved_vessels.hpp"
 #include "grow/method.hpp"
 #include "raster/label_policy.hpp"
@@ -33,7 +34,7 @@ struct ImageParameters {
   int centerline_connectivity = 26;    // of the centreline channel: 26 or 6
   double background = 0, vessel = 255; // image = background + (vessel − background) × fraction
   std::string dtype = "uint8";         // uint8, uint16, int16, float32
-  std::vector<std::string> formats{"nifti", "png"};                        // nifti, nrrd, tiff, png, vdb
+  std::vector<std::string> formats{"nifti", "png"};                        // names of io/volume_formats.hpp
   std::vector<std::string> graph_formats{"csv", "vtp", "swc", "graphml"};  // besides GXL and DOT
   LabelPolicy labels;                  // the training label (label.nii.gz) beside the mask
   int labels_line = 0;
@@ -126,10 +127,5 @@ Scenario readParameters(const std::filesystem::path& file, const ReadOptions& op
 
 // Every file a scenario reads (parameter file, maps, mask, profile files): outputs must not hold them.
 std::vector<std::filesystem::path> scenarioInputs(const Scenario& sc);
-
-// Resolves a path named in a parameter file: relative to that file's directory if it exists
-// there, else relative to the working directory (VascuSynth's convention).
-std::filesystem::path resolveInputPath(const std::filesystem::path& named, const std::filesystem::path& param_file,
-                                       int line);
 
 }  // namespace angiosynth
