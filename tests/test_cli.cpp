@@ -11,6 +11,8 @@
 #include "cli_run.hpp"
 #include "grow/method.hpp"
 #include "config/scenario.hpp"
+#include "io/mesh_writers.hpp"
+#include "io/volume_formats.hpp"
 
 using Json = nlohmann::json;
 namespace fs = std::filesystem;
@@ -278,3 +280,26 @@ TEST_F(Cli, HelpAndVersion) {
 }
 
 }  // namespace
+
+TEST_F(Cli, EveryRegisteredFormatIsListedByParamsAndTakenByFileAndFlag) {
+  // The format registries are the only lists: the parameter reference, the readers and the
+  // flags read them (the reference once left out 3mf, which the reader took).
+  const auto reference = runPrinted("params", dir_);
+  ASSERT_EQ(reference.code, 0) << reference.err;
+  for (const auto& f : angiosynth::volumeFormats()) EXPECT_NE(reference.err.find(std::string(f.name) + " ("), std::string::npos) << f.name;
+  for (const auto& f : angiosynth::meshFormats()) EXPECT_NE(reference.err.find(std::string(f.name) + " ("), std::string::npos) << f.name;
+  const auto help = runPrinted("generate --help", dir_), mesh_help = runPrinted("mesh --help", dir_);
+  EXPECT_NE(help.err.find("mha (MetaImage"), std::string::npos) << help.err;
+  EXPECT_NE(mesh_help.err.find("3mf (3MF"), std::string::npos) << mesh_help.err;
+  // A format the registry lacks is refused by the file reader, naming what is allowed.
+  std::ifstream in(src_ / "examples/cco_disc_2d.toml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string p = text.str();
+  p.replace(p.find("formats = [\"nifti\", \"png\"]"), 26, "formats = [\"mha\", \"dicom\"]");
+  std::ofstream(dir_ / "p.toml") << p;
+  const auto refused = run("generate p.toml --out o", dir_);
+  EXPECT_EQ(refused.code, 2) << refused.err;
+  EXPECT_NE(refused.err.find("dicom"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("mha"), std::string::npos) << refused.err;
+}

@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "core/physical_ranges.hpp"
+#include "io/mesh_writers.hpp"
 #include "io/network_files.hpp"
 #include "files/staged_directory.hpp"
 #include "pipeline/mesh_outputs.hpp"
@@ -84,9 +85,9 @@ CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
                 "stays open there: the printed block of seed 004)")
       ->delimiter(',')
       ->expected(6);
-  c->add_option("--format", a.formats, "mesh formats: stl (binary), obj, ply (binary), off, vtp, 3mf (default stl)")
+  c->add_option("--format", a.formats, "mesh formats (default stl): " + meshFormatSummary())
       ->delimiter(',')
-      ->check(CLI::IsMember({"stl", "obj", "ply", "off", "vtp", "3mf"}));
+      ->check(CLI::IsMember(meshFormatNames()));
   c->add_flag("--force", a.force, "replace an earlier angiosynth output in --out (only the files it wrote there)");
   addCommonOptions(*c, a.common);
   return c;

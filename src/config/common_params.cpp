@@ -3,12 +3,14 @@
 #include <sstream>
 
 #include "angiosynth/templates.hpp"
+#include "io/mesh_writers.hpp"
 #include "io/volume_formats.hpp"
 
 namespace angiosynth {
 
 const std::vector<MethodParam>& commonParams() {
   static const std::string volume_formats = "any of " + volumeFormatSummary();
+  static const std::string mesh_formats = "any of " + meshFormatSummary() + ": surface.<format> each";
   static const std::vector<MethodParam> p{
       {"", "seed", "integer ≥ 0", "fresh, recorded in sample.json", "the random seed: same seed and parameters, same bytes"},
       {"curves", "tortuosity", "", "1.2", "with a [curves] table, every vessel becomes a smooth curve whose arc length over chord is this (1 … 3)"},
@@ -37,7 +39,7 @@ const std::vector<MethodParam>& commonParams() {
       {"degrade", "profiles", "[text]", "[]", "degraded images to write, one image_<name> each: shipped profile names, .toml profiles or VascuSynth noise files"},
       {"output", "gxl_dialect", "text", "gxl", "gxl (GXL 1.0) or vascusynth"},
       {"mesh", "enabled", "true/false", "true", "with a [mesh] table: write the vessels' surface (one closed mesh per tree) beside the graphs"},
-      {"mesh", "formats", "[text]", "[\"stl\"]", "any of stl, obj, ply, off, vtp: surface.<format> each"},
+      {"mesh", "formats", "[text]", "[\"stl\"]", mesh_formats.c_str()},
       {"mesh", "method", "tubes/contour", "tubes",
        "tubes: each vessel's free middle (no other vessel near its wall) a tube of rings on its exact wall, the parts where vessels "
        "meet (bifurcations, round ends, vessels that touch) contoured and joined to the tubes ring to ring; contour: the whole surface "

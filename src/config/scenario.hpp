@@ -43,7 +43,7 @@ struct ImageParameters {
 // [mesh]: the outer surface of each tree, written beside the graphs (src/mesh; `angiosynth mesh`).
 struct MeshParameters {
   bool enabled = false;
-  std::vector<std::string> formats{"stl"};  // stl, obj, ply, off, vtp
+  std::vector<std::string> formats{"stl"};  // names of io/mesh_writers.hpp's meshFormats()
   std::string method = "tubes";             // tubes (rings along free vessels, contoured junctions) or contour (all contoured)
   std::string junctions = "nets";           // tubes: parts contoured by surface nets where they pass their checks, or by tetrahedra only
   double voxel_mm = 0;                      // finest step; 0: the thinnest vessel's diameter / samples_across

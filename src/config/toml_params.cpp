@@ -9,6 +9,7 @@
 #include "grow/method.hpp"
 #include "config/scenario.hpp"
 #include "settings/toml_reader.hpp"
+#include "io/mesh_writers.hpp"
 #include "io/volume_formats.hpp"
 
 namespace angiosynth {
@@ -153,7 +154,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
     auto& mp = sc.mesh;
     sc.mesh_line = r.lineOf(n);
     mp.enabled = r.boolean(me, "enabled", true);
-    if (me.get("formats")) mp.formats = stringsOf(me, "formats", {"stl", "obj", "ply", "off", "vtp", "3mf"});
+    if (me.get("formats")) mp.formats = stringsOf(me, "formats", meshFormatNames());
     if (mp.formats.empty()) throw InputError(file, r.lineOf(me.get("formats")), "formats must name at least one of stl, obj, ply, off, vtp, 3mf");
     if (me.get("voxel_size")) {
       mp.voxel_mm = r.quantity(me, "mesh", "voxel_size", Dimension::Length, voxel_mm);

@@ -97,14 +97,39 @@ void writeMeshVtp(std::ostream& out, const SurfaceMesh& m) {
   out << "</DataArray>\n</Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";
 }
 
+namespace {
+
+constexpr MeshFormat kMeshFormats[] = {
+    {"stl", "binary STL", &writeStl},
+    {"obj", "Wavefront OBJ", &writeObj},
+    {"ply", "binary PLY", &writePly},
+    {"off", "OFF", &writeOff},
+    {"vtp", "VTK PolyData", &writeMeshVtp},
+    {"3mf", "3MF, one object per tree", &writeThreeMf},
+};
+
+}  // namespace
+
+std::span<const MeshFormat> meshFormats() { return kMeshFormats; }
+
+std::vector<std::string> meshFormatNames() {
+  std::vector<std::string> names;
+  for (const auto& f : kMeshFormats) names.emplace_back(f.name);
+  return names;
+}
+
+std::string meshFormatSummary() {
+  std::string s;
+  for (const auto& f : kMeshFormats) s += (s.empty() ? "" : ", ") + std::string(f.name) + " (" + std::string(f.meaning) + ")";
+  return s;
+}
+
 MeshWriter meshWriter(const std::string& format) {
-  if (format == "stl") return writeStl;
-  if (format == "obj") return writeObj;
-  if (format == "ply") return writePly;
-  if (format == "off") return writeOff;
-  if (format == "vtp") return writeMeshVtp;
-  if (format == "3mf") return writeThreeMf;
-  throw std::invalid_argument("mesh format '" + format + "'; allowed: stl, obj, ply, off, vtp, 3mf");
+  for (const auto& f : kMeshFormats)
+    if (f.name == format) return f.write;
+  std::string allowed;
+  for (const auto& f : kMeshFormats) allowed += (allowed.empty() ? "" : ", ") + std::string(f.name);
+  throw std::invalid_argument("mesh format '" + format + "'; allowed: " + allowed);
 }
 
 }  // namespace angiosynth

@@ -4,7 +4,10 @@
 // corners still weld back exactly (the mesher keeps vertices far apart compared with float
 // rounding). Positions in mm; OBJ, PLY, OFF and VTP keep every bit of them.
 #include <ostream>
+#include <span>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "mesh/vessel_surface.hpp"
 
@@ -17,9 +20,19 @@ void writeOff(std::ostream& out, const SurfaceMesh& m);
 void writeMeshVtp(std::ostream& out, const SurfaceMesh& m);  // cell arrays `Tree` and (ends cut) `CellEntityIds`, `ModelFaceID`
 void writeThreeMf(std::ostream& out, const SurfaceMesh& m);  // 3MF, millimetres, one object per tree (mesh_3mf.cpp)
 
-// The writer of a format name (stl, obj, ply, off, vtp, 3mf), also its file extension; throws
-// std::invalid_argument for another name.
+// The mesh formats, one entry each: the parameter reader, the command line, `angiosynth params`
+// and the surface writer read this list. The name is also the file extension (surface.<name>).
 using MeshWriter = void (*)(std::ostream&, const SurfaceMesh&);
+struct MeshFormat {
+  std::string_view name;
+  std::string_view meaning;  // for help and the parameter reference
+  MeshWriter write;
+};
+std::span<const MeshFormat> meshFormats();
+// The writer of a format name; throws std::invalid_argument for another name.
 MeshWriter meshWriter(const std::string& format);
+std::vector<std::string> meshFormatNames();
+// "stl (binary), obj, …": the list with meanings, for help and references.
+std::string meshFormatSummary();
 
 }  // namespace angiosynth
