@@ -11,6 +11,7 @@
 #include "cli_run.hpp"
 #include "grow/method.hpp"
 #include "config/scenario.hpp"
+#include "io/graph_formats.hpp"
 #include "io/mesh_writers.hpp"
 #include "io/volume_formats.hpp"
 
@@ -287,6 +288,7 @@ TEST_F(Cli, EveryRegisteredFormatIsListedByParamsAndTakenByFileAndFlag) {
   const auto reference = runPrinted("params", dir_);
   ASSERT_EQ(reference.code, 0) << reference.err;
   for (const auto& f : angiosynth::volumeFormats()) EXPECT_NE(reference.err.find(std::string(f.name) + " ("), std::string::npos) << f.name;
+  for (const auto& f : angiosynth::graphFormats()) EXPECT_NE(reference.err.find(std::string(f.name) + " ("), std::string::npos) << f.name;
   for (const auto& f : angiosynth::meshFormats()) EXPECT_NE(reference.err.find(std::string(f.name) + " ("), std::string::npos) << f.name;
   const auto help = runPrinted("generate --help", dir_), mesh_help = runPrinted("mesh --help", dir_);
   EXPECT_NE(help.err.find("mha (MetaImage"), std::string::npos) << help.err;

@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "angiosynth/templates.hpp"
+#include "io/graph_formats.hpp"
 #include "io/mesh_writers.hpp"
 #include "io/volume_formats.hpp"
 
@@ -10,6 +11,7 @@ namespace angiosynth {
 
 const std::vector<MethodParam>& commonParams() {
   static const std::string volume_formats = "any of " + volumeFormatSummary();
+  static const std::string graph_formats = "any of " + graphFormatSummary() + "; GXL and DOT are always written";
   static const std::string mesh_formats = "any of " + meshFormatSummary() + ": surface.<format> each";
   static const std::vector<MethodParam> p{
       {"", "seed", "integer ≥ 0", "fresh, recorded in sample.json", "the random seed: same seed and parameters, same bytes"},
@@ -29,7 +31,7 @@ const std::vector<MethodParam>& commonParams() {
       {"image", "vessel", "", "255", "image intensity inside vessels (image = background + (vessel − background) × partial volume)"},
       {"image", "dtype", "text", "uint8", "uint8, uint16, int16 or float32"},
       {"image", "formats", "[text]", "[\"nifti\", \"png\"]", volume_formats.c_str()},
-      {"image", "graph_formats", "[text]", "[\"csv\", \"vtp\", \"swc\", \"graphml\"]", "any of csv, vtp, swc, graphml, cco (GXL and DOT are always written)"},
+      {"image", "graph_formats", "[text]", "[\"csv\", \"vtp\", \"swc\", \"graphml\"]", graph_formats.c_str()},
       {"image", "label_policy", "text", "binary",
        "the training label (label.nii.gz; the mask stays as it is): binary (the mask), threshold, visible, soft or ignore"},
       {"image", "label_threshold", "", "0.5", "label_policy = threshold: vessel where the partial volume is at least this (0 … 1]"},

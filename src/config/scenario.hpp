@@ -35,7 +35,7 @@ struct ImageParameters {
   double background = 0, vessel = 255; // image = background + (vessel − background) × fraction
   std::string dtype = "uint8";         // uint8, uint16, int16, float32
   std::vector<std::string> formats{"nifti", "png"};                        // names of io/volume_formats.hpp
-  std::vector<std::string> graph_formats{"csv", "vtp", "swc", "graphml"};  // besides GXL and DOT
+  std::vector<std::string> graph_formats{"csv", "vtp", "swc", "graphml"};  // names of io/graph_formats.hpp; GXL and DOT always
   LabelPolicy labels;                  // the training label (label.nii.gz) beside the mask
   int labels_line = 0;
 };

@@ -9,6 +9,7 @@
 #include "grow/method.hpp"
 #include "config/scenario.hpp"
 #include "settings/toml_reader.hpp"
+#include "io/graph_formats.hpp"
 #include "io/mesh_writers.hpp"
 #include "io/volume_formats.hpp"
 
@@ -145,7 +146,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   };
   readLabelPolicy(r, im, ip);
   if (im.get("formats")) ip.formats = stringsOf(im, "formats", volumeFormatNames());
-  if (im.get("graph_formats")) ip.graph_formats = stringsOf(im, "graph_formats", {"csv", "vtp", "swc", "graphml", "cco"});
+  if (im.get("graph_formats")) ip.graph_formats = stringsOf(im, "graph_formats", graphFormatNames());
 
   // [mesh]: the vessels' surface beside the graphs (src/mesh); the table's presence enables it.
   const auto& me = r.table("mesh", {"enabled", "method", "formats", "voxel_size", "junctions", "samples_across", "ring_spacing", "uniform", "on_surface", "ends",

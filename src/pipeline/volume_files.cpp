@@ -6,6 +6,7 @@
 
 #include "core/format.hpp"
 #include "degrade/effect.hpp"
+#include "io/graph_formats.hpp"
 #include "io/graph_writers.hpp"
 #include "io/network_files.hpp"
 #include "io/volume_formats.hpp"
@@ -106,20 +107,10 @@ void writeGraphFiles(const VascularTree& tree, const std::vector<TreeInfo>& tree
     files[role + suffix] = name;
   };
   file("keypoints", ".csv", "keypoints", [&](std::ostream& o) { writeKeypoints(o, tree, trees, g); });
-  for (const auto& fmt : graph_formats) {
-    if (fmt == "csv") {
-      file("nodes", ".csv", "nodes_csv", [&](std::ostream& o) { writeNodesCsv(o, tree, trees); });
-      file("edges", ".csv", "edges_csv", [&](std::ostream& o) { writeEdgesCsv(o, tree, trees); });
-    } else if (fmt == "vtp") {
-      file("centerlines", ".vtp", "vtp", [&](std::ostream& o) { writeVtp(o, tree, trees); });
-    } else if (fmt == "swc") {
-      file("tree", ".swc", "swc", [&](std::ostream& o) { writeSwc(o, tree, trees); });
-    } else if (fmt == "cco") {
-      file("tree", ".cco", "cco", [&](std::ostream& o) { writeCco(o, tree, trees); });
-    } else if (fmt == "graphml") {
-      file("tree", ".graphml", "graphml", [&](std::ostream& o) { writeGraphml(o, tree, trees); });
-    }
-  }
+  for (const auto& name : graph_formats)
+    if (const GraphFormat* format = findGraphFormat(name))
+      for (const auto& f : format->files)
+        file(std::string(f.stem), std::string(f.extension), std::string(f.role), [&](std::ostream& o) { f.write(o, tree, trees); });
 }
 
 }  // namespace angiosynth
