@@ -1,5 +1,6 @@
 #include "io/graph_formats.hpp"
 
+#include "io/format_lists.hpp"
 #include "io/graph_writers.hpp"
 #include "io/network_files.hpp"
 
@@ -24,22 +25,8 @@ const GraphFormat kGraphFormats[] = {
 
 std::span<const GraphFormat> graphFormats() { return kGraphFormats; }
 
-const GraphFormat* findGraphFormat(std::string_view name) {
-  for (const auto& f : kGraphFormats)
-    if (f.name == name) return &f;
-  return nullptr;
-}
-
-std::vector<std::string> graphFormatNames() {
-  std::vector<std::string> names;
-  for (const auto& f : kGraphFormats) names.emplace_back(f.name);
-  return names;
-}
-
-std::string graphFormatSummary() {
-  std::string s;
-  for (const auto& f : kGraphFormats) s += (s.empty() ? "" : ", ") + std::string(f.name) + " (" + std::string(f.meaning) + ")";
-  return s;
-}
+const GraphFormat* findGraphFormat(std::string_view name) { return findFormat(graphFormats(), name); }
+std::vector<std::string> graphFormatNames() { return formatNames(graphFormats()); }
+std::string graphFormatSummary() { return formatSummary(graphFormats()); }
 
 }  // namespace angiosynth

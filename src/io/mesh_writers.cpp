@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/format.hpp"
+#include "io/format_lists.hpp"
 
 namespace angiosynth {
 namespace {
@@ -112,23 +113,13 @@ constexpr MeshFormat kMeshFormats[] = {
 
 std::span<const MeshFormat> meshFormats() { return kMeshFormats; }
 
-std::vector<std::string> meshFormatNames() {
-  std::vector<std::string> names;
-  for (const auto& f : kMeshFormats) names.emplace_back(f.name);
-  return names;
-}
-
-std::string meshFormatSummary() {
-  std::string s;
-  for (const auto& f : kMeshFormats) s += (s.empty() ? "" : ", ") + std::string(f.name) + " (" + std::string(f.meaning) + ")";
-  return s;
-}
+std::vector<std::string> meshFormatNames() { return formatNames(meshFormats()); }
+std::string meshFormatSummary() { return formatSummary(meshFormats()); }
 
 MeshWriter meshWriter(const std::string& format) {
-  for (const auto& f : kMeshFormats)
-    if (f.name == format) return f.write;
+  if (const MeshFormat* f = findFormat(meshFormats(), format)) return f->write;
   std::string allowed;
-  for (const auto& f : kMeshFormats) allowed += (allowed.empty() ? "" : ", ") + std::string(f.name);
+  for (const auto& name : meshFormatNames()) allowed += (allowed.empty() ? "" : ", ") + name;
   throw std::invalid_argument("mesh format '" + format + "'; allowed: " + allowed);
 }
 

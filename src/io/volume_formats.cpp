@@ -1,5 +1,7 @@
 #include "io/volume_formats.hpp"
 
+#include "io/format_lists.hpp"
+
 namespace angiosynth {
 namespace {
 
@@ -18,25 +20,8 @@ constexpr VolumeFormat kFormats[] = {
 
 std::span<const VolumeFormat> volumeFormats() { return kFormats; }
 
-const VolumeFormat* findVolumeFormat(std::string_view name) {
-  for (const auto& f : kFormats)
-    if (f.name == name) return &f;
-  return nullptr;
-}
-
-std::vector<std::string> volumeFormatNames() {
-  std::vector<std::string> names;
-  for (const auto& f : kFormats) names.emplace_back(f.name);
-  return names;
-}
-
-std::string volumeFormatSummary() {
-  std::string s;
-  for (const auto& f : kFormats) {
-    if (!s.empty()) s += ", ";
-    s += std::string(f.name) + " (" + std::string(f.meaning) + ")";
-  }
-  return s;
-}
+const VolumeFormat* findVolumeFormat(std::string_view name) { return findFormat(volumeFormats(), name); }
+std::vector<std::string> volumeFormatNames() { return formatNames(volumeFormats()); }
+std::string volumeFormatSummary() { return formatSummary(volumeFormats()); }
 
 }  // namespace angiosynth
