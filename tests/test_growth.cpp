@@ -234,6 +234,34 @@ TEST(SegmentIndex, NearestMatchesBruteForce) {
   }
 }
 
+TEST(SegmentIndex, ARolledBackTrialLeavesNoEntryAndAKeptOneStays) {
+  auto ex = test::vascusynthExample(200, 2);
+  const VascularTree t = test::grow(ex);
+  SegmentIndex index(Vec3(0, 0, 0), ex.map.extentMm());
+  index.refresh(t, true);
+  const auto before = index.entryCount();
+  ASSERT_GT(before, std::size_t(t.segmentCount() - 1));
+  const auto trial = [&] {
+    index.beginTrial();
+    for (std::int32_t s = 1; s < t.nodeCount(); s += 7)
+      if (!t.isRoot(s)) index.insert(t, s);
+  };
+  trial();
+  EXPECT_GT(index.entryCount(), before);
+  index.endTrial(false);
+  EXPECT_EQ(index.entryCount(), before);
+  trial();
+  const auto kept = index.entryCount();
+  index.endTrial(true);
+  EXPECT_EQ(index.entryCount(), kept);
+  EXPECT_GT(kept, before);
+  // A rebuild inside a trial leaves nothing to take back.
+  trial();
+  index.refresh(t, true);
+  index.endTrial(false);
+  EXPECT_EQ(index.entryCount(), before);
+}
+
 TEST(DemandSampler, DrawsProportionallyToDemandAndUpdatesExactly) {
   std::vector<float> d{0, 1, 3, 0, 6};
   DemandSampler s(d);

@@ -391,6 +391,23 @@ TEST_F(Robustness, DccoStageThatCannotConnectGivesUpAfterItsRelaxationsAndCounts
   EXPECT_FALSE(fs::exists(dir_ / "o"));
 }
 
+TEST_F(Robustness, DccoRejectedTrialsLeaveNothingBehindSoACrowdedNetworkIsRefusedQuickly) {
+  // A crowded network in which one terminal joins and no second can: every draw commits and
+  // rolls back about seventy trials. Each rollback left its vessels in the segment index and the
+  // list of thick vessels, so every draw searched more than the last: over two minutes where the
+  // thousand draws of the budget take under a second.
+  write("tree.swc", "1 1 0 20 0 0.3 -1\n2 2 0 13 0 0.3 1\n3 2 -8 12 0 0.2 2\n4 2 8 12 0 0.2 3\n5 2 -5 6 0 0.2 2\n"
+                    "6 2 1 11 0 0.2 2\n7 2 -1 9 0 0.2 6\n8 2 1 7 0 0.2 7\n9 2 0 5 0 0.2 8\n10 2 -4 -2 0 0.15 9\n"
+                    "11 2 7 -2 0 0.15 9\n12 2 0 -7 0 0.15 9\n");
+  write("r.toml", "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.2 mm\"\n[tree]\nmethod = \"dcco\"\n"
+                  "root_radius = \"0.2 mm\"\n[initial]\nfile = \"tree.swc\"\nbranching = \"versatile\"\nrole = \"distribution\"\n"
+                  "[physics]\nperfusion_flow = \"0.3 mL/min\"\n[[stage]]\nterminals = 2\ndraws_before_relaxing = 10\n[image]\nformats = []\n");
+  const auto r = run("generate r.toml --out o --no-image", dir_);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("placed 1 of its 2 terminals: 1000 points in a row"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+}
+
 TEST_F(Robustness, CurvePiecesFarBelowTheVesselsStayFew) {
   writeExample(dir_, "cco_sphere_curved_3d.toml", "c.toml",
                {{"terminals = 4000", "terminals = 50"}, {"wall_clearance", "piece_length = \"1e-4 mm\"\nwall_clearance"}});

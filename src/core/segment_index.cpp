@@ -25,6 +25,8 @@ void SegmentIndex::refresh(const VascularTree& tree, bool force) {
 
 void SegmentIndex::build(const VascularTree& tree, double cell) {
   cell_ = cell;
+  journal_.clear();  // a rebuild keeps what it finds: nothing left to take back
+  journaling_ = false;
   const Vec3 ext = hi_ - lo_;
   for (int ax = 0; ax < 3; ++ax) n_[ax] = std::max(1, static_cast<int>(std::ceil(ext[ax] / cell_)));
   cells_.assign(std::size_t(n_[0]) * n_[1] * n_[2], {});
@@ -57,7 +59,16 @@ void SegmentIndex::insert(const VascularTree& tree, std::int32_t s) {
           if (pointSegmentDistance(c, p, q) > half_diag) continue;
         }
         cells_[cellId(i, j, k)].push_back(s);
+        if (journaling_) journal_.push_back(cellId(i, j, k));
       }
+}
+
+void SegmentIndex::endTrial(bool keep) {
+  // Each journalled entry is the last of its cell once the later ones are popped.
+  if (!keep)
+    for (auto it = journal_.rbegin(); it != journal_.rend(); ++it) cells_[std::size_t(*it)].pop_back();
+  journal_.clear();
+  journaling_ = false;
 }
 
 void SegmentIndex::nearest(const VascularTree& tree, const Vec3& p, int k,

@@ -23,6 +23,14 @@ class SegmentIndex {
   // Rebuilds when the tree has doubled since the last build (or on `force`).
   void refresh(const VascularTree& tree, bool force = false);
   void insert(const VascularTree& tree, std::int32_t segment);
+  // Insertions between beginTrial() and endTrial(false) are taken back: a grower that inserts a
+  // trial's segments before checking them leaves nothing behind when it rolls the trial back
+  // (thousands of stale entries would otherwise crowd the cells it keeps querying).
+  void beginTrial() {
+    journal_.clear();
+    journaling_ = true;
+  }
+  void endTrial(bool keep);
 
   // The k segments nearest to p (point–segment distance), nearest first: (distance, id).
   void nearest(const VascularTree& tree, const Vec3& p, int k,
@@ -88,6 +96,12 @@ class SegmentIndex {
         }
   }
   double cellSize() const { return cell_; }
+  // Entries over all cells (a segment counts once per cell it touches).
+  std::size_t entryCount() const {
+    std::size_t n = 0;
+    for (const auto& c : cells_) n += c.size();
+    return n;
+  }
 
  private:
   void build(const VascularTree& tree, double cell);
@@ -105,6 +119,8 @@ class SegmentIndex {
   std::vector<std::vector<std::int32_t>> cells_;
   Marks marks_;
   std::int32_t built_for_ = 0;
+  std::vector<std::int64_t> journal_;  // cells appended to since beginTrial(), in order
+  bool journaling_ = false;
 };
 
 }  // namespace angiosynth

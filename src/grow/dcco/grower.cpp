@@ -632,12 +632,14 @@ class DccoGrower {
       if (other >= 0) rel_[other] = rel_[seg] * L.beta_other;
     }
     vol_[std::size_t(T.tree[s])] = treeVolumeOf(T.tree[s]);
-    // In the index before the checks (entries left by a rollback are harmless: queries measure
-    // the current geometry); s's distal part leaves its old line.
+    // In the index before the checks, taken back by a rollback; s's distal part keeps its old
+    // entries too (they are harmless: queries measure the current geometry).
+    index_.beginTrial();
     if (!tr.distal) index_.insert(T, b);
     index_.insert(T, n);
     index_.insert(T, s);
-    if (!tr.distal && rel_[b] >= kThickList) thick_.push_back(b);
+    listed_thick_ = !tr.distal && rel_[b] >= kThickList;
+    if (listed_thick_) thick_.push_back(b);
   }
 
   void rollback(const Trial& tr, const std::vector<Saved>& undo) {
@@ -656,6 +658,8 @@ class DccoGrower {
       T.length[s] = distance(T.position[q], T.position[s]);
       cut = b;
     }
+    index_.endTrial(false);
+    if (listed_thick_) thick_.pop_back();
     T.truncate(cut);
     eta_.resize(cut);
     rel_.resize(cut);
@@ -770,6 +774,7 @@ class DccoGrower {
       if (!tr.distal) checked_[n - 1] = radiusOf(n - 1);
       checked_[n] = radiusOf(n);
       checked_[tr.s] = radiusOf(tr.s);
+      index_.endTrial(true);
       index_.refresh(t_);
       if (double(t_.nodeCount()) > (1 + kRefreshShare) * double(solved_at_)) solve();
       return true;
@@ -1013,6 +1018,7 @@ class DccoGrower {
   SegmentIndex index_;
   std::vector<double> eta_, rel_, checked_, gamma_;
   std::vector<std::int32_t> thick_;
+  bool listed_thick_ = false;  // the last commit appended its proximal part to thick_
   std::int64_t moved_ = 0;
   std::vector<PowerKernel> kernels_;
   int stage_ = 0;
