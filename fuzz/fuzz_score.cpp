@@ -61,9 +61,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto truth = sampleTruth(sampleDir());
   ScoreOptions opt;
   opt.memory_limit = fuzz::kMemoryLimit;
-  opt.topcow = size % 2 == 1;
+  if (size % 2 == 1) opt.conventions = ScoreConventions::TopCoW;
   // A gzip stream (its magic bytes first) is read as .nii.gz, truncated or corrupt as it comes.
   const bool gz = size >= 2 && data[0] == 0x1f && data[1] == 0x8b;
   const auto file = fuzz::writeInput(data, size, gz ? "pred.nii.gz" : "pred.nii");
-  return fuzz::expectOnlyInputErrors([&] { scoreCase(file, truth, opt); });
+  return fuzz::expectOnlyInputErrors([&] { scoreCase(file, truth, opt).toJson(); });
 }

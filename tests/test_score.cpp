@@ -1,19 +1,25 @@
-// Scoring (issue 16, first part): overlap and surface distances against a brute-force
+// Scoring: overlap and surface distances against a brute-force
 // computation on hand-made volumes (shifted spheres, anisotropic voxels), the empty-mask
 // conventions, the NumPy percentile, and `angiosynth score` on a generated sample with a
 // prediction that misses every vessel thinner than one voxel.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <array>
 #include <fstream>
 #include <map>
 
 #include "cli_run.hpp"
+#include "test_support.hpp"
 #include "io/nifti_reader.hpp"
 #include "io/volume_writers.hpp"
 #include "score/betti.hpp"
 #include "score/calibre_plot.hpp"
 #include "score/case_scores.hpp"
+#include "score/dataset_scores.hpp"
+#include "score/measures.hpp"
+#include "score/metric.hpp"
 #include "score/skeleton.hpp"
 
 namespace {
@@ -214,6 +220,8 @@ TEST_F(ScoreRun, SurfaceAndOverlapAgreeWithScipy) {
                                     "[tree]\nmethod = \"cco\"\nterminals = 200\n[image]\nformats = [\"nifti\"]\n";
   ASSERT_EQ(run("generate p.toml --out s --quiet", dir_).code, 0);
   ASSERT_EQ(run("score s/image.nii.gz s --out scores.json --quiet", dir_).code, 0);
+  // A band of 3 mm: twelve voxels each way, measured by distance transform instead of neighbourhoods.
+  ASSERT_EQ(run("score s/image.nii.gz s --out wide.json --boundary-width 3 --quiet", dir_).code, 0);
   const std::string out = debianPython(R"(
 import json, numpy as np, nibabel as nib
 from scipy import ndimage as ndi
@@ -230,14 +238,40 @@ ref = [2 * tp / (2 * tp + fp + fn), max(a.max(), b.max()), max(np.percentile(a, 
        (a.sum() + b.sum()) / (len(a) + len(b)), 0.5 * (a.mean() + b.mean()), ((a <= tau).sum() + (b <= tau).sum()) / (len(a) + len(b))]
 j = json.load(open('scores.json'))
 s = j['surface']
-ours = [j['overlap']['dice'], s['hd_mm'], s['hd95_mm'], s['assd_mm'], s['masd_mm'], s['nsd']]
-print('max_difference', max(abs(x - y) for x, y in zip(ref, ours)), 'fp', int(fp))
+# Boundary IoU: the inner bands by SciPy's distance transform of the padded masks, Cheng et al.'s
+# default width; the boxes' shells as sets of voxels, as the TopCoW 2024 evaluation builds them.
+d = 0.02 * np.sqrt(sum((n * h) ** 2 for n, h in zip(t.shape, sp)))
+band = lambda m: m & (ndi.distance_transform_edt(np.pad(m, 1), sampling=sp)[1:-1, 1:-1, 1:-1] <= d)
+Bp, Bt = band(p), band(t)
+def shell(m, ratio):
+    idx = np.argwhere(m)
+    lo, hi = idx.min(0), idx.max(0)
+    dist = [int(np.ceil((h - l + 1) * ratio)) for l, h in zip(lo, hi)]
+    pts = set()
+    for x in range(lo[0], hi[0] + 1):
+        for y in range(lo[1], hi[1] + 1):
+            for z in range(lo[2], hi[2] + 1):
+                q = (x, y, z)
+                if any(q[a] - lo[a] < dist[a] or hi[a] - q[a] < dist[a] for a in range(3)):
+                    pts.add(q)
+    return pts
+sp_, st_ = shell(p, 0.2), shell(t, 0.2)
+b = j['boundary_iou']
+ref += [(Bp & Bt).sum() / (Bp | Bt).sum(), len(sp_ & st_) / len(sp_ | st_), b['band_width_mm']]
+ours = [j['overlap']['dice'], s['hd_mm'], s['hd95_mm'], s['assd_mm'], s['masd_mm'], s['nsd'],
+        b['boundary_iou'], b['bounding_box']['boundary_iou'], d]
+d = 3
+Bp, Bt = band(p), band(t)
+ref.append((Bp & Bt).sum() / (Bp | Bt).sum())
+ours.append(json.load(open('wide.json'))['boundary_iou']['boundary_iou'])
+print('max_difference', max(abs(x - y) for x, y in zip(ref, ours)), 'fp', int(fp), 'biou', b['boundary_iou'], 'jaccard', j['overlap']['jaccard'])
 )", dir_);
-  double diff = 1;
+  double diff = 1, biou = 0, jaccard = 0;
   int fp = 0;
-  ASSERT_EQ(std::sscanf(out.c_str(), "max_difference %lf fp %d", &diff, &fp), 2) << out;
+  ASSERT_EQ(std::sscanf(out.c_str(), "max_difference %lf fp %d biou %lf jaccard %lf", &diff, &fp, &biou, &jaccard), 4) << out;
   EXPECT_LT(diff, 1e-9) << out;
   EXPECT_GT(fp, 0) << out;  // not vacuous: the prediction differs from the truth
+  EXPECT_LT(biou, 1) << out;
 }
 
 }  // namespace
@@ -284,6 +318,64 @@ namespace {
 // Betti numbers of shapes whose topology is known: a ball (1, 0, 0), two balls (2, 0, 0), a
 // hollow ball (1, 0, 1), a solid torus (1, 1, 0), a ring of two tori linked by a bar (1, 2, 0),
 // diagonal neighbours (26-connected: one piece), an empty volume (0, 0, 0).
+// The registry is the one list: every metric has its definition in the results, its headline
+// columns in the CSV header in registry order, and a row in the README's table of metrics.
+TEST(Score, EveryRegisteredMetricIsDefinedInTheResultsInTheCsvAndInTheReadme) {
+  std::ifstream in(test::sourceDir() / "README.md");
+  const std::string readme((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto section = readme.substr(readme.find("## Scoring a segmentation"));
+  std::string header = "case";
+  for (const auto* m : scoreMetrics()) {
+    EXPECT_EQ(findScoreMetric(m->key), m);
+    EXPECT_NE(section.find(std::string("`") + m->key + "`"), std::string::npos) << m->key << " is missing from the README's table";
+    EXPECT_GT(std::string(m->definition).size(), 40u) << m->key;
+    for (const auto& h : m->headline) (header += ',') += h.column;
+  }
+  EXPECT_EQ(scoreCsvHeader(), header + "\n");
+  CaseScores none;
+  const auto defs = Json::parse(none.toJson().dump())["definitions"];
+  for (const auto* m : scoreMetrics()) EXPECT_TRUE(defs.contains(m->key)) << m->key;
+}
+
+// Solid boxes as masks, their box Boundary IoU against the values the TopCoW 2024 evaluation's
+// own tests state for the same boxes (size, location), and the box IoU at a ratio of one half.
+TEST(Score, BoxBoundaryIoUHasTheTopCowEvaluationsValues) {
+  const auto box = [](std::array<int, 3> size, std::array<int, 3> at) {
+    Volume<std::uint8_t> v(grid(20, Vec3(0.5, 0.5, 2)));
+    for (int k = at[2]; k < at[2] + size[2]; ++k)
+      for (int j = at[1]; j < at[1] + size[1]; ++j)
+        for (int i = at[0]; i < at[0] + size[0]; ++i) v.at(i, j, k) = 1;
+    return v;
+  };
+  EXPECT_DOUBLE_EQ(*boxBoundaryIoU(box({6, 3, 3}, {0, 0, 0}), box({6, 3, 3}, {2, 1, 1}), 0.2), 12.0 / 92);
+  EXPECT_DOUBLE_EQ(*boxBoundaryIoU(box({6, 3, 3}, {0, 0, 0}), box({6, 3, 3}, {3, 1, 1}), 0.2), 10.0 / 94);
+  EXPECT_DOUBLE_EQ(*boxBoundaryIoU(box({6, 3, 3}, {0, 2, 0}), box({4, 7, 3}, {1, 0, 0}), 0.2), 30.0 / 100);
+  EXPECT_DOUBLE_EQ(*boxBoundaryIoU(box({9, 6, 4}, {0, 0, 0}), box({3, 8, 4}, {3, 0, 0}), 0.2), 56.0 / 228);
+  EXPECT_DOUBLE_EQ(*boxBoundaryIoU(box({9, 6, 4}, {0, 0, 0}), box({3, 8, 4}, {3, 0, 0}), 0.5), 0.3);
+  EXPECT_DOUBLE_EQ(*boxBoundaryIoU(box({3, 4, 5}, {0, 0, 0}), box({5, 4, 3}, {1, 0, 0}), 0.5), 24.0 / 96);
+  EXPECT_FALSE(boxBoundaryIoU(box({3, 4, 5}, {0, 0, 0}), Volume<std::uint8_t>(grid(20, Vec3(0.5, 0.5, 2))), 0.2));
+}
+
+// The inner band of a ball: its border voxels at one voxel's width, every voxel once the band is
+// wider than the ball, and the two shifted balls' Boundary IoU below their IoU (the band weighs
+// the boundary only).
+TEST(Score, BoundaryBandsOfBallsAndTheirIoU) {
+  const VolumeGrid g = grid(32, Vec3(0.25, 0.25, 0.25));
+  const Volume<std::uint8_t> a = ball(g, Vec3(4, 4, 4), 2.5), b = ball(g, Vec3(4.5, 4, 4), 2.5);
+  const auto count = [](const Volume<std::uint8_t>& v) { return std::count(v.data.begin(), v.data.end(), 1); };
+  const auto thin = innerBoundaryBand(a, 0.25);
+  EXPECT_EQ(count(thin), std::int64_t(border(a).size()));
+  EXPECT_EQ(innerBoundaryBand(a, 10).data, a.data);
+  const auto iou = [&](const Volume<std::uint8_t>& p, const Volume<std::uint8_t>& t) {
+    std::int64_t both = 0, either = 0;
+    for (std::size_t i = 0; i < p.data.size(); ++i) both += p.data[i] && t.data[i], either += p.data[i] || t.data[i];
+    return double(both) / double(either);
+  };
+  const double whole = iou(a, b), boundary = iou(innerBoundaryBand(a, 0.5), innerBoundaryBand(b, 0.5));
+  EXPECT_LT(boundary, whole - 0.2) << whole << " " << boundary;
+  EXPECT_DOUBLE_EQ(iou(innerBoundaryBand(a, 10), innerBoundaryBand(b, 10)), whole);
+}
+
 TEST(Score, BettiNumbersOfShapesWithKnownTopology) {
   const VolumeGrid g = grid(40, Vec3(1, 1, 1));
   const auto make = [&](auto&& inside) {

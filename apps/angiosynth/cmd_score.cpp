@@ -42,7 +42,10 @@ CLI::App* addScore(CLI::App& app, ScoreArgs& a) {
   c->add_option("--predictions", a.predictions, "with --dataset: the directory of predictions, <case>.nii.gz (nnU-Net naming)");
   c->add_option("--out", a.out, "write the scores as JSON here (default: print them)");
   c->add_option("--csv", a.csv, "also write the headline numbers as one CSV row here");
-  c->add_option("--tolerance", a.tolerance_mm, "NSD tolerance in mm (default: the smallest voxel edge)")->check(finiteIn(0, 1e6));
+  c->add_option("--tolerance", a.options.tolerance_mm, "NSD tolerance in mm (default: the smallest voxel edge)")->check(finiteIn(0, 1e6));
+  c->add_option("--boundary-width", a.options.boundary_width_mm,
+                "Boundary IoU's band width in mm (default: 2 % of the image diagonal, at least one voxel)")
+      ->check(finiteIn(0, 1e6));
   c->add_flag("--topcow", a.topcow, "TopCoW's conventions: 26-neighbour borders, 90 mm when a mask is empty, Dice 0 when both are");
   c->add_option("--bins-voxels", a.bins_voxels, "calibre bins: increasing lower edges of the radius in voxels (default 0 0.5 1 2 4)")
       ->expected(1, 64);
@@ -56,16 +59,12 @@ CLI::App* addScore(CLI::App& app, ScoreArgs& a) {
 int runScore(const ScoreArgs& a) {
   const auto guard = limitThreads(a.common.threads);
   checkOutputs(a);
-  ScoreOptions opt;
-  opt.tolerance_mm = a.tolerance_mm;
-  opt.topcow = a.topcow;
+  ScoreOptions opt = a.options;
+  if (a.topcow) opt.conventions = ScoreConventions::TopCoW;
   opt.memory_limit = memoryLimit(a.common);
-  for (const auto* bins : {&a.bins_voxels, &a.bins_mm})
-    for (std::size_t k = 0; k < bins->size(); ++k)
-      if (!std::isfinite((*bins)[k]) || (*bins)[k] < 0 || (k > 0 && (*bins)[k] <= (*bins)[k - 1]))
-        throw InputError("", 0, "calibre bins must be finite, non-negative and increasing (lower edges)");
   if (!a.bins_voxels.empty()) opt.bins_voxels = a.bins_voxels;
   opt.bins_mm = a.bins_mm;
+  if (const auto why = opt.invalid(); !why.empty()) throw InputError("", 0, why);
   const bool dataset = !a.dataset.empty() || !a.predictions.empty();
   if (dataset ? (a.dataset.empty() || a.predictions.empty() || !a.prediction.empty()) : (a.prediction.empty() || a.sample.empty()))
     throw InputError("", 0, "give PRED SAMPLE_DIR (one case) or --dataset DIR --predictions DIR (every case of a dataset)");
@@ -74,8 +73,9 @@ int runScore(const ScoreArgs& a) {
   if (dataset) {
     j = scoreDataset(a.dataset, a.predictions, opt, progressPrinter(a.common, "scoring"), csv);
   } else {
-    j = scoreCase(a.prediction, sampleTruth(a.sample), opt);
-    csv = scoreCsvHeader() + scoreCsvRow(a.prediction, j);
+    const CaseScores scores = scoreCase(a.prediction, sampleTruth(a.sample), opt);
+    j = scores.toJson();
+    csv = scoreCsvHeader() + scoreCsvRow(a.prediction, scores);
   }
   if (a.out.empty()) std::cout << j.dump(2) << "\n";
   else writeFileAtomically(a.out, j.dump(2) + "\n");

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli_support.hpp"
+#include "score/case_scores.hpp"
 
 namespace angiosynth::cli {
 
@@ -65,7 +66,7 @@ struct ScoreArgs {
   std::string prediction, sample, out, csv;
   std::string dataset, predictions;  // --dataset mode
   std::string plot;
-  double tolerance_mm = 0;
+  ScoreOptions options;  // tolerance and band width from their flags
   bool topcow = false, force = false;
   std::vector<double> bins_voxels, bins_mm;
   CommonOptions common;

@@ -1,55 +1,36 @@
 #pragma once
-// Scoring a segmentation against a generated sample's exact truth: overlap, surface distances
-// in mm, recall by vessel calibre from the exact centreline and radius, and vessels detected
-// from the generating graph. Every metric's definition, connectivity and empty-mask convention
-// is written into the result.
+// Scoring a segmentation against a generated sample's exact truth (the stage's front door):
+// `ScoreOptions` in, `scoreCase` runs every registered metric (score/metric.hpp), `CaseScores`
+// out, with its own JSON form. Every metric's definition, connectivity and empty-mask convention
+// is written into that JSON.
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "raster/volume.hpp"
-
 namespace angiosynth {
 
-struct ScoreOptions {
-  double tolerance_mm = 0;                           // NSD's τ; 0: the smallest voxel edge
-  bool topcow = false;                               // TopCoW's conventions (see surfaceScores)
-  std::vector<double> bins_voxels{0, 0.5, 1, 2, 4};  // calibre bins: lower edges, radius in voxels
-  std::vector<double> bins_mm;                       // calibre bins in mm (none unless given)
-  std::uint64_t memory_limit = 0;
+enum class ScoreConventions {
+  Default,  // 6-neighbour borders, null for a surface distance when one mask is empty, Dice 1 when both are
+  TopCoW,   // the TopCoW challenge's: 26-neighbour borders, 90 mm when one mask is empty, Dice 0 when both are
 };
 
-// A ratio, or null when its denominator is 0 (undefined): how every score states an empty case.
-nlohmann::ordered_json ratio(double num, double den);
-
-// Overlap of two binary volumes on one grid: tp, fp, fn, Dice, Jaccard, precision, recall.
-nlohmann::ordered_json overlapScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, bool topcow);
-
-// Border voxels: foreground voxels with a background neighbour (6 face neighbours; 26 with
-// `all_neighbours`), voxels beyond the grid counting as background.
-Volume<std::uint8_t> borderVoxels(const Volume<std::uint8_t>& v, bool all_neighbours);
-
-// The distance (mm, between voxel centres, the grid's spacing per axis) from each border voxel
-// of `from` to the nearest border voxel of `to`, in voxel order.
-std::vector<double> directedBorderDistances(const Volume<std::uint8_t>& from_border, const Volume<std::uint8_t>& to_border);
-
-// HD, HD95 (the larger of the two directed 95th percentiles, linear interpolation between order
-// statistics as NumPy's default), ASSD, MASD and NSD at tolerance τ between the borders of two
-// volumes. Empty masks: both empty give 0 mm and NSD 1; one empty gives null (TopCoW: 90 mm).
-nlohmann::ordered_json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, double tolerance_mm,
-                                     bool topcow);
-
-// clDice (Shit et al. 2021) from the two skeletons and masks: topology precision, sensitivity,
-// their harmonic mean (null when a skeleton is empty).
-nlohmann::ordered_json clDice(const Volume<std::uint8_t>& pred_skeleton, const Volume<std::uint8_t>& truth,
-                              const Volume<std::uint8_t>& truth_skeleton, const Volume<std::uint8_t>& pred);
-
-// 95th percentile, linear interpolation between order statistics (NumPy's default).
-double percentile95(std::vector<double> values);
+struct ScoreOptions {
+  std::optional<double> tolerance_mm;                // NSD's τ; unset: the smallest voxel edge
+  ScoreConventions conventions = ScoreConventions::Default;
+  std::vector<double> bins_voxels{0, 0.5, 1, 2, 4};  // calibre bins: lower edges, radius in voxels
+  std::vector<double> bins_mm;                       // calibre bins in mm (none unless given)
+  // Boundary IoU's band width d; unset: 2 % of the image diagonal (Cheng et al. 2021), at least a voxel.
+  std::optional<double> boundary_width_mm;
+  std::uint64_t memory_limit = 0;
+  // What makes these options unusable ("" when none): bins must be finite, non-negative and
+  // increasing; widths and tolerances positive and finite.
+  std::string invalid() const;
+};
 
 // The truth of one case: its mask, exact centreline and radius volumes, and its graph's edges
 // file (with nodes beside it; empty: no vessel scores).
@@ -67,7 +48,29 @@ std::map<int, std::string> classLegend(const std::filesystem::path& sample_json)
 // The files of a sample directory `generate` wrote (mask.nii.gz, centerline.nii.gz, …).
 TruthFiles sampleTruth(const std::filesystem::path& sample_dir);
 
+struct ScoreMetric;
+
+// The scores of one case: each metric's block, and its headline numbers typed.
+struct CaseScores {
+  std::string prediction, truth;  // as the results name them
+  ScoreConventions conventions = ScoreConventions::Default;
+  struct Block {
+    const ScoreMetric* metric;
+    nlohmann::ordered_json detail;                // the metric's block
+    std::vector<std::optional<double>> headline;  // its headline columns (unset: undefined or not computed)
+  };
+  std::vector<Block> blocks;  // every registered metric that applied, in the registry's order
+
+  // A headline number by its CSV column (unset: undefined, not computed or no such column).
+  std::optional<double> headline(const std::string& column) const;
+  // The results file: prediction, truth, conventions, each block, the definitions.
+  nlohmann::ordered_json toJson() const;
+};
+
+// Every headline column, in the registry's order (the CSV's columns after `case`).
+std::vector<std::string> headlineColumns();
+
 // Scores PRED (a NIfTI; voxels > 0 are vessel) against the truth; the grids must agree.
-nlohmann::ordered_json scoreCase(const std::filesystem::path& pred, const TruthFiles& truth, const ScoreOptions& opt);
+CaseScores scoreCase(const std::filesystem::path& pred, const TruthFiles& truth, const ScoreOptions& opt);
 
 }  // namespace angiosynth

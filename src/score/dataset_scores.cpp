@@ -13,36 +13,6 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
-// The headline metrics: JSON pointer into a case's scores, and the CSV column.
-const std::vector<std::pair<const char*, const char*>>& headline() {
-  static const std::vector<std::pair<const char*, const char*>> h{
-      {"/overlap/dice", "dice"},
-      {"/overlap/jaccard", "jaccard"},
-      {"/overlap/precision", "precision"},
-      {"/overlap/recall", "recall"},
-      {"/surface/hd_mm", "hd_mm"},
-      {"/surface/hd95_mm", "hd95_mm"},
-      {"/surface/assd_mm", "assd_mm"},
-      {"/surface/masd_mm", "masd_mm"},
-      {"/surface/nsd", "nsd"},
-      {"/centreline/recall", "centreline_recall"},
-      {"/vessels/detected_rate", "vessels_detected_rate"},
-      {"/vessels/tree_length_detected", "tree_length_detected"},
-      {"/cldice/skeletons/cldice", "cldice"},
-      {"/cldice/exact_centreline/cldice", "cldice_exact_centreline"},
-      {"/topology/b0_error", "b0_error"},
-      {"/topology/b1_error", "b1_error"},
-      {"/topology/b2_error", "b2_error"},
-      {"/keypoints/bifurcations/f1", "bifurcation_f1"},
-      {"/keypoints/endpoints/f1", "endpoint_f1"}};
-  return h;
-}
-
-const Json* at(const Json& j, const char* pointer) {
-  const Json::json_pointer p(pointer);
-  return j.contains(p) && j.at(p).is_number() ? &j.at(p) : nullptr;
-}
-
 std::string number(double v) {
   std::ostringstream o;
   o.precision(17);
@@ -80,15 +50,15 @@ Json summary(std::vector<double> v) {
 
 std::string scoreCsvHeader() {
   std::string h = "case";
-  for (const auto& [p, name] : headline()) (h += ',') += name;
+  for (const auto& name : headlineColumns()) (h += ',') += name;
   return h + '\n';
 }
 
-std::string scoreCsvRow(const std::string& name, const Json& j) {
+std::string scoreCsvRow(const std::string& name, const CaseScores& scores) {
   std::string r = '"' + name + '"';
-  for (const auto& [p, column] : headline()) {
+  for (const auto& column : headlineColumns()) {
     r += ',';
-    if (const Json* v = at(j, p)) r += number(v->get<double>());
+    if (const auto v = scores.headline(column)) r += number(*v);
   }
   return r + '\n';
 }
@@ -140,18 +110,20 @@ Json scoreDataset(const fs::path& ds, const fs::path& predictions, const ScoreOp
   for (const auto& id : ids)
     if (!fs::is_regular_file(predictions / (id + ".nii.gz")))
       throw InputError((predictions / (id + ".nii.gz")).string(), 0, "missing: no prediction for case " + id + " (nnU-Net naming: <case>.nii.gz)");
+  const auto columns = headlineColumns();
   Json cases = Json::array();
   csv = scoreCsvHeader();
-  std::vector<std::vector<double>> values(headline().size());
+  std::vector<std::vector<double>> values(columns.size());
   std::int64_t done = 0;
   Json conventions, definitions;
   for (const auto& id : ids) {
-    const Json j = scoreCase(predictions / (id + ".nii.gz"), datasetCaseTruth(ds, id), opt);
+    const CaseScores scores = scoreCase(predictions / (id + ".nii.gz"), datasetCaseTruth(ds, id), opt);
+    csv += scoreCsvRow(id, scores);
+    for (std::size_t k = 0; k < columns.size(); ++k)
+      if (const auto v = scores.headline(columns[k])) values[k].push_back(*v);
+    const Json j = scores.toJson();
     conventions = j["conventions"];
     definitions = j["definitions"];
-    csv += scoreCsvRow(id, j);
-    for (std::size_t k = 0; k < headline().size(); ++k)
-      if (const Json* v = at(j, headline()[k].first)) values[k].push_back(v->get<double>());
     Json c{{"case", id}};
     for (const auto& [k, v] : j.items())
       if (k != "definitions" && k != "conventions") c[k] = v;
@@ -159,12 +131,12 @@ Json scoreDataset(const fs::path& ds, const fs::path& predictions, const ScoreOp
     if (progress) progress(++done, std::int64_t(ids.size()));
   }
   Json sum = Json::object();
-  for (std::size_t k = 0; k < headline().size(); ++k) sum[headline()[k].second] = summary(values[k]);
+  for (std::size_t k = 0; k < columns.size(); ++k) sum[columns[k]] = summary(values[k]);
   for (const char* stat : {"mean", "median", "sd"}) {
     std::string row = stat;
-    for (std::size_t k = 0; k < headline().size(); ++k) {
+    for (const auto& column : columns) {
       row += ',';
-      const Json& s = sum[headline()[k].second];
+      const Json& s = sum[column];
       if (s.contains(stat) && s[stat].is_number()) row += number(s[stat].get<double>());
     }
     csv += row + '\n';

@@ -23,6 +23,6 @@ nlohmann::ordered_json scoreDataset(const std::filesystem::path& dataset_dir, co
 
 // One CSV header and row of a case's headline numbers, in the same columns.
 std::string scoreCsvHeader();
-std::string scoreCsvRow(const std::string& name, const nlohmann::ordered_json& scores);
+std::string scoreCsvRow(const std::string& name, const CaseScores& scores);
 
 }  // namespace angiosynth

@@ -7,7 +7,7 @@
 
 #include "core/error.hpp"
 #include "files/text_lines.hpp"
-#include "score/case_scores.hpp"
+#include "score/measures.hpp"
 
 namespace angiosynth {
 

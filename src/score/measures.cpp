@@ -1,0 +1,192 @@
+#include "score/measures.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/distance_transform.hpp"
+#include "core/error.hpp"
+#include "settings/param_checks.hpp"
+
+namespace angiosynth {
+
+using Json = nlohmann::ordered_json;
+
+Volume<std::uint8_t> binaryMask(const Volume<float>& v) {
+  Volume<std::uint8_t> out(v.grid);
+  for (std::size_t i = 0; i < v.data.size(); ++i) out.data[i] = v.data[i] > 0;
+  return out;
+}
+
+double smallestEdge(const VolumeGrid& g) { return std::min({g.spacing_mm.x, g.spacing_mm.y, g.spacing_mm.z}); }
+
+Json ratio(double num, double den) { return den > 0 ? Json(num / den) : Json(nullptr); }
+
+Json overlapScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, bool topcow) {
+  std::int64_t tp = 0, fp = 0, fn = 0;
+  for (std::size_t i = 0; i < pred.data.size(); ++i) {
+    const bool p = pred.data[i] != 0, t = truth.data[i] != 0;
+    tp += p && t;
+    fp += p && !t;
+    fn += !p && t;
+  }
+  const bool both_empty = tp + fp + fn == 0;
+  Json j{{"true_positive_voxels", tp}, {"false_positive_voxels", fp}, {"false_negative_voxels", fn}};
+  j["dice"] = both_empty ? Json(topcow ? 0.0 : 1.0) : Json(2.0 * tp / double(2 * tp + fp + fn));
+  j["jaccard"] = both_empty ? Json(topcow ? 0.0 : 1.0) : Json(double(tp) / double(tp + fp + fn));
+  j["precision"] = ratio(double(tp), double(tp + fp));
+  j["recall"] = ratio(double(tp), double(tp + fn));
+  return j;
+}
+
+Volume<std::uint8_t> borderVoxels(const Volume<std::uint8_t>& v, bool all_neighbours) {
+  const VolumeGrid& g = v.grid;
+  Volume<std::uint8_t> out(g);
+  const auto on = [&](std::int64_t i, std::int64_t j, std::int64_t k) { return g.contains(i, j, k) && v.at(i, j, k) != 0; };
+  tbb::parallel_for(tbb::blocked_range<std::int32_t>(0, g.dims[2]), [&](const tbb::blocked_range<std::int32_t>& r) {
+    for (std::int64_t k = r.begin(); k < r.end(); ++k)
+      for (std::int64_t j = 0; j < g.dims[1]; ++j)
+        for (std::int64_t i = 0; i < g.dims[0]; ++i) {
+          if (!v.at(i, j, k)) continue;
+          bool border = false;
+          for (int dz = -1; dz <= 1 && !border; ++dz)
+            for (int dy = -1; dy <= 1 && !border; ++dy)
+              for (int dx = -1; dx <= 1 && !border; ++dx) {
+                const int n = std::abs(dx) + std::abs(dy) + std::abs(dz);
+                if (n == 0 || (!all_neighbours && n > 1)) continue;
+                border = !on(i + dx, j + dy, k + dz);
+              }
+          out.at(i, j, k) = border;
+        }
+  });
+  return out;
+}
+
+std::vector<double> directedBorderDistances(const Volume<std::uint8_t>& from, const Volume<std::uint8_t>& to) {
+  const VolumeGrid& g = to.grid;
+  std::vector<double> d2(to.data.size());
+  for (std::size_t i = 0; i < d2.size(); ++i) d2[i] = to.data[i] ? 0.0 : kFarSquared;
+  squaredDistances(d2, {g.dims[0], g.dims[1], g.dims[2]}, {g.spacing_mm.x, g.spacing_mm.y, g.spacing_mm.z});
+  std::vector<double> out;
+  for (std::size_t i = 0; i < from.data.size(); ++i)
+    if (from.data[i]) out.push_back(std::sqrt(d2[i]));
+  return out;
+}
+
+double percentile95(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  const double x = 0.95 * double(v.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(x));
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (x - double(lo)) * (v[hi] - v[lo]);
+}
+
+Json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, double tolerance_mm, bool topcow) {
+  const Volume<std::uint8_t> bp = borderVoxels(pred, topcow), bt = borderVoxels(truth, topcow);
+  const std::int64_t np = std::count(bp.data.begin(), bp.data.end(), 1), nt = std::count(bt.data.begin(), bt.data.end(), 1);
+  Json j{{"border", topcow ? "foreground voxels with a background voxel among their 26 neighbours"
+                           : "foreground voxels with a background voxel among their 6 face neighbours"},
+         {"border_voxels_prediction", np},
+         {"border_voxels_truth", nt},
+         {"tolerance_mm", tolerance_mm}};
+  if (np == 0 || nt == 0) {
+    const Json none = np == nt ? Json(0.0) : (topcow ? Json(90.0) : Json(nullptr));
+    for (const char* k : {"hd_mm", "hd95_mm", "assd_mm", "masd_mm"}) j[k] = none;
+    j["nsd"] = np == nt ? Json(1.0) : Json(0.0);
+    return j;
+  }
+  const std::vector<double> p_to_t = directedBorderDistances(bp, bt), t_to_p = directedBorderDistances(bt, bp);
+  const auto max = [](const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); };
+  const auto sum = [](const std::vector<double>& v) {
+    double s = 0;
+    for (double x : v) s += x;
+    return s;
+  };
+  const auto within = [&](const std::vector<double>& v) { return double(std::count_if(v.begin(), v.end(), [&](double x) { return x <= tolerance_mm; })); };
+  j["hd_mm"] = std::max(max(p_to_t), max(t_to_p));
+  j["hd95_mm"] = std::max(percentile95(p_to_t), percentile95(t_to_p));
+  j["assd_mm"] = (sum(p_to_t) + sum(t_to_p)) / double(np + nt);
+  j["masd_mm"] = 0.5 * (sum(p_to_t) / double(np) + sum(t_to_p) / double(nt));
+  j["nsd"] = (within(p_to_t) + within(t_to_p)) / double(np + nt);
+  return j;
+}
+
+Json clDice(const Volume<std::uint8_t>& pred_skeleton, const Volume<std::uint8_t>& truth, const Volume<std::uint8_t>& truth_skeleton,
+           const Volume<std::uint8_t>& pred) {
+  std::int64_t sp = 0, sp_in = 0, st = 0, st_in = 0;
+  for (std::size_t i = 0; i < pred.data.size(); ++i) {
+    if (pred_skeleton.data[i]) ++sp, sp_in += truth.data[i] != 0;
+    if (truth_skeleton.data[i]) ++st, st_in += pred.data[i] != 0;
+  }
+  const Json tprec = ratio(double(sp_in), double(sp)), tsens = ratio(double(st_in), double(st));
+  Json j{{"topology_precision", tprec}, {"topology_sensitivity", tsens}};
+  if (tprec.is_null() || tsens.is_null()) j["cldice"] = nullptr;
+  else {
+    const double a = tprec.get<double>(), b = tsens.get<double>();
+    j["cldice"] = a + b > 0 ? 2 * a * b / (a + b) : 0.0;
+  }
+  return j;
+}
+
+void checkSameGrid(const NiftiVolume& pred, const NiftiVolume& truth, const std::string& pred_file, const std::string& truth_file) {
+  const auto& a = pred.values.grid;
+  const auto& b = truth.values.grid;
+  const auto size = [](const VolumeGrid& g) {
+    return std::to_string(g.dims[0]) + " x " + std::to_string(g.dims[1]) + " x " + std::to_string(g.dims[2]);
+  };
+  if (a.dims != b.dims)
+    throw InputError(pred_file, 0, "the prediction has " + size(a) + " voxels, the truth (" + truth_file + ") " + size(b) +
+                                       "; allowed: the truth's grid (resample the prediction onto it)");
+  const double tol = 1e-3 * smallestEdge(b);
+  for (std::size_t k = 0; k < 12; ++k)
+    if (!(std::abs(pred.affine[k] - truth.affine[k]) <= tol)) {
+      std::string pa, ta;
+      for (std::size_t q = 0; q < 12; ++q) {  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on " " + string
+        if (q) pa += ' ', ta += ' ';
+        pa += show(pred.affine[q]);
+        ta += show(truth.affine[q]);
+      }
+      throw InputError(pred_file, 0, "the prediction's voxel-to-world affine [" + pa + "] is not the truth's [" + ta + "] (" + truth_file +
+                                         "); allowed: the same to 1e-3 voxel (mm)");
+    }
+}
+
+namespace {
+
+std::vector<double> binEdges(const std::vector<double>& lower) {
+  std::vector<double> e = lower;
+  e.push_back(INFINITY);
+  return e;
+}
+
+Json binRange(double lo, double hi) { return Json::array({lo, std::isfinite(hi) ? Json(hi) : Json("inf")}); }
+
+}  // namespace
+
+Json calibreRecall(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, const Volume<float>& centre,
+                   const Volume<float>& radius, const std::vector<double>& lower, double scale, const char* unit) {
+  const auto edges = binEdges(lower);
+  std::vector<std::int64_t> n(lower.size()), hit(lower.size()), covered(lower.size());
+  for (std::size_t i = 0; i < centre.data.size(); ++i) {
+    if (!(centre.data[i] > 0)) continue;
+    const double r = radius.data[i] / scale;
+    for (std::size_t b = 0; b < lower.size(); ++b)
+      if (r >= edges[b] && r < edges[b + 1]) {
+        ++n[b];
+        hit[b] += pred.data[i] != 0;
+        covered[b] += truth.data[i] != 0;
+      }
+  }
+  Json bins = Json::array();
+  for (std::size_t b = 0; b < lower.size(); ++b)
+    bins.push_back(Json{{std::string("radius_") + unit, binRange(edges[b], edges[b + 1])},
+                        {"centreline_voxels", n[b]},
+                        {"recall", ratio(double(hit[b]), double(n[b]))},
+                        {"truth_coverage", ratio(double(covered[b]), double(n[b]))}});
+  return bins;
+}
+
+}  // namespace angiosynth
