@@ -752,11 +752,11 @@ TEST(Mesh, MeshTableInAParameterFileWritesTheSurfaceWithTheSample) {
     EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(dir / name)) << name;
   };
-  refused("bad3", "ends = \"round\"\n", "ends 'round'; allowed: closed, open, capped");
+  refused("bad3", "ends = \"round\"\n", "ends 'round' is not allowed; allowed: closed, open, capped");
   refused("bad4", "wall_ratio = 0.2\nends = \"capped\"\n", "a hollow wall keeps its ends open");
   refused("bad5", "ends = \"capped\"\nclip_box = [0, 0, 0, 10, 10]\n", "clip_box must be an array of 6 numbers");
   refused("bad", "samples_across = 0\n", "samples_across = 0 is out of range; allowed: [1, 64]");
-  refused("bad2", "formats = [\"amf\"]\n", "'amf' is not a format; allowed: stl, obj, ply, off, vtp, 3mf");
+  refused("bad2", "formats = [\"amf\"]\n", "formats 'amf' is not allowed; allowed: stl, obj, ply, off, vtp, 3mf");
   // A clip box from the file: the same surface as the command's --clip-box.
   std::ofstream(dir / "with_box.toml") << text << "\n[mesh]\nformats = [\"off\"]\nsamples_across = 3\nends = \"capped\"\nclip_box = [20, 20, 20, 40, 40, 40]\n";
   ASSERT_EQ(run("generate with_box.toml --out boxed --no-image --quiet", dir).code, 0);
@@ -873,7 +873,7 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
 
   const auto bad = run("mesh sample --out bad --flow-extension 2 --quiet", dir);
   EXPECT_EQ(bad.code, 2);
-  EXPECT_NE(bad.err.find("--flow-extension needs --ends open or capped"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("flow_extension needs open or capped ends"), std::string::npos) << bad.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "bad"));
   std::filesystem::remove_all(dir);
 }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli_support.hpp"
+#include "config/mesh_settings.hpp"
 #include "score/case_scores.hpp"
 
 namespace angiosynth::cli {
@@ -76,23 +77,7 @@ int runScore(const ScoreArgs& a);
 
 struct MeshArgs {
   std::string input, out;
-  std::string method = "tubes";
-  std::string junctions = "nets";
-  double voxel_mm = 0;
-  int samples_across = 0;
-  double ring_spacing = -1;
-  double wall_thickness = 0, wall_ratio = 0;
-  bool wall_from_graph = false;
-  bool uniform = false, on_surface = false;
-  std::string ends = "closed";
-  double flow_extension = 0;
-  bool decimate = false;
-  double max_error = 0.1;
-  double sliver_angle = -1;
-  double max_angle = -1;
-  int remesh = -1;
-  std::vector<double> clip_box;
-  std::vector<std::string> formats;
+  MeshParameters mesh;  // every setting of [mesh], filled by its flag (config/mesh_settings.cpp)
   bool force = false;
   CommonOptions common;
 };

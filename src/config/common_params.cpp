@@ -4,7 +4,7 @@
 
 #include "angiosynth/templates.hpp"
 #include "io/graph_formats.hpp"
-#include "io/mesh_writers.hpp"
+#include "config/mesh_settings.hpp"
 #include "io/volume_formats.hpp"
 
 namespace angiosynth {
@@ -12,7 +12,6 @@ namespace angiosynth {
 const std::vector<MethodParam>& commonParams() {
   static const std::string volume_formats = "any of " + volumeFormatSummary();
   static const std::string graph_formats = "any of " + graphFormatSummary() + "; GXL and DOT are always written";
-  static const std::string mesh_formats = "any of " + meshFormatSummary() + ": surface.<format> each";
   static const std::vector<MethodParam> p{
       {"", "seed", "integer ≥ 0", "fresh, recorded in sample.json", "the random seed: same seed and parameters, same bytes"},
       {"curves", "tortuosity", "", "1.2", "with a [curves] table, every vessel becomes a smooth curve whose arc length over chord is this (1 … 3)"},
@@ -40,53 +39,15 @@ const std::vector<MethodParam>& commonParams() {
        "label_policy = ignore: vessel at partial volume >= high; nnU-Net's ignore label on (low, high) and on centreline voxels below high"},
       {"degrade", "profiles", "[text]", "[]", "degraded images to write, one image_<name> each: shipped profile names, .toml profiles or VascuSynth noise files"},
       {"output", "gxl_dialect", "text", "gxl", "gxl (GXL 1.0) or vascusynth"},
-      {"mesh", "enabled", "true/false", "true", "with a [mesh] table: write the vessels' surface (one closed mesh per tree) beside the graphs"},
-      {"mesh", "formats", "[text]", "[\"stl\"]", mesh_formats.c_str()},
-      {"mesh", "method", "tubes/contour", "tubes",
-       "tubes: each vessel's free middle (no other vessel near its wall) a tube of rings on its exact wall, the parts where vessels "
-       "meet (bifurcations, round ends, vessels that touch) contoured and joined to the tubes ring to ring; contour: the whole surface "
-       "contoured from the signed distance"},
-      {"mesh", "junctions", "nets/tetrahedra", "nets",
-       "tubes: how the parts where vessels meet are contoured: nets (surface nets, about a third of the triangles: on a uniform "
-       "grid where the part's radii are alike, else on the octree, where the result is a closed manifold without "
-       "self-intersections and of the union's shape; else marching tetrahedra) or tetrahedra (marching tetrahedra everywhere: "
-       "manifold by construction)"},
-      {"mesh", "voxel_size", "mm", "the thinnest vessel's diameter / samples_across", "the finest grid step"},
-      {"mesh", "samples_across", "count", "3 (tubes), 4 (contour)",
-       "grid steps across each vessel's thinnest end where it is contoured (1 … 64); thicker vessels get coarser cells"},
-      {"mesh", "ring_spacing", "radii", "8; with capped ends 1.5 times the rings' vertex spacing (turned by half of it)",
-       "tubes: rings at most this many radii of the vessel apart (0.1 … 100); successive rings are turned by half a vertex spacing"},
-      {"mesh", "wall_thickness", "mm", "0 (no wall)",
-       "a hollow wall of this thickness around each vessel's lumen (seed 004): the surface bounds the wall (outer side, lumen, a flat "
-       "ring at each end, all ends open); one of wall_thickness, wall_ratio, wall_from_graph"},
-      {"mesh", "wall_ratio", "share of the radius", "0 (no wall)", "a hollow wall of this share of each vessel's radius at each of its ends"},
-      {"mesh", "wall_from_graph", "true/false", "false", "a hollow wall of each vessel's own thickness (wall values of an [initial] network or a graph file)"},
-      {"mesh", "uniform", "true/false", "false", "every vessel at the finest step"},
-      {"mesh", "on_surface", "true/false", "false", "vertices exactly on the surface (no volume restoration)"},
-      {"mesh", "ends", "closed/open/capped", "closed",
-       "closed: round vessel ends; open: each tree's inlet and every outlet cut by the plane through its end node, perpendicular to "
-       "its vessel (one boundary loop per end); capped: those loops filled by planar caps, faces labelled (CellEntityIds/ModelFaceID "
-       "1 the wall, 2 … the caps; surface_faces.csv)"},
-      {"mesh", "decimate", "true/false", "false",
-       "collapse edges (quadric error, volume kept) while the surface keeps its topology, its triangles do not fold or turn by more than "
-       "45 degrees, no new angle falls below 15 degrees (unless one already was), and every moved vertex and new triangle stays within "
-       "max_error of the vessels"},
-      {"mesh", "max_error", "share of the local step", "0.1", "with decimate: the largest distance from the vessels' surface, (0, 1]"},
-      {"mesh", "sliver_angle", "degrees", "10 with capped ends, else 0",
-       "contoured triangles with an angle below this are repaired (an edge collapsed, a cap's edge flipped, a corner moved) under "
-       "decimation's checks, as a tetrahedral mesher needs; so are those with an edge shorter than 0.35 of the local step; 0: none, [0, 30]"},
-      {"mesh", "max_angle", "degrees", "90 with capped ends, else 0",
-       "with the sliver repair: contoured triangles with an angle above this are improved (the long edge flipped, a corner moved) under "
-       "the same checks: a tetrahedral mesher splits the edge an obtuse angle faces; 0: none, else [90, 180)"},
-      {"mesh", "remesh", "true/false", "true with capped ends (without decimate), else false",
-       "tubes: each contoured part remeshed isotropically to its local step (long edges split, short ones collapsed, flips, moves, "
-       "under decimation's checks): the nets' right-angled triangle pairs are what TetGen's quality refinement splits"},
-      {"mesh", "flow_extension", "radii", "0", "open/capped: each end prolonged straight by this many radii of its vessel before the cut (0 … 100)"},
-      {"mesh", "clip_box", "[mm × 6]", "none",
-       "[x0, y0, z0, x1, y1, z1]: the closed surface (closed or capped ends, or a hollow wall) clipped to this box, each side's section "
-       "filled flat with a hollow wall's lumens left open (seed 004's printed block); ends outside the box are gone"},
   };
-  return p;
+  // [mesh] from its declarations (config/mesh_settings.cpp).
+  static const std::vector<SettingRow> mesh_rows = referenceRows(meshSettings());
+  static const std::vector<MethodParam> all = [] {
+    std::vector<MethodParam> out = p;
+    for (const auto& r : mesh_rows) out.push_back({r.table.c_str(), r.key.c_str(), r.unit.c_str(), r.fallback.c_str(), r.meaning.c_str()});
+    return out;
+  }();
+  return all;
 }
 
 namespace {

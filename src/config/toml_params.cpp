@@ -149,80 +149,15 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   if (im.get("graph_formats")) ip.graph_formats = stringsOf(im, "graph_formats", graphFormatNames());
 
   // [mesh]: the vessels' surface beside the graphs (src/mesh); the table's presence enables it.
-  const auto& me = r.table("mesh", {"enabled", "method", "formats", "voxel_size", "junctions", "samples_across", "ring_spacing", "uniform", "on_surface", "ends",
-                                    "flow_extension", "decimate", "max_error", "sliver_angle", "max_angle", "remesh", "wall_thickness", "wall_ratio", "wall_from_graph", "clip_box"});
+  const auto& me = r.table("mesh", settingKeys(meshSettings()));
   if (const auto* n = root.get("mesh")) {
-    auto& mp = sc.mesh;
     sc.mesh_line = r.lineOf(n);
-    mp.enabled = r.boolean(me, "enabled", true);
-    if (me.get("formats")) mp.formats = stringsOf(me, "formats", meshFormatNames());
-    if (mp.formats.empty()) throw InputError(file, r.lineOf(me.get("formats")), "formats must name at least one of stl, obj, ply, off, vtp, 3mf");
-    if (me.get("voxel_size")) {
-      mp.voxel_mm = r.quantity(me, "mesh", "voxel_size", Dimension::Length, voxel_mm);
-      checkRange(mp.voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, r.at(me, "voxel_size"), "mesh voxel_size (mm)");
-    }
-    if (me.get("method")) {
-      mp.method = r.string(me, "mesh", "method");
-      if (mp.method != "tubes" && mp.method != "contour")
-        throw InputError(file, r.lineOf(me.get("method")), "method '" + mp.method + "'; allowed: tubes, contour");
-    }
-    if (me.get("junctions")) {
-      mp.junctions = r.string(me, "mesh", "junctions");
-      if (mp.junctions != "nets" && mp.junctions != "tetrahedra")
-        throw InputError(file, r.lineOf(me.get("junctions")), "junctions '" + mp.junctions + "'; allowed: nets, tetrahedra");
-    }
-    if (me.get("samples_across")) mp.samples_across = r.smallInteger(me, "mesh", "samples_across", 1, 64);
-    if (me.get("ring_spacing")) {
-      mp.ring_spacing = r.number(me, "mesh", "ring_spacing");
-      checkRange(mp.ring_spacing, 0.1, false, 100, false, r.at(me, "ring_spacing"), "ring_spacing (radii)");
-    }
-    mp.uniform = r.boolean(me, "uniform", mp.uniform);
-    mp.on_surface = r.boolean(me, "on_surface", mp.on_surface);
-    if (me.get("ends")) {
-      mp.ends = r.string(me, "mesh", "ends");
-      if (mp.ends != "closed" && mp.ends != "open" && mp.ends != "capped")
-        throw InputError(file, r.lineOf(me.get("ends")), "ends '" + mp.ends + "'; allowed: closed, open, capped");
-    }
-    mp.decimate = r.boolean(me, "decimate", mp.decimate);
-    if (me.get("max_error")) {
-      mp.max_error = r.number(me, "mesh", "max_error");
-      checkRange(mp.max_error, 0, true, 1, false, r.at(me, "max_error"), "max_error (share of the local step)");
-    }
-    if (me.get("sliver_angle")) {
-      mp.sliver_angle = r.number(me, "mesh", "sliver_angle");
-      checkRange(mp.sliver_angle, 0, false, 30, false, r.at(me, "sliver_angle"), "sliver_angle (degrees)");
-    }
-    if (me.get("max_angle")) {
-      mp.max_angle = r.number(me, "mesh", "max_angle");
-      if (const auto why = maxAngleProblem(mp.max_angle); !why.empty()) throw InputError(file, r.lineOf(me.get("max_angle")), why);
-    }
-    if (me.get("remesh")) mp.remesh = r.boolean(me, "remesh", false) ? 1 : 0;
-    if (me.get("wall_thickness")) {
-      mp.wall_thickness = r.quantity(me, "mesh", "wall_thickness", Dimension::Length, voxel_mm);
-      checkRange(mp.wall_thickness, 0, false, Limits::kMaxRadius, false, r.at(me, "wall_thickness"), "wall_thickness (mm)");
-    }
-    if (me.get("wall_ratio")) {
-      mp.wall_ratio = r.number(me, "mesh", "wall_ratio");
-      checkRange(mp.wall_ratio, 0, false, 100, false, r.at(me, "wall_ratio"), "wall_ratio (share of the radius)");
-    }
-    mp.wall_from_graph = r.boolean(me, "wall_from_graph", mp.wall_from_graph);
-    if (int(mp.wall_thickness > 0) + int(mp.wall_ratio > 0) + int(mp.wall_from_graph) > 1)
-      throw InputError(file, r.lineOf(&me), "wall_thickness, wall_ratio and wall_from_graph exclude each other; allowed: one of them");
-    if (mp.hollowWall()) {
-      if (mp.method != "tubes") throw InputError(file, r.lineOf(&me), "a hollow wall is built on the tubes; allowed: method = \"tubes\"");
-      if (mp.ends == "capped")
-        throw InputError(file, r.lineOf(me.get("ends")), "a hollow wall keeps its ends open (the lumen runs through); allowed: ends = \"open\" or \"closed\"");
-    }
-    if (me.get("clip_box")) {
-      mp.clip_box = r.numbers(me.get("clip_box"), "clip_box", 6);
-      if (const auto why = clipBoxProblem(mp); !why.empty()) throw InputError(file, r.lineOf(me.get("clip_box")), why);
-    }
-    if (me.get("flow_extension")) {
-      mp.flow_extension = r.number(me, "mesh", "flow_extension");
-      checkRange(mp.flow_extension, 0, false, 100, false, r.at(me, "flow_extension"), "flow_extension (radii)");
-      if (mp.ends == "closed" && mp.flow_extension > 0)
-        throw InputError(file, r.lineOf(me.get("flow_extension")), "flow_extension needs open or capped ends; allowed: ends = \"open\" or \"capped\"");
-    }
+    sc.mesh.enabled = true;
+    readSettings(r, me, meshSettings(), sc.mesh, voxel_mm);
+    checkRules(meshRules(), sc.mesh, [&](const char* key) -> std::optional<Where> {
+      if (me.get(key)) return r.at(me, key);
+      return std::nullopt;
+    }, Where{file, sc.mesh_line});
   }
 
   if (root.get("curves")) {

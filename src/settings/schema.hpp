@@ -1,0 +1,186 @@
+#pragma once
+// Settings declared once. Each declaration names a setting's table and key, its unit, its range
+// or choices, its default as a user reads it, its meaning, the field of an Options struct it fills
+// and the command-line flag that overrides it. From the one list come the parameter file's reader
+// (readSettings), the flags (apps/angiosynth/setting_flags.hpp), `angiosynth params` and the
+// parameter reference (referenceRows); the rules between settings are declared beside them and
+// checked on the filled Options, whichever way it was filled (checkRules).
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <set>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "core/units.hpp"
+#include "settings/toml_reader.hpp"
+
+namespace angiosynth {
+
+template <class Options>
+using SettingField = std::variant<bool Options::*, int Options::*, double Options::*, std::optional<double> Options::*,
+                                  std::optional<bool> Options::*, std::string Options::*, std::vector<double> Options::*,
+                                  std::vector<std::string> Options::*>;
+
+// How a number is bounded: lo < v or lo <= v, and v < hi or v <= hi.
+struct SettingRange {
+  double lo = -1e300, hi = 1e300;
+  bool lo_open = false, hi_open = false;
+  bool holds(double v) const { return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi); }
+  std::string text() const {
+    return std::string(lo_open ? "(" : "[") + show(lo) + ", " + (hi >= 1e300 ? "inf" : show(hi)) + (hi_open ? ")" : "]");
+  }
+};
+
+template <class Options>
+struct Setting;
+
+// The unit after a range in a message: the setting's unit when it is one ("mm", "degrees"), the
+// length's mm, nothing for descriptions such as "true/false".
+template <class Options>
+std::string rangeUnit(const Setting<Options>& s) {
+  const std::string u = s.length ? "mm" : s.unit;
+  if (u == "[mm × 6]") return " mm";
+  return u.empty() || u.find_first_of("[/ ") != std::string::npos || u == "count" ? "" : " " + u;
+}
+
+template <class Options>
+struct Setting {
+  const char* table;     // "mesh"
+  const char* key;       // "sliver_angle"
+  const char* unit;      // "degrees", "mm", "true/false", "count", … (a length given as "<number> <unit>" when `length`)
+  const char* fallback;  // the default as a user reads it
+  const char* meaning;
+  SettingField<Options> field;
+  SettingRange range{};                // numbers, counts and the entries of a list of numbers
+  std::vector<std::string> choices{};  // texts and lists of texts: the allowed values
+  std::size_t count = 0;               // a list of numbers: exactly this many
+  bool length = false;                 // a length: a string with its unit in a file, mm on the command line
+  const char* flag = nullptr;          // the command-line flag that overrides it ("--sliver-angle"), if any
+  // Further refusal of a value in range (""; or why): a bound with a hole in it.
+  std::string (*problem)(double) = nullptr;
+};
+
+// A rule between settings: `problem` says what is wrong with the filled Options, or "". `keys`:
+// the settings it concerns, the first one present in a file naming the line of an error.
+template <class Options>
+struct SettingRule {
+  std::vector<const char*> keys;
+  std::string (*problem)(const Options&);
+};
+
+template <class Options>
+std::set<std::string> settingKeys(const std::vector<Setting<Options>>& settings) {
+  std::set<std::string> keys;
+  for (const auto& s : settings) keys.insert(s.key);
+  return keys;
+}
+
+namespace detail {
+
+inline std::string choiceList(const std::vector<std::string>& choices) {
+  std::string list;
+  for (const auto& c : choices) list += (list.empty() ? "" : ", ") + c;
+  return list;
+}
+
+}  // namespace detail
+
+// The value of one number setting checked against its declaration; `where` names it in errors.
+template <class Options>
+void checkSettingNumber(const Setting<Options>& s, double v, const Where& where, const std::string& name) {
+  if (!std::isfinite(v) || !s.range.holds(v))
+    throw InputError(where.file, where.line, name + " = " + show(v) + " is out of range; allowed: " + s.range.text() + rangeUnit(s));
+  if (s.problem)
+    if (const auto why = s.problem(v); !why.empty()) throw InputError(where.file, where.line, name + ": " + why);
+}
+
+template <class Options>
+void checkSettingChoice(const Setting<Options>& s, const std::string& v, const Where& where, const std::string& name) {
+  if (std::find(s.choices.begin(), s.choices.end(), v) == s.choices.end())
+    throw InputError(where.file, where.line, name + " '" + v + "' is not allowed; allowed: " + detail::choiceList(s.choices));
+}
+
+// Fills `o` from the keys of table `t` that `settings` declares (the table's keys are checked
+// against them by the caller's TomlReader::table). Lengths take the voxel as a unit.
+template <class Options>
+void readSettings(const TomlReader& r, const toml::table& t, const std::vector<Setting<Options>>& settings, Options& o,
+                  double voxel_mm) {
+  for (const auto& s : settings) {
+    const toml::node* n = t.get(s.key);
+    if (!n) continue;
+    const Where where = r.at(t, s.key);
+    const std::string name = s.key;
+    const auto number = [&] {
+      const double v = s.length ? r.quantity(t, s.table, s.key, Dimension::Length, voxel_mm) : r.number(t, s.table, s.key);
+      checkSettingNumber(s, v, where, name);
+      return v;
+    };
+    std::visit(
+        [&](auto member) {
+          using T = std::remove_reference_t<decltype(o.*member)>;
+          if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::optional<bool>>) {
+            o.*member = r.boolean(t, s.key, false);
+          } else if constexpr (std::is_same_v<T, int>) {
+            o.*member = r.smallInteger(t, s.table, s.key, std::int64_t(s.range.lo), std::int64_t(s.range.hi));
+          } else if constexpr (std::is_same_v<T, double> || std::is_same_v<T, std::optional<double>>) {
+            o.*member = number();
+          } else if constexpr (std::is_same_v<T, std::string>) {
+            const std::string v = r.string(t, s.table, s.key);
+            checkSettingChoice(s, v, where, name);
+            o.*member = v;
+          } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+            const auto v = r.numbers(n, s.key, s.count);
+            for (double x : v) checkSettingNumber(s, x, where, name + " entry");
+            o.*member = v;
+          } else {
+            static_assert(std::is_same_v<T, std::vector<std::string>>);
+            const auto* a = n->as_array();
+            if (!a) throw InputError(where.file, where.line, name + " must be a list of strings; allowed: " + detail::choiceList(s.choices));
+            std::vector<std::string> v;
+            for (const auto& e : *a) {
+              const auto text = e.value<std::string>();
+              if (!text) throw InputError(where.file, r.lineOf(&e), name + ": '?' is not allowed; allowed: " + detail::choiceList(s.choices));
+              checkSettingChoice(s, *text, {where.file, r.lineOf(&e)}, name);
+              v.push_back(*text);
+            }
+            o.*member = v;
+          }
+        },
+        s.field);
+  }
+}
+
+// Refuses the first rule `o` breaks: `where(key)` says where a setting was given (a file's line),
+// `fallback` where none of the rule's settings was (the table's line; none for flags).
+template <class Options, class WhereOf>
+void checkRules(const std::vector<SettingRule<Options>>& rules, const Options& o, WhereOf&& where, const Where& fallback = {"", 0}) {
+  for (const auto& rule : rules) {
+    const auto why = rule.problem(o);
+    if (why.empty()) continue;
+    Where w = fallback;
+    for (const char* k : rule.keys)
+      if (const auto at = where(k); at) {
+        w = *at;
+        break;
+      }
+    throw InputError(w.file, w.line, why);
+  }
+}
+
+// One reference row per setting: table, key, unit, default, meaning (and the flag).
+struct SettingRow {
+  std::string table, key, unit, fallback, meaning, flag;
+};
+
+template <class Options>
+std::vector<SettingRow> referenceRows(const std::vector<Setting<Options>>& settings) {
+  std::vector<SettingRow> rows;
+  for (const auto& s : settings) {
+    rows.push_back({s.table, s.key, s.unit, s.fallback, s.meaning, s.flag ? s.flag : ""});
+  }
+  return rows;
+}
+
+}  // namespace angiosynth
