@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Quick start 2: install what is missing, build, run every test; then every test again under
+# Quick start 2: install what is missing, build, run every test; then the suite again under
 # address and undefined-behaviour sanitizers, and a short fuzzing run of every input parser
 # (scripts/sanitize.sh; FUZZ_SECONDS per target, default 20).
 set -euo pipefail
