@@ -58,7 +58,7 @@ struct Setting {
   std::size_t count = 0;               // a list of numbers: exactly this many
   bool length = false;                 // a length: a string with its unit in a file, mm on the command line
   const char* flag = nullptr;          // the command-line flag that overrides it ("--sliver-angle"), if any
-  // Further refusal of a value in range (""; or why): a bound with a hole in it.
+  // Further refusal of a value in range ("", or the whole message naming the key): a bound with a hole in it.
   std::string (*problem)(double) = nullptr;
 };
 
@@ -93,7 +93,7 @@ void checkSettingNumber(const Setting<Options>& s, double v, const Where& where,
   if (!std::isfinite(v) || !s.range.holds(v))
     throw InputError(where.file, where.line, name + " = " + show(v) + " is out of range; allowed: " + s.range.text() + rangeUnit(s));
   if (s.problem)
-    if (const auto why = s.problem(v); !why.empty()) throw InputError(where.file, where.line, name + ": " + why);
+    if (const auto why = s.problem(v); !why.empty()) throw InputError(where.file, where.line, why);
 }
 
 template <class Options>
