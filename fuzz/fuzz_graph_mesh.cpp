@@ -1,9 +1,8 @@
 // Graph files through `mesh`: the same bytes read as each of the five formats (VItA's .cco,
 // SWC, GXL, VTP, the CSV pair), then meshed with the default tubes under a small memory limit
 // (the surface is built in full, no file is written); networks of up to 24 nodes are meshed, under
-// a limit of 1 MiB (about 16,000 triangles): thick vessels at the default step made 140,000
-// triangles, 30 s a case under ASan, and 65,000 (a limit of 4 MiB) still kept a long campaign to
-// a few cases a second.
+// a limit of 1 MiB (about 16,000 triangles), so that a long campaign stays at many cases a second
+// (docs/fuzzing.md).
 #include "fuzz_support.hpp"
 #include "io/network_files.hpp"
 #include "pipeline/mesh_outputs.hpp"

@@ -2,8 +2,7 @@
 // applied to a small tree with a junction, a taper and walls (the surface is built in full, no
 // file is written). The tree is a few radii long and the sampling density is capped after
 // reading (at most 3 grid steps across, a grid step of at least 0.25 mm, rings at least half a
-// radius apart), so a case stays small: decimating the contour at the default 4 steps across took
-// about 10 s under ASan, and 4.5 s at 3 across on a tree of 15 mm.
+// radius apart), so that a case stays small enough for long campaigns (docs/fuzzing.md).
 #include <algorithm>
 #include <sstream>
 
