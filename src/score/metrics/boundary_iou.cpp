@@ -198,11 +198,12 @@ Json boundaryIoU(const ScoringCase& c) {
          {"band_voxels_prediction", np},
          {"band_voxels_truth", nt},
          {"boundary_iou", either > 0 ? Json(double(both) / double(either)) : Json(c.topcow() ? 0.0 : 1.0)}};
-  Json box{{"prediction", boxJson(boundingBox(c.prediction))}, {"truth", boxJson(boundingBox(c.truth))}, {"boundary_distance_ratio", kBoxBoundaryRatio}};
+  const Box p = boundingBox(c.prediction), t = boundingBox(c.truth);
+  Json box{{"prediction", boxJson(p)}, {"truth", boxJson(t)}, {"boundary_distance_ratio", kBoxBoundaryRatio}};
   const Json none = c.topcow() ? Json(0.0) : Json(nullptr);
-  const auto iou = boxBoundaryIoU(c.prediction, c.truth, 0.5), biou = boxBoundaryIoU(c.prediction, c.truth, kBoxBoundaryRatio);
-  box["iou"] = iou ? Json(*iou) : none;
-  box["boundary_iou"] = biou ? Json(*biou) : none;
+  const bool boxes = !p.empty && !t.empty;
+  box["iou"] = boxes ? Json(shellIoU(p, t, 0.5)) : none;
+  box["boundary_iou"] = boxes ? Json(shellIoU(p, t, kBoxBoundaryRatio)) : none;
   j["bounding_box"] = box;
   return j;
 }
