@@ -34,11 +34,11 @@ inline void degradeSmallSample(const Profile& profile) {
 inline void growParameterFile(const std::filesystem::path& params, const std::filesystem::path& out) {
   std::filesystem::remove_all(out);
   std::filesystem::create_directories(out);
-  const Scenario sc = readTomlParameters(params);
+  Scenario sc = readTomlParameters(params);
+  sc.image.enabled = false;
   SampleRequest req;
   req.scenario = &sc;
   req.memory_limit = kMemoryLimit;
-  req.no_image = true;
   generateSample(req, out);
 }
 

@@ -1,5 +1,5 @@
 // The shipped examples' outputs, byte for byte, against the SHA-256 recorded in
-// tests/data/example_outputs.sha256: a refactoring (growth methods as plug-ins, issue 11) must
+// tests/data/example_outputs.sha256: a refactoring must
 // not change one byte of what the examples write. JSON sidecars are compared without what
 // depends on the run rather than the data (time, command line, absolute paths).
 // ANGIOSYNTH_RECORD_EXAMPLE_HASHES=1 rewrites the record instead of checking it.

@@ -45,7 +45,7 @@ TEST(LabelPolicy, EachPolicyFollowsItsRuleVoxelByVoxel) {
   EXPECT_EQ(values(makeLabel(p, gt, plain)), (std::vector<int>{0, 0, 1, 1, 1}));
   p.name = "ignore";  // band (0.25, 0.75): the thin centreline voxel, 0.3 and 0.6 are ignored
   EXPECT_EQ(values(makeLabel(p, gt, plain)), (std::vector<int>{0, 2, 2, 2, 1}));
-  p.ignore_low = 0.5, p.ignore_high = 0.55;
+  p.ignore_band = {0.5, 0.55};
   EXPECT_EQ(values(makeLabel(p, gt, plain)), (std::vector<int>{0, 2, 0, 1, 1}));
   p.name = "soft";
   const Label soft = makeLabel(p, gt, plain);
@@ -159,7 +159,7 @@ print('mismatch', int(((label > 0) != expected).sum()), 'label', int((label > 0)
   ASSERT_GE(thin, 0);
   EXPECT_LT(blur_bins[thin]["vessel"].get<double>(), 0.9 * mask_bins[thin]["vessel"].get<double>());
   EXPECT_GT(blur_bins[4]["vessel"].is_null() ? 1.0 : blur_bins[4]["vessel"].get<double>(), 0.99);
-  EXPECT_EQ(s["parameters"]["image"]["label"]["policy"], "visible");
+  EXPECT_EQ(s["parameters"]["image"]["label_policy"], "visible");
 }
 
 TEST_F(LabelPolicyRun, SameSeedSameLabelsOnOneAndTwoThreads) {

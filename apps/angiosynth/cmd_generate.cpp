@@ -4,7 +4,7 @@
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "files/staged_directory.hpp"
-#include "io/volume_formats.hpp"
+#include "config/sample_settings.hpp"
 #include "pipeline/generate_sample.hpp"
 
 namespace angiosynth::cli {
@@ -15,12 +15,8 @@ CLI::App* addGenerate(CLI::App& app, GenerateArgs& a) {
   c->add_option("--out", a.out, "output directory (default: out/<PARAMS name>)");
   c->add_option("--seed", a.seed, "random seed (default: the file's seed, else fresh and recorded in sample.json)")
       ->check(CLI::Range(std::uint64_t(0), std::uint64_t(INT64_MAX)));  // as TOML seeds: int64 >= 0
-  c->add_option("--gxl-dialect", a.gxl_dialect, "gxl: valid GXL 1.0 (default); vascusynth: VascuSynth 2011's dialect")
-      ->check(CLI::IsMember({"gxl", "vascusynth"}));
-  c->add_option("--format", a.formats, "volume formats, overriding [image] formats: " + volumeFormatSummary())
-      ->delimiter(',')
-      ->check(CLI::IsMember(volumeFormatNames()));
-  c->add_flag("--no-image", a.no_image, "grow and write graphs only, no volumes");
+  a.image.add(*c, imageSettings());
+  a.output.add(*c, outputSettings());
   c->add_option("--profile", a.profiles,
                 "degradation profiles, overriding [degrade] profiles: shipped names (clean, vascusynth, cta, tof_mra, "
                 "two_photon, domain_randomisation), .toml profiles, or VascuSynth noise files; one image_<name> each")
@@ -35,7 +31,9 @@ int runGenerate(const GenerateArgs& a, const std::string& command_line) {
   const auto threads = limitThreads(a.common.threads);
   ReadOptions ro;
   ro.vascusynth_length_unit = a.common.vascusynth_unit;
-  const Scenario sc = readParameters(a.params, ro);
+  Scenario sc = readParameters(a.params, ro);
+  a.image.applyTo(sc.image);
+  a.output.applyTo(sc);
   const std::filesystem::path out = a.out.empty() ? std::filesystem::path("out") / std::filesystem::path(a.params).stem()
                                                   : std::filesystem::path(a.out);
   std::vector<std::filesystem::path> inputs = scenarioInputs(sc);
@@ -44,27 +42,22 @@ int runGenerate(const GenerateArgs& a, const std::string& command_line) {
   SampleRequest req;
   req.scenario = &sc;
   req.seed = a.seed ? *a.seed : (sc.seed ? *sc.seed : freshSeed());
-  req.gxl_dialect = a.gxl_dialect.empty() ? sc.gxl_dialect : a.gxl_dialect;
+  req.gxl_dialect = sc.gxl_dialect;
   req.graph_id = "tree";
   req.command_line = command_line;
   req.memory_limit = memoryLimit(a.common);
   req.progress = progressPrinter(a.common, "growing");
-  req.formats = a.formats;
-  req.no_image = a.no_image;
   if (a.no_profiles) req.profiles.emplace();
   if (!a.profiles.empty()) {
     req.profiles.emplace();
     for (const auto& p : a.profiles) req.profiles->push_back(loadProfile(p, "--profile", 0));
   }
-  const auto j = generateSample(req, dir.path());
+  const SampleSummary made = generateSample(req, dir.path());
   dir.commit();
-  if (!a.common.quiet) {
-    const auto& s = j["statistics"];
-    std::cerr << "wrote " << dir.target().string() << ": " << s["terminals"] << " terminals, total volume "
-              << s["total_volume"]["value"].get<double>() << " mm^3, " << s["intersecting_pairs"]
-              << " intersecting pairs, seed " << req.seed << ", " << j["timing_seconds"]["grow"].get<double>()
+  if (!a.common.quiet)
+    std::cerr << "wrote " << dir.target().string() << ": " << made.terminals << " terminals, total volume " << made.total_volume_mm3
+              << " mm^3, " << made.intersecting_pairs << " intersecting pairs, seed " << req.seed << ", " << made.grow_seconds
               << " s growth\n";
-  }
   return 0;
 }
 

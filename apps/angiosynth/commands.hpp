@@ -8,6 +8,8 @@
 
 #include "cli_support.hpp"
 #include "config/mesh_settings.hpp"
+#include "config/scenario.hpp"
+#include "setting_flags.hpp"
 #include "score/case_scores.hpp"
 
 namespace angiosynth::cli {
@@ -16,9 +18,8 @@ struct GenerateArgs {
   std::string params;
   std::string out;
   std::optional<std::uint64_t> seed;
-  std::string gxl_dialect;
-  std::vector<std::string> formats;
-  bool no_image = false;
+  SettingOverrides<ImageParameters> image;  // [image] settings given as flags
+  SettingOverrides<Scenario> output;        // [output] settings given as flags
   bool force = false;
   std::vector<std::string> profiles;
   bool no_profiles = false;

@@ -31,11 +31,19 @@ CLI::Validator settingNumberCheck(const Setting<Options>& s) {
       s.range.text());
 }
 
+// Each flag with the setting it fills.
 template <class Options>
-void addSettingFlags(CLI::App& c, const std::vector<Setting<Options>>& settings, Options& o) {
+using SettingFlagList = std::vector<std::pair<const Setting<Options>*, const CLI::Option*>>;
+
+template <class Options>
+SettingFlagList<Options> addSettingFlags(CLI::App& c, const std::vector<Setting<Options>>& settings, Options& o) {
+  SettingFlagList<Options> added;
   for (const auto& s : settings) {
     if (!s.flag) continue;
-    const std::string help = std::string(s.meaning) + " (default " + s.fallback + ")";
+    const std::string key = std::string("[") + s.table + "] " + s.key;
+    const std::string help = s.flag[0] == '!' ? "sets " + key + " = false (" + s.meaning + ")"
+                                              : std::string(s.meaning) + " (" + key + "; default " + s.fallback + ")";
+    const std::size_t before = c.get_options().size();
     std::visit(
         [&](auto member) {
           using T = std::remove_reference_t<decltype(o.*member)>;
@@ -46,6 +54,9 @@ void addSettingFlags(CLI::App& c, const std::vector<Setting<Options>>& settings,
                 ->check(CLI::IsMember({0, 1}));
           } else if constexpr (std::is_same_v<T, int>) {
             c.add_option(s.flag, o.*member, help)->check(CLI::Range(int(s.range.lo), int(s.range.hi)));
+          } else if constexpr (std::is_same_v<T, std::optional<int>>) {
+            c.add_option_function<int>(s.flag, [&o, member](const int& v) { o.*member = v; }, help)
+                ->check(CLI::Range(int(s.range.lo), int(s.range.hi)));
           } else if constexpr (std::is_same_v<T, double> || std::is_same_v<T, std::optional<double>>) {
             c.add_option_function<double>(s.flag, [&o, member](const double& v) { o.*member = v; }, help)->check(settingNumberCheck(s));
           } else if constexpr (std::is_same_v<T, std::string>) {
@@ -55,13 +66,37 @@ void addSettingFlags(CLI::App& c, const std::vector<Setting<Options>>& settings,
                 ->delimiter(',')
                 ->expected(int(s.count))
                 ->check(settingNumberCheck(s));
+          } else if constexpr (std::is_same_v<T, std::optional<Vec3>>) {
+            c.add_option_function<std::vector<double>>(
+                 s.flag, [&o, member](const std::vector<double>& v) { o.*member = Vec3(v[0], v[1], v[2]); }, help + " (3 numbers, comma-separated)")
+                ->delimiter(',')
+                ->expected(3)
+                ->check(settingNumberCheck(s));
           } else {
             static_assert(std::is_same_v<T, std::vector<std::string>>);
             c.add_option(s.flag, o.*member, help + " (comma-separated)")->delimiter(',')->check(CLI::IsMember(s.choices));
           }
         },
         s.field);
+    added.emplace_back(&s, c.get_options()[before]);
   }
+  return added;
 }
+
+// Flags that override a parameter file's settings: parsed into `values`, then copied onto the
+// file's Options for each flag the command line held (applyTo).
+template <class Options>
+struct SettingOverrides {
+  Options values;
+  SettingFlagList<Options> flags;
+  void add(CLI::App& c, const std::vector<Setting<Options>>& settings) {
+    const auto more = addSettingFlags(c, settings, values);
+    flags.insert(flags.end(), more.begin(), more.end());
+  }
+  void applyTo(Options& target) const {
+    for (const auto& [s, option] : flags)
+      if (option->count() > 0) std::visit([&](auto member) { target.*member = values.*member; }, s->field);
+  }
+};
 
 }  // namespace angiosynth::cli

@@ -87,7 +87,7 @@ const std::vector<Setting<MeshParameters>>& meshSettings() {
       {.table = "mesh", .key = "clip_box", .unit = "[mm × 6]", .fallback = "none",
        .meaning = "[x0, y0, z0, x1, y1, z1]: the closed surface (closed or capped ends, or a hollow wall) clipped to this box, each side's section "
        "filled flat with a hollow wall's lumens left open (the printed block of Lázaro 2011); ends outside the box are gone",
-       .field = &MeshParameters::clip_box, .range = {-physical::kMaxCoordinateMm, physical::kMaxCoordinateMm}, .count = 6, .flag = "--clip-box"},
+       .field = &MeshParameters::clip_box, .range = {-physical::kMaxCoordinateMm, physical::kMaxCoordinateMm}, .count = 6, .flag = "--clip-box", .range_unit = "mm"},
   };
   return settings;
 }

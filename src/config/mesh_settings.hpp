@@ -16,8 +16,8 @@ struct MeshParameters {
   std::vector<std::string> formats{"stl"};  // names of io/mesh_writers.hpp's meshFormats()
   std::string method = "tubes";             // tubes (rings along free vessels, contoured junctions) or contour (all contoured)
   std::string junctions = "nets";           // tubes: parts contoured by surface nets where they pass their checks, or by tetrahedra only
-  double voxel_mm = 0;                      // finest step; 0: the thinnest vessel's diameter / samples_across
-  int samples_across = 0;                   // 0: the method's (contour 4, tubes 3)
+  std::optional<double> voxel_mm;           // finest step; unset: the thinnest vessel's diameter / samples_across
+  std::optional<int> samples_across;        // unset: the method's (contour 4, tubes 3)
   std::optional<double> ring_spacing;       // tubes: rings at most this many radii apart; unset: 8, with capped ends 1.5 ring vertex spacings (0)
   double ringSpacing() const { return ring_spacing ? *ring_spacing : ends == "capped" ? 0 : 8; }
   double wall_thickness = 0;                // mm: a hollow wall of this thickness (0: none), or

@@ -11,12 +11,12 @@
 #include <nlohmann/json.hpp>
 
 #include "core/units.hpp"
+#include "config/image_settings.hpp"
 #include "config/mesh_settings.hpp"
 #include "settings/input_paths.hpp"
 #include "settings/param_checks.hpp"
 #include "grow/common/curved_vessels.hpp"
 #include "grow/method.hpp"
-#include "raster/label_policy.hpp"
 
 namespace toml {
 inline namespace v3 {
@@ -25,21 +25,6 @@ class table;
 }  // namespace toml
 
 namespace angiosynth {
-
-// How the tree becomes volumes (issue: rasterizer). Defaults suit 8-bit images of the map.
-struct ImageParameters {
-  bool enabled = true;
-  double voxel_mm = 0;                 // 0: the demand map's voxel size
-  Vec3 field_of_view_mm;               // 0: the demand map's extent
-  int supersampling = 4;               // S: S³ samples per partially covered voxel
-  int centerline_connectivity = 26;    // of the centreline channel: 26 or 6
-  double background = 0, vessel = 255; // image = background + (vessel − background) × fraction
-  std::string dtype = "uint8";         // uint8, uint16, int16, float32
-  std::vector<std::string> formats{"nifti", "png"};                        // names of io/volume_formats.hpp
-  std::vector<std::string> graph_formats{"csv", "vtp", "swc", "graphml"};  // names of io/graph_formats.hpp; GXL and DOT always
-  LabelPolicy labels;                  // the training label (label.nii.gz) beside the mask
-  int labels_line = 0;
-};
 
 struct Scenario {
   std::string parameter_file;

@@ -115,15 +115,14 @@ Json generateOne(const DatasetSpec& spec, const fs::path& dir, const fs::path& p
     req.memory_limit = opt.memory_limit;
     req.record_timing = false;  // sample files depend on (spec, index) only
     if (spec.labels == "kind") req.class_kinds = spec.kinds;
-    const Json sample = generateSample(req, staging);
+    const SampleSummary sample = generateSample(req, staging);
     // The image of the profile, and as label the mask or the classes: of the warped image when the
     // profile warps. Roles carry the profile's name (a profile file's stem), not its reference.
     std::string suffix(1, '_');  // (appended: GCC 12 warns falsely, -Wrestrict, on "_" + string)
     suffix += loadProfile(r.profile, spec.file, 0).name;
     const auto written = [&](const std::string& role) {
-      const auto& files = sample.at("files");
       const std::string own = role + suffix;
-      return staging / files.at(files.contains(own) ? own : role).get<std::string>();
+      return staging / sample.file(sample.wrote(own) ? own : role);
     };
     const fs::path label = written(spec.label_policy != "binary" ? "label" : spec.labels == "kind" ? "classes" : "mask"),
                    image = written("image");
@@ -137,7 +136,7 @@ Json generateOne(const DatasetSpec& spec, const fs::path& dir, const fs::path& p
               {"label", label_rel},
               {"label_values", labelValues(spec)},
               {"parameters_toml", r.toml},
-              {"sample", sample}};
+              {"sample", sample.sidecar}};
     writeTextFile(staging / "meta.json", [&](std::ostream& o) { o << meta.dump(2) << "\n"; });
     // Renames: ground truth first, the image last, then the manifest line. Each replaces an
     // earlier copy only once the new one is complete.

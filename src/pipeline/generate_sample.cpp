@@ -7,6 +7,7 @@
 
 #include "angiosynth/version.hpp"
 #include "core/error.hpp"
+#include "config/sample_settings.hpp"
 #include "core/quantity_json.hpp"
 #include "core/format.hpp"
 #include "domain/growth_domain.hpp"
@@ -16,6 +17,7 @@
 #include "pipeline/volume_files.hpp"
 #include "pipeline/volume_outputs.hpp"
 #include "physics/hemodynamics.hpp"
+#include "settings/settings_json.hpp"
 
 namespace angiosynth {
 namespace {
@@ -29,37 +31,12 @@ double seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock
 
 Json describeParameters(const Scenario& sc) {
   Json j = sc.growth->describe();
-  const auto& im = sc.image;
-  j["image"] = Json{{"enabled", im.enabled},
-                    {"voxel_size", quantityJson(im.voxel_mm > 0 ? im.voxel_mm : sc.growth->voxelMm(), "mm")},
-                    {"field_of_view", im.field_of_view_mm.x > 0 ? Json{{"value", {im.field_of_view_mm.x, im.field_of_view_mm.y, im.field_of_view_mm.z}}, {"unit", "mm"}}
-                                                               : Json("the demand map's extent")},
-                    {"supersampling", im.supersampling},
-                    {"centerline_connectivity", im.centerline_connectivity},
-                    {"background", im.background},
-                    {"vessel", im.vessel},
-                    {"dtype", im.dtype},
-                    {"formats", im.formats},
-                    {"graph_formats", im.graph_formats},
-                    {"label", im.labels.describe()}};
-  if (sc.curves.enabled) {
-    const auto& c = sc.curves;
-    Json cj{{"tortuosity", c.tortuosity}, {"tortuosity_sd", c.tortuosity_sd}};
-    if (c.wavelength_mm > 0) cj["wavelength"] = quantityJson(c.wavelength_mm, "mm");
-    else cj["wavelength_radii"] = c.wavelength_radii;
-    cj["piece_length"] = quantityJson(c.piece_mm > 0 ? c.piece_mm : sc.growth->voxelMm(), "mm");
-    cj["wall_clearance"] = quantityJson(c.wall_clearance_mm, "mm");
-    cj["avoid_overlaps"] = c.avoid_overlaps;
-    j["curves"] = cj;
-  }
-  j["profiles"] = sc.profiles;
-  if (sc.mesh.enabled)
-    j["mesh"] = Json{{"formats", sc.mesh.formats},
-                     {"voxel_size", sc.mesh.voxel_mm > 0 ? quantityJson(sc.mesh.voxel_mm, "mm") : Json(nullptr)},
-                     {"junctions", sc.mesh.junctions},
-                     {"samples_across", sc.mesh.samples_across},
-                     {"uniform", sc.mesh.uniform},
-                     {"on_surface", sc.mesh.on_surface}};
+  j["image"] = settingsJson(imageSettings(), sc.image);
+  j["image"].update(settingsJson(labelSettings(), sc.image.labels));
+  if (sc.curves.enabled) j["curves"] = settingsJson(curveSettings(), sc.curves);
+  j["degrade"] = settingsJson(outputSettings(), sc, "degrade");
+  j["output"] = settingsJson(outputSettings(), sc, "output");
+  if (sc.mesh.enabled) j["mesh"] = settingsJson(meshSettings(), sc.mesh);
   return j;
 }
 
@@ -83,9 +60,8 @@ PreparedSample prepareSample(const SampleRequest& req) {
 
   // The volume request is settled, and its size checked, before the (possibly long) growth.
   ImageParameters ip = sc.image;
-  if (!req.formats.empty()) ip.formats = req.formats;
   if (req.vascusynth_layout) ip.formats = {"nifti"};  // beside the slices of original_image
-  ps.volumes = ip.enabled && !req.no_image;
+  ps.volumes = ip.enabled;
   VolumeRequest& vr = ps.vr;
   std::vector<Profile>& profiles = ps.profiles;
   if (req.profiles) profiles = *req.profiles;
@@ -126,24 +102,15 @@ void checkSampleInputs(const Scenario& sc, std::uint64_t memory_limit) {
   SampleRequest req;
   req.scenario = &sc;
   req.memory_limit = memory_limit;
-  req.no_image = !sc.image.enabled;
   prepareSample(req);
 }
 
-Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) {
-  const Scenario& sc = *req.scenario;
-  Json timing;
-  auto t0 = Clock::now();
-  PreparedSample ps = prepareSample(req);
-  const GrowthDomain* domain = ps.growth->domain();
-  const DemandMap& map = *ps.map;
-  const VolumeRequest& vr = ps.vr;
-  const bool volumes = ps.volumes;
-  const std::vector<Profile>& profiles = ps.profiles;
-  timing["read_maps"] = seconds(t0);
+namespace {
 
-  GrowthReport report;
-  t0 = Clock::now();
+// Growth, class labels and curves: the forest every later stage writes.
+Forest growForest(const PreparedSample& ps, const SampleRequest& req, GrowthReport& report, CurveReport& curves, Json& timing) {
+  const Scenario& sc = *req.scenario;
+  auto t0 = Clock::now();
   Forest forest;
   try {
     forest = ps.growth->grow(req.seed, req.sample, report, req.progress);
@@ -157,67 +124,49 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
     throw InputError(sc.parameter_file, 0, e.what());
   }
   timing["grow"] = seconds(t0);
-  CurveReport curves;
   if (sc.curves.enabled) {
     t0 = Clock::now();
     try {
-      forest.vessels = curveVessels(forest.vessels, sc.curves, domain, map, req.seed, req.sample, curves, req.memory_limit);
+      forest.vessels = curveVessels(forest.vessels, sc.curves, ps.growth->domain(), *ps.map, req.seed, req.sample, curves, req.memory_limit);
     } catch (const InputError& e) {
       throw InputError(sc.parameter_file, sc.curves_line, e.what());
     }
     timing["curves"] = seconds(t0);
   }
+  return forest;
+}
+
+// GXL and DOT always (VascuSynth's layout: its tree_structure.xml), and an SVG of a 2-D domain.
+void writeGraphs(const Forest& forest, const PreparedSample& ps, const SampleRequest& req, const std::filesystem::path& dir, Json& files) {
   const VascularTree& tree = forest.vessels;
-
-  t0 = Clock::now();
-  GraphFrame frame{map.voxel_mm, sc.input_units};
-  Json files;
-  if (req.vascusynth_layout) {
-    writeTextFile(dir / "tree_structure.xml", [&](std::ostream& o) { writeVascuSynthGxl(o, tree, frame, req.graph_id); });
-    files["gxl"] = "tree_structure.xml";
-    writeTextFile(dir / "tree.dot", [&](std::ostream& o) { writeDot(o, tree, forest.trees, frame); });
-    files["dot"] = "tree.dot";
-  } else {
-    writeTextFile(dir / "tree.gxl", [&](std::ostream& o) {
-      if (req.gxl_dialect == "vascusynth") writeVascuSynthGxl(o, tree, frame, req.graph_id);
-      else writeGxl(o, tree, forest.trees, frame, req.graph_id);
-    });
-    files["gxl"] = "tree.gxl";
-    writeTextFile(dir / "tree.dot", [&](std::ostream& o) { writeDot(o, tree, forest.trees, frame); });
-    files["dot"] = "tree.dot";
-    if (domain && domain->dimension() == 2) {
-      writeTextFile(dir / "tree.svg", [&](std::ostream& o) { writeSvg(o, forest, *domain); });
-      files["svg"] = "tree.svg";
-    }
+  const GraphFrame frame{ps.map->voxel_mm, req.scenario->input_units};
+  const bool vascusynth_file = req.vascusynth_layout || req.gxl_dialect == "vascusynth";
+  const std::string gxl = req.vascusynth_layout ? "tree_structure.xml" : "tree.gxl";
+  writeTextFile(dir / gxl, [&](std::ostream& o) {
+    if (vascusynth_file) writeVascuSynthGxl(o, tree, frame, req.graph_id);
+    else writeGxl(o, tree, forest.trees, frame, req.graph_id);
+  });
+  files["gxl"] = gxl;
+  writeTextFile(dir / "tree.dot", [&](std::ostream& o) { writeDot(o, tree, forest.trees, frame); });
+  files["dot"] = "tree.dot";
+  const GrowthDomain* domain = ps.growth->domain();
+  if (!req.vascusynth_layout && domain && domain->dimension() == 2) {
+    writeTextFile(dir / "tree.svg", [&](std::ostream& o) { writeSvg(o, forest, *domain); });
+    files["svg"] = "tree.svg";
   }
-  timing["write_graphs"] = seconds(t0);
+}
 
-  Json stats, degradation;
-  if (volumes) {
-    t0 = Clock::now();
-    Json degrade_seconds;
-    writeVolumes(forest, vr, dir, files, stats, degradation, &degrade_seconds);
-    if (!degrade_seconds.empty()) timing["degrade_effects"] = degrade_seconds;
-    timing["rasterize_and_write_volumes"] = seconds(t0);
-  } else if (!req.vascusynth_layout) {
-    // Without volumes the graphs asked for are written all the same; voxel coordinates in the
-    // key points refer to the grid the image would have had.
-    t0 = Clock::now();
-    writeGraphFiles(tree, forest.trees, imageGrid(map, sc.image, sc.parameter_file, sc.image_line), sc.image.graph_formats, "", dir, files);
-    timing["write_graphs"] = timing["write_graphs"].get<double>() + seconds(t0);
-  }
+// The surface of each tree ([mesh]), its files and statistics.
+void writeSurface(const Forest& forest, const SampleRequest& req, const std::filesystem::path& dir, Json& files, Json& stats) {
+  std::vector<std::string> kinds;
+  for (const auto& t : forest.trees) kinds.push_back(t.kind);
+  const auto surface = writeSurfaceFiles(forest.vessels, req.scenario->mesh, req.memory_limit, dir, {}, kinds);
+  for (const auto& [format, name] : surface.files.items()) files["surface_" + format] = name;
+  stats["surface"] = surface.statistics;
+}
 
-  if (sc.mesh.enabled) {
-    t0 = Clock::now();
-    std::vector<std::string> kinds;
-    for (const auto& t : forest.trees) kinds.push_back(t.kind);
-    const auto surface = writeSurfaceFiles(tree, sc.mesh, req.memory_limit, dir, {}, kinds);
-    for (const auto& [format, name] : surface.files.items()) files["surface_" + format] = name;
-    stats["surface"] = surface.statistics;
-    timing["mesh"] = seconds(t0);
-  }
-
-  // Statistics of the final tree.
+// The final tree's size, cost, radii and depths, growth's counts and the method's own.
+void addTreeStatistics(const VascularTree& tree, const PreparedSample& ps, const Scenario& sc, const GrowthReport& report, Json& stats) {
   const auto& p = sc.growth->physics();
   std::int64_t depth_max = 0;
   double depth_sum = 0, r_min = INFINITY, r_max = 0;
@@ -260,53 +209,48 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
   stats["moved_nodes"] = report.moved_nodes;
   stats["repaired_terminals"] = report.repaired_terminals;
   ps.growth->addStatistics(report, stats);
-  if (sc.curves.enabled)
-    stats["curves"] = Json{{"vessels", curves.vessels},
-                           {"curved", curves.curved},
-                           {"already_tortuous", curves.already_tortuous},
-                           {"flattened_by_domain", curves.flattened_by_domain},
-                           {"flattened_by_overlap", curves.flattened_by_overlap},
-                           {"left_straight", curves.straightened},
-                           {"overlap_rounds", curves.overlap_rounds},
-                           {"overlapping_vessel_pairs", curves.overlapping_vessel_pairs},
-                           {"nodes_before", curves.nodes_before},
-                           {"nodes_after", curves.nodes_after},
-                           {"tortuosity_mean", curves.tortuosity_mean},
-                           {"tortuosity_min", curves.tortuosity_min},
-                           {"tortuosity_max", curves.tortuosity_max},
-                           {"tortuosity_target_error_max", curves.target_error_max},
-                           {"tortuosity_definition", "distance metric of each vessel (root, bifurcation or terminal to the next): arc length over chord"},
-                           {"pressures", "radii and flows as grown; pressures along the longer paths (Poiseuille)"}};
-  // Mean radius per bifurcation level (the root segment is level 0), as in seed 000 Fig. 6–7.
-  {
-    std::vector<double> sum;
-    std::vector<std::int64_t> count;
-    for (std::int32_t i = 1; i < tree.nodeCount(); ++i) {
-      if (tree.isRoot(i)) continue;
-      const auto level = static_cast<std::size_t>(tree.depth[i] - 1);
-      if (level >= sum.size()) sum.resize(level + 1, 0.0), count.resize(level + 1, 0);
-      sum[level] += tree.radius[i];
-      ++count[level];
-    }
-    Json levels = Json::array();
-    for (std::size_t l = 0; l < sum.size(); ++l)
-      levels.push_back(Json{{"level", l}, {"segments", count[l]}, {"mean_radius_mm", count[l] ? sum[l] / double(count[l]) : 0.0}});
-    stats["radius_by_bifurcation_level"] = levels;
-  }
+}
 
-  Json j;
-  j["tool"] = Json{{"name", "angiosynth"}, {"version", kVersion}};
-  j["command_line"] = req.command_line;
-  j["seed"] = req.seed;
-  j["sample"] = req.sample;
-  j["parameter_file"] = sc.parameter_file;
-  j["parameter_format"] = sc.format;
-  j["units"] = Json{{"length", "mm"}, {"flow", "mm^3/s"}, {"pressure", "Pa"}, {"viscosity", "Pa*s"},
-                    {"input", sc.units_note},
-                    {"frame", "positions in mm from the corner of map voxel (0,0,0), axes along the map's x, y, z; "
-                              "position_voxel in map voxels"}};
-  j["parameters"] = describeParameters(sc);
-  // The trees of the forest: their ids and kinds, and the class label of each kind in `classes`.
+Json curveStatistics(const CurveReport& curves) {
+  return Json{{"vessels", curves.vessels},
+              {"curved", curves.curved},
+              {"already_tortuous", curves.already_tortuous},
+              {"flattened_by_domain", curves.flattened_by_domain},
+              {"flattened_by_overlap", curves.flattened_by_overlap},
+              {"left_straight", curves.straightened},
+              {"overlap_rounds", curves.overlap_rounds},
+              {"overlapping_vessel_pairs", curves.overlapping_vessel_pairs},
+              {"nodes_before", curves.nodes_before},
+              {"nodes_after", curves.nodes_after},
+              {"tortuosity_mean", curves.tortuosity_mean},
+              {"tortuosity_min", curves.tortuosity_min},
+              {"tortuosity_max", curves.tortuosity_max},
+              {"tortuosity_target_error_max", curves.target_error_max},
+              {"tortuosity_definition", "distance metric of each vessel (root, bifurcation or terminal to the next): arc length over chord"},
+              {"pressures", "radii and flows as grown; pressures along the longer paths (Poiseuille)"}};
+}
+
+// Mean radius per bifurcation level (the root segment is level 0), as Kerautret et al. (OpenCCO)
+// plot it (their Figs. 6–7).
+Json radiusByBifurcationLevel(const VascularTree& tree) {
+  std::vector<double> sum;
+  std::vector<std::int64_t> count;
+  for (std::int32_t i = 1; i < tree.nodeCount(); ++i) {
+    if (tree.isRoot(i)) continue;
+    const auto level = static_cast<std::size_t>(tree.depth[i] - 1);
+    if (level >= sum.size()) sum.resize(level + 1, 0.0), count.resize(level + 1, 0);
+    sum[level] += tree.radius[i];
+    ++count[level];
+  }
+  Json levels = Json::array();
+  for (std::size_t l = 0; l < sum.size(); ++l)
+    levels.push_back(Json{{"level", l}, {"segments", count[l]}, {"mean_radius_mm", count[l] ? sum[l] / double(count[l]) : 0.0}});
+  return levels;
+}
+
+// The trees of the forest: their ids and kinds, roots, flows and pressures.
+Json describeTrees(const Forest& forest) {
+  const VascularTree& tree = forest.vessels;
   Json trees = Json::array();
   const auto roots = tree.roots();
   for (std::size_t k = 0; k < forest.trees.size(); ++k) {
@@ -326,20 +270,89 @@ Json generateSample(const SampleRequest& req, const std::filesystem::path& dir) 
                          {"terminal_pressure", quantityJson(terminal_pressure, "Pa")},
                          {"flow_direction", terminal_pressure > tree.pressure[root] ? "terminals to root (drains)" : "root to terminals"}});
   }
-  j["trees"] = trees;
+  return trees;
+}
+
+// The class label of each kind in `classes`.
+Json classLegend(const Forest& forest) {
   Json legend = Json::object();
   legend["0"] = "background";
   const auto kinds = kindsByLabel(forest.trees);
   for (std::size_t c = 0; c < kinds.size(); ++c)
     if (!kinds[c].empty()) legend[std::to_string(c + 1)] = kinds[c];
-  j["classes"] = legend;
+  return legend;
+}
+
+}  // namespace
+
+std::filesystem::path SampleSummary::file(const std::string& role) const { return sidecar.at("files").at(role).get<std::string>(); }
+
+bool SampleSummary::wrote(const std::string& role) const { return sidecar.at("files").contains(role); }
+
+SampleSummary generateSample(const SampleRequest& req, const std::filesystem::path& dir) {
+  const Scenario& sc = *req.scenario;
+  Json timing;
+  auto t0 = Clock::now();
+  const PreparedSample ps = prepareSample(req);
+  timing["read_maps"] = seconds(t0);
+
+  GrowthReport report;
+  CurveReport curves;
+  const Forest forest = growForest(ps, req, report, curves, timing);
+  const VascularTree& tree = forest.vessels;
+
+  t0 = Clock::now();
+  Json files, stats, degradation;
+  writeGraphs(forest, ps, req, dir, files);
+  timing["write_graphs"] = seconds(t0);
+  if (ps.volumes) {
+    t0 = Clock::now();
+    Json degrade_seconds;
+    writeVolumes(forest, ps.vr, dir, files, stats, degradation, &degrade_seconds);
+    if (!degrade_seconds.empty()) timing["degrade_effects"] = degrade_seconds;
+    timing["rasterize_and_write_volumes"] = seconds(t0);
+  } else if (!req.vascusynth_layout) {
+    // Without volumes the graphs asked for are written all the same; voxel coordinates in the
+    // key points refer to the grid the image would have had.
+    t0 = Clock::now();
+    writeGraphFiles(tree, forest.trees, imageGrid(*ps.map, sc.image, sc.parameter_file, sc.image_line), sc.image.graph_formats, "", dir, files);
+    timing["write_graphs"] = timing["write_graphs"].get<double>() + seconds(t0);
+  }
+  if (sc.mesh.enabled) {
+    t0 = Clock::now();
+    writeSurface(forest, req, dir, files, stats);
+    timing["mesh"] = seconds(t0);
+  }
+  addTreeStatistics(tree, ps, sc, report, stats);
+  if (sc.curves.enabled) stats["curves"] = curveStatistics(curves);
+  stats["radius_by_bifurcation_level"] = radiusByBifurcationLevel(tree);
+
+  SampleSummary summary;
+  summary.terminals = tree.totalTerminals();
+  summary.total_volume_mm3 = treeVolume(tree);
+  summary.intersecting_pairs = report.intersecting_pairs;
+  summary.grow_seconds = timing["grow"].get<double>();
+  Json& j = summary.sidecar;
+  j["tool"] = Json{{"name", "angiosynth"}, {"version", kVersion}};
+  j["command_line"] = req.command_line;
+  j["seed"] = req.seed;
+  j["sample"] = req.sample;
+  j["parameter_file"] = sc.parameter_file;
+  j["parameter_format"] = sc.format;
+  j["units"] = Json{{"length", "mm"}, {"flow", "mm^3/s"}, {"pressure", "Pa"}, {"viscosity", "Pa*s"},
+                    {"input", sc.units_note},
+                    {"frame", "positions in mm from the corner of map voxel (0,0,0), axes along the map's x, y, z; "
+                              "position_voxel in map voxels"}};
+  j["parameters"] = describeParameters(sc);
+  j["trees"] = describeTrees(forest);
+  j["classes"] = classLegend(forest);
   for (const auto& [k, v] : req.extra.items()) j["parameters"][k] = v;
-  if (!profiles.empty()) j["degradation"] = degradation;
+  if (!ps.profiles.empty()) j["degradation"] = degradation;
   j["statistics"] = stats;
   j["files"] = files;
   if (req.record_timing) j["timing_seconds"] = timing;
   writeTextFile(dir / "sample.json", [&](std::ostream& o) { o << j.dump(2) << "\n"; });
-  return j;
+  return summary;
 }
 
 }  // namespace angiosynth

@@ -24,8 +24,6 @@ struct SampleRequest {
   nlohmann::ordered_json extra;           // more resolved parameters for sample.json
   ProgressFn progress;
   double output_voxel_mm = 0;             // VascuSynth layout: the image voxel width
-  std::vector<std::string> formats;       // volume formats overriding the parameters' (empty: keep)
-  bool no_image = false;                  // graphs only
   std::uint64_t sample = 0;               // index within a dataset (part of every random stream)
   // Degradation profiles overriding the parameter file's [degrade] profiles when set.
   std::optional<std::vector<Profile>> profiles;
@@ -36,8 +34,20 @@ struct SampleRequest {
   std::vector<std::string> class_kinds;
 };
 
-// Writes the sample's files into `dir` and returns the content of its sample.json.
-nlohmann::ordered_json generateSample(const SampleRequest& request, const std::filesystem::path& dir);
+// What a sample made: the numbers a command reports, and its sidecar.
+struct SampleSummary {
+  std::int64_t terminals = 0;
+  double total_volume_mm3 = 0;
+  std::int64_t intersecting_pairs = 0;  // segment capsules that overlap, more than two segments apart
+  double grow_seconds = 0;
+  nlohmann::ordered_json sidecar;       // sample.json as written
+  // The file written for `role` ("image", "mask", "image_cta", …), relative to the sample's directory.
+  std::filesystem::path file(const std::string& role) const;
+  bool wrote(const std::string& role) const;
+};
+
+// Writes the sample's files and its sample.json into `dir`.
+SampleSummary generateSample(const SampleRequest& request, const std::filesystem::path& dir);
 
 // Reads and checks everything a sample needs before growth (maps, masks, profiles, volume sizes,
 // feasibility of the growth), writing nothing: so a batch can refuse a bad input before its first

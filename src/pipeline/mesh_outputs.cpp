@@ -93,12 +93,12 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   const bool tubes = p.method == "tubes";
   // At least two grid steps across the thinnest vessel: coarser, its surface falls between the
   // samples and comes out empty, or its volume wrong by a tenth and more.
-  if (p.voxel_mm > 0) {
+  if (p.voxel_mm) {
     double thinnest = INFINITY;
     for (std::int32_t i = 0; i < tree.nodeCount(); ++i)
       if (!tree.isRoot(i) && !tree.isLink(i)) thinnest = std::min({thinnest, tree.radius[i], tree.startRadius(i)});
-    if (p.voxel_mm > thinnest)
-      throw InputError("", 0, "a mesh voxel of " + exactNumber(p.voxel_mm) + " mm is coarser than half the thinnest vessel's diameter (" +
+    if (*p.voxel_mm > thinnest)
+      throw InputError("", 0, "a mesh voxel of " + exactNumber(*p.voxel_mm) + " mm is coarser than half the thinnest vessel's diameter (" +
                                   exactNumber(2 * thinnest) + " mm); allowed: at most " + exactNumber(thinnest) + " mm, two steps across it");
   }
   WallThickness wall;
@@ -107,8 +107,8 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   wall.from_tree = p.wall_from_graph;
   const bool walls = wall.any();
   SurfaceOptions o;
-  o.voxel_mm = p.voxel_mm;
-  o.samples_across = p.samples_across > 0 ? p.samples_across : tubes ? 3 : 4;
+  o.voxel_mm = p.voxel_mm.value_or(0);
+  o.samples_across = p.samples_across.value_or(tubes ? 3 : 4);
   o.adaptive = !p.uniform;
   o.restore_volume = !p.on_surface;
   o.memory_limit = memory_limit;
@@ -193,7 +193,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   out.parameters = {{"formats", p.formats},
                     {"method", p.method},
                     {"junctions", tubes ? Json(p.junctions) : Json(nullptr)},
-                    {"voxel_mm", p.voxel_mm > 0 ? Json(p.voxel_mm) : Json(nullptr)},
+                    {"voxel_mm", p.voxel_mm ? Json(*p.voxel_mm) : Json(nullptr)},
                     {"samples_across", o.samples_across},
                     {"ring_spacing_radii", tubes && p.ringSpacing() > 0 ? Json(p.ringSpacing()) : Json(nullptr)},
                     {"ring_spacing_vertex_spacings", tubes && p.ringSpacing() == 0 ? Json(kCfdRingSpacing) : Json(nullptr)},

@@ -37,8 +37,8 @@ std::int32_t axisVoxels(double n, const std::string& file, int line) {
 
 VolumeGrid imageGrid(const DemandMap& map, const ImageParameters& p, const std::string& file, int line) {
   VolumeGrid g;
-  const double h = p.voxel_mm > 0 ? p.voxel_mm : map.voxel_mm;
-  const Vec3 fov = p.field_of_view_mm.x > 0 ? p.field_of_view_mm : map.extentMm();
+  const double h = p.voxel_mm.value_or(map.voxel_mm);
+  const Vec3 fov = p.field_of_view_mm.value_or(map.extentMm());
   for (int ax = 0; ax < 3; ++ax) {
     // Whole voxels covering the field of view (a hair of rounding does not add a voxel).
     g.dims[ax] = axisVoxels(std::ceil(fov[ax] / h - 1e-9), file, line);

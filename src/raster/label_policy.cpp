@@ -37,20 +37,6 @@ const std::vector<std::string>& labelPolicyNames() {
   return names;
 }
 
-Json LabelPolicy::describe() const {
-  Json j{{"policy", name}};
-  if (name == "binary") j["rule"] = "the mask: partial volume >= 0.5 or crossed by a centreline";
-  else if (name == "threshold") j["rule"] = "partial volume >= threshold", j["threshold"] = threshold;
-  else if (name == "visible")
-    j["rule"] = "mask voxels whose noise-free contrast in the image is >= visible_snr x the noise sigma of that image",
-    j["visible_snr"] = visible_snr;
-  else if (name == "soft") j["rule"] = "the partial volume, float in [0, 1]";
-  else
-    j["rule"] = "vessel at partial volume >= ignore_band[1]; ignore label on (ignore_band[0], ignore_band[1]) and on centreline voxels below it",
-    j["ignore_band"] = {ignore_low, ignore_high};
-  return j;
-}
-
 Label makeLabel(const LabelPolicy& p, const GroundTruthVolumes& gt, const LabelNumbering& n, const VisibilityEvidence* evidence) {
   Label out;
   const VolumeGrid& g = gt.fraction.grid;
@@ -79,8 +65,8 @@ Label makeLabel(const LabelPolicy& p, const GroundTruthVolumes& gt, const LabelN
       const double c = evidence && evidence->contrast ? evidence->contrast->data[v] : pv[v];
       l = gt.mask.data[v] && pv[v] > 0 && c > 0 && c >= p.visible_snr * sigma ? vessel(v) : 0;
     } else {  // ignore
-      if (pv[v] >= p.ignore_high) l = vessel(v);
-      else if (pv[v] > p.ignore_low || gt.centerline.data[v]) l = n.ignore_value;
+      if (pv[v] >= p.ignoreHigh()) l = vessel(v);
+      else if (pv[v] > p.ignoreLow() || gt.centerline.data[v]) l = n.ignore_value;
     }
     out.values.data[v] = l;
   });

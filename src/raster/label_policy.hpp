@@ -18,17 +18,18 @@ struct GroundTruthVolumes;
 struct LabelPolicy {
   // binary: the mask; threshold: partial volume ≥ threshold; visible: mask voxels whose
   // noise-free contrast in the degraded image is ≥ visible_snr × the noise σ there; soft: the
-  // partial volume itself (float); ignore: vessel at partial volume ≥ ignore_high, the ignore
-  // label on the ambiguous band (ignore_low, ignore_high) and on centreline voxels below it.
+  // partial volume itself (float); ignore: vessel at partial volume ≥ the band's high end, the
+  // ignore label on the ambiguous band (low, high) and on centreline voxels below it.
   std::string name = "binary";
   double threshold = 0.5;
   double visible_snr = 2;
-  double ignore_low = 0.25, ignore_high = 0.75;
+  std::vector<double> ignore_band{0.25, 0.75};  // low, high
+  double ignoreLow() const { return ignore_band[0]; }
+  double ignoreHigh() const { return ignore_band[1]; }
   bool writesLabel() const { return name != "binary"; }
   bool isSoft() const { return name == "soft"; }
   // The label depends on each profile's image (not only on the geometry).
   bool perProfile() const { return name == "visible"; }
-  nlohmann::ordered_json describe() const;
 };
 
 const std::vector<std::string>& labelPolicyNames();

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/units.hpp"
+#include "core/vec3.hpp"
 #include "settings/toml_reader.hpp"
 
 namespace angiosynth {
@@ -21,7 +22,7 @@ namespace angiosynth {
 template <class Options>
 using SettingField = std::variant<bool Options::*, int Options::*, double Options::*, std::optional<double> Options::*,
                                   std::optional<bool> Options::*, std::string Options::*, std::vector<double> Options::*,
-                                  std::vector<std::string> Options::*>;
+                                  std::vector<std::string> Options::*, std::optional<Vec3> Options::*, std::optional<int> Options::*>;
 
 // How a number is bounded: lo < v or lo <= v, and v < hi or v <= hi.
 struct SettingRange {
@@ -36,14 +37,20 @@ struct SettingRange {
 template <class Options>
 struct Setting;
 
-// The unit after a range in a message: the setting's unit when it is one ("mm", "degrees"), the
-// length's mm, nothing for descriptions such as "true/false".
+// The unit after a range in a message: the declared one, the length's mm, else the setting's unit
+// when it is one ("degrees"), nothing for descriptions such as "true/false".
 template <class Options>
 std::string rangeUnit(const Setting<Options>& s) {
+  if (s.range_unit) return std::string(" ") + s.range_unit;
   const std::string u = s.length ? "mm" : s.unit;
-  if (u == "[mm × 6]") return " mm";
   return u.empty() || u.find_first_of("[/ ") != std::string::npos || u == "count" ? "" : " " + u;
 }
+
+// A setting that belongs to one choice of another: label_threshold to label_policy = "threshold".
+struct SettingCondition {
+  const char* key = nullptr;
+  const char* value = nullptr;
+};
 
 template <class Options>
 struct Setting {
@@ -54,12 +61,16 @@ struct Setting {
   const char* meaning;
   SettingField<Options> field;
   SettingRange range{};                // numbers, counts and the entries of a list of numbers
-  std::vector<std::string> choices{};  // texts and lists of texts: the allowed values
+  std::vector<std::string> choices{};  // texts and lists of texts: the allowed values (none: any text but the empty one)
   std::size_t count = 0;               // a list of numbers: exactly this many
-  bool length = false;                 // a length: a string with its unit in a file, mm on the command line
-  const char* flag = nullptr;          // the command-line flag that overrides it ("--sliver-angle"), if any
+  bool length = false;                 // a length (or a list of them): strings with their unit in a file, mm on the command line
+  // The command-line flag that overrides it ("--sliver-angle"), if any; "!--no-image" sets a
+  // true/false setting to false.
+  const char* flag = nullptr;
   // Further refusal of a value in range ("", or the whole message naming the key): a bound with a hole in it.
   std::string (*problem)(double) = nullptr;
+  SettingCondition only_with{};        // given only with this choice of another setting of the table
+  const char* range_unit = nullptr;    // the unit of the range when `unit` describes a list ("mm" for "[mm × 6]")
 };
 
 // A rule between settings: `problem` says what is wrong with the filled Options, or "". `keys`:
@@ -85,6 +96,12 @@ inline std::string choiceList(const std::vector<std::string>& choices) {
   return list;
 }
 
+// What a text setting allows: its choices, or what its meaning says.
+template <class Options>
+std::string allowedTexts(const Setting<Options>& s) {
+  return s.choices.empty() ? std::string(s.meaning) : choiceList(s.choices);
+}
+
 }  // namespace detail
 
 // The value of one number setting checked against its declaration; `where` names it in errors.
@@ -98,9 +115,47 @@ void checkSettingNumber(const Setting<Options>& s, double v, const Where& where,
 
 template <class Options>
 void checkSettingChoice(const Setting<Options>& s, const std::string& v, const Where& where, const std::string& name) {
+  if (s.choices.empty()) {
+    if (v.empty()) throw InputError(where.file, where.line, name + " holds an empty text; allowed: " + s.meaning);
+    return;
+  }
   if (std::find(s.choices.begin(), s.choices.end(), v) == s.choices.end())
     throw InputError(where.file, where.line, name + " '" + v + "' is not allowed; allowed: " + detail::choiceList(s.choices));
 }
+
+namespace detail {
+
+// A list of numbers, or of lengths "<number> <unit>", of the declared count.
+template <class Options>
+std::vector<double> listOfNumbers(const TomlReader& r, const toml::node* n, const Setting<Options>& s, double voxel_mm) {
+  if (!s.length) return r.numbers(n, s.key, s.count);
+  const auto* a = n->as_array();
+  if (!a || (s.count && a->size() != s.count) || a->empty())
+    throw InputError(r.file(), r.lineOf(n), std::string(s.key) + " must be an array of " + (s.count ? std::to_string(s.count) + " " : "") +
+                                                "lengths \"<number> <unit>\"");
+  std::vector<double> out;
+  for (const auto& e : *a) {
+    const auto text = e.value<std::string>();
+    if (!text) throw InputError(r.file(), r.lineOf(&e), std::string(s.key) + " must hold strings \"<number> <unit>\"; units: " + allowedUnits(Dimension::Length));
+    try {
+      out.push_back(parseQuantity(*text, Dimension::Length, voxel_mm));
+    } catch (const std::invalid_argument& err) {
+      throw InputError(r.file(), r.lineOf(&e), std::string(s.key) + ": " + err.what());
+    }
+  }
+  return out;
+}
+
+// The text a string setting holds in `o` (the other side of a SettingCondition).
+template <class Options>
+std::string textOf(const std::vector<Setting<Options>>& settings, const Options& o, const char* key) {
+  for (const auto& s : settings)
+    if (std::string(s.key) == key)
+      if (const auto* m = std::get_if<std::string Options::*>(&s.field)) return o.**m;
+  return {};
+}
+
+}  // namespace detail
 
 // Fills `o` from the keys of table `t` that `settings` declares (the table's keys are checked
 // against them by the caller's TomlReader::table). Lengths take the voxel as a unit.
@@ -108,6 +163,7 @@ template <class Options>
 void readSettings(const TomlReader& r, const toml::table& t, const std::vector<Setting<Options>>& settings, Options& o,
                   double voxel_mm) {
   for (const auto& s : settings) {
+    if (&t != &r.tableOrEmpty(s.table)) continue;  // a setting of another table of the same Options
     const toml::node* n = t.get(s.key);
     if (!n) continue;
     const Where where = r.at(t, s.key);
@@ -122,8 +178,11 @@ void readSettings(const TomlReader& r, const toml::table& t, const std::vector<S
           using T = std::remove_reference_t<decltype(o.*member)>;
           if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::optional<bool>>) {
             o.*member = r.boolean(t, s.key, false);
-          } else if constexpr (std::is_same_v<T, int>) {
-            o.*member = r.smallInteger(t, s.table, s.key, std::int64_t(s.range.lo), std::int64_t(s.range.hi));
+          } else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::optional<int>>) {
+            const int v = r.smallInteger(t, s.table, s.key, std::int64_t(s.range.lo), std::int64_t(s.range.hi));
+            if (s.problem)
+              if (const auto why = s.problem(v); !why.empty()) throw InputError(where.file, where.line, why);
+            o.*member = v;
           } else if constexpr (std::is_same_v<T, double> || std::is_same_v<T, std::optional<double>>) {
             o.*member = number();
           } else if constexpr (std::is_same_v<T, std::string>) {
@@ -131,17 +190,21 @@ void readSettings(const TomlReader& r, const toml::table& t, const std::vector<S
             checkSettingChoice(s, v, where, name);
             o.*member = v;
           } else if constexpr (std::is_same_v<T, std::vector<double>>) {
-            const auto v = r.numbers(n, s.key, s.count);
+            const auto v = detail::listOfNumbers(r, n, s, voxel_mm);
             for (double x : v) checkSettingNumber(s, x, where, name + " entry");
             o.*member = v;
+          } else if constexpr (std::is_same_v<T, std::optional<Vec3>>) {
+            const auto v = detail::listOfNumbers(r, n, s, voxel_mm);
+            for (double x : v) checkSettingNumber(s, x, where, name + " entry");
+            o.*member = Vec3(v[0], v[1], v[2]);
           } else {
             static_assert(std::is_same_v<T, std::vector<std::string>>);
             const auto* a = n->as_array();
-            if (!a) throw InputError(where.file, where.line, name + " must be a list of strings; allowed: " + detail::choiceList(s.choices));
+            if (!a) throw InputError(where.file, where.line, name + " must be a list of strings; allowed: " + detail::allowedTexts(s));
             std::vector<std::string> v;
             for (const auto& e : *a) {
               const auto text = e.value<std::string>();
-              if (!text) throw InputError(where.file, r.lineOf(&e), name + ": '?' is not allowed; allowed: " + detail::choiceList(s.choices));
+              if (!text) throw InputError(where.file, r.lineOf(&e), name + ": '?' is not allowed; allowed: " + detail::allowedTexts(s));
               checkSettingChoice(s, *text, {where.file, r.lineOf(&e)}, name);
               v.push_back(*text);
             }
@@ -149,6 +212,13 @@ void readSettings(const TomlReader& r, const toml::table& t, const std::vector<S
           }
         },
         s.field);
+  }
+  for (const auto& s : settings) {
+    if (!s.only_with.key || &t != &r.tableOrEmpty(s.table) || !t.get(s.key)) continue;
+    const std::string chosen = detail::textOf(settings, o, s.only_with.key);
+    if (chosen != s.only_with.value)
+      throw InputError(r.file(), r.at(t, s.key).line, std::string(s.key) + " is a parameter of " + s.only_with.key + " = \"" + s.only_with.value +
+                                                          "\", not of \"" + chosen + "\"; set that " + s.only_with.key + " or remove the key");
   }
 }
 

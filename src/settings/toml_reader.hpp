@@ -24,14 +24,17 @@ class TomlReader {
 
   const toml::table& table(const std::string& name, const std::set<std::string>& allowed) const {
     const toml::node* n = root_.get(name);
-    if (!n) {
-      static const toml::table empty;
-      return empty;
-    }
-    if (!n->is_table()) throw InputError(file_, lineOf(n), "[" + name + "] must be a table");
-    const auto& t = *n->as_table();
+    if (n && !n->is_table()) throw InputError(file_, lineOf(n), "[" + name + "] must be a table");
+    const auto& t = tableOrEmpty(name);
     checkKeys(t, allowed, "[" + name + "]");
     return t;
+  }
+
+  // The table `name` of the root, or one shared empty table when there is none.
+  const toml::table& tableOrEmpty(const std::string& name) const {
+    static const toml::table empty;
+    const toml::node* n = root_.get(name);
+    return n && n->is_table() ? *n->as_table() : empty;
   }
 
   void checkKeys(const toml::table& t, const std::set<std::string>& allowed, const std::string& where) const {

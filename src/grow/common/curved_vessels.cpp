@@ -221,7 +221,7 @@ VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const Gr
   const auto paths = vesselPaths(t);
   rep.vessels = std::int64_t(paths.size());
   const bool flat = frame.dims[2] == 1;
-  const double piece = o.piece_mm > 0 ? o.piece_mm : frame.voxel_mm;
+  const double piece = o.piece_mm.value_or(frame.voxel_mm);
   const Bounds bounds{domain, frame, o.wall_clearance_mm};
 
   // The pieces before anything is drawn (each knot interval gets at least 8, as below): a piece
@@ -238,7 +238,7 @@ VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const Gr
       r = std::max(r, t.maxRadius(seg));
       prev = seg;
     }
-    const double wavelength = o.wavelength_mm > 0 ? o.wavelength_mm : o.wavelength_radii * r;
+    const double wavelength = o.wavelength(r);
     const int m = std::clamp(int(std::lround(2 * length / std::max(wavelength, 1e-12))), 2, 4096);
     const double step = pieceStep(piece, length, m, r);
     for (double a : arcs) pieces += std::max(1.0, std::ceil(a / std::max(step, 1e-12) - 1e-9));
@@ -270,7 +270,7 @@ VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const Gr
     c.chord = distance(c.base.front(), c.base.back());
     Rng rng(seed, sample, Stage::Curves, std::uint64_t(c.path.segments.front()));
     c.target = std::max(1.0, o.tortuosity + o.tortuosity_sd * rng.normal());
-    const double wavelength = o.wavelength_mm > 0 ? o.wavelength_mm : o.wavelength_radii * r;
+    const double wavelength = o.wavelength(r);
     const int m = std::clamp(int(std::lround(2 * c.length() / std::max(wavelength, 1e-12))), 2, 4096);
     const double step = pieceStep(piece, c.length(), m, r);
     for (std::size_t j = 0; j + 1 < c.base.size(); ++j)

@@ -1,5 +1,5 @@
 #pragma once
-// Curved vessels for every method (issue 14): after growth, each vessel (a chain of segments
+// Curved vessels for every method: after growth, each vessel (a chain of segments
 // between the root, bifurcations and terminals) becomes a smooth curve through its end points,
 // drawn as a chain of short straight pieces that every later stage already treats exactly.
 // The curve is the vessel's own path plus a lateral Catmull-Rom displacement that vanishes at
@@ -8,6 +8,7 @@
 // overlap another vessel are flattened (amplitude halved) until they fit, down to the straight
 // vessel growth made. Radii and flows stay; pressures follow the longer paths (Poiseuille).
 #include <cstdint>
+#include <optional>
 
 #include "core/vascular_tree.hpp"
 #include "domain/demand_map.hpp"
@@ -20,9 +21,10 @@ struct CurveOptions {
   bool enabled = false;
   double tortuosity = 1.2;        // the target distance metric of each vessel (≥ 1)
   double tortuosity_sd = 0;       // normal spread of the target between vessels
-  double wavelength_mm = 0;       // the curve's wavelength; 0: wavelength_radii × the vessel's radius
-  double wavelength_radii = 40;
-  double piece_mm = 0;            // longest piece; 0: one voxel of the frame
+  std::optional<double> wavelength_mm;     // the curve's wavelength; unset: wavelength_radii × the vessel's radius
+  std::optional<double> wavelength_radii;  // unset: 40
+  std::optional<double> piece_mm;          // longest piece; unset: one voxel of the frame
+  double wavelength(double radius_mm) const { return wavelength_mm ? *wavelength_mm : wavelength_radii.value_or(40) * radius_mm; }
   double wall_clearance_mm = 0;   // beyond the radius, from the domain's wall
   bool avoid_overlaps = true;
 };

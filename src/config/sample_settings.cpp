@@ -1,0 +1,53 @@
+#include "config/sample_settings.hpp"
+
+#include "settings/param_checks.hpp"
+
+namespace angiosynth {
+
+const std::vector<Setting<CurveOptions>>& curveSettings() {
+  using P = CurveOptions;
+  static const std::vector<Setting<P>> settings{
+      {.table = "curves", .key = "tortuosity", .unit = "", .fallback = "1.2",
+       .meaning = "with a [curves] table, every vessel becomes a smooth curve whose arc length over chord is this (1 … 3)",
+       .field = &P::tortuosity, .range = {1, 3}},
+      {.table = "curves", .key = "tortuosity_sd", .unit = "", .fallback = "0", .meaning = "normal spread of the target between vessels (0 … 1)",
+       .field = &P::tortuosity_sd, .range = {0, 1}},
+      {.table = "curves", .key = "wavelength", .unit = "mm", .fallback = "40 × the vessel's radius",
+       .meaning = "the curve's wavelength (or wavelength_radii, multiples of each vessel's radius)",
+       .field = &P::wavelength_mm, .range = {0, Limits::kMaxLength, true, false}, .length = true},
+      {.table = "curves", .key = "wavelength_radii", .unit = "", .fallback = "40",
+       .meaning = "the curve's wavelength in multiples of each vessel's radius (≥ 2)", .field = &P::wavelength_radii, .range = {2, 1e4}},
+      {.table = "curves", .key = "piece_length", .unit = "mm", .fallback = "1 voxel",
+       .meaning = "the longest straight piece a curve is drawn with (none shorter than an eighth of its vessel's radius)",
+       .field = &P::piece_mm, .range = {Limits::kMinVoxel, Limits::kMaxLength}, .length = true},
+      {.table = "curves", .key = "wall_clearance", .unit = "mm", .fallback = "0 mm", .meaning = "kept beyond the radius (and wall) from the domain's wall",
+       .field = &P::wall_clearance_mm, .range = {0, Limits::kMaxLength}, .length = true},
+      {.table = "curves", .key = "avoid_overlaps", .unit = "true/false", .fallback = "true", .meaning = "flatten a curve that would touch another vessel",
+       .field = &P::avoid_overlaps},
+  };
+  return settings;
+}
+
+const std::vector<SettingRule<CurveOptions>>& curveRules() {
+  static const std::vector<SettingRule<CurveOptions>> rules{
+      {{"wavelength_radii", "wavelength"}, [](const CurveOptions& o) {
+         return o.wavelength_mm && o.wavelength_radii
+                    ? std::string("give wavelength (a length) or wavelength_radii (multiples of each vessel's radius), not both")
+                    : "";
+       }},
+  };
+  return rules;
+}
+
+const std::vector<Setting<Scenario>>& outputSettings() {
+  static const std::vector<Setting<Scenario>> settings{
+      {.table = "degrade", .key = "profiles", .unit = "[text]", .fallback = "[]",
+       .meaning = "degraded images to write, one image_<name> each: shipped profile names, .toml profiles or VascuSynth noise files",
+       .field = &Scenario::profiles},
+      {.table = "output", .key = "gxl_dialect", .unit = "text", .fallback = "gxl", .meaning = "gxl (GXL 1.0) or vascusynth",
+       .field = &Scenario::gxl_dialect, .choices = {"gxl", "vascusynth"}, .flag = "--gxl-dialect"},
+  };
+  return settings;
+}
+
+}  // namespace angiosynth
