@@ -65,16 +65,13 @@ int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line) {
     SampleRequest req;
     req.scenario = &sc;
     req.seed = sc.seed ? *sc.seed : freshSeed();
-    req.vascusynth_layout = true;
     req.graph_id = names[i].text + "/tree_structure.xml";
     req.command_line = command_line;
     req.memory_limit = memoryLimit(a.common);
     req.progress = progressPrinter(a.common, names[i].text);
     req.profiles = noise;
-    req.vascusynth_noise_layout = true;
-    req.slice_format = a.slices;
-    req.output_voxel_mm = a.output_voxel_width * sc.input_units.mm_per_length;
-    checkRange(req.output_voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, Where{"VOXEL_WIDTH", 0},
+    req.vascusynth = VascuSynthLayout{a.output_voxel_width * sc.input_units.mm_per_length, a.slices};
+    checkRange(req.vascusynth->voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, Where{"VOXEL_WIDTH", 0},
                "VOXEL_WIDTH (mm)");
     req.extra["output_voxel_width"] = {{"value", a.output_voxel_width * sc.input_units.mm_per_length}, {"unit", "mm"}};
     generateSample(req, dir.path());

@@ -44,8 +44,8 @@ void writeDegradedImages(const Forest& forest, const std::vector<std::uint8_t>& 
     makeTypedImage(image, d.image, 0, 1, d.dtype, "angiosynth image, profile " + profile.name);
     // Previews span the profile's background to vessel intensities.
     const double lo = std::min(d.background, d.vessel), hi = std::max(d.background, d.vessel);
-    if (req.vascusynth_noise_layout) {
-      writeSlices(image.view, d.image, lo, hi, profile.name, profile.name, req.slice_format, dir, files);
+    if (req.vascusynth) {
+      writeVascuSynthSlices(image.view, d.image, lo, hi, profile.name, *req.vascusynth, dir, files);
     } else {
       std::vector<Channel> channels{{"image" + suffix, image.view}};
       if (d.labels) {

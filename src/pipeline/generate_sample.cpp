@@ -60,7 +60,7 @@ PreparedSample prepareSample(const SampleRequest& req) {
 
   // The volume request is settled, and its size checked, before the (possibly long) growth.
   ImageParameters ip = sc.image;
-  if (req.vascusynth_layout) ip.formats = {"nifti"};  // beside the slices of original_image
+  if (req.vascusynth) ip.formats = {"nifti"};  // beside the slices of original_image
   ps.volumes = ip.enabled;
   VolumeRequest& vr = ps.vr;
   std::vector<Profile>& profiles = ps.profiles;
@@ -73,19 +73,17 @@ PreparedSample prepareSample(const SampleRequest& req) {
         throw InputError(profiles[i].file, 0, "two profiles are named '" + profiles[i].name +
                                                   "' (roles image_<name> must differ); rename one file");
   if (ps.volumes) {
-    vr.grid = req.vascusynth_layout ? vascusynthGrid(map, req.output_voxel_mm, "VOXEL_WIDTH", 0)
-                                     : imageGrid(map, ip, sc.parameter_file, sc.image_line);
+    vr.grid = req.vascusynth ? vascusynthGrid(map, req.vascusynth->voxel_mm, "VOXEL_WIDTH", 0)
+                             : imageGrid(map, ip, sc.parameter_file, sc.image_line);
     vr.image = ip;
     vr.memory_limit = req.memory_limit;
     vr.parameter_file = sc.parameter_file;
     vr.image_line = sc.image_line;
-    vr.slices = req.vascusynth_layout;
-    vr.slice_format = req.slice_format;
+    vr.vascusynth = req.vascusynth;
     vr.profiles = profiles;
     vr.seed = req.seed;
     vr.sample = req.sample;
     vr.frame = GraphFrame{map.voxel_mm, sc.input_units};
-    vr.vascusynth_noise_layout = req.vascusynth_noise_layout;
     // Labelled by kind (a dataset's `labels = "kind"`): vessels carry their kind's number and the
     // ignore label comes after the last kind.
     vr.label_numbering.by_kind = !req.class_kinds.empty();
@@ -136,21 +134,20 @@ Forest growForest(const PreparedSample& ps, const SampleRequest& req, GrowthRepo
   return forest;
 }
 
-// GXL and DOT always (VascuSynth's layout: its tree_structure.xml), and an SVG of a 2-D domain.
+// GXL (in VascuSynth's dialect when asked) and DOT, and an SVG of a 2-D domain.
 void writeGraphs(const Forest& forest, const PreparedSample& ps, const SampleRequest& req, const std::filesystem::path& dir, Json& files) {
-  const VascularTree& tree = forest.vessels;
   const GraphFrame frame{ps.map->voxel_mm, req.scenario->input_units};
-  const bool vascusynth_file = req.vascusynth_layout || req.gxl_dialect == "vascusynth";
-  const std::string gxl = req.vascusynth_layout ? "tree_structure.xml" : "tree.gxl";
-  writeTextFile(dir / gxl, [&](std::ostream& o) {
-    if (vascusynth_file) writeVascuSynthGxl(o, tree, frame, req.graph_id);
+  if (req.vascusynth) return writeVascuSynthGraphs(forest, frame, req.graph_id, dir, files);
+  const VascularTree& tree = forest.vessels;
+  writeTextFile(dir / "tree.gxl", [&](std::ostream& o) {
+    if (req.gxl_dialect == "vascusynth") writeVascuSynthGxl(o, tree, frame, req.graph_id);
     else writeGxl(o, tree, forest.trees, frame, req.graph_id);
   });
-  files["gxl"] = gxl;
+  files["gxl"] = "tree.gxl";
   writeTextFile(dir / "tree.dot", [&](std::ostream& o) { writeDot(o, tree, forest.trees, frame); });
   files["dot"] = "tree.dot";
   const GrowthDomain* domain = ps.growth->domain();
-  if (!req.vascusynth_layout && domain && domain->dimension() == 2) {
+  if (domain && domain->dimension() == 2) {
     writeTextFile(dir / "tree.svg", [&](std::ostream& o) { writeSvg(o, forest, *domain); });
     files["svg"] = "tree.svg";
   }
@@ -311,7 +308,7 @@ SampleSummary generateSample(const SampleRequest& req, const std::filesystem::pa
     writeVolumes(forest, ps.vr, dir, files, stats, degradation, &degrade_seconds);
     if (!degrade_seconds.empty()) timing["degrade_effects"] = degrade_seconds;
     timing["rasterize_and_write_volumes"] = seconds(t0);
-  } else if (!req.vascusynth_layout) {
+  } else if (!req.vascusynth) {
     // Without volumes the graphs asked for are written all the same; voxel coordinates in the
     // key points refer to the grid the image would have had.
     t0 = Clock::now();

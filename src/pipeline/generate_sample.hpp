@@ -10,6 +10,7 @@
 #include "degrade/profile.hpp"
 #include "grow/common/growth_report.hpp"
 #include "config/scenario.hpp"
+#include "pipeline/vascusynth_layout.hpp"
 
 namespace angiosynth {
 
@@ -17,18 +18,15 @@ struct SampleRequest {
   const Scenario* scenario = nullptr;
   std::uint64_t seed = 1;
   std::string gxl_dialect = "gxl";        // "gxl" or "vascusynth"
-  bool vascusynth_layout = false;         // NAME/tree_structure.xml as VascuSynth writes it
+  std::optional<VascuSynthLayout> vascusynth;  // VascuSynth's own directory layout instead of angiosynth's
   std::string graph_id = "tree";
   std::string command_line;
   std::uint64_t memory_limit = 0;
   nlohmann::ordered_json extra;           // more resolved parameters for sample.json
   ProgressFn progress;
-  double output_voxel_mm = 0;             // VascuSynth layout: the image voxel width
   std::uint64_t sample = 0;               // index within a dataset (part of every random stream)
   // Degradation profiles overriding the parameter file's [degrade] profiles when set.
   std::optional<std::vector<Profile>> profiles;
-  bool vascusynth_noise_layout = false;   // profiles write <name>/image.nii.gz + slices
-  std::string slice_format = "jpg";       // VascuSynth layout: jpg (VascuSynth's) or png
   bool record_timing = true;              // false: sample.json depends on seed and parameters only
   // The kinds in class-label order (1, 2, ...), when a dataset fixes them; empty: artery 1, vein 2.
   std::vector<std::string> class_kinds;

@@ -85,20 +85,6 @@ void writeMips(const Volume<float>& v, const Volume<std::uint8_t>* classes, doub
   }
 }
 
-void writeSlices(const VolumeView& image, const Volume<float>& shown, double lo, double hi, const std::string& sub,
-                 const std::string& role, const std::string& format, const std::filesystem::path& dir, Json& files) {
-  std::filesystem::create_directories(dir / sub);
-  writeNifti(dir / sub / "image.nii.gz", image);
-  files[role] = sub + "/image.nii.gz";
-  for (std::int32_t z = 0; z < shown.grid.dims[2]; ++z) {
-    char name[32];
-    std::snprintf(name, sizeof name, "image%03d.%s", z, format == "png" ? "png" : "jpg");
-    if (format == "png") writePng(dir / sub / name, sliceZ(shown, z, lo, hi));
-    else writeJpeg(dir / sub / name, sliceZ(shown, z, lo, hi));
-  }
-  files[role + "_slices"] = sub + "/image%03d." + (format == "png" ? "png" : "jpg");
-}
-
 void writeGraphFiles(const VascularTree& tree, const std::vector<TreeInfo>& trees, const VolumeGrid& g, const std::vector<std::string>& graph_formats,
                      const std::string& suffix, const std::filesystem::path& dir, Json& files) {
   const auto file = [&](const std::string& stem, const std::string& ext, const std::string& role, auto&& write) {

@@ -48,10 +48,6 @@ inline const Volume<std::uint8_t>* previewClasses(const std::vector<TreeInfo>& t
   const bool kinds = std::any_of(trees.begin(), trees.end(), [](const TreeInfo& t) { return t.class_label != 1; });
   return kinds && !gt.classes.data.empty() ? &gt.classes : nullptr;
 }
-// VascuSynth's layout: <sub>/image.nii.gz (the exact image) and one 8-bit slice per z,
-// image000.<format> (`jpg` as VascuSynth writes them, or lossless `png`), [lo, hi] → [0, 255].
-void writeSlices(const VolumeView& image, const Volume<float>& shown, double lo, double hi, const std::string& sub,
-                 const std::string& role, const std::string& format, const std::filesystem::path& dir, nlohmann::ordered_json& files);
 // Key points and the graph formats besides GXL and DOT (csv, vtp, swc, graphml), with `suffix`
 // appended to file stems and roles.
 void writeGraphFiles(const VascularTree& tree, const std::vector<TreeInfo>& trees, const VolumeGrid& g, const std::vector<std::string>& graph_formats,

@@ -23,17 +23,12 @@ using Json = nlohmann::ordered_json;
 
 }  // namespace
 
-namespace {
-
-// Voxels along one axis, refused past 10^5 before any integer conversion.
 std::int32_t axisVoxels(double n, const std::string& file, int line) {
   if (!(n <= 1e5))
     throw InputError(file, line, "the image would be " + show(n) + " voxels along one axis; allowed: at most 100000 "
                                  "(raise [image] voxel_size or shrink field_of_view)");
   return std::max<std::int32_t>(1, static_cast<std::int32_t>(n));
 }
-
-}  // namespace
 
 VolumeGrid imageGrid(const DemandMap& map, const ImageParameters& p, const std::string& file, int line) {
   VolumeGrid g;
@@ -48,17 +43,8 @@ VolumeGrid imageGrid(const DemandMap& map, const ImageParameters& p, const std::
   return g;
 }
 
-VolumeGrid vascusynthGrid(const DemandMap& map, double output_voxel_mm, const std::string& file, int line) {
-  VolumeGrid g;
-  for (int ax = 0; ax < 3; ++ax)
-    g.dims[ax] = axisVoxels(std::floor(map.dims[ax] * map.voxel_mm / output_voxel_mm + 1e-9) + 1, file, line);
-  g.spacing_mm = Vec3(output_voxel_mm, output_voxel_mm, output_voxel_mm);
-  g.origin_mm = Vec3(0, 0, 0);
-  return g;
-}
-
 bool needsDense(const VolumeRequest& req) {
-  return req.slices || !req.profiles.empty() || std::any_of(req.image.formats.begin(), req.image.formats.end(), [](const std::string& f) { return f != "vdb"; });
+  return req.vascusynth || !req.profiles.empty() || std::any_of(req.image.formats.begin(), req.image.formats.end(), [](const std::string& f) { return f != "vdb"; });
 }
 
 void checkVolumeMemory(const VolumeRequest& req) {
@@ -130,7 +116,7 @@ void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::fil
     }
     writeChannels(channels, ip.formats, dir, files);
     if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end()) writeMips(gt.fraction, previewClasses(forest.trees, gt), 0, 1, "", dir, files);
-    if (req.slices) writeSlices(image.view, gt.fraction, 0, 1, req.slice_dir, "original_image", req.slice_format, dir, files);
+    if (req.vascusynth) writeVascuSynthSlices(image.view, gt.fraction, 0, 1, "original_image", *req.vascusynth, dir, files);
   }
   std::int64_t mask_voxels = 0;
   for (auto m : gt.mask.data) mask_voxels += m;

@@ -11,6 +11,7 @@
 #include "core/forest.hpp"
 #include "io/graph_writers.hpp"
 #include "config/scenario.hpp"
+#include "pipeline/vascusynth_layout.hpp"
 #include "raster/label_policy.hpp"
 #include "raster/volume.hpp"
 
@@ -19,9 +20,8 @@ namespace angiosynth {
 // The image grid over the demand map: voxel size and field of view from the parameters, by
 // default the map's own; voxel centres at (i + ½)·voxel from the map's corner.
 VolumeGrid imageGrid(const DemandMap& map, const ImageParameters& p, const std::string& file = "", int line = 0);
-// VascuSynth's output grid: floor(map size × VOXEL_WIDTH / OUTPUT_VOXEL_WIDTH) + 1 samples per
-// axis at i·OUTPUT_VOXEL_WIDTH (map-voxel corners), so a 100³ map at 0.04/0.04 gives 101³.
-VolumeGrid vascusynthGrid(const DemandMap& map, double output_voxel_mm, const std::string& file = "", int line = 0);
+// Voxels along one axis of an image, refused past 10^5 before any integer conversion.
+std::int32_t axisVoxels(double n, const std::string& file, int line);
 
 struct VolumeRequest {
   VolumeGrid grid;
@@ -29,15 +29,12 @@ struct VolumeRequest {
   std::uint64_t memory_limit = 0;
   std::string parameter_file;     // for size errors
   int image_line = 0;
-  bool slices = false;            // also one 8-bit image per z slice (VascuSynth's layout)
-  std::string slice_format = "jpg";  // jpg (VascuSynth's) or png (lossless)
-  std::string slice_dir = "original_image";
+  std::optional<VascuSynthLayout> vascusynth;  // VascuSynth's layout: slices of each image
   // Degradation: one image per profile (role image_<profile>), drawn from (seed, sample).
   std::vector<Profile> profiles;
   std::uint64_t seed = 1, sample = 0;
   GraphFrame frame;               // for the GXL of warped trees
   LabelNumbering label_numbering;  // vessel 1 (or each kind's class), ignore value
-  bool vascusynth_noise_layout = false;  // <profile>/image.nii.gz + slices, as VascuSynth's noise_image_<i>
 };
 
 // Throws InputError when the request's volumes would exceed its memory limit.
