@@ -57,15 +57,15 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
             {"command_line", command_line},
             {"input", graph.string()},
             {"parameters", surface.parameters},
-            {"statistics", surface.statistics},
+            {"statistics", surface.statistics.toJson()},
             {"files", surface.files},
             {"timing_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()}};
   std::ofstream(dir.path() / "mesh.json") << j.dump(2) << '\n';
   dir.commit();
   if (!a.common.quiet)
-    std::cerr << "wrote " << dir.target().string() << ": " << surface.statistics["triangles"] << " triangles (" << surface.statistics["trees"]
-              << " trees, " << surface.statistics["segments"] << " segments, finest step " << surface.statistics["finest_step_mm"]
-              << " mm), enclosed volume " << surface.statistics["enclosed_volume_mm3"] << " mm^3\n";
+    std::cerr << "wrote " << dir.target().string() << ": " << surface.statistics.triangles << " triangles (" << surface.statistics.trees
+              << " trees, " << surface.statistics.segments << " segments, finest step " << surface.statistics.finest_step_mm
+              << " mm), enclosed volume " << surface.statistics.topology.volume_mm3 << " mm^3\n";
   return 0;
 }
 

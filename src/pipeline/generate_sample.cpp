@@ -159,7 +159,7 @@ void writeSurface(const Forest& forest, const SampleRequest& req, const std::fil
   for (const auto& t : forest.trees) kinds.push_back(t.kind);
   const auto surface = writeSurfaceFiles(forest.vessels, req.scenario->mesh, req.memory_limit, dir, {}, kinds);
   for (const auto& [format, name] : surface.files.items()) files["surface_" + format] = name;
-  stats["surface"] = surface.statistics;
+  stats["surface"] = surface.statistics.toJson();
 }
 
 // The final tree's size, cost, radii and depths, growth's counts and the method's own.

@@ -85,179 +85,251 @@ std::vector<double> endFaceAreas(const SurfaceMesh& m, std::size_t n, std::vecto
   return area;
 }
 
-}  // namespace
+// At least two grid steps across the thinnest vessel: coarser, its surface falls between the
+// samples and comes out empty, or its volume wrong by a tenth and more.
+void checkVoxelAgainstThinnest(const VascularTree& tree, const MeshParameters& p) {
+  if (!p.voxel_mm) return;
+  double thinnest = INFINITY;
+  for (std::int32_t i = 0; i < tree.nodeCount(); ++i)
+    if (!tree.isRoot(i) && !tree.isLink(i)) thinnest = std::min({thinnest, tree.radius[i], tree.startRadius(i)});
+  if (*p.voxel_mm > thinnest)
+    throw InputError("", 0, "a mesh voxel of " + exactNumber(*p.voxel_mm) + " mm is coarser than half the thinnest vessel's diameter (" +
+                                exactNumber(2 * thinnest) + " mm); allowed: at most " + exactNumber(thinnest) + " mm, two steps across it");
+}
 
-SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p, std::uint64_t memory_limit, const std::filesystem::path& dir,
-                               const std::function<void(std::int64_t, std::int64_t)>& progress, const std::vector<std::string>& tree_kinds,
-                               const std::vector<std::string>& vessel_ids) {
-  const bool tubes = p.method == "tubes";
-  // At least two grid steps across the thinnest vessel: coarser, its surface falls between the
-  // samples and comes out empty, or its volume wrong by a tenth and more.
-  if (p.voxel_mm) {
-    double thinnest = INFINITY;
-    for (std::int32_t i = 0; i < tree.nodeCount(); ++i)
-      if (!tree.isRoot(i) && !tree.isLink(i)) thinnest = std::min({thinnest, tree.radius[i], tree.startRadius(i)});
-    if (*p.voxel_mm > thinnest)
-      throw InputError("", 0, "a mesh voxel of " + exactNumber(*p.voxel_mm) + " mm is coarser than half the thinnest vessel's diameter (" +
-                                  exactNumber(2 * thinnest) + " mm); allowed: at most " + exactNumber(thinnest) + " mm, two steps across it");
-  }
+// The meshers' options, from the settings.
+struct SurfacePlan {
+  bool tubes = false, walls = false, cut_ends = false;
   WallThickness wall;
-  wall.constant_mm = p.wall_thickness;
-  wall.ratio = p.wall_ratio;
-  wall.from_tree = p.wall_from_graph;
-  const bool walls = wall.any();
-  SurfaceOptions o;
+  SurfaceOptions contour;   // the contour method's, and the tubes' junctions'
+  DecimateOptions decimation;
+  TubeSurfaceOptions tube;  // the tube surface's and a hollow wall's two (whose ends are open)
+  std::vector<VesselEnd> ends;
+};
+
+SurfacePlan planSurface(const VascularTree& tree, const MeshParameters& p, std::uint64_t memory_limit) {
+  SurfacePlan plan;
+  plan.tubes = p.method == "tubes";
+  plan.wall = WallThickness{p.wall_thickness, p.wall_ratio, p.wall_from_graph};
+  plan.walls = plan.wall.any();
+  SurfaceOptions& o = plan.contour;
   o.voxel_mm = p.voxel_mm.value_or(0);
-  o.samples_across = p.samples_across.value_or(tubes ? 3 : 4);
+  o.samples_across = p.samples_across.value_or(plan.tubes ? 3 : 4);
   o.adaptive = !p.uniform;
   o.restore_volume = !p.on_surface;
   o.memory_limit = memory_limit;
-  SurfaceReport report;
-  const bool cut_ends = p.ends != "closed" || walls;  // a hollow wall's ends are open
-  const auto ends = cut_ends ? openEnds(tree, p.flow_extension) : std::vector<VesselEnd>{};
-  EndCutReport cut;
-  DecimateReport reduced, slivers;
-  DecimateOptions d;
+  plan.cut_ends = p.ends != "closed" || plan.walls;  // a hollow wall's ends are open
+  if (plan.cut_ends) plan.ends = openEnds(tree, p.flow_extension);
+  DecimateOptions& d = plan.decimation;
   d.max_error = p.max_error;
   d.sliver_deg = p.sliverAngle();
   d.obtuse_deg = p.maxAngle();
-  TubeSurfaceReport tube_report;
-  HollowWallReport wall_report;
-  SurfaceMesh mesh;
-  // The tubes' options, for the tube surface and a hollow wall's two (whose ends are open).
-  TubeSurfaceOptions to;
+  TubeSurfaceOptions& to = plan.tube;
   to.junction = o;
   to.ring_spacing_radii = p.ringSpacing();
-  to.ends = ends;
-  to.cap_ends = !walls && p.ends == "capped";
+  to.ends = plan.ends;
+  to.cap_ends = !plan.walls && p.ends == "capped";
   to.decimate = p.decimate;
   to.decimation = d;
   to.nets = p.junctions == "nets";
   to.remesh = p.remeshes();
-  if (walls) {
-    mesh = hollowWall(tree, to, wall, &wall_report, progress);
-    tube_report = wall_report.outer;
-    report.voxel_mm = std::min(wall_report.outer.finest_step_mm, wall_report.lumen.finest_step_mm);
-    report.estimated_bytes = std::max(wall_report.outer.estimated_bytes, wall_report.lumen.estimated_bytes);
-    cut.cut = wall_report.rings;
-    cut.left_closed = wall_report.not_joined;
+  return plan;
+}
+
+// The surface and what its mesher reported: a hollow wall, tubes with contoured junctions, or
+// one contour of the whole tree (with its sliver repair, end cuts and decimation).
+struct BuiltSurface {
+  SurfaceMesh mesh;
+  SurfaceReport contour;
+  TubeSurfaceReport tube;
+  HollowWallReport wall;
+  EndCutReport cut;
+  DecimateReport reduced, slivers;
+  BoxClipReport clipped;
+};
+
+BuiltSurface buildSurface(const VascularTree& tree, const MeshParameters& p, SurfacePlan& plan,
+                          const std::function<void(std::int64_t, std::int64_t)>& progress) {
+  BuiltSurface b;
+  const auto& ends = plan.ends;
+  if (plan.walls) {
+    b.mesh = hollowWall(tree, plan.tube, plan.wall, &b.wall, progress);
+    b.tube = b.wall.outer;
+    b.contour.voxel_mm = std::min(b.wall.outer.finest_step_mm, b.wall.lumen.finest_step_mm);
+    b.contour.estimated_bytes = std::max(b.wall.outer.estimated_bytes, b.wall.lumen.estimated_bytes);
+    b.cut.cut = b.wall.rings;
+    b.cut.left_closed = b.wall.not_joined;
     // A ring's loop vertices: its two loops' together.
-    cut.cap_area_mm2 = endFaceAreas(mesh, ends.size(), &cut.loop_vertices);
-  } else if (tubes) {
-    mesh = tubeSurface(tree, to, &tube_report, progress);
-    cut = tube_report.ends;
-    report.voxel_mm = tube_report.finest_step_mm;
-    report.estimated_bytes = tube_report.estimated_bytes;
-    reduced.before = tube_report.triangles_before_decimation + tube_report.tube_triangles;
-    reduced.collapses = tube_report.decimation_collapses;
-    reduced.largest_error_mm = tube_report.decimation_largest_error_mm;
+    b.cut.cap_area_mm2 = endFaceAreas(b.mesh, ends.size(), &b.cut.loop_vertices);
+  } else if (plan.tubes) {
+    b.mesh = tubeSurface(tree, plan.tube, &b.tube, progress);
+    b.cut = b.tube.ends;
+    b.contour.voxel_mm = b.tube.finest_step_mm;
+    b.contour.estimated_bytes = b.tube.estimated_bytes;
+    b.reduced.before = b.tube.triangles_before_decimation + b.tube.tube_triangles;
+    b.reduced.collapses = b.tube.decimation_collapses;
+    b.reduced.largest_error_mm = b.tube.decimation_largest_error_mm;
   } else {
-    o.finish = [&](SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
+    const DecimateOptions& d = plan.decimation;
+    plan.contour.finish = [&](SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
       // Slivers before the cut too (tube_surface.cpp says why).
-      if (d.sliver_deg > 0) slivers = repairSlivers(m, d, distance);
-      if (cut_ends) cut = cutEnds(m, ends, p.ends == "capped");
-      if (p.decimate) reduced = decimate(m, d, distance);
-      else if (d.sliver_deg > 0) slivers += repairSlivers(m, d, distance, nullptr, true);
+      if (d.sliver_deg > 0) b.slivers = repairSlivers(m, d, distance);
+      if (plan.cut_ends) b.cut = cutEnds(m, ends, p.ends == "capped");
+      if (p.decimate) b.reduced = decimate(m, d, distance);
+      else if (d.sliver_deg > 0) b.slivers += repairSlivers(m, d, distance, nullptr, true);
     };
-    mesh = vesselSurface(cut_ends ? prolongEnds(tree, ends) : tree, o, &report, progress);
+    b.mesh = vesselSurface(plan.cut_ends ? prolongEnds(tree, ends) : tree, plan.contour, &b.contour, progress);
+    plan.contour.finish = nullptr;  // it refers to this function's locals
   }
   // The caps as made: the sliver repair may join two of a cap's loop vertices.
-  if (p.ends == "capped" && !walls) cut.cap_area_mm2 = endFaceAreas(mesh, ends.size(), &cut.loop_vertices);
-  BoxClipReport clipped;
+  if (p.ends == "capped" && !plan.walls) b.cut.cap_area_mm2 = endFaceAreas(b.mesh, ends.size(), &b.cut.loop_vertices);
   if (!p.clip_box.empty()) {
-    const auto& b = p.clip_box;
-    clipped = clipToBox(mesh, Vec3(b[0], b[1], b[2]), Vec3(b[3], b[4], b[5]), std::int32_t(ends.size()) + 1);
+    const auto& box = p.clip_box;
+    b.clipped = clipToBox(b.mesh, Vec3(box[0], box[1], box[2]), Vec3(box[3], box[4], box[5]), std::int32_t(ends.size()) + 1);
     // What is left of each end's face (a box side may cut it; outside the box it is gone).
-    if (cut_ends) cut.cap_area_mm2 = endFaceAreas(mesh, ends.size());
+    if (plan.cut_ends) b.cut.cap_area_mm2 = endFaceAreas(b.mesh, ends.size());
   }
-  if (mesh.triangles.empty() && p.clip_box.empty())
-    throw std::logic_error("the surface of a tree with vessels came out empty");
-  const auto topo = meshTopology(mesh);
+  if (b.mesh.triangles.empty() && p.clip_box.empty()) throw std::logic_error("the surface of a tree with vessels came out empty");
+  return b;
+}
+
+SurfaceSummary summarise(const VascularTree& tree, const MeshParameters& p, const SurfacePlan& plan, const BuiltSurface& b) {
+  SurfaceSummary s;
+  const bool tubes = plan.tubes, clip = !p.clip_box.empty();
+  for (std::int32_t i = 0; i < tree.nodeCount(); ++i) s.trees += tree.isRoot(i), s.segments += !tree.isRoot(i) && !tree.isLink(i);
+  s.vertices = std::int64_t(b.mesh.vertices.size());
+  s.triangles = std::int64_t(b.mesh.triangles.size());
+  s.finest_step_mm = b.contour.voxel_mm;
+  if (!tubes) {
+    s.contour = SurfaceSummary::Contour{b.contour.coarsest_mm, b.contour.levels, b.contour.cells, b.contour.largest_volume_move_mm};
+  } else {
+    const auto& t = b.tube;
+    s.tube = SurfaceSummary::Tubes{t.tubes, t.clusters, t.netted, t.largest_cluster_vessels, t.tube_triangles, t.contour_triangles, t.fallbacks, t.cut_retries};
+  }
+  if (plan.walls) s.wall_ends_joined = b.wall.rings;
+  s.estimated_bytes = b.contour.estimated_bytes;
+  s.topology = meshTopology(b.mesh);
+  s.cavities_removed = tubes ? b.tube.cavities_removed : b.contour.cavities_removed;
+  if (p.decimate) s.triangles_before_decimation = b.reduced.before;
+  s.decimation_collapses = b.reduced.collapses;
+  s.decimation_largest_error_mm = b.reduced.largest_error_mm;
+  s.slivers_repaired = tubes ? b.tube.slivers_repaired : b.slivers.changes();
+  s.remesh_splits = b.tube.remesh_splits;
+  s.remesh_changes = b.tube.remesh_changes;
+  s.ends = std::int64_t(plan.ends.size());
+  s.ends_cut = b.cut.cut;
+  s.ends_left_closed = std::int64_t(b.cut.left_closed.size());
+  if (clip) s.clip = b.clipped;
+  return s;
+}
+
+// The settings as the meshers took them (defaults resolved) and how the surface is made.
+Json resolvedParameters(const MeshParameters& p, const SurfacePlan& plan) {
+  const bool tubes = plan.tubes, walls = plan.walls;
+  return {{"formats", p.formats},
+          {"method", p.method},
+          {"junctions", tubes ? Json(p.junctions) : Json(nullptr)},
+          {"voxel_mm", p.voxel_mm ? Json(*p.voxel_mm) : Json(nullptr)},
+          {"samples_across", plan.contour.samples_across},
+          {"ring_spacing_radii", tubes && p.ringSpacing() > 0 ? Json(p.ringSpacing()) : Json(nullptr)},
+          {"ring_spacing_vertex_spacings", tubes && p.ringSpacing() == 0 ? Json(kCfdRingSpacing) : Json(nullptr)},
+          {"wall", !walls ? Json(nullptr)
+                          : p.wall_thickness > 0 ? Json({{"thickness_mm", p.wall_thickness}})
+                          : p.wall_ratio > 0     ? Json({{"ratio_of_radius", p.wall_ratio}})
+                                                 : Json({{"from", "the graph's wall values"}})},
+          {"adaptive", !p.uniform},
+          {"volume_restored", !p.on_surface},
+          {"ends", walls ? std::string("open") : p.ends},
+          {"flow_extension_radii", p.flow_extension},
+          {"clip_box_mm", p.clip_box.empty() ? Json(nullptr) : Json(p.clip_box)},
+          {"decimate", p.decimate},
+          {"max_error_steps", p.max_error},
+          {"sliver_angle_deg", p.sliverAngle()},
+          {"max_angle_deg", p.maxAngle()},
+          {"remesh", tubes && p.remeshes()},
+          {"description", tubes ? "each vessel's free middle a tube of rings on its exact wall (at most ring_spacing_radii radii "
+                                  "apart, aligned; or ring_spacing_vertex_spacings apart, each turned by half a vertex spacing); where vessels meet, the signed distance to the union of their capsules and round cones "
+                                  "contoured by surface nets on a uniform grid or on the octree (junctions = nets, where the part passes its checks) or "
+                                  "by marching tetrahedra (2:1-balanced octree of cells sized to each vessel's radius), cut by "
+                                  "planes across the tubes and joined to their rings"
+                                : "marching tetrahedra of the signed distance to the union of each tree's capsules and round cones, on a "
+                                  "2:1-balanced octree of cells sized to each vessel's radius, split into conforming tetrahedra"}};
+}
+
+void writeFile(const std::filesystem::path& file, const std::function<void(std::ostream&)>& write) {
+  std::ofstream os(file, std::ios::binary);
+  write(os);
+  if (!os) throw std::runtime_error("cannot write " + file.string());
+}
+
+}  // namespace
+
+Json SurfaceSummary::toJson() const {
+  const auto opt = [](const auto& v, auto get) { return v ? Json(get(*v)) : Json(nullptr); };
+  const auto& t = topology;
+  return {{"trees", trees},
+          {"segments", segments},
+          {"vertices", vertices},
+          {"triangles", triangles},
+          {"triangles_per_segment", segments > 0 ? double(triangles) / double(segments) : 0.0},
+          {"finest_step_mm", finest_step_mm},
+          {"coarsest_cell_mm", opt(contour, [](const Contour& c) { return c.coarsest_cell_mm; })},
+          {"levels", opt(contour, [](const Contour& c) { return c.levels; })},
+          {"cells", opt(contour, [](const Contour& c) { return c.cells; })},
+          {"largest_volume_move_mm", opt(contour, [](const Contour& c) { return c.largest_volume_move_mm; })},
+          {"tubes", opt(tube, [](const Tubes& c) { return c.tubes; })},
+          {"contoured_parts", opt(tube, [](const Tubes& c) { return c.contoured_parts; })},
+          {"parts_by_nets", opt(tube, [](const Tubes& c) { return c.parts_by_nets; })},
+          {"largest_contoured_part_vessels", opt(tube, [](const Tubes& c) { return c.largest_contoured_part_vessels; })},
+          {"tube_triangles", opt(tube, [](const Tubes& c) { return c.tube_triangles; })},
+          {"contoured_triangles", opt(tube, [](const Tubes& c) { return c.contoured_triangles; })},
+          {"tubes_given_up", opt(tube, [](const Tubes& c) { return c.given_up; })},
+          {"cuts_retried", opt(tube, [](const Tubes& c) { return c.cuts_retried; })},
+          {"wall_ends_joined", opt(wall_ends_joined, [](std::int64_t v) { return v; })},
+          {"estimated_bytes", estimated_bytes},
+          {"enclosed_volume_mm3", t.volume_mm3},
+          {"boundary_edges", t.boundary_edges},
+          {"nonmanifold_edges", t.nonmanifold_edges},
+          {"misoriented_edges", t.misoriented_edges},
+          {"degenerate_triangles", t.degenerate_triangles},
+          {"cavities_removed", cavities_removed},
+          {"triangles_before_decimation", opt(triangles_before_decimation, [](std::int64_t v) { return v; })},
+          {"decimation_collapses", decimation_collapses},
+          {"decimation_largest_error_mm", decimation_largest_error_mm},
+          {"slivers_repaired", slivers_repaired},
+          {"remesh_splits", remesh_splits},
+          {"remesh_changes", remesh_changes},
+          {"ends", ends},
+          {"ends_cut", ends_cut},
+          {"ends_left_closed", ends_left_closed},
+          {"clip_box_removed_triangles", opt(clip, [](const BoxClipReport& c) { return c.removed_triangles; })},
+          {"clip_box_section_loops", opt(clip, [](const BoxClipReport& c) { return c.section_loops; })},
+          {"clip_box_section_area_mm2", opt(clip, [](const BoxClipReport& c) { return c.section_area_mm2; })},
+          {"tree_components", t.tree_components},
+          {"tree_euler_characteristic", t.tree_euler}};
+}
+
+SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p, std::uint64_t memory_limit, const std::filesystem::path& dir,
+                               const std::function<void(std::int64_t, std::int64_t)>& progress, const std::vector<std::string>& tree_kinds,
+                               const std::vector<std::string>& vessel_ids) {
+  checkVoxelAgainstThinnest(tree, p);
+  SurfacePlan plan = planSurface(tree, p, memory_limit);
+  const BuiltSurface built = buildSurface(tree, p, plan, progress);
   SurfaceFiles out;
   out.files = Json::object();
-  if (cut_ends || !p.clip_box.empty()) {
-    std::ofstream os(dir / "surface_faces.csv", std::ios::binary);
-    writeFaces(os, ends, cut, walls ? "open" : p.ends, tree_kinds, vessel_ids, p.clip_box, clipped);
-    if (!os) throw std::runtime_error("cannot write " + (dir / "surface_faces.csv").string());
+  if (plan.cut_ends || !p.clip_box.empty()) {
+    writeFile(dir / "surface_faces.csv", [&](std::ostream& os) {
+      writeFaces(os, plan.ends, built.cut, plan.walls ? "open" : p.ends, tree_kinds, vessel_ids, p.clip_box, built.clipped);
+    });
     out.files["faces"] = "surface_faces.csv";
   }
   for (const auto& f : p.formats) {
     const std::string name = "surface." + f;
-    std::ofstream os(dir / name, std::ios::binary);
-    meshWriter(f)(os, mesh);
-    if (!os) throw std::runtime_error("cannot write " + (dir / name).string());
+    writeFile(dir / name, [&](std::ostream& os) { meshWriter(f)(os, built.mesh); });
     out.files[f] = name;
   }
-  std::int64_t trees = 0, segments = 0;
-  for (std::int32_t i = 0; i < tree.nodeCount(); ++i) trees += tree.isRoot(i), segments += !tree.isRoot(i) && !tree.isLink(i);
-  out.parameters = {{"formats", p.formats},
-                    {"method", p.method},
-                    {"junctions", tubes ? Json(p.junctions) : Json(nullptr)},
-                    {"voxel_mm", p.voxel_mm ? Json(*p.voxel_mm) : Json(nullptr)},
-                    {"samples_across", o.samples_across},
-                    {"ring_spacing_radii", tubes && p.ringSpacing() > 0 ? Json(p.ringSpacing()) : Json(nullptr)},
-                    {"ring_spacing_vertex_spacings", tubes && p.ringSpacing() == 0 ? Json(kCfdRingSpacing) : Json(nullptr)},
-                    {"wall", !walls ? Json(nullptr)
-                                    : p.wall_thickness > 0 ? Json({{"thickness_mm", p.wall_thickness}})
-                                    : p.wall_ratio > 0     ? Json({{"ratio_of_radius", p.wall_ratio}})
-                                                           : Json({{"from", "the graph's wall values"}})},
-                    {"adaptive", !p.uniform},
-                    {"volume_restored", !p.on_surface},
-                    {"ends", walls ? std::string("open") : p.ends},
-                    {"flow_extension_radii", p.flow_extension},
-                    {"clip_box_mm", p.clip_box.empty() ? Json(nullptr) : Json(p.clip_box)},
-                    {"decimate", p.decimate},
-                    {"max_error_steps", p.max_error},
-                    {"sliver_angle_deg", p.sliverAngle()},
-                    {"max_angle_deg", p.maxAngle()},
-                    {"remesh", tubes && p.remeshes()},
-                    {"description", tubes ? "each vessel's free middle a tube of rings on its exact wall (at most ring_spacing_radii radii "
-                                            "apart, aligned; or ring_spacing_vertex_spacings apart, each turned by half a vertex spacing); where vessels meet, the signed distance to the union of their capsules and round cones "
-                                            "contoured by surface nets on a uniform grid or on the octree (junctions = nets, where the part passes its checks) or "
-                                            "by marching tetrahedra (2:1-balanced octree of cells sized to each vessel's radius), cut by "
-                                            "planes across the tubes and joined to their rings"
-                                          : "marching tetrahedra of the signed distance to the union of each tree's capsules and round cones, on a "
-                                            "2:1-balanced octree of cells sized to each vessel's radius, split into conforming tetrahedra"}};
-  out.statistics = {{"trees", trees},
-                    {"segments", segments},
-                    {"vertices", mesh.vertices.size()},
-                    {"triangles", mesh.triangles.size()},
-                    {"triangles_per_segment", segments > 0 ? double(mesh.triangles.size()) / double(segments) : 0.0},
-                    {"finest_step_mm", report.voxel_mm},
-                    {"coarsest_cell_mm", tubes ? Json(nullptr) : Json(report.coarsest_mm)},
-                    {"levels", tubes ? Json(nullptr) : Json(report.levels)},
-                    {"cells", tubes ? Json(nullptr) : Json(report.cells)},
-                    {"largest_volume_move_mm", tubes ? Json(nullptr) : Json(report.largest_volume_move_mm)},
-                    {"tubes", tubes ? Json(tube_report.tubes) : Json(nullptr)},
-                    {"contoured_parts", tubes ? Json(tube_report.clusters) : Json(nullptr)},
-                    {"parts_by_nets", tubes ? Json(tube_report.netted) : Json(nullptr)},
-                    {"largest_contoured_part_vessels", tubes ? Json(tube_report.largest_cluster_vessels) : Json(nullptr)},
-                    {"tube_triangles", tubes ? Json(tube_report.tube_triangles) : Json(nullptr)},
-                    {"contoured_triangles", tubes ? Json(tube_report.contour_triangles) : Json(nullptr)},
-                    {"tubes_given_up", tubes ? Json(tube_report.fallbacks) : Json(nullptr)},
-                    {"cuts_retried", tubes ? Json(tube_report.cut_retries) : Json(nullptr)},
-                    {"wall_ends_joined", walls ? Json(wall_report.rings) : Json(nullptr)},
-                    {"estimated_bytes", report.estimated_bytes},
-                    {"enclosed_volume_mm3", topo.volume_mm3},
-                    {"boundary_edges", topo.boundary_edges},
-                    {"nonmanifold_edges", topo.nonmanifold_edges},
-                    {"misoriented_edges", topo.misoriented_edges},
-                    {"degenerate_triangles", topo.degenerate_triangles},
-                    {"cavities_removed", tubes ? tube_report.cavities_removed : report.cavities_removed},
-                    {"triangles_before_decimation", p.decimate ? Json(reduced.before) : Json(nullptr)},
-                    {"decimation_collapses", reduced.collapses},
-                    {"decimation_largest_error_mm", reduced.largest_error_mm},
-                    {"slivers_repaired", tubes ? tube_report.slivers_repaired : slivers.changes()},
-                    {"remesh_splits", tube_report.remesh_splits},
-                    {"remesh_changes", tube_report.remesh_changes},
-                    {"ends", ends.size()},
-                    {"ends_cut", cut.cut},
-                    {"ends_left_closed", cut.left_closed.size()},
-                    {"clip_box_removed_triangles", p.clip_box.empty() ? Json(nullptr) : Json(clipped.removed_triangles)},
-                    {"clip_box_section_loops", p.clip_box.empty() ? Json(nullptr) : Json(clipped.section_loops)},
-                    {"clip_box_section_area_mm2", p.clip_box.empty() ? Json(nullptr) : Json(clipped.section_area_mm2)},
-                    {"tree_components", topo.tree_components},
-                    {"tree_euler_characteristic", topo.tree_euler}};
+  out.parameters = resolvedParameters(p, plan);
+  out.statistics = summarise(tree, p, plan, built);
   return out;
 }
 

@@ -5,17 +5,51 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
 #include "core/vascular_tree.hpp"
 #include "config/scenario.hpp"
+#include "mesh/box_clip.hpp"
+#include "mesh/vessel_surface.hpp"
 
 namespace angiosynth {
 
+// What the surface stage made: counts, steps, topology, volume, and each phase's work. The
+// fields of one method only are unset for the other (null in JSON).
+struct SurfaceSummary {
+  std::int64_t trees = 0, segments = 0, vertices = 0, triangles = 0;
+  double finest_step_mm = 0;
+  struct Contour {  // method contour: the octree
+    double coarsest_cell_mm = 0;
+    int levels = 0;
+    std::int64_t cells = 0;
+    double largest_volume_move_mm = 0;
+  };
+  std::optional<Contour> contour;
+  struct Tubes {  // method tubes: tubes and the contoured parts where vessels meet
+    std::int64_t tubes = 0, contoured_parts = 0, parts_by_nets = 0, largest_contoured_part_vessels = 0;
+    std::int64_t tube_triangles = 0, contoured_triangles = 0, given_up = 0, cuts_retried = 0;
+  };
+  std::optional<Tubes> tube;
+  std::optional<std::int64_t> wall_ends_joined;  // a hollow wall
+  double estimated_bytes = 0;
+  MeshTopology topology;
+  std::int64_t cavities_removed = 0;
+  std::optional<std::int64_t> triangles_before_decimation;  // with decimation
+  std::int64_t decimation_collapses = 0;
+  double decimation_largest_error_mm = 0;
+  std::int64_t slivers_repaired = 0, remesh_splits = 0, remesh_changes = 0;
+  std::int64_t ends = 0, ends_cut = 0, ends_left_closed = 0;
+  std::optional<BoxClipReport> clip;  // with a clip box
+  // As sample.json's statistics.surface and mesh.json's statistics record it.
+  nlohmann::ordered_json toJson() const;
+};
+
 struct SurfaceFiles {
-  nlohmann::ordered_json parameters;  // as resolved
-  nlohmann::ordered_json statistics;  // counts, topology, volume, steps
+  nlohmann::ordered_json parameters;  // the settings as the meshers took them (defaults resolved)
+  SurfaceSummary statistics;
   nlohmann::ordered_json files;       // format → file name
 };
 
