@@ -1075,9 +1075,23 @@ double restoreVolumeAlongNormals(SurfaceMesh& m, const std::function<double(std:
   return largest;
 }
 
-SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, SurfaceReport* report,
-                          const std::function<void(std::int64_t, std::int64_t)>& progress) {
-  SurfaceMesh mesh;
+namespace {
+
+// The contour's grid: the vessels, the finest step, each vessel's finest cells (at gaps) and
+// coarse cells (elsewhere), the fillets, the top level, and the lattice with its bins.
+struct ContourPlan {
+  std::vector<std::int32_t> vessels;  // none: nothing to contour
+  double h = 0;
+  std::vector<std::int8_t> level, coarse;
+  std::vector<double> fillet;
+  int top = 0;
+  Lattice lat;
+  double cellSize(int l) const { return h * double(std::int64_t(1) << l); }
+};
+
+// Throws InputError past the memory limit or the lattice's index range.
+ContourPlan planContour(const VascularTree& t, const SurfaceOptions& o, SurfaceReport* report) {
+  ContourPlan plan;
   Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
   double r_min = INFINITY;
   std::vector<std::int32_t> vessels;
@@ -1091,7 +1105,7 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
       hi = componentMax(hi, p + Vec3(r, r, r));
     }
   }
-  if (vessels.empty()) return mesh;
+  if (vessels.empty()) return plan;
   if (!(r_min > 0)) throw InputError("", 0, "a vessel of radius 0 has no surface; every radius must be > 0");
   const int across = std::max(1, o.samples_across);
   double h = o.voxel_mm > 0 ? o.voxel_mm : o.max_cell_mm > 0 ? std::min(2 * r_min / across, o.max_cell_mm) : 2 * r_min / across;
@@ -1152,7 +1166,24 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
                                 "; allowed: a larger voxel or a higher --memory-limit");
   lat.bins = binSegments(inflated, lat.grid);
   inflated = VascularTree();
+  plan.vessels = std::move(vessels);
+  plan.h = h;
+  plan.level = level;
+  plan.coarse = coarse;
+  plan.fillet = std::move(fillet);
+  plan.top = top;
+  plan.lat = std::move(lat);
+  return plan;
+}
 
+// The cells asked for: at each vessel's level, those its surface may pass through.
+std::vector<std::vector<std::uint64_t>> requestedCells(const VascularTree& t, const SurfaceOptions& o, const ContourPlan& plan) {
+  const auto& vessels = plan.vessels;
+  const auto &level = plan.level, &coarse = plan.coarse;
+  const auto& fillet = plan.fillet;
+  const int top = plan.top;
+  const Lattice& lat = plan.lat;
+  const auto cellSize = [&](int l) { return plan.cellSize(l); };
   // Cells asked for: at each vessel's level, those its surface may pass through, found by
   // descending from the top level.
   std::vector<std::vector<std::uint64_t>> requests(std::size_t(top + 1));
@@ -1206,104 +1237,63 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
       r.erase(std::unique(r.begin(), r.end()), r.end());
     }
   }
-  const BalancedOctree octree(top, std::move(requests));
-  // Units: the level-3 nodes (8³ finest cells) with their leaves, and the coarser leaves alone.
-  const std::vector<OctreeLeaf> units = octree.units(kUnitLevel);
-  std::vector<Solid> solids(std::size_t(t.nodeCount()));
-  for (auto s : vessels) solids[std::size_t(s)] = {capsuleOf(t, s), fillet[std::size_t(s)]};
-  // The solids of a tree in the bin of a point, as the units sample it.
-  const auto solidsAt = [&](std::int32_t tree, const Vec3& p) -> const std::vector<Solid>& {
-    const Vec3 half = (p - lat.origin) / (0.5 * lat.h);
-    thread_local std::vector<Solid> here;
-    here.clear();
-    if (const auto* segs = lat.segmentsIn(Lattice::binOf(half.x), Lattice::binOf(half.y), Lattice::binOf(half.z)))
-      for (auto s : *segs)
-        if ((t.tree.empty() ? 0 : t.tree[s]) == tree) here.push_back(solids[std::size_t(s)]);
-    return here;
+  return requests;
+}
+
+// Folds of the dual contour relaxed, then tangles smoothed off the surface: the triangles that
+// still cross (none: a surface without self-intersections).
+std::vector<std::int32_t> relaxAndUntangle(SurfaceMesh& dual, const Vec3& origin, double h,
+                                           const std::function<double(std::int32_t, const Vec3&)>& distance) {
+  // Folds relaxed until no two triangles cross (the moved vertices back on the surface).
+  std::vector<std::int32_t> tree_of;
+  const auto treesOfVertices = [&] {
+    tree_of.assign(dual.vertices.size(), 0);
+    for (std::size_t k = 0; k < dual.triangles.size(); ++k)
+      for (auto v : dual.triangles[k]) tree_of[std::size_t(v)] = dual.triangle_tree[k];
   };
-  const std::function<double(std::int32_t, const Vec3&)> distance = [&](std::int32_t tree, const Vec3& p) { return unionDistance(solidsAt(tree, p), p); };
-  const std::function<double(std::int32_t, const Vec3&)> strict = [&](std::int32_t tree, const Vec3& p) { return strictDistance(solidsAt(tree, p), p); };
-  if (o.dual) {
-    const char* refused = nullptr;
-    if (auto dual = dualContour(t, lat, octree, units, fillet, refused, progress)) {
-      if (o.restore_volume) {
-        const double moved = restoreVolumeAlongNormals(*dual, distance);
-        if (report) report->largest_volume_move_mm = moved;
+  treesOfVertices();
+  std::vector<std::int32_t> crossing;
+  // Checked again after a move only where it moved: the triangles at moved vertices and
+  // those that crossed are dirty, the other pairs did not cross and stand.
+  std::vector<Vec3> before;
+  std::vector<char> dirty;
+  const auto recheck = [&] {
+    dirty.assign(dual.triangles.size(), 0);
+    for (auto k : crossing) dirty[std::size_t(k)] = 1;
+    for (std::size_t k = 0; k < dual.triangles.size(); ++k)
+      for (auto v : dual.triangles[k]) {
+        const Vec3 &p = dual.vertices[std::size_t(v)], &q = before[std::size_t(v)];
+        if (p.x != q.x || p.y != q.y || p.z != q.z) dirty[k] = 1;
       }
-      auto removed = removeCavities(*dual);
-      if (!closedManifold(*dual)) {
-        refused = "not a closed manifold";
-      } else {
-        // Folds relaxed until no two triangles cross (the moved vertices back on the surface).
-        std::vector<std::int32_t> tree_of;
-        const auto treesOfVertices = [&] {
-          tree_of.assign(dual->vertices.size(), 0);
-          for (std::size_t k = 0; k < dual->triangles.size(); ++k)
-            for (auto v : dual->triangles[k]) tree_of[std::size_t(v)] = dual->triangle_tree[k];
-        };
-        treesOfVertices();
-        std::vector<std::int32_t> crossing;
-        // Checked again after a move only where it moved: the triangles at moved vertices and
-        // those that crossed are dirty, the other pairs did not cross and stand.
-        std::vector<Vec3> before;
-        std::vector<char> dirty;
-        const auto recheck = [&] {
-          dirty.assign(dual->triangles.size(), 0);
-          for (auto k : crossing) dirty[std::size_t(k)] = 1;
-          for (std::size_t k = 0; k < dual->triangles.size(); ++k)
-            for (auto v : dual->triangles[k]) {
-              const Vec3 &p = dual->vertices[std::size_t(v)], &q = before[std::size_t(v)];
-              if (p.x != q.x || p.y != q.y || p.z != q.z) dirty[k] = 1;
-            }
-          crossing = crossingTriangles(*dual, lat.origin, h, false, &dirty);
-        };
-        for (int round = 0; round < kRelaxRounds; ++round) {
-          if (round > 0) before = dual->vertices;
-          relax(*dual, tree_of, crossing, distance);
-          if (round == 0)
-            crossing = crossingTriangles(*dual, lat.origin, h);
-          else
-            recheck();
-          if (crossing.empty()) break;
-        }
-        // Tangles relax cannot undo (sheets a fifth of a step apart at creases and thin gaps):
-        // smoothed off the surface, within kUntangleOffset of a step.
-        for (int round = 0; round < kUntangleRounds && !crossing.empty(); ++round) {
-          if (removeThreeFans(*dual, crossing, dirty)) {
-            treesOfVertices();
-            crossing = crossingTriangles(*dual, lat.origin, h, false, &dirty);
-            if (crossing.empty()) break;
-          }
-          before = dual->vertices;
-          untangle(*dual, tree_of, crossing, round + 1, distance);
-          recheck();
-        }
-        if (!crossing.empty()) refused = "self-intersecting";
-        else removed += removeSpecks(*dual);
-      }
-      if (!refused) {
-        if (report)
-          report->dual = true, report->cavities_removed = removed, report->cells = std::int64_t(dual->vertices.size()),
-          report->units = std::int64_t(units.size()), report->levels = top + 1;
-        if (o.finish) o.finish(*dual, strict);
-        return std::move(*dual);
-      }
-    }
-    if (report) report->dual_refused = refused;
+    crossing = crossingTriangles(dual, origin, h, false, &dirty);
+  };
+  for (int round = 0; round < kRelaxRounds; ++round) {
+    if (round > 0) before = dual.vertices;
+    relax(dual, tree_of, crossing, distance);
+    if (round == 0)
+      crossing = crossingTriangles(dual, origin, h);
+    else
+      recheck();
+    if (crossing.empty()) break;
   }
-  std::atomic<std::int64_t> cells{0};
-  std::vector<UnitMesh> meshes(units.size());
-  forEachUnit(t, lat, octree, units, fillet, progress, [&](UnitMesher& mesher, std::size_t u, const std::vector<OctreeLeaf>& leaves) {
-    auto& out = meshes[u];
-    cells += std::int64_t(leaves.size());
-    mesher.mesh(units[u].level, units[u].cell, leaves.data(), leaves.data() + leaves.size(), out);
-    out.vertices.shrink_to_fit();
-    out.triangles.shrink_to_fit();
-    out.triangle_tree.shrink_to_fit();
-  });
-  if (report) report->cells = cells, report->units = std::int64_t(units.size()), report->levels = top + 1;
-  // Weld: one vertex per (tree, edge), numbered in key order; triangles in unit order. Units
-  // that share an edge computed the same vertex, so the first copy stands for all.
+  // Tangles relax cannot undo (sheets a fifth of a step apart at creases and thin gaps):
+  // smoothed off the surface, within kUntangleOffset of a step.
+  for (int round = 0; round < kUntangleRounds && !crossing.empty(); ++round) {
+    if (removeThreeFans(dual, crossing, dirty)) {
+      treesOfVertices();
+      crossing = crossingTriangles(dual, origin, h, false, &dirty);
+      if (crossing.empty()) break;
+    }
+    before = dual.vertices;
+    untangle(dual, tree_of, crossing, round + 1, distance);
+    recheck();
+  }
+  return crossing;
+}
+
+// Weld: one vertex per (tree, edge), numbered in key order; triangles in unit order. Units
+// that share an edge computed the same vertex, so the first copy stands for all.
+void weldUnits(std::vector<UnitMesh>& meshes, SurfaceMesh& mesh, std::vector<Vec3>& along, std::vector<double>& on_edge) {
   struct Copy {
     EdgeKey key;
     std::uint32_t unit, local;
@@ -1333,8 +1323,8 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
   const std::size_t nv = id.empty() ? 0 : std::size_t(id.back());
   mesh.vertices.resize(nv);
   mesh.vertex_step.resize(nv);
-  std::vector<Vec3> along(nv);  // per vertex, its edge
-  std::vector<double> on_edge(nv);
+  along.assign(nv, Vec3());
+  on_edge.assign(nv, 0.0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, copies.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       const auto& c = copies[i];
@@ -1363,6 +1353,76 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
       UnitMesh().vertices.swap(meshes[u].vertices);
     }
   });
+}
+
+}  // namespace
+
+SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, SurfaceReport* report,
+                          const std::function<void(std::int64_t, std::int64_t)>& progress) {
+  ContourPlan plan = planContour(t, o, report);
+  SurfaceMesh mesh;
+  if (plan.vessels.empty()) return mesh;
+  const Lattice& lat = plan.lat;
+  const double h = plan.h;
+  const int top = plan.top;
+  const auto& fillet = plan.fillet;
+  std::vector<std::vector<std::uint64_t>> requests = requestedCells(t, o, plan);
+  const BalancedOctree octree(top, std::move(requests));
+  // Units: the level-3 nodes (8³ finest cells) with their leaves, and the coarser leaves alone.
+  const std::vector<OctreeLeaf> units = octree.units(kUnitLevel);
+  std::vector<Solid> solids(std::size_t(t.nodeCount()));
+  for (auto s : plan.vessels) solids[std::size_t(s)] = {capsuleOf(t, s), fillet[std::size_t(s)]};
+  // The solids of a tree in the bin of a point, as the units sample it.
+  const auto solidsAt = [&](std::int32_t tree, const Vec3& p) -> const std::vector<Solid>& {
+    const Vec3 half = (p - lat.origin) / (0.5 * lat.h);
+    thread_local std::vector<Solid> here;
+    here.clear();
+    if (const auto* segs = lat.segmentsIn(Lattice::binOf(half.x), Lattice::binOf(half.y), Lattice::binOf(half.z)))
+      for (auto s : *segs)
+        if ((t.tree.empty() ? 0 : t.tree[s]) == tree) here.push_back(solids[std::size_t(s)]);
+    return here;
+  };
+  const std::function<double(std::int32_t, const Vec3&)> distance = [&](std::int32_t tree, const Vec3& p) { return unionDistance(solidsAt(tree, p), p); };
+  const std::function<double(std::int32_t, const Vec3&)> strict = [&](std::int32_t tree, const Vec3& p) { return strictDistance(solidsAt(tree, p), p); };
+  if (o.dual) {
+    const char* refused = nullptr;
+    if (auto dual = dualContour(t, lat, octree, units, fillet, refused, progress)) {
+      if (o.restore_volume) {
+        const double moved = restoreVolumeAlongNormals(*dual, distance);
+        if (report) report->largest_volume_move_mm = moved;
+      }
+      auto removed = removeCavities(*dual);
+      if (!closedManifold(*dual)) {
+        refused = "not a closed manifold";
+      } else {
+        const std::vector<std::int32_t> crossing = relaxAndUntangle(*dual, lat.origin, h, distance);
+        if (!crossing.empty()) refused = "self-intersecting";
+        else removed += removeSpecks(*dual);
+      }
+      if (!refused) {
+        if (report)
+          report->dual = true, report->cavities_removed = removed, report->cells = std::int64_t(dual->vertices.size()),
+          report->units = std::int64_t(units.size()), report->levels = top + 1;
+        if (o.finish) o.finish(*dual, strict);
+        return std::move(*dual);
+      }
+    }
+    if (report) report->dual_refused = refused;
+  }
+  std::atomic<std::int64_t> cells{0};
+  std::vector<UnitMesh> meshes(units.size());
+  forEachUnit(t, lat, octree, units, fillet, progress, [&](UnitMesher& mesher, std::size_t u, const std::vector<OctreeLeaf>& leaves) {
+    auto& out = meshes[u];
+    cells += std::int64_t(leaves.size());
+    mesher.mesh(units[u].level, units[u].cell, leaves.data(), leaves.data() + leaves.size(), out);
+    out.vertices.shrink_to_fit();
+    out.triangles.shrink_to_fit();
+    out.triangle_tree.shrink_to_fit();
+  });
+  if (report) report->cells = cells, report->units = std::int64_t(units.size()), report->levels = top + 1;
+  std::vector<Vec3> along;  // per vertex, its edge
+  std::vector<double> on_edge;
+  weldUnits(meshes, mesh, along, on_edge);
   if (o.restore_volume) {
     const double moved = restoreVolume(mesh, along, on_edge, distance);
     if (report) report->largest_volume_move_mm = moved;
