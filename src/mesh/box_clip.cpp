@@ -115,25 +115,16 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
   // shrink it below a tenth is not made.
   constexpr double kSliver = 0.05;
   const std::size_t nt = m.triangles.size();
-  std::vector<std::uint32_t> first(m.vertices.size() + 1, 0);
-  for (const auto& tri : m.triangles)
-    for (auto v : tri) ++first[std::size_t(v) + 1];
-  for (std::size_t v = 0; v + 1 < first.size(); ++v) first[v + 1] += first[v];
-  std::vector<std::uint32_t> incident(first.back());
-  {
-    std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
-    for (std::size_t k = 0; k < nt; ++k)
-      for (auto v : m.triangles[k]) incident[fill[std::size_t(v)]++] = std::uint32_t(k);
-  }
+  const VertexTriangles incident(m);
   const auto normalOf = [&](const std::array<std::int32_t, 3>& t, std::int32_t v, const Vec3& at) {
     const auto P = [&](std::int32_t q) -> const Vec3& { return q == v ? at : m.vertices[std::size_t(q)]; };
     return cross(P(t[1]) - P(t[0]), P(t[2]) - P(t[0]));
   };
   // The vertex opposite edge (v, n) in v's triangle other than `skip`, or -1.
-  const auto opposite = [&](std::int32_t v, std::int32_t n, std::uint32_t skip) {
-    for (auto q = first[std::size_t(v)]; q < first[std::size_t(v) + 1]; ++q) {
-      if (incident[q] == skip) continue;
-      const auto& t = m.triangles[incident[q]];
+  const auto opposite = [&](std::int32_t v, std::int32_t n, std::int32_t skip) {
+    for (const auto k : incident.of(v)) {
+      if (k == skip) continue;
+      const auto& t = m.triangles[std::size_t(k)];
       if (t[0] == n || t[1] == n || t[2] == n) return t[0] != v && t[0] != n ? t[0] : t[1] != v && t[1] != n ? t[1] : t[2];
     }
     return std::int32_t(-1);
@@ -141,8 +132,8 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
   const auto moveOnto = [&](std::int32_t v, Vec3 p) {
     setCoord(p, axis, c);
     const Vec3 here = m.vertices[std::size_t(v)];
-    for (auto q = first[std::size_t(v)]; q < first[std::size_t(v) + 1]; ++q) {
-      const auto& t = m.triangles[incident[q]];
+    for (const auto k : incident.of(v)) {
+      const auto& t = m.triangles[std::size_t(k)];
       const Vec3 before = normalOf(t, v, here), after = normalOf(t, v, p);
       const double nb = norm(before), na = norm(after);
       if (!(na > 0.1 * nb) || !(dot(before, after) > 0.5 * nb * na)) return;
@@ -153,7 +144,7 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
         std::int32_t x = -1;
         for (auto w : t)
           if (w != v && w != n) x = w;
-        const auto y = opposite(v, n, incident[q]);
+        const auto y = opposite(v, n, k);
         if (y >= 0 && s[std::size_t(x)] < 0 && s[std::size_t(y)] < 0) return;
       }
     }

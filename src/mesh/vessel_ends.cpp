@@ -168,17 +168,7 @@ EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool ca
   const std::size_t nv = m.vertices.size();
   std::vector<char> is_near(nv, 0);
   for (const auto& p : near) is_near[std::size_t(p.second)] = 1;
-  std::vector<std::uint32_t> first(nv + 1, 0);
-  for (const auto& tri : m.triangles)
-    for (auto v : tri) first[std::size_t(v) + 1] += is_near[std::size_t(v)];
-  for (std::size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
-  std::vector<std::int32_t> incident(first[nv]);
-  {
-    std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
-    for (std::size_t k = 0; k < m.triangles.size(); ++k)
-      for (auto v : m.triangles[k])
-        if (is_near[std::size_t(v)]) incident[fill[std::size_t(v)]++] = std::int32_t(k);
-  }
+  const VertexTriangles incident(m, &is_near);
 
   std::vector<char> removed(m.triangles.size(), 0);
   std::vector<std::int32_t> region_of(nv, -1);  // the end whose region a vertex was last found in
@@ -198,8 +188,8 @@ EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool ca
       double s = dot(m.vertices[std::size_t(v)] - reg.c, reg.n);
       double snap = m.vertex_step.empty() ? 0.0 : kSnapSteps * double(m.vertex_step[std::size_t(v)]);
       if (std::abs(s) < snap)
-        for (auto q = first[std::size_t(v)]; q < first[std::size_t(v) + 1]; ++q) {
-          const auto& tri = m.triangles[std::size_t(incident[q])];
+        for (const auto k : incident.of(v)) {
+          const auto& tri = m.triangles[std::size_t(k)];
           const int i = tri[0] == v ? 0 : tri[1] == v ? 1 : 2;
           const Vec3 p = m.vertices[std::size_t(v)], a = m.vertices[std::size_t(tri[std::size_t((i + 1) % 3)])],
                      b = m.vertices[std::size_t(tri[std::size_t((i + 2) % 3)])];
@@ -229,12 +219,11 @@ EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool ca
     std::vector<std::int32_t> cut;
     std::unordered_set<std::int32_t> in_cut;
     bool ok = true;
-    for (auto k = first[std::size_t(apex)]; k < first[std::size_t(apex) + 1]; ++k)
-      if (in_cut.insert(incident[k]).second) cut.push_back(incident[k]);
+    for (const auto k : incident.of(apex))
+      if (in_cut.insert(k).second) cut.push_back(k);
     // The triangle across edge (a, b) of triangle k, or −1.
     const auto across = [&](std::int32_t k, std::int32_t a, std::int32_t b) {
-      for (auto q = first[std::size_t(a)]; q < first[std::size_t(a) + 1]; ++q) {
-        const auto o = incident[q];
+      for (const auto o : incident.of(a)) {
         if (o == k || removed[std::size_t(o)]) continue;
         const auto& tri = m.triangles[std::size_t(o)];
         if (tri[0] == b || tri[1] == b || tri[2] == b) return o;

@@ -14,16 +14,9 @@
 #include <vector>
 
 #include "core/vascular_tree.hpp"
+#include "mesh/surface_mesh.hpp"
 
 namespace angiosynth {
-
-struct SurfaceMesh {
-  std::vector<Vec3> vertices;                          // mm
-  std::vector<std::array<std::int32_t, 3>> triangles;  // counter-clockwise seen from outside
-  std::vector<std::int32_t> triangle_tree;             // the tree (forest index) of each triangle
-  std::vector<float> vertex_step;                      // mm: the sampling step where each vertex was found
-  std::vector<std::int32_t> triangle_face;             // empty, or per triangle: 0 the wall, k + 1 the cap of end k (vessel_ends.hpp)
-};
 
 // Cells grow up to 2^kMaxSurfaceLevel finest steps.
 constexpr int kMaxSurfaceLevel = 10;
