@@ -154,6 +154,196 @@ VascularTree prolongEnds(const VascularTree& t, const std::vector<VesselEnd>& en
   return out;
 }
 
+namespace {
+
+// What the cut of every end shares: the mesh, the triangles of the vertices near an end, the
+// triangles cut away so far, and for each vertex the end whose region it was last found in and
+// its signed distance to that end's plane.
+struct CutState {
+  SurfaceMesh& m;
+  const VertexTriangles& incident;
+  std::vector<char> removed;
+  std::vector<std::int32_t> region_of;
+  std::vector<double> side;
+};
+
+// Snaps the end's vertices within kSnap·r (or a sliver's height) onto its plane and records their
+// sides; the apex, the vertex nearest the prolongation's tip, or -1 when the end has none.
+std::int32_t snapToPlane(CutState& st, const EndRegion& reg, std::int32_t e, const std::vector<std::int32_t>& local) {
+  SurfaceMesh& m = st.m;
+  std::int32_t apex = -1;
+  double apex_distance = INFINITY;
+  const Vec3 tip = reg.c + reg.n * ((kOvershootRadii + 1) * reg.r);
+  for (auto v : local) {
+    double s = dot(m.vertices[std::size_t(v)] - reg.c, reg.n);
+    double snap = m.vertex_step.empty() ? 0.0 : kSnapSteps * double(m.vertex_step[std::size_t(v)]);
+    if (std::abs(s) < snap)
+      for (const auto k : st.incident.of(v)) {
+        const auto& tri = m.triangles[std::size_t(k)];
+        const int i = tri[0] == v ? 0 : tri[1] == v ? 1 : 2;
+        const Vec3 p = m.vertices[std::size_t(v)], a = m.vertices[std::size_t(tri[std::size_t((i + 1) % 3)])],
+                   b = m.vertices[std::size_t(tri[std::size_t((i + 2) % 3)])];
+        snap = std::min(snap, kSnapHeight * norm(cross(a - p, b - p)) / std::max(norm(b - a), 1e-300));
+      }
+    if (std::abs(s) < std::max(snap, kSnap * reg.r)) {
+      m.vertices[std::size_t(v)] = m.vertices[std::size_t(v)] - reg.n * s;
+      s = 0;
+    }
+    st.region_of[std::size_t(v)] = e;
+    st.side[std::size_t(v)] = s;
+    const double d = distance(m.vertices[std::size_t(v)], tip);
+    if (apex < 0 || d < apex_distance) apex = v, apex_distance = d;
+  }
+  return apex;
+}
+
+// The prolongation's triangles: those with a vertex beyond the plane connected to the apex, and
+// the directed edges of the untouched neighbours facing them. False when one of their vertices
+// lies outside the end's region (the prolongation merged with another vessel) or an edge has no
+// triangle across.
+bool collectProlongation(const CutState& st, std::int32_t e, std::int32_t apex, std::vector<std::int32_t>& cut,
+                         std::vector<std::uint64_t>& boundary_side) {
+  const SurfaceMesh& m = st.m;
+  const auto mine = [&](std::int32_t v) { return st.region_of[std::size_t(v)] == e; };
+  const auto beyond = [&](std::int32_t k) {
+    const auto& tri = m.triangles[std::size_t(k)];
+    return st.side[std::size_t(tri[0])] > 0 || st.side[std::size_t(tri[1])] > 0 || st.side[std::size_t(tri[2])] > 0;
+  };
+  std::unordered_set<std::int32_t> in_cut;
+  for (const auto k : st.incident.of(apex))
+    if (in_cut.insert(k).second) cut.push_back(k);
+  // The triangle across edge (a, b) of triangle k, or −1.
+  const auto across = [&](std::int32_t k, std::int32_t a, std::int32_t b) {
+    for (const auto o : st.incident.of(a)) {
+      if (o == k || st.removed[std::size_t(o)]) continue;
+      const auto& tri = m.triangles[std::size_t(o)];
+      if (tri[0] == b || tri[1] == b || tri[2] == b) return o;
+    }
+    return std::int32_t(-1);
+  };
+  for (std::size_t q = 0; q < cut.size(); ++q) {
+    const auto k = cut[q];
+    const auto& tri = m.triangles[std::size_t(k)];
+    if (st.removed[std::size_t(k)] || !mine(tri[0]) || !mine(tri[1]) || !mine(tri[2])) return false;
+    for (int i = 0; i < 3; ++i) {
+      const auto a = tri[std::size_t(i)], b = tri[std::size_t((i + 1) % 3)];
+      const auto o = across(k, a, b);
+      if (o < 0) return false;
+      if (in_cut.count(o)) continue;
+      const auto& ot = m.triangles[std::size_t(o)];
+      if ((mine(ot[0]) && mine(ot[1]) && mine(ot[2])) && beyond(o)) {
+        in_cut.insert(o);
+        cut.push_back(o);
+      } else {
+        boundary_side.push_back(directedKey(b, a));
+      }
+    }
+  }
+  return true;
+}
+
+// The prolongation clipped to the side s ≤ 0: the pieces kept and the new vertices on the plane
+// (numbered from `base`, after the mesh's), cut points shared through their edge.
+struct ClippedEnd {
+  std::int32_t base = 0;
+  std::vector<Vec3> new_vertices;
+  std::vector<float> new_steps;
+  std::vector<std::array<std::int32_t, 3>> kept;
+  std::vector<std::int32_t> kept_tree;
+};
+
+ClippedEnd clipProlongation(const CutState& st, const EndRegion& reg, std::vector<std::int32_t>& cut) {
+  const SurfaceMesh& m = st.m;
+  ClippedEnd c;
+  c.base = std::int32_t(m.vertices.size());
+  std::unordered_map<std::uint64_t, std::int32_t> cut_point;
+  const auto pointOn = [&](std::int32_t a, std::int32_t b) {
+    const auto key = pairKey(a, b);
+    if (const auto it = cut_point.find(key); it != cut_point.end()) return it->second;
+    const double sa = st.side[std::size_t(a)], sb = st.side[std::size_t(b)];
+    Vec3 p = m.vertices[std::size_t(a)] + (m.vertices[std::size_t(b)] - m.vertices[std::size_t(a)]) * (sa / (sa - sb));
+    p = p - reg.n * dot(p - reg.c, reg.n);
+    const auto id = c.base + std::int32_t(c.new_vertices.size());
+    c.new_vertices.push_back(p);
+    c.new_steps.push_back(m.vertex_step.empty() ? 0.f : std::min(m.vertex_step[std::size_t(a)], m.vertex_step[std::size_t(b)]));
+    cut_point.emplace(key, id);
+    return id;
+  };
+  const auto at_of = [&](std::int32_t v) -> const Vec3& { return v >= c.base ? c.new_vertices[std::size_t(v - c.base)] : m.vertices[std::size_t(v)]; };
+  std::sort(cut.begin(), cut.end());
+  for (auto k : cut)
+    clipTriangleToPlane(
+        m.triangles[std::size_t(k)], [&](std::int32_t v) { return st.side[std::size_t(v)]; }, pointOn, at_of,
+        [&](std::int32_t a, std::int32_t b, std::int32_t t) {
+          c.kept.push_back({a, b, t});
+          c.kept_tree.push_back(m.triangle_tree[std::size_t(k)]);
+        });
+  return c;
+}
+
+// The cut's loop: the directed edges of the kept pieces and of the neighbours facing the cut
+// that have no reverse among them, all on the plane, from the lowest vertex; empty when they do
+// not form one simple loop.
+std::vector<std::int32_t> traceLoop(const CutState& st, const ClippedEnd& c, const std::vector<std::uint64_t>& boundary_side) {
+  const auto sideOf = [&](std::int32_t v) { return v >= c.base ? 0.0 : st.side[std::size_t(v)]; };
+  std::unordered_set<std::uint64_t> edges(boundary_side.begin(), boundary_side.end());
+  for (const auto& tri : c.kept)
+    for (int i = 0; i < 3; ++i) edges.insert(directedKey(tri[std::size_t(i)], tri[std::size_t((i + 1) % 3)]));
+  std::unordered_map<std::int32_t, std::int32_t> next;
+  std::int32_t start = -1;
+  bool ok = true;
+  for (auto key : edges) {
+    const auto a = std::int32_t(key >> 32), b = std::int32_t(key & 0xffffffffu);
+    if (edges.count(directedKey(b, a))) continue;
+    if (sideOf(a) != 0 || sideOf(b) != 0 || !next.emplace(a, b).second) ok = false;
+    if (start < 0 || a < start) start = a;
+  }
+  std::vector<std::int32_t> loop;
+  for (std::int32_t v = start; ok && v >= 0;) {
+    loop.push_back(v);
+    const auto it = next.find(v);
+    if (it == next.end()) ok = false;
+    else v = it->second == start ? -1 : it->second;
+    if (loop.size() > next.size()) ok = false;
+  }
+  if (!ok || loop.size() < 3 || loop.size() != next.size()) return {};
+  return loop;
+}
+
+// The cap of the loop: a fan from the plane's centre when the loop is star-shaped around it
+// (seen along the outward normal; the centre becomes a new vertex), else the loop's ears. False
+// when ear clipping finds no triangulation.
+bool capLoop(const SurfaceMesh& m, ClippedEnd& c, const std::vector<std::int32_t>& loop, const VesselEnd& end, const EndRegion& reg,
+             std::vector<std::array<std::int32_t, 3>>& cap, double& area) {
+  const auto at_of = [&](std::int32_t v) -> const Vec3& { return v >= c.base ? c.new_vertices[std::size_t(v - c.base)] : m.vertices[std::size_t(v)]; };
+  const auto centre = c.base + std::int32_t(c.new_vertices.size());
+  bool star = true;
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    const auto a = loop[i], b = loop[(i + 1) % loop.size()];
+    const double twice = dot(cross(at_of(a) - end.centre, at_of(b) - end.centre), reg.n);
+    star = star && twice < 0;  // the wall runs a → b; the cap runs b → a around the normal
+  }
+  if (star) {
+    for (std::size_t i = 0; i < loop.size(); ++i) cap.push_back({loop[(i + 1) % loop.size()], loop[i], centre});
+    float step = INFINITY;
+    for (auto v : loop) step = std::min(step, v >= c.base ? c.new_steps[std::size_t(v - c.base)] : m.vertex_step.empty() ? 0.f : m.vertex_step[std::size_t(v)]);
+    c.new_vertices.push_back(end.centre);
+    c.new_steps.push_back(step);
+  } else {
+    std::vector<Vec3> polygon;
+    for (std::size_t i = loop.size(); i-- > 0;) polygon.push_back(at_of(loop[i]));
+    const Vec3 u = unit(std::abs(reg.n.x) < 0.9 ? cross(reg.n, Vec3(1, 0, 0)) : cross(reg.n, Vec3(0, 1, 0))), w = cross(reg.n, u);
+    const auto ears = earClip(polygon, u, w);
+    if (ears.empty()) return false;
+    const auto vertexOf = [&](int i) { return loop[loop.size() - 1 - std::size_t(i)]; };
+    for (const auto& ear : ears) cap.push_back({vertexOf(ear[0]), vertexOf(ear[1]), vertexOf(ear[2])});
+  }
+  for (const auto& tri : cap) area += 0.5 * norm(cross(at_of(tri[1]) - at_of(tri[0]), at_of(tri[2]) - at_of(tri[0])));
+  return true;
+}
+
+}  // namespace
+
 EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool caps) {
   EndCutReport rep;
   rep.cap_area_mm2.assign(ends.size(), 0.0);
@@ -169,10 +359,7 @@ EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool ca
   std::vector<char> is_near(nv, 0);
   for (const auto& p : near) is_near[std::size_t(p.second)] = 1;
   const VertexTriangles incident(m, &is_near);
-
-  std::vector<char> removed(m.triangles.size(), 0);
-  std::vector<std::int32_t> region_of(nv, -1);  // the end whose region a vertex was last found in
-  std::vector<double> side(nv, 0.0);            // its signed distance to that end's plane
+  CutState st{m, incident, std::vector<char>(m.triangles.size(), 0), std::vector<std::int32_t>(nv, -1), std::vector<double>(nv, 0.0)};
   std::size_t at = 0;
   for (std::size_t e = 0; e < ends.size(); ++e) {
     const auto& end = ends[e];
@@ -180,186 +367,44 @@ EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool ca
     std::vector<std::int32_t> local;
     for (; at < near.size() && near[at].first == std::int32_t(e); ++at) local.push_back(near[at].second);
     const auto leaveClosed = [&] { rep.left_closed.push_back(std::int32_t(e)); };
-    // Signed distances to the plane; vertices within kSnap·r go onto it.
-    std::int32_t apex = -1;
-    double apex_distance = INFINITY;
-    const Vec3 tip = reg.c + reg.n * ((kOvershootRadii + 1) * reg.r);
-    for (auto v : local) {
-      double s = dot(m.vertices[std::size_t(v)] - reg.c, reg.n);
-      double snap = m.vertex_step.empty() ? 0.0 : kSnapSteps * double(m.vertex_step[std::size_t(v)]);
-      if (std::abs(s) < snap)
-        for (const auto k : incident.of(v)) {
-          const auto& tri = m.triangles[std::size_t(k)];
-          const int i = tri[0] == v ? 0 : tri[1] == v ? 1 : 2;
-          const Vec3 p = m.vertices[std::size_t(v)], a = m.vertices[std::size_t(tri[std::size_t((i + 1) % 3)])],
-                     b = m.vertices[std::size_t(tri[std::size_t((i + 2) % 3)])];
-          snap = std::min(snap, kSnapHeight * norm(cross(a - p, b - p)) / std::max(norm(b - a), 1e-300));
-        }
-      if (std::abs(s) < std::max(snap, kSnap * reg.r)) {
-        m.vertices[std::size_t(v)] = m.vertices[std::size_t(v)] - reg.n * s;
-        s = 0;
-      }
-      region_of[std::size_t(v)] = std::int32_t(e);
-      side[std::size_t(v)] = s;
-      // The apex: the vertex nearest the prolongation's tip.
-      const double d = distance(m.vertices[std::size_t(v)], tip);
-      if (apex < 0 || d < apex_distance) apex = v, apex_distance = d;
-    }
-    if (apex < 0 || !(side[std::size_t(apex)] > 0)) {
+    const std::int32_t apex = snapToPlane(st, reg, std::int32_t(e), local);
+    if (apex < 0 || !(st.side[std::size_t(apex)] > 0)) {
       leaveClosed();
       continue;
     }
-    const auto mine = [&](std::int32_t v) { return region_of[std::size_t(v)] == std::int32_t(e); };
-    const auto beyond = [&](std::int32_t k) {
-      const auto& tri = m.triangles[std::size_t(k)];
-      return side[std::size_t(tri[0])] > 0 || side[std::size_t(tri[1])] > 0 || side[std::size_t(tri[2])] > 0;
-    };
-    // The prolongation's triangles: those with a vertex beyond the plane connected to the apex.
-    // All their vertices must lie in the end's region (else it merged with another vessel).
     std::vector<std::int32_t> cut;
-    std::unordered_set<std::int32_t> in_cut;
-    bool ok = true;
-    for (const auto k : incident.of(apex))
-      if (in_cut.insert(k).second) cut.push_back(k);
-    // The triangle across edge (a, b) of triangle k, or −1.
-    const auto across = [&](std::int32_t k, std::int32_t a, std::int32_t b) {
-      for (const auto o : incident.of(a)) {
-        if (o == k || removed[std::size_t(o)]) continue;
-        const auto& tri = m.triangles[std::size_t(o)];
-        if (tri[0] == b || tri[1] == b || tri[2] == b) return o;
-      }
-      return std::int32_t(-1);
-    };
-    std::vector<std::uint64_t> boundary_side;  // directed edges of untouched neighbours facing the cut
-    for (std::size_t q = 0; q < cut.size() && ok; ++q) {
-      const auto k = cut[q];
-      const auto& tri = m.triangles[std::size_t(k)];
-      if (removed[std::size_t(k)] || !mine(tri[0]) || !mine(tri[1]) || !mine(tri[2])) {
-        ok = false;
-        break;
-      }
-      for (int i = 0; i < 3; ++i) {
-        const auto a = tri[std::size_t(i)], b = tri[std::size_t((i + 1) % 3)];
-        const auto o = across(k, a, b);
-        if (o < 0) {
-          ok = false;
-          break;
-        }
-        if (in_cut.count(o)) continue;
-        const auto& ot = m.triangles[std::size_t(o)];
-        if ((mine(ot[0]) && mine(ot[1]) && mine(ot[2])) && beyond(o)) {
-          in_cut.insert(o);
-          cut.push_back(o);
-        } else {
-          boundary_side.push_back(directedKey(b, a));
-        }
-      }
-    }
-    if (!ok) {
+    std::vector<std::uint64_t> boundary_side;
+    if (!collectProlongation(st, std::int32_t(e), apex, cut, boundary_side)) {
       leaveClosed();
       continue;
     }
-    // Clip each triangle of the cut to the side s ≤ 0; cut points are shared through their edge.
-    std::unordered_map<std::uint64_t, std::int32_t> cut_point;
-    std::vector<Vec3> new_vertices;
-    std::vector<float> new_steps;
-    const std::int32_t base = std::int32_t(m.vertices.size());
-    const auto pointOn = [&](std::int32_t a, std::int32_t b) {
-      const auto key = pairKey(a, b);
-      if (const auto it = cut_point.find(key); it != cut_point.end()) return it->second;
-      const double sa = side[std::size_t(a)], sb = side[std::size_t(b)];
-      Vec3 p = m.vertices[std::size_t(a)] + (m.vertices[std::size_t(b)] - m.vertices[std::size_t(a)]) * (sa / (sa - sb));
-      p = p - reg.n * dot(p - reg.c, reg.n);
-      const auto id = base + std::int32_t(new_vertices.size());
-      new_vertices.push_back(p);
-      new_steps.push_back(m.vertex_step.empty() ? 0.f : std::min(m.vertex_step[std::size_t(a)], m.vertex_step[std::size_t(b)]));
-      cut_point.emplace(key, id);
-      return id;
-    };
-    const auto sideOf = [&](std::int32_t v) { return v >= base ? 0.0 : side[std::size_t(v)]; };
-    const auto at_of = [&](std::int32_t v) -> const Vec3& { return v >= base ? new_vertices[std::size_t(v - base)] : m.vertices[std::size_t(v)]; };
-    std::vector<std::array<std::int32_t, 3>> kept;
-    std::vector<std::int32_t> kept_tree;
-    std::sort(cut.begin(), cut.end());
-    for (auto k : cut)
-      clipTriangleToPlane(
-          m.triangles[std::size_t(k)], [&](std::int32_t v) { return side[std::size_t(v)]; }, pointOn, at_of,
-          [&](std::int32_t a, std::int32_t b, std::int32_t c) {
-            kept.push_back({a, b, c});
-            kept_tree.push_back(m.triangle_tree[std::size_t(k)]);
-          });
-    // The loop: directed edges of the kept pieces and of the neighbours facing the cut that have
-    // no reverse among them.
-    std::unordered_set<std::uint64_t> edges(boundary_side.begin(), boundary_side.end());
-    for (const auto& tri : kept)
-      for (int i = 0; i < 3; ++i) edges.insert(directedKey(tri[std::size_t(i)], tri[std::size_t((i + 1) % 3)]));
-    std::unordered_map<std::int32_t, std::int32_t> next;
-    std::int32_t start = -1;
-    for (auto key : edges) {
-      const auto a = std::int32_t(key >> 32), b = std::int32_t(key & 0xffffffffu);
-      if (edges.count(directedKey(b, a))) continue;
-      if (sideOf(a) != 0 || sideOf(b) != 0 || !next.emplace(a, b).second) ok = false;
-      if (start < 0 || a < start) start = a;
-    }
-    std::vector<std::int32_t> loop;
-    for (std::int32_t v = start; ok && v >= 0;) {
-      loop.push_back(v);
-      const auto it = next.find(v);
-      if (it == next.end()) ok = false;
-      else v = it->second == start ? -1 : it->second;
-      if (loop.size() > next.size()) ok = false;
-    }
-    if (!ok || loop.size() < 3 || loop.size() != next.size()) {
+    ClippedEnd clipped = clipProlongation(st, reg, cut);
+    const std::vector<std::int32_t> loop = traceLoop(st, clipped, boundary_side);
+    if (loop.empty()) {
       leaveClosed();
       continue;
     }
-    // The cap: a fan from the plane's centre when the loop is star-shaped around it (seen along
-    // the outward normal), else the loop's ears.
     std::vector<std::array<std::int32_t, 3>> cap;
     double area = 0;
-    if (caps && !end.open) {
-      const auto centre = base + std::int32_t(new_vertices.size());
-      bool star = true;
-      for (std::size_t i = 0; i < loop.size(); ++i) {
-        const auto a = loop[i], b = loop[(i + 1) % loop.size()];
-        const double twice = dot(cross(at_of(a) - end.centre, at_of(b) - end.centre), reg.n);
-        star = star && twice < 0;  // the wall runs a → b; the cap runs b → a around the normal
-      }
-      if (star) {
-        for (std::size_t i = 0; i < loop.size(); ++i) cap.push_back({loop[(i + 1) % loop.size()], loop[i], centre});
-        float step = INFINITY;
-        for (auto v : loop) step = std::min(step, v >= base ? new_steps[std::size_t(v - base)] : m.vertex_step.empty() ? 0.f : m.vertex_step[std::size_t(v)]);
-        new_vertices.push_back(end.centre);
-        new_steps.push_back(step);
-      } else {
-        std::vector<Vec3> polygon;
-        for (std::size_t i = loop.size(); i-- > 0;) polygon.push_back(at_of(loop[i]));
-        const Vec3 u = unit(std::abs(reg.n.x) < 0.9 ? cross(reg.n, Vec3(1, 0, 0)) : cross(reg.n, Vec3(0, 1, 0))), w = cross(reg.n, u);
-        const auto ears = earClip(polygon, u, w);
-        if (ears.empty()) {
-          leaveClosed();
-          continue;
-        }
-        const auto vertexOf = [&](int i) { return loop[loop.size() - 1 - std::size_t(i)]; };
-        for (const auto& ear : ears) cap.push_back({vertexOf(ear[0]), vertexOf(ear[1]), vertexOf(ear[2])});
-      }
-      for (const auto& tri : cap) area += 0.5 * norm(cross(at_of(tri[1]) - at_of(tri[0]), at_of(tri[2]) - at_of(tri[0])));
+    if (caps && !end.open && !capLoop(m, clipped, loop, end, reg, cap, area)) {
+      leaveClosed();
+      continue;
     }
     // Commit.
-    for (auto k : cut) removed[std::size_t(k)] = 1;
-    m.vertices.insert(m.vertices.end(), new_vertices.begin(), new_vertices.end());
-    if (!m.vertex_step.empty()) m.vertex_step.insert(m.vertex_step.end(), new_steps.begin(), new_steps.end());
-    for (std::size_t i = 0; i < kept.size(); ++i) {
-      m.triangles.push_back(kept[i]);
-      m.triangle_tree.push_back(kept_tree[i]);
+    for (auto k : cut) st.removed[std::size_t(k)] = 1;
+    m.vertices.insert(m.vertices.end(), clipped.new_vertices.begin(), clipped.new_vertices.end());
+    if (!m.vertex_step.empty()) m.vertex_step.insert(m.vertex_step.end(), clipped.new_steps.begin(), clipped.new_steps.end());
+    for (std::size_t i = 0; i < clipped.kept.size(); ++i) {
+      m.triangles.push_back(clipped.kept[i]);
+      m.triangle_tree.push_back(clipped.kept_tree[i]);
       m.triangle_face.push_back(0);
-      removed.push_back(0);
+      st.removed.push_back(0);
     }
     for (const auto& tri : cap) {
       m.triangles.push_back(tri);
       m.triangle_tree.push_back(end.tree);
       m.triangle_face.push_back(std::int32_t(e) + 1);
-      removed.push_back(0);
+      st.removed.push_back(0);
     }
     ++rep.cut;
     rep.cap_area_mm2[e] = area;
@@ -367,8 +412,8 @@ EndCutReport cutEnds(SurfaceMesh& m, const std::vector<VesselEnd>& ends, bool ca
   }
 
   // Drop the prolongations and the vertices only they used; the others keep their order.
-  for (auto& r : removed) r = !r;
-  keepTriangles(m, removed);
+  for (auto& r : st.removed) r = !r;
+  keepTriangles(m, st.removed);
   return rep;
 }
 
