@@ -99,16 +99,21 @@ bool collapseShortLoopEdges(const SurfaceMesh& m, std::vector<std::array<std::in
 }
 
 // Keeps the part of m where sigma·(x_axis − c) ≤ 0 and fills the section in the plane.
-void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std::int32_t face, BoxClipReport& rep, int side) {
-  const std::size_t nv0 = m.vertices.size();
-  std::vector<double> s(nv0);
-  for (std::size_t v = 0; v < nv0; ++v) {
+// Each vertex's signed distance to the side's plane (positive outside the box); vertices within
+// `snap` of it go onto it, exactly.
+std::vector<double> signedSides(SurfaceMesh& m, int axis, double c, double sigma, double snap) {
+  std::vector<double> s(m.vertices.size());
+  for (std::size_t v = 0; v < m.vertices.size(); ++v) {
     s[v] = sigma * (coord(m.vertices[v], axis) - c);
     if (std::abs(s[v]) < snap) {  // onto the plane, exactly
       setCoord(m.vertices[v], axis, c);
       s[v] = 0;
     }
   }
+  return s;
+}
+
+void moveSliverEndsOntoPlane(SurfaceMesh& m, std::vector<double>& s, int axis, double c) {
   // A cut within kSliver of an edge's end moves that end along the edge onto the plane instead
   // (it stays on the surface): a sliver there would turn over when a format rounds it to single
   // precision (STL). A move that would turn one of the vertex's triangles by more than 60° or
@@ -161,6 +166,20 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
       if (t < kSliver) moveOnto(a, p);
       else if (t > 1 - kSliver) moveOnto(b, p);
     }
+}
+
+// The wall clipped to the inside of the side: the triangles kept (cut ones as their inside
+// pieces, cut points shared through their edge) with their trees and faces.
+struct ClippedWall {
+  std::vector<std::array<std::int32_t, 3>> tris;
+  std::vector<std::int32_t> tree, faces;
+};
+
+ClippedWall clipWall(SurfaceMesh& m, std::vector<double>& s, int axis, double c, BoxClipReport& rep) {
+  ClippedWall w;
+  auto& tris = w.tris;
+  auto& tree = w.tree;
+  auto& faces = w.faces;
   // Cut points, shared through their edge.
   std::unordered_map<std::uint64_t, std::int32_t> cut_point;
   const auto pointOn = [&](std::int32_t a, std::int32_t b) {
@@ -176,8 +195,6 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
     cut_point.emplace(key, id);
     return id;
   };
-  std::vector<std::array<std::int32_t, 3>> tris;
-  std::vector<std::int32_t> tree, faces;
   tris.reserve(m.triangles.size());
   for (std::size_t k = 0; k < m.triangles.size(); ++k) {
     const auto tri = m.triangles[k];
@@ -200,9 +217,23 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
         [&](std::int32_t v) -> const Vec3& { return m.vertices[std::size_t(v)]; },
         [&](std::int32_t p, std::int32_t q, std::int32_t r) { keep({p, q, r}); });
   }
-  // The cut's loops: directed edges in the plane used once (a closed surface has no others).
+  return w;
+}
+
+// The cut's loops: the directed edges in the plane that the kept wall uses once, with the tree of
+// the triangle each belongs to.
+struct SectionLoops {
   std::unordered_map<std::uint64_t, std::int32_t> edge_tree;
   std::vector<std::pair<std::int32_t, std::int32_t>> loop_edges;
+};
+
+SectionLoops findSectionLoops(SurfaceMesh& m, const std::vector<double>& s, ClippedWall& w) {
+  SectionLoops l;
+  auto& tris = w.tris;
+  auto& tree = w.tree;
+  auto& faces = w.faces;
+  auto& edge_tree = l.edge_tree;
+  auto& loop_edges = l.loop_edges;
   const auto findLoops = [&] {
     edge_tree.clear();
     loop_edges.clear();
@@ -225,11 +256,11 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
     tris.resize(n), tree.resize(n), faces.resize(n);
     findLoops();
   }
-  m.triangles = std::move(tris);
-  m.triangle_tree = std::move(tree);
-  m.triangle_face = std::move(faces);
-  if (loop_edges.empty()) return;
+  return l;
+}
 
+std::vector<std::array<std::int32_t, 3>> triangulateSection(const SurfaceMesh& m, const std::vector<std::pair<std::int32_t, std::int32_t>>& loop_edges,
+                                                           int axis, double sigma, int side) {
   // The section: a constrained Delaunay triangulation of the loops, inside where it lies behind
   // an odd number of loops seen from outside them all.
   const int u = (axis + 1) % 3, w = (axis + 2) % 3;  // e_u × e_w = e_axis
@@ -295,7 +326,12 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
       if (auto it = loop_reverse.find(directedKey(t[std::size_t(i)], t[std::size_t((i + 1) % 3)])); it != loop_reverse.end() && !it->second++) ++matched;
   if (matched != loop_edges.size())
     throw std::runtime_error(std::string("clipping to the box: the section of side ") + kBoxSideNames[side] + " does not close the cut");
-  // Trees: each section triangle takes the tree of a loop edge of its connected patch.
+  return section;
+}
+
+// Each section triangle takes the tree of a loop edge of its connected patch.
+std::vector<std::int32_t> sectionTrees(const std::vector<std::array<std::int32_t, 3>>& section,
+                                       const std::unordered_map<std::uint64_t, std::int32_t>& edge_tree) {
   std::unordered_map<std::uint64_t, std::size_t> at_edge;
   for (std::size_t k = 0; k < section.size(); ++k)
     for (int i = 0; i < 3; ++i) at_edge.emplace(directedKey(section[k][std::size_t(i)], section[k][std::size_t((i + 1) % 3)]), k);
@@ -320,6 +356,39 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
     }
     for (auto k : patch) section_tree[k] = std::max(found, 0);
   }
+  return section_tree;
+}
+
+// The loops: components of the loop edges' graph.
+std::int64_t countLoops(const std::vector<std::pair<std::int32_t, std::int32_t>>& loop_edges) {
+  std::int64_t loops = 0;
+  std::unordered_map<std::int32_t, std::int32_t> next_of;
+  for (const auto& [a, b] : loop_edges) next_of.emplace(a, b);
+  std::unordered_map<std::int32_t, char> seen;
+  for (const auto& [a, b] : loop_edges) {
+    if (seen.count(a)) continue;
+    ++loops;
+    for (std::int32_t v = a; !seen.count(v);) {
+      seen.emplace(v, 1);
+      const auto it = next_of.find(v);
+      if (it == next_of.end()) break;
+      v = it->second;
+    }
+  }
+  return loops;
+}
+
+void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std::int32_t face, BoxClipReport& rep, int side) {
+  std::vector<double> s = signedSides(m, axis, c, sigma, snap);
+  moveSliverEndsOntoPlane(m, s, axis, c);
+  ClippedWall wall = clipWall(m, s, axis, c, rep);
+  const SectionLoops loops = findSectionLoops(m, s, wall);
+  m.triangles = std::move(wall.tris);
+  m.triangle_tree = std::move(wall.tree);
+  m.triangle_face = std::move(wall.faces);
+  if (loops.loop_edges.empty()) return;
+  const auto section = triangulateSection(m, loops.loop_edges, axis, sigma, side);
+  const auto section_tree = sectionTrees(section, loops.edge_tree);
   for (std::size_t k = 0; k < section.size(); ++k) {
     const auto& t = section[k];
     m.triangles.push_back(t);
@@ -328,20 +397,7 @@ void clipSide(SurfaceMesh& m, int axis, double c, double sigma, double snap, std
     rep.section_area_mm2[std::size_t(side)] += triangleArea(m, t);
   }
   rep.section_triangles[std::size_t(side)] = std::int64_t(section.size());
-  // Loops: components of the loop edges' graph.
-  std::unordered_map<std::int32_t, std::int32_t> next_of;
-  for (const auto& [a, b] : loop_edges) next_of.emplace(a, b);
-  std::unordered_map<std::int32_t, char> seen;
-  for (const auto& [a, b] : loop_edges) {
-    if (seen.count(a)) continue;
-    ++rep.section_loops[std::size_t(side)];
-    for (std::int32_t v = a; !seen.count(v);) {
-      seen.emplace(v, 1);
-      const auto it = next_of.find(v);
-      if (it == next_of.end()) break;
-      v = it->second;
-    }
-  }
+  rep.section_loops[std::size_t(side)] += countLoops(loops.loop_edges);
 }
 
 }  // namespace
