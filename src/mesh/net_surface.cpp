@@ -66,67 +66,29 @@ struct NetCell {
 
 }  // namespace
 
-std::optional<SurfaceMesh> netSurface(const VascularTree& t, const SurfaceOptions& o, SurfaceReport* report, NetReport* net) {
-  const auto refuse = [&](const char* why) -> std::optional<SurfaceMesh> {
-    if (net) net->refused = why;
-    return std::nullopt;
-  };
-  if (net) *net = NetReport();
-  for (auto c : o.vessel_max_cell_mm)
-    if (c > 0) return refuse("gaps to resolve");
-  std::vector<std::int32_t> vessels;
-  double r_min = INFINITY, r_max = 0;
-  for (std::int32_t s = 0; s < t.nodeCount(); ++s) {
-    if (t.isRoot(s) || t.isLink(s)) continue;
-    if (!t.tree.empty() && t.tree[s] != t.tree[vessels.empty() ? s : vessels.front()]) return refuse("several trees");
-    vessels.push_back(s);
-    r_min = std::min({r_min, t.radius[s], t.startRadius(s)});
-    r_max = std::max(r_max, t.maxRadius(s));
-  }
-  if (vessels.empty()) return SurfaceMesh();
-  if (vessels.size() > kNetMaxVessels) return refuse("too many vessels");
-  if (!(r_min > 0)) return refuse("a vessel of radius 0");
-  // vesselSurface's finest step and the fillet of its cells there.
-  const int across = std::max(1, o.samples_across);
-  double h = o.voxel_mm > 0 ? o.voxel_mm : 2 * r_min / across;
-  if (o.max_cell_mm > 0 && !(o.voxel_mm > 0)) h = std::min(h, o.max_cell_mm);
-  // One step for all: thick vessels get more triangles than marching tetrahedra give them at
-  // their own coarser level; nets only where that costs less in all (per area: kNetTriangles per
-  // step², marching tetrahedra kTetTriangles per step² of each vessel's level).
-  double net_cost = 0, tet_cost = 0;
-  for (auto s : vessels) {
-    const double r = std::min(t.radius[s], t.startRadius(s)), area = 2 * std::numbers::pi * t.maxRadius(s) * (t.length[s] + 2 * r);
-    double c = 2 * r / across;
-    if (o.max_cell_mm > 0) c = std::min(c, o.max_cell_mm);
-    const int level = c >= 2 * h ? int(std::floor(std::log2(c / h) + 1e-9)) : 0;
-    net_cost += kNetTriangles * area;
-    tet_cost += kTetTriangles * area / double(std::int64_t(1) << (2 * std::min(level, 20)));
-  }
-  if (net_cost > tet_cost) {
-    if (net) net->costlier = true;
-    return refuse("marching tetrahedra make fewer triangles");
-  }
-  std::vector<Solid> solids;
-  Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
-  for (auto s : vessels) {
-    solids.emplace_back(capsuleOf(t, s), kFillet * h);
-    const double r = t.maxRadius(s);
-    for (const Vec3& p : {t.position[t.parent[s]], t.position[s]})
-      lo = componentMin(lo, p - Vec3(r, r, r)), hi = componentMax(hi, p + Vec3(r, r, r));
-  }
-  // Two steps of room (and the fillet's stand-off) keep the surface off the grid's border.
-  const double room = 2 * h + kFillet * h;
-  const Vec3 origin = lo - Vec3(room, room, room);
-  std::int64_t n[3];
-  for (int a = 0; a < 3; ++a) n[a] = std::int64_t(std::ceil((hi[a] - lo[a] + 2 * room) / h)) + 1;
-  if (n[0] * n[1] * n[2] > kNetMaxPoints) return refuse("grid too large");
-  const auto index = [&](std::int64_t x, std::int64_t y, std::int64_t z) { return x + n[0] * (y + n[1] * z); };
-  const auto point = [&](std::int64_t x, std::int64_t y, std::int64_t z) { return origin + Vec3(double(x), double(y), double(z)) * h; };
+namespace {
+
+// The signed distance at the lattice points near the solids (within two steps of their boxes:
+// every corner of a cell the surface passes through); further out the points are outside, far.
+struct NetGrid {
+  Vec3 origin;
+  double h = 0;
+  std::int64_t n[3] = {0, 0, 0};
+  std::vector<double> f;
+  std::int64_t index(std::int64_t x, std::int64_t y, std::int64_t z) const { return x + n[0] * (y + n[1] * z); }
+  Vec3 point(std::int64_t x, std::int64_t y, std::int64_t z) const { return origin + Vec3(double(x), double(y), double(z)) * h; }
+};
+
+void sampleDistance(NetGrid& g, const std::vector<Solid>& solids) {
+  const double h = g.h;
+  const auto& n = g.n;
+  const Vec3& origin = g.origin;
+  const auto index = [&](std::int64_t x, std::int64_t y, std::int64_t z) { return g.index(x, y, z); };
+  const auto point = [&](std::int64_t x, std::int64_t y, std::int64_t z) { return g.point(x, y, z); };
   const auto distance = [&](const Vec3& p) { return unionDistance(solids, p); };
-  // The distance near the solids (within two steps of their boxes: every corner of a cell the
-  // surface passes through); further out the points are outside, far.
+  auto& f = g.f;
   constexpr double kFar = 1e30;
-  std::vector<double> f(std::size_t(n[0] * n[1] * n[2]), kFar);
+  f.assign(std::size_t(n[0] * n[1] * n[2]), kFar);
   std::vector<char> near(f.size(), 0);
   for (const auto& sol : solids) {
     std::int64_t b0[3], b1[3];
@@ -148,12 +110,19 @@ std::optional<SurfaceMesh> netSurface(const VascularTree& t, const SurfaceOption
     if (v == 0) v = std::numeric_limits<double>::min();  // on the surface counts as outside
     f[i] = v;
   }
-  if (report) report->voxel_mm = h, report->coarsest_mm = h, report->levels = 1, report->estimated_bytes = double(f.size()) * 12;
+}
 
-  // Cells: the sheets of each crossed cell, one vertex each.
-  SurfaceMesh mesh;
+// The sheets of each crossed cell, one vertex each (the mean of its crossings taken onto the
+// surface), into `mesh`; `cell_of` numbers the crossed cells.
+std::vector<NetCell> netCells(const NetGrid& g, const std::vector<Solid>& solids, SurfaceMesh& mesh, std::vector<std::int32_t>& cell_of) {
+  const double h = g.h;
+  const auto& n = g.n;
+  const auto& f = g.f;
+  const auto index = [&](std::int64_t x, std::int64_t y, std::int64_t z) { return g.index(x, y, z); };
+  const auto point = [&](std::int64_t x, std::int64_t y, std::int64_t z) { return g.point(x, y, z); };
+  const auto distance = [&](const Vec3& p) { return unionDistance(solids, p); };
   const std::int64_t cx = n[0] - 1, cy = n[1] - 1, cz = n[2] - 1;
-  std::vector<std::int32_t> cell_of(std::size_t(cx * cy * cz), -1);
+  cell_of.assign(std::size_t(cx * cy * cz), -1);
   std::vector<NetCell> cells;
   const double margin = 1e-3 * h;
   for (std::int64_t z = 0; z < cz; ++z)
@@ -219,9 +188,16 @@ std::optional<SurfaceMesh> netSurface(const VascularTree& t, const SurfaceOption
         cell_of[std::size_t(x + cx * (y + cy * z))] = std::int32_t(cells.size());
         cells.push_back(cell);
       }
+  return cells;
+}
 
-  // A quadrilateral around each crossed edge, from the four cells around it (counter-clockwise
-  // seen from the outside).
+// A quadrilateral around each crossed edge, from the four cells around it (counter-clockwise
+// seen from the outside).
+void connectQuads(const NetGrid& g, const std::vector<NetCell>& cells, const std::vector<std::int32_t>& cell_of, SurfaceMesh& mesh) {
+  const auto& n = g.n;
+  const auto& f = g.f;
+  const auto index = [&](std::int64_t x, std::int64_t y, std::int64_t z) { return g.index(x, y, z); };
+  const std::int64_t cx = n[0] - 1, cy = n[1] - 1, cz = n[2] - 1;
   for (std::int64_t z = 1; z < cz; ++z)
     for (std::int64_t y = 1; y < cy; ++y)
       for (std::int64_t x = 1; x < cx; ++x) {
@@ -247,6 +223,78 @@ std::optional<SurfaceMesh> netSurface(const VascularTree& t, const SurfaceOption
           appendQuad(mesh, quad);
         }
       }
+}
+
+}  // namespace
+
+std::optional<SurfaceMesh> netSurface(const VascularTree& t, const SurfaceOptions& o, SurfaceReport* report, NetReport* net) {
+  const auto refuse = [&](const char* why) -> std::optional<SurfaceMesh> {
+    if (net) net->refused = why;
+    return std::nullopt;
+  };
+  if (net) *net = NetReport();
+  for (auto c : o.vessel_max_cell_mm)
+    if (c > 0) return refuse("gaps to resolve");
+  std::vector<std::int32_t> vessels;
+  double r_min = INFINITY, r_max = 0;
+  for (std::int32_t s = 0; s < t.nodeCount(); ++s) {
+    if (t.isRoot(s) || t.isLink(s)) continue;
+    if (!t.tree.empty() && t.tree[s] != t.tree[vessels.empty() ? s : vessels.front()]) return refuse("several trees");
+    vessels.push_back(s);
+    r_min = std::min({r_min, t.radius[s], t.startRadius(s)});
+    r_max = std::max(r_max, t.maxRadius(s));
+  }
+  if (vessels.empty()) return SurfaceMesh();
+  if (vessels.size() > kNetMaxVessels) return refuse("too many vessels");
+  if (!(r_min > 0)) return refuse("a vessel of radius 0");
+  // vesselSurface's finest step and the fillet of its cells there.
+  const int across = std::max(1, o.samples_across);
+  double h = o.voxel_mm > 0 ? o.voxel_mm : 2 * r_min / across;
+  if (o.max_cell_mm > 0 && !(o.voxel_mm > 0)) h = std::min(h, o.max_cell_mm);
+  // One step for all: thick vessels get more triangles than marching tetrahedra give them at
+  // their own coarser level; nets only where that costs less in all (per area: kNetTriangles per
+  // step², marching tetrahedra kTetTriangles per step² of each vessel's level).
+  double net_cost = 0, tet_cost = 0;
+  for (auto s : vessels) {
+    const double r = std::min(t.radius[s], t.startRadius(s)), area = 2 * std::numbers::pi * t.maxRadius(s) * (t.length[s] + 2 * r);
+    double c = 2 * r / across;
+    if (o.max_cell_mm > 0) c = std::min(c, o.max_cell_mm);
+    const int level = c >= 2 * h ? int(std::floor(std::log2(c / h) + 1e-9)) : 0;
+    net_cost += kNetTriangles * area;
+    tet_cost += kTetTriangles * area / double(std::int64_t(1) << (2 * std::min(level, 20)));
+  }
+  if (net_cost > tet_cost) {
+    if (net) net->costlier = true;
+    return refuse("marching tetrahedra make fewer triangles");
+  }
+  std::vector<Solid> solids;
+  Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
+  for (auto s : vessels) {
+    solids.emplace_back(capsuleOf(t, s), kFillet * h);
+    const double r = t.maxRadius(s);
+    for (const Vec3& p : {t.position[t.parent[s]], t.position[s]})
+      lo = componentMin(lo, p - Vec3(r, r, r)), hi = componentMax(hi, p + Vec3(r, r, r));
+  }
+  // Two steps of room (and the fillet's stand-off) keep the surface off the grid's border.
+  const double room = 2 * h + kFillet * h;
+  const Vec3 origin = lo - Vec3(room, room, room);
+  std::int64_t n[3];
+  for (int a = 0; a < 3; ++a) n[a] = std::int64_t(std::ceil((hi[a] - lo[a] + 2 * room) / h)) + 1;
+  if (n[0] * n[1] * n[2] > kNetMaxPoints) return refuse("grid too large");
+  const auto distance = [&](const Vec3& p) { return unionDistance(solids, p); };
+  NetGrid g;
+  g.origin = origin;
+  g.h = h;
+  std::copy(n, n + 3, g.n);
+  sampleDistance(g, solids);
+  const auto& f = g.f;
+  if (report) report->voxel_mm = h, report->coarsest_mm = h, report->levels = 1, report->estimated_bytes = double(f.size()) * 12;
+
+  SurfaceMesh mesh;
+  std::vector<std::int32_t> cell_of;
+  const std::vector<NetCell> cells = netCells(g, solids, mesh, cell_of);
+
+  connectQuads(g, cells, cell_of, mesh);
   mesh.triangle_tree.assign(mesh.triangles.size(), t.tree.empty() ? 0 : t.tree[vessels.front()]);
   if (report) report->cells = std::int64_t(cells.size()), report->units = 1;
 
