@@ -1,4 +1,4 @@
-// CCO growth time and memory for N terminals in the seed 000 §5 sphere (or the 2D disc):
+// CCO growth time and memory for N terminals in the Kerautret et al. (OpenCCO) §5 sphere (or the 2D disc):
 //   bench_cco [N ...] [--disc] [--threads T] [--max-nu M] [--seed S]
 // One line per N: seconds, µs per terminal, µs per terminal / log2 N, peak RSS, checks.
 #include <tbb/global_control.h>

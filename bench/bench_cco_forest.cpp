@@ -1,5 +1,5 @@
-// CCO forests: the two benchmarks of issue 11.
-//   bench_cco_forest split [seeds]   two equiradial inlets on opposite sides of a disc (seed 001
+// CCO forests: two benchmarks.
+//   bench_cco_forest split [seeds]   two equiradial inlets on opposite sides of a disc (Maso Talou et al. 2021
 //                                     Fig. 3, volume cost), 1000 terminals: the flow share of each
 //                                     inlet per seed, its mean and spread
 //   bench_cco_forest av [N] [seeds]  an artery and a vein, N terminals each (default 4000), in the

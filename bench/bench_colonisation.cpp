@@ -1,7 +1,7 @@
-// Space colonisation growth time (seed 003): the forest of each parameter file, grown 5 times,
+// Space colonisation growth time (Rauch & Harders 2021): the forest of each parameter file, grown 5 times,
 // the fastest run reported with the node counts per kind (seed: the file's, else 1):
 //   bench_colonisation FILE.toml ... [--threads T]
-// Targets (issue 13): examples/colonisation_fig5_2d.toml ≤ 15 ms, 40k nodes ≤ 0.8 s, the
+// Targets: examples/colonisation_fig5_2d.toml ≤ 15 ms, 40k nodes ≤ 0.8 s, the
 // retina-like example ≤ 0.5 s.
 #include <cstdio>
 #include <map>

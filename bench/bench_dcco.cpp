@@ -1,4 +1,4 @@
-// DCCO growth time and memory (seed 001): one volume-cost stage with Pries' viscosity, θ ≥ 20°
+// DCCO growth time and memory (Maso Talou et al. 2021): one volume-cost stage with Pries' viscosity, θ ≥ 20°
 // and Δv = 7 in a 1 cm sphere fed by a 0.5 mm artery (examples/dcco_sphere_pries_3d.toml):
 //   bench_dcco [N ...] [--threads T]
 // One line per N: seconds, µs per terminal, peak RSS, final checks; then the time exponent

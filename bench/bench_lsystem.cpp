@@ -1,4 +1,4 @@
-// L-system grammar mode (issue 14): growth of each parameter file (best of 5, the final overlap
+// L-system grammar mode: growth of each parameter file (best of 5, the final overlap
 // count apart), then the tree rasterised with every channel into a 512 × 512 × 140 grid over its
 // bounding box (V-System's voxelisation), best of 3:
 //   bench_lsystem FILE.toml ... [--threads T] [--supersampling S]

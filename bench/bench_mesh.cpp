@@ -1,4 +1,4 @@
-// Surface meshing (issue 15): the forest of each parameter file grown once, then its closed
+// Surface meshing: the forest of each parameter file grown once, then its closed
 // surface (src/mesh): tubes joined to contoured junctions (--tubes 1, the default; --samples N
 // across each vessel where vessels meet, default 3) or contoured whole (--tubes 0; 4 samples
 // across), optionally decimated (--decimate 1) or with the contour's slivers repaired
@@ -9,7 +9,7 @@
 //   bench_mesh FILE.toml ... [--tubes 0|1] [--samples N] [--decimate 0|1] [--slivers DEG] [--max-angle DEG] [--nets 0|1] [--ring-spacing R]
 //              [--remesh 0|1] [--voxel MM] [--threads T]
 // Prints the step, the time, triangles in all and per segment, and the peak memory.
-// Targets (issue 15): 10k segments ≤ 10 s, ≤ 4 GB, ≤ 500 triangles per segment; 100k ≤ 2 min.
+// Targets: 10k segments ≤ 10 s, ≤ 4 GB, ≤ 500 triangles per segment; 100k ≤ 2 min.
 #include <cstdio>
 
 #include "bench_files.hpp"

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""CCO trees in OpenCCO's own set-up, to compare with OpenCCO's (issue 19).
+"""CCO trees in OpenCCO's own set-up, to compare with OpenCCO's.
 
 A 20,000 mm^3 ball, OpenCCO's constants (13300 Pa, 7980 Pa beyond 250 terminals, 8330 mm^3/s,
 3.6 mPa*s), seeds 1..S. Prints the total volume sum(pi r^2 l) (mean, sd, each seed), the

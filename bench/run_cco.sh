@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# CCO growth in the seed 000 §5 sphere (100 cm³, 500 mL/min) for N = 1k … 50k terminals, and the
+# CCO growth in the Kerautret et al. (OpenCCO) §5 sphere (100 cm³, 500 mL/min) for N = 1k … 50k terminals, and the
 # 2D disc: seconds, µs per terminal, and µs per terminal / log2 N (flat = O(N log N) overall).
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Time of `angiosynth score` on one 256³ case (issue 16: every metric <= 3 s on 2 cores): the
+# Time of `angiosynth score` on one 256³ case (target: every metric within 3 s on 2 cores): the
 # 4000-terminal CCO sphere imaged on 256³ voxels, scored with its clean image (every voxel with
 # some partial volume) as the prediction.
 #   bash bench/run_score.sh [WORK_DIR]          (SCORE_DATASET=1: also the 200-case dataset)
@@ -16,7 +16,7 @@ for i in 1 2 3; do
     --out "$work/scores_$i.json" --force --quiet
 done
 
-# A 200-case 128³ dataset (bench/dataset_200_128.toml, cta) scored with every metric (issue 16:
+# A 200-case 128³ dataset (bench/dataset_200_128.toml, cta) scored with every metric (target:
 # <= 2 min on 2 cores), its degraded images thresholded at 150 HU as the predictions.
 if [ -n "${SCORE_DATASET:-}" ]; then
   build/angiosynth dataset bench/dataset_200_128.toml --out "$work/ds" --quiet

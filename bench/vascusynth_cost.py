@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""VascuSynth mode against VascuSynth's own cost (issue 19).
+"""VascuSynth mode against VascuSynth's own cost.
 
 Grows examples/vascusynth_like.toml (VascuSynth's 100^3 rods example, 1000 terminals) for seeds
 1..S with the given extra [tree] keys and prints the cost sum(l r^2) in mm^3 (VascuSynth reaches

@@ -7,4 +7,4 @@ PROGRAM_ONLY=1 bash scripts/build.sh angiosynth  # the program alone (and its Op
 build/angiosynth generate examples/vascusynth_like.toml --out out/vascusynth_like --force
 echo "wrote out/vascusynth_like/: sample.json, graphs (GXL, DOT, CSV, VTP, SWC, GraphML), image and label volumes, image_vascusynth and image_cta"
 build/angiosynth generate examples/cco_sphere_3d.toml --out out/cco_sphere_3d --force
-echo "wrote out/cco_sphere_3d/: a 4000-terminal CCO tree (seed 000 §5) with its graphs and volumes"
+echo "wrote out/cco_sphere_3d/: a 4000-terminal CCO tree (Kerautret et al. (OpenCCO) §5) with its graphs and volumes"

@@ -1,5 +1,5 @@
-// Every input kind refuses values that used to overflow, hang or allocate without an estimate
-// (issue 17): exit 2, `file:line: what is wrong, what is allowed`, and no output written.
+// Every input kind refuses values that used to overflow, hang or allocate without an estimate:
+// exit 2, `file:line: what is wrong, what is allowed`, and no output written.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -70,11 +70,11 @@ const BadCase kCases[] = {
     // Space colonisation.
 #define COLONISATION "[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"colonisation\"\n"
     {"colonisation_kappa_4_5", "p.toml", "", "", COLONISATION "[physics]\nmurray_exponent = 4.5\n",
-     "generate p.toml --out out", "p.toml:8: murray_exponent (κ of seed 003) = 4.5 is out of range; allowed: (2, 4)"},
+     "generate p.toml --out out", "p.toml:8: murray_exponent (κ of Rauch & Harders 2021) = 4.5 is out of range; allowed: (2, 4)"},
     {"colonisation_no_vein_root", "p.toml", "", "", COLONISATION "[[tree.inlet]]\nkind = \"artery\"\nroot_offset = [0, 9]\n",
      "generate p.toml --out out", "p.toml:7: no vein root: add a [[tree.inlet]] with kind = \"vein\", or set [tree] veins = false"},
 #undef COLONISATION
-    // L-system (seed 004): blocks the inverse problem cannot fill.
+    // L-system (Lázaro 2011): blocks the inverse problem cannot fill.
 #define LZH "[domain]\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"lsystem\"\nblock_width = \"10 mm\"\nstart_length = \"3 mm\"\n" \
             "capillary_length = \"2 mm\"\nstart_diameter = \"1 mm\"\ncapillary_diameter = \"0.2 mm\"\ncapillary_spacing = \"1.2 mm\"\n"
     {"lzh_block_too_low", "p.toml", "", "", LZH "block_height = \"7 mm\"\n", "generate p.toml --out out",

@@ -1,4 +1,4 @@
-// Faithful CCO (seed 000): Kamiya's bifurcation, domains, and the invariants of real grown trees
+// Faithful CCO (Kerautret et al. (OpenCCO)): Kamiya's bifurcation, domains, and the invariants of real grown trees
 // in 3D, 2D and a non-convex mask.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -162,7 +162,7 @@ TEST(Cco, SphereTreeMeetsEveryConstraintAndHemodynamicInvariant) {
   test::expectHemodynamicInvariants(t, p, 4000);
   test::expectGeometry(t, d);
   EXPECT_EQ(rep.intersecting_pairs, 0);
-  // Mean radius falls with the bifurcation level over the first levels (seed 000 Fig. 6–7),
+  // Mean radius falls with the bifurcation level over the first levels (Kerautret et al. (OpenCCO) Fig. 6–7),
   // from a root of about a millimetre (Karch 1999: 1.3–1.5 mm) to terminals under 0.15 mm.
   // Volume-optimal bifurcations carry trunks deep, with side branches off them, so beyond
   // level 8 the means level off (within 10 % of each other) instead of falling further.

@@ -84,7 +84,7 @@ TEST_F(Cli, GenerateWritesValidRoundTrippingGxlAndSidecar) {
   EXPECT_NEAR(volume, j["statistics"]["total_volume"]["value"].get<double>(), 1e-12 * volume);
 }
 
-// --no-image drops the volumes, not the graph formats the file asks for (issue 18).
+// --no-image drops the volumes, not the graph formats the file asks for.
 TEST_F(Cli, NoImageStillWritesEveryGraphFormat) {
   const auto r = run("generate " + (src_ / "examples/cco_disc_2d.toml").string() + " --out g --no-image --quiet", dir_);
   ASSERT_EQ(r.code, 0) << r.err;

@@ -1,4 +1,4 @@
-// Space colonisation (seed 003) on real grown forests: Murray's angles and law, edge lengths
+// Space colonisation (Rauch & Harders 2021) on real grown forests: Murray's angles and law, edge lengths
 // per step, radii toward the leaves, the domain kept (analytic and mask, with its avascular
 // zone), arteries and veins grown together, the same forest on any thread count, bad input.
 #include <gtest/gtest.h>
@@ -152,7 +152,7 @@ TEST(Colonisation, Fig5ForestKeepsMurraysLawStepLengthsAndTheDisc) {
   const auto arteries = nodesOfKind(g.forest, "artery"), veins = nodesOfKind(g.forest, "vein");
   EXPECT_GT(arteries, 2000);
   EXPECT_GE(veins, arteries / 2) << "arteries " << arteries << ", veins " << veins;
-  EXPECT_GT(nodes, 5000);  // seed 003 reports about 6500 for this set-up
+  EXPECT_GT(nodes, 5000);  // Rauch & Harders 2021 reports about 6500 for this set-up
 }
 
 TEST(Colonisation, OrganVeinsGrowWithTheArteries) {

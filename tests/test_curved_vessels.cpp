@@ -1,4 +1,4 @@
-// Curved vessels (issue 14): a grown CCO tree made curved keeps its ends, reaches the asked
+// Curved vessels: a grown CCO tree made curved keeps its ends, reaches the asked
 // tortuosity, stays in its sphere and off the other vessels, conserves flow with Poiseuille
 // pressures along the longer paths, does not depend on the thread count, and rasterises to the
 // curves' volume.

@@ -1,4 +1,4 @@
-// DCCO (seed 001): the bifurcation lattice, Pries' viscosity, the angle formulas, and the
+// DCCO (Maso Talou et al. 2021): the bifurcation lattice, Pries' viscosity, the angle formulas, and the
 // invariants of every shipped dcco example's tree (Murray, flow, pressure, stages, δ, θ, roles,
 // no overlapping vessels), terminal density against the pdf, and determinism across threads.
 #include <gtest/gtest.h>
@@ -119,7 +119,7 @@ TEST(DccoDomains, OneSliceMaskDepthIsTheDiscsDistanceNotCappedNearTheBorder) {
   EXPECT_GT(deepest, 9.5);
 }
 
-// Every shipped dcco example: the invariants of seed 001 §1.4 on its grown tree.
+// Every shipped dcco example: the invariants of Maso Talou et al. 2021 §1.4 on its grown tree.
 class DccoExample : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(DccoExample, TreeMeetsEveryConstraintOfItsStages) {
@@ -432,7 +432,7 @@ double p_min_of(const VascularTree& v) {
 
 }  // namespace
 
-// Growth from an existing network with a prescribed outflow (seed 001 Fig. 5): the given vessels
+// Growth from an existing network with a prescribed outflow (Maso Talou et al. 2021 Fig. 5): the given vessels
 // keep their geometry, the outlet carries f·Q and the domain's terminals share the rest, Murray,
 // flow and pressure hold everywhere, and re-solving the same tree for another outflow scales
 // every radius of the domain's tree by (R_old/R_new)^(1/4), R the domain tree's resistance.
@@ -626,7 +626,7 @@ TEST(DccoInitial, CcoReadWriteReadRoundTripIsExact) {
   EXPECT_DOUBLE_EQ(first.root_radius, 0.15);
 }
 
-// Two inlets from one feeding vessel (seed 001 Fig. 3, 2D): 25 sprouting terminals then 975 by
+// Two inlets from one feeding vessel (Maso Talou et al. 2021 Fig. 3, 2D): 25 sprouting terminals then 975 by
 // volume keep the equiradial inlets balanced; the volume cost alone lets one inlet take most.
 TEST(DccoInitial, SproutingKeepsTwoInletsBalancedAndVolumeAloneDoesNot) {
   const auto share = [](const Forest& f) {

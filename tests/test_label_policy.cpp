@@ -1,4 +1,4 @@
-// Label policies (issue 18): each policy's rule voxel by voxel on hand-made volumes, the length
+// Label policies: each policy's rule voxel by voxel on hand-made volumes, the length
 // kept by calibre, the visible policy against an independent derivation on a grown tree (nibabel),
 // and datasets whose labelsTr follow the policy (nnU-Net's ignore label declared).
 #include <gtest/gtest.h>

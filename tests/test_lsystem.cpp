@@ -1,4 +1,4 @@
-// Method lsystem, mode lzh (seed 004): the inverse problem's geometry on random high-level
+// Method lsystem, mode lzh (Lázaro 2011): the inverse problem's geometry on random high-level
 // parameters, the closed network's flows, tapered vessels in the rasteriser, connectivity.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>

@@ -878,7 +878,7 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
   std::filesystem::remove_all(dir);
 }
 
-// Hollow walls (seed 004): a constant wall of 0.1 mm around the test forest's vessels, every end
+// Hollow walls (Lázaro 2011): a constant wall of 0.1 mm around the test forest's vessels, every end
 // open. The surface is closed, manifold and outward, and each tree's has genus k − 1 for its k
 // open ends (an end whose vessel ends against another stays closed and is not counted); judged
 // on the written file by an independent Monte Carlo of the wall (thickened capsules cut by the

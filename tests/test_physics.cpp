@@ -1,4 +1,4 @@
-// Physics invariants on real generated trees (seed 002 §2, §3.7–3.8), each to 1e-9 relative.
+// Physics invariants on real generated trees (Hamarneh & Jassi 2010 §2, §3.7–3.8), each to 1e-9 relative.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// Safety (issue 17): the program deletes only what it wrote, interrupted runs leave nothing, and
+// Safety: the program deletes only what it wrote, interrupted runs leave nothing, and
 // datasets stay whole under concurrent shards, torn or hostile manifests and edited specs.
 #include <gtest/gtest.h>
 #include <signal.h>

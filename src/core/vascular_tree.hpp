@@ -35,10 +35,10 @@ struct VascularTree {
   std::vector<std::int16_t> stage;
   std::vector<std::uint8_t> role;
   std::vector<std::uint8_t> branching;
-  // Prescribed outflow of terminal segment i as a fraction of its tree's inflow (seed 001's
+  // Prescribed outflow of terminal segment i as a fraction of its tree's inflow (Maso Talou et al.'s
   // outlets to adjacent territories; 0: an ordinary terminal sharing the rest equally).
   std::vector<double> outflow;
-  // Tapered vessels (seed 004: diameter and wall linear along the path): segment i runs from
+  // Tapered vessels (Lázaro 2011: diameter and wall linear along the path): segment i runs from
   // radius_start[i] at its proximal node to radius[i] at its distal node, a cone with spherical
   // caps; −1 (the default) is a cylinder of radius[i]. wall_start/wall: the wall thickness at its
   // two ends (0: none given).

@@ -1,5 +1,5 @@
 #pragma once
-// Per-vessel attributes of staged growth (DCCO, seed 001 §1.1.6 and §1.1.9), as VascularTree
+// Per-vessel attributes of staged growth (DCCO, Maso Talou et al. 2021 §1.1.6 and §1.1.9), as VascularTree
 // stores them (0: not set) and graphs write them.
 #include <cstdint>
 

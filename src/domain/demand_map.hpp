@@ -1,5 +1,5 @@
 #pragma once
-// The oxygen-demand map (seed 002 §3.2) and the supply coefficients (§3.10) on one voxel grid.
+// The oxygen-demand map (Hamarneh & Jassi 2010 §3.2) and the supply coefficients (§3.10) on one voxel grid.
 // Map voxel (i,j,k) covers [i,i+1)×[j,j+1)×[k,k+1) in map-voxel coordinates; position in mm
 // = map-voxel coordinate × voxel_mm, origin at the corner of voxel (0,0,0).
 #include <array>

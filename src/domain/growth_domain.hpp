@@ -1,5 +1,5 @@
 #pragma once
-// The region a CCO tree perfuses (seed 000 §2.1, §3.3): a sphere, cube, disc or square given
+// The region a CCO tree perfuses (Kerautret et al. (OpenCCO) §2.1, §3.3): a sphere, cube, disc or square given
 // analytically, or a voxel mask. Every domain also carries the voxel frame the rest of the
 // pipeline works in (a DemandMap whose demand is the sampling weight, 0 outside), so CCO and
 // VascuSynth growth share one domain model. Disc, square and one-slice masks are 2D: the tree

@@ -1,5 +1,5 @@
 #pragma once
-// Lowers the demand around a newly perfused terminal (seed 002 §3.10, eq. 13) with VascuSynth's
+// Lowers the demand around a newly perfused terminal (Hamarneh & Jassi 2010 §3.10, eq. 13) with VascuSynth's
 // supply law: a voxel at distance d (map voxels) from the terminal is multiplied by
 // 1 if d ≥ c_{K-1} (cut-off), else max(0, 1 − 1/Σ_i c_i dⁱ); d = 0 gives 0.
 #include <cstdint>

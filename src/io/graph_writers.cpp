@@ -34,7 +34,7 @@ std::string stageAttrs(const VascularTree& t, std::int32_t i, bool staged) {
          stringAttr("role", roleName(t.role[i])) + stringAttr("branching", branchingName(t.branching[i]));
 }
 
-// Tapered vessels (seed 004): the radius at the proximal end and the wall at both ends.
+// Tapered vessels (Lázaro 2011): the radius at the proximal end and the wall at both ends.
 std::string taperAttrs(const VascularTree& t, std::int32_t i, bool tapered) {
   if (!tapered) return "";
   return floatAttr("radius_start", t.startRadius(i)) + floatAttr("wall_start", t.wall_start[i]) + floatAttr("wall", t.wall[i]);

@@ -1,5 +1,5 @@
 // TIFF, PNG and JPEG through the format libraries themselves (libtiff, libpng, libjpeg): a general
-// image library would load video, GIS and computer-vision libraries into every run (issue 18).
+// image library would load video, GIS and computer-vision libraries into every run.
 #include <csetjmp>
 #include <cstdarg>
 #include <cstddef>

@@ -1,5 +1,5 @@
 #pragma once
-// Existing vascular networks as files: VItA's .cco trees (seed 001's public code) and SWC, read
+// Existing vascular networks as files: VItA's .cco trees (VItA, the public code of Maso Talou et al. 2021) and SWC, read
 // as the initial tree a growth continues (vascular completion), and .cco written for VItA users.
 #include <filesystem>
 #include <ostream>

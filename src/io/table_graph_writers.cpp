@@ -47,7 +47,7 @@ void writeEdgesCsv(std::ostream& out, const VascularTree& t, const std::vector<T
 
 namespace {
 
-// The cell arrays VItA's VTK writer names (seed 001's public code), with its codes, so scripts
+// The cell arrays VItA's VTK writer names (VItA, the public code of Maso Talou et al. 2021), with its codes, so scripts
 // written for VItA's trees read ours: vesselFunction 0 distribution, 1 perforator, 2 transport;
 // branchingType 0 none, 1 rigid (fixed), 2 deformable (versatile), 3 distal; pressure at the
 // proximal end (Pa here), level from 0 at the root vessel, ID_Vessel our segment id.
@@ -122,7 +122,7 @@ void writeVtp(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
     }
     writeVitaCellArrays(out, t, segments);
   }
-  if (t.hasTapers() || t.hasWalls()) {  // tapered vessels (seed 004): the proximal radius, the wall at both ends
+  if (t.hasTapers() || t.hasWalls()) {  // tapered vessels (Lázaro 2011): the proximal radius, the wall at both ends
     const auto array = [&](const char* name, auto&& value) {
       out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
       for (auto i : segments) out << exactNumber(value(i)) << '\n';

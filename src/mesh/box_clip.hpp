@@ -1,5 +1,5 @@
 #pragma once
-// A closed surface clipped to an axis-aligned box: the block a print is cut to (seed 004
+// A closed surface clipped to an axis-aligned box: the block a print is cut to (Lázaro 2011
 // intersects its hollow vessels with their bounding box to open them). Each side of the box in
 // turn cuts the triangles that cross its plane, drops what lies outside, and fills the section
 // of the solid in that plane: the polygons the cut loops bound, with their holes (a hollow

@@ -1,5 +1,5 @@
 #pragma once
-// Hollow vessels (seed 004: printable vessel walls): the lumen (the vessels' own surface) and
+// Hollow vessels (Lázaro 2011: printable vessel walls): the lumen (the vessels' own surface) and
 // the outer wall (each vessel thickened by its wall), both built by the tube mesher with every
 // end of the tree open in its plane, the lumen turned inside out, and each end's two loops
 // joined by a flat ring. One closed surface per tree bounds the wall; with k open ends it has

@@ -766,7 +766,7 @@ bool removeThreeFans(SurfaceMesh& m, const std::vector<std::int32_t>& crossing, 
 
 // Rounds of untangle() after relax (each a ring wider: the 100k bench tree's largest part, 13,411
 // vessels, kept one knot of 3 crossing triangles until the eighth), and how far off the surface
-// it may leave a vertex (of its step; the issue asks every vertex within half a step).
+// it may leave a vertex (of its step; every vertex stays within half a step).
 constexpr int kUntangleRounds = 8;
 constexpr double kUntangleOffset = 0.4;
 

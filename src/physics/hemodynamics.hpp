@@ -1,6 +1,6 @@
 #pragma once
 // Poiseuille flow in a tree with equal terminal flows, Murray's law with exponent γ, and radii
-// fixed by the root pressure drop (seed 002 §2, §3.7–3.8; Karch 1999). Reduced resistances are
+// fixed by the root pressure drop (Hamarneh & Jassi 2010 §2, §3.7–3.8; Karch 1999). Reduced resistances are
 // stored without the constant 8η/π, i.e. in mm: R̃_i = l_i + [β_a⁴/R̃_a + β_b⁴/R̃_b]⁻¹.
 #include <cmath>
 #include <cstdint>

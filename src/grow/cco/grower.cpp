@@ -572,7 +572,7 @@ class CcoGrower {
             trials[j] = evaluate(g, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
             // The exact point where Kamiya found a valid one, and on the kRefineNearest nearest
             // segments where he found none (merged or l <= 2r: there the exact optimum often
-            // lies inside). Measured on 4000 terminals in seed 000's sphere: refining every
+            // lies inside). Measured on 4000 terminals in Kerautret et al.'s sphere: refining every
             // segment 748.8 mm³ in 1.04 s, these 754.9 mm³ in 0.85 s; Kamiya alone 886.8 mm³ in
             // 0.56 s (with the §3.3.2 spacing).
             // In the plane, not where his point merged into the proximal node and the exact
@@ -693,7 +693,7 @@ class CcoGrower {
         continue;
       }
       const std::int64_t n = systemTerminals(sys);
-      // δ_max (seed 000 eq. 15) for the system's current number of terminals, relaxed by runs of failures.
+      // δ_max (Kerautret et al. (OpenCCO) eq. 15) for the system's current number of terminals, relaxed by runs of failures.
       double delta = std::pow(dom_.measure() / double(n), 1.0 / dom_.dimension());
       for (std::int64_t failures = 1;; ++failures) {
         if (failures > opt_.max_draws)

@@ -1,6 +1,6 @@
 #pragma once
 // Constrained constructive optimisation as Schreiner & Buxbaum 1993 and Karch et al. 1999 define
-// it, following OpenCCO's reading (seed 000 §2–6), without its quadratic costs:
+// it, following OpenCCO's reading (Kerautret et al. (OpenCCO) §2–6), without its quadratic costs:
 // - the domain grows with the tree (§3.3.1): positions live in the final domain and lengths are
 //   scaled by s = (n/N)^(1/d), so radii in final-domain units are r·s^(-3/4);
 // - a terminal is drawn uniformly (or ∝ a demand map) and kept when it lies farther than
@@ -40,12 +40,12 @@ struct CcoOptions {
   double kamiya_tolerance = 1e-6;     // of the bifurcation's step, relative to its three lengths
   int draws_before_relaxing = 100;
   double relaxation = 0.9;
-  // What a drawn terminal keeps δ from: the terminal points (seed 000's Algorithm 2 and
+  // What a drawn terminal keeps δ from: the terminal points (Kerautret et al.'s Algorithm 2 and
   // OpenCCO's code), or every segment (the wording of its §3.3.2), which spreads terminals
   // evenly but forces long connections. Either way it lies outside every vessel.
   bool spacing_from_segments = false;
   // Each connection's bifurcation also from the optimiser of the exact tree volume, started at
-  // Kamiya's fixed point; false: Kamiya's point alone, as seed 000.
+  // Kamiya's fixed point; false: Kamiya's point alone, as in OpenCCO (Kerautret et al.).
   bool exact_bifurcations = true;
   PhysicsParameters physics;          // λ = 2 and μ = 1 (volume) are imposed
   std::uint64_t seed = 1;

@@ -335,7 +335,7 @@ std::unique_ptr<PreparedGrowth> CcoSetup::prepare(std::uint64_t memory_limit) co
 
 const GrowthMethod kCcoMethod{
     "cco",
-    "constrained constructive optimisation (Karch 1999, OpenCCO; seed 000) in a sphere, cube, disc, square or mask: the "
+    "constrained constructive optimisation (Karch 1999; Kerautret et al., OpenCCO) in a sphere, cube, disc, square or mask: the "
     "domain grows with the tree, each terminal joins the one of its nearest segments whose Kamiya bifurcation gives the "
     "least total volume, no vessel leaves the domain or overlaps another",
     // Seed 000 §5 (Karch 1999): 3.6 cP, written in Pa*s, since "3.6 cP" parses one ulp off 3.6e-3.
@@ -348,8 +348,8 @@ const GrowthMethod kCcoMethod{
         {"tree", "kamiya_tolerance", "", "1e-6", "its step, relative to the three lengths, at convergence"},
         {"tree", "draws_before_relaxing", "count", "100", "failed draws before the distance threshold shrinks"},
         {"tree", "relaxation", "", "0.9", "the factor on the distance threshold after such a run"},
-        {"tree", "spacing_from", "terminals/segments", "terminals", "a drawn terminal keeps delta_max from the terminal points (seed 000's Algorithm 2, OpenCCO's code) or from every segment (its §3.3.2 wording; evenly spread terminals, long connections, 10 % more volume); either way it lies outside every vessel"},
-        {"tree", "bifurcation", "exact/kamiya", "exact", "each connection's bifurcation: the lighter of Kamiya's fixed point and the exact minimum of the tree's volume (which slides along l = 2r), or Kamiya's point alone (seed 000)"},
+        {"tree", "spacing_from", "terminals/segments", "terminals", "a drawn terminal keeps delta_max from the terminal points (Kerautret et al.'s Algorithm 2, OpenCCO's code) or from every segment (its §3.3.2 wording; evenly spread terminals, long connections, 10 % more volume); either way it lies outside every vessel"},
+        {"tree", "bifurcation", "exact/kamiya", "exact", "each connection's bifurcation: the lighter of Kamiya's fixed point and the exact minimum of the tree's volume (which slides along l = 2r), or Kamiya's point alone (as in OpenCCO, Kerautret et al.)"},
         {"tree.inlet", "id", "text", "its kind (kind_1, kind_2, ... when several)", "the tree's name in graphs and sample.json"},
         {"tree.inlet", "kind", "text", "artery", "artery, vein or a free name; inlets of one kind compete for its `terminals`, each kind fills the domain"},
         {"tree.inlet", "root_offset", "[x, y(, z)] mm", nullptr, "analytic shapes: the root relative to the centre"},

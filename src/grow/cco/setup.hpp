@@ -1,5 +1,5 @@
 #pragma once
-// Method "cco": constrained constructive optimisation (Karch 1999 / OpenCCO, seed 000) in an
+// Method "cco": constrained constructive optimisation (Karch 1999; Kerautret et al., OpenCCO) in an
 // analytic shape or a mask.
 #include <filesystem>
 #include <memory>

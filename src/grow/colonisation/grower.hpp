@@ -1,5 +1,5 @@
 #pragma once
-// Space colonisation with physiological constraints (Rauch & Harders 2021, seed 003): arterial
+// Space colonisation with physiological constraints (Rauch & Harders 2021): arterial
 // and venous trees grow together towards oxygen drains sampled in the tissue, leaves inside a
 // perception cone (eq. 2), inter-nodes inside the Murray-angle shell of a lateral branch
 // (eq. 3), with inertia ω (eq. 4); a leaf whose drains spread wider than φ splits into two

@@ -388,7 +388,7 @@ std::shared_ptr<const GrowthSetup> readColonisationToml(const TomlReader& r, con
   readRoots(r, m, tree, *s, flat);
   auto& p = s->physics_summary;
   p.murray_exponent = declaredNumber(r, m, ph, "physics", "murray_exponent");
-  checkRange(p.murray_exponent, 2, true, 4, true, r.at(ph, "murray_exponent"), "murray_exponent (κ of seed 003)");
+  checkRange(p.murray_exponent, 2, true, 4, true, r.at(ph, "murray_exponent"), "murray_exponent (κ of Rauch & Harders 2021)");
   o.murray_exponent = p.murray_exponent;
   p.viscosity = declaredQuantity(r, m, ph, "physics", "viscosity", Dimension::Viscosity);
   checkRange(p.viscosity, Limits::kMinViscosity, false, Limits::kMaxViscosity, false, r.at(ph, "viscosity"), "viscosity (Pa*s)");
@@ -491,7 +491,7 @@ std::unique_ptr<PreparedGrowth> ColonisationSetup::prepare(std::uint64_t memory_
 
 const GrowthMethod kColonisationMethod{
     "colonisation",
-    "space colonisation with physiological constraints (Rauch & Harders 2021; seed 003): arterial and venous trees grow "
+    "space colonisation with physiological constraints (Rauch & Harders 2021): arterial and venous trees grow "
     "together toward oxygen drains sampled in the tissue (oxygenated tissue near the arteries and the drains they satisfy become the veins' CO2 sources), leaves "
     "inside a perception cone, inter-nodes in the Murray-angle shell of a lateral branch, symmetric bifurcations at Murray's "
     "angles when the drains spread wider than φ, radii by Murray's law with κ, tissue growth Δσ per step, in stages with "

@@ -1,5 +1,5 @@
 #pragma once
-// Method "colonisation": space colonisation of arterial and venous trees (seed 003) in an
+// Method "colonisation": space colonisation of arterial and venous trees (Rauch & Harders 2021) in an
 // analytic shape or a mask, in stages with their own parameters and regions.
 #include <filesystem>
 #include <map>

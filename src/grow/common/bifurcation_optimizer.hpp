@@ -1,6 +1,6 @@
 #pragma once
 // Places the bifurcation that connects a new terminal t to segment s so that the cost of the
-// whole tree, Σ l^μ r^λ (seed 002 eq. 8), is minimal. The cost of a trial point is exact and
+// whole tree, Σ l^μ r^λ (Hamarneh & Jassi 2010 eq. 8), is minimal. The cost of a trial point is exact and
 // costs O(depth): only the new bifurcation and the ancestors of s change their reduced
 // resistance, radius ratios and subtree cost; everything else is reused from the tree.
 //

@@ -2,7 +2,7 @@
 // Applies a recorded connection (BifurcationOptimizer::record) to the tree, and undoes it. The
 // new bifurcation node splits segment s, the new terminal hangs from it, and the path to the root
 // takes the recorded reduced resistances, radius ratios, cost ratios and terminal counts: the
-// incremental update of CCO (seed 000 §3.1.3), O(depth). `rel` (radius / root radius, ρ) is
+// incremental update of CCO (Kerautret et al. (OpenCCO) §3.1.3), O(depth). `rel` (radius / root radius, ρ) is
 // refreshed along the path and its siblings; deeper descendants keep theirs until refreshRelative.
 #include <cstdint>
 #include <vector>

@@ -127,7 +127,7 @@ struct Bounds {
     }
     return true;
   }
-  // A frame without demand (seed 004's block) bounds by its box alone.
+  // A frame without demand (Lázaro's block) bounds by its box alone.
   bool open(const Vec3& p) const { return frame.demand.empty() ? frame.voxelAt(p) >= 0 : frame.perfusable(p); }
   bool fitsAt(const Vec3& p, const Vec3& q, double r) const {
     if (open(q) && !open(p)) return false;

@@ -46,7 +46,7 @@ KamiyaResult kamiyaBifurcation(const KamiyaProblem& p, int max_iterations, doubl
   const double span = distance(p.x0, p.x1) + distance(p.x1, p.x2) + distance(p.x2, p.x0);
   const double floor_len = 1e-12 * span;
   double r0 = p.r0, r1 = p.r1, r2 = p.r2;
-  Vec3 x = (p.x0 + p.x1) * 0.5;  // seed 000 eq. (8)
+  Vec3 x = (p.x0 + p.x1) * 0.5;  // Kerautret et al. (OpenCCO) eq. (8)
   using Solver = ceres::TinySolver<ceres::TinySolverAutoDiffFunction<KamiyaResidual, 2, 2>>;
   Solver solver;
   solver.options.max_num_iterations = 50;

@@ -1,6 +1,6 @@
 #pragma once
 // Kamiya's bifurcation iteration (Kamiya & Togawa 1972, as used by Karch 1999 and OpenCCO;
-// seed 000 §3.2, eqs. 9–13). Given the parent's proximal end x0, the split segment's distal end
+// Kerautret et al. (OpenCCO) §3.2, eqs. 9–13). Given the parent's proximal end x0, the split segment's distal end
 // x1, the new terminal x2 and the flows f0 = f1 + f2, each step
 //   1. takes the lengths l_i = |x_i − x| and the pressure drops (in units of 8η/π)
 //      Δ_i = f0 l0 / r0⁴ + f_i l_i / r_i⁴ with the radii of the previous step;
@@ -17,7 +17,7 @@ namespace angiosynth {
 struct KamiyaProblem {
   Vec3 x0, x1, x2;
   double f1 = 1, f2 = 1;                // f0 = f1 + f2
-  double r0 = 1, r1 = 1, r2 = 1;        // starting radii (seed 000: all equal, from the current tree)
+  double r0 = 1, r1 = 1, r2 = 1;        // starting radii (Kerautret et al. (OpenCCO): all equal, from the current tree)
   double murray_exponent = 3;
 };
 

@@ -1,5 +1,5 @@
 #pragma once
-// Named regions of a domain (seed 001 §1.1.5–1.1.6; staged colonisation too): analytic shapes placed relative to the
+// Named regions of a domain (Maso Talou et al. 2021 §1.1.5–1.1.6; staged colonisation too): analytic shapes placed relative to the
 // domain's centre. A stage's domain is the union of some regions (or the whole domain), minus its
 // avascular regions (no vessel enters) and, for terminals, its carriage regions (vessels pass,
 // no terminal lies there). Unions are rasterised on the domain's voxel frame and get a distance

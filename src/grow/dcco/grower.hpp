@@ -1,5 +1,5 @@
 #pragma once
-// Domain-constrained CCO (DCCO; Maso Talou et al. 2021, seed 001 §1.1): the tree grows in stages,
+// Domain-constrained CCO (DCCO; Maso Talou et al. 2021 §1.1): the tree grows in stages,
 // each with its own domain, terminal count, terminal pdf, geometric and optimisation parameters,
 // cost (volume, eq. 10, or sprouting, eq. 15) and the role of the vessels it makes. The root's
 // radius and inflow are fixed (not the pressure drop), the domain does not grow with the tree.
@@ -71,7 +71,7 @@ struct DccoOptions {
   double root_pressure = 13300;       // Pa at the root (pressures downstream follow)
   Viscosity viscosity;
   const GrowthDomain* world = nullptr;  // every vessel stays inside (minus the avascular regions of its stage)
-  // The network growth continues (seed 001's vascular completion; null: the first stage plants a
+  // The network growth continues (Maso Talou et al.'s vascular completion; null: the first stage plants a
   // root vessel at root_mm). Its vessels keep their geometry, role, branching and outflow and
   // take stage -1; each of its roots is an inlet with the fixed radius root_radii[tree] (empty:
   // root_radius), all inlets share Q by the terminals they feed.

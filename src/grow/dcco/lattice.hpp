@@ -1,5 +1,5 @@
 #pragma once
-// DCCO's candidate bifurcation points and angle limits (seed 001 §1.1.4, §1.1.9–1.1.10).
+// DCCO's candidate bifurcation points and angle limits (Maso Talou et al. 2021 §1.1.4, §1.1.9–1.1.10).
 #include <vector>
 
 #include "core/vec3.hpp"

@@ -522,7 +522,7 @@ std::unique_ptr<PreparedGrowth> DccoSetup::prepare(std::uint64_t memory_limit) c
 
 const GrowthMethod kDccoMethod{
     "dcco",
-    "domain-constrained CCO in stages (Maso Talou et al. 2021, seed 001): each [[stage]] adds its terminals in its own "
+    "domain-constrained CCO in stages (Maso Talou et al. 2021): each [[stage]] adds its terminals in its own "
     "region with its own parameters, cost (volume or sprouting) and vessel role; bifurcations on DCCO's triangle lattice, "
     "a fixed root radius and inflow, constant or Pries viscosity, angle and symmetry limits, no overlapping vessels",
     withRegionParams(withDomainParams("sphere, cube, disc or square (2D), or mask: the region every vessel stays in",

@@ -1,5 +1,5 @@
 #pragma once
-// Method "dcco": domain-constrained CCO in stages (Maso Talou et al. 2021, seed 001).
+// Method "dcco": domain-constrained CCO in stages (Maso Talou et al. 2021).
 #include <memory>
 #include <string>
 #include <vector>

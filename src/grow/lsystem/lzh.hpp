@@ -51,7 +51,7 @@ struct LzhPlan {
   std::int64_t nodes = 0;           // of the whole network
 };
 
-// The inverse problem (seed 004 §4, Algorithm 4.1); throws LzhError.
+// The inverse problem (Lázaro 2011 §4, Algorithm 4.1); throws LzhError.
 LzhPlan planLzh(const LzhParameters& p);
 
 // The network in a frame whose block corner is at `corner` (mm): tree 0 the inlet's arterial

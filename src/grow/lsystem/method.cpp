@@ -334,7 +334,7 @@ std::unique_ptr<PreparedGrowth> LsystemSetup::prepare(std::uint64_t memory_limit
 
 const GrowthMethod kLsystemMethod{
     "lsystem",
-    "L-system vessel networks. Mode lzh (Lázaro 2011; seed 004): a printable closed network from high-level parameters "
+    "L-system vessel networks. Mode lzh (Lázaro 2011): a printable closed network from high-level parameters "
     "(block, start and capillary vessels, capillary spacing) inverted into levels N, angle θ and lengths L_n; a 3D turtle "
     "with a 90° roll per level; the venous half mirrored through the block's mid-plane and joined by vertical capillaries; "
     "diameter and wall thickness linear in path length (tapered vessels). Mode grammar (Galarreta-Valverde 2013, as V-System): "
@@ -346,7 +346,7 @@ const GrowthMethod kLsystemMethod{
         {"domain", "radius", "mm", nullptr, "grammar: sphere and disc: the radius"},
         {"domain", "side", "mm", nullptr, "grammar: cube and square: the side"},
         {"domain", "mask", "file", nullptr, "grammar, shape = \"mask\": a NIfTI volume (voxels > 0 inside) or a VascuSynth box map"},
-        {"tree", "mode", "text", "lzh", "lzh: seed 004's inverse problem; grammar: the stochastic vessel grammar (V-System)"},
+        {"tree", "mode", "text", "lzh", "lzh: Lázaro's inverse problem; grammar: the stochastic vessel grammar (V-System)"},
         {"tree", "root_offset", "[x, y(, z)] mm", "the top (+y)", "grammar, analytic shapes: the root relative to the centre"},
         {"tree", "root", "[x, y, z] mm", nullptr, "grammar, masks: the root in mm in the frame (or root_voxel)"},
         {"tree", "root_voxel", "[x, y, z] mask voxels", nullptr, "grammar, masks: the root in voxels (or root)"},

@@ -1,5 +1,5 @@
 #pragma once
-// Method "lsystem" as read from a parameter file. Mode "lzh": seed 004's closed network from
+// Method "lsystem" as read from a parameter file. Mode "lzh": Lázaro's closed network from
 // high-level parameters (the block, the start and capillary vessels, the capillary spacing);
 // mode "grammar": the stochastic vessel grammar (V-System) grown inside a domain.
 #include <string>

@@ -1,5 +1,5 @@
 #pragma once
-// VascuSynth's oxygen-demand-driven CCO (seed 002 §3.4–3.10), done right:
+// VascuSynth's oxygen-demand-driven CCO (Hamarneh & Jassi 2010 §3.4–3.10), done right:
 // - candidates at continuous positions, drawn ∝ current demand from a sum tree (O(log V));
 // - the CLOSEST_NEIGHBOURS nearest segments from a uniform grid, each given its optimal
 //   bifurcation for the whole-tree cost (BifurcationOptimizer, evaluated in parallel);

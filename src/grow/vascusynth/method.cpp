@@ -128,7 +128,7 @@ std::unique_ptr<PreparedGrowth> VascuSynthSetup::prepare(std::uint64_t memory_li
 
 const GrowthMethod kVascuSynthMethod{
     "vascusynth",
-    "VascuSynth's oxygen-demand CCO (seed 002) on box maps: terminals drawn ∝ the remaining demand, each joined to the "
+    "VascuSynth's oxygen-demand CCO (Hamarneh & Jassi 2010) on box maps: terminals drawn ∝ the remaining demand, each joined to the "
     "cheapest of its nearest segments for the cost Σ l^μ r^λ, radii by Poiseuille flow and Murray's law",
     withPhysicsParams({
         {"domain", "demand_map", "file", nullptr, "the oxygen-demand box map (VascuSynth format), beside the parameter file or the working directory"},

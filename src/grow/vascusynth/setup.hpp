@@ -1,5 +1,5 @@
 #pragma once
-// Method "vascusynth": VascuSynth's oxygen-demand CCO on box maps (seed 002), as read from a
+// Method "vascusynth": VascuSynth's oxygen-demand CCO on box maps (Hamarneh & Jassi 2010), as read from a
 // TOML file or from VascuSynth's own parameter files.
 #include <memory>
 
