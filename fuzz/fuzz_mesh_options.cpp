@@ -37,8 +37,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   return fuzz::expectOnlyInputErrors([&] {
     Scenario sc = readTomlParameters(params);
     sc.mesh.formats = {};
-    sc.mesh.samples_across = std::min(sc.mesh.samples_across > 0 ? sc.mesh.samples_across : 4, 3);
-    if (sc.mesh.voxel_mm > 0) sc.mesh.voxel_mm = std::max(sc.mesh.voxel_mm, 0.25);
+    sc.mesh.samples_across = std::min(sc.mesh.samples_across.value_or(4), 3);
+    if (sc.mesh.voxel_mm) sc.mesh.voxel_mm = std::max(*sc.mesh.voxel_mm, 0.25);
     if (sc.mesh.ring_spacing) sc.mesh.ring_spacing = std::max(*sc.mesh.ring_spacing, 0.5);
     writeSurfaceFiles(smallTree().tree, sc.mesh, fuzz::kMemoryLimit, out, {}, {}, smallTree().ids);
   });

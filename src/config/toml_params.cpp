@@ -22,6 +22,19 @@ auto keysOf(const TomlReader& r, const toml::table& t) {
   };
 }
 
+// A table whose presence enables its stage ([mesh], [curves]): its settings and rules, and its line.
+template <class Options>
+void readEnablingTable(const TomlReader& r, const char* name, const std::vector<Setting<Options>>& settings,
+                       const std::vector<SettingRule<Options>>& rules, Options& o, int& line, double voxel_mm) {
+  const auto& t = r.table(name, settingKeys(settings));
+  const auto* n = r.root().get(name);
+  if (!n) return;
+  line = r.lineOf(n);
+  o.enabled = true;
+  readSettings(r, t, settings, o, voxel_mm);
+  checkRules(rules, o, keysOf(r, t), Where{r.file(), line});
+}
+
 template <class... Lists>
 std::set<std::string> keysOfAll(const Lists&... lists) {
   std::set<std::string> keys;
@@ -71,28 +84,15 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   sc.growth = m->read(r, *m);
   const double voxel_mm = sc.growth->voxelMm();
 
-  // [image]; [mesh] (the table's presence enables it); [curves] (likewise); [degrade]; [output].
+  // [image]; [mesh] and [curves] (each table's presence enables its stage); [degrade]; [output].
   const auto& im = r.table("image", keysOfAll(imageSettings(), labelSettings()));
   sc.image_line = r.lineOf(root.get("image"));
   readSettings(r, im, imageSettings(), sc.image, voxel_mm);
   readSettings(r, im, labelSettings(), sc.image.labels, voxel_mm);
   checkRules(labelRules(), sc.image.labels, keysOf(r, im), Where{file, sc.image_line});
 
-  const auto& me = r.table("mesh", settingKeys(meshSettings()));
-  if (const auto* n = root.get("mesh")) {
-    sc.mesh_line = r.lineOf(n);
-    sc.mesh.enabled = true;
-    readSettings(r, me, meshSettings(), sc.mesh, voxel_mm);
-    checkRules(meshRules(), sc.mesh, keysOf(r, me), Where{file, sc.mesh_line});
-  }
-
-  const auto& cv = r.table("curves", settingKeys(curveSettings()));
-  if (const auto* n = root.get("curves")) {
-    sc.curves_line = r.lineOf(n);
-    sc.curves.enabled = true;
-    readSettings(r, cv, curveSettings(), sc.curves, voxel_mm);
-    checkRules(curveRules(), sc.curves, keysOf(r, cv), Where{file, sc.curves_line});
-  }
+  readEnablingTable(r, "mesh", meshSettings(), meshRules(), sc.mesh, sc.mesh_line, voxel_mm);
+  readEnablingTable(r, "curves", curveSettings(), curveRules(), sc.curves, sc.curves_line, voxel_mm);
 
   std::set<std::string> degrade_keys, output_keys;
   for (const auto& s : outputSettings()) (std::string(s.table) == "degrade" ? degrade_keys : output_keys).insert(s.key);

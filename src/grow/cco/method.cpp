@@ -338,7 +338,7 @@ const GrowthMethod kCcoMethod{
     "constrained constructive optimisation (Karch 1999; Kerautret et al., OpenCCO) in a sphere, cube, disc, square or mask: the "
     "domain grows with the tree, each terminal joins the one of its nearest segments whose Kamiya bifurcation gives the "
     "least total volume, no vessel leaves the domain or overlaps another",
-    // Seed 000 §5 (Karch 1999): 3.6 cP, written in Pa*s, since "3.6 cP" parses one ulp off 3.6e-3.
+    // Kerautret et al. (OpenCCO) §5 after Karch 1999: 3.6 cP, written in Pa*s, since "3.6 cP" parses one ulp off 3.6e-3.
     withPhysicsParams(withDomainParams("sphere, cube, disc or square (2D), or mask",
                                        "masks: terminals drawn uniformly, or ∝ the mask value (demand)", {
         {"tree", "terminals", "count", nullptr, "N, the number of terminal segments"},

@@ -254,7 +254,7 @@ DccoStageSpec readStage(const TomlReader& r, const GrowthMethod& m, const toml::
   if (st.cost == StageCost::Volume) {
     r.forbid(t, "stage", {"c_v", "c_p", "c_d"}, "weighs the sprouting cost; set cost = \"sprout\" or remove it");
   } else {
-    // Seed 001 Fig. 3: c_v 0.5e2 in 2D, 1e4 in 3D; c_p 0.5; c_d 1.
+    // Maso Talou et al. 2021 Fig. 3: c_v 0.5e2 in 2D, 1e4 in 3D; c_p 0.5; c_d 1.
     st.c_v = t.get("c_v") ? r.number(t, "stage", "c_v") : flat ? 50.0 : 1e4;
     st.c_p = declaredNumber(r, m, t, "stage", "c_p");
     st.c_d = declaredNumber(r, m, t, "stage", "c_d");

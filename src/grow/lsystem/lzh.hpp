@@ -1,5 +1,5 @@
 #pragma once
-// Seed 004 (Lázaro 2011): a printable closed vessel network from high-level parameters. The
+// Lázaro 2011: a printable closed vessel network from high-level parameters. The
 // inverse problem turns the block size, the start and capillary vessels and the capillary
 // spacing into the L-system's levels N, angle θ and lengths L_n; a 3D turtle with a 90° roll per
 // level draws the "middle tree"; the venous half is its mirror image through the block's
