@@ -48,7 +48,8 @@ SettingFlagList<Options> addSettingFlags(CLI::App& c, const std::vector<Setting<
         [&](auto member) {
           using T = std::remove_reference_t<decltype(o.*member)>;
           if constexpr (std::is_same_v<T, bool>) {
-            c.add_flag(s.flag, o.*member, help);
+            if (s.flag[0] == '!') c.add_flag_callback(s.flag + 1, [&o, member] { o.*member = false; }, help);
+            else c.add_flag(s.flag, o.*member, help);
           } else if constexpr (std::is_same_v<T, std::optional<bool>>) {
             c.add_option_function<int>(s.flag, [&o, member](const int& v) { o.*member = v != 0; }, help + "; 1 or 0")
                 ->check(CLI::IsMember({0, 1}));
