@@ -31,7 +31,7 @@ void readEnablingTable(const TomlReader& r, const char* name, const std::vector<
   if (!n) return;
   line = r.lineOf(n);
   o.enabled = true;
-  readSettings(r, t, settings, o, voxel_mm);
+  readSettings(r, name, settings, o, voxel_mm);
   checkRules(rules, o, keysOf(r, t), Where{r.file(), line});
 }
 
@@ -87,19 +87,18 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   // [image]; [mesh] and [curves] (each table's presence enables its stage); [degrade]; [output].
   const auto& im = r.table("image", keysOfAll(imageSettings(), labelSettings()));
   sc.image_line = r.lineOf(root.get("image"));
-  readSettings(r, im, imageSettings(), sc.image, voxel_mm);
-  readSettings(r, im, labelSettings(), sc.image.labels, voxel_mm);
+  readSettings(r, "image", imageSettings(), sc.image, voxel_mm);
+  readSettings(r, "image", labelSettings(), sc.image.labels, voxel_mm);
   checkRules(labelRules(), sc.image.labels, keysOf(r, im), Where{file, sc.image_line});
 
   readEnablingTable(r, "mesh", meshSettings(), meshRules(), sc.mesh, sc.mesh_line, voxel_mm);
   readEnablingTable(r, "curves", curveSettings(), curveRules(), sc.curves, sc.curves_line, voxel_mm);
 
-  std::set<std::string> degrade_keys, output_keys;
-  for (const auto& s : outputSettings()) (std::string(s.table) == "degrade" ? degrade_keys : output_keys).insert(s.key);
-  const auto& deg = r.table("degrade", degrade_keys);
-  sc.profiles_line = r.lineOf(deg.get("profiles"));
-  readSettings(r, deg, outputSettings(), sc, voxel_mm);
-  readSettings(r, r.table("output", output_keys), outputSettings(), sc, voxel_mm);
+  for (const char* table : {"degrade", "output"}) {
+    r.table(table, settingKeys(outputSettings(), table));
+    readSettings(r, table, outputSettings(), sc, voxel_mm);
+  }
+  sc.profiles_line = r.lineOf(r.tableOrEmpty("degrade").get("profiles"));
   sc.units_note = "all values carry their units in the parameter file; internal units are mm, mm^3/s, Pa, Pa*s";
   return sc;
 }

@@ -1114,7 +1114,7 @@ ContourPlan planContour(const VascularTree& t, const SurfaceOptions& o, SurfaceR
       if (c > 0) h = std::min(h, c);
   // `level`: the finest cells a vessel gets (and its fillet's width); `coarse`: those it gets
   // away from a gap (the same without gap partners).
-  const auto level = vesselLevels(t, vessels, h, o), coarse = vesselLevels(t, vessels, h, o, true);
+  auto level = vesselLevels(t, vessels, h, o), coarse = vesselLevels(t, vessels, h, o, true);
   std::vector<double> fillet(std::size_t(t.nodeCount()), 0.0);
   for (auto s : vessels) fillet[std::size_t(s)] = kFillet * h * double(std::int64_t(1) << level[std::size_t(s)]);
   int top = 0;
@@ -1168,8 +1168,8 @@ ContourPlan planContour(const VascularTree& t, const SurfaceOptions& o, SurfaceR
   inflated = VascularTree();
   plan.vessels = std::move(vessels);
   plan.h = h;
-  plan.level = level;
-  plan.coarse = coarse;
+  plan.level = std::move(level);
+  plan.coarse = std::move(coarse);
   plan.fillet = std::move(fillet);
   plan.top = top;
   plan.lat = std::move(lat);

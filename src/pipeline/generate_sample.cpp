@@ -163,7 +163,8 @@ void writeSurface(const Forest& forest, const SampleRequest& req, const std::fil
 }
 
 // The final tree's size, cost, radii and depths, growth's counts and the method's own.
-void addTreeStatistics(const VascularTree& tree, const PreparedSample& ps, const Scenario& sc, const GrowthReport& report, Json& stats) {
+void addTreeStatistics(const VascularTree& tree, const PreparedSample& ps, const Scenario& sc, const GrowthReport& report,
+                       const SampleSummary& summary, Json& stats) {
   const auto& p = sc.growth->physics();
   std::int64_t depth_max = 0;
   double depth_sum = 0, r_min = INFINITY, r_max = 0;
@@ -179,11 +180,11 @@ void addTreeStatistics(const VascularTree& tree, const PreparedSample& ps, const
   pp.total_terminals = sc.growth->terminals();
   const double cost = treeCost(tree, pp);
   const double len_unit = sc.input_units.mm_per_length;
-  const std::int64_t terminals = tree.totalTerminals();
+  const std::int64_t terminals = summary.terminals;
   stats["terminals"] = terminals;
   stats["nodes"] = tree.nodeCount();
   stats["segments"] = tree.segmentCount();
-  stats["total_volume"] = quantityJson(treeVolume(tree), "mm^3");
+  stats["total_volume"] = quantityJson(summary.total_volume_mm3, "mm^3");
   stats["cost"] = Json{{"value", cost},
                        {"unit", "mm^" + exactNumber(p.cost_length_exponent + p.cost_radius_exponent)},
                        {"definition", "sum over segments of length^mu * radius^lambda"}};
@@ -320,14 +321,14 @@ SampleSummary generateSample(const SampleRequest& req, const std::filesystem::pa
     writeSurface(forest, req, dir, files, stats);
     timing["mesh"] = seconds(t0);
   }
-  addTreeStatistics(tree, ps, sc, report, stats);
-  if (sc.curves.enabled) stats["curves"] = curveStatistics(curves);
-  stats["radius_by_bifurcation_level"] = radiusByBifurcationLevel(tree);
-
   SampleSummary summary;
   summary.terminals = tree.totalTerminals();
   summary.total_volume_mm3 = treeVolume(tree);
   summary.intersecting_pairs = report.intersecting_pairs;
+  addTreeStatistics(tree, ps, sc, report, summary, stats);
+  if (sc.curves.enabled) stats["curves"] = curveStatistics(curves);
+  stats["radius_by_bifurcation_level"] = radiusByBifurcationLevel(tree);
+
   summary.grow_seconds = timing["grow"].get<double>();
   Json& j = summary.sidecar;
   j["tool"] = Json{{"name", "angiosynth"}, {"version", kVersion}};

@@ -102,9 +102,9 @@ struct SurfacePlan {
   bool tubes = false, walls = false, cut_ends = false;
   WallThickness wall;
   SurfaceOptions contour;   // the contour method's, and the tubes' junctions'
-  DecimateOptions decimation;
-  TubeSurfaceOptions tube;  // the tube surface's and a hollow wall's two (whose ends are open)
-  std::vector<VesselEnd> ends;
+  TubeSurfaceOptions tube;  // the tube surface's and a hollow wall's two (whose ends are open); its
+                            // ends and decimation serve the contour method too
+  const std::vector<VesselEnd>& ends() const { return tube.ends; }
 };
 
 SurfacePlan planSurface(const VascularTree& tree, const MeshParameters& p, std::uint64_t memory_limit) {
@@ -119,18 +119,16 @@ SurfacePlan planSurface(const VascularTree& tree, const MeshParameters& p, std::
   o.restore_volume = !p.on_surface;
   o.memory_limit = memory_limit;
   plan.cut_ends = p.ends != "closed" || plan.walls;  // a hollow wall's ends are open
-  if (plan.cut_ends) plan.ends = openEnds(tree, p.flow_extension);
-  DecimateOptions& d = plan.decimation;
+  TubeSurfaceOptions& to = plan.tube;
+  if (plan.cut_ends) to.ends = openEnds(tree, p.flow_extension);
+  DecimateOptions& d = to.decimation;
   d.max_error = p.max_error;
   d.sliver_deg = p.sliverAngle();
   d.obtuse_deg = p.maxAngle();
-  TubeSurfaceOptions& to = plan.tube;
   to.junction = o;
   to.ring_spacing_radii = p.ringSpacing();
-  to.ends = plan.ends;
   to.cap_ends = !plan.walls && p.ends == "capped";
   to.decimate = p.decimate;
-  to.decimation = d;
   to.nets = p.junctions == "nets";
   to.remesh = p.remeshes();
   return plan;
@@ -151,7 +149,7 @@ struct BuiltSurface {
 BuiltSurface buildSurface(const VascularTree& tree, const MeshParameters& p, SurfacePlan& plan,
                           const std::function<void(std::int64_t, std::int64_t)>& progress) {
   BuiltSurface b;
-  const auto& ends = plan.ends;
+  const auto& ends = plan.ends();
   if (plan.walls) {
     b.mesh = hollowWall(tree, plan.tube, plan.wall, &b.wall, progress);
     b.tube = b.wall.outer;
@@ -170,7 +168,7 @@ BuiltSurface buildSurface(const VascularTree& tree, const MeshParameters& p, Sur
     b.reduced.collapses = b.tube.decimation_collapses;
     b.reduced.largest_error_mm = b.tube.decimation_largest_error_mm;
   } else {
-    const DecimateOptions& d = plan.decimation;
+    const DecimateOptions& d = plan.tube.decimation;
     plan.contour.finish = [&](SurfaceMesh& m, const std::function<double(std::int32_t, const Vec3&)>& distance) {
       // Slivers before the cut too (tube_surface.cpp says why).
       if (d.sliver_deg > 0) b.slivers = repairSlivers(m, d, distance);
@@ -216,7 +214,7 @@ SurfaceSummary summarise(const VascularTree& tree, const MeshParameters& p, cons
   s.slivers_repaired = tubes ? b.tube.slivers_repaired : b.slivers.changes();
   s.remesh_splits = b.tube.remesh_splits;
   s.remesh_changes = b.tube.remesh_changes;
-  s.ends = std::int64_t(plan.ends.size());
+  s.ends = std::int64_t(plan.ends().size());
   s.ends_cut = b.cut.cut;
   s.ends_left_closed = std::int64_t(b.cut.left_closed.size());
   if (clip) s.clip = b.clipped;
@@ -319,7 +317,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   out.files = Json::object();
   if (plan.cut_ends || !p.clip_box.empty()) {
     writeFile(dir / "surface_faces.csv", [&](std::ostream& os) {
-      writeFaces(os, plan.ends, built.cut, plan.walls ? "open" : p.ends, tree_kinds, vessel_ids, p.clip_box, built.clipped);
+      writeFaces(os, plan.ends(), built.cut, plan.walls ? "open" : p.ends, tree_kinds, vessel_ids, p.clip_box, built.clipped);
     });
     out.files["faces"] = "surface_faces.csv";
   }

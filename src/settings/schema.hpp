@@ -81,10 +81,12 @@ struct SettingRule {
   std::string (*problem)(const Options&);
 };
 
+// The keys `settings` declares (of table `table` only, when given).
 template <class Options>
-std::set<std::string> settingKeys(const std::vector<Setting<Options>>& settings) {
+std::set<std::string> settingKeys(const std::vector<Setting<Options>>& settings, const char* table = nullptr) {
   std::set<std::string> keys;
-  for (const auto& s : settings) keys.insert(s.key);
+  for (const auto& s : settings)
+    if (!table || std::string(table) == s.table) keys.insert(s.key);
   return keys;
 }
 
@@ -157,13 +159,16 @@ std::string textOf(const std::vector<Setting<Options>>& settings, const Options&
 
 }  // namespace detail
 
-// Fills `o` from the keys of table `t` that `settings` declares (the table's keys are checked
-// against them by the caller's TomlReader::table). Lengths take the voxel as a unit.
+// Fills `o` from the keys of the file's table `table` that `settings` declares for it (the
+// table's keys are checked against them by the caller's TomlReader::table). Lengths take the
+// voxel as a unit.
 template <class Options>
-void readSettings(const TomlReader& r, const toml::table& t, const std::vector<Setting<Options>>& settings, Options& o,
+void readSettings(const TomlReader& r, const char* table, const std::vector<Setting<Options>>& settings, Options& o,
                   double voxel_mm) {
+  const toml::table& t = r.tableOrEmpty(table);
+  const auto here = [&](const Setting<Options>& s) { return std::string(table) == s.table; };
   for (const auto& s : settings) {
-    if (&t != &r.tableOrEmpty(s.table)) continue;  // a setting of another table of the same Options
+    if (!here(s)) continue;
     const toml::node* n = t.get(s.key);
     if (!n) continue;
     const Where where = r.at(t, s.key);
@@ -214,7 +219,7 @@ void readSettings(const TomlReader& r, const toml::table& t, const std::vector<S
         s.field);
   }
   for (const auto& s : settings) {
-    if (!s.only_with.key || &t != &r.tableOrEmpty(s.table) || !t.get(s.key)) continue;
+    if (!s.only_with.key || !here(s) || !t.get(s.key)) continue;
     const std::string chosen = detail::textOf(settings, o, s.only_with.key);
     if (chosen != s.only_with.value)
       throw InputError(r.file(), r.at(t, s.key).line, std::string(s.key) + " is a parameter of " + s.only_with.key + " = \"" + s.only_with.value +
