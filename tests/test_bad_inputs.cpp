@@ -70,7 +70,7 @@ const BadCase kCases[] = {
     // Space colonisation.
 #define COLONISATION "[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"colonisation\"\n"
     {"colonisation_kappa_4_5", "p.toml", "", "", COLONISATION "[physics]\nmurray_exponent = 4.5\n",
-     "generate p.toml --out out", "p.toml:8: murray_exponent (κ of Rauch & Harders 2021) = 4.5 is out of range; allowed: (2, 4)"},
+     "generate p.toml --out out", "p.toml:8: murray_exponent = 4.5 is out of range; allowed: (2, 4)"},
     {"colonisation_no_vein_root", "p.toml", "", "", COLONISATION "[[tree.inlet]]\nkind = \"artery\"\nroot_offset = [0, 9]\n",
      "generate p.toml --out out", "p.toml:7: no vein root: add a [[tree.inlet]] with kind = \"vein\", or set [tree] veins = false"},
 #undef COLONISATION

@@ -473,8 +473,8 @@ TEST(Cco, TreesAreAsLightAsOpenCcosInItsOwnSetUp) {
   const auto d = openccoBall();
   const auto volume = [&](bool from_segments, bool exact, std::uint64_t seed) {
     auto o = openccoOptions(1000, d, seed);
-    o.spacing_from_segments = from_segments;
-    o.exact_bifurcations = exact;
+    o.spacing_from = from_segments ? TerminalSpacing::Segments : TerminalSpacing::Terminals;
+    o.bifurcation = exact ? BifurcationPoint::Exact : BifurcationPoint::Kamiya;
     GrowthReport rep;
     const auto t = growCco(d, o, rep);
     test::expectGeometry(t, d);

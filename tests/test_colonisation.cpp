@@ -230,7 +230,7 @@ TEST(Colonisation, BadParametersNameTheirLine) {
   };
   expectError("bias = 1.5\n", "bad.toml:20: bias = 1.5 is out of range");
   expectError("perception_distance = \"0.1 mm\"\n", "perception_distance (0.1 mm) must exceed satisfaction_distance");
-  expectError("spread_statistic = \"mad\"\n", "bad.toml:20: spread_statistic 'mad'; allowed: sd, rms");
+  expectError("spread_statistic = \"mad\"\n", "bad.toml:20: spread_statistic 'mad' is not allowed; allowed: sd, rms");
   expectError("lateral = 3\n", "bad.toml:20: lateral must be true or false");
   expectError("drain_lifetime = -1\n", "bad.toml:20: drain_lifetime = -1 is out of range");
 }

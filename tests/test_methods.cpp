@@ -73,7 +73,7 @@ TEST_F(MethodFiles, OmittedKeysTakeTheDeclaredDefaults) {
   EXPECT_EQ(c.physics.terminal_pressure, declared("physics", "terminal_pressure", Dimension::Pressure));
   EXPECT_EQ(c.physics.perfusion_flow, declared("physics", "perfusion_flow", Dimension::Flow));
   EXPECT_EQ(c.closest_neighbours, std::stoi(findParam(kCcoMethod, "tree", "closest_neighbours")->fallback));
-  EXPECT_EQ(c.max_neighbours, std::stoi(findParam(kCcoMethod, "tree", "max_closest_neighbours")->fallback));
+  EXPECT_EQ(c.max_neighbours, c.closest_neighbours);  // the declared default: closest_neighbours
   EXPECT_EQ(c.relaxation, std::stod(findParam(kCcoMethod, "tree", "relaxation")->fallback));
   EXPECT_EQ(std::string(sc.growth->method()), "cco");
 }

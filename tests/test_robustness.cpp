@@ -298,7 +298,7 @@ TEST_F(Robustness, GrammarRootDiameterBelowTheRangeIsRefused) {
   write("g.toml", t);
   const auto r = run("generate g.toml --out o --no-image", dir_);
   EXPECT_EQ(r.code, 2) << r.err;
-  EXPECT_NE(r.err.find("root_diameter (mm) = 1e-06 is out of range"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("root_diameter = 1e-06 is out of range; allowed: [0.0002, 2000] mm"), std::string::npos) << r.err;
 }
 
 // ---- Hangs -----------------------------------------------------------------------------------

@@ -13,6 +13,7 @@
 #include "config/image_settings.hpp"
 #include "config/mesh_settings.hpp"
 #include "config/sample_settings.hpp"
+#include "grow/cco/setup.hpp"
 #include "config/scenario.hpp"
 #include "pipeline/generate_sample.hpp"
 #include "test_support.hpp"
@@ -32,6 +33,11 @@ Given valueOf(const Setting<Options>& s) {
   static const Options defaults{};
   return std::visit(
       [&](auto member) -> Given {
+        if constexpr (detail::isChoiceField<decltype(member)>) {
+          const std::string now = member.get(defaults);
+          const std::string v = s.choices.front() == now ? s.choices.back() : s.choices.front();
+          return {"\"" + v + "\"", v};
+        } else {
         using T = std::remove_reference_t<decltype(Options().*member)>;
         // Entries of a list: increasing, inside the range.
         const auto entries = [&](std::size_t n, bool lengths) {
@@ -47,23 +53,24 @@ Given valueOf(const Setting<Options>& s) {
         };
         if constexpr (std::is_same_v<T, bool>) return {defaults.*member ? "false" : "true", ""};
         else if constexpr (std::is_same_v<T, std::optional<bool>>) return {"true", "1"};
-        else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::optional<int>>) {
+        else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::optional<int>> || std::is_same_v<T, std::int64_t>) {
           // The top of the range, or its bottom where the top is the default.
-          int v = int(s.range.hi);
-          if (defaults.*member == v) v = int(s.range.lo);
+          std::int64_t v = std::int64_t(s.range.hi);
+          if (defaults.*member == v) v = std::int64_t(s.range.lo);
           return {std::to_string(v), std::to_string(v)};
         } else if constexpr (std::is_same_v<T, std::string>) return {"\"" + s.choices.back() + "\"", s.choices.back()};
         else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
           const std::string v = s.choices.empty() ? "clean" : s.choices.back();
           return {"[\"" + v + "\"]", v};
-        } else if constexpr (std::is_same_v<T, std::vector<double>>) return entries(s.count, s.length);
-        else if constexpr (std::is_same_v<T, std::optional<Vec3>>) return entries(3, s.length);
+        } else if constexpr (std::is_same_v<T, std::vector<double>>) return entries(s.count, s.quantity.has_value());
+        else if constexpr (std::is_same_v<T, std::optional<Vec3>>) return entries(3, s.quantity.has_value());
         else {
           // A number inside the range that its extra check (a bound with a hole) takes too.
           double v = s.range.lo + 0.37 * (std::min(s.range.hi, s.range.lo + 100) - s.range.lo);
           if (s.problem && !s.problem(v).empty()) v = 0.5 * (90 + s.range.hi);
-          if (s.length) return {"\"" + show(v) + " mm\"", show(v)};
+          if (s.quantity) return {"\"" + show(v) + " " + internalUnit(*s.quantity) + "\"", show(v)};
           return {show(v), show(v)};
+        }
         }
       },
       s.field);
@@ -71,7 +78,12 @@ Given valueOf(const Setting<Options>& s) {
 
 template <class Options>
 bool sameField(const Setting<Options>& s, const Options& a, const Options& b) {
-  return std::visit([&](auto member) { return a.*member == b.*member; }, s.field);
+  return std::visit(
+      [&](auto member) {
+        if constexpr (detail::isChoiceField<decltype(member)>) return member.get(a) == member.get(b);
+        else return a.*member == b.*member;
+      },
+      s.field);
 }
 
 class Settings : public ::testing::Test {
@@ -156,6 +168,35 @@ TEST_F(Settings, EverySampleKeyAndItsFlagFillTheSameField) {
   compareFileAndFlags(curveSettings(), [](const Scenario& sc) { return sc.curves; }, none);
   compared += compareFileAndFlags(outputSettings(), [](const Scenario& sc) { return sc; }, none);
   EXPECT_EQ(compared, 3);
+}
+
+// A growth method's settings: each key of [tree] and [physics] fills its own field (a value
+// other than the default it gets without the key), and the sidecar records it.
+TEST_F(Settings, EveryCcoKeyFillsItsFieldAndTheSidecar) {
+  const auto read = [&](const std::string& tree, const std::string& physics) {
+    std::ofstream(dir_ / "p.toml") << "[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"cco\"\n"
+                                   << tree << "[physics]\n" << physics;
+    return readTomlParameters(dir_ / "p.toml");
+  };
+  const auto cco = [](const Scenario& sc) { return dynamic_cast<const CcoSetup&>(*sc.growth).cco; };
+  const Scenario base = read("terminals = 2\n", "");
+  int checked = 0;
+  const auto check = [&](const auto& settings, auto&& of) {
+    for (const auto& s : settings) {
+      const Given g = valueOf(s);
+      const std::string line = std::string(s.key) + " = " + g.file + "\n";
+      const bool tree = std::string(s.table) == "tree", terminals = std::string(s.key) == "terminals";
+      // A perfusion pressure this low needs a terminal pressure below it.
+      const std::string physics = tree ? "" : line + (std::string(s.key) == "perfusion_pressure" ? "terminal_pressure = \"1 Pa\"\n" : "");
+      const Scenario sc = read((tree ? line : "") + (terminals ? "" : "terminals = 2\n"), physics);
+      EXPECT_FALSE(sameField(s, of(sc), of(base))) << s.key << " = " << g.file << " left its field at the default";
+      EXPECT_TRUE(sc.growth->describe().contains(s.key)) << s.key << " is missing from the sidecar";
+      ++checked;
+    }
+  };
+  check(ccoSettings(), cco);
+  check(ccoPhysics(), [&](const Scenario& sc) { return cco(sc).physics; });
+  EXPECT_EQ(checked, 14);
 }
 
 TEST_F(Settings, TheParameterReferencePrintsEachDeclaration) {

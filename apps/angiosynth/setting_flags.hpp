@@ -46,6 +46,10 @@ SettingFlagList<Options> addSettingFlags(CLI::App& c, const std::vector<Setting<
     const std::size_t before = c.get_options().size();
     std::visit(
         [&](auto member) {
+          if constexpr (detail::isChoiceField<decltype(member)>) {
+            c.add_option_function<std::string>(s.flag, [&o, member](const std::string& v) { member.set(o, v); }, help)
+                ->check(CLI::IsMember(s.choices));
+          } else {
           using T = std::remove_reference_t<decltype(o.*member)>;
           if constexpr (std::is_same_v<T, bool>) {
             if (s.flag[0] == '!') c.add_flag_callback(s.flag + 1, [&o, member] { o.*member = false; }, help);
@@ -55,6 +59,8 @@ SettingFlagList<Options> addSettingFlags(CLI::App& c, const std::vector<Setting<
                 ->check(CLI::IsMember({0, 1}));
           } else if constexpr (std::is_same_v<T, int>) {
             c.add_option(s.flag, o.*member, help)->check(CLI::Range(int(s.range.lo), int(s.range.hi)));
+          } else if constexpr (std::is_same_v<T, std::int64_t>) {
+            c.add_option(s.flag, o.*member, help)->check(CLI::Range(std::int64_t(s.range.lo), std::int64_t(s.range.hi)));
           } else if constexpr (std::is_same_v<T, std::optional<int>>) {
             c.add_option_function<int>(s.flag, [&o, member](const int& v) { o.*member = v; }, help)
                 ->check(CLI::Range(int(s.range.lo), int(s.range.hi)));
@@ -77,6 +83,7 @@ SettingFlagList<Options> addSettingFlags(CLI::App& c, const std::vector<Setting<
             static_assert(std::is_same_v<T, std::vector<std::string>>);
             c.add_option(s.flag, o.*member, help + " (comma-separated)")->delimiter(',')->check(CLI::IsMember(s.choices));
           }
+          }
         },
         s.field);
     added.emplace_back(&s, c.get_options()[before]);
@@ -96,7 +103,13 @@ struct SettingOverrides {
   }
   void applyTo(Options& target) const {
     for (const auto& [s, option] : flags)
-      if (option->count() > 0) std::visit([&](auto member) { target.*member = values.*member; }, s->field);
+      if (option->count() > 0)
+        std::visit(
+            [&](auto member) {
+              if constexpr (detail::isChoiceField<decltype(member)>) member.set(target, member.get(values));
+              else target.*member = values.*member;
+            },
+            s->field);
   }
 };
 

@@ -33,7 +33,7 @@ const std::vector<Setting<MeshParameters>>& meshSettings() {
        .field = &MeshParameters::junctions, .choices = {"nets", "tetrahedra"}, .flag = "--junctions"},
       {.table = "mesh", .key = "voxel_size", .unit = "mm", .fallback = "the thinnest vessel's diameter / samples_across",
        .meaning = "the finest grid step",
-       .field = &MeshParameters::voxel_mm, .range = {physical::kMinStepMm, physical::kMaxStepMm}, .length = true, .flag = "--voxel"},
+       .field = &MeshParameters::voxel_mm, .range = {physical::kMinStepMm, physical::kMaxStepMm}, .quantity = Dimension::Length, .flag = "--voxel"},
       {.table = "mesh", .key = "samples_across", .unit = "count", .fallback = "3 (tubes), 4 (contour)",
        .meaning = "grid steps across each vessel's thinnest end where it is contoured (1 … 64); thicker vessels get coarser cells",
        .field = &MeshParameters::samples_across, .range = {1, 64}, .flag = "--samples-across"},
@@ -43,7 +43,7 @@ const std::vector<Setting<MeshParameters>>& meshSettings() {
       {.table = "mesh", .key = "wall_thickness", .unit = "mm", .fallback = "0 (no wall)",
        .meaning = "a hollow wall of this thickness around each vessel's lumen (Lázaro 2011): the surface bounds the wall (outer side, lumen, a flat "
        "ring at each end, all ends open); one of wall_thickness, wall_ratio, wall_from_graph",
-       .field = &MeshParameters::wall_thickness, .range = {0, physical::kMaxRadiusMm}, .length = true, .flag = "--wall-thickness"},
+       .field = &MeshParameters::wall_thickness, .range = {0, physical::kMaxRadiusMm}, .quantity = Dimension::Length, .flag = "--wall-thickness"},
       {.table = "mesh", .key = "wall_ratio", .unit = "share of the radius", .fallback = "0 (no wall)",
        .meaning = "a hollow wall of this share of each vessel's radius at each of its ends",
        .field = &MeshParameters::wall_ratio, .range = {0, 100}, .flag = "--wall-ratio"},

@@ -135,6 +135,7 @@ Scenario readVascuSynthParameters(const std::filesystem::path& path, const ReadO
   g.terminals = n;
   g.closest_neighbours = static_cast<int>(k);
   g.min_distance_mm = min_dist * d.voxel_mm;
+  g.min_segment_length_mm = g.minSegmentLength(d.voxel_mm);  // the default (voxel / 20), recorded in the sidecar
   g.physics.murray_exponent = gamma;
   g.physics.cost_radius_exponent = lambda;
   g.physics.cost_length_exponent = mu;

@@ -19,10 +19,51 @@
 
 namespace angiosynth {
 
+// A choice kept as an enum (or a bool) in Options: the words are the setting's choices, `get` and
+// `set` translate between a word and the field.
 template <class Options>
-using SettingField = std::variant<bool Options::*, int Options::*, double Options::*, std::optional<double> Options::*,
-                                  std::optional<bool> Options::*, std::string Options::*, std::vector<double> Options::*,
-                                  std::vector<std::string> Options::*, std::optional<Vec3> Options::*, std::optional<int> Options::*>;
+struct ChoiceField {
+  std::string (*get)(const Options&);
+  void (*set)(Options&, const std::string&);
+};
+
+// The words of an enum (or a bool) numbered from 0, ending with nullptr: words[k] names enum
+// value k; "" names a value no file chooses ("unset").
+template <std::size_t N>
+std::vector<std::string> wordList(const char* const (&words)[N]) {
+  std::vector<std::string> out;
+  for (std::size_t k = 0; k + 1 < N; ++k)
+    if (*words[k]) out.emplace_back(words[k]);
+  return out;
+}
+
+// The ChoiceField of enum (or bool) member `Member` whose values `Words` names in order.
+template <class Options, auto Member, const char* const* Words>
+ChoiceField<Options> enumChoice() {
+  return {[](const Options& o) { return std::string(Words[static_cast<int>(o.*Member)]); },
+          [](Options& o, const std::string& word) {
+            using E = std::remove_reference_t<decltype(o.*Member)>;
+            for (int k = 0; Words[k]; ++k)
+              if (*Words[k] && word == Words[k]) o.*Member = static_cast<E>(k);
+          }};
+}
+
+template <class Options>
+using SettingField = std::variant<bool Options::*, int Options::*, std::int64_t Options::*, double Options::*,
+                                  std::optional<double> Options::*, std::optional<bool> Options::*, std::string Options::*,
+                                  std::vector<double> Options::*, std::vector<std::string> Options::*,
+                                  std::optional<Vec3> Options::*, std::optional<int> Options::*, ChoiceField<Options>>;
+
+// The internal unit of a quantity, as sidecars record it.
+inline const char* internalUnit(Dimension d) {
+  switch (d) {
+    case Dimension::Length: return "mm";
+    case Dimension::Flow: return "mm^3/s";
+    case Dimension::Pressure: return "Pa";
+    case Dimension::Viscosity: return "Pa*s";
+  }
+  return "";
+}
 
 // How a number is bounded: lo < v or lo <= v, and v < hi or v <= hi.
 struct SettingRange {
@@ -42,7 +83,7 @@ struct Setting;
 template <class Options>
 std::string rangeUnit(const Setting<Options>& s) {
   if (s.range_unit) return std::string(" ") + s.range_unit;
-  const std::string u = s.length ? "mm" : s.unit;
+  const std::string u = s.quantity ? internalUnit(*s.quantity) : s.unit;
   return u.empty() || u.find_first_of("[/ ") != std::string::npos || u == "count" ? "" : " " + u;
 }
 
@@ -56,14 +97,16 @@ template <class Options>
 struct Setting {
   const char* table;     // "mesh"
   const char* key;       // "sliver_angle"
-  const char* unit;      // "degrees", "mm", "true/false", "count", … (a length given as "<number> <unit>" when `length`)
-  const char* fallback;  // the default as a user reads it
+  const char* unit;      // "degrees", "mm", "true/false", "count", … (a quantity given as "<number> <unit>" when `quantity`)
+  const char* fallback;  // the default as a user reads it; nullptr: the setting is required
   const char* meaning;
   SettingField<Options> field;
   SettingRange range{};                // numbers, counts and the entries of a list of numbers
   std::vector<std::string> choices{};  // texts and lists of texts: the allowed values (none: any text but the empty one)
   std::size_t count = 0;               // a list of numbers: exactly this many
-  bool length = false;                 // a length (or a list of them): strings with their unit in a file, mm on the command line
+  // A quantity (or a list of lengths): strings with their unit in a file, the internal unit (mm,
+  // Pa, Pa*s, mm^3/s) on the command line and in sidecars.
+  std::optional<Dimension> quantity{};
   // The command-line flag that overrides it ("--sliver-angle"), if any; "!--no-image" sets a
   // true/false setting to false.
   const char* flag = nullptr;
@@ -71,6 +114,10 @@ struct Setting {
   std::string (*problem)(double) = nullptr;
   SettingCondition only_with{};        // given only with this choice of another setting of the table
   const char* range_unit = nullptr;    // the unit of the range when `unit` describes a list ("mm" for "[mm × 6]")
+  // The fallback is the value itself ("100 mmHg", "20"): read into the field when the key is
+  // absent, so the declaration alone holds the default (methods that share a setting declare
+  // their own defaults).
+  bool fallback_is_value = false;
 };
 
 // A rule between settings: `problem` says what is wrong with the filled Options, or "". `keys`:
@@ -130,7 +177,7 @@ namespace detail {
 // A list of numbers, or of lengths "<number> <unit>", of the declared count.
 template <class Options>
 std::vector<double> listOfNumbers(const TomlReader& r, const toml::node* n, const Setting<Options>& s, double voxel_mm) {
-  if (!s.length) return r.numbers(n, s.key, s.count);
+  if (!s.quantity) return r.numbers(n, s.key, s.count);
   const auto* a = n->as_array();
   if (!a || (s.count && a->size() != s.count) || a->empty())
     throw InputError(r.file(), r.lineOf(n), std::string(s.key) + " must be an array of " + (s.count ? std::to_string(s.count) + " " : "") +
@@ -152,46 +199,74 @@ std::vector<double> listOfNumbers(const TomlReader& r, const toml::node* n, cons
 template <class Options>
 std::string textOf(const std::vector<Setting<Options>>& settings, const Options& o, const char* key) {
   for (const auto& s : settings)
-    if (std::string(s.key) == key)
+    if (std::string(s.key) == key) {
       if (const auto* m = std::get_if<std::string Options::*>(&s.field)) return o.**m;
+      if (const auto* c = std::get_if<ChoiceField<Options>>(&s.field)) return c->get(o);
+    }
   return {};
 }
 
 }  // namespace detail
 
-// Fills `o` from the keys of the file's table `table` that `settings` declares for it (the
-// table's keys are checked against them by the caller's TomlReader::table). Lengths take the
-// voxel as a unit.
+namespace detail {
+
+// The number a setting's fallback states ("100 mmHg", "20"), for fallback_is_value.
 template <class Options>
-void readSettings(const TomlReader& r, const char* table, const std::vector<Setting<Options>>& settings, Options& o,
-                  double voxel_mm) {
-  const toml::table& t = r.tableOrEmpty(table);
+double fallbackNumber(const Setting<Options>& s, double voxel_mm) {
+  return s.quantity ? parseQuantity(s.fallback, *s.quantity, voxel_mm) : std::stod(s.fallback);
+}
+
+template <class Options>
+constexpr bool isChoiceField = false;
+template <class Options>
+constexpr bool isChoiceField<ChoiceField<Options>> = true;
+
+}  // namespace detail
+
+// Fills `o` from the keys of table `t` (named `table` in the file: "tree", "tree.inlet") that
+// `settings` declares for it (the table's keys are checked against them by the caller). Lengths
+// take the voxel as a unit. A required setting (no fallback) missing is an error; an absent one
+// whose fallback is its value gets that value.
+template <class Options>
+void readSettingsFrom(const TomlReader& r, const toml::table& t, const char* table, const std::vector<Setting<Options>>& settings,
+                      Options& o, double voxel_mm) {
   const auto here = [&](const Setting<Options>& s) { return std::string(table) == s.table; };
   for (const auto& s : settings) {
     if (!here(s)) continue;
     const toml::node* n = t.get(s.key);
-    if (!n) continue;
+    if (!n && s.fallback) continue;
+    if (!n) r.need(t, table, s.key);  // refuses: required
     const Where where = r.at(t, s.key);
     const std::string name = s.key;
     const auto number = [&] {
-      const double v = s.length ? r.quantity(t, s.table, s.key, Dimension::Length, voxel_mm) : r.number(t, s.table, s.key);
+      const double v = s.quantity ? r.quantity(t, table, s.key, *s.quantity, voxel_mm) : r.number(t, table, s.key);
       checkSettingNumber(s, v, where, name);
       return v;
     };
     std::visit(
         [&](auto member) {
+          if constexpr (detail::isChoiceField<decltype(member)>) {
+            const std::string v = r.string(t, table, s.key);
+            checkSettingChoice(s, v, where, name);
+            member.set(o, v);
+            return;
+          } else {
           using T = std::remove_reference_t<decltype(o.*member)>;
           if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::optional<bool>>) {
             o.*member = r.boolean(t, s.key, false);
           } else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::optional<int>>) {
-            const int v = r.smallInteger(t, s.table, s.key, std::int64_t(s.range.lo), std::int64_t(s.range.hi));
+            const int v = r.smallInteger(t, table, s.key, std::int64_t(s.range.lo), std::int64_t(s.range.hi));
             if (s.problem)
               if (const auto why = s.problem(v); !why.empty()) throw InputError(where.file, where.line, why);
+            o.*member = v;
+          } else if constexpr (std::is_same_v<T, std::int64_t>) {
+            const std::int64_t v = r.integer(t, table, s.key);
+            checkSettingNumber(s, double(v), where, name);
             o.*member = v;
           } else if constexpr (std::is_same_v<T, double> || std::is_same_v<T, std::optional<double>>) {
             o.*member = number();
           } else if constexpr (std::is_same_v<T, std::string>) {
-            const std::string v = r.string(t, s.table, s.key);
+            const std::string v = r.string(t, table, s.key);
             checkSettingChoice(s, v, where, name);
             o.*member = v;
           } else if constexpr (std::is_same_v<T, std::vector<double>>) {
@@ -215,6 +290,25 @@ void readSettings(const TomlReader& r, const char* table, const std::vector<Sett
             }
             o.*member = v;
           }
+          }
+        },
+        s.field);
+  }
+  // Defaults that are values, once the choices they may depend on are read.
+  for (const auto& s : settings) {
+    if (!here(s) || !s.fallback_is_value || t.get(s.key)) continue;
+    if (s.only_with.key && detail::textOf(settings, o, s.only_with.key) != s.only_with.value) continue;
+    std::visit(
+        [&](auto member) {
+          if constexpr (!detail::isChoiceField<decltype(member)>) {
+            using T = std::remove_reference_t<decltype(o.*member)>;
+            if constexpr (std::is_same_v<T, std::string>) o.*member = s.fallback;
+            else if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) o.*member = T(detail::fallbackNumber(s, voxel_mm));
+            else if constexpr (std::is_same_v<T, std::optional<double>> || std::is_same_v<T, std::optional<int>>)
+              o.*member = typename T::value_type(detail::fallbackNumber(s, voxel_mm));
+          } else {
+            member.set(o, s.fallback);
+          }
         },
         s.field);
   }
@@ -225,6 +319,13 @@ void readSettings(const TomlReader& r, const char* table, const std::vector<Sett
       throw InputError(r.file(), r.at(t, s.key).line, std::string(s.key) + " is a parameter of " + s.only_with.key + " = \"" + s.only_with.value +
                                                           "\", not of \"" + chosen + "\"; set that " + s.only_with.key + " or remove the key");
   }
+}
+
+// Fills `o` from the file's table `table` (see readSettingsFrom).
+template <class Options>
+void readSettings(const TomlReader& r, const char* table, const std::vector<Setting<Options>>& settings, Options& o,
+                  double voxel_mm) {
+  readSettingsFrom(r, r.tableOrEmpty(table), table, settings, o, voxel_mm);
 }
 
 // Refuses the first rule `o` breaks: `where(key)` says where a setting was given (a file's line),

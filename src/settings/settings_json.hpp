@@ -1,6 +1,6 @@
 #pragma once
 // The `parameters` block of a sidecar (sample.json) from the declared settings: each key with the
-// value it holds, lengths as {"value", "unit": "mm"}, a setting left unset as its default's words
+// value it holds, quantities as {"value", "unit": "mm"} (or Pa, Pa*s, mm^3/s, deg), choices as their word, a setting left unset as its default's words
 // ("the domain's voxel"). A setting that belongs to another choice (label_threshold when the
 // policy is not threshold) is left out; `table`, when given, keeps that table's settings only.
 #include <nlohmann/json.hpp>
@@ -17,9 +17,17 @@ nlohmann::ordered_json settingsJson(const std::vector<Setting<Options>>& setting
   for (const auto& s : settings) {
     if (table && std::string(table) != s.table) continue;
     if (s.only_with.key && detail::textOf(settings, o, s.only_with.key) != s.only_with.value) continue;
-    const auto number = [&](double v) { return s.length ? quantityJson(v, "mm") : Json(v); };
+    // Quantities, and angles in degrees, with their unit.
+    const auto number = [&](double v) {
+      if (s.quantity) return quantityJson(v, internalUnit(*s.quantity));
+      return std::string(s.unit) == "deg" ? quantityJson(v, "deg") : Json(v);
+    };
+    const bool length = s.quantity == Dimension::Length;
     j[s.key] = std::visit(
         [&](auto member) -> Json {
+          if constexpr (detail::isChoiceField<decltype(member)>) {
+            return Json(member.get(o));
+          } else {
           using T = std::remove_cvref_t<decltype(o.*member)>;
           const auto& v = o.*member;
           if constexpr (std::is_same_v<T, double>) return number(v);
@@ -27,11 +35,12 @@ nlohmann::ordered_json settingsJson(const std::vector<Setting<Options>>& setting
           else if constexpr (std::is_same_v<T, std::optional<bool>> || std::is_same_v<T, std::optional<int>>) return v ? Json(*v) : Json(s.fallback);
           else if constexpr (std::is_same_v<T, std::optional<Vec3>>) {
             if (!v) return Json(s.fallback);
-            return s.length ? Json{{"value", {v->x, v->y, v->z}}, {"unit", "mm"}} : Json{v->x, v->y, v->z};
+            return length ? Json{{"value", {v->x, v->y, v->z}}, {"unit", "mm"}} : Json{v->x, v->y, v->z};
           } else if constexpr (std::is_same_v<T, std::vector<double>>) {
             if (v.empty()) return Json(s.fallback);
-            return s.length || (s.range_unit && std::string(s.range_unit) == "mm") ? Json{{"value", v}, {"unit", "mm"}} : Json(v);
+            return length || (s.range_unit && std::string(s.range_unit) == "mm") ? Json{{"value", v}, {"unit", "mm"}} : Json(v);
           } else return Json(v);
+          }
         },
         s.field);
   }

@@ -316,7 +316,7 @@ class CcoGrower {
 
   // The bifurcations of segment s towards terminal p, with their volume and the checks that need
   // no other vessel (run in parallel on a tree that does not change): Kamiya's fixed point, and
-  // with exact_bifurcations the exact minimum of the tree's volume near it. Both are ranked:
+  // with BifurcationPoint::Exact the exact minimum of the tree's volume near it. Both are ranked:
   // where the lighter one collides, the other may not.
   Trial evaluate(const TreeGrowth& g, std::int32_t s, const Vec3& p, std::int64_t n_new, double shrink_new,
                  const BifurcationOptimizer& opt) const {
@@ -584,9 +584,9 @@ class CcoGrower {
             // In space such steps, stopped short of the node, are valid 12 % of the time, and
             // without them the sphere's trees came out heavier (7 of 8, 0.1-0.8 %).
             const auto& k = trials[j].c[0];
-            trials[j].at_node = planar && opt_.exact_bifurcations && j < kRefineNearest && trials[j].merged_at_parent &&
+            trials[j].at_node = planar && opt_.bifurcation == BifurcationPoint::Exact && j < kRefineNearest && trials[j].merged_at_parent &&
                                 opts[i].optimumAtProximalNode(g.near[j].second, p);
-            if (opt_.exact_bifurcations && (k.valid || (j < kRefineNearest && !trials[j].at_node)))
+            if (opt_.bifurcation == BifurcationPoint::Exact && (k.valid || (j < kRefineNearest && !trials[j].at_node)))
               trials[j].c[1] = refine(g, k, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
             if (planar)
               for (int w : {0, 1}) trials[j].crosses[w] = trials[j].c[w].valid && terminalCrossesInPlane(g.tree, trials[j].c[w], g.near);
@@ -729,10 +729,10 @@ class CcoGrower {
   }
 
   // True if a point drawn at p lies within `spacing` of tree k (its terminal points, or every
-  // segment with opt_.spacing_from_segments).
+  // segment with TerminalSpacing::Segments).
   bool tooClose(int k, const Vec3& p, double spacing) {
     auto& g = trees_[k];
-    if (opt_.spacing_from_segments) return g.index.anyWithin(g.tree, p, spacing);
+    if (opt_.spacing_from == TerminalSpacing::Segments) return g.index.anyWithin(g.tree, p, spacing);
     const auto& T = g.tree;
     if (!g.terminal_grid || T.nodeCount() < g.grid_nodes || g.terminalCount() >= 2 * g.grid_built) {
       const double delta = std::pow(dom_.measure() / double(std::max<std::int64_t>(1, g.terminalCount())), 1.0 / dom_.dimension());

@@ -30,6 +30,14 @@
 
 namespace angiosynth {
 
+// What a drawn terminal keeps δ from: the terminal points (Kerautret et al.'s Algorithm 2 and
+// OpenCCO's code), or every segment (the wording of its §3.3.2), which spreads terminals evenly
+// but forces long connections. Either way it lies outside every vessel.
+enum class TerminalSpacing { Terminals, Segments };
+// Each connection's bifurcation: also from the optimiser of the exact tree volume, started at
+// Kamiya's fixed point (Exact), or Kamiya's point alone, as in OpenCCO (Kerautret et al.).
+enum class BifurcationPoint { Exact, Kamiya };
+
 struct CcoOptions {
   std::int64_t terminals = 4000;      // N
   Vec3 root_mm;                       // in the domain's frame
@@ -40,13 +48,8 @@ struct CcoOptions {
   double kamiya_tolerance = 1e-6;     // of the bifurcation's step, relative to its three lengths
   int draws_before_relaxing = 100;
   double relaxation = 0.9;
-  // What a drawn terminal keeps δ from: the terminal points (Kerautret et al.'s Algorithm 2 and
-  // OpenCCO's code), or every segment (the wording of its §3.3.2), which spreads terminals
-  // evenly but forces long connections. Either way it lies outside every vessel.
-  bool spacing_from_segments = false;
-  // Each connection's bifurcation also from the optimiser of the exact tree volume, started at
-  // Kamiya's fixed point; false: Kamiya's point alone, as in OpenCCO (Kerautret et al.).
-  bool exact_bifurcations = true;
+  TerminalSpacing spacing_from = TerminalSpacing::Terminals;
+  BifurcationPoint bifurcation = BifurcationPoint::Exact;
   PhysicsParameters physics;          // λ = 2 and μ = 1 (volume) are imposed
   std::uint64_t seed = 1;
   std::uint64_t sample = 0;

@@ -13,6 +13,61 @@
 #include "settings/input_paths.hpp"
 
 namespace angiosynth {
+
+constexpr const char* kSpacingWords[] = {"terminals", "segments", nullptr};
+constexpr const char* kBifurcationWords[] = {"exact", "kamiya", nullptr};
+
+// [tree]'s settings of one tree or of each kind of a forest.
+const std::vector<Setting<CcoOptions>>& ccoSettings() {
+  using O = CcoOptions;
+  static const std::vector<Setting<O>> settings{
+      {.table = "tree", .key = "terminals", .unit = "count", .fallback = nullptr, .meaning = "N, the number of terminal segments",
+       .field = &O::terminals, .range = {1, Limits::kMaxTerminals}},
+      {.table = "tree", .key = "closest_neighbours", .unit = "count", .fallback = "20", .meaning = "ν, the nearest segments tried per terminal",
+       .field = &O::closest_neighbours, .range = {1, Limits::kMaxNeighbours}, .fallback_is_value = true},
+      {.table = "tree", .key = "max_closest_neighbours", .unit = "count", .fallback = "closest_neighbours",
+       .meaning = "in 3D, ν doubles up to this while no candidate connects (never in 2D); at least closest_neighbours; equal to it (the default), "
+                  "ν stays, as doubling joins points to far segments by long, heavy connections",
+       .field = &O::max_neighbours, .range = {1, Limits::kMaxNeighbours * 64}},
+      {.table = "tree", .key = "kamiya_iterations", .unit = "count", .fallback = "100", .meaning = "iterations of Kamiya's bifurcation solver",
+       .field = &O::kamiya_iterations, .range = {1, 100000}, .fallback_is_value = true},
+      {.table = "tree", .key = "kamiya_tolerance", .unit = "", .fallback = "1e-6", .meaning = "its step, relative to the three lengths, at convergence",
+       .field = &O::kamiya_tolerance, .range = {0, 1, true, false}, .fallback_is_value = true},
+      {.table = "tree", .key = "draws_before_relaxing", .unit = "count", .fallback = "100", .meaning = "failed draws before the distance threshold shrinks",
+       .field = &O::draws_before_relaxing, .range = {1, 1000000}, .fallback_is_value = true},
+      {.table = "tree", .key = "relaxation", .unit = "", .fallback = "0.9", .meaning = "the factor on the distance threshold after such a run",
+       .field = &O::relaxation, .range = {0, 1, true, false}, .fallback_is_value = true},
+      {.table = "tree", .key = "spacing_from", .unit = "terminals/segments", .fallback = "terminals",
+       .meaning = "a drawn terminal keeps delta_max from the terminal points (Kerautret et al.'s Algorithm 2, OpenCCO's code) or from every "
+                  "segment (its §3.3.2 wording; evenly spread terminals, long connections, 10 % more volume); either way it lies outside every vessel",
+       .field = enumChoice<O, &O::spacing_from, kSpacingWords>(), .choices = wordList(kSpacingWords), .fallback_is_value = true},
+      {.table = "tree", .key = "bifurcation", .unit = "exact/kamiya", .fallback = "exact",
+       .meaning = "each connection's bifurcation: the lighter of Kamiya's fixed point and the exact minimum of the tree's volume (which "
+                  "slides along l = 2r), or Kamiya's point alone (as in OpenCCO, Kerautret et al.)",
+       .field = enumChoice<O, &O::bifurcation, kBifurcationWords>(), .choices = wordList(kBifurcationWords), .fallback_is_value = true},
+  };
+  return settings;
+}
+
+const std::vector<SettingRule<CcoOptions>>& ccoRules() {
+  static const std::vector<SettingRule<CcoOptions>> rules{
+      {{"max_closest_neighbours"}, [](const CcoOptions& o) {
+         return o.max_neighbours >= o.closest_neighbours
+                    ? std::string()
+                    : "max_closest_neighbours = " + std::to_string(o.max_neighbours) + " is below closest_neighbours = " +
+                          std::to_string(o.closest_neighbours) + "; allowed: at least closest_neighbours";
+       }}};
+  return rules;
+}
+
+// Kerautret et al. (OpenCCO) §5 after Karch 1999: 3.6 cP, written in Pa*s, since "3.6 cP" parses one ulp off 3.6e-3.
+const std::vector<Setting<PhysicsParameters>>& ccoPhysics() {
+  static const std::vector<Setting<PhysicsParameters>> settings{
+      physicsSetting("murray_exponent", "3"), physicsSetting("viscosity", "0.0036 Pa*s"), physicsSetting("perfusion_pressure", "100 mmHg"),
+      physicsSetting("terminal_pressure", "60 mmHg"), physicsSetting("perfusion_flow", "500 mL/min")};
+  return settings;
+}
+
 namespace {
 
 using Json = nlohmann::ordered_json;
@@ -249,24 +304,13 @@ std::shared_ptr<const GrowthSetup> readCcoToml(const TomlReader& r, const Growth
   s->domain = readDomainSpec(r, dom, path);
 
   auto& c = s->cco;
-  c.terminals = readTerminals(r, tree, s->terminals_line);
-  const auto whole = [&](const char* key, int& out, int lo, int hi) { out = declaredCount(r, m, tree, "tree", key, lo, hi); };
-  whole("closest_neighbours", c.closest_neighbours, 1, Limits::kMaxNeighbours);
-  c.physics = readPhysics(r, m, methodTable(r, m, "physics"));
+  readSettingsFrom(r, tree, "tree", ccoSettings(), c, s->domain.voxel_mm);
+  if (!tree.get("max_closest_neighbours")) c.max_neighbours = c.closest_neighbours;
+  checkRules(ccoRules(), c, keysIn(r, tree), Where{file, r.lineOf(&tree)});
+  s->terminals_line = r.lineOf(tree.get("terminals"));
+  c.physics = readPhysics(r, ccoPhysics(), methodTable(r, m, "physics"));
   c.physics.total_terminals = c.terminals;
   readInlets(r, m, tree, *s);
-  whole("max_closest_neighbours", c.max_neighbours, c.closest_neighbours, Limits::kMaxNeighbours * 64);
-  // Unset, ν stays whatever its value (the fallback is the default ν's).
-  if (!tree.get("max_closest_neighbours")) c.max_neighbours = c.closest_neighbours;
-  c.max_neighbours = std::max(c.max_neighbours, c.closest_neighbours);
-  whole("kamiya_iterations", c.kamiya_iterations, 1, 100000);
-  whole("draws_before_relaxing", c.draws_before_relaxing, 1, 1000000);
-  c.kamiya_tolerance = declaredNumber(r, m, tree, "tree", "kamiya_tolerance");
-  checkRange(c.kamiya_tolerance, 0, true, 1, true, r.at(tree, "kamiya_tolerance"), "kamiya_tolerance");
-  c.relaxation = declaredNumber(r, m, tree, "tree", "relaxation");
-  checkRange(c.relaxation, 0, true, 1, true, r.at(tree, "relaxation"), "relaxation");
-  c.spacing_from_segments = choice<bool>(r, tree, "tree", "spacing_from", false, {{"terminals", false}, {"segments", true}});
-  c.exact_bifurcations = choice<bool>(r, tree, "tree", "bifurcation", true, {{"exact", true}, {"kamiya", false}});
   return s;
 }
 
@@ -298,17 +342,8 @@ Json CcoSetup::describe() const {
   }
   if (!inlet_tables) describeRoot(inlets.front().root, j);
   if (d.voxel_mm > 0) j["voxel_size"] = quantityJson(d.voxel_mm, "mm");
-  j["terminals"] = c.terminals;
-  j["closest_neighbours"] = c.closest_neighbours;
-  j["max_closest_neighbours"] = c.max_neighbours;
-  j["kamiya_iterations"] = c.kamiya_iterations;
-  j["kamiya_tolerance"] = c.kamiya_tolerance;
-  j["draws_before_relaxing"] = c.draws_before_relaxing;
-  j["relaxation"] = c.relaxation;
-  j["spacing_from"] = c.spacing_from_segments ? "segments" : "terminals";
-  j["bifurcation"] = c.exact_bifurcations ? "exact" : "kamiya";
-  j["murray_exponent"] = c.physics.murray_exponent;
-  describePhysics(c.physics, c.terminals, j);
+  j.update(settingsJson(ccoSettings(), c));
+  describePhysics(ccoPhysics(), c.physics, c.terminals, j);
   if (inlet_tables) {
     j["terminals_per"] = "kind: each kind of inlet perfuses (or drains) the whole domain with this many terminals";
     Json list = Json::array();
@@ -338,18 +373,8 @@ const GrowthMethod kCcoMethod{
     "constrained constructive optimisation (Karch 1999; Kerautret et al., OpenCCO) in a sphere, cube, disc, square or mask: the "
     "domain grows with the tree, each terminal joins the one of its nearest segments whose Kamiya bifurcation gives the "
     "least total volume, no vessel leaves the domain or overlaps another",
-    // Kerautret et al. (OpenCCO) §5 after Karch 1999: 3.6 cP, written in Pa*s, since "3.6 cP" parses one ulp off 3.6e-3.
-    withPhysicsParams(withDomainParams("sphere, cube, disc or square (2D), or mask",
-                                       "masks: terminals drawn uniformly, or ∝ the mask value (demand)", {
-        {"tree", "terminals", "count", nullptr, "N, the number of terminal segments"},
-        {"tree", "closest_neighbours", "count", "20", "ν, the nearest segments tried per terminal"},
-        {"tree", "max_closest_neighbours", "count", "20", "in 3D, ν doubles up to this while no candidate connects (never in 2D); unset or at most closest_neighbours: ν stays, as doubling joins points to far segments by long, heavy connections"},
-        {"tree", "kamiya_iterations", "count", "100", "iterations of Kamiya's bifurcation solver"},
-        {"tree", "kamiya_tolerance", "", "1e-6", "its step, relative to the three lengths, at convergence"},
-        {"tree", "draws_before_relaxing", "count", "100", "failed draws before the distance threshold shrinks"},
-        {"tree", "relaxation", "", "0.9", "the factor on the distance threshold after such a run"},
-        {"tree", "spacing_from", "terminals/segments", "terminals", "a drawn terminal keeps delta_max from the terminal points (Kerautret et al.'s Algorithm 2, OpenCCO's code) or from every segment (its §3.3.2 wording; evenly spread terminals, long connections, 10 % more volume); either way it lies outside every vessel"},
-        {"tree", "bifurcation", "exact/kamiya", "exact", "each connection's bifurcation: the lighter of Kamiya's fixed point and the exact minimum of the tree's volume (which slides along l = 2r), or Kamiya's point alone (as in OpenCCO, Kerautret et al.)"},
+    withDomainParams("sphere, cube, disc or square (2D), or mask",
+                     "masks: terminals drawn uniformly, or ∝ the mask value (demand)", joinRows({settingRows(ccoSettings()), {
         {"tree.inlet", "id", "text", "its kind (kind_1, kind_2, ... when several)", "the tree's name in graphs and sample.json"},
         {"tree.inlet", "kind", "text", "artery", "artery, vein or a free name; inlets of one kind compete for its `terminals`, each kind fills the domain"},
         {"tree.inlet", "root_offset", "[x, y(, z)] mm", nullptr, "analytic shapes: the root relative to the centre"},
@@ -358,7 +383,7 @@ const GrowthMethod kCcoMethod{
         {"tree.inlet", "share", "", "territory", "its fixed share (0, 1] of its kind's terminals and flow, or \"territory\": what it wins"},
         {"tree.inlet", "root_pressure", "Pa", "[physics] perfusion_pressure; vein 5 mmHg", "pressure at its root (a vein's outlet)"},
         {"tree.inlet", "terminal_pressure", "Pa", "[physics] terminal_pressure; vein 20 mmHg", "pressure at its terminals (above the root: it drains)"},
-    }), false, "0.0036 Pa*s", "100 mmHg", "60 mmHg", "500 mL/min"),
+    }, settingRows(ccoPhysics())})),
     &readCcoToml};
 
 }  // namespace angiosynth

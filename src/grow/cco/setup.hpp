@@ -8,6 +8,7 @@
 #include "grow/common/domain_spec.hpp"
 #include "grow/cco/grower.hpp"
 #include "grow/method.hpp"
+#include "settings/schema.hpp"
 
 namespace angiosynth {
 
@@ -41,5 +42,8 @@ struct CcoSetup final : GrowthSetup {
 };
 
 extern const GrowthMethod kCcoMethod;
+// Its [tree] and [physics] settings (the inlets' tables are read beside them).
+const std::vector<Setting<CcoOptions>>& ccoSettings();
+const std::vector<Setting<PhysicsParameters>>& ccoPhysics();
 
 }  // namespace angiosynth

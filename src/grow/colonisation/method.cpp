@@ -22,6 +22,106 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
+constexpr const char* kSpreadWords[] = {"sd", "rms", nullptr};
+constexpr const char* kSourceWords[] = {"volume", "surface", nullptr};
+
+const std::vector<Setting<ColonisationOptions>>& colonisationSettings() {
+  using O = ColonisationOptions;
+  static const std::vector<Setting<O>> settings{
+      {.table = "tree", .key = "veins", .unit = "true/false", .fallback = "true", .meaning = "grow the venous system (needs a vein root)",
+       .field = &O::veins},
+      {.table = "tree", .key = "sigma0", .unit = "", .fallback = "1", .meaning = "σ_0, the tissue's initial size (σ_t = σ_0 + Σ Δσ)",
+       .field = &O::sigma0, .range = {0, 1e6, true, false}, .fallback_is_value = true},
+      {.table = "tree", .key = "avoid_crossing", .unit = "true/false", .fallback = "false",
+       .meaning = "no new vessel comes closer to another than their radii", .field = &O::avoid_crossing},
+  };
+  return settings;
+}
+
+// A [[stage]]'s settings but its lengths.
+const std::vector<Setting<ColonisationStage>>& stageSettings() {
+  using O = ColonisationStage;
+  static const std::vector<Setting<O>> settings{
+      {.table = "stage", .key = "name", .unit = "text", .fallback = "stage_1, stage_2, ...", .meaning = "the stage's name in sample.json",
+       .field = &O::name},
+      {.table = "stage", .key = "steps", .unit = "count", .fallback = "100", .meaning = "iterations of the stage",
+       .field = &O::steps, .range = {1, 100000}, .fallback_is_value = true},
+      {.table = "stage", .key = "drains_per_step", .unit = "count", .fallback = "1000", .meaning = "oxygen drains sampled per step",
+       .field = &O::drains_per_step, .range = {1, 10000000}, .fallback_is_value = true},
+      {.table = "stage", .key = "drain_lifetime", .unit = "count", .fallback = "1",
+       .meaning = "steps an unsatisfied drain (or CO2 source) lives (0: until satisfied); satisfied drains go at once",
+       .field = &O::drain_lifetime, .range = {0, 1000000}, .fallback_is_value = true},
+      {.table = "stage", .key = "delta_sigma", .unit = "", .fallback = "0.02", .meaning = "Δσ, tissue growth per step",
+       .field = &O::delta_sigma, .range = {0, 100}, .fallback_is_value = true},
+      {.table = "stage", .key = "perception_angle", .unit = "deg", .fallback = "90", .meaning = "γ, the full angle of the perception cone",
+       .field = &O::perception_angle, .range = {0, 360, true, false}, .fallback_is_value = true},
+      {.table = "stage", .key = "bias", .unit = "", .fallback = "0.5",
+       .meaning = "ω in [0, 1]: weight of the current (or Murray-branch) direction against the drains' mean",
+       .field = &O::bias, .range = {0, 1}, .fallback_is_value = true},
+      {.table = "stage", .key = "bifurcation_spread", .unit = "deg", .fallback = "10", .meaning = "φ: a leaf splits when its drains' angular spread exceeds it",
+       .field = &O::bifurcation_spread, .range = {0, 180}, .fallback_is_value = true},
+      {.table = "stage", .key = "spread_statistic", .unit = "text", .fallback = "sd",
+       .meaning = "sd (the standard deviation of the angles to their mean direction, as the paper) or rms (their root mean square)",
+       .field = enumChoice<O, &O::spread, kSpreadWords>(), .choices = wordList(kSpreadWords), .fallback_is_value = true},
+      {.table = "stage", .key = "lateral", .unit = "true/false", .fallback = "true", .meaning = "inter-nodes may take lateral branches",
+       .field = &O::lateral},
+      {.table = "stage", .key = "source", .unit = "text", .fallback = "volume",
+       .meaning = "volume: drains anywhere in the stage's region; surface: within surface_depth of the border",
+       .field = enumChoice<O, &O::source, kSourceWords>(), .choices = wordList(kSourceWords), .fallback_is_value = true},
+  };
+  return settings;
+}
+
+// A [[stage]]'s lengths: given in mm, or a share of the domain's diameter (the fallback's "× f").
+const std::vector<Setting<ColonisationStageSpec>>& stageLengthSettings() {
+  using O = ColonisationStageSpec;
+  const auto length = [](const char* key, const char* fallback, const char* meaning, std::optional<double> O::*field) {
+    return Setting<O>{.table = "stage", .key = key, .unit = "mm", .fallback = fallback, .meaning = meaning, .field = field,
+                      .range = {0, Limits::kMaxLength}, .quantity = Dimension::Length};
+  };
+  static const std::vector<Setting<O>> settings{
+      length("step", "[domain] diameter × 0.008", "d, the growth step (at the last step; × σ_T/σ_t at step t)", &O::step),
+      length("perception_distance", "[domain] diameter × 0.04", "δ, how far a node perceives drains", &O::perception_distance),
+      length("satisfaction_distance", "[domain] diameter × 0.01", "a drain this close to a node of its system is supplied", &O::satisfaction_distance),
+      length("co2_distance", "[domain] diameter × 0.04",
+             "tissue this close to an artery makes CO2: a drain for the veins (unless a vein is within satisfaction_distance)", &O::co2_distance),
+      length("drain_spacing", "[domain] diameter × 0.005", "minimum distance between drains", &O::drain_spacing),
+      length("terminal_radius", "[domain] diameter × 0.0004", "r, the radius of every leaf", &O::terminal_radius),
+      length("surface_depth", "[domain] diameter × 0.01", "source = surface: the shell drains and new nodes lie in", &O::surface_depth),
+  };
+  return settings;
+}
+
+// A stage length in mm: as given, or its declared share of the domain's diameter.
+double stageLength(const ColonisationStageSpec& spec, std::optional<double> ColonisationStageSpec::*field, double diameter) {
+  if (spec.*field) return *(spec.*field);
+  for (const auto& s : stageLengthSettings())
+    if (std::get<std::optional<double> ColonisationStageSpec::*>(s.field) == field) {
+      const std::string fallback = s.fallback;
+      return std::stod(fallback.substr(fallback.find("× ") + 3)) * diameter;
+    }
+  throw std::logic_error("an undeclared stage length");
+}
+
+const std::vector<Setting<PhysicsParameters>>& colonisationPhysics() {
+  static const std::vector<Setting<PhysicsParameters>> settings = [] {
+    auto murray = physicsSetting("murray_exponent", "2.55");
+    murray.meaning = "κ in (2, 4): r_p^κ = r_a^κ + r_b^κ";
+    murray.range = {2, 4, true, true};
+    auto viscosity = physicsSetting("viscosity", "0.0036 Pa*s");
+    viscosity.meaning = "blood viscosity η (flows and pressures of the outputs)";
+    auto pressure = physicsSetting("perfusion_pressure", "100 mmHg");
+    pressure.meaning = "pressure at the arterial roots";
+    auto venous = physicsSetting("terminal_pressure", "5 mmHg");
+    venous.key = "venous_pressure";
+    venous.meaning = "pressure at the venous roots";
+    auto flow = physicsSetting("perfusion_flow", "1 mL/min");
+    flow.meaning = "Q, split equally among the leaves of each system";
+    return std::vector<Setting<PhysicsParameters>>{murray, viscosity, pressure, venous, flow};
+  }();
+  return settings;
+}
+
 class PreparedColonisation final : public PreparedGrowth {
  public:
   PreparedColonisation(const ColonisationSetup& s, GrowthDomain loaded) : setup_(s), loaded_(std::move(loaded)) {
@@ -38,13 +138,14 @@ class PreparedColonisation final : public PreparedGrowth {
     const double diameter = diameterOf(loaded_);
     for (const auto& spec : s.stages) {
       auto st = spec.stage;
-      st.step = spec.step.resolve(diameter);
-      st.perception_distance = spec.perception_distance.resolve(diameter);
-      st.satisfaction_distance = spec.satisfaction_distance.resolve(diameter);
-      st.co2_distance = spec.co2_distance.resolve(diameter);
-      st.drain_spacing = spec.drain_spacing.resolve(diameter);
-      st.terminal_radius = spec.terminal_radius.resolve(diameter);
-      st.surface_depth = spec.surface_depth.resolve(diameter);
+      using Spec = ColonisationStageSpec;
+      st.step = stageLength(spec, &Spec::step, diameter);
+      st.perception_distance = stageLength(spec, &Spec::perception_distance, diameter);
+      st.satisfaction_distance = stageLength(spec, &Spec::satisfaction_distance, diameter);
+      st.co2_distance = stageLength(spec, &Spec::co2_distance, diameter);
+      st.drain_spacing = stageLength(spec, &Spec::drain_spacing, diameter);
+      st.terminal_radius = stageLength(spec, &Spec::terminal_radius, diameter);
+      st.surface_depth = stageLength(spec, &Spec::surface_depth, diameter);
       if (spec.domain.empty()) {
         st.drains = &world;
       } else {
@@ -176,6 +277,14 @@ class PreparedColonisation final : public PreparedGrowth {
     stats["elongations"] = cr_.elongations;
     stats["outside_rejected"] = cr_.outside_rejected;
     stats["crossing_rejected"] = cr_.crossing_rejected;
+    // Each stage's lengths in mm, as the domain's diameter resolved them (the sidecar's parameters give the rule).
+    Json lengths = Json::array();
+    for (const auto& st : options_.stages)
+      lengths.push_back(Json{{"stage", st.name}, {"step", quantityJson(st.step, "mm")}, {"perception_distance", quantityJson(st.perception_distance, "mm")},
+                             {"satisfaction_distance", quantityJson(st.satisfaction_distance, "mm")}, {"co2_distance", quantityJson(st.co2_distance, "mm")},
+                             {"drain_spacing", quantityJson(st.drain_spacing, "mm")}, {"terminal_radius", quantityJson(st.terminal_radius, "mm")},
+                             {"surface_depth", quantityJson(st.surface_depth, "mm")}});
+    stats["stage_lengths"] = lengths;
     if (setup_.options.avoid_crossing) {
       stats["crossing_pruned"] = cr_.pruned;
       stats["crossing_pruned_definition"] = "branches removed after growth because Murray's law had thickened vessels into each other";
@@ -251,52 +360,17 @@ class PreparedColonisation final : public PreparedGrowth {
   mutable ColonisationReport cr_;
 };
 
-DomainLength readLength(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const char* key) {
-  DomainLength l;
-  if (t.get(key)) {
-    l.value = r.quantity(t, "stage", key, Dimension::Length);
-    l.of_diameter = false;
-    checkRange(l.value, 0, false, Limits::kMaxLength, false, r.at(t, key), std::string(key) + " (mm)");
-    return l;
-  }
-  // The declared default: "[domain] diameter × f".
-  const std::string fallback = findParam(m, "stage", key)->fallback;
-  l.value = std::stod(fallback.substr(fallback.find("× ") + 3));
-  return l;
-}
-
 ColonisationStageSpec readStage(const TomlReader& r, const GrowthMethod& m, const toml::table& t, int index,
                                 const std::set<std::string>& regions) {
   checkMethodKeys(r, m, t, "stage");
   ColonisationStageSpec spec;
   spec.line = r.lineOf(&t);
   auto& st = spec.stage;
-  st.name = t.get("name") ? r.string(t, "stage", "name") : "stage_" + std::to_string(index + 1);
-  st.steps = declaredCount(r, m, t, "stage", "steps", 1, 100000);
-  st.drains_per_step = declaredCount(r, m, t, "stage", "drains_per_step", 1, 10000000);
-  st.drain_lifetime = declaredCount(r, m, t, "stage", "drain_lifetime", 0, 1000000);
-  const auto number = [&](const char* key, double lo, bool lo_open, double hi, bool hi_open) {
-    const double v = declaredNumber(r, m, t, "stage", key);
-    checkRange(v, lo, lo_open, hi, hi_open, r.at(t, key), key);
-    return v;
-  };
-  st.delta_sigma = number("delta_sigma", 0, false, 100, false);
-  st.perception_angle = number("perception_angle", 0, true, 360, false);
-  st.bias = number("bias", 0, false, 1, false);
-  st.bifurcation_spread = number("bifurcation_spread", 0, false, 180, false);
-  st.spread = choice<SpreadStatistic>(r, t, "stage", "spread_statistic", SpreadStatistic::StandardDeviation,
-                                      {{"sd", SpreadStatistic::StandardDeviation}, {"rms", SpreadStatistic::RootMeanSquare}});
-  st.lateral = r.boolean(t, "lateral", true);
-  st.source = choice<DrainSource>(r, t, "stage", "source", DrainSource::Volume, {{"volume", DrainSource::Volume}, {"surface", DrainSource::Surface}});
+  st.name = "stage_" + std::to_string(index + 1);
+  readSettingsFrom(r, t, "stage", stageSettings(), st, 0);
+  readSettingsFrom(r, t, "stage", stageLengthSettings(), spec, 0);
   for (const char* key : {"step", "terminal_radius"})
     if (t.get(key)) spec.lines[key] = r.lineOf(t.get(key));
-  spec.step = readLength(r, m, t, "step");
-  spec.perception_distance = readLength(r, m, t, "perception_distance");
-  spec.satisfaction_distance = readLength(r, m, t, "satisfaction_distance");
-  spec.co2_distance = readLength(r, m, t, "co2_distance");
-  spec.drain_spacing = readLength(r, m, t, "drain_spacing");
-  spec.terminal_radius = readLength(r, m, t, "terminal_radius");
-  spec.surface_depth = readLength(r, m, t, "surface_depth");
   spec.domain = regionNames(r, t, "domain", regions);
   return spec;
 }
@@ -374,10 +448,7 @@ std::shared_ptr<const GrowthSetup> readColonisationToml(const TomlReader& r, con
   const auto [dom, tree, ph, domain, flat] = readMethodFileTables(r, m);
   s->domain = domain;
   auto& o = s->options;
-  o.veins = r.boolean(tree, "veins", true);
-  o.avoid_crossing = r.boolean(tree, "avoid_crossing", false);
-  o.sigma0 = declaredNumber(r, m, tree, "tree", "sigma0");
-  checkRange(o.sigma0, 0, true, 1e6, false, r.at(tree, "sigma0"), "sigma0");
+  readSettingsFrom(r, tree, "tree", colonisationSettings(), o, domain.voxel_mm);
   if (const auto* node = r.root().get("initial")) {
     auto in = readInitialNetwork(r, m, *node, flat);
     s->initial_file = in.file;
@@ -386,18 +457,8 @@ std::shared_ptr<const GrowthSetup> readColonisationToml(const TomlReader& r, con
     s->initial_kind = choice<std::string>(r, *node->as_table(), "initial", "kind", "artery", {{"artery", "artery"}, {"vein", "vein"}});
   }
   readRoots(r, m, tree, *s, flat);
-  auto& p = s->physics_summary;
-  p.murray_exponent = declaredNumber(r, m, ph, "physics", "murray_exponent");
-  checkRange(p.murray_exponent, 2, true, 4, true, r.at(ph, "murray_exponent"), "murray_exponent (κ of Rauch & Harders 2021)");
-  o.murray_exponent = p.murray_exponent;
-  p.viscosity = declaredQuantity(r, m, ph, "physics", "viscosity", Dimension::Viscosity);
-  checkRange(p.viscosity, Limits::kMinViscosity, false, Limits::kMaxViscosity, false, r.at(ph, "viscosity"), "viscosity (Pa*s)");
-  p.perfusion_pressure = declaredQuantity(r, m, ph, "physics", "perfusion_pressure", Dimension::Pressure);
-  checkRange(p.perfusion_pressure, 0, false, Limits::kMaxPressure, false, r.at(ph, "perfusion_pressure"), "perfusion_pressure (Pa)");
-  p.terminal_pressure = declaredQuantity(r, m, ph, "physics", "venous_pressure", Dimension::Pressure);
-  checkRange(p.terminal_pressure, 0, false, Limits::kMaxPressure, false, r.at(ph, "venous_pressure"), "venous_pressure (Pa)");
-  p.perfusion_flow = declaredQuantity(r, m, ph, "physics", "perfusion_flow", Dimension::Flow);
-  checkRange(p.perfusion_flow, Limits::kMinFlow, false, Limits::kMaxFlow, false, r.at(ph, "perfusion_flow"), "perfusion_flow (mm^3/s)");
+  s->physics_summary = readPhysics(r, colonisationPhysics(), ph);
+  o.murray_exponent = s->physics_summary.murray_exponent;
   s->regions = readRegions(r, m, flat);
   std::set<std::string> names;
   for (const auto& g : s->regions) names.insert(g.name);
@@ -437,10 +498,7 @@ Json ColonisationSetup::describe() const {
     j[domain.shape == DomainShape::Sphere || domain.shape == DomainShape::Disc ? "radius" : "side"] = quantityJson(domain.size_mm, "mm");
   }
   if (domain.voxel_mm > 0) j["voxel_size"] = quantityJson(domain.voxel_mm, "mm");
-  j["murray_exponent"] = options.murray_exponent;
-  j["sigma0"] = options.sigma0;
-  j["veins"] = options.veins;
-  j["avoid_crossing"] = options.avoid_crossing;
+  j.update(settingsJson(colonisationSettings(), options));
   j["frame"] = "lengths are their values at the last step; at step t they are scaled by sigma_T / sigma_t";
   Json roots_json = Json::array();
   for (const auto& r : roots) {
@@ -459,28 +517,15 @@ Json ColonisationSetup::describe() const {
     j["initial"] = Json{{"file", initial_file.string()}, {"kind", initial_kind}, {"origin", initial_from_corner ? "corner" : "centre"},
                         {"vessels", initial.tree.segmentCount()}, {"roots", initial.tree.roots().size()}};
   Json st = Json::array();
-  const auto length = [](const DomainLength& l) {
-    return l.of_diameter ? Json{{"value", l.value}, {"unit", "domain diameter"}} : quantityJson(l.value, "mm");
-  };
   for (const auto& spec : stages) {
-    const auto& s = spec.stage;
-    Json e{{"name", s.name}, {"steps", s.steps}, {"drains_per_step", s.drains_per_step}, {"drain_lifetime", s.drain_lifetime}, {"delta_sigma", s.delta_sigma},
-           {"step", length(spec.step)}, {"perception_distance", length(spec.perception_distance)},
-           {"perception_angle", quantityJson(s.perception_angle, "deg")}, {"satisfaction_distance", length(spec.satisfaction_distance)}, {"co2_distance", length(spec.co2_distance)},
-           {"drain_spacing", length(spec.drain_spacing)}, {"terminal_radius", length(spec.terminal_radius)}, {"bias", s.bias},
-           {"bifurcation_spread", quantityJson(s.bifurcation_spread, "deg")},
-           {"spread_statistic", s.spread == SpreadStatistic::StandardDeviation ? "sd" : "rms"}, {"lateral", s.lateral},
-           {"source", s.source == DrainSource::Volume ? "volume" : "surface"}};
-    if (s.source == DrainSource::Surface) e["surface_depth"] = length(spec.surface_depth);
+    Json e = settingsJson(stageSettings(), spec.stage);
+    e.update(settingsJson(stageLengthSettings(), spec));
     if (!spec.domain.empty()) e["domain"] = spec.domain;
     st.push_back(e);
   }
   j["stages"] = st;
   if (!avascular.empty()) j["avascular"] = avascular;
-  j["viscosity"] = quantityJson(physics_summary.viscosity, "Pa*s");
-  j["perfusion_pressure"] = quantityJson(physics_summary.perfusion_pressure, "Pa");
-  j["venous_pressure"] = quantityJson(physics_summary.terminal_pressure, "Pa");
-  j["perfusion_flow"] = quantityJson(physics_summary.perfusion_flow, "mm^3/s");
+  j.update(settingsJson(colonisationPhysics(), physics_summary));
   return j;
 }
 
@@ -496,10 +541,7 @@ const GrowthMethod kColonisationMethod{
     "inside a perception cone, inter-nodes in the Murray-angle shell of a lateral branch, symmetric bifurcations at Murray's "
     "angles when the drains spread wider than φ, radii by Murray's law with κ, tissue growth Δσ per step, in stages with "
     "their own parameters and regions; no node or centreline leaves the domain",
-    withRegionParams(withDomainParams("sphere, cube, disc or square (2D), or mask", "masks: drains drawn uniformly, or ∝ the mask value (demand)", {
-        {"tree", "veins", "true/false", "true", "grow the venous system (needs a vein root)"},
-        {"tree", "sigma0", "", "1", "σ_0, the tissue's initial size (σ_t = σ_0 + Σ Δσ)"},
-        {"tree", "avoid_crossing", "true/false", "false", "no new vessel comes closer to another than their radii"},
+    withRegionParams(withDomainParams("sphere, cube, disc or square (2D), or mask", "masks: drains drawn uniformly, or ∝ the mask value (demand)", joinRows({settingRows(colonisationSettings()), {
         {"tree", "avascular", "region names", "none", "regions no vessel enters (a foveal avascular zone)"},
         {"initial", "file", "path", "none", "an existing network whose trees grow on (stumps; .swc, .vtp, .gxl, .csv, VItA's .cco); every node must lie in the domain"},
         {"initial", "kind", "text", "artery", "the kind of its trees: artery or vein"},
@@ -511,31 +553,9 @@ const GrowthMethod kColonisationMethod{
         {"tree.inlet", "root", "[x, y, z] mm", nullptr, "masks: the root in mm in the frame (or root_voxel)"},
         {"tree.inlet", "root_voxel", "[x, y, z] mask voxels", nullptr, "masks: the root in voxels (or root)"},
         {"tree.inlet", "direction", "[x, y(, z)]", "toward the domain's centre", "where the root vessel heads"},
-        {"physics", "murray_exponent", "", "2.55", "κ in (2, 4): r_p^κ = r_a^κ + r_b^κ"},
-        {"physics", "viscosity", "Pa*s", "0.0036 Pa*s", "blood viscosity η (flows and pressures of the outputs)"},
-        {"physics", "perfusion_pressure", "Pa", "100 mmHg", "pressure at the arterial roots"},
-        {"physics", "venous_pressure", "Pa", "5 mmHg", "pressure at the venous roots"},
-        {"physics", "perfusion_flow", "mm^3/s", "1 mL/min", "Q, split equally among the leaves of each system"},
-        {"stage", "name", "text", "stage_1, stage_2, ...", "the stage's name in sample.json"},
-        {"stage", "steps", "count", "100", "iterations of the stage"},
-        {"stage", "drains_per_step", "count", "1000", "oxygen drains sampled per step"},
-        {"stage", "drain_lifetime", "count", "1", "steps an unsatisfied drain (or CO2 source) lives (0: until satisfied); satisfied drains go at once"},
-        {"stage", "delta_sigma", "", "0.02", "Δσ, tissue growth per step"},
-        {"stage", "step", "mm", "[domain] diameter × 0.008", "d, the growth step (at the last step; × σ_T/σ_t at step t)"},
-        {"stage", "perception_distance", "mm", "[domain] diameter × 0.04", "δ, how far a node perceives drains"},
-        {"stage", "perception_angle", "deg", "90", "γ, the full angle of the perception cone"},
-        {"stage", "satisfaction_distance", "mm", "[domain] diameter × 0.01", "a drain this close to a node of its system is supplied"},
-        {"stage", "co2_distance", "mm", "[domain] diameter × 0.04", "tissue this close to an artery makes CO2: a drain for the veins (unless a vein is within satisfaction_distance)"},
-        {"stage", "drain_spacing", "mm", "[domain] diameter × 0.005", "minimum distance between drains"},
-        {"stage", "terminal_radius", "mm", "[domain] diameter × 0.0004", "r, the radius of every leaf"},
-        {"stage", "bias", "", "0.5", "ω in [0, 1]: weight of the current (or Murray-branch) direction against the drains' mean"},
-        {"stage", "bifurcation_spread", "deg", "10", "φ: a leaf splits when its drains' angular spread exceeds it"},
-        {"stage", "spread_statistic", "text", "sd", "sd (the standard deviation of the angles to their mean direction, as the paper) or rms (their root mean square)"},
-        {"stage", "lateral", "true/false", "true", "inter-nodes may take lateral branches"},
-        {"stage", "source", "text", "volume", "volume: drains anywhere in the stage's region; surface: within surface_depth of the border"},
-        {"stage", "surface_depth", "mm", "[domain] diameter × 0.01", "source = surface: the shell drains and new nodes lie in"},
+    }, settingRows(colonisationPhysics()), settingRows(stageSettings()), settingRows(stageLengthSettings()), {
         {"stage", "domain", "region names", "the whole domain", "the regions its drains are sampled in (a plexus)"},
-    }), "the region's name, used by [tree] avascular and [[stage]] domain"),
+    }})), "the region's name, used by [tree] avascular and [[stage]] domain"),
     &readColonisationToml};
 
 }  // namespace angiosynth

@@ -1,6 +1,7 @@
 #pragma once
 // Method "colonisation": space colonisation of arterial and venous trees (Rauch & Harders 2021) in an
 // analytic shape or a mask, in stages with their own parameters and regions.
+#include <optional>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -14,15 +15,10 @@
 namespace angiosynth {
 
 // A length as the file gives it: mm, or (absent) a fraction of the domain's diameter.
-struct DomainLength {
-  double value = 0;
-  bool of_diameter = true;
-  double resolve(double diameter) const { return of_diameter ? value * diameter : value; }
-};
-
 struct ColonisationStageSpec {
   ColonisationStage stage;  // lengths filled in by prepare()
-  DomainLength step, perception_distance, satisfaction_distance, co2_distance, drain_spacing, terminal_radius, surface_depth;
+  // The lengths as the file gives them (mm); unset: their declared share of the domain's diameter.
+  std::optional<double> step, perception_distance, satisfaction_distance, co2_distance, drain_spacing, terminal_radius, surface_depth;
   std::vector<std::string> domain;  // regions its drains come from (empty: the whole domain)
   int line = 0;
   std::map<std::string, int> lines;  // the lines of keys checked against the domain once it is loaded

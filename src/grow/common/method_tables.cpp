@@ -73,41 +73,55 @@ int declaredCount(const TomlReader& r, const GrowthMethod& m, const toml::table&
   return std::stoi(fallback);
 }
 
-std::vector<MethodParam> withPhysicsParams(std::vector<MethodParam> rows, bool cost_exponents, const char* viscosity,
-                                           const char* perfusion_pressure, const char* terminal_pressure,
-                                           const char* perfusion_flow) {
-  rows.push_back({"physics", "murray_exponent", "", "3", "γ in r_parent^γ = r_a^γ + r_b^γ"});
-  if (cost_exponents) {
-    rows.push_back({"physics", "cost_radius_exponent", "", "2", "λ of the cost Σ l^μ r^λ"});
-    rows.push_back({"physics", "cost_length_exponent", "", "1", "μ of the cost Σ l^μ r^λ"});
-  }
-  rows.push_back({"physics", "viscosity", "Pa*s", viscosity, "blood viscosity η"});
-  rows.push_back({"physics", "perfusion_pressure", "Pa", perfusion_pressure, "pressure at the root"});
-  rows.push_back({"physics", "terminal_pressure", "Pa", terminal_pressure, "pressure at every terminal"});
-  rows.push_back({"physics", "perfusion_flow", "mm^3/s", perfusion_flow, "flow into the root, split equally among the terminals"});
+std::vector<MethodParam> joinRows(std::initializer_list<std::vector<MethodParam>> lists) {
+  std::vector<MethodParam> rows;
+  for (const auto& l : lists) rows.insert(rows.end(), l.begin(), l.end());
   return rows;
 }
 
-PhysicsParameters readPhysics(const TomlReader& r, const GrowthMethod& m, const toml::table& ph) {
+Setting<PhysicsParameters> physicsSetting(const char* key, const char* fallback) {
+  using P = PhysicsParameters;
+  static const std::vector<Setting<P>> shared{
+      {.table = "physics", .key = "murray_exponent", .unit = "", .fallback = nullptr, .meaning = "γ in r_parent^γ = r_a^γ + r_b^γ",
+       .field = &P::murray_exponent, .range = {Limits::kMinMurray, Limits::kMaxMurray, true, false}},
+      {.table = "physics", .key = "cost_radius_exponent", .unit = "", .fallback = nullptr, .meaning = "λ of the cost Σ l^μ r^λ",
+       .field = &P::cost_radius_exponent, .range = {0, Limits::kMaxCostExponent}},
+      {.table = "physics", .key = "cost_length_exponent", .unit = "", .fallback = nullptr, .meaning = "μ of the cost Σ l^μ r^λ",
+       .field = &P::cost_length_exponent, .range = {0, Limits::kMaxCostExponent}},
+      {.table = "physics", .key = "viscosity", .unit = "Pa*s", .fallback = nullptr, .meaning = "blood viscosity η",
+       .field = &P::viscosity, .range = {Limits::kMinViscosity, Limits::kMaxViscosity}, .quantity = Dimension::Viscosity},
+      {.table = "physics", .key = "perfusion_pressure", .unit = "Pa", .fallback = nullptr, .meaning = "pressure at the root",
+       .field = &P::perfusion_pressure, .range = {0, Limits::kMaxPressure}, .quantity = Dimension::Pressure},
+      {.table = "physics", .key = "terminal_pressure", .unit = "Pa", .fallback = nullptr, .meaning = "pressure at every terminal",
+       .field = &P::terminal_pressure, .range = {0, Limits::kMaxPressure}, .quantity = Dimension::Pressure},
+      {.table = "physics", .key = "perfusion_flow", .unit = "mm^3/s", .fallback = nullptr,
+       .meaning = "flow into the root, split equally among the terminals",
+       .field = &P::perfusion_flow, .range = {Limits::kMinFlow, Limits::kMaxFlow}, .quantity = Dimension::Flow},
+  };
+  for (auto s : shared)
+    if (std::string(s.key) == key) {
+      s.fallback = fallback;
+      s.fallback_is_value = fallback != nullptr;
+      return s;
+    }
+  throw std::logic_error(std::string("no shared [physics] setting ") + key);
+}
+
+const std::vector<SettingRule<PhysicsParameters>>& physicsRules() {
+  static const std::vector<SettingRule<PhysicsParameters>> rules{
+      {{"perfusion_pressure", "terminal_pressure"}, [](const PhysicsParameters& p) {
+         return p.perfusion_pressure - p.terminal_pressure >= Limits::kMinPressureDrop
+                    ? std::string()
+                    : std::string("perfusion_pressure must exceed terminal_pressure by at least 0.001 Pa");
+       }}};
+  return rules;
+}
+
+PhysicsParameters readPhysics(const TomlReader& r, const std::vector<Setting<PhysicsParameters>>& settings, const toml::table& ph) {
   PhysicsParameters p;
-  p.murray_exponent = declaredNumber(r, m, ph, "physics", "murray_exponent");
-  checkRange(p.murray_exponent, Limits::kMinMurray, true, Limits::kMaxMurray, false, r.at(ph, "murray_exponent"), "murray_exponent");
-  if (findParam(m, "physics", "cost_radius_exponent")) {
-    p.cost_radius_exponent = declaredNumber(r, m, ph, "physics", "cost_radius_exponent");
-    checkRange(p.cost_radius_exponent, 0, false, Limits::kMaxCostExponent, false, r.at(ph, "cost_radius_exponent"), "cost_radius_exponent");
-    p.cost_length_exponent = declaredNumber(r, m, ph, "physics", "cost_length_exponent");
-    checkRange(p.cost_length_exponent, 0, false, Limits::kMaxCostExponent, false, r.at(ph, "cost_length_exponent"), "cost_length_exponent");
-  }
-  p.viscosity = declaredQuantity(r, m, ph, "physics", "viscosity", Dimension::Viscosity);
-  checkRange(p.viscosity, Limits::kMinViscosity, false, Limits::kMaxViscosity, false, r.at(ph, "viscosity"), "viscosity (Pa*s)");
-  p.perfusion_pressure = declaredQuantity(r, m, ph, "physics", "perfusion_pressure", Dimension::Pressure);
-  p.terminal_pressure = declaredQuantity(r, m, ph, "physics", "terminal_pressure", Dimension::Pressure);
-  checkRange(p.terminal_pressure, 0, false, Limits::kMaxPressure, false, r.at(ph, "terminal_pressure"), "terminal_pressure (Pa)");
-  checkRange(p.perfusion_pressure, 0, false, Limits::kMaxPressure, false, r.at(ph, "perfusion_pressure"), "perfusion_pressure (Pa)");
-  if (!(p.perfusion_pressure - p.terminal_pressure >= Limits::kMinPressureDrop))
-    throw InputError(r.file(), r.lineOf(ph.get("perfusion_pressure")), "perfusion_pressure must exceed terminal_pressure by at least 0.001 Pa");
-  p.perfusion_flow = declaredQuantity(r, m, ph, "physics", "perfusion_flow", Dimension::Flow);
-  checkRange(p.perfusion_flow, Limits::kMinFlow, false, Limits::kMaxFlow, false, r.at(ph, "perfusion_flow"), "perfusion_flow (mm^3/s)");
+  readSettingsFrom(r, ph, "physics", settings, p, 0);
+  const auto keys = settingKeys(settings);
+  if (keys.count("perfusion_pressure") && keys.count("terminal_pressure")) checkRules(physicsRules(), p, keysIn(r, ph), Where{r.file(), r.lineOf(&ph)});
   return p;
 }
 
@@ -127,18 +141,10 @@ std::optional<Vec3> readRoot(const TomlReader& r, const toml::table& tree, Vec3&
   throw InputError(r.file(), r.lineOf(&tree), "missing key 'root' (mm) or 'root_voxel' (" + voxels + ") in [" + table + "]" + why_required);
 }
 
-std::int64_t readTerminals(const TomlReader& r, const toml::table& tree, int& line) {
-  const std::int64_t n = r.integer(tree, "tree", "terminals");
-  line = r.lineOf(tree.get("terminals"));
-  checkRange(double(n), 1, false, Limits::kMaxTerminals, false, r.at(tree, "terminals"), "terminals");
-  return n;
-}
 
-void describePhysics(const PhysicsParameters& p, std::int64_t terminals, nlohmann::ordered_json& j) {
-  j["viscosity"] = quantityJson(p.viscosity, "Pa*s");
-  j["perfusion_pressure"] = quantityJson(p.perfusion_pressure, "Pa");
-  j["terminal_pressure"] = quantityJson(p.terminal_pressure, "Pa");
-  j["perfusion_flow"] = quantityJson(p.perfusion_flow, "mm^3/s");
+void describePhysics(const std::vector<Setting<PhysicsParameters>>& settings, const PhysicsParameters& p, std::int64_t terminals,
+                     nlohmann::ordered_json& j) {
+  j.update(settingsJson(settings, p));
   j["terminal_flow"] = quantityJson(p.perfusion_flow / double(terminals), "mm^3/s");
 }
 

@@ -10,6 +10,8 @@
 #include "core/error.hpp"
 #include "core/units.hpp"
 #include "grow/method.hpp"
+#include "settings/schema.hpp"
+#include "settings/settings_json.hpp"
 #include "settings/toml_reader.hpp"
 
 namespace angiosynth {
@@ -49,23 +51,42 @@ double declaredNumber(const TomlReader& r, const GrowthMethod& m, const toml::ta
 int declaredCount(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table,
                   const std::string& key, std::int64_t lo, std::int64_t hi);
 
-// The [physics] declarations of a flow-driven method, appended to `rows`: murray_exponent, the
-// cost exponents when `cost_exponents`, viscosity, pressures and flow with the given defaults
-// (nullptr: required).
-std::vector<MethodParam> withPhysicsParams(std::vector<MethodParam> rows, bool cost_exponents, const char* viscosity,
-                                           const char* perfusion_pressure, const char* terminal_pressure,
-                                           const char* perfusion_flow);
+// The reference rows of declared settings, for key checks and `angiosynth methods`.
+template <class Options>
+std::vector<MethodParam> settingRows(const std::vector<Setting<Options>>& settings) {
+  std::vector<MethodParam> rows;
+  for (const auto& s : settings) rows.push_back({s.table, s.key, s.unit, s.fallback, s.meaning});
+  return rows;
+}
 
-// [physics] with m's defaults and the shared range checks; cost exponents only when m declares them.
-PhysicsParameters readPhysics(const TomlReader& r, const GrowthMethod& m, const toml::table& ph);
+// Rows of several lists, in order.
+std::vector<MethodParam> joinRows(std::initializer_list<std::vector<MethodParam>> lists);
+
+// One [physics] setting of the flow-driven methods as they share it (murray_exponent,
+// cost_radius_exponent, cost_length_exponent, viscosity, perfusion_pressure, terminal_pressure,
+// perfusion_flow), with the method's default (nullptr: required), which is its value.
+Setting<PhysicsParameters> physicsSetting(const char* key, const char* fallback);
+// perfusion_pressure above terminal_pressure by at least 0.001 Pa.
+const std::vector<SettingRule<PhysicsParameters>>& physicsRules();
+
+// [physics] of a file read through the method's declarations; the rules checked when both
+// pressures are declared.
+PhysicsParameters readPhysics(const TomlReader& r, const std::vector<Setting<PhysicsParameters>>& settings, const toml::table& ph);
+
+// Where each key of `t` stands in the file, for checkRules.
+inline auto keysIn(const TomlReader& r, const toml::table& t) {
+  return [&r, &t](const char* key) -> std::optional<Where> {
+    if (t.get(key)) return r.at(t, key);
+    return std::nullopt;
+  };
+}
 
 // The root from [tree] (or the named table): root_voxel (in `voxels`) is stored in root_voxel; root (mm) is returned.
 // Exactly one of them is required.
 std::optional<Vec3> readRoot(const TomlReader& r, const toml::table& tree, Vec3& root_voxel, int& root_line,
                              const std::string& voxels, const std::string& why_required, const std::string& table = "tree");
-// [tree] terminals, checked; its line is stored for feasibility errors.
-std::int64_t readTerminals(const TomlReader& r, const toml::table& tree, int& line);
-// viscosity, pressures and flows with units, as sample.json records them.
-void describePhysics(const PhysicsParameters& p, std::int64_t terminals, nlohmann::ordered_json& j);
+// The declared [physics] settings with units, and the flow of each terminal, as sample.json records them.
+void describePhysics(const std::vector<Setting<PhysicsParameters>>& settings, const PhysicsParameters& p, std::int64_t terminals,
+                     nlohmann::ordered_json& j);
 
 }  // namespace angiosynth

@@ -1,4 +1,5 @@
 // Method "dcco": its parameters, TOML reader, description, domains and grow function.
+#include <cctype>
 #include <cmath>
 #include <map>
 #include <random>
@@ -20,7 +21,90 @@ using Json = nlohmann::ordered_json;
 
 Json vectorJson(const Vec3& v) { return Json{{"value", {v.x, v.y, v.z}}, {"unit", "mm"}}; }
 
-const char* roleText(VesselRole r) { return roleName(std::uint8_t(r)); }
+
+constexpr const char* kPdfWords[] = {"uniform", "demand", "gaussian", nullptr};
+constexpr const char* kCostWords[] = {"volume", "sprout", nullptr};
+constexpr const char* kRoleWords[] = {"", "distribution", "transport", "perforator", nullptr};
+
+// A [[stage]]'s settings but its regions, symmetry and Gaussians.
+const std::vector<Setting<DccoStage>>& stageSettings() {
+  using O = DccoStage;
+  const auto degrees = [](const char* key, const char* fallback, double hi, const char* meaning, double O::*field) {
+    return Setting<O>{.table = "stage", .key = key, .unit = "deg", .fallback = fallback, .meaning = meaning, .field = field,
+                      .range = {0, hi}, .fallback_is_value = std::isdigit(static_cast<unsigned char>(*fallback)) != 0};
+  };
+  static const std::vector<Setting<O>> settings{
+      {.table = "stage", .key = "name", .unit = "text", .fallback = "stage_1, stage_2, ...", .meaning = "the stage's name in sample.json",
+       .field = &O::name},
+      {.table = "stage", .key = "terminals", .unit = "count", .fallback = nullptr, .meaning = "N^t, the terminals this stage adds",
+       .field = &O::terminal_count, .range = {1, Limits::kMaxTerminals}},
+      {.table = "stage", .key = "pdf", .unit = "text", .fallback = "uniform",
+       .meaning = "terminal positions: uniform, demand (∝ the mask value), or gaussian ([[stage.gaussian]])",
+       .field = enumChoice<O, &O::pdf, kPdfWords>(), .choices = wordList(kPdfWords), .fallback_is_value = true},
+      {.table = "stage", .key = "murray_exponent", .unit = "", .fallback = "3", .meaning = "γ of the bifurcations the stage makes",
+       .field = &O::gamma, .range = {Limits::kMinMurray, Limits::kMaxMurray, true, false}, .fallback_is_value = true},
+      {.table = "stage", .key = "nu", .unit = "", .fallback = "1", .meaning = "ν in l_lim = l_c (ν / (N_T + 1))^(1/D)",
+       .field = &O::nu, .range = {0, 1e6, true, false}, .fallback_is_value = true},
+      {.table = "stage", .key = "relaxation", .unit = "", .fallback = "0.9", .meaning = "f_r: l_lim × f_r after draws_before_relaxing rejected points",
+       .field = &O::f_r, .range = {0, 1, true, true}, .fallback_is_value = true},
+      {.table = "stage", .key = "neighbourhood", .unit = "", .fallback = "8",
+       .meaning = "f_n: candidate vessels lie within the box of half-side f_n·l_lim around the terminal",
+       .field = &O::f_n, .range = {0, 1e6, true, false}, .fallback_is_value = true},
+      {.table = "stage", .key = "lattice", .unit = "count", .fallback = "7", .meaning = "Δv: points per edge of the bifurcation lattice (Δv(Δv+1)/2 − 3 points)",
+       .field = &O::delta_v, .range = {3, 50}, .fallback_is_value = true},
+      {.table = "stage", .key = "cost", .unit = "text", .fallback = "volume", .meaning = "volume (eq. 10) or sprout (eq. 15)",
+       .field = enumChoice<O, &O::cost, kCostWords>(), .choices = wordList(kCostWords), .fallback_is_value = true},
+      {.table = "stage", .key = "c_v", .unit = "", .fallback = "50 (2D), 1e4 (3D)", .meaning = "sprout: weight of the added volume / the stage domain's measure",
+       .field = &O::c_v, .range = {0, 1e12}, .only_with = {"cost", "sprout"}},
+      {.table = "stage", .key = "c_p", .unit = "", .fallback = "0.5", .meaning = "sprout: weight of the parent's radius / r_1",
+       .field = &O::c_p, .range = {0, 1e12}, .only_with = {"cost", "sprout"}, .fallback_is_value = true},
+      {.table = "stage", .key = "c_d", .unit = "", .fallback = "1", .meaning = "sprout: weight of (new vessel length / l_c)²",
+       .field = &O::c_d, .range = {0, 1e12}, .only_with = {"cost", "sprout"}, .fallback_is_value = true},
+      degrees("theta_min", "0", 180, "θ_min, bifurcation angle between the split vessel's distal part and the new vessel", &O::theta_min),
+      degrees("theta_max", "180 − theta_min", 180, "θ_max", &O::theta_max),
+      degrees("phi_min", "0", 90,
+              "φ_min, angle between the new vessel and the plane of the split vessel's parts (that of the bifurcation it leaves when they are collinear)",
+              &O::phi_min),
+      degrees("phi_max", "90", 90, "φ_max", &O::phi_max),
+      {.table = "stage", .key = "role", .unit = "text", .fallback = "distribution",
+       .meaning = "role of the vessels the stage makes: distribution (inside Ω_t), transport (anywhere), perforator (anywhere, branching only inside Ω_t)",
+       .field = enumChoice<O, &O::role, kRoleWords>(), .choices = wordList(kRoleWords), .fallback_is_value = true},
+      {.table = "stage", .key = "draws_before_relaxing", .unit = "count", .fallback = "100", .meaning = "N_fail: rejected points before l_lim shrinks",
+       .field = &O::draws_before_relaxing, .range = {1, 1000000}, .fallback_is_value = true},
+      {.table = "stage", .key = "max_candidates", .unit = "count", .fallback = "64", .meaning = "candidate vessels tried per terminal, nearest first",
+       .field = &O::max_candidates, .range = {1, 100000}, .fallback_is_value = true},
+  };
+  return settings;
+}
+
+const std::vector<SettingRule<DccoStage>>& stageRules() {
+  static const std::vector<SettingRule<DccoStage>> rules{
+      {{"theta_max", "theta_min"}, [](const DccoStage& st) { return st.theta_max > st.theta_min ? std::string() : "theta_max must exceed theta_min"; }},
+      {{"phi_max", "phi_min"}, [](const DccoStage& st) { return st.phi_max >= st.phi_min ? std::string() : "phi_max must not be below phi_min"; }},
+  };
+  return rules;
+}
+
+const std::vector<Setting<DccoOptions>>& dccoSettings() {
+  static const std::vector<Setting<DccoOptions>> settings{
+      {.table = "tree", .key = "root_radius", .unit = "mm", .fallback = "[initial]: each root vessel's radius in its file; required without it",
+       .meaning = "r_1, the fixed radius of the root vessel (of every root of [initial])",
+       .field = &DccoOptions::root_radius, .range = {Limits::kMinRadius, Limits::kMaxRadius}, .quantity = Dimension::Length},
+  };
+  return settings;
+}
+
+// perfusion_flow and perfusion_pressure; the viscosity, a quantity or "pries", is read beside them.
+const std::vector<Setting<PhysicsParameters>>& dccoPhysics() {
+  static const std::vector<Setting<PhysicsParameters>> settings = [] {
+    auto flow = physicsSetting("perfusion_flow", "500 mL/min");
+    flow.meaning = "Q, the inflow, split equally among the terminals";
+    auto pressure = physicsSetting("perfusion_pressure", "100 mmHg");
+    pressure.meaning = "pressure at the root (the pressures downstream follow from the radii)";
+    return std::vector<Setting<PhysicsParameters>>{flow, pressure};
+  }();
+  return settings;
+}
 
 // The domains of one stage on the world's frame; identical region sets share one domain.
 struct StageDomains {
@@ -230,52 +314,18 @@ DccoStageSpec readStage(const TomlReader& r, const GrowthMethod& m, const toml::
   DccoStageSpec s;
   s.line = r.lineOf(&t);
   auto& st = s.stage;
-  st.name = t.get("name") ? r.string(t, "stage", "name") : "stage_" + std::to_string(index + 1);
-  st.terminal_count = r.integer(t, "stage", "terminals");
-  checkRange(double(st.terminal_count), 1, false, Limits::kMaxTerminals, false, r.at(t, "terminals"), "terminals");
+  st.name = "stage_" + std::to_string(index + 1);
+  readSettingsFrom(r, t, "stage", stageSettings(), st, 0);
   s.domain = regionNames(r, t, "domain", regions);
   s.avascular = regionNames(r, t, "avascular", regions);
   s.carriage = regionNames(r, t, "carriage", regions);
-  st.pdf = choice<TerminalPdf>(r, t, "stage", "pdf", TerminalPdf::Uniform,
-                               {{"uniform", TerminalPdf::Uniform}, {"demand", TerminalPdf::Demand}, {"gaussian", TerminalPdf::Gaussian}});
   if (st.pdf == TerminalPdf::Gaussian) st.gaussians = readGaussians(r, m, t, flat);
   else if (t.get("gaussian")) throw InputError(r.file(), r.lineOf(t.get("gaussian")), "[[stage.gaussian]] needs pdf = \"gaussian\"");
-  st.gamma = declaredNumber(r, m, t, "stage", "murray_exponent");
-  checkRange(st.gamma, Limits::kMinMurray, true, Limits::kMaxMurray, false, r.at(t, "murray_exponent"), "murray_exponent (γ)");
   st.delta = readSymmetry(r, t);
-  st.nu = declaredNumber(r, m, t, "stage", "nu");
-  checkRange(st.nu, 0, true, 1e6, false, r.at(t, "nu"), "nu (ν)");
-  st.f_r = declaredNumber(r, m, t, "stage", "relaxation");
-  checkRange(st.f_r, 0, true, 1, true, r.at(t, "relaxation"), "relaxation (f_r)");
-  st.f_n = declaredNumber(r, m, t, "stage", "neighbourhood");
-  checkRange(st.f_n, 0, true, 1e6, false, r.at(t, "neighbourhood"), "neighbourhood (f_n)");
-  st.delta_v = declaredCount(r, m, t, "stage", "lattice", 3, 50);
-  st.cost = choice<StageCost>(r, t, "stage", "cost", StageCost::Volume, {{"volume", StageCost::Volume}, {"sprout", StageCost::Sprout}});
-  if (st.cost == StageCost::Volume) {
-    r.forbid(t, "stage", {"c_v", "c_p", "c_d"}, "weighs the sprouting cost; set cost = \"sprout\" or remove it");
-  } else {
-    // Maso Talou et al. 2021 Fig. 3: c_v 0.5e2 in 2D, 1e4 in 3D; c_p 0.5; c_d 1.
-    st.c_v = t.get("c_v") ? r.number(t, "stage", "c_v") : flat ? 50.0 : 1e4;
-    st.c_p = declaredNumber(r, m, t, "stage", "c_p");
-    st.c_d = declaredNumber(r, m, t, "stage", "c_d");
-    for (const auto& [k, v] : {std::pair<const char*, double>{"c_v", st.c_v}, {"c_p", st.c_p}, {"c_d", st.c_d}})
-      checkRange(v, 0, false, 1e12, false, r.at(t, k), k);
-  }
-  const auto degrees = [&](const char* key, double fallback, double hi) {
-    const double v = t.get(key) ? r.number(t, "stage", key) : fallback;
-    checkRange(v, 0, false, hi, false, r.at(t, key), std::string(key) + " (degrees)");
-    return v;
-  };
-  st.theta_min = degrees("theta_min", 0, 180);
-  st.theta_max = degrees("theta_max", 180 - st.theta_min, 180);  // Table 1: the supplement
-  st.phi_min = degrees("phi_min", 0, 90);
-  st.phi_max = degrees("phi_max", 90, 90);
-  if (!(st.theta_max > st.theta_min)) throw InputError(r.file(), r.lineOf(t.get("theta_max") ? t.get("theta_max") : t.get("theta_min")), "theta_max must exceed theta_min");
-  if (!(st.phi_max >= st.phi_min)) throw InputError(r.file(), r.lineOf(t.get("phi_max") ? t.get("phi_max") : t.get("phi_min")), "phi_max must not be below phi_min");
-  st.role = choice<VesselRole>(r, t, "stage", "role", VesselRole::Distribution,
-                               {{"distribution", VesselRole::Distribution}, {"transport", VesselRole::Transport}, {"perforator", VesselRole::Perforator}});
-  st.draws_before_relaxing = declaredCount(r, m, t, "stage", "draws_before_relaxing", 1, 1000000);
-  st.max_candidates = declaredCount(r, m, t, "stage", "max_candidates", 1, 100000);
+  // Maso Talou et al. 2021 Fig. 3: c_v 0.5e2 in 2D, 1e4 in 3D.
+  if (st.cost == StageCost::Sprout && !t.get("c_v")) st.c_v = flat ? 50.0 : 1e4;
+  if (!t.get("theta_max")) st.theta_max = 180 - st.theta_min;  // Table 1: the supplement
+  checkRules(stageRules(), st, keysIn(r, t), Where{r.file(), s.line});
   return s;
 }
 
@@ -370,10 +420,7 @@ std::shared_ptr<const GrowthSetup> readDccoToml(const TomlReader& r, const Growt
   s->domain = domain;
   s->root = readRootOf(r, tree, "tree", s->domain, false);
   auto& o = s->options;
-  if (tree.get("root_radius")) {
-    o.root_radius = r.quantity(tree, "tree", "root_radius", Dimension::Length);
-    checkRange(o.root_radius, Limits::kMinRadius, false, Limits::kMaxRadius, false, r.at(tree, "root_radius"), "root_radius (mm)");
-  }
+  readSettingsFrom(r, tree, "tree", dccoSettings(), o, 0);
   readInitial(r, m, *s, flat, tree.get("root_radius") ? &tree : nullptr);
   if (tree.get("kind")) {
     s->kind = r.string(tree, "tree", "kind");
@@ -391,10 +438,9 @@ std::shared_ptr<const GrowthSetup> readDccoToml(const TomlReader& r, const Growt
   checkRange(o.viscosity.exponent, 0.1, false, 2, false, r.at(ph, "pries_exponent"), "pries_exponent");
   if (o.viscosity.model == ViscosityModel::Pries && !(o.root_radius > 0.01))
     throw InputError(r.file(), r.lineOf(tree.get("root_radius")), "root_radius below 10 µm: Pries' law holds for diameters of about 10 µm and more");
-  o.flow = declaredQuantity(r, m, ph, "physics", "perfusion_flow", Dimension::Flow);
-  checkRange(o.flow, Limits::kMinFlow, false, Limits::kMaxFlow, false, r.at(ph, "perfusion_flow"), "perfusion_flow (mm^3/s)");
-  o.root_pressure = declaredQuantity(r, m, ph, "physics", "perfusion_pressure", Dimension::Pressure);
-  checkRange(o.root_pressure, 0, false, Limits::kMaxPressure, false, r.at(ph, "perfusion_pressure"), "perfusion_pressure (Pa)");
+  s->physics_summary = readPhysics(r, dccoPhysics(), ph);
+  o.flow = s->physics_summary.perfusion_flow;
+  o.root_pressure = s->physics_summary.perfusion_pressure;
   s->regions = readRegions(r, m, flat);
   std::set<std::string> region_names;
   for (const auto& g : s->regions) region_names.insert(g.name);
@@ -414,8 +460,6 @@ std::shared_ptr<const GrowthSetup> readDccoToml(const TomlReader& r, const Growt
   auto& p = s->physics_summary;
   p.murray_exponent = s->stages.front().stage.gamma;
   p.viscosity = o.viscosity.constant;
-  p.perfusion_flow = o.flow;
-  p.perfusion_pressure = o.root_pressure;
   p.total_terminals = s->terminals();
   return s;
 }
@@ -446,9 +490,8 @@ Json DccoSetup::describe() const {
     init["outlets"] = outlets;
     j["initial"] = init;
   }
-  j["root_radius"] = quantityJson(o.root_radius, "mm");
-  j["perfusion_flow"] = quantityJson(o.flow, "mm^3/s");
-  j["perfusion_pressure"] = quantityJson(o.root_pressure, "Pa");
+  j.update(settingsJson(dccoSettings(), o));
+  j.update(settingsJson(dccoPhysics(), physics_summary));
   if (o.viscosity.model == ViscosityModel::Pries) {
     j["viscosity"] = "pries";
     j["pries_exponent"] = o.viscosity.exponent;
@@ -471,13 +514,10 @@ Json DccoSetup::describe() const {
   Json stages_json = Json::array();
   for (const auto& sp : stages) {
     const auto& st = sp.stage;
-    Json e;
-    e["name"] = st.name;
-    e["terminals"] = st.terminal_count;
+    Json e = settingsJson(stageSettings(), st);
     e["domain"] = sp.domain.empty() ? Json("the whole domain") : Json(sp.domain);
     if (!sp.avascular.empty()) e["avascular"] = sp.avascular;
     if (!sp.carriage.empty()) e["carriage"] = sp.carriage;
-    e["pdf"] = st.pdf == TerminalPdf::Uniform ? "uniform" : st.pdf == TerminalPdf::Demand ? "demand" : "gaussian";
     if (st.pdf == TerminalPdf::Gaussian) {
       Json gs = Json::array();
       for (const auto& g : st.gaussians)
@@ -485,25 +525,7 @@ Json DccoSetup::describe() const {
                           {"sigma", vectorJson(g.sigma)}, {"weight", g.weight}});
       e["gaussians"] = gs;
     }
-    e["murray_exponent"] = st.gamma;
     e["symmetry"] = st.delta;
-    e["nu"] = st.nu;
-    e["relaxation"] = st.f_r;
-    e["neighbourhood"] = st.f_n;
-    e["lattice"] = st.delta_v;
-    e["cost"] = st.cost == StageCost::Volume ? "volume" : "sprout";
-    if (st.cost == StageCost::Sprout) {
-      e["c_v"] = st.c_v;
-      e["c_p"] = st.c_p;
-      e["c_d"] = st.c_d;
-    }
-    e["theta_min"] = quantityJson(st.theta_min, "degree");
-    e["theta_max"] = quantityJson(st.theta_max, "degree");
-    e["phi_min"] = quantityJson(st.phi_min, "degree");
-    e["phi_max"] = quantityJson(st.phi_max, "degree");
-    e["role"] = roleText(st.role);
-    e["draws_before_relaxing"] = st.draws_before_relaxing;
-    e["max_candidates"] = st.max_candidates;
     stages_json.push_back(e);
   }
   j["stages"] = stages_json;
@@ -526,8 +548,8 @@ const GrowthMethod kDccoMethod{
     "region with its own parameters, cost (volume or sprouting) and vessel role; bifurcations on DCCO's triangle lattice, "
     "a fixed root radius and inflow, constant or Pries viscosity, angle and symmetry limits, no overlapping vessels",
     withRegionParams(withDomainParams("sphere, cube, disc or square (2D), or mask: the region every vessel stays in",
-                     "masks: terminals of stages over the whole domain drawn uniformly, or ∝ the mask value (demand; as [[stage]] pdf = \"demand\")", {
-        {"tree", "root_radius", "mm", "[initial]: each root vessel's radius in its file; required without it", "r_1, the fixed radius of the root vessel (of every root of [initial])"},
+                     "masks: terminals of stages over the whole domain drawn uniformly, or ∝ the mask value (demand; as [[stage]] pdf = \"demand\")", joinRows({{
+    }, settingRows(dccoSettings()), {
         {"initial", "file", "path", "none", "an existing network the growth continues (.cco of VItA, .swc, .vtp of VItA or VTK, angiosynth's .gxl or nodes/edges .csv); each root is an inlet"},
         {"initial", "origin", "text", "centre", "where the file's positions start: centre (of the domain) or corner (of its grid, as angiosynth's graphs write them)"},
         {"initial", "unit", "text", "mm", "length unit of the file: mm, cm, m, um"},
@@ -540,35 +562,15 @@ const GrowthMethod kDccoMethod{
         {"tree", "kind", "text", "artery", "the tree's kind in labels and graphs"},
         {"physics", "viscosity", "Pa*s or \"pries\"", "0.0036 Pa*s", "constant blood viscosity, or \"pries\": Pries' in-vivo law η(D) at haematocrit 0.45 (eqs. 8–9), solved with the radii to |Δη/η| < 1e-6"},
         {"physics", "pries_exponent", "", "0.645", "the exponent of D in Pries' law (the paper prints 0.64)"},
-        {"physics", "perfusion_flow", "mm^3/s", "500 mL/min", "Q, the inflow, split equally among the terminals"},
-        {"physics", "perfusion_pressure", "Pa", "100 mmHg", "pressure at the root (the pressures downstream follow from the radii)"},
-        {"stage", "name", "text", "stage_1, stage_2, ...", "the stage's name in sample.json"},
-        {"stage", "terminals", "count", nullptr, "N^t, the terminals this stage adds"},
+    }, settingRows(dccoPhysics()), settingRows(stageSettings()), {
         {"stage", "domain", "region names", "the whole [domain]", "Ω_t, the union of these regions"},
         {"stage", "avascular", "region names", "none", "regions no vessel of the stage enters and no terminal lies in"},
         {"stage", "carriage", "region names", "none", "regions vessels may cross but no terminal lies in"},
-        {"stage", "pdf", "text", "uniform", "terminal positions: uniform, demand (∝ the mask value), or gaussian ([[stage.gaussian]])"},
-        {"stage", "murray_exponent", "", "3", "γ of the bifurcations the stage makes"},
         {"stage", "symmetry", "number or list", "0", "δ: min/max radius of a new bifurcation's branches must exceed it; a list gives δ per bifurcation level (the last repeats)"},
-        {"stage", "nu", "", "1", "ν in l_lim = l_c (ν / (N_T + 1))^(1/D)"},
-        {"stage", "relaxation", "", "0.9", "f_r: l_lim × f_r after draws_before_relaxing rejected points"},
-        {"stage", "neighbourhood", "", "8", "f_n: candidate vessels lie within the box of half-side f_n·l_lim around the terminal"},
-        {"stage", "lattice", "count", "7", "Δv: points per edge of the bifurcation lattice (Δv(Δv+1)/2 − 3 points)"},
-        {"stage", "cost", "text", "volume", "volume (eq. 10) or sprout (eq. 15)"},
-        {"stage", "c_v", "", "50 (2D), 1e4 (3D)", "sprout: weight of the added volume / the stage domain's measure"},
-        {"stage", "c_p", "", "0.5", "sprout: weight of the parent's radius / r_1"},
-        {"stage", "c_d", "", "1", "sprout: weight of (new vessel length / l_c)²"},
-        {"stage", "theta_min", "degrees", "0", "θ_min, bifurcation angle between the split vessel's distal part and the new vessel"},
-        {"stage", "theta_max", "degrees", "180 − theta_min", "θ_max"},
-        {"stage", "phi_min", "degrees", "0", "φ_min, angle between the new vessel and the plane of the split vessel's parts (that of the bifurcation it leaves when they are collinear)"},
-        {"stage", "phi_max", "degrees", "90", "φ_max"},
-        {"stage", "role", "text", "distribution", "role of the vessels the stage makes: distribution (inside Ω_t), transport (anywhere), perforator (anywhere, branching only inside Ω_t)"},
-        {"stage", "draws_before_relaxing", "count", "100", "N_fail: rejected points before l_lim shrinks"},
-        {"stage", "max_candidates", "count", "64", "candidate vessels tried per terminal, nearest first"},
         {"stage.gaussian", "mean", "[x, y(, z)] mm", "[0, 0, 0]", "centre of the Gaussian, relative to the domain's centre"},
         {"stage.gaussian", "sigma", "[x, y(, z)] mm", nullptr, "standard deviation per axis"},
         {"stage.gaussian", "weight", "", "1", "its weight in the mixture"},
-    }), "the region's name, used by [[stage]] domain, avascular and carriage"),
+    }})), "the region's name, used by [[stage]] domain, avascular and carriage"),
     &readDccoToml};
 
 }  // namespace angiosynth

@@ -45,7 +45,7 @@ class GrammarGrower {
 
   VascularTree run(const ProgressFn& progress) {
     t_.addNode(o_.root, -1);
-    std::vector<Branch> gen{{0, unit(o_.direction), perpendicular(unit(o_.direction)), unit(o_.direction), o_.root_diameter}};
+    std::vector<Branch> gen{{0, unit(o_.direction), perpendicular(unit(o_.direction)), unit(o_.direction), *o_.root_diameter}};
     if (o_.domain->dimension() == 2) gen[0].up = Vec3(0, 0, 1);  // turns stay in the plane
     r_.asked_tips = std::int64_t(1) << o_.iterations;
     for (int g = 0; g <= o_.iterations; ++g) {
@@ -65,7 +65,7 @@ class GrammarGrower {
  private:
   // Cells of about a piece of a middle generation (diameters fall by 2^(1/k) per generation).
   static double cellSize(const GrammarOptions& o) {
-    const double d = o.root_diameter * std::pow(2.0, -double(o.iterations) / (2 * o.murray_exponent));
+    const double d = *o.root_diameter * std::pow(2.0, -double(o.iterations) / (2 * o.murray_exponent));
     return std::max(1e-6, 2 * o.length_ratio * d / o.stem_segments);
   }
 

@@ -8,6 +8,7 @@
 // domain: a stem that would leave the domain (or come closer to its wall than `wall_clearance`
 // plus its radius) or overlap a vessel is drawn again, up to `tries` times, then dropped with its
 // subtree. The run fails when fewer tips than `min_tip_fraction`·2^n remain.
+#include <optional>
 #include <cstdint>
 #include <string>
 
@@ -19,7 +20,7 @@ namespace angiosynth {
 
 struct GrammarOptions {
   int iterations = 6;              // n: generations of bifurcations
-  double root_diameter = 0;        // d0, mm
+  std::optional<double> root_diameter;  // d0, mm (unset: a share of the domain's diameter, set when prepared)
   double length_ratio = 10;        // ε: a stem is ε·d long
   double length_margin = 0.2;      // m: relative half-width of the stem length
   double diameter_sd = 0.2;        // d1's standard deviation relative to d/2^(1/k) (0: exact)

@@ -78,16 +78,115 @@ class PreparedLsystem final : public PreparedGrowth {
   Vec3 corner_;
 };
 
-// The keys only one mode reads: a key of the other mode is an error naming it.
-const std::vector<std::pair<const char*, const char*>>& grammarOnlyKeys() {
-  static const std::vector<std::pair<const char*, const char*>> keys{
-      {"domain", "shape"}, {"domain", "radius"}, {"domain", "side"}, {"domain", "mask"}, {"tree", "root_offset"}, {"tree", "root"},
-      {"tree", "root_voxel"}, {"tree", "direction"}, {"tree", "iterations"}, {"tree", "root_diameter"}, {"tree", "length_ratio"},
-      {"tree", "length_margin"}, {"tree", "diameter_sd"}, {"tree", "radii"}, {"tree", "radius_ratio"}, {"tree", "angles"},
-      {"tree", "branch_angle"}, {"tree", "angle_sd"}, {"tree", "roll_angle"}, {"tree", "roll_sd"}, {"tree", "stem_segments"},
-      {"tree", "stem_angle"}, {"tree", "avoid_collisions"}, {"tree", "wall_clearance"}, {"tree", "tries"}, {"tree", "min_tip_fraction"},
-      {"physics", "murray_exponent"}};
-  return keys;
+constexpr const char* kRadiiWords[] = {"ratio", "murray", nullptr};       // GrammarOptions::murray false, true
+constexpr const char* kAnglesWords[] = {"fixed", "zamir", nullptr};        // GrammarOptions::zamir_angles false, true
+constexpr const char* kLevelRuleWords[] = {"corrected", "printed", nullptr};  // LzhParameters::printed_level_rule false, true
+
+// Mode grammar's [tree] settings.
+const std::vector<Setting<GrammarOptions>>& grammarSettings() {
+  using O = GrammarOptions;
+  static const std::vector<Setting<O>> settings{
+      {.table = "tree", .key = "iterations", .unit = "count", .fallback = "6", .meaning = "grammar: n, bifurcation generations (2^n tips)",
+       .field = &O::iterations, .range = {0, 20}, .fallback_is_value = true},
+      {.table = "tree", .key = "root_diameter", .unit = "mm", .fallback = "[domain] diameter × 0.02", .meaning = "grammar: d0, the first stem's diameter",
+       .field = &O::root_diameter, .range = {2 * Limits::kMinRadius, 2 * Limits::kMaxRadius}, .quantity = Dimension::Length},
+      {.table = "tree", .key = "length_ratio", .unit = "", .fallback = "10", .meaning = "grammar: ε, a stem is ε·d long",
+       .field = &O::length_ratio, .range = {0, 1e4, true, false}, .fallback_is_value = true},
+      {.table = "tree", .key = "length_margin", .unit = "", .fallback = "0.2", .meaning = "grammar: m, the stem length is drawn uniformly in ε·d·[1 − m, 1 + m]",
+       .field = &O::length_margin, .range = {0, 1, false, true}, .fallback_is_value = true},
+      {.table = "tree", .key = "diameter_sd", .unit = "", .fallback = "0.2",
+       .meaning = "grammar: the first daughter's diameter is normal around d/2^(1/k), this standard deviation relative to it (0: exact)",
+       .field = &O::diameter_sd, .range = {0, 10}, .fallback_is_value = true},
+      {.table = "tree", .key = "radii", .unit = "text", .fallback = "murray",
+       .meaning = "grammar: murray (the second daughter by Murray's law with [physics] murray_exponent) or ratio (both d·radius_ratio)",
+       .field = enumChoice<O, &O::murray, kRadiiWords>(), .choices = wordList(kRadiiWords), .fallback_is_value = true},
+      {.table = "tree", .key = "radius_ratio", .unit = "", .fallback = "0.7937", .meaning = "grammar, radii = \"ratio\": daughter over parent diameter",
+       .field = &O::radius_ratio, .range = {0, 1, true, true}, .only_with = {"radii", "ratio"}, .fallback_is_value = true},
+      {.table = "tree", .key = "angles", .unit = "text", .fallback = "zamir",
+       .meaning = "grammar: zamir (the optimal angles of the daughters' diameters, as V-System) or fixed (±branch_angle)",
+       .field = enumChoice<O, &O::zamir_angles, kAnglesWords>(), .choices = wordList(kAnglesWords), .fallback_is_value = true},
+      {.table = "tree", .key = "branch_angle", .unit = "deg", .fallback = "35", .meaning = "grammar, angles = \"fixed\": each daughter's angle to its parent",
+       .field = &O::branch_angle, .range = {0, 90}, .only_with = {"angles", "fixed"}, .fallback_is_value = true},
+      {.table = "tree", .key = "angle_sd", .unit = "deg", .fallback = "0", .meaning = "grammar: normal spread added to each daughter's angle",
+       .field = &O::angle_sd, .range = {0, 90}, .fallback_is_value = true},
+      {.table = "tree", .key = "roll_angle", .unit = "deg", .fallback = "70",
+       .meaning = "grammar: β, the roll of each daughter's frame (3D: successive bifurcation planes differ)",
+       .field = &O::roll_angle, .range = {-360, 360}, .fallback_is_value = true},
+      {.table = "tree", .key = "roll_sd", .unit = "deg", .fallback = "0", .meaning = "grammar: normal spread of β",
+       .field = &O::roll_sd, .range = {0, 360}, .fallback_is_value = true},
+      {.table = "tree", .key = "stem_segments", .unit = "count", .fallback = "5", .meaning = "grammar: pieces of a stem",
+       .field = &O::stem_segments, .range = {1, 100}, .fallback_is_value = true},
+      {.table = "tree", .key = "stem_angle", .unit = "deg", .fallback = "25", .meaning = "grammar: the turns between a stem's pieces (+ − − +, or mirrored)",
+       .field = &O::stem_angle, .range = {0, 90, false, true}, .fallback_is_value = true},
+      {.table = "tree", .key = "avoid_collisions", .unit = "true/false", .fallback = "true",
+       .meaning = "grammar: a stem that would overlap a vessel is drawn again", .field = &O::avoid_collisions},
+      {.table = "tree", .key = "wall_clearance", .unit = "mm", .fallback = "0 mm",
+       .meaning = "grammar: vessels keep this much beyond their radius from the domain's wall",
+       .field = &O::wall_clearance, .range = {0, Limits::kMaxLength}, .quantity = Dimension::Length, .fallback_is_value = true},
+      {.table = "tree", .key = "tries", .unit = "count", .fallback = "8",
+       .meaning = "grammar: draws of a stem (later ones in another plane about the parent) before its branch is dropped",
+       .field = &O::tries, .range = {1, 1000}, .fallback_is_value = true},
+      {.table = "tree", .key = "min_tip_fraction", .unit = "", .fallback = "0.9", .meaning = "grammar: the run fails when fewer than this fraction of the 2^n tips grow",
+       .field = &O::min_tip_fraction, .range = {0, 1}, .fallback_is_value = true},
+  };
+  return settings;
+}
+
+// Mode lzh's [tree] settings (Lázaro 2011's high-level parameters).
+const std::vector<Setting<LzhParameters>>& lzhSettings() {
+  using O = LzhParameters;
+  const auto length = [](const char* key, const char* meaning, double O::*field) {
+    return Setting<O>{.table = "tree", .key = key, .unit = "mm", .fallback = nullptr, .meaning = meaning, .field = field,
+                      .range = {0, Limits::kMaxLength, true, false}, .quantity = Dimension::Length};
+  };
+  const auto wall = [](const char* key, const char* meaning, double O::*field) {
+    return Setting<O>{.table = "tree", .key = key, .unit = "mm", .fallback = "0 mm", .meaning = meaning, .field = field,
+                      .range = {0, Limits::kMaxLength}, .quantity = Dimension::Length, .fallback_is_value = true};
+  };
+  static const std::vector<Setting<O>> settings{
+      {.table = "tree", .key = "dimension", .unit = "count", .fallback = "3",
+       .meaning = "2: one plane (2^N capillaries in a row); 3: levels alternate between two planes (a 2^N × 2^N capillary grid)",
+       .field = &O::dimension, .range = {2, 3}, .fallback_is_value = true},
+      length("block_width", "w_b, the block's width (3D: w_b × w_b × h)", &O::block_width),
+      length("block_height", "h, from the inlet's top to the outlet's bottom", &O::height),
+      length("start_length", "L_s, the vertical inlet (and outlet) vessel", &O::start_length),
+      length("capillary_length", "L_c, the vertical capillaries", &O::capillary_length),
+      length("start_diameter", "d_s, the lumen at the inlet", &O::start_diameter),
+      length("capillary_diameter", "d_c, the lumen of the capillaries", &O::capillary_diameter),
+      wall("start_wall", "t_ws, the wall thickness at the inlet", &O::start_wall),
+      wall("capillary_wall", "t_wc, the wall thickness of the capillaries", &O::capillary_wall),
+      length("capillary_spacing", "d, the largest distance between neighbouring capillaries (and twice their distance from the block's sides)", &O::spacing),
+      {.table = "tree", .key = "level_rule", .unit = "text", .fallback = "corrected",
+       .meaning = "corrected: N = ⌈log2(c/d + 1)⌉, so capillaries lie at most d apart; printed: the thesis's ⌈log2(c/d)⌉ (farther apart than d "
+                  "when c/d is a power of 2)",
+       .field = enumChoice<O, &O::printed_level_rule, kLevelRuleWords>(), .choices = wordList(kLevelRuleWords), .fallback_is_value = true},
+  };
+  return settings;
+}
+
+const std::vector<Setting<PhysicsParameters>>& lsystemPhysics() {
+  static const std::vector<Setting<PhysicsParameters>> settings = [] {
+    auto murray = physicsSetting("murray_exponent", "3");
+    murray.meaning = "grammar: k of Murray's law d^k = d1^k + d2^k";
+    auto viscosity = physicsSetting("viscosity", "0.0036 Pa*s");
+    viscosity.meaning = "blood viscosity η (flows and pressures of the outputs)";
+    auto pressure = physicsSetting("perfusion_pressure", "100 mmHg");
+    pressure.meaning = "pressure at the inlet (grammar: the root)";
+    auto flow = physicsSetting("perfusion_flow", "1 mL/min");
+    flow.meaning = "Q into the inlet: lzh, the same through every capillary, the outlet's pressure follows (Poiseuille, tapered vessels); "
+                   "grammar, split equally among the tips";
+    return std::vector<Setting<PhysicsParameters>>{murray, viscosity, pressure, flow};
+  }();
+  return settings;
+}
+
+// The keys only mode grammar reads (its domain, root and settings, and Murray's exponent): such
+// a key in an lzh file, or a key of lzh's settings in a grammar file, is an error naming its mode.
+bool grammarOnly(const std::string& table, const std::string& key) {
+  static const std::set<std::string> domain{"shape", "radius", "side", "mask"}, tree{"root_offset", "root", "root_voxel", "direction"};
+  if (table == "domain") return domain.count(key) > 0;
+  if (table == "physics") return key == "murray_exponent";
+  return tree.count(key) > 0 || settingKeys(grammarSettings()).count(key) > 0;
 }
 
 void forbidOtherModeKeys(const TomlReader& r, const GrowthMethod& m, bool grammar,
@@ -95,8 +194,7 @@ void forbidOtherModeKeys(const TomlReader& r, const GrowthMethod& m, bool gramma
   for (const auto& [name, t] : tables)
     for (const auto& p : m.params) {
       if (std::string(p.table) != name || !t->get(p.key)) continue;
-      bool grammar_key = false;
-      for (const auto& [tb, key] : grammarOnlyKeys()) grammar_key = grammar_key || (std::string(tb) == name && std::string(key) == p.key);
+      const bool grammar_key = grammarOnly(name, p.key);
       const bool shared = std::string(p.key) == "mode" || std::string(p.key) == "voxel_size" || std::string(name) == "physics";
       if (shared && !grammar_key) continue;
       if (grammar_key != grammar)
@@ -106,18 +204,7 @@ void forbidOtherModeKeys(const TomlReader& r, const GrowthMethod& m, bool gramma
     }
 }
 
-void readPhysicsRows(const TomlReader& r, const GrowthMethod& m, const toml::table& ph, PhysicsParameters& phys) {
-  phys.viscosity = declaredQuantity(r, m, ph, "physics", "viscosity", Dimension::Viscosity);
-  checkRange(phys.viscosity, Limits::kMinViscosity, false, Limits::kMaxViscosity, false, r.at(ph, "viscosity"), "viscosity (Pa*s)");
-  phys.perfusion_pressure = declaredQuantity(r, m, ph, "physics", "perfusion_pressure", Dimension::Pressure);
-  checkRange(phys.perfusion_pressure, 0, false, Limits::kMaxPressure, false, r.at(ph, "perfusion_pressure"), "perfusion_pressure (Pa)");
-  phys.perfusion_flow = declaredQuantity(r, m, ph, "physics", "perfusion_flow", Dimension::Flow);
-  checkRange(phys.perfusion_flow, Limits::kMinFlow, false, Limits::kMaxFlow, false, r.at(ph, "perfusion_flow"), "perfusion_flow (mm^3/s)");
-  phys.murray_exponent = declaredNumber(r, m, ph, "physics", "murray_exponent");
-  checkRange(phys.murray_exponent, Limits::kMinMurray, true, Limits::kMaxMurray, false, r.at(ph, "murray_exponent"), "murray_exponent");
-}
-
-void readGrammar(const TomlReader& r, const GrowthMethod& m, const toml::table& dom, const toml::table& tree, LsystemSetup& s) {
+void readGrammar(const TomlReader& r, const toml::table& dom, const toml::table& tree, LsystemSetup& s) {
   s.domain = readDomainSpec(r, dom, s.parameter_file);
   const bool flat = s.domain.shape == DomainShape::Disc || s.domain.shape == DomainShape::Square;
   s.root = readRootOf(r, tree, "tree", s.domain, false);
@@ -128,33 +215,7 @@ void readGrammar(const TomlReader& r, const GrowthMethod& m, const toml::table& 
   }
   s.voxel_mm = s.domain.voxel_mm;
   auto& g = s.grammar_options;
-  g.iterations = declaredCount(r, m, tree, "tree", "iterations", 0, 20);
-  if (tree.get("root_diameter")) {
-    s.root_diameter_mm = r.quantity(tree, "tree", "root_diameter", Dimension::Length, s.voxel_mm);
-    checkRange(s.root_diameter_mm, 2 * Limits::kMinRadius, false, 2 * Limits::kMaxRadius, false, r.at(tree, "root_diameter"), "root_diameter (mm)");
-  }
-  const auto number = [&](const char* key, double lo, bool lo_open, double hi, bool hi_open) {
-    const double v = declaredNumber(r, m, tree, "tree", key);
-    checkRange(v, lo, lo_open, hi, hi_open, r.at(tree, key), key);
-    return v;
-  };
-  g.length_ratio = number("length_ratio", 0, true, 1e4, false);
-  g.length_margin = number("length_margin", 0, false, 1, true);
-  g.diameter_sd = number("diameter_sd", 0, false, 10, false);
-  g.murray = choice<bool>(r, tree, "tree", "radii", true, {{"murray", true}, {"ratio", false}});
-  g.radius_ratio = number("radius_ratio", 0, true, 1, true);
-  g.zamir_angles = choice<bool>(r, tree, "tree", "angles", true, {{"zamir", true}, {"fixed", false}});
-  g.branch_angle = number("branch_angle", 0, false, 90, false);
-  g.angle_sd = number("angle_sd", 0, false, 90, false);
-  g.roll_angle = number("roll_angle", -360, false, 360, false);
-  g.roll_sd = number("roll_sd", 0, false, 360, false);
-  g.stem_segments = declaredCount(r, m, tree, "tree", "stem_segments", 1, 100);
-  g.stem_angle = number("stem_angle", 0, false, 90, true);
-  g.avoid_collisions = r.boolean(tree, "avoid_collisions", true);
-  g.wall_clearance = declaredQuantity(r, m, tree, "tree", "wall_clearance", Dimension::Length, s.voxel_mm);
-  checkRange(g.wall_clearance, 0, false, Limits::kMaxLength, false, r.at(tree, "wall_clearance"), "wall_clearance (mm)");
-  g.tries = declaredCount(r, m, tree, "tree", "tries", 1, 1000);
-  g.min_tip_fraction = number("min_tip_fraction", 0, false, 1, false);
+  readSettingsFrom(r, tree, "tree", grammarSettings(), g, s.voxel_mm);
   g.murray_exponent = s.physics_summary.murray_exponent;
   s.physics_summary.total_terminals = std::int64_t(1) << g.iterations;
 }
@@ -170,7 +231,7 @@ class PreparedGrammar final : public PreparedGrowth {
     if (loaded_.dimension() == 2) d.z = 0;
     if (!(norm(d) > 0)) d = Vec3(0, -1, 0);
     options_.direction = d / norm(d);
-    options_.root_diameter = s.root_diameter_mm > 0 ? s.root_diameter_mm : s.root_diameter_fraction * diameterOf(loaded_);
+    if (!options_.root_diameter) options_.root_diameter = s.root_diameter_fraction * diameterOf(loaded_);
   }
   const DemandMap& frame() const override { return loaded_.frame(); }
   void checkFeasibility() const override {}
@@ -190,11 +251,11 @@ class PreparedGrammar final : public PreparedGrowth {
     const auto t0 = std::chrono::steady_clock::now();
     report.intersecting_pairs = std::int64_t(crossingPairs(t).size());
     check_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    report.root_radius_mm = o.root_diameter / 2;
+    report.root_radius_mm = *o.root_diameter / 2;
     return singleTreeForest(std::move(t));
   }
   void addStatistics(const GrowthReport&, Json& stats) const override {
-    stats["root_diameter"] = quantityJson(options_.root_diameter, "mm");
+    stats["root_diameter"] = quantityJson(*options_.root_diameter, "mm");
     stats["tips_asked"] = gr_.asked_tips;
     stats["tips"] = gr_.tips;
     stats["stems_redrawn"] = gr_.redrawn;
@@ -221,33 +282,15 @@ std::shared_ptr<const GrowthSetup> readLsystemToml(const TomlReader& r, const Gr
   s->tree_line = r.lineOf(&tree);
   s->grammar = choice<bool>(r, tree, "tree", "mode", false, {{"lzh", false}, {"grammar", true}});
   forbidOtherModeKeys(r, m, s->grammar, {{"domain", &dom}, {"tree", &tree}, {"physics", &ph}});
-  readPhysicsRows(r, m, ph, s->physics_summary);
+  s->physics_summary = readPhysics(r, lsystemPhysics(), ph);
   if (s->grammar) {
-    readGrammar(r, m, dom, tree, *s);
+    readGrammar(r, dom, tree, *s);
     return s;
   }
   s->voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
   checkRange(s->voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, r.at(dom, "voxel_size"), "voxel_size (mm)");
   auto& p = s->lzh;
-  p.dimension = declaredCount(r, m, tree, "tree", "dimension", 2, 3);
-  const auto length = [&](const char* key) {
-    const double v = declaredQuantity(r, m, tree, "tree", key, Dimension::Length, s->voxel_mm);
-    checkRange(v, 0, true, Limits::kMaxLength, false, r.at(tree, key), std::string(key) + " (mm)");
-    return v;
-  };
-  p.block_width = length("block_width");
-  p.height = length("block_height");
-  p.start_length = length("start_length");
-  p.capillary_length = length("capillary_length");
-  p.start_diameter = length("start_diameter");
-  p.capillary_diameter = length("capillary_diameter");
-  p.spacing = length("capillary_spacing");
-  for (const char* key : {"start_wall", "capillary_wall"}) {
-    const double v = declaredQuantity(r, m, tree, "tree", key, Dimension::Length, s->voxel_mm);
-    checkRange(v, 0, false, Limits::kMaxLength, false, r.at(tree, key), std::string(key) + " (mm)");
-    (std::string(key) == "start_wall" ? p.start_wall : p.capillary_wall) = v;
-  }
-  p.printed_level_rule = choice<bool>(r, tree, "tree", "level_rule", false, {{"corrected", false}, {"printed", true}});
+  readSettingsFrom(r, tree, "tree", lzhSettings(), p, s->voxel_mm);
   auto& phys = s->physics_summary;
   p.viscosity = phys.viscosity;
   p.perfusion_pressure = phys.perfusion_pressure;
@@ -269,13 +312,6 @@ std::shared_ptr<const GrowthSetup> readLsystemToml(const TomlReader& r, const Gr
   return s;
 }
 
-// Both modes drive the network from its inlet with a given pressure and flow.
-void describeInflow(const PhysicsParameters& p, Json& j) {
-  j["viscosity"] = quantityJson(p.viscosity, "Pa*s");
-  j["perfusion_pressure"] = quantityJson(p.perfusion_pressure, "Pa");
-  j["perfusion_flow"] = quantityJson(p.perfusion_flow, "mm^3/s");
-}
-
 }  // namespace
 
 Json LsystemSetup::describe() const {
@@ -287,42 +323,17 @@ Json LsystemSetup::describe() const {
     j["mode"] = "grammar";
     describeDomainAndRoot(domain, root, j);
     if (has_direction) j["direction"] = {direction.x, direction.y, direction.z};
-    j["iterations"] = g.iterations;
-    j["root_diameter"] = root_diameter_mm > 0 ? quantityJson(root_diameter_mm, "mm") : Json{{"value", root_diameter_fraction}, {"unit", "domain diameter"}};
-    j["length_ratio"] = g.length_ratio;
-    j["length_margin"] = g.length_margin;
-    j["diameter_sd"] = g.diameter_sd;
-    j["radii"] = g.murray ? "murray" : "ratio";
-    if (!g.murray) j["radius_ratio"] = g.radius_ratio;
-    j["angles"] = g.zamir_angles ? "zamir" : "fixed";
-    if (!g.zamir_angles) j["branch_angle"] = quantityJson(g.branch_angle, "deg");
-    j["angle_sd"] = quantityJson(g.angle_sd, "deg");
-    j["roll_angle"] = quantityJson(g.roll_angle, "deg");
-    j["roll_sd"] = quantityJson(g.roll_sd, "deg");
-    j["stem_segments"] = g.stem_segments;
-    j["stem_angle"] = quantityJson(g.stem_angle, "deg");
-    j["avoid_collisions"] = g.avoid_collisions;
-    j["wall_clearance"] = quantityJson(g.wall_clearance, "mm");
-    j["tries"] = g.tries;
-    j["min_tip_fraction"] = g.min_tip_fraction;
-    j["murray_exponent"] = physics_summary.murray_exponent;
-    describeInflow(physics_summary, j);
+    j.update(settingsJson(grammarSettings(), g));
+    j.update(settingsJson(lsystemPhysics(), physics_summary));
     return j;
+
   }
   j["mode"] = "lzh";
-  j["dimension"] = p.dimension;
   j["voxel_size"] = quantityJson(voxel_mm, "mm");
-  j["block_width"] = quantityJson(p.block_width, "mm");
-  j["block_height"] = quantityJson(p.height, "mm");
-  j["start_length"] = quantityJson(p.start_length, "mm");
-  j["capillary_length"] = quantityJson(p.capillary_length, "mm");
-  j["start_diameter"] = quantityJson(p.start_diameter, "mm");
-  j["capillary_diameter"] = quantityJson(p.capillary_diameter, "mm");
-  j["start_wall"] = quantityJson(p.start_wall, "mm");
-  j["capillary_wall"] = quantityJson(p.capillary_wall, "mm");
-  j["capillary_spacing"] = quantityJson(p.spacing, "mm");
-  j["level_rule"] = p.printed_level_rule ? "printed: N = ceil(log2(c/d))" : "corrected: N = ceil(log2(c/d + 1))";
-  describeInflow(physics_summary, j);
+  j.update(settingsJson(lzhSettings(), p));
+  auto inflow = settingsJson(lsystemPhysics(), physics_summary);
+  inflow.erase("murray_exponent");  // grammar only
+  j.update(inflow);
   j["outlet_pressure"] = quantityJson(physics_summary.terminal_pressure, "Pa");
   return j;
 }
@@ -340,7 +351,7 @@ const GrowthMethod kLsystemMethod{
     "diameter and wall thickness linear in path length (tapered vessels). Mode grammar (Galarreta-Valverde 2013, as V-System): "
     "the stochastic grammar F(d) → {S(d)} [+θ1 /β F(d1)] [−θ2 /β F(d2)] with curved stems, Murray or ratio diameters and "
     "Zamir or fixed angles, grown breadth first inside a domain without overlaps",
-    {
+    joinRows({{
         {"domain", "voxel_size", "mm", nullptr, "the voxel edge (lzh: the frame is the block with room for the vessels; grammar: of the domain's frame)"},
         {"domain", "shape", "text", "sphere", "grammar: sphere, cube, disc or square (2D), or mask"},
         {"domain", "radius", "mm", nullptr, "grammar: sphere and disc: the radius"},
@@ -351,40 +362,7 @@ const GrowthMethod kLsystemMethod{
         {"tree", "root", "[x, y, z] mm", nullptr, "grammar, masks: the root in mm in the frame (or root_voxel)"},
         {"tree", "root_voxel", "[x, y, z] mask voxels", nullptr, "grammar, masks: the root in voxels (or root)"},
         {"tree", "direction", "[x, y(, z)]", "toward the domain's centre", "grammar: the first stem's heading"},
-        {"tree", "iterations", "count", "6", "grammar: n, bifurcation generations (2^n tips)"},
-        {"tree", "root_diameter", "mm", "[domain] diameter × 0.02", "grammar: d0, the first stem's diameter"},
-        {"tree", "length_ratio", "", "10", "grammar: ε, a stem is ε·d long"},
-        {"tree", "length_margin", "", "0.2", "grammar: m, the stem length is drawn uniformly in ε·d·[1 − m, 1 + m]"},
-        {"tree", "diameter_sd", "", "0.2", "grammar: the first daughter's diameter is normal around d/2^(1/k), this standard deviation relative to it (0: exact)"},
-        {"tree", "radii", "text", "murray", "grammar: murray (the second daughter by Murray's law with [physics] murray_exponent) or ratio (both d·radius_ratio)"},
-        {"tree", "radius_ratio", "", "0.7937", "grammar, radii = \"ratio\": daughter over parent diameter"},
-        {"tree", "angles", "text", "zamir", "grammar: zamir (the optimal angles of the daughters' diameters, as V-System) or fixed (±branch_angle)"},
-        {"tree", "branch_angle", "deg", "35", "grammar, angles = \"fixed\": each daughter's angle to its parent"},
-        {"tree", "angle_sd", "deg", "0", "grammar: normal spread added to each daughter's angle"},
-        {"tree", "roll_angle", "deg", "70", "grammar: β, the roll of each daughter's frame (3D: successive bifurcation planes differ)"},
-        {"tree", "roll_sd", "deg", "0", "grammar: normal spread of β"},
-        {"tree", "stem_segments", "count", "5", "grammar: pieces of a stem"},
-        {"tree", "stem_angle", "deg", "25", "grammar: the turns between a stem's pieces (+ − − +, or mirrored)"},
-        {"tree", "avoid_collisions", "true/false", "true", "grammar: a stem that would overlap a vessel is drawn again"},
-        {"tree", "wall_clearance", "mm", "0 mm", "grammar: vessels keep this much beyond their radius from the domain's wall"},
-        {"tree", "tries", "count", "8", "grammar: draws of a stem (later ones in another plane about the parent) before its branch is dropped"},
-        {"tree", "min_tip_fraction", "", "0.9", "grammar: the run fails when fewer than this fraction of the 2^n tips grow"},
-        {"tree", "dimension", "count", "3", "2: one plane (2^N capillaries in a row); 3: levels alternate between two planes (a 2^N × 2^N capillary grid)"},
-        {"tree", "block_width", "mm", nullptr, "w_b, the block's width (3D: w_b × w_b × h)"},
-        {"tree", "block_height", "mm", nullptr, "h, from the inlet's top to the outlet's bottom"},
-        {"tree", "start_length", "mm", nullptr, "L_s, the vertical inlet (and outlet) vessel"},
-        {"tree", "capillary_length", "mm", nullptr, "L_c, the vertical capillaries"},
-        {"tree", "start_diameter", "mm", nullptr, "d_s, the lumen at the inlet"},
-        {"tree", "capillary_diameter", "mm", nullptr, "d_c, the lumen of the capillaries"},
-        {"tree", "start_wall", "mm", "0 mm", "t_ws, the wall thickness at the inlet"},
-        {"tree", "capillary_wall", "mm", "0 mm", "t_wc, the wall thickness of the capillaries"},
-        {"tree", "capillary_spacing", "mm", nullptr, "d, the largest distance between neighbouring capillaries (and twice their distance from the block's sides)"},
-        {"tree", "level_rule", "text", "corrected", "corrected: N = ⌈log2(c/d + 1)⌉, so capillaries lie at most d apart; printed: the thesis's ⌈log2(c/d)⌉ (farther apart than d when c/d is a power of 2)"},
-        {"physics", "murray_exponent", "", "3", "grammar: k of Murray's law d^k = d1^k + d2^k"},
-        {"physics", "viscosity", "Pa*s", "0.0036 Pa*s", "blood viscosity η (flows and pressures of the outputs)"},
-        {"physics", "perfusion_pressure", "Pa", "100 mmHg", "pressure at the inlet (grammar: the root)"},
-        {"physics", "perfusion_flow", "mm^3/s", "1 mL/min", "Q into the inlet: lzh, the same through every capillary, the outlet's pressure follows (Poiseuille, tapered vessels); grammar, split equally among the tips"},
-    },
+    }, settingRows(grammarSettings()), settingRows(lzhSettings()), settingRows(lsystemPhysics())}),
     &readLsystemToml};
 
 }  // namespace angiosynth

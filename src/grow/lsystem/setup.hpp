@@ -21,8 +21,7 @@ struct LsystemSetup final : GrowthSetup {
   RootSpec root;
   bool has_direction = false;
   Vec3 direction;
-  double root_diameter_mm = 0;          // 0: a fraction of the domain's diameter
-  double root_diameter_fraction = 0.02;
+  double root_diameter_fraction = 0.02;  // of the domain's diameter: d0 when the file gives none
   int tree_line = 0;
   double voxel_mm = 0;
   PhysicsParameters physics_summary;

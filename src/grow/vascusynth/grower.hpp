@@ -9,6 +9,7 @@
 //   check that removes and regrows the few branches that still collide;
 // - no segment shorter than min_length_ratio × its radius (CCO's l > 2r), so that no bifurcation
 //   collapses into a disguised multifurcation (VascuSynth leaves 5.8 % of its segments shorter).
+#include <optional>
 #include <cstdint>
 
 #include "core/vascular_tree.hpp"
@@ -23,7 +24,7 @@ struct GrowthOptions {
   Vec3 root_mm;                        // perforation point
   double min_distance_mm = 0;          // candidates closer than this to any segment are rejected
   int closest_neighbours = 5;          // segments tried per candidate
-  double min_segment_length_mm = 0;    // no segment shorter than this (0: voxel/20)
+  std::optional<double> min_segment_length_mm;  // no segment shorter than this (unset: voxel/20)
   double min_length_ratio = 2;         // no segment shorter than this × its radius (0: VascuSynth's rule, none)
   int relax_sweeps = 4;                // final sweeps moving each bifurcation to its optimum for the final radii
   PhysicsParameters physics;           // total_terminals is set from `terminals`
@@ -34,7 +35,7 @@ struct GrowthOptions {
   // Give up after this many consecutive rejected candidates.
   std::int64_t max_consecutive_rejections = 200000;
 
-  double minSegmentLength(double voxel_mm) const { return min_segment_length_mm > 0 ? min_segment_length_mm : voxel_mm / 20; }
+  double minSegmentLength(double voxel_mm) const { return min_segment_length_mm ? *min_segment_length_mm : voxel_mm / 20; }
 };
 
 // Grows the tree; throws GrowthError when the domain cannot take N terminals.

@@ -13,6 +13,39 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
+// [tree]'s settings.
+const std::vector<Setting<GrowthOptions>>& vascuSynthSettings() {
+  using O = GrowthOptions;
+  static const std::vector<Setting<O>> settings{
+      {.table = "tree", .key = "terminals", .unit = "count", .fallback = nullptr, .meaning = "N, the number of terminal segments",
+       .field = &O::terminals, .range = {1, Limits::kMaxTerminals}},
+      {.table = "tree", .key = "min_distance", .unit = "mm", .fallback = "1 voxel", .meaning = "candidates closer than this to any vessel are drawn again",
+       .field = &O::min_distance_mm, .range = {0, Limits::kMaxLength}, .quantity = Dimension::Length, .fallback_is_value = true},
+      {.table = "tree", .key = "closest_neighbours", .unit = "count", .fallback = "5", .meaning = "segments tried per candidate terminal",
+       .field = &O::closest_neighbours, .range = {1, Limits::kMaxNeighbours}, .fallback_is_value = true},
+      {.table = "tree", .key = "min_segment_length", .unit = "mm", .fallback = "0.05 voxel", .meaning = "no segment shorter than this",
+       .field = &O::min_segment_length_mm, .range = {0, Limits::kMaxLength, true, false}, .quantity = Dimension::Length},
+      {.table = "tree", .key = "min_length_ratio", .unit = "ratio", .fallback = "2",
+       .meaning = "no segment shorter than this × its radius (CCO's l > 2r; 0: VascuSynth's rule, which leaves stubs where bifurcations merge)",
+       .field = &O::min_length_ratio, .range = {0, 100}, .fallback_is_value = true},
+      {.table = "tree", .key = "relax_sweeps", .unit = "count", .fallback = "4",
+       .meaning = "final sweeps that move every bifurcation to its cost optimum for the final radii, keeping every constraint (0: the greedy tree as grown)",
+       .field = &O::relax_sweeps, .range = {0, 100}, .fallback_is_value = true},
+      {.table = "tree", .key = "avoid_intersections", .unit = "true/false", .fallback = "true", .meaning = "refuse connections whose vessels would overlap",
+       .field = &O::avoid_intersections},
+  };
+  return settings;
+}
+
+// VascuSynth's files carry every physical value: none has a default but the exponents.
+const std::vector<Setting<PhysicsParameters>>& vascuSynthPhysics() {
+  static const std::vector<Setting<PhysicsParameters>> settings{
+      physicsSetting("murray_exponent", "3"),        physicsSetting("cost_radius_exponent", "2"), physicsSetting("cost_length_exponent", "1"),
+      physicsSetting("viscosity", nullptr),          physicsSetting("perfusion_pressure", nullptr), physicsSetting("terminal_pressure", nullptr),
+      physicsSetting("perfusion_flow", nullptr)};
+  return settings;
+}
+
 class PreparedVascuSynth final : public PreparedGrowth {
  public:
   PreparedVascuSynth(const VascuSynthSetup& s, DemandMap map) : setup_(s), map_(std::move(map)) {}
@@ -69,21 +102,10 @@ std::shared_ptr<const GrowthSetup> readVascuSynthToml(const TomlReader& r, const
   }
 
   if (const auto mm = readRoot(r, tree, d.root_voxel, d.root_line, "map voxels", "")) d.root_voxel = *mm / d.voxel_mm;
-  g.min_distance_mm = declaredQuantity(r, m, tree, "tree", "min_distance", Dimension::Length, d.voxel_mm);
-  checkRange(g.min_distance_mm, 0, false, Limits::kMaxLength, false, r.at(tree, "min_distance"), "min_distance (mm)");
-  if (tree.get("min_segment_length")) {
-    g.min_segment_length_mm = r.quantity(tree, "tree", "min_segment_length", Dimension::Length, d.voxel_mm);
-    checkRange(g.min_segment_length_mm, 0, true, Limits::kMaxLength, false, r.at(tree, "min_segment_length"), "min_segment_length (mm)");
-  }
-  if (tree.get("min_length_ratio")) {
-    g.min_length_ratio = r.number(tree, "tree", "min_length_ratio");
-    checkRange(g.min_length_ratio, 0, false, 100, false, r.at(tree, "min_length_ratio"), "min_length_ratio (length / radius; 0 turns the rule off)");
-  }
-  g.relax_sweeps = int(declaredCount(r, m, tree, "tree", "relax_sweeps", 0, 100));
-  g.avoid_intersections = r.boolean(tree, "avoid_intersections", true);
-  g.terminals = readTerminals(r, tree, s->terminals_line);
-  g.closest_neighbours = declaredCount(r, m, tree, "tree", "closest_neighbours", 1, std::int64_t(Limits::kMaxNeighbours));
-  g.physics = readPhysics(r, m, methodTable(r, m, "physics"));
+  readSettingsFrom(r, tree, "tree", vascuSynthSettings(), g, d.voxel_mm);
+  if (!g.min_segment_length_mm) g.min_segment_length_mm = g.minSegmentLength(d.voxel_mm);
+  s->terminals_line = r.lineOf(tree.get("terminals"));
+  g.physics = readPhysics(r, vascuSynthPhysics(), methodTable(r, m, "physics"));
   g.physics.total_terminals = g.terminals;
   return s;
 }
@@ -102,17 +124,8 @@ Json VascuSynthSetup::describe() const {
   j["voxel_size"] = quantityJson(d.voxel_mm, "mm");
   j["root"] = Json{{"value", {d.root_voxel.x * d.voxel_mm, d.root_voxel.y * d.voxel_mm, d.root_voxel.z * d.voxel_mm}}, {"unit", "mm"}};
   j["root_voxel"] = {d.root_voxel.x, d.root_voxel.y, d.root_voxel.z};
-  j["terminals"] = g.terminals;
-  j["min_distance"] = quantityJson(g.min_distance_mm, "mm");
-  j["closest_neighbours"] = g.closest_neighbours;
-  j["min_segment_length"] = quantityJson(g.minSegmentLength(d.voxel_mm), "mm");
-  j["min_length_ratio"] = g.min_length_ratio;
-  j["relax_sweeps"] = g.relax_sweeps;
-  j["avoid_intersections"] = g.avoid_intersections;
-  j["murray_exponent"] = p.murray_exponent;
-  j["cost_radius_exponent"] = p.cost_radius_exponent;
-  j["cost_length_exponent"] = p.cost_length_exponent;
-  describePhysics(p, g.terminals, j);
+  j.update(settingsJson(vascuSynthSettings(), g));
+  describePhysics(vascuSynthPhysics(), p, g.terminals, j);
   return j;
 }
 
@@ -130,21 +143,14 @@ const GrowthMethod kVascuSynthMethod{
     "vascusynth",
     "VascuSynth's oxygen-demand CCO (Hamarneh & Jassi 2010) on box maps: terminals drawn ∝ the remaining demand, each joined to the "
     "cheapest of its nearest segments for the cost Σ l^μ r^λ, radii by Poiseuille flow and Murray's law",
-    withPhysicsParams({
+    joinRows({{
         {"domain", "demand_map", "file", nullptr, "the oxygen-demand box map (VascuSynth format), beside the parameter file or the working directory"},
         {"domain", "supply_map", "file", "none", "the supply box map; without it supply_coefficients hold everywhere"},
         {"domain", "supply_coefficients", "numbers", "[0.65, 0.34, 0.01, 7]", "supply reduction coefficients, the last one the cut-off radius in map voxels"},
         {"domain", "voxel_size", "mm", nullptr, "the edge of a map voxel"},
-        {"tree", "terminals", "count", nullptr, "N, the number of terminal segments"},
         {"tree", "root_voxel", "[x, y, z] map voxels", nullptr, "the perforation point (or root in mm; one of the two)"},
         {"tree", "root", "[x, y, z] mm", nullptr, "the perforation point in mm from the map's corner (or root_voxel)"},
-        {"tree", "closest_neighbours", "count", "5", "segments tried per candidate terminal"},
-        {"tree", "min_distance", "mm", "1 voxel", "candidates closer than this to any vessel are drawn again"},
-        {"tree", "min_segment_length", "mm", "0.05 voxel", "no segment shorter than this"},
-        {"tree", "min_length_ratio", "ratio", "2", "no segment shorter than this × its radius (CCO's l > 2r; 0: VascuSynth's rule, which leaves stubs where bifurcations merge)"},
-        {"tree", "relax_sweeps", "count", "4", "final sweeps that move every bifurcation to its cost optimum for the final radii, keeping every constraint (0: the greedy tree as grown)"},
-        {"tree", "avoid_intersections", "true/false", "true", "refuse connections whose vessels would overlap"},
-    }, true, nullptr, nullptr, nullptr, nullptr),
+    }, settingRows(vascuSynthSettings()), settingRows(vascuSynthPhysics())}),
     &readVascuSynthToml};
 
 }  // namespace angiosynth
