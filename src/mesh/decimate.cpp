@@ -102,8 +102,8 @@ bool needsRepair(const SurfaceMesh& m, const std::array<std::int32_t, 3>& t, Pas
   return largestAngleCosine(m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[1])], m.vertices[std::size_t(t[2])]) < cos_bound;
 }
 
-// Component-wise min and max of finite points, inlined (std::fmin and fmax are calls into libm,
-// 4 % of the repair's time).
+// Component-wise min and max of finite points, inlined: std::fmin and fmax are calls into libm,
+// and the repair makes many.
 Vec3 lower(const Vec3& a, const Vec3& b) { return {a.x < b.x ? a.x : b.x, a.y < b.y ? a.y : b.y, a.z < b.z ? a.z : b.z}; }
 Vec3 upper(const Vec3& a, const Vec3& b) { return {a.x > b.x ? a.x : b.x, a.y > b.y ? a.y : b.y, a.z > b.z ? a.z : b.z}; }
 // A triangle's bounding box, and whether two boxes are apart on some axis.
@@ -482,9 +482,8 @@ class Worker {
   // Moves x to the mean of its neighbours, then along its star's normal to where the star keeps
   // its volume (the volume is linear in x's position), if that raises the smallest angle of its
   // triangles (Aim::largest: lowers the largest, the smallest staying above the floor or where it
-  // was) and passes the checks of a collapse (turn, distance, nothing nearby cut). Put onto the
-  // surface instead, the corners moved lost 0.12 % of the test forest's volume; kept at their
-  // offset from it, they gained 0.09 %.
+  // was) and passes the checks of a collapse (turn, distance, nothing nearby cut). It keeps its
+  // offset from the surface rather than being put onto it, which loses volume at every corner.
   bool relax(std::int32_t x, std::int32_t tree, Aim aim = Aim::smallest) {
     if (locked_[std::size_t(x)]) return false;
     neighbours(x, ring_u_);

@@ -764,9 +764,9 @@ bool removeThreeFans(SurfaceMesh& m, const std::vector<std::int32_t>& crossing, 
   return true;
 }
 
-// Rounds of untangle() after relax (each a ring wider: the 100k bench tree's largest part, 13,411
-// vessels, kept one knot of 3 crossing triangles until the eighth), and how far off the surface
-// it may leave a vertex (of its step; every vertex stays within half a step).
+// Rounds of untangle() after relax (each a ring wider: the largest parts of the 100k-segment
+// benchmark tree keep a knot of crossing triangles through most of them), and how far off the
+// surface it may leave a vertex (of its step; every vertex stays within half a step).
 constexpr int kUntangleRounds = 8;
 constexpr double kUntangleOffset = 0.4;
 
@@ -1155,9 +1155,9 @@ ContourPlan planContour(const VascularTree& t, const SurfaceOptions& o, SurfaceR
   lat.grid.origin_mm = lat.origin;
   for (int a = 0; a < 3; ++a) lat.grid.dims[a] = std::int32_t(steps[a] + 1);
   // Bins (12 bytes a pair); about 4 octree cells per cell² of vessel surface (64 bytes in the
-  // octree's sets); about 8 triangles per cell² (marching tetrahedra; measured 6–8) at a peak
-  // of about 170 bytes each (the units' triangles and vertices until they are welded, and the
-  // mesh). Measured: 2.0 GB against 2.4 estimated for examples/vascusynth_like.toml.
+  // octree's sets); about 8 triangles per cell² (marching tetrahedra) at a peak of about 170
+  // bytes each (the units' triangles and vertices until they are welded, and the mesh): an upper
+  // bound of the peak (docs/benchmarks.md compares it with the measured one).
   const double estimate = brickPairBound(inflated, lat.grid) * 12 + area_over_cell2 * (4 * 64 + 8 * 170);
   if (report) report->voxel_mm = h, report->coarsest_mm = cellSize(top), report->estimated_bytes = estimate;
   if (o.memory_limit > 0 && estimate > double(o.memory_limit))

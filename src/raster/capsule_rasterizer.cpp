@@ -196,7 +196,7 @@ void rasterizeBricks(const VascularTree& tree, const VolumeGrid& g, const BrickB
         // ramp of its width w (the same second moment, w²/12, as the exact cube coverage in
         // any orientation), with the surface moved in by σ²κ/2 (κ = 1/r on the cylinder,
         // 2/r on the caps): the level shift that smoothing causes on a curved surface.
-        // Second-order accurate; 0/1 samples alias on thin vessels (1.5 % at r = 0.5 voxel).
+        // Second-order accurate, where 0/1 samples alias on thin vessels.
         // Capsule by capsule over all samples (the minimum is the same in any order; the sum
         // below runs in sample order as before), so the cylinder loop vectorises.
         std::fill(sd.begin(), sd.end(), 1e300);

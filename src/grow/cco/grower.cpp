@@ -24,7 +24,7 @@ constexpr std::int64_t kRefreshEvery = 64;
 // The final repair never removes more than this share of the terminals for one violation.
 constexpr double kMaxRepairShare = 0.05;
 // For a trunk shorter than 2r that no move can lengthen, the side branch it merges with its
-// larger child by losing may be larger (measured: 1 trunk in 10 trees of 4000 terminals).
+// larger child by losing may be larger (rare: docs/benchmarks.md, "Figures behind design choices").
 constexpr double kMaxShortRepairShare = 0.15;
 // Vessels in the way of a short trunk's lengthening, with at most this many terminals, are
 // removed and regrown rather than leave the trunk short; in a single tree's growth, an ancestor
@@ -42,17 +42,17 @@ constexpr std::int64_t kLenientAfter = 100;
 constexpr std::uint8_t kDeferAfter = 8;
 // A vessel whose surface lies within this fraction of the last connected terminal's radius from
 // a drawn point crowds out the connections whose terminal segment it would touch (crowdedOut).
-// Half the radius, as a new terminal is rarely thinner than half the last one: the sphere's trees
-// stay the same (seeds 1-4, 20,000 and 50,000 terminals); 0.8 makes them differ, and 3 of 4
-// heavier. On the disc, 50,000 terminals, seed 1: 17,665 points crowded out everywhere.
+// Half the radius, as a new terminal is rarely thinner than half the last one; a larger fraction
+// crowds out connections that would have fitted and makes trees heavier (docs/benchmarks.md,
+// "Why the CCO grower's constants are what they are").
 constexpr double kCrowdedTerminal = 0.5;
 // Nearest segments that first test whether a drawn point lies inside a vessel.
 constexpr int kInsideProbe = 4;
 // Segments with ρ at least this are "thick": checked from a list rather than through the grid.
 constexpr double kThick = 0.25;
 
-// Nearest segments that may hide a farther one from a drawn point in the plane (on the disc, 40
-// hide 3.5 % more trials than 20; 80 only 0.5 % more than 40).
+// Nearest segments that may hide a farther one from a drawn point in the plane: beyond about 40
+// more of them hide hardly any further trial (docs/benchmarks.md, as above).
 constexpr std::size_t kOccluders = 40;
 
 // True if segment y is within two segments of the terminal segment of a connection that splits
@@ -135,12 +135,11 @@ struct System {
 
 // Quasi-Newton steps of the exact optimiser from Kamiya's point. Kamiya's radii come from his
 // law, not from the tree, so his point is off the tree's optimum; the first steps recover most
-// of the difference (1000 terminals in 20,000 mm³, 4 seeds: 1 step 284 mm³, 4 steps 285, 20
-// steps 284; Kamiya alone 308 mm³).
+// of the difference, and more steps do not make lighter trees (docs/benchmarks.md, as above).
 constexpr int kRefineIterations = 4;
 // The exact point counts only inside l > 2.1 r: an optimum pressed against l = 2r crowds its
 // neighbours, and as they thicken their ancestors collide and refuse every later connection
-// below them (measured: 300 terminals took 24 s instead of 0.5 s).
+// below them, and growth slows by orders of magnitude.
 constexpr double kInteriorMargin = 1.05;
 constexpr double kRootMargin = 1.25;
 constexpr std::size_t kRefineNearest = 8;
@@ -420,9 +419,8 @@ class CcoGrower {
       // own): after kDeferAfter refusals only vessels too large to regrow still block it (the
       // final check finds the others, and the repair regrows them), and after a long run of
       // failures no other tree's vessel does. A single tree does so while the repair regrows:
-      // the holes it fills lie beside the trunks that made them (sphere, 20,000 terminals, seed
-      // 4: the first regrowth of 3,109 terminals placed none in 150 s; with this, 1 s); while
-      // it grows, only vessels of a few terminals stop counting.
+      // the holes it fills lie beside the trunks that made them, and without this a regrowth can
+      // place nothing for minutes; while it grows, only vessels of a few terminals stop counting.
       const bool ancestor = &x - check_.data() >= 3;
       const bool defer = forest || repairing_;
       const bool big_only = defer && ancestor && g.blocks[x] >= kDeferAfter;
@@ -448,9 +446,9 @@ class CcoGrower {
   // refused kDeferAfter connections stops counting the vessels the final repair may regrow: in a
   // forest, or while the repair regrows, those up to kMaxRepairShare of the terminals; in a
   // single tree's growth, those of at most kMaxClearedTerminals terminals or 1/kSmallBeside of
-  // its own. (Sphere, 50,000 terminals: a trunk of 10,070 terminals thickened into a branch of
-  // 23 below it and refused connections 8 million times, seed 2: 184 s -> 36 s; seed 3: 185 s
-  // -> 50 s. Any vessel up to 32 terminals: 17,166 terminals regrown in seed 3.)
+  // its own: a trunk that thickened into a small branch below it would otherwise refuse millions
+  // of connections, and clearing any vessel of a few dozen terminals regrows too many
+  // (docs/benchmarks.md, as above).
   bool counts(int k, std::int32_t x, std::int32_t y, bool ancestor) const {
     const auto& g = trees_[k];
     if (!ancestor || y >= g.tree.nodeCount() || g.blocks[x] < kDeferAfter) return true;
@@ -512,8 +510,7 @@ class CcoGrower {
       if (accepts(k) && trees_[k].tree.segmentCount() > 0) open.push_back(k);
     // Most points drawn into a dense planar tree lie inside a vessel, which Algorithm 2 refuses:
     // the segments listed in p's cell, then the few nearest (the first of the ν nearest), settle
-    // that before the ν are sought (disc, 50,000 terminals: 1.3 million such points, 22.2 -> 19.7
-    // s with the look in the cell first).
+    // that before the ν are sought.
     for (int k : open) {
       auto& g = trees_[k];
       const double rr = currentRootRadius(g);
@@ -556,8 +553,7 @@ class CcoGrower {
         auto& trials = trials_[i];
         trials.resize(g.near.size());
         // One task per segment: the other thread is often asleep when a candidate arrives and
-        // wakes too late to take half of the list (halves gained 7 % on 2 cores, single segments
-        // 35 %: 20,000 terminals on the disc 9.2 -> 7.1 s, in the sphere 4.8 -> 3.9 s).
+        // wakes too late to take half of the list.
         const bool planar = dom_.dimension() == 2;
         tbb::parallel_for(tbb::blocked_range<std::size_t>(g.done, g.near.size(), 1), [&](const auto& r) {
           for (auto j = r.begin(); j != r.end(); ++j) {
@@ -572,17 +568,12 @@ class CcoGrower {
             trials[j] = evaluate(g, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
             // The exact point where Kamiya found a valid one, and on the kRefineNearest nearest
             // segments where he found none (merged or l <= 2r: there the exact optimum often
-            // lies inside). Measured on 4000 terminals in Kerautret et al.'s sphere: refining every
-            // segment 748.8 mm³ in 1.04 s, these 754.9 mm³ in 0.85 s; Kamiya alone 886.8 mm³ in
-            // 0.56 s (with the §3.3.2 spacing).
+            // lies inside): nearly the volume of refining every segment at a fraction of its cost.
             // In the plane, not where his point merged into the proximal node and the exact
             // optimum lies there too (the weighted Fermat condition, one walk): the steps would
-            // only slide towards the node, where the parent part is short. Disc, 50,000
-            // terminals, seed 1: 464,168 of the 849,080 refinements started so, 3,340 of them
-            // valid, 934 of the 54,800 connections made; seeds 1-4 skipping those the test picks:
-            // 16.1-18.0 -> 12.8-13.6 s, 50,000 terminals +0.0-0.1 % volume, 20,000 -1.3 to +0.1 %.
-            // In space such steps, stopped short of the node, are valid 12 % of the time, and
-            // without them the sphere's trees came out heavier (7 of 8, 0.1-0.8 %).
+            // only slide towards the node, where the parent part is short, and skipping them saves
+            // time at no cost in volume. In space such steps, stopped short of the node, are often
+            // valid, and without them the trees come out heavier (docs/benchmarks.md, as above).
             const auto& k = trials[j].c[0];
             trials[j].at_node = planar && opt_.bifurcation == BifurcationPoint::Exact && j < kRefineNearest && trials[j].merged_at_parent &&
                                 opts[i].optimumAtProximalNode(g.near[j].second, p);
@@ -641,12 +632,8 @@ class CcoGrower {
       // ν doubles only where a user asks for it (max_closest_neighbours), and never in the plane.
       // The segments beyond the ν nearest are reached by long, heavy connections, around the
       // vessels near the point (in the plane across them: half of the ν nearest are hidden
-      // already). Without doubling, every tree measured is lighter: sphere, seeds 1-4, 20,000
-      // terminals 920.3, 916.2, 918.3, 967.6 -> 918.3, 915.8, 913.5, 929.1 mm³, 50,000 terminals
-      // 1022.3, 1026.4, 1047.8, 1100.1 -> 1019.9, 1018.4, 1016.0, 1039.9 mm³ (seed 3 then
-      // regrows 849 terminals in the repair instead of 14,228); OpenCCO's ball 282.0 -> 280.4 mm³
-      // at 1000 terminals and 345.7 -> 343.2 at 4000 (10 seeds); the disc, seeds 1-4, all 8 by
-      // 0.1-1.2 % (50,000 terminals, seed 1: 413 of 53,635 connections came after ν doubled).
+      // already). Without doubling, every tree measured came out lighter (docs/benchmarks.md, as
+      // above).
       if (!more || nu >= opt_.max_neighbours || dom_.dimension() == 2) return false;
       nu = std::min(2 * nu, opt_.max_neighbours);
       ++report_.neighbour_doublings;
@@ -656,8 +643,7 @@ class CcoGrower {
   // True if a vessel near the point (g.crowding) is more than two segments from the terminal
   // segment of a connection that splits s: the collision check would refuse every connection on
   // s, as the terminal segment's capsule ends at the point and reaches that vessel. Such trials
-  // are not costed (disc, 50,000 terminals, seed 1: evaluations of the exact optimiser 7.1 -> 6.1
-  // million, 19.7 -> 16.3 s; of the 7.1 million, 3.7 went to points that connected nowhere).
+  // are not costed: most of them would go to points that connect nowhere.
   static bool crowdedOut(const TreeGrowth& g, std::int32_t s) {
     return std::any_of(g.crowding.begin(), g.crowding.end(), [&](std::int32_t y) { return !besideSplit(g.tree, s, y); });
   }
@@ -808,9 +794,8 @@ class CcoGrower {
   // bifurcation outwards (along the trunk, or towards its children), or its proximal one back,
   // to 2.1–3 r, whichever first fits. Failing that, the same slides to 2.1 r where only small
   // vessels (at most kMaxClearedTerminals terminals or 1/kSmallBeside of the trunk's, fewer
-  // than its own, so none of its ancestors) are in the way: they go to `regrow`. Measured: the
-  // one trunk left short in the sphere at 20,000 terminals was blocked by a single terminal
-  // segment.
+  // than its own, so none of its ancestors) are in the way: they go to `regrow`. A trunk left
+  // short is typically blocked by a single terminal segment.
   bool lengthen(int k, std::int32_t s, std::vector<std::int32_t>& regrow) {
     if (lengthenFree(k, s)) return true;
     const auto& T = trees_[k].tree;
@@ -825,12 +810,10 @@ class CcoGrower {
   }
 
   // In a chain of trunks each near 2r, neither neighbour has the room alone: both ends of s
-  // slide half way, to 2.1 r or 2.05 r (sphere, 50,000 terminals, seed 4: a trunk of 21,539
-  // terminals, 1.91 mm at r 0.99 mm, whose parent and larger child each had half the 0.1 mm it
-  // lacked, and a terminal segment in the way). Or the distal end slides on with one child,
-  // which keeps its length: a root segment's proximal end cannot move (4000 terminals in
-  // OpenCCO's ball, seed 1: a root segment 2.04 mm at r 1.07 mm whose larger child would have
-  // come 0.005 mm short of its own 2r).
+  // slide half way, to 2.1 r or 2.05 r (a trunk whose parent and larger child each have half
+  // the length it lacks). Or the distal end slides on with one child,
+  // which keeps its length: a root segment's proximal end cannot move (a root segment just over
+  // 2r whose larger child would come a hair short of its own 2r).
   bool slideWithNeighbour(int k, std::int32_t s, std::vector<std::int32_t>* regrow = nullptr, std::int32_t small = 0) {
     const auto& T = trees_[k].tree;
     const auto P = T.parent[s];

@@ -37,8 +37,9 @@ void checkVesselRoom(const PhysicsParameters& p, std::int64_t n, double measure,
   const RadiusEstimate e = estimateRadii(p, n, measure, dim);
   const std::string unit = dim == 2 ? " mm^2" : " mm^3";
   // Terminal vessels wider than a quarter of the spacing between terminals leave no room to
-  // branch without collisions: measured on the shipped examples, growth slows 25-fold at 0.42 of
-  // that limit (100x their flow) and runs for minutes past it (300x), while 1x sits at 0.13.
+  // branch without collisions: growth slows steeply well before the limit and runs for minutes
+  // past it, while the shipped examples sit far below it (docs/benchmarks.md, "Figures behind
+  // design choices").
   if (2 * e.terminal > e.spacing / 4)
     throw InputError(file, line,
                      "vessels too thick for the domain: this flow, pressure drop and viscosity give terminal vessels of "

@@ -10,8 +10,8 @@ namespace angiosynth {
 
 // Estimated radii of an N-terminal tree: a symmetric tree whose segments halve in flow and
 // shrink by 2^(-1/γ) in radius and 2^(-1/d) in length per level, with the given pressure drop.
-// It sits within 15 % of grown CCO trees' root and terminal radii (examples/cco_sphere_3d.toml:
-// 1.44 vs 1.25 mm, 0.091 vs 0.090 mm).
+// It is close to grown CCO trees' root and terminal radii (docs/benchmarks.md, "Figures behind
+// design choices"), close enough to refuse a file that cannot grow before any growth.
 struct RadiusEstimate {
   double root = 0, terminal = 0, spacing = 0;
 };

@@ -25,7 +25,7 @@ constexpr int kAncestorsChecked = 6;
 // Radii are checked at their predicted final size. The root grows as r ∝ n^a (a measured on the
 // growing tree, about 0.29 for VascuSynth's example, clamped to [0.2, 0.4] against early noise);
 // the prediction holds for the trunk but overstates thin peripheral branches, so it is capped
-// (measured: scaling each vessel by its flow share instead leaves ten times more collisions).
+// (scaling each vessel by its flow share instead leaves many more collisions: docs/benchmarks.md).
 constexpr double kMaxPredictedScale = 4.0;
 // The final repair never removes more than this share of the terminals for one collision.
 constexpr double kMaxRepairShare = 0.05;
@@ -114,7 +114,7 @@ class Grower {
       // fixed proximal end the final check cannot slide back, by 1.1 × its predicted growth; the
       // others by its square root (the trunk's growth overstates theirs, the present radii
       // understate it). Measured over 20 seeds of examples/vascusynth_like.toml, this leaves the
-      // fewest vessels for the final check to lengthen at the lowest cost (see the README).
+      // fewest vessels for the final check to lengthen at the lowest cost (docs/methods/vascusynth.md).
       const double growth = rootGrowth();
       const BifurcationOptimizer opt(tree_, params_, map_, min_length_, opt_.min_length_ratio, std::sqrt(finalScale()), 1.1 * growth);
       tbb::parallel_for(std::size_t(0), near.size(), [&](std::size_t i) { trials[i] = opt.optimise(near[i].second, cand); });

@@ -8,7 +8,7 @@
 //   predicted to have in the final tree (they thicken as terminals are added), and a final exact
 //   check that removes and regrows the few branches that still collide;
 // - no segment shorter than min_length_ratio × its radius (CCO's l > 2r), so that no bifurcation
-//   collapses into a disguised multifurcation (VascuSynth leaves 5.8 % of its segments shorter).
+//   collapses into a disguised multifurcation (VascuSynth leaves such stubs where bifurcations merge).
 #include <optional>
 #include <cstdint>
 
