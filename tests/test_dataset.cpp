@@ -98,6 +98,13 @@ TEST_F(Dataset, LayoutObeysTheRulesNnUNetChecks) {
   const Json prov = Json::parse(slurp(ds / "provenance.json"));
   EXPECT_NE(prov["spec"].get<std::string>().find("VesselTiny"), std::string::npos);
   EXPECT_EQ(prov["runs"].size(), 1u);
+  // The data's licence and how to cite the tool, and no host name unless the spec asks for one.
+  EXPECT_EQ(j["licence"], "CC0-1.0");
+  EXPECT_NE(j["reference"].get<std::string>().find("CITATION.cff"), std::string::npos);
+  EXPECT_EQ(prov["licence"], "CC0-1.0");
+  EXPECT_FALSE(prov["finalized_on"].contains("hostname"));
+  EXPECT_FALSE(prov["runs"][0]["machine"].contains("hostname"));
+  EXPECT_TRUE(prov["runs"][0]["machine"].contains("cores"));
   // Every manifest line names its files with size and hash.
   std::ifstream in(ds / "manifest.jsonl");
   int lines = 0;
@@ -108,6 +115,25 @@ TEST_F(Dataset, LayoutObeysTheRulesNnUNetChecks) {
     EXPECT_EQ(e["files"][0]["sha256"].get<std::string>().size(), 64u);
   }
   EXPECT_EQ(lines, 6);
+}
+
+// The spec names the data's licence and may ask for the host names.
+TEST_F(Dataset, TheSpecNamesTheLicenceAndMayRecordTheHost) {
+  std::string text = slurp(src_ / "tests/data/dataset_tiny.toml");
+  text.replace(text.find("../../demand_maps"), 17, (src_ / "demand_maps").string());
+  text.replace(text.find("channel_name"), 0, "licence = \"CC-BY-4.0\"\nrecord_host = true\n");
+  std::ofstream(dir_ / "tiny_licence.toml") << text;
+  ASSERT_EQ(run("dataset tiny_licence.toml --out l --quiet", dir_).code, 0);
+  EXPECT_EQ(Json::parse(slurp(dir_ / "l" / name_ / "dataset.json"))["licence"], "CC-BY-4.0");
+  const Json prov = Json::parse(slurp(dir_ / "l" / name_ / "provenance.json"));
+  EXPECT_EQ(prov["licence"], "CC-BY-4.0");
+  EXPECT_TRUE(prov["finalized_on"].contains("hostname"));
+  EXPECT_TRUE(prov["runs"][0]["machine"].contains("hostname"));
+  text.replace(text.find("\"CC-BY-4.0\""), 11, "\"\"");
+  std::ofstream(dir_ / "tiny_licence.toml") << text;
+  const auto bad = run("dataset tiny_licence.toml --out m --quiet", dir_);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("licence must be a text of 1 to 200 characters"), std::string::npos) << bad.err;
 }
 
 // previews = true: MIPs of the clean and the degraded image beside each sample's ground truth,

@@ -165,12 +165,22 @@ Json generateOne(const DatasetSpec& spec, const fs::path& dir, const fs::path& p
   return e;
 }
 
-Json machine() {
-  char host[256] = {0};
-  ::gethostname(host, sizeof host - 1);
-  return Json{{"hostname", host},
-              {"cores", std::thread::hardware_concurrency()},
-              {"memory_bytes", physicalMemoryBytes()}};
+// The machine a run used: its cores and memory, and its host name only when the spec asks for it
+// (a host name can identify a person or an institution).
+Json machine(bool record_host) {
+  Json j{{"cores", std::thread::hardware_concurrency()}, {"memory_bytes", physicalMemoryBytes()}};
+  if (record_host) {
+    char host[256] = {0};
+    ::gethostname(host, sizeof host - 1);
+    j["hostname"] = host;
+  }
+  return j;
+}
+
+// How to cite what made a dataset, for dataset.json and provenance.json.
+std::string citation() {
+  return std::string("synthetic data generated with angiosynth ") + kVersion +
+         ": cite angiosynth as its CITATION.cff gives, and the papers of the growth method and degradation profile used (docs/references.md)";
 }
 
 }  // namespace
@@ -260,6 +270,8 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
                    {"channel_name", spec.channel_name},
                    {"labels", labelValues(spec)}};
   if (spec.label_policy != "binary") spec_record["label_policy"] = spec.label_policy;  // binary datasets as before
+  spec_record["licence"] = spec.licence;
+  if (spec.record_host) spec_record["record_host"] = true;
   spec_record["spec_file"] = spec.file;
   spec_record["spec_sha256"] = spec.sha256;
   spec_record["spec"] = spec.text;
@@ -268,7 +280,7 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
                       Json{{"tool", {{"name", "angiosynth"}, {"version", kVersion}}},
                            {"command_line", opt.command_line},
                            {"part", sel.part},
-                           {"machine", machine()},
+                           {"machine", machine(spec.record_host)},
                            {"started_unix", nowUnix()}});
   if (opt.resume) {
     const auto done = readManifests(dir, spec.samples);
@@ -383,7 +395,8 @@ DatasetCheck finalizeDataset(const fs::path& dir) {
                     {"file_ending", ".nii.gz"},
                     {"name", info["name"]},
                     {"description", "synthetic vascular trees with exact ground truth (angiosynth)"},
-                    {"licence", "generated data; see provenance.json"},
+                    {"licence", info.value("licence", std::string("not recorded (made by an earlier version)"))},
+                    {"reference", citation()},
                     {"release", kVersion}};
   // A non-binary label policy is named (nnU-Net reads the ignore label from "labels"; "soft"
   // labelsTr hold the partial volume as float, for trainers with soft targets).
@@ -406,7 +419,9 @@ DatasetCheck finalizeDataset(const fs::path& dir) {
                                                     {"spec", info["spec"]},
                                                     {"seed", info["seed"]},
                                                     {"samples", c.samples},
-                                                    {"finalized_on", machine()},
+                                                    {"licence", info.value("licence", std::string("not recorded (made by an earlier version)"))},
+                                                    {"citation", citation()},
+                                                    {"finalized_on", machine(info.value("record_host", false))},
                                                     {"finalized_unix", nowUnix()},
                                                     {"runs", runs}});
   return c;

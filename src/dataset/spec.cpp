@@ -259,9 +259,10 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
   const auto& d = *ds->as_table();
   for (const auto& [k, v] : d)
     if (k != "name" && k != "id" && k != "samples" && k != "seed" && k != "profile" && k != "channel_name" && k != "labels" &&
-        k != "kinds" && k != "previews")
+        k != "kinds" && k != "previews" && k != "licence" && k != "record_host")
       throw InputError(s.file, lineOf(v), "unknown key '" + std::string(k.str()) +
-                                              "' in [dataset]; allowed: name, id, samples, seed, profile, channel_name, labels, kinds, previews");
+                                              "' in [dataset]; allowed: name, id, samples, seed, profile, channel_name, labels, kinds, previews, "
+                                              "licence, record_host");
   const auto need = [&](const char* key) -> const toml::node& {
     const auto* n = d.get(key);
     if (!n) throw InputError(s.file, lineOf(d), std::string("missing key '") + key + "' in [dataset]");
@@ -287,6 +288,16 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
   if (const auto* p = d.get("previews")) {
     if (!p->is_boolean()) throw InputError(s.file, lineOf(*p), "previews must be true or false (MIPs of each sample in groundtruth/)");
     s.previews = *p->value<bool>();
+  }
+  if (const auto* l = d.get("licence")) {
+    const auto v = l->value<std::string>();
+    if (!v || v->empty() || v->size() > 200)
+      throw InputError(s.file, lineOf(*l), "licence must be a text of 1 to 200 characters: the generated data's licence, e.g. \"CC0-1.0\" or \"CC-BY-4.0\"");
+    s.licence = *v;
+  }
+  if (const auto* h = d.get("record_host")) {
+    if (!h->is_boolean()) throw InputError(s.file, lineOf(*h), "record_host must be true or false (host names in provenance.json)");
+    s.record_host = *h->value<bool>();
   }
   s.sha256 = canonicalSpecSha256(s.text, s.file);
   if (root->contains("seed")) throw InputError(s.file, lineOf(*root->get("seed")), "the seed of a dataset goes in [dataset]");

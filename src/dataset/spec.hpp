@@ -40,6 +40,10 @@ struct DatasetSpec {
   // label (a float partial volume for "soft"); "ignore" adds nnU-Net's ignore label.
   std::string label_policy = "binary";
   bool previews = false;           // MIPs (PNG) of each sample's clean and degraded image in groundtruth/
+  // The licence the dataset's author gives the generated data (an SPDX identifier or any text):
+  // dataset.json and provenance.json name it.
+  std::string licence = "CC0-1.0";
+  bool record_host = false;        // provenance.json names the machines' host names (off: cores and memory only)
 };
 
 // The label values of labelsTr, as dataset.json and each sample's meta list them.
