@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The scoring worked example of the README: a degraded CTA-like image thresholded at three levels,
+# The scoring worked example of docs/scoring.md: a degraded CTA-like image thresholded at three levels,
 # each threshold scored against the exact truth, and the three calibre curves drawn into one PNG.
 #   bash examples/score_thresholds.sh [WORK_DIR]     (after scripts/example.sh; needs python3-nibabel)
 set -euo pipefail

@@ -427,10 +427,10 @@ TEST(Degrade, ShippedProfilesDrawWithinTheirRangesAndFitTheirDtype) {
   EXPECT_EQ(profiles, 6);
 }
 
-TEST(Degrade, ReadmeListsEveryEffectAsTheCodeDeclaresIt) {
-  std::ifstream in(test::sourceDir() / "README.md");
-  const std::string readme((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_NE(readme.find(effectReference()), std::string::npos) << "paste the output of `angiosynth effects` into README.md";
+TEST(Degrade, TheDocsListEveryEffectAsTheCodeDeclaresIt) {
+  std::ifstream in(test::sourceDir() / "docs/degradation.md");
+  const std::string page((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(page.find(effectReference()), std::string::npos) << "run bash scripts/docs.sh: docs/degradation.md lists the effects";
 }
 
 TEST(Degrade, VascuSynthProfileAddsSigma20WhereTheImageIsNotClamped) {

@@ -1,5 +1,5 @@
 // Growth methods as plug-ins: the registry, the declarations that drive reader, defaults and
-// reference, and the README generated from them.
+// reference, and the docs generated from them.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -18,10 +18,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-TEST(Methods, ReadmeListsEveryMethodAsTheCodeDeclaresIt) {
-  std::ifstream in(test::sourceDir() / "README.md");
-  const std::string readme((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_NE(readme.find(methodReference()), std::string::npos) << "paste the output of `angiosynth methods` into README.md";
+TEST(Methods, TheDocsListEveryMethodAsTheCodeDeclaresIt) {
+  std::ifstream in(test::sourceDir() / "docs/methods.md");
+  const std::string page((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(page.find(methodReference()), std::string::npos) << "run bash scripts/docs.sh: docs/methods.md lists the methods";
 }
 
 TEST(Methods, EveryDeclaredDefaultIsReadableInItsUnitAndDeclaredOnce) {

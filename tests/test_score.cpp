@@ -319,15 +319,14 @@ namespace {
 // hollow ball (1, 0, 1), a solid torus (1, 1, 0), a ring of two tori linked by a bar (1, 2, 0),
 // diagonal neighbours (26-connected: one piece), an empty volume (0, 0, 0).
 // The registry is the one list: every metric has its definition in the results, its headline
-// columns in the CSV header in registry order, and a row in the README's table of metrics.
-TEST(Score, EveryRegisteredMetricIsDefinedInTheResultsInTheCsvAndInTheReadme) {
-  std::ifstream in(test::sourceDir() / "README.md");
-  const std::string readme((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto section = readme.substr(readme.find("## Scoring a segmentation"));
+// columns in the CSV header in registry order, and a row in the docs' table of metrics.
+TEST(Score, EveryRegisteredMetricIsDefinedInTheResultsInTheCsvAndInTheDocs) {
+  std::ifstream in(test::sourceDir() / "docs/scoring.md");
+  const std::string section((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   std::string header = "case";
   for (const auto* m : scoreMetrics()) {
     EXPECT_EQ(findScoreMetric(m->key), m);
-    EXPECT_NE(section.find(std::string("`") + m->key + "`"), std::string::npos) << m->key << " is missing from the README's table";
+    EXPECT_NE(section.find(std::string("`") + m->key + "`"), std::string::npos) << m->key << " is missing from docs/scoring.md's table";
     EXPECT_GT(std::string(m->definition).size(), 40u) << m->key;
     for (const auto& h : m->headline) (header += ',') += h.column;
   }

@@ -15,7 +15,7 @@ inline constexpr double kPaPerMmHg = 133.322387415;
 // std::invalid_argument whose message says what is allowed.
 double parseQuantity(const std::string& text, Dimension dim, double voxel_mm = 0);
 
-// Units accepted for a dimension, for error messages and the README.
+// Units accepted for a dimension, for error messages and the docs.
 std::string allowedUnits(Dimension dim);
 
 // Size of a plain length unit (um, mm, cm, m) in mm; throws std::invalid_argument.

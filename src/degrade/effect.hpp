@@ -44,17 +44,17 @@ struct EffectContext {
 
 struct EffectType {
   const char* name;
-  const char* summary;              // one line for the README and `--help`
+  const char* summary;              // one line for the docs and `--help`
   std::vector<ParamDecl> params;
   void (*apply)(const Drawn& p, EffectContext& ctx);
   bool moves_geometry = false;      // a warp: at most one per profile
   bool noise = false;               // random noise (left out of the visible label's noise-free runs)
 };
 
-// Every effect, in the order the README lists them.
+// Every effect, in the order the docs list them.
 const std::vector<const EffectType*>& effectTypes();
 const EffectType* findEffectType(const std::string& name);
-// Markdown list of every effect with its parameters (`angiosynth effects`, the README).
+// Markdown list of every effect with its parameters (`angiosynth effects`, docs/degradation.md).
 std::string effectReference();
 
 // Applies f(v) to every voxel index in parallel; f must depend on v only (not on scheduling).

@@ -60,7 +60,7 @@ struct ParamDecl {
   ParamKind kind;
   double lo, hi;              // allowed values after resolution, closed interval
   const char* fallback;       // default, written as in a profile ("0", "vessel", "1 voxel"); nullptr: required
-  const char* meaning;        // for the README and errors
+  const char* meaning;        // for the docs and errors
   // Lengths only: bounds relative to the image grid (0: none), per axis. A B-spline lattice finer
   // than a voxel has more control points than the image has voxels; a blur wider than the field
   // of view only costs time.
@@ -99,7 +99,7 @@ double drawComponent(const ParamRange& r, double u, const ParamScale& s, int axi
 // A fixed plain value (VascuSynth noise files, code-built profiles).
 ParamSpec fixedParam(double value, const std::string& file = "", int line = 0);
 
-// "a value", "a range" etc. as written in the README.
+// "a value", "a range" etc. as the docs write it.
 std::string describeKind(ParamKind kind);
 
 }  // namespace angiosynth

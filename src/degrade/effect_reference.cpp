@@ -1,5 +1,5 @@
 // The reference of every effect and its parameters, generated from the declarations so that
-// `angiosynth effects` and the README cannot drift from the code.
+// `angiosynth effects` and the docs cannot drift from the code.
 #include <sstream>
 
 #include "degrade/effect.hpp"

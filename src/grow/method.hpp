@@ -21,7 +21,7 @@ namespace angiosynth {
 class GrowthDomain;
 class TomlReader;
 
-// One key of a method's tables, as the README and `angiosynth methods` list it.
+// One key of a method's tables, as docs/methods.md and `angiosynth methods` list it.
 struct MethodParam {
   const char* table;     // "domain", "tree", "physics", or a sub-table such as "tree.inlet"
   const char* key;
@@ -69,18 +69,18 @@ class GrowthSetup {
 
 struct GrowthMethod {
   const char* name;
-  const char* summary;            // one line for the README and `angiosynth methods`
+  const char* summary;            // one line for the docs and `angiosynth methods`
   std::vector<MethodParam> params;
   // Reads [domain], [tree] and [physics] of a TOML parameter file.
   std::shared_ptr<const GrowthSetup> (*read)(const TomlReader& reader, const GrowthMethod& self);
 };
 
-// Every method, in the order the README lists them.
+// Every method, in the order the docs list them.
 const std::vector<const GrowthMethod*>& growthMethods();
 const GrowthMethod* findGrowthMethod(const std::string& name);
 // The names, comma-separated, for errors.
 std::string growthMethodNames();
-// Markdown reference of every method with its parameters (`angiosynth methods`, the README).
+// Markdown reference of every method with its parameters (`angiosynth methods`, docs/methods.md).
 std::string methodReference();
 // The method (other than `self`) that declares table.key, or nullptr: for "is for method X" errors.
 const GrowthMethod* methodDeclaring(const std::string& table, const std::string& key, const GrowthMethod* self);

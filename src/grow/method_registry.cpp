@@ -1,5 +1,5 @@
 // The growth methods by name, and their reference generated from their declarations so that
-// `angiosynth methods` and the README cannot drift from the readers.
+// `angiosynth methods` and the docs cannot drift from the readers.
 #include <sstream>
 
 #include "grow/cco/setup.hpp"
