@@ -23,11 +23,16 @@ int main(int argc, char** argv) {
   int max_nu = 0;  // ν doubles up to this (0: the default)
   long seed = 1;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--disc")) disc = true;
-    else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) seed = std::atol(argv[++i]);
-    else if (!std::strcmp(argv[i], "--max-nu") && i + 1 < argc) max_nu = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::atoi(argv[++i]);
-    else sizes.push_back(std::atol(argv[i]));
+    if (!std::strcmp(argv[i], "--disc"))
+      disc = true;
+    else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc)
+      seed = std::atol(argv[++i]);
+    else if (!std::strcmp(argv[i], "--max-nu") && i + 1 < argc)
+      max_nu = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc)
+      threads = std::atoi(argv[++i]);
+    else
+      sizes.push_back(std::atol(argv[i]));
   }
   if (sizes.empty()) sizes = {1000, 4000};
   std::unique_ptr<tbb::global_control> gc;
@@ -35,8 +40,8 @@ int main(int argc, char** argv) {
   // Seed 000 §5 / Karch 1999: 100 cm³ perfused with 500 mL/min (4000 terminals of 0.125 mL/min).
   const double radius = disc ? 50.0 : std::cbrt(3 * 1e5 / (4 * M_PI));
   const auto dom = GrowthDomain::analytic(disc ? DomainShape::Disc : DomainShape::Sphere, radius, radius / 50);
-  std::printf("%-7s %9s %9s %12s %16s %10s %6s %6s %9s\n", "domain", "terminals", "time (s)", "us/terminal",
-              "us/term/log2(N)", "peak MiB", "pairs", "short", "volume mm3");
+  std::printf("%-7s %9s %9s %12s %16s %10s %6s %6s %9s\n", "domain", "terminals", "time (s)", "us/terminal", "us/term/log2(N)", "peak MiB", "pairs",
+              "short", "volume mm3");
   for (long n : sizes) {
     CcoOptions o;
     o.terminals = n;
@@ -51,12 +56,17 @@ int main(int argc, char** argv) {
     const auto tree = growCco(dom, o, rep);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("%-7s %9ld %9.3f %12.1f %16.2f %10.1f %6lld %6lld %9.1f\n", disc ? "disc" : "sphere", n, s, s / n * 1e6,
-                s / n * 1e6 / std::log2(double(n)), peakRssBytes() / 1048576.0, (long long)rep.intersecting_pairs,
-                (long long)rep.short_segments, treeVolume(tree));
-    std::fprintf(stderr, "  draws too close %lld, candidates %lld, unconnectable %lld, relaxations %lld, doublings %lld, kamiya failures %lld, collisions %lld, repair rounds %d, repaired %lld\n", (long long)rep.rejected_too_close, (long long)rep.candidates, (long long)rep.rejected_unreachable, (long long)rep.threshold_relaxations, (long long)rep.neighbour_doublings, (long long)rep.kamiya_failures, (long long)rep.rejected_intersection, rep.repair_rounds, (long long)rep.repaired_terminals);
+                s / n * 1e6 / std::log2(double(n)), peakRssBytes() / 1048576.0, (long long)rep.intersecting_pairs, (long long)rep.short_segments,
+                treeVolume(tree));
+    std::fprintf(stderr,
+                 "  draws too close %lld, candidates %lld, unconnectable %lld, relaxations %lld, doublings %lld, kamiya failures %lld, collisions "
+                 "%lld, repair rounds %d, repaired %lld\n",
+                 (long long)rep.rejected_too_close, (long long)rep.candidates, (long long)rep.rejected_unreachable,
+                 (long long)rep.threshold_relaxations, (long long)rep.neighbour_doublings, (long long)rep.kamiya_failures,
+                 (long long)rep.rejected_intersection, rep.repair_rounds, (long long)rep.repaired_terminals);
     for (const auto& x : rep.short_list)
-      std::fprintf(stderr, "  short segment left: length %.4g mm, radius %.4g mm, distal (%.4g, %.4g, %.4g)\n", x.length, x.radius,
-                   x.distal[0], x.distal[1], x.distal[2]);
+      std::fprintf(stderr, "  short segment left: length %.4g mm, radius %.4g mm, distal (%.4g, %.4g, %.4g)\n", x.length, x.radius, x.distal[0],
+                   x.distal[1], x.distal[2]);
     std::fflush(stdout);
   }
 }

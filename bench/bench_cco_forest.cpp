@@ -21,7 +21,6 @@ using namespace angiosynth;
 
 namespace {
 
-
 CcoInlet inlet(const Vec3& root, int system, double p_root, double p_term) {
   CcoInlet in;
   in.root_mm = root;
@@ -42,9 +41,7 @@ CcoOptions options(long n, std::uint64_t seed, double flow_ml_min) {
   return o;
 }
 
-double seconds(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
+double seconds(std::chrono::steady_clock::time_point t0) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); }
 
 }  // namespace
 

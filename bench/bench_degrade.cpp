@@ -75,7 +75,8 @@ void BM_GaussianPass101(benchmark::State& state) {
     benchmark::DoNotOptimize(st.image.data.data());
   }
   state.counters["voxels"] = double(st.grid.voxelCount());
-  state.counters["ns_per_voxel"] = benchmark::Counter(double(st.grid.voxelCount()), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_voxel"] =
+      benchmark::Counter(double(st.grid.voxelCount()), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 void BM_CtaProfile256(benchmark::State& state) { runProfile(state, shipped("cta"), 256); }

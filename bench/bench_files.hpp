@@ -25,8 +25,10 @@ struct FileArgs {
 inline double takeOption(int argc, char** argv, const char* name, double fallback, std::vector<char*>& rest) {
   rest.clear();
   for (int i = 0; i < argc; ++i) {
-    if (!std::strcmp(argv[i], name) && i + 1 < argc) fallback = std::atof(argv[++i]);
-    else rest.push_back(argv[i]);
+    if (!std::strcmp(argv[i], name) && i + 1 < argc)
+      fallback = std::atof(argv[++i]);
+    else
+      rest.push_back(argv[i]);
   }
   return fallback;
 }

@@ -26,8 +26,7 @@ void BM_GrowVascuSynth(benchmark::State& state) {
   }
   state.counters["terminals"] = double(n);
   state.counters["map"] = double(state.range(1));
-  state.counters["us_per_terminal"] =
-      benchmark::Counter(double(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["us_per_terminal"] = benchmark::Counter(double(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.counters["peak_rss_MiB"] = double(peakRssBytes()) / double(1 << 20);
   state.counters["intersecting_pairs"] = double(report.intersecting_pairs);
   state.counters["repaired"] = double(report.repaired_terminals);

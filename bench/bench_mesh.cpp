@@ -86,9 +86,12 @@ int main(int argc, char** argv) {
                 (long long)topo.nonmanifold_edges, (long long)topo.misoriented_edges, (long long)topo.degenerate_triangles, topo.volume_mm3);
     for (auto e : topo.tree_euler) std::printf(" %lld", (long long)e);
     if (tubes)
-      std::printf("\n  tubes %lld of %lld vessels, clusters %lld (largest %lld vessels), contour %lld (of %lld contoured) + tube %lld triangles, fallbacks %lld, parts cut again %lld",
-                  (long long)trep.tubes, (long long)trep.vessels, (long long)trep.clusters, (long long)trep.largest_cluster_vessels,
-                  (long long)trep.contour_triangles, (long long)trep.contoured_triangles, (long long)trep.tube_triangles, (long long)trep.fallbacks, (long long)trep.cut_retries);
+      std::printf(
+          "\n  tubes %lld of %lld vessels, clusters %lld (largest %lld vessels), contour %lld (of %lld contoured) + tube %lld triangles, fallbacks "
+          "%lld, parts cut again %lld",
+          (long long)trep.tubes, (long long)trep.vessels, (long long)trep.clusters, (long long)trep.largest_cluster_vessels,
+          (long long)trep.contour_triangles, (long long)trep.contoured_triangles, (long long)trep.tube_triangles, (long long)trep.fallbacks,
+          (long long)trep.cut_retries);
     if (tubes) std::printf(", netted parts %lld", (long long)trep.netted);
     if (tubes && slivers > 0) std::printf(", slivers repaired %lld", (long long)trep.slivers_repaired);
     if (tubes && remesh) std::printf(", remeshed: %lld splits, %lld changes", (long long)trep.remesh_splits, (long long)trep.remesh_changes);

@@ -27,9 +27,8 @@ int main(int argc, char** argv) {
   const auto path = std::filesystem::temp_directory_path() / "angiosynth_bench.vdb";
   const VdbReport rep = writeVdb(path, tree, g, bins, RasterOptions{4});
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("%d^3 (%.3g voxels): %.1f s, %lld leaves, %lld active voxels, file %.1f MiB, estimate %s, peak RSS %s (after growth %s)\n",
-              size, double(g.voxelCount()), s, (long long)rep.leaves, (long long)rep.active_voxels,
-              double(std::filesystem::file_size(path)) / (1 << 20), formatBytes(sparseRasterBytes(bins)).c_str(),
-              formatBytes(peakRssBytes()).c_str(), formatBytes(grown_rss).c_str());
+  std::printf("%d^3 (%.3g voxels): %.1f s, %lld leaves, %lld active voxels, file %.1f MiB, estimate %s, peak RSS %s (after growth %s)\n", size,
+              double(g.voxelCount()), s, (long long)rep.leaves, (long long)rep.active_voxels, double(std::filesystem::file_size(path)) / (1 << 20),
+              formatBytes(sparseRasterBytes(bins)).c_str(), formatBytes(peakRssBytes()).c_str(), formatBytes(grown_rss).c_str());
   std::filesystem::remove(path);
 }

@@ -14,7 +14,8 @@ std::string parameters(bool dcco, const std::string& network) {
   const std::string domain = "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.2 mm\"\n";
   if (dcco)
     return domain + "[tree]\nmethod = \"dcco\"\nroot_radius = \"0.2 mm\"\n[initial]\nfile = \"" + network +
-           "\"\nbranching = \"versatile\"\nrole = \"distribution\"\n[physics]\nperfusion_flow = \"0.3 mL/min\"\n[[stage]]\nterminals = 4\ndraws_before_relaxing = 3\nlattice = 4\nmax_candidates = 8\n"
+           "\"\nbranching = \"versatile\"\nrole = \"distribution\"\n[physics]\nperfusion_flow = \"0.3 mL/min\"\n[[stage]]\nterminals = "
+           "4\ndraws_before_relaxing = 3\nlattice = 4\nmax_candidates = 8\n"
            "[image]\nformats = []\ngraph_formats = []\n";
   return domain + "[tree]\nmethod = \"colonisation\"\nveins = false\n[initial]\nfile = \"" + network +
          "\"\n[[stage]]\nsteps = 8\ndrains_per_step = 100\n[image]\nformats = []\ngraph_formats = []\n";

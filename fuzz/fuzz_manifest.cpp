@@ -9,8 +9,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto dir = fuzz::scratchDir() / "Dataset001_F";
   static const bool made = [&] {
     for (const char* sub : {"imagesTr", "labelsTr", "groundtruth/F_0000", "manifest"}) std::filesystem::create_directories(dir / sub);
-    std::ofstream(dir / "spec.json") << nlohmann::json{{"name", "F"}, {"id", 1}, {"samples", 3}, {"seed", 1},
-                                                         {"channel_name", ""}, {"spec_file", "f.toml"}, {"spec", "x = 1\n"}}
+    std::ofstream(dir / "spec.json") << nlohmann::json{{"name", "F"},           {"id", 1},          {"samples", 3}, {"seed", 1}, {"channel_name", ""},
+                                                       {"spec_file", "f.toml"}, {"spec", "x = 1\n"}}
                                             .dump();
     std::ofstream(dir / "imagesTr" / "F_0000_0000.nii.gz") << "image";
     std::ofstream(dir / "groundtruth" / "F_0000" / "sample.json") << "{}";

@@ -14,11 +14,13 @@ std::string templateOf(int method, const std::string& map) {
   const std::string disc = "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.1 mm\"\n";
   switch (method) {
     case 0:
-      return "seed = 1\n[domain]\ndemand_map = \"" + map + "\"\nvoxel_size = \"1 mm\"\n[tree]\nterminals = 24\nroot_voxel = [0, 8, 8]\n"
+      return "seed = 1\n[domain]\ndemand_map = \"" + map +
+             "\"\nvoxel_size = \"1 mm\"\n[tree]\nterminals = 24\nroot_voxel = [0, 8, 8]\n"
              "[physics]\nviscosity = \"3.6 mPa*s\"\nperfusion_pressure = \"13300 Pa\"\nterminal_pressure = \"8300 Pa\"\n"
              "perfusion_flow = \"100 mm3/s\"\n";
     case 1: return disc + "[tree]\nmethod = \"cco\"\nterminals = 30\n[physics]\nperfusion_flow = \"5 mL/min\"\n";
-    case 2: return disc + "[tree]\nmethod = \"dcco\"\nroot_radius = \"0.2 mm\"\n[physics]\nperfusion_flow = \"0.3 mL/min\"\n[[stage]]\nterminals = 20\n";
+    case 2:
+      return disc + "[tree]\nmethod = \"dcco\"\nroot_radius = \"0.2 mm\"\n[physics]\nperfusion_flow = \"0.3 mL/min\"\n[[stage]]\nterminals = 20\n";
     case 3: return disc + "[tree]\nmethod = \"colonisation\"\n[[stage]]\nsteps = 10\ndrains_per_step = 200\n";
     default: return disc + "[tree]\nmethod = \"lsystem\"\nmode = \"grammar\"\niterations = 5\n";
   }

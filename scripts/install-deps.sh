@@ -10,7 +10,8 @@ pkgs=(build-essential cmake pkg-config ccache
 if [ "${1:-all}" != program ]; then
   pkgs+=(libgtest-dev libbenchmark-dev
          libopenimageio-dev python3-nibabel python3-networkx python3-scipy python3-skimage python3-vtk9 tetgen  # independent readers and references
-         clang libclang-rt-14-dev)  # the sanitizer build and libFuzzer (scripts/sanitize.sh)
+         clang libclang-rt-14-dev  # the sanitizer build and libFuzzer (scripts/sanitize.sh)
+         clang-format-14)  # the style check (scripts/check_format.sh)
 fi
 missing=()
 for p in "${pkgs[@]}"; do

@@ -13,12 +13,12 @@ namespace fs = std::filesystem;
 
 struct BadCase {
   const char* name;
-  const char* file;     // written into the test directory, from the base text of `base`
-  const char* base;     // "toml", "vs" (VascuSynth parameters), "spec" (dataset spec), "" (text below as is)
-  const char* from;     // replaced in the base text ("" : append `to`)
+  const char* file;  // written into the test directory, from the base text of `base`
+  const char* base;  // "toml", "vs" (VascuSynth parameters), "spec" (dataset spec), "" (text below as is)
+  const char* from;  // replaced in the base text ("" : append `to`)
   const char* to;
-  const char* args;     // the command line; its output goes to out/
-  const char* expect;   // a piece of the first line of stderr, file:line included where there is one
+  const char* args;    // the command line; its output goes to out/
+  const char* expect;  // a piece of the first line of stderr, file:line included where there is one
 };
 
 const BadCase kCases[] = {
@@ -26,16 +26,15 @@ const BadCase kCases[] = {
      "p.toml:14: root_voxel must hold finite numbers only"},
     {"background_nan", "p.toml", "toml", "[output]", "[image]\nbackground = nan\n[output]", "generate p.toml --out out",
      "p.toml:31: background must be a finite number"},
-    {"supply_cutoff_huge", "p.toml", "toml", "[0.65, 0.34, 0.01, 7]", "[0.65, 0.34, 0.01, 1e300]",
-     "generate p.toml --out out", "p.toml:8: supply_coefficients: the last value is the cut-off radius (map voxels); allowed: 0 to 1e6"},
-    {"fov_huge", "p.toml", "toml", "[output]", "[image]\nfield_of_view = [\"1e300 mm\", \"1 mm\", \"1 mm\"]\n[output]",
-     "generate p.toml --out out", "p.toml:31: field_of_view entry = 1e+300 is out of range; allowed: (0, 1e+06] mm"},
+    {"supply_cutoff_huge", "p.toml", "toml", "[0.65, 0.34, 0.01, 7]", "[0.65, 0.34, 0.01, 1e300]", "generate p.toml --out out",
+     "p.toml:8: supply_coefficients: the last value is the cut-off radius (map voxels); allowed: 0 to 1e6"},
+    {"fov_huge", "p.toml", "toml", "[output]", "[image]\nfield_of_view = [\"1e300 mm\", \"1 mm\", \"1 mm\"]\n[output]", "generate p.toml --out out",
+     "p.toml:31: field_of_view entry = 1e+300 is out of range; allowed: (0, 1e+06] mm"},
     {"fov_too_many_voxels", "p.toml", "toml", "[output]", "[image]\nvoxel_size = \"0.0001 mm\"\nformats = [\"vdb\"]\n[output]",
      "generate p.toml --out out --no-profiles", "p.toml:30: the image would be 400000 voxels along one axis"},
-    {"closest_neighbours_wraps", "p.toml", "toml", "closest_neighbours = 5", "closest_neighbours = 4294967301",
-     "generate p.toml --out out", "p.toml:16: closest_neighbours = 4294967301 is out of range; allowed: [1, 100]"},
-    {"flow_1000x", "p.toml", "toml", "8330 mm3/s", "8330000 mm3/s", "generate p.toml --out out",
-     "p.toml:13: vessels too thick for the domain"},
+    {"closest_neighbours_wraps", "p.toml", "toml", "closest_neighbours = 5", "closest_neighbours = 4294967301", "generate p.toml --out out",
+     "p.toml:16: closest_neighbours = 4294967301 is out of range; allowed: [1, 100]"},
+    {"flow_1000x", "p.toml", "toml", "8330 mm3/s", "8330000 mm3/s", "generate p.toml --out out", "p.toml:13: vessels too thick for the domain"},
     {"terminals_5M_on_100cubed", "p.toml", "toml", "terminals = 60", "terminals = 5000000", "generate p.toml --out out",
      "p.toml:13: 5000000 terminals cannot lie 0.4 mm apart"},
     {"voxel_width_tiny", "p.txt", "vs", "VOXEL_WIDTH: 0.04", "VOXEL_WIDTH: 1e-12", "generate p.txt --out out",
@@ -45,38 +44,46 @@ const BadCase kCases[] = {
      "p.txt:7: PERF_FLOW (cm^3/s) = 1e+300 is out of range"},
     {"min_distance_huge", "p.txt", "vs", "MIN_DISTANCE: 1", "MIN_DISTANCE: 1e300", "generate p.txt --out out",
      "p.txt:12: MIN_DISTANCE (map voxels) = 1e+300 is out of range"},
-    // Forests of method cco: [[tree.inlet]] tables.
+// Forests of method cco: [[tree.inlet]] tables.
 #define CCO_FOREST "[domain]\nshape = \"sphere\"\nradius = \"10 mm\"\nvoxel_size = \"0.5 mm\"\n[tree]\nmethod = \"cco\"\nterminals = 100\n"
-    {"inlet_shares_sum", "p.toml", "", "", CCO_FOREST "[[tree.inlet]]\nroot_offset = [0, 10, 0]\nshare = 0.5\n[[tree.inlet]]\nroot_offset = [0, -10, 0]\nshare = 0.4\n",
+    {"inlet_shares_sum", "p.toml", "", "",
+     CCO_FOREST "[[tree.inlet]]\nroot_offset = [0, 10, 0]\nshare = 0.5\n[[tree.inlet]]\nroot_offset = [0, -10, 0]\nshare = 0.4\n",
      "generate p.toml --out out", "p.toml:11: the shares of the artery inlets sum to 0.9; fixed shares of one kind must sum to 1"},
-    {"inlet_vein_supplies", "p.toml", "", "", CCO_FOREST "[[tree.inlet]]\nroot_offset = [0, 10, 0]\n[[tree.inlet]]\nkind = \"vein\"\nroot_offset = [0, -10, 0]\nroot_pressure = \"30 mmHg\"\nterminal_pressure = \"20 mmHg\"\n",
+    {"inlet_vein_supplies", "p.toml", "", "",
+     CCO_FOREST "[[tree.inlet]]\nroot_offset = [0, 10, 0]\n[[tree.inlet]]\nkind = \"vein\"\nroot_offset = [0, -10, 0]\nroot_pressure = \"30 "
+                "mmHg\"\nterminal_pressure = \"20 mmHg\"\n",
      "generate p.toml --out out", "p.toml:13: inlet 'vein' is a vein: it drains, so its terminal_pressure must exceed its root_pressure"},
-    {"inlet_duplicate_id", "p.toml", "", "", CCO_FOREST "[[tree.inlet]]\nid = \"a\"\nroot_offset = [0, 10, 0]\n[[tree.inlet]]\nid = \"a\"\nroot_offset = [0, -10, 0]\n",
+    {"inlet_duplicate_id", "p.toml", "", "",
+     CCO_FOREST "[[tree.inlet]]\nid = \"a\"\nroot_offset = [0, 10, 0]\n[[tree.inlet]]\nid = \"a\"\nroot_offset = [0, -10, 0]\n",
      "generate p.toml --out out", "p.toml:12: a second inlet with id 'a'; ids must be unique"},
     {"inlet_without_root", "p.toml", "", "", CCO_FOREST "[[tree.inlet]]\nroot_offset = [0, 10, 0]\n[[tree.inlet]]\nkind = \"vein\"\n",
      "generate p.toml --out out", "p.toml:10: missing key 'root_offset' (mm from the centre) in [[tree.inlet]]"},
     {"inlet_roots_touch", "p.toml", "", "", CCO_FOREST "[[tree.inlet]]\nroot_offset = [0, 10, 0]\n[[tree.inlet]]\nroot_offset = [0.1, 9.99, 0]\n",
      "generate p.toml --out out", "p.toml:11: the roots of inlets 'artery_1' and 'artery_2' lie 0.100499 mm apart"},
 #undef CCO_FOREST
-    // dcco growing from an existing network ([initial]).
-#define DCCO_INITIAL "[domain]\nshape = \"disc\"\nradius = \"20 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"dcco\"\n[[stage]]\nterminals = 10\n[initial]\n"
-    {"initial_origin_unknown", "p.toml", "", "", DCCO_INITIAL "file = \"" ANGIOSYNTH_SOURCE_DIR "/examples/dcco_outlet_t0_2d.swc\"\norigin = \"middle\"\n",
-     "generate p.toml --out out", "p.toml:11: origin 'middle'; allowed: centre, corner"},
-    {"initial_format_unknown", "p.toml", "", "", DCCO_INITIAL "file = \"p.toml\"\n",
-     "generate p.toml --out out", "p.toml: unknown network format '.toml'; allowed: .cco (VItA), .swc, .gxl, .csv (nodes and edges), .vtp"},
-    {"initial_unit_unknown", "p.toml", "", "", DCCO_INITIAL "file = \"" ANGIOSYNTH_SOURCE_DIR "/tests/data/network/tree_ascii.vtp\"\nunit = \"inch\"\n",
-     "generate p.toml --out out", "p.toml:11: unit 'inch'; allowed: mm, cm, m, um"},
+// dcco growing from an existing network ([initial]).
+#define DCCO_INITIAL \
+  "[domain]\nshape = \"disc\"\nradius = \"20 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"dcco\"\n[[stage]]\nterminals = 10\n[initial]\n"
+    {"initial_origin_unknown", "p.toml", "", "",
+     DCCO_INITIAL "file = \"" ANGIOSYNTH_SOURCE_DIR "/examples/dcco_outlet_t0_2d.swc\"\norigin = \"middle\"\n", "generate p.toml --out out",
+     "p.toml:11: origin 'middle'; allowed: centre, corner"},
+    {"initial_format_unknown", "p.toml", "", "", DCCO_INITIAL "file = \"p.toml\"\n", "generate p.toml --out out",
+     "p.toml: unknown network format '.toml'; allowed: .cco (VItA), .swc, .gxl, .csv (nodes and edges), .vtp"},
+    {"initial_unit_unknown", "p.toml", "", "",
+     DCCO_INITIAL "file = \"" ANGIOSYNTH_SOURCE_DIR "/tests/data/network/tree_ascii.vtp\"\nunit = \"inch\"\n", "generate p.toml --out out",
+     "p.toml:11: unit 'inch'; allowed: mm, cm, m, um"},
 #undef DCCO_INITIAL
-    // Space colonisation.
+// Space colonisation.
 #define COLONISATION "[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"colonisation\"\n"
-    {"colonisation_kappa_4_5", "p.toml", "", "", COLONISATION "[physics]\nmurray_exponent = 4.5\n",
-     "generate p.toml --out out", "p.toml:8: murray_exponent = 4.5 is out of range; allowed: (2, 4)"},
+    {"colonisation_kappa_4_5", "p.toml", "", "", COLONISATION "[physics]\nmurray_exponent = 4.5\n", "generate p.toml --out out",
+     "p.toml:8: murray_exponent = 4.5 is out of range; allowed: (2, 4)"},
     {"colonisation_no_vein_root", "p.toml", "", "", COLONISATION "[[tree.inlet]]\nkind = \"artery\"\nroot_offset = [0, 9]\n",
      "generate p.toml --out out", "p.toml:7: no vein root: add a [[tree.inlet]] with kind = \"vein\", or set [tree] veins = false"},
 #undef COLONISATION
-    // L-system (Lázaro 2011): blocks the inverse problem cannot fill.
-#define LZH "[domain]\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"lsystem\"\nblock_width = \"10 mm\"\nstart_length = \"3 mm\"\n" \
-            "capillary_length = \"2 mm\"\nstart_diameter = \"1 mm\"\ncapillary_diameter = \"0.2 mm\"\ncapillary_spacing = \"1.2 mm\"\n"
+// L-system (Lázaro 2011): blocks the inverse problem cannot fill.
+#define LZH                                                                                                             \
+  "[domain]\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"lsystem\"\nblock_width = \"10 mm\"\nstart_length = \"3 mm\"\n" \
+  "capillary_length = \"2 mm\"\nstart_diameter = \"1 mm\"\ncapillary_diameter = \"0.2 mm\"\ncapillary_spacing = \"1.2 mm\"\n"
     {"lzh_block_too_low", "p.toml", "", "", LZH "block_height = \"7 mm\"\n", "generate p.toml --out out",
      "p.toml:11: block_height 7 mm leaves no room for the trees: it must exceed 2·start_length + capillary_length = 8 mm"},
     {"lzh_capillary_walls_overlap", "p.toml", "", "", LZH "block_height = \"20 mm\"\ncapillary_wall = \"0.3 mm\"\n", "generate p.toml --out out",
@@ -97,17 +104,17 @@ const BadCase kCases[] = {
      "generate p.toml --out out --profile prof.toml", "prof.toml:1: background = 1e+30 is out of range"},
     {"bias_scale_tiny", "prof.toml", "", "", "[[effect]]\ntype = \"bias\"\namplitude = 0.2\nscale = \"1e-9 mm\"\n",
      "generate p.toml --out out --profile prof.toml", "prof.toml:4: scale = 1e-09 mm is finer than 1 voxel"},
-    {"blur_sigma_huge", "prof.toml", "", "", "[[effect]]\ntype = \"blur\"\nsigma = \"1e6 mm\"\n",
-     "generate p.toml --out out --profile prof.toml", "prof.toml:3: sigma = 1e+06 mm exceeds 1 fov"},
-    {"shadows_million", "prof.toml", "", "", "[[effect]]\ntype = \"shadow\"\ncount = 1000000\n",
-     "generate p.toml --out out --profile prof.toml", "prof.toml:3: count = 1e+06 is out of range; allowed: [0, 1000]"},
+    {"blur_sigma_huge", "prof.toml", "", "", "[[effect]]\ntype = \"blur\"\nsigma = \"1e6 mm\"\n", "generate p.toml --out out --profile prof.toml",
+     "prof.toml:3: sigma = 1e+06 mm exceeds 1 fov"},
+    {"shadows_million", "prof.toml", "", "", "[[effect]]\ntype = \"shadow\"\ncount = 1000000\n", "generate p.toml --out out --profile prof.toml",
+     "prof.toml:3: count = 1e+06 is out of range; allowed: [0, 1000]"},
     {"spec_integer_int64_max", "s.toml", "spec", "terminals = {integer = [60, 160]}",
      "terminals = {integer = [9223372036854775807, 9223372036854775807]}", "dataset s.toml --out out",
      "s.toml:15: integer takes whole numbers [a, b] with a <= b, each within ±2^53"},
     {"spec_misspelt_distribution", "s.toml", "spec", "terminals = {integer = [60, 160]}", "terminals = {unifrom = [60, 160]}",
      "dataset s.toml --out out", "s.toml:15: unknown key 'unifrom' in a distribution; allowed: uniform"},
-    {"spec_draw_out_of_range_names_its_line", "s.toml", "spec", "terminals = {integer = [60, 160]}",
-     "terminals = {uniform = [60, 160]}", "dataset s.toml --out out", "s.toml:15: terminals must be a whole number"},
+    {"spec_draw_out_of_range_names_its_line", "s.toml", "spec", "terminals = {integer = [60, 160]}", "terminals = {uniform = [60, 160]}",
+     "dataset s.toml --out out", "s.toml:15: terminals must be a whole number"},
     {"dataset_index_int64_max", "s.toml", "spec", "", "", "dataset s.toml --out out --index 9223372036854775807",
      "--index 9223372036854775807 is beyond the dataset's 6 samples"},
     // Label policies ([image] label_policy and its parameters), in parameter files and specs.
@@ -157,8 +164,10 @@ TEST_P(BadInput, ExitsTwoNamingFileAndLineAndWritesNothing) {
   replaceOnce(p, "profiles = [\"vascusynth\", \"cta\"]", "profiles = []");
   std::ofstream(dir_ / "p.toml") << p;
   std::string text = baseText(c.base, src_);
-  if (std::string(c.from).empty()) text += c.to;
-  else replaceOnce(text, c.from, c.to);
+  if (std::string(c.from).empty())
+    text += c.to;
+  else
+    replaceOnce(text, c.from, c.to);
   fs::create_directories((dir_ / c.file).parent_path());
   std::ofstream(dir_ / c.file) << text;
   const auto t0 = std::chrono::steady_clock::now();
@@ -179,9 +188,11 @@ TEST(BadInputFiles, NiftiMaskWithMicroscopicVoxelsAndDamagedDatasetsAreInputErro
   const fs::path dir = freshTestDir("angiosynth_badnii_");
   const fs::path src = ANGIOSYNTH_SOURCE_DIR;
   // An 8^3 ball with pixdim 1e-9 mm, written by nibabel.
-  const std::string py = "/usr/bin/python3 -c \"import numpy as np, nibabel as nib; i,j,k = np.mgrid[:8,:8,:8]; "
-                         "m = (((i-3.5)**2+(j-3.5)**2+(k-3.5)**2) < 12).astype(np.uint8); "
-                         "nib.save(nib.Nifti1Image(m, np.diag([1e-9, 1e-9, 1e-9, 1])), '" + (dir / "m.nii").string() + "')\"";
+  const std::string py =
+      "/usr/bin/python3 -c \"import numpy as np, nibabel as nib; i,j,k = np.mgrid[:8,:8,:8]; "
+      "m = (((i-3.5)**2+(j-3.5)**2+(k-3.5)**2) < 12).astype(np.uint8); "
+      "nib.save(nib.Nifti1Image(m, np.diag([1e-9, 1e-9, 1e-9, 1])), '" +
+      (dir / "m.nii").string() + "')\"";
   ASSERT_EQ(std::system(py.c_str()), 0);
   std::ofstream(dir / "p.toml") << "[domain]\nshape = \"mask\"\nmask = \"m.nii\"\n[tree]\nmethod = \"cco\"\nterminals = 10\n"
                                    "root_voxel = [4, 4, 4]\n";
@@ -191,14 +202,14 @@ TEST(BadInputFiles, NiftiMaskWithMicroscopicVoxelsAndDamagedDatasetsAreInputErro
   EXPECT_FALSE(fs::exists(dir / "out"));
   // Dimensions 5 to 7 count too (fuzzing found a header whose dim[6], dim[7] made the library
   // read 2 GB past the 3D memory estimate).
-  const std::string py7 = "/usr/bin/python3 -c \"import numpy as np, nibabel as nib; "
-                          "nib.save(nib.Nifti1Image(np.ones((8, 8, 8, 1, 1, 1, 3), np.uint8), np.eye(4)), '" +
-                          (dir / "m.nii").string() + "')\"";
+  const std::string py7 =
+      "/usr/bin/python3 -c \"import numpy as np, nibabel as nib; "
+      "nib.save(nib.Nifti1Image(np.ones((8, 8, 8, 1, 1, 1, 3), np.uint8), np.eye(4)), '" +
+      (dir / "m.nii").string() + "')\"";
   ASSERT_EQ(std::system(py7.c_str()), 0);
   r = run("generate p.toml --out out", dir);
   EXPECT_EQ(r.code, 2) << r.err;
-  EXPECT_NE(r.err.find("m.nii: a mask must be one 3D (or one-slice 2D) volume; this one has dims 8 8 8 1 1 1 3"), std::string::npos)
-      << r.err;
+  EXPECT_NE(r.err.find("m.nii: a mask must be one 3D (or one-slice 2D) volume; this one has dims 8 8 8 1 1 1 3"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out"));
   // A dataset directory without imagesTr/: a problem verify reports, not an internal error.
   std::ofstream(dir / "s.toml") << selfContained(src / "tests/data/dataset_tiny.toml");

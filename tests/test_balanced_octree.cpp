@@ -35,7 +35,8 @@ TEST(BalancedOctree, LeavesSplitIntoAConformingTetrahedralMeshAcrossLevels) {
     const int l = int(rng() % (top + 1));
     const std::int64_t span = 64 >> l;  // the same region at every level
     const std::int64_t off = 64 >> l;
-    requests[std::size_t(l)].push_back(cellCode(off + std::int64_t(rng() % span), off + std::int64_t(rng() % span), off + std::int64_t(rng() % span)));
+    requests[std::size_t(l)].push_back(
+        cellCode(off + std::int64_t(rng() % span), off + std::int64_t(rng() % span), off + std::int64_t(rng() % span)));
   }
   const BalancedOctree octree(top, requests);
   const auto leaves = octree.units(0);  // at level 0 the units are the leaves
@@ -60,28 +61,28 @@ TEST(BalancedOctree, LeavesSplitIntoAConformingTetrahedralMeshAcrossLevels) {
   std::size_t split = 0;
   for (const auto& unit : octree.units(2)) {
     splitter.leaves(unit, unit_leaves);
-   for (const auto& leaf : unit_leaves) {
-    ++split;
-    out.clear();
-    splitter.tetrahedra(leaf, out);
-    std::int64_t leaf_volume = 0;
-    for (const auto& t : out) {
-      const std::int64_t v = std::abs(sixVolume(t));
-      ASSERT_GT(v, 0) << "a flat tetrahedron";
-      leaf_volume += v;
-      ++tets;
-      for (int skip = 0; skip < 4; ++skip) {
-        std::array<HalfPoint, 3> f;
-        int n = 0;
-        for (int q = 0; q < 4; ++q)
-          if (q != skip) f[std::size_t(n++)] = t[std::size_t(q)];
-        std::sort(f.begin(), f.end());
-        ++faces[f];
+    for (const auto& leaf : unit_leaves) {
+      ++split;
+      out.clear();
+      splitter.tetrahedra(leaf, out);
+      std::int64_t leaf_volume = 0;
+      for (const auto& t : out) {
+        const std::int64_t v = std::abs(sixVolume(t));
+        ASSERT_GT(v, 0) << "a flat tetrahedron";
+        leaf_volume += v;
+        ++tets;
+        for (int skip = 0; skip < 4; ++skip) {
+          std::array<HalfPoint, 3> f;
+          int n = 0;
+          for (int q = 0; q < 4; ++q)
+            if (q != skip) f[std::size_t(n++)] = t[std::size_t(q)];
+          std::sort(f.begin(), f.end());
+          ++faces[f];
+        }
       }
+      const std::int64_t edge = std::int64_t(2) << leaf.level;  // half steps
+      EXPECT_EQ(leaf_volume, 6 * edge * edge * edge) << "the tetrahedra fill their leaf";
     }
-    const std::int64_t edge = std::int64_t(2) << leaf.level;  // half steps
-    EXPECT_EQ(leaf_volume, 6 * edge * edge * edge) << "the tetrahedra fill their leaf";
-   }
   }
   EXPECT_EQ(split, leaves.size()) << "the units hold every leaf once";
   // Faces used once lie on the boundary of the covered region: a plane of the top cells' lattice
@@ -97,13 +98,13 @@ TEST(BalancedOctree, LeavesSplitIntoAConformingTetrahedralMeshAcrossLevels) {
     ++outer;
     bool on_top_plane = false;
     for (int a = 0; a < 3; ++a)
-      on_top_plane |= f[0][std::size_t(a)] == f[1][std::size_t(a)] && f[1][std::size_t(a)] == f[2][std::size_t(a)] &&
-                      f[0][std::size_t(a)] % top_edge == 0;
+      on_top_plane |=
+          f[0][std::size_t(a)] == f[1][std::size_t(a)] && f[1][std::size_t(a)] == f[2][std::size_t(a)] && f[0][std::size_t(a)] % top_edge == 0;
     EXPECT_TRUE(on_top_plane) << "an unshared triangle inside the covered region: a crack between levels";
   }
   EXPECT_GT(inner, outer);
-  std::cout << leaves.size() << " leaves (" << per_level.size() << " levels), " << tets << " tetrahedra, " << inner << " inner and "
-            << outer << " boundary triangles\n";
+  std::cout << leaves.size() << " leaves (" << per_level.size() << " levels), " << tets << " tetrahedra, " << inner << " inner and " << outer
+            << " boundary triangles\n";
   // 2:1 balance: a leaf's face neighbour is refined at most once, its children on the face are
   // leaves.
   for (const auto& l : leaves)

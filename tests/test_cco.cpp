@@ -192,8 +192,10 @@ TEST(Cco, NuDoublesOnlyWhereAskedAndOnlyInSpace) {
       const auto t = growCco(*d, o, rep);
       EXPECT_EQ(rep.intersecting_pairs, 0);
       EXPECT_EQ(rep.short_segments, 0);
-      if (max_nu > 20 && d == &sphere) EXPECT_GT(rep.neighbour_doublings, 0);
-      else EXPECT_EQ(rep.neighbour_doublings, 0) << (d == &sphere ? "sphere" : "disc") << " with up to " << max_nu;
+      if (max_nu > 20 && d == &sphere)
+        EXPECT_GT(rep.neighbour_doublings, 0);
+      else
+        EXPECT_EQ(rep.neighbour_doublings, 0) << (d == &sphere ? "sphere" : "disc") << " with up to " << max_nu;
     }
 }
 
@@ -379,9 +381,8 @@ TEST(Cco, TheProximalNodeTestAgreesWithTheExactCost) {
 
 TEST(Cco, NonConvexMaskKeepsEveryVesselInsideTheMask) {
   // An L-shaped slab: the straight line between its arms leaves the domain.
-  const auto m = voxelMap({60, 60, 16}, 0.5, [](int i, int j, int k) {
-    return k >= 2 && k < 14 && j >= 2 && j < 58 && i >= 2 && i < 58 && (i < 22 || j < 22);
-  });
+  const auto m =
+      voxelMap({60, 60, 16}, 0.5, [](int i, int j, int k) { return k >= 2 && k < 14 && j >= 2 && j < 58 && i >= 2 && i < 58 && (i < 22 || j < 22); });
   const auto d = GrowthDomain::mask(m, false);
   auto o = karch(600, d, 5);
   o.root_mm = Vec3(1.0, 1.0, 4.0);  // on the corner face of the L
@@ -435,9 +436,7 @@ TEST(Cco, DemandWeightedSamplingPutsTerminalsWhereDemandIsHigh) {
 namespace {
 // OpenCCO's set-up: a 20,000 mm³ ball and its constants (13300 Pa, 7980 Pa, 8330 mm³/s,
 // 3.6 mPa·s).
-GrowthDomain openccoBall() {
-  return GrowthDomain::analytic(DomainShape::Sphere, std::cbrt(3 * 20000.0 / (4 * std::numbers::pi)), 0.3);
-}
+GrowthDomain openccoBall() { return GrowthDomain::analytic(DomainShape::Sphere, std::cbrt(3 * 20000.0 / (4 * std::numbers::pi)), 0.3); }
 CcoOptions openccoOptions(std::int64_t n, const GrowthDomain& d, std::uint64_t seed) {
   CcoOptions o;
   o.terminals = n;

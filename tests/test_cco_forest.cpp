@@ -17,7 +17,6 @@ using namespace angiosynth;
 
 namespace {
 
-
 CcoOptions options(std::int64_t n, std::uint64_t seed) {
   CcoOptions o;
   o.terminals = n;
@@ -41,14 +40,13 @@ CcoInlet inlet(const Vec3& root, int system, double share = 0, double p_root = 1
 
 // Hemodynamics and geometry of every tree (terminal flow Q/N of its system), and no overlap
 // within or across trees on the assembled forest.
-void expectForestInvariants(const std::vector<VascularTree>& trees, const std::vector<CcoInlet>& inlets,
-                            const CcoOptions& o, const GrowthDomain& d) {
+void expectForestInvariants(const std::vector<VascularTree>& trees, const std::vector<CcoInlet>& inlets, const CcoOptions& o, const GrowthDomain& d) {
   ASSERT_EQ(trees.size(), inlets.size());
   VascularTree forest;
   for (std::size_t k = 0; k < trees.size(); ++k) {
     SCOPED_TRACE("tree " + std::to_string(k));
-    test::expectHemodynamicInvariants(trees[k], inletPhysics(o.physics, inlets[k].root_pressure, inlets[k].terminal_pressure), trees[k].terminalCount(),
-                                      o.physics.perfusion_flow / double(o.terminals));
+    test::expectHemodynamicInvariants(trees[k], inletPhysics(o.physics, inlets[k].root_pressure, inlets[k].terminal_pressure),
+                                      trees[k].terminalCount(), o.physics.perfusion_flow / double(o.terminals));
     test::expectGeometry(trees[k], d);
     EXPECT_EQ(trees[k].position[0], inlets[k].root_mm);
     forest.appendTree(trees[k], int(k));
@@ -80,8 +78,7 @@ TEST(CcoForest, FixedSharesGiveEachInletItsQuotaOfTerminalsAndFlow) {
   const auto d = GrowthDomain::analytic(DomainShape::Sphere, 10, 0.25);
   const auto o = options(500, 5);
   const Vec3 c = d.center();
-  const std::vector<CcoInlet> inlets{inlet(c + Vec3(0, 10, 0), 0, 0.5), inlet(c + Vec3(10, 0, 0), 0, 0.3),
-                                     inlet(c + Vec3(0, -10, 0), 0, 0.2)};
+  const std::vector<CcoInlet> inlets{inlet(c + Vec3(0, 10, 0), 0, 0.5), inlet(c + Vec3(10, 0, 0), 0, 0.3), inlet(c + Vec3(0, -10, 0), 0, 0.2)};
   GrowthReport rep;
   const auto trees = growCcoForest(d, o, inlets, rep);
   expectForestInvariants(trees, inlets, o, d);

@@ -22,9 +22,7 @@ namespace {
 
 class Cli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = freshTestDir("angiosynth_cli_");
-  }
+  void SetUp() override { dir_ = freshTestDir("angiosynth_cli_"); }
   void TearDown() override { fs::remove_all(dir_); }
   fs::path dir_;
   const fs::path src_ = ANGIOSYNTH_SOURCE_DIR;
@@ -42,8 +40,8 @@ TEST_F(Cli, GenerateWritesValidRoundTrippingGxlAndSidecar) {
   EXPECT_EQ(j["parameters"]["viscosity"]["unit"], "Pa*s");
   EXPECT_LT(j["statistics"]["cost_cm"]["value"].get<double>(), 0.1719);
   ASSERT_TRUE(fs::exists(dir_ / "out/tree.dot"));
-  for (const char* role : {"image", "mask", "centerline", "radius", "instances", "keypoints", "mip_x", "mip_y", "mip_z",
-                           "nodes_csv", "edges_csv", "vtp", "swc", "graphml"}) {
+  for (const char* role : {"image", "mask", "centerline", "radius", "instances", "keypoints", "mip_x", "mip_y", "mip_z", "nodes_csv", "edges_csv",
+                           "vtp", "swc", "graphml"}) {
     ASSERT_TRUE(j["files"].contains(role)) << role;
     EXPECT_TRUE(fs::exists(dir_ / "out" / j["files"][role].get<std::string>())) << role;
   }
@@ -103,8 +101,8 @@ TEST_F(Cli, SameSeedSameBytesWhateverTheThreads) {
   ASSERT_EQ(run("generate " + params + " --out two --threads 2 --quiet", dir_).code, 0);
   EXPECT_EQ(slurp(dir_ / "one/tree.gxl"), slurp(dir_ / "two/tree.gxl"));
   EXPECT_EQ(slurp(dir_ / "one/tree.dot"), slurp(dir_ / "two/tree.dot"));
-  for (const char* f : {"image.nii.gz", "mask.nii.gz", "centerline.nii.gz", "radius.nii.gz", "instances.nii.gz", "mip_z.png",
-                        "keypoints.csv", "tree.graphml", "centerlines.vtp"})
+  for (const char* f : {"image.nii.gz", "mask.nii.gz", "centerline.nii.gz", "radius.nii.gz", "instances.nii.gz", "mip_z.png", "keypoints.csv",
+                        "tree.graphml", "centerlines.vtp"})
     EXPECT_EQ(slurp(dir_ / "one" / f), slurp(dir_ / "two" / f)) << f;
   Json a = Json::parse(slurp(dir_ / "one/sample.json")), b = Json::parse(slurp(dir_ / "two/sample.json"));
   for (auto* j : {&a, &b}) j->erase("timing_seconds"), j->erase("command_line");
@@ -135,8 +133,7 @@ TEST_F(Cli, BadInputExitsNonZeroWithFileLineAndLeavesNoOutput) {
 
 TEST_F(Cli, VascuSynthSubcommandWritesItsLayoutAndDialect) {
   const fs::path ex = src_ / "examples/vascusynth";
-  for (const char* f : {"param_rods_1000.txt", "param_2008_crlf_200.txt", "paramList.txt", "imageNames.txt"})
-    fs::copy_file(ex / f, dir_ / f);
+  for (const char* f : {"param_rods_1000.txt", "param_2008_crlf_200.txt", "paramList.txt", "imageNames.txt"}) fs::copy_file(ex / f, dir_ / f);
   fs::create_directories(dir_ / "../../demand_maps");
   // The parameter files name maps relative to themselves; point them at the source tree.
   for (const char* f : {"param_rods_1000.txt", "param_2008_crlf_200.txt"}) {
@@ -197,8 +194,8 @@ TEST_F(Cli, ProfilesGiveOneDegradedImageEachWithWarpedLabelsAndTheSameBytesForAn
   std::ofstream(dir_ / "p.toml") << exampleWithProfiles(src_, "\"cta\", \"warpy.toml\"");
   ASSERT_EQ(run("generate p.toml --out one --threads 1 --quiet", dir_).code, 0);
   ASSERT_EQ(run("generate p.toml --out two --threads 2 --quiet", dir_).code, 0);
-  for (const char* f : {"image_cta.nii.gz", "image_warpy.nii.gz", "mask_warpy.nii.gz", "centerline_warpy.nii.gz",
-                        "radius_warpy.nii.gz", "instances_warpy.nii.gz", "tree_warpy.gxl", "warp_warpy.json", "mip_z_cta.png"}) {
+  for (const char* f : {"image_cta.nii.gz", "image_warpy.nii.gz", "mask_warpy.nii.gz", "centerline_warpy.nii.gz", "radius_warpy.nii.gz",
+                        "instances_warpy.nii.gz", "tree_warpy.gxl", "warp_warpy.json", "mip_z_cta.png"}) {
     ASSERT_TRUE(fs::exists(dir_ / "one" / f)) << f;
     EXPECT_EQ(slurp(dir_ / "one" / f), slurp(dir_ / "two" / f)) << f;
   }

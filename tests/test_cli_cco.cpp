@@ -113,10 +113,8 @@ TEST_F(CliCco, BadCcoInputNamesTheLineAndWritesNothing) {
   expectError(head + "shape = \"sphere\"\nradius = \"10 mm\"\nvoxel_size = \"1 mm\"\n" + tree + "root_offset = [0, 12, 0]\n",
               "lies outside the sphere domain");
   std::ofstream(dir_ / "m.txt") << "10 10 10\n0 0 0 9 9 9\n1\n";
-  expectError(head + "shape = \"mask\"\nmask = \"m.txt\"\nvoxel_size = \"1 mm\"\n" + tree,
-              "missing key 'root' (mm) or 'root_voxel'");
-  expectError(head + "shape = \"sphere\"\nradius = \"10 mm\"\nvoxel_size = \"1 mm\"\n" + tree +
-                  "[physics]\ncost_radius_exponent = 2\n",
+  expectError(head + "shape = \"mask\"\nmask = \"m.txt\"\nvoxel_size = \"1 mm\"\n" + tree, "missing key 'root' (mm) or 'root_voxel'");
+  expectError(head + "shape = \"sphere\"\nradius = \"10 mm\"\nvoxel_size = \"1 mm\"\n" + tree + "[physics]\ncost_radius_exponent = 2\n",
               "cco minimises the total volume");
 }
 

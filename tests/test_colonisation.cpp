@@ -224,9 +224,7 @@ TEST(Colonisation, BadParametersNameTheirLine) {
     try {
       test::growFile(file);
       ADD_FAILURE() << extra << " was accepted";
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-    }
+    } catch (const InputError& e) { EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what(); }
   };
   expectError("bias = 1.5\n", "bad.toml:20: bias = 1.5 is out of range");
   expectError("perception_distance = \"0.1 mm\"\n", "perception_distance (0.1 mm) must exceed satisfaction_distance");
@@ -303,9 +301,7 @@ TEST(PointHash, QueriesEqualBruteForce) {
     const Vec3 lo(-1, -1, flat ? 0 : -1), hi(1, 1, flat ? 0 : 1);
     PointHash grid(lo, hi, 0.05, flat);
     std::vector<Vec3> pts;
-    const auto draw = [&](double spread) {
-      return uniformPoint(rng, -spread, spread, flat);
-    };
+    const auto draw = [&](double spread) { return uniformPoint(rng, -spread, spread, flat); };
     for (int i = 0; i < 3000; ++i) pts.push_back(i % 3 == 0 ? draw(1.3) : draw(0.3) * 0.5 + Vec3(0.4, -0.2, 0));
     pts.push_back(pts[10]);  // an exact tie: the earlier id must win
     NeighbourhoodCount counts(lo, hi, 0.02, flat);
@@ -329,9 +325,7 @@ TEST(PointHash, QueriesEqualBruteForce) {
         for (const auto& x : pts) any = any || dot(x - p, x - p) < rr * rr;
         const bool got_any = grid.anyNear(p, rr, [&](std::int32_t id) { return dot(pts[std::size_t(id)] - p, pts[std::size_t(id)] - p) < rr * rr; });
         ASSERT_EQ(got_any, any) << "flat " << flat << " query " << q << " r " << rr;
-        if (rr <= 0.02 && any) {
-          ASSERT_TRUE(counts.mayBeNear(p)) << "flat " << flat << " query " << q;
-        }
+        if (rr <= 0.02 && any) { ASSERT_TRUE(counts.mayBeNear(p)) << "flat " << flat << " query " << q; }
         far += !counts.mayBeNear(p);
       }
       found += got >= 0;

@@ -103,8 +103,8 @@ TEST(CurvedVessels, KeepEveryEndAndReachTheAskedTortuosity) {
   }
   EXPECT_EQ(above, 0);
   // Only curves that had to be flattened fall short; most reach the target.
-  EXPECT_GE(on_target, std::int64_t(paths.size()) * 7 / 10) << "flattened by domain " << rep.flattened_by_domain << ", by overlap "
-                                                             << rep.flattened_by_overlap;
+  EXPECT_GE(on_target, std::int64_t(paths.size()) * 7 / 10)
+      << "flattened by domain " << rep.flattened_by_domain << ", by overlap " << rep.flattened_by_overlap;
   EXPECT_LE(rep.target_error_max, 1e-6);
   EXPECT_GT(w.nodeCount(), 10 * t.nodeCount());
 }
@@ -144,8 +144,7 @@ TEST(CurvedVessels, StayInTheSphereAndOffOtherVessels) {
   const Vec3 root = w.position[0];
   std::int64_t outside = 0;
   for (std::int32_t i = 1; i < w.nodeCount(); ++i)
-    if (distance(w.position[i], root) > 4 * w.radius[i])
-      outside += distance(w.position[i], centre) > kRadius - w.radius[i] + 1e-9;
+    if (distance(w.position[i], root) > 4 * w.radius[i]) outside += distance(w.position[i], centre) > kRadius - w.radius[i] + 1e-9;
   EXPECT_EQ(outside, 0);
   const auto now = touchingVesselPairs(w), grown = touchingVesselPairs(sphereTree().forest.vessels);
   EXPECT_TRUE(std::includes(grown.begin(), grown.end(), now.begin(), now.end())) << now.size() << " pairs touch, " << grown.size() << " as grown";

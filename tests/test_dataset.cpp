@@ -26,9 +26,7 @@ std::string quoted(const fs::path& p) {
 
 class Dataset : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = freshTestDir("angiosynth_ds_");
-  }
+  void SetUp() override { dir_ = freshTestDir("angiosynth_ds_"); }
   void TearDown() override { fs::remove_all(dir_); }
   // path → sha256 of every file of every sample, per index.
   static std::map<std::int64_t, std::map<std::string, std::string>> hashes(const fs::path& ds) {
@@ -72,8 +70,8 @@ TEST_F(Dataset, SampleBytesAreTheSameAloneInAFullRunInAnyShardAndForAnyThreads) 
   EXPECT_EQ(slurp(dir_ / "merged" / name_ / "dataset.json"), slurp(dir_ / "full2" / name_ / "dataset.json"));
   // The cluster scripts' way: shard K from Slurm's or Kubernetes' index variable.
   for (const std::string env : {"SLURM_ARRAY_TASK_ID=0", "JOB_COMPLETION_INDEX=1"}) {
-    const std::string cmd = "cd '" + dir_.string() + "' && env -u SLURM_ARRAY_TASK_ID -u JOB_COMPLETION_INDEX " + env + " '" +
-                            ANGIOSYNTH_EXE + "' dataset " + spec_ + " --out cluster --shard auto/2 --quiet >/dev/null 2>&1";
+    const std::string cmd = "cd '" + dir_.string() + "' && env -u SLURM_ARRAY_TASK_ID -u JOB_COMPLETION_INDEX " + env + " '" + ANGIOSYNTH_EXE +
+                            "' dataset " + spec_ + " --out cluster --shard auto/2 --quiet >/dev/null 2>&1";
     ASSERT_EQ(std::system(cmd.c_str()), 0) << env;
   }
   ASSERT_EQ(run("dataset finalize cluster/" + name_, dir_).code, 0);
@@ -83,17 +81,17 @@ TEST_F(Dataset, SampleBytesAreTheSameAloneInAFullRunInAnyShardAndForAnyThreads) 
 TEST_F(Dataset, LayoutObeysTheRulesNnUNetChecks) {
   ASSERT_EQ(run("dataset " + spec_ + " --out raw --quiet", dir_).code, 0);
   const fs::path ds = dir_ / "raw" / name_;
-  const std::string cmd = "/usr/bin/python3 '" + (src_ / "tests/check_nnunet.py").string() + "' '" + ds.string() + "' > '" +
-                          (dir_ / "check.txt").string() + "' 2>&1";
+  const std::string cmd =
+      "/usr/bin/python3 '" + (src_ / "tests/check_nnunet.py").string() + "' '" + ds.string() + "' > '" + (dir_ / "check.txt").string() + "' 2>&1";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << slurp(dir_ / "check.txt");
   EXPECT_NE(slurp(dir_ / "check.txt").find("6 cases checked, 0 problems"), std::string::npos) << slurp(dir_ / "check.txt");
   const Json j = Json::parse(slurp(ds / "dataset.json"));
   EXPECT_EQ(j["channel_names"]["0"], "angio");
   EXPECT_EQ(j["numTraining"], 6);
-  for (const char* f : {"manifest.jsonl", "provenance.json", "groundtruth/VesselTiny_0002.json",
-                        "groundtruth/VesselTiny_0002/centerline.nii.gz", "groundtruth/VesselTiny_0002/radius.nii.gz",
-                        "groundtruth/VesselTiny_0002/instances.nii.gz", "groundtruth/VesselTiny_0002/keypoints.csv",
-                        "groundtruth/VesselTiny_0002/tree.gxl", "groundtruth/VesselTiny_0002/image.nii.gz"})
+  for (const char* f :
+       {"manifest.jsonl", "provenance.json", "groundtruth/VesselTiny_0002.json", "groundtruth/VesselTiny_0002/centerline.nii.gz",
+        "groundtruth/VesselTiny_0002/radius.nii.gz", "groundtruth/VesselTiny_0002/instances.nii.gz", "groundtruth/VesselTiny_0002/keypoints.csv",
+        "groundtruth/VesselTiny_0002/tree.gxl", "groundtruth/VesselTiny_0002/image.nii.gz"})
     EXPECT_TRUE(fs::exists(ds / f)) << f;
   const Json prov = Json::parse(slurp(ds / "provenance.json"));
   EXPECT_NE(prov["spec"].get<std::string>().find("VesselTiny"), std::string::npos);
@@ -147,7 +145,8 @@ TEST_F(Dataset, PreviewsPutMipsInTheGroundTruthOnly) {
   const fs::path gt = dir_ / "p" / name_ / "groundtruth/VesselTiny_0002";
   const Json meta = Json::parse(slurp(dir_ / "p" / name_ / "groundtruth/VesselTiny_0002.json"));
   const std::string profile = meta["profile"];
-  for (const std::string& f : std::vector<std::string>{"mip_x.png", "mip_y.png", "mip_z.png", "mip_z_" + profile + ".png"}) EXPECT_TRUE(fs::exists(gt / f)) << f;
+  for (const std::string& f : std::vector<std::string>{"mip_x.png", "mip_y.png", "mip_z.png", "mip_z_" + profile + ".png"})
+    EXPECT_TRUE(fs::exists(gt / f)) << f;
   for (const char* sub : {"imagesTr", "labelsTr"})
     for (const auto& e : fs::directory_iterator(dir_ / "p" / name_ / sub)) EXPECT_NE(e.path().extension(), ".png") << e.path();
 }
@@ -216,8 +215,8 @@ TEST_F(Dataset, FailedSamplesAreRecordedAndMakeTheExitCodeNonZero) {
 TEST_F(Dataset, KindLabelsNumberEachKindAsTheSpecListsItAndFollowTheWarpedImage) {
   ASSERT_EQ(run("dataset " + quoted(src_ / "tests/data/dataset_av.toml") + " --out raw --quiet", dir_).code, 0);
   const fs::path ds = dir_ / "raw" / "Dataset903_ArteryVeinTiny";
-  const std::string cmd = "/usr/bin/python3 '" + (src_ / "tests/check_nnunet.py").string() + "' '" + ds.string() + "' > '" +
-                          (dir_ / "check.txt").string() + "' 2>&1";
+  const std::string cmd =
+      "/usr/bin/python3 '" + (src_ / "tests/check_nnunet.py").string() + "' '" + ds.string() + "' > '" + (dir_ / "check.txt").string() + "' 2>&1";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << slurp(dir_ / "check.txt");
   const Json labels = Json::parse(slurp(ds / "dataset.json"))["labels"];
   EXPECT_EQ(labels, (Json{{"background", 0}, {"vein", 1}, {"artery", 2}}));
@@ -243,16 +242,15 @@ for lab in sorted(glob.glob('labelsTr/*.nii.gz')):
           'roots', *((int(l[roots['vein']]), int(l[roots['artery']])) if not warp else ('moved', 'by the warp')),
           'on mask', bool(((l > 0) == (mask > 0)).all()), 'image', 'clean' if np.array_equal(image, clean) else 'degraded')
 print('warped', warped)
-)", ds);
+)",
+                                       ds);
   for (const char* c : {"ArteryVeinTiny_0000", "ArteryVeinTiny_0001", "ArteryVeinTiny_0002"}) {
     const auto at = out.find(c);
     ASSERT_NE(at, std::string::npos) << out;
     const std::string line = out.substr(at, out.find('\n', at) - at);
     EXPECT_NE(line.find("values [0, 1, 2] legend vein artery meta 1 2"), std::string::npos) << line;
     EXPECT_NE(line.find("on mask True image degraded"), std::string::npos) << line;
-    if (line.find("roots moved") == std::string::npos) {
-      EXPECT_NE(line.find("roots 1 2"), std::string::npos) << line;
-    }
+    if (line.find("roots moved") == std::string::npos) { EXPECT_NE(line.find("roots 1 2"), std::string::npos) << line; }
   }
   EXPECT_EQ(out.find("warped 0"), std::string::npos) << out;  // the spec's profile file warps
 }
@@ -292,8 +290,7 @@ TEST_F(Dataset, BadSpecsNameFileAndLine) {
   EXPECT_NE(r.err.find("bad3.toml:10: kinds numbers the labels of labels = \"kind\""), std::string::npos) << r.err;
   r = with("kinds = [\"vein\", \"artery\"]", "kinds = [\"artery\"]");
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("bad3.toml:10: the sample grows a tree of kind 'vein', which has no label: kinds = [artery]"), std::string::npos)
-      << r.err;
+  EXPECT_NE(r.err.find("bad3.toml:10: the sample grows a tree of kind 'vein', which has no label: kinds = [artery]"), std::string::npos) << r.err;
   r = with("kinds = [\"vein\", \"artery\"]", "kinds = [\"vein\", \"vein\"]");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("bad3.toml:10: kinds must be a list of distinct kind names"), std::string::npos) << r.err;

@@ -29,8 +29,8 @@ using namespace angiosynth;
 
 namespace {
 
-using test::Grown;
 using test::growFile;
+using test::Grown;
 
 // Writes `text` to a scratch file and returns its path.
 std::filesystem::path scratchToml(const std::string& name, const std::string& text) {
@@ -90,8 +90,8 @@ TEST(DccoAngles, BifurcationAndOpeningAnglesOnHandMadeGeometries) {
   EXPECT_NEAR(bifurcationAngle(b, Vec3(1, 0, 0), Vec3(-1, 0, 0)), 180, 1e-12);
   // The split vessel bends at b: its parts span the plane z = 0 (normal (b − xp) × (xd − b)).
   const Vec3 xp(-1, 0, 0), xd(1, 1, 0);
-  EXPECT_NEAR(openingAngle(xp, b, xd, Vec3(0, 0, 1), {}), 90, 1e-12);   // straight out of the plane
-  EXPECT_NEAR(openingAngle(xp, b, xd, Vec3(1, -1, 0), {}), 0, 1e-12);   // in the plane
+  EXPECT_NEAR(openingAngle(xp, b, xd, Vec3(0, 0, 1), {}), 90, 1e-12);  // straight out of the plane
+  EXPECT_NEAR(openingAngle(xp, b, xd, Vec3(1, -1, 0), {}), 0, 1e-12);  // in the plane
   EXPECT_NEAR(openingAngle(xp, b, xd, Vec3(0, 1, 1), {}), 45, 1e-12);
   EXPECT_NEAR(openingAngle(xp, b, xd, Vec3(0, 1, -std::sqrt(3.0)), {}), 60, 1e-12);  // either side
   // The printed normal (xd − b) × (xt − b) would make φ ≡ 0: the corrected one does not.
@@ -181,8 +181,8 @@ TEST_P(DccoExample, TreeMeetsEveryConstraintOfItsStages) {
       continue;
     }
     const double g3 = s.stages[std::size_t(std::max<int>(t.stage[b], 0))].stage.gamma;
-    worst_murray = std::max(worst_murray, std::abs(std::pow(t.radius[i], g3) - std::pow(t.radius[a], g3) - std::pow(t.radius[b], g3)) /
-                                              std::pow(t.radius[i], g3));
+    worst_murray = std::max(worst_murray,
+                            std::abs(std::pow(t.radius[i], g3) - std::pow(t.radius[a], g3) - std::pow(t.radius[b], g3)) / std::pow(t.radius[i], g3));
     worst_flow = std::max(worst_flow, std::abs(t.flow[i] - t.flow[a] - t.flow[b]) / t.flow[i]);
   }
   EXPECT_LE(worst_murray, 1e-9);
@@ -303,10 +303,10 @@ TEST_P(DccoExample, TreeMeetsEveryConstraintOfItsStages) {
 
 INSTANTIATE_TEST_SUITE_P(Shipped, DccoExample,
                          ::testing::Values("dcco_scale_specific_2d.toml", "dcco_hierarchical_2d.toml", "dcco_pdf_mixture_2d.toml",
-                                           "dcco_pdf_uniform_2d.toml", "dcco_pdf_gaussian_2d.toml",
-                                           "dcco_sphere_pries_3d.toml", "dcco_outlet_half_2d.toml", "dcco_outlet_most_2d.toml",
-                                           "dcco_two_inlets_2d.toml", "dcco_two_inlets_3d.toml", "dcco_sequential_2d.toml",
-                                           "dcco_brain_shell_3d.toml", "dcco_junctions_2d.toml"),
+                                           "dcco_pdf_uniform_2d.toml", "dcco_pdf_gaussian_2d.toml", "dcco_sphere_pries_3d.toml",
+                                           "dcco_outlet_half_2d.toml", "dcco_outlet_most_2d.toml", "dcco_two_inlets_2d.toml",
+                                           "dcco_two_inlets_3d.toml", "dcco_sequential_2d.toml", "dcco_brain_shell_3d.toml",
+                                           "dcco_junctions_2d.toml"),
                          [](const auto& info) {
                            std::string n = info.param;
                            return n.substr(5, n.size() - 10);  // dcco_<name>.toml
@@ -374,8 +374,10 @@ TEST(Dcco, TerminalsFollowEachPdfOfFig4) {
     const double critical = 1.628 * std::sqrt(4000.0 / (2000.0 * 2000.0));  // α = 0.01
     for (int axis = 0; axis < 3; ++axis) {
       const double d = ksStatistic(grown[axis], drawn[axis]);
-      std::cout << name << " " << "xyr"[axis] << ": KS statistic " << d << ", critical " << critical << " (alpha 0.01)\n";
-      EXPECT_LT(d, critical) << name << " " << "xyr"[axis];
+      std::cout << name << " "
+                << "xyr"[axis] << ": KS statistic " << d << ", critical " << critical << " (alpha 0.01)\n";
+      EXPECT_LT(d, critical) << name << " "
+                             << "xyr"[axis];
     }
   }
 }
@@ -450,9 +452,7 @@ TEST(DccoInitial, OutletCarriesItsShareAndTheDomainTreeScalesAsFig5Says) {
     for (std::int32_t i = 0; i < given.nodeCount(); ++i) {
       EXPECT_EQ(t.position[i].x, given.position[i].x + world.center().x);
       EXPECT_EQ(t.position[i].y, given.position[i].y + world.center().y);
-      if (!t.isRoot(i)) {
-        EXPECT_EQ(t.stage[i], -1);
-      }
+      if (!t.isRoot(i)) { EXPECT_EQ(t.stage[i], -1); }
     }
     std::int32_t outlet = -1;
     double f = 0;
@@ -476,9 +476,7 @@ TEST(DccoInitial, OutletCarriesItsShareAndTheDomainTreeScalesAsFig5Says) {
     for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
       const auto a = t.child0[i], b = t.child1[i];
       if (a < 0) {
-        if (i != outlet) {
-          EXPECT_NEAR(t.flow[i] / q_f, 1, 1e-12);
-        }
+        if (i != outlet) { EXPECT_NEAR(t.flow[i] / q_f, 1, 1e-12); }
         p_min = std::min(p_min, t.pressure[i]);
         p_max = std::max(p_max, t.pressure[i]);
         continue;
@@ -486,8 +484,8 @@ TEST(DccoInitial, OutletCarriesItsShareAndTheDomainTreeScalesAsFig5Says) {
       const double sum = b < 0 ? t.flow[a] : t.flow[a] + t.flow[b];
       worst_flow = std::max(worst_flow, std::abs(t.flow[i] - sum) / t.flow[i]);
       if (b < 0) continue;
-      worst_murray = std::max(worst_murray, std::abs(std::pow(t.radius[i], 3) - std::pow(t.radius[a], 3) - std::pow(t.radius[b], 3)) /
-                                                std::pow(t.radius[i], 3));
+      worst_murray =
+          std::max(worst_murray, std::abs(std::pow(t.radius[i], 3) - std::pow(t.radius[a], 3) - std::pow(t.radius[b], 3)) / std::pow(t.radius[i], 3));
     }
     EXPECT_LE(worst_murray, 1e-9);
     EXPECT_LE(worst_flow, 1e-12);
@@ -525,9 +523,7 @@ TEST(DccoInitial, OutletCarriesItsShareAndTheDomainTreeScalesAsFig5Says) {
     EXPECT_LE(worst, 1e-9) << "every radius of the domain's tree scales alike";
     const auto resistance = [&](const VascularTree& v) { return (v.pressure[v.parent[domain]] - p_min_of(v)) / v.flow[domain]; };
     EXPECT_NEAR(k, std::pow(resistance(t) / resistance(u), 0.25), 1e-6 * k);
-    if (f < 0.99) {
-      EXPECT_LT(k, 1);
-    }
+    if (f < 0.99) { EXPECT_LT(k, 1); }
   }
   EXPECT_LT(mean_radius[1], mean_radius[0]) << "the more flow leaves, the thinner the domain's vessels";
 }

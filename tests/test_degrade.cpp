@@ -109,8 +109,9 @@ TEST(Degrade, UniformNoiseHasItsBoundsMeanAndVariance) {
 
 TEST(Degrade, ImpulseRatesMatchTheirProbabilities) {
   const auto gt = flatTruth(64);
-  const auto d = run(profileFrom("i", "background = 100\nvessel = 200\n[[effect]]\ntype = \"impulse\"\nsalt_probability = 0.03\n"
-                                      "pepper_value = 0\npepper_probability = 0.05\n"),
+  const auto d = run(profileFrom("i",
+                                 "background = 100\nvessel = 200\n[[effect]]\ntype = \"impulse\"\nsalt_probability = 0.03\n"
+                                 "pepper_value = 0\npepper_probability = 0.05\n"),
                      gt, kNoTree);
   const double n = double(d.image.data.size());
   const double salt = std::count(d.image.data.begin(), d.image.data.end(), 200.0f) / n;
@@ -252,8 +253,8 @@ TEST_F(Warp, GraphCentrelinesLieInTheWarpedMaskAndOnTheWarpedVessels) {
   ASSERT_GT(thick, 1000);
   EXPECT_GE(double(in_mask) / samples, 0.99);
   EXPECT_GE(double(thick_on_vessel) / thick, 0.99) << thick_on_vessel << " of " << thick;
-  std::printf("[ measure  ] graph samples in warped mask %.4f (%lld); thick-vessel samples on warped vessel %.4f (%lld)\n",
-              double(in_mask) / samples, (long long)samples, double(thick_on_vessel) / thick, (long long)thick);
+  std::printf("[ measure  ] graph samples in warped mask %.4f (%lld); thick-vessel samples on warped vessel %.4f (%lld)\n", double(in_mask) / samples,
+              (long long)samples, double(thick_on_vessel) / thick, (long long)thick);
 }
 
 TEST_F(Warp, WarpedMaskAgreesWithTheMaskRasterizedFromTheWarpedTree) {
@@ -267,8 +268,7 @@ TEST_F(Warp, WarpedMaskAgreesWithTheMaskRasterizedFromTheWarpedTree) {
     moved += w.labels->mask.data[v] != clean_->mask.data[v];
   }
   const double dice = 2.0 * both / double(a + b);
-  std::printf("[ measure  ] Dice(warped mask, mask of warped tree) = %.4f; %lld of %lld mask voxels moved\n", dice,
-              (long long)moved, (long long)a);
+  std::printf("[ measure  ] Dice(warped mask, mask of warped tree) = %.4f; %lld of %lld mask voxels moved\n", dice, (long long)moved, (long long)a);
   EXPECT_GE(dice, 0.95) << "Dice " << dice;
   // Not vacuous: most of the mask moved.
   EXPECT_GT(moved, a / 2);
@@ -390,8 +390,7 @@ TEST(Degrade, ProfileErrorsNameFileAndLine) {
   EXPECT_TRUE(expectError("[[effect]]\ntype = \"blur\"\nsigma = \"1 furlong\"\n", ":3: unknown length unit"));
   EXPECT_TRUE(expectError("[[effect]]\ntype = \"gaussian\"\nsigma = -1\n", ":3: sigma = -1 is out of range"));
   EXPECT_TRUE(expectError("[[effect]]\ntype = \"gaussian\"\nsigma = {min = 3, max = 1}\n", ":3: the range of sigma has min > max"));
-  EXPECT_TRUE(expectError("[[effect]]\ntype = \"warp\"\nspacing = \"4 voxel\"\nmax_displacement = \"2 voxel\"\n",
-                          ":1: warp: max_displacement"));
+  EXPECT_TRUE(expectError("[[effect]]\ntype = \"warp\"\nspacing = \"4 voxel\"\nmax_displacement = \"2 voxel\"\n", ":1: warp: max_displacement"));
   EXPECT_TRUE(expectError("[[effect]]\ntype = \"warp\"\n[[effect]]\ntype = \"warp\"\n", ":3: a profile may hold one warp"));
 }
 

@@ -24,7 +24,8 @@ void normalise(Json& j) {
     for (auto& [k, v] : j.items()) {
       if (v.is_string() && (k == "demand_map" || k == "supply_map" || k == "mask" || k == "source" || k == "file"))
         v = fs::path(v.get<std::string>()).filename().string();
-      else normalise(v);
+      else
+        normalise(v);
     }
   } else if (j.is_array()) {
     for (auto& v : j) normalise(v);
@@ -75,7 +76,10 @@ TEST(ExampleOutputs, EveryFileTheShippedExamplesWriteIsByteIdenticalToTheRecord)
     std::ofstream(dir / "vascusynth" / f, std::ios::binary) << selfContained(src / "examples/vascusynth" / f);
   ASSERT_EQ(run("vascusynth paramList.txt imageNames.txt 0.04 --quiet", dir / "vascusynth").code, 0);
   std::map<std::string, std::string> now;
-  for (const char* out : {"vascusynth_like", "cco_sphere_3d", "cco_sphere_curved_3d", "cco_disc_2d", "cco_two_inlets_2d", "cco_artery_vein_3d", "dcco_scale_specific_2d", "dcco_outlet_half_2d", "dcco_junctions_2d", "colonisation_fig5_2d", "lsystem_lzh_2d", "lsystem_grammar_2d", "dataset_small"}) hashTree(dir / out, out, now);
+  for (const char* out : {"vascusynth_like", "cco_sphere_3d", "cco_sphere_curved_3d", "cco_disc_2d", "cco_two_inlets_2d", "cco_artery_vein_3d",
+                          "dcco_scale_specific_2d", "dcco_outlet_half_2d", "dcco_junctions_2d", "colonisation_fig5_2d", "lsystem_lzh_2d",
+                          "lsystem_grammar_2d", "dataset_small"})
+    hashTree(dir / out, out, now);
   for (const char* out : {"image1", "image2"}) hashTree(dir / "vascusynth" / out, std::string("vascusynth/") + out, now);
   const fs::path record = src / "tests/data/example_outputs.sha256";
   // Another compiler rounds some floating-point steps differently and grows other (valid) trees;
@@ -96,8 +100,10 @@ TEST(ExampleOutputs, EveryFileTheShippedExamplesWriteIsByteIdenticalToTheRecord)
   ASSERT_GT(want.size(), 100u) << "no record at " << record;
   for (const auto& [k, v] : want) {
     const auto it = now.find(k);
-    if (it == now.end()) ADD_FAILURE() << "not written any more: " << k;
-    else EXPECT_EQ(it->second, v) << "changed: " << k;
+    if (it == now.end())
+      ADD_FAILURE() << "not written any more: " << k;
+    else
+      EXPECT_EQ(it->second, v) << "changed: " << k;
   }
   for (const auto& [k, v] : now) EXPECT_TRUE(want.count(k)) << "new file: " << k;
   fs::remove_all(dir);

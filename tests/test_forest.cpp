@@ -72,8 +72,7 @@ TEST(Forest, TreesKeepTheirRootsTopologyAndNoVesselOfOneTouchesAnother) {
   for (std::int32_t x = 1; x < t.nodeCount(); ++x)
     for (std::int32_t y = x + 1; y < t.nodeCount(); ++y)
       if (!t.isRoot(x) && !t.isRoot(y) && t.tree[x] != t.tree[y])
-        across += capsulesOverlap(t.position[t.parent[x]], t.position[x], t.radius[x], t.position[t.parent[y]], t.position[y],
-                                  t.radius[y]);
+        across += capsulesOverlap(t.position[t.parent[x]], t.position[x], t.radius[x], t.position[t.parent[y]], t.position[y], t.radius[y]);
   EXPECT_EQ(across, 0);
   EXPECT_TRUE(intersectingPairs(t, Vec3(-1, -1, -1), Vec3(50, 30, 30)).empty());
   // Removing a subtree keeps both roots and their trees.
@@ -107,7 +106,8 @@ rows = [l.split() for l in open('tree.swc') if not l.startswith('#')]
 print('swc roots', sum(r[6] == '-1' for r in rows), 'types', sorted({r[1] for r in rows}))
 c = collections.Counter(r['kind'] for r in csv.DictReader(open('edges.csv')))
 print('csv', c['artery'], c['vein'])
-)", dir);
+)",
+                                       dir);
   const auto segments = f.vessels.nodeCount() / 2 - 1;
   EXPECT_NE(out.find("components 2 True"), std::string::npos) << out;
   EXPECT_NE(out.find("kinds [('artery',), ('vein',)]"), std::string::npos) << out;
@@ -168,8 +168,7 @@ TEST(Forest, ClassesVolumeGivesEveryMaskVoxelOneKindAndEachCentrelineItsOwn) {
       for (int k = 0; k <= n; ++k) {
         const Vec3 v = g.index(a + (b - a) * (double(k) / n));
         // Voxel i covers [i - 1/2, i + 1/2).
-        s << std::floor(v.x + 0.5) << ' ' << std::floor(v.y + 0.5) << ' ' << std::floor(v.z + 0.5) << ' '
-          << f.trees[t.tree[i]].class_label << '\n';
+        s << std::floor(v.x + 0.5) << ' ' << std::floor(v.y + 0.5) << ' ' << std::floor(v.z + 0.5) << ' ' << f.trees[t.tree[i]].class_label << '\n';
       }
     }
   }
@@ -182,7 +181,8 @@ s = np.loadtxt('samples.txt', dtype=int)
 for k in (1, 2):
     q = s[s[:, 3] == k]
     print('class', k, 'share %.5f' % np.mean(c[q[:, 0], q[:, 1], q[:, 2]] == k), 'of', len(q))
-)", dir);
+)",
+                                       dir);
   std::cout << out;
   EXPECT_NE(out.find("unlabelled 0 outside 0 kinds [0, 1, 2]"), std::string::npos) << out;
   for (int k : {1, 2}) {
@@ -210,8 +210,8 @@ TEST(Forest, AVoxelTwoKindsShareGoesToTheThinVesselThatCrossesItThenToTheShorter
   // the artery's axis) lie mostly inside the artery.
   f.vessels.appendTree(segment(Vec3(2, 10.9, 10.5), Vec3(30, 10.9, 10.5), 3.0), 0);
   f.vessels.appendTree(segment(Vec3(2, 13.95, 10.5), Vec3(30, 13.95, 10.5), 0.04), 1);
-  f.vessels.appendTree(segment(Vec3(10.5, 2, 25.5), Vec3(10.5, 30, 25.5), 0.05), 0);    // long thin artery
-  f.vessels.appendTree(segment(Vec3(6, 2.2, 25.7), Vec3(15, 2.2, 25.7), 0.1), 1);       // short thin vein crossing its first voxel
+  f.vessels.appendTree(segment(Vec3(10.5, 2, 25.5), Vec3(10.5, 30, 25.5), 0.05), 0);  // long thin artery
+  f.vessels.appendTree(segment(Vec3(6, 2.2, 25.7), Vec3(15, 2.2, 25.7), 0.1), 1);     // short thin vein crossing its first voxel
   f.trees = {{"artery", "artery", 0}, {"vein", "vein", 0}};
   assignClassLabels(f.trees);
   VolumeGrid g;

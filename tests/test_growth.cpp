@@ -190,7 +190,11 @@ TEST(Growth, OptimiserBeatsVascuSynthAxisHillClimb) {
     }
     ASSERT_TRUE(ours.valid);
     ++compared;
-    EXPECT_LE(ours.cost, c * (1 + 1e-12)) << std::setprecision(17) << "rel " << (ours.cost - c) / c << " ours " << ours.bifurcation.x << "," << ours.bifurcation.y << "," << ours.bifurcation.z << " hill " << b.x << "," << b.y << "," << b.z << " seg " << s << " p " << t.position[t.parent[s]].x << "," << t.position[t.parent[s]].y << "," << t.position[t.parent[s]].z << " o " << t.position[s].x << "," << t.position[s].y << "," << t.position[s].z << " t " << cand.x << "," << cand.y << "," << cand.z;
+    EXPECT_LE(ours.cost, c * (1 + 1e-12)) << std::setprecision(17) << "rel " << (ours.cost - c) / c << " ours " << ours.bifurcation.x << ","
+                                          << ours.bifurcation.y << "," << ours.bifurcation.z << " hill " << b.x << "," << b.y << "," << b.z << " seg "
+                                          << s << " p " << t.position[t.parent[s]].x << "," << t.position[t.parent[s]].y << ","
+                                          << t.position[t.parent[s]].z << " o " << t.position[s].x << "," << t.position[s].y << "," << t.position[s].z
+                                          << " t " << cand.x << "," << cand.y << "," << cand.z;
     if (ours.cost < c * (1 - 1e-9)) ++better;
   }
   EXPECT_GT(compared, 50);
@@ -226,8 +230,7 @@ TEST(SegmentIndex, NearestMatchesBruteForce) {
     const Vec3 p = ex.map.extentMm() * 0.0 + uniformPoint(rng, 0, 40);
     index.nearest(t, p, 5, got);
     std::vector<std::pair<double, std::int32_t>> all;
-    for (std::int32_t s = 1; s < t.nodeCount(); ++s)
-      all.emplace_back(pointSegmentDistance(p, t.position[t.parent[s]], t.position[s]), s);
+    for (std::int32_t s = 1; s < t.nodeCount(); ++s) all.emplace_back(pointSegmentDistance(p, t.position[t.parent[s]], t.position[s]), s);
     std::sort(all.begin(), all.end());
     ASSERT_EQ(got.size(), 5u);
     for (int k = 0; k < 5; ++k) EXPECT_EQ(got[k].first, all[k].first);

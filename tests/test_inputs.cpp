@@ -24,8 +24,8 @@ namespace {
 class Files : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("angiosynth_inputs_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-                                        "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = fs::temp_directory_path() / ("angiosynth_inputs_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     write("demand.txt", "20 20 20\n0 0 0 20 20 20\n1\n5 5 5 10 10 10\n0\n");
@@ -38,17 +38,16 @@ class Files : public ::testing::Test {
   }
   static std::string params(const std::string& eol = "\n", const std::string& sep = ": ") {
     std::string s;
-    for (const char* kv : {"SUPPLY_MAP|supply.txt", "OXYGENATION_MAP|demand.txt", "RANDOM_SEED|3", "PERF_POINT|0 10 10",
-                           "PERF_PRESSURE|133000", "TERM_PRESSURE|83000", "PERF_FLOW|8.33", "RHO|0.036", "GAMMA|3",
-                           "LAMBDA|2", "MU|1", "MIN_DISTANCE|1", "NUM_NODES|20", "VOXEL_WIDTH|0.04", "CLOSEST_NEIGHBOURS|5"}) {
+    for (const char* kv : {"SUPPLY_MAP|supply.txt", "OXYGENATION_MAP|demand.txt", "RANDOM_SEED|3", "PERF_POINT|0 10 10", "PERF_PRESSURE|133000",
+                           "TERM_PRESSURE|83000", "PERF_FLOW|8.33", "RHO|0.036", "GAMMA|3", "LAMBDA|2", "MU|1", "MIN_DISTANCE|1", "NUM_NODES|20",
+                           "VOXEL_WIDTH|0.04", "CLOSEST_NEIGHBOURS|5"}) {
       const std::string t = kv;
       s += t.substr(0, t.find('|')) + sep + t.substr(t.find('|') + 1) + eol;
     }
     return s;
   }
   // Success if f throws an InputError starting with "<file>:<line>: " and containing `what`.
-  static ::testing::AssertionResult errorAt(const fs::path& file, int line, const std::string& what,
-                                            const std::function<void()>& f) {
+  static ::testing::AssertionResult errorAt(const fs::path& file, int line, const std::string& what, const std::function<void()>& f) {
     try {
       f();
     } catch (const InputError& e) {

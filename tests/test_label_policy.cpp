@@ -94,10 +94,10 @@ TEST(LabelPolicy, LengthKeptByCalibreIsTheLabelledShareOfTheCentreline) {
   EXPECT_NEAR(j["ignore"].get<double>(), 1 / 20.0, 1e-9);
   const Json& bins = j["by_calibre"];
   ASSERT_EQ(bins.size(), 6u);
-  EXPECT_NEAR(bins[1]["vessel"].get<double>(), 0.4, 1e-9);   // radius 0.3 voxel
-  EXPECT_NEAR(bins[4]["vessel"].get<double>(), 0.9, 1e-9);   // radius 3 voxels
+  EXPECT_NEAR(bins[1]["vessel"].get<double>(), 0.4, 1e-9);  // radius 0.3 voxel
+  EXPECT_NEAR(bins[4]["vessel"].get<double>(), 0.9, 1e-9);  // radius 3 voxels
   EXPECT_NEAR(bins[4]["ignore"].get<double>(), 0.1, 1e-9);
-  EXPECT_TRUE(bins[0]["vessel"].is_null());                  // no vessel that thin
+  EXPECT_TRUE(bins[0]["vessel"].is_null());  // no vessel that thin
 }
 
 class LabelPolicyRun : public ::testing::Test {
@@ -142,7 +142,8 @@ sigma = )" + std::to_string(sigma) + R"(
 expected = (mask > 0) & (pv > 0) & (180 * pv >= 2 * sigma * (1 - 1e-6))
 print('mismatch', int(((label > 0) != expected).sum()), 'label', int((label > 0).sum()), 'mask', int((mask > 0).sum()),
       'clean_label_is_mask', bool(((ld('label.nii.gz') > 0) == ((mask > 0) & (pv > 0))).all()))
-)", dir_);
+)",
+                                       dir_);
   int mismatch = -1, label = 0, mask = 0;
   ASSERT_EQ(std::sscanf(out.c_str(), "mismatch %d label %d mask %d", &mismatch, &label, &mask), 3) << out;
   EXPECT_LE(mismatch, 2) << out;  // float rounding exactly at the threshold at most
@@ -189,8 +190,8 @@ TEST_F(LabelPolicyRun, DatasetLabelsFollowThePolicyAndDeclareTheIgnoreLabel) {
   const Json dj = Json::parse(slurp(ds / "dataset.json"));
   EXPECT_EQ(dj["labels"], (Json{{"background", 0}, {"vein", 1}, {"artery", 2}, {"ignore", 3}}));
   EXPECT_EQ(dj["label_policy"], "ignore");
-  const std::string cmd = "/usr/bin/python3 '" + (src_ / "tests/check_nnunet.py").string() + "' '" + ds.string() + "' > '" +
-                          (dir_ / "check.txt").string() + "' 2>&1";
+  const std::string cmd =
+      "/usr/bin/python3 '" + (src_ / "tests/check_nnunet.py").string() + "' '" + ds.string() + "' > '" + (dir_ / "check.txt").string() + "' 2>&1";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << slurp(dir_ / "check.txt");
   const std::string out = debianPython(R"(
 import glob, os
@@ -206,7 +207,8 @@ for lab in sorted(glob.glob('labelsTr/*.nii.gz')):
     mask = np.asarray(nib.load(g + ('/mask_profile_warp.nii.gz' if warped else '/mask.nii.gz')).dataobj)
     print(case, 'values', sorted(int(v) for v in np.unique(l)), 'moved', moved,
           'vessel_on_mask', bool((mask[(l == 1) | (l == 2)] > 0).all()))
-)", ds);
+)",
+                                       ds);
   for (const char* c : {"ArteryVeinTiny_0000", "ArteryVeinTiny_0001"}) {
     const auto at = out.find(c);
     ASSERT_NE(at, std::string::npos) << out;

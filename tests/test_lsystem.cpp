@@ -183,18 +183,14 @@ TEST(Lzh, ImpossibleBlocksNameTheKey) {
   try {
     planLzh(p);
     FAIL() << "a block too low for its vessels was accepted";
-  } catch (const LzhError& e) {
-    EXPECT_EQ(e.key, "block_height");
-  }
+  } catch (const LzhError& e) { EXPECT_EQ(e.key, "block_height"); }
   p.height = 20;
   p.capillary_diameter = 0.6;
   p.capillary_wall = 0.2;  // outer 1.0 mm, pitch 9/15 = 0.6 mm
   try {
     planLzh(p);
     FAIL() << "overlapping capillary walls were accepted";
-  } catch (const LzhError& e) {
-    EXPECT_EQ(e.key, "capillary_spacing");
-  }
+  } catch (const LzhError& e) { EXPECT_EQ(e.key, "capillary_spacing"); }
 }
 
 // Flow: Q in at the inlet, Q/K through each capillary, conserved at every junction; pressure
@@ -344,9 +340,7 @@ TEST(Grammar, AskedTipsGrowOrTheRunFails) {
     GrammarReport r2;
     growGrammar(o, r2, {});
     FAIL() << "a tree that cannot fit was returned";
-  } catch (const GrowthError& e) {
-    EXPECT_NE(std::string(e.what()).find("tips its 6 iterations ask for"), std::string::npos) << e.what();
-  }
+  } catch (const GrowthError& e) { EXPECT_NE(std::string(e.what()).find("tips its 6 iterations ask for"), std::string::npos) << e.what(); }
 }
 
 // V-System's grammar trees fall apart into hundreds of pieces once voxelised; ours rasterises as

@@ -343,7 +343,8 @@ TEST(Mesh, StaggeredRingsMakeAcuteTrianglesAndKeepTheCapsulesVolume) {
       const double x = dot((p[0] + p[1] + p[2]) / 3.0, Vec3(20, 3, 4)) / length;
       if (x < 1 || x > length - 1) continue;
       ++along;
-      for (int i = 0; i < 3; ++i) right_or_obtuse += dot(p[(i + 1) % 3] - p[i], p[(i + 2) % 3] - p[i]) <= 1e-9 * dot(p[(i + 1) % 3] - p[i], p[(i + 1) % 3] - p[i]);
+      for (int i = 0; i < 3; ++i)
+        right_or_obtuse += dot(p[(i + 1) % 3] - p[i], p[(i + 2) % 3] - p[i]) <= 1e-9 * dot(p[(i + 1) % 3] - p[i], p[(i + 1) % 3] - p[i]);
     }
     EXPECT_GT(along, 40);
     EXPECT_EQ(right_or_obtuse, 0);
@@ -448,9 +449,9 @@ TEST(Mesh, ATubeFromAPartBackToItselfTooShortForTwoCutsIsContouredWhole) {
   VascularTree t;
   const auto add = [&](const Vec3& p, std::int32_t parent) { return addVessel(t, p, parent, 0.2); };
   const auto root = add({0, 0, 0}, -1), a = add({5, 0, 0}, root);
-  const auto b = add({7, 0, 0}, a);                               // the short vessel
+  const auto b = add({7, 0, 0}, a);                                                         // the short vessel
   add({5 + 3 * std::cos(std::numbers::pi / 3), 3 * std::sin(std::numbers::pi / 3), 0}, a);  // its sibling, ending at (6.5, 2.6)
-  add({6.5, 2.6 - 0.3, 0}, b);                                    // a child overlapping the sibling's end
+  add({6.5, 2.6 - 0.3, 0}, b);                                                              // a child overlapping the sibling's end
   add({10, 0, 0}, b);
   TubeSurfaceReport rep;
   const auto m = tubeMesh(t, 3, &rep);
@@ -558,8 +559,7 @@ TEST(Mesh, CutLoopsKeepNoEdgeThatSinglePrecisionCollapses) {
   const auto loops = starLoops(m, {plane});
   ASSERT_EQ(loops.size(), 1u);
   ASSERT_EQ(loops[0].size(), 16u);
-  for (std::size_t k = 0; k < loops[0].size(); ++k)
-    EXPECT_NE(rounded(loops[0][k]), rounded(loops[0][(k + 1) % loops[0].size()])) << k;
+  for (std::size_t k = 0; k < loops[0].size(); ++k) EXPECT_NE(rounded(loops[0][k]), rounded(loops[0][(k + 1) % loops[0].size()])) << k;
   // Every triangle keeps an area with its corners rounded to single precision, and the tube is
   // still a surface with the loop as its one boundary.
   for (const auto& t : m.triangles) {
@@ -597,8 +597,8 @@ TEST(Mesh, OneClosedOrientedSurfacePerTreeWithItsVerticesOnTheVessels) {
   // volume restoration moves vertices by a fraction of the chords' sagitta only.
   const double worst = largestDistanceOverStep(t, m);
   EXPECT_LE(worst, 0.5);
-  std::cout << "largest distance from the surface / local step: " << worst << "; largest volume move "
-            << rep.largest_volume_move_mm << " mm; finest step " << rep.voxel_mm << " mm\n";
+  std::cout << "largest distance from the surface / local step: " << worst << "; largest volume move " << rep.largest_volume_move_mm
+            << " mm; finest step " << rep.voxel_mm << " mm\n";
   EXPECT_GT(rep.levels, 1) << "thick vessels sampled coarser than thin ones";
   // The same mesh, bit for bit, on one thread.
   tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
@@ -611,44 +611,44 @@ TEST(Mesh, OneClosedOrientedSurfacePerTreeWithItsVerticesOnTheVessels) {
 // region per tree, outward, and the volume of the union of capsules (Monte Carlo) within 0.5 %.
 TEST(Mesh, WrittenFilesReadBackClosedByVtkWithTheUnionsVolume) {
   for (const bool tubes : {false, true}) {
-  SCOPED_TRACE(tubes ? "tubes" : "contour");
-  const auto& g = forest();
-  const auto& t = g.forest.vessels;
-  const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_files_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const auto m = tubes ? tubeMesh(t, 3) : vesselSurface(t, SurfaceOptions{});
-  for (const char* f : {"stl", "obj", "ply", "off", "vtp", "3mf"}) {
-    std::ofstream out(dir / (std::string("surface.") + f), std::ios::binary);
-    meshWriter(f)(out, m);
-  }
-  {
-    std::ofstream n(dir / "nodes.csv"), e(dir / "edges.csv");
-    writeNodesCsv(n, t, g.forest.trees);
-    writeEdgesCsv(e, t, g.forest.trees);
-  }
-  const double volume = meshTopology(m).volume_mm3;
-  const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' '" + dir.string() + "' '" +
-                          (dir / "nodes.csv").string() + "' '" + (dir / "edges.csv").string() + "' > '" + (dir / "check.json").string() + "'";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  const auto j = nlohmann::json::parse(readText(dir / "check.json"));
-  const double mc = j["union_volume_monte_carlo"];
-  std::cout << "mesh volume " << volume << " mm^3, Monte Carlo union " << mc << " mm^3\n";
-  EXPECT_LT(std::abs(volume - mc) / mc, 0.005);
-  EXPECT_EQ(j["formats"].size(), 6u);
-  for (const auto& [ext, f] : j["formats"].items()) {
-    EXPECT_EQ(f["points"], m.vertices.size()) << ext << ": vertices welded as written";
-    EXPECT_EQ(f["triangles"], m.triangles.size()) << ext;
-    EXPECT_EQ(f["boundary_edges"], 0) << ext;
-    EXPECT_EQ(f["nonmanifold_edges"], 0) << ext;
-    EXPECT_EQ(f["duplicate_faces"], 0) << ext;
-    EXPECT_EQ(f["degenerate_faces"], 0) << ext;
-    // STL holds single precision, and so do VTK's OBJ, OFF and PLY readers and the 3MF reader's
-    // points (about 1e-7 of the volume here, 1e-5 allowed); VTP is read in double.
-    EXPECT_NEAR(f["volume"].get<double>() / volume, 1, ext == "vtp" ? 1e-9 : 1e-5) << ext;
-    ASSERT_EQ(f["regions"].size(), 2u) << ext << ": one closed surface per tree";
-    for (const auto& r : f["regions"]) EXPECT_GT(r["signed_volume"], 0) << ext << ": outward";
-  }
-  std::filesystem::remove_all(dir);
+    SCOPED_TRACE(tubes ? "tubes" : "contour");
+    const auto& g = forest();
+    const auto& t = g.forest.vessels;
+    const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_files_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const auto m = tubes ? tubeMesh(t, 3) : vesselSurface(t, SurfaceOptions{});
+    for (const char* f : {"stl", "obj", "ply", "off", "vtp", "3mf"}) {
+      std::ofstream out(dir / (std::string("surface.") + f), std::ios::binary);
+      meshWriter(f)(out, m);
+    }
+    {
+      std::ofstream n(dir / "nodes.csv"), e(dir / "edges.csv");
+      writeNodesCsv(n, t, g.forest.trees);
+      writeEdgesCsv(e, t, g.forest.trees);
+    }
+    const double volume = meshTopology(m).volume_mm3;
+    const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' '" + dir.string() + "' '" +
+                            (dir / "nodes.csv").string() + "' '" + (dir / "edges.csv").string() + "' > '" + (dir / "check.json").string() + "'";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    const auto j = nlohmann::json::parse(readText(dir / "check.json"));
+    const double mc = j["union_volume_monte_carlo"];
+    std::cout << "mesh volume " << volume << " mm^3, Monte Carlo union " << mc << " mm^3\n";
+    EXPECT_LT(std::abs(volume - mc) / mc, 0.005);
+    EXPECT_EQ(j["formats"].size(), 6u);
+    for (const auto& [ext, f] : j["formats"].items()) {
+      EXPECT_EQ(f["points"], m.vertices.size()) << ext << ": vertices welded as written";
+      EXPECT_EQ(f["triangles"], m.triangles.size()) << ext;
+      EXPECT_EQ(f["boundary_edges"], 0) << ext;
+      EXPECT_EQ(f["nonmanifold_edges"], 0) << ext;
+      EXPECT_EQ(f["duplicate_faces"], 0) << ext;
+      EXPECT_EQ(f["degenerate_faces"], 0) << ext;
+      // STL holds single precision, and so do VTK's OBJ, OFF and PLY readers and the 3MF reader's
+      // points (about 1e-7 of the volume here, 1e-5 allowed); VTP is read in double.
+      EXPECT_NEAR(f["volume"].get<double>() / volume, 1, ext == "vtp" ? 1e-9 : 1e-5) << ext;
+      ASSERT_EQ(f["regions"].size(), 2u) << ext << ": one closed surface per tree";
+      for (const auto& r : f["regions"]) EXPECT_GT(r["signed_volume"], 0) << ext << ": outward";
+    }
+    std::filesystem::remove_all(dir);
   }
 }
 
@@ -658,30 +658,30 @@ TEST(Mesh, WrittenFilesReadBackClosedByVtkWithTheUnionsVolume) {
 // cells) keeps TetGen's run short.
 TEST(Mesh, TetgenFindsNoSelfIntersectionInAnyFormat) {
   for (const bool tubes : {false, true}) {
-  SCOPED_TRACE(tubes ? "tubes" : "contour");
-  const auto& t = forest().forest.vessels;
-  const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_tetgen_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  SurfaceOptions o;
-  o.samples_across = 2;
-  SurfaceReport rep;
-  const auto m = tubes ? tubeMesh(t, 2) : vesselSurface(t, o, &rep);
-  if (!tubes) {
-    EXPECT_GE(rep.levels, 3);
-    EXPECT_GT(rep.largest_volume_move_mm, 0);
-  }
-  for (const char* f : {"stl", "obj", "ply", "off", "vtp", "3mf"}) {
-    std::ofstream out(dir / (std::string("surface.") + f), std::ios::binary);
-    meshWriter(f)(out, m);
-  }
-  const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' --self-intersections '" + dir.string() +
-                          "' stl obj ply off vtp 3mf > '" + (dir / "tetgen.json").string() + "'";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  const auto j = nlohmann::json::parse(readText(dir / "tetgen.json"));
-  ASSERT_EQ(j.size(), 6u);
-  for (const auto& [ext, pairs] : j.items()) EXPECT_EQ(pairs, 0) << ext << ": intersecting face pairs";
-  std::cout << m.triangles.size() << " triangles, " << j.dump() << "\n";
-  std::filesystem::remove_all(dir);
+    SCOPED_TRACE(tubes ? "tubes" : "contour");
+    const auto& t = forest().forest.vessels;
+    const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_tetgen_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    SurfaceOptions o;
+    o.samples_across = 2;
+    SurfaceReport rep;
+    const auto m = tubes ? tubeMesh(t, 2) : vesselSurface(t, o, &rep);
+    if (!tubes) {
+      EXPECT_GE(rep.levels, 3);
+      EXPECT_GT(rep.largest_volume_move_mm, 0);
+    }
+    for (const char* f : {"stl", "obj", "ply", "off", "vtp", "3mf"}) {
+      std::ofstream out(dir / (std::string("surface.") + f), std::ios::binary);
+      meshWriter(f)(out, m);
+    }
+    const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' --self-intersections '" + dir.string() +
+                            "' stl obj ply off vtp 3mf > '" + (dir / "tetgen.json").string() + "'";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    const auto j = nlohmann::json::parse(readText(dir / "tetgen.json"));
+    ASSERT_EQ(j.size(), 6u);
+    for (const auto& [ext, pairs] : j.items()) EXPECT_EQ(pairs, 0) << ext << ": intersecting face pairs";
+    std::cout << m.triangles.size() << " triangles, " << j.dump() << "\n";
+    std::filesystem::remove_all(dir);
   }
 }
 
@@ -758,7 +758,8 @@ TEST(Mesh, MeshTableInAParameterFileWritesTheSurfaceWithTheSample) {
   refused("bad", "samples_across = 0\n", "samples_across = 0 is out of range; allowed: [1, 64]");
   refused("bad2", "formats = [\"amf\"]\n", "formats 'amf' is not allowed; allowed: stl, obj, ply, off, vtp, 3mf");
   // A clip box from the file: the same surface as the command's --clip-box.
-  std::ofstream(dir / "with_box.toml") << text << "\n[mesh]\nformats = [\"off\"]\nsamples_across = 3\nends = \"capped\"\nclip_box = [20, 20, 20, 40, 40, 40]\n";
+  std::ofstream(dir / "with_box.toml")
+      << text << "\n[mesh]\nformats = [\"off\"]\nsamples_across = 3\nends = \"capped\"\nclip_box = [20, 20, 20, 40, 40, 40]\n";
   ASSERT_EQ(run("generate with_box.toml --out boxed --no-image --quiet", dir).code, 0);
   const auto boxed = nlohmann::json::parse(readText(dir / "boxed/sample.json"))["statistics"]["surface"];
   EXPECT_GT(boxed["clip_box_removed_triangles"].get<int>(), 0);
@@ -777,8 +778,8 @@ TEST(Mesh, MeshTableInAParameterFileWritesTheSurfaceWithTheSample) {
 TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
   const auto dir = grownSample("ends", 12);
   const auto check = [&](const std::string& sub, const char* mode) {
-    const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' " + mode + " '" + (dir / sub).string() + "'" +
-                            (std::string(mode) == "--ends" ? "" : " vtp off") + " > '" + (dir / (sub + ".json")).string() + "'";
+    const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' " + mode + " '" + (dir / sub).string() +
+                            "'" + (std::string(mode) == "--ends" ? "" : " vtp off") + " > '" + (dir / (sub + ".json")).string() + "'";
     EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
     return nlohmann::json::parse(readText(dir / (sub + ".json")));
   };
@@ -786,7 +787,8 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
   // Both methods: the tubes' ends are rings of their own, the contour's cut from it.
   nlohmann::json st, caps;
   for (const std::string method : {"contour", "tubes"}) {
-    const auto capped = run("mesh sample --out capped --format vtp,off --ends capped --flow-extension 3 --samples-across 2 --method " + method + " --force --quiet", dir);
+    const auto capped = run(
+        "mesh sample --out capped --format vtp,off --ends capped --flow-extension 3 --samples-across 2 --method " + method + " --force --quiet", dir);
     ASSERT_EQ(capped.code, 0) << capped.err;
     st = nlohmann::json::parse(readText(dir / "capped/mesh.json"))["statistics"];
     EXPECT_EQ(st["ends"], 26) << method;  // per tree: its root and 12 leaves
@@ -798,7 +800,7 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
     EXPECT_EQ(caps["caps"], 26) << method;
     EXPECT_EQ(caps["boundary_loops"], 0) << method;
     EXPECT_LT(caps["max_cap_plane_distance"].get<double>(), 1e-9) << method;  // share of the radius
-    EXPECT_GT(caps["min_cap_area_ratio"].get<double>(), 0.95) << method;  // at two samples across a loop can have 12 vertices (0.955 πr²)
+    EXPECT_GT(caps["min_cap_area_ratio"].get<double>(), 0.95) << method;      // at two samples across a loop can have 12 vertices (0.955 πr²)
     // (the contour's loop runs through vertices the volume restoration moved out and the repair
     // moved along: at two samples across, up to 1.4 % over)
     EXPECT_LT(caps["max_cap_area_ratio"].get<double>(), 1.02) << method;
@@ -806,7 +808,8 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
     const auto tetgen = check("capped", "--self-intersections");
     for (const auto& [ext, pairs] : tetgen.items()) EXPECT_EQ(pairs, 0) << method << ", " << ext << ": intersecting face pairs";
     const auto faces = readText(dir / "capped/surface_faces.csv");
-    EXPECT_EQ(faces.substr(0, faces.find('\n')), "face_id,kind,tree,vessel,end,state,centre_x,centre_y,centre_z,normal_x,normal_y,normal_z,radius,cap_area,loop_vertices");
+    EXPECT_EQ(faces.substr(0, faces.find('\n')),
+              "face_id,kind,tree,vessel,end,state,centre_x,centre_y,centre_z,normal_x,normal_y,normal_z,radius,cap_area,loop_vertices");
   }
   // Capped, the contour's slivers are repaired by default, and TetGen meshes the volume with
   // quality (radius–edge ratio 1.414) at its default tolerance, undecimated.
@@ -818,7 +821,8 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
   // fewer of the input triangles than of the nets as they are (--remesh 0), each split costing
   // it a traversal of its queues. Its boundary faces (surface.1.face) per input triangle.
   EXPECT_GT(st["remesh_splits"].get<int>(), 0);
-  const auto plain = run("mesh sample --out plain --format off --ends capped --flow-extension 3 --samples-across 2 --method tubes --remesh 0 --quiet", dir);
+  const auto plain =
+      run("mesh sample --out plain --format off --ends capped --flow-extension 3 --samples-across 2 --method tubes --remesh 0 --quiet", dir);
   ASSERT_EQ(plain.code, 0) << plain.err;
   const auto sp = nlohmann::json::parse(readText(dir / "plain/mesh.json"))["statistics"];
   EXPECT_EQ(sp["remesh_changes"], 0);
@@ -912,8 +916,9 @@ TEST(Mesh, HollowWallIsClosedOfGenusEndsLessOneWithItsThicknessAndVolume) {
   }
   EXPECT_GE(open[0] + open[1], 24) << "at most two of the 26 ends stay closed";
   for (int k = 0; k < 2; ++k) EXPECT_EQ(st["tree_euler_characteristic"][std::size_t(k)], 2 - 2 * (open[std::size_t(k)] - 1)) << "tree " << k;
-  const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' --wall '" + (dir / "wall").string() + "' '" +
-                          (dir / "sample/nodes.csv").string() + "' '" + (dir / "sample/edges.csv").string() + "' 0.1 > '" + (dir / "wall.json").string() + "'";
+  const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' --wall '" + (dir / "wall").string() +
+                          "' '" + (dir / "sample/nodes.csv").string() + "' '" + (dir / "sample/edges.csv").string() + "' 0.1 > '" +
+                          (dir / "wall.json").string() + "'";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   const auto j = nlohmann::json::parse(readText(dir / "wall.json"));
   const double mc = j["wall_volume_monte_carlo"], volume = j["mesh_volume"];
@@ -923,8 +928,8 @@ TEST(Mesh, HollowWallIsClosedOfGenusEndsLessOneWithItsThicknessAndVolume) {
   std::cout << j.dump() << "\n";
   const auto thick = run("mesh sample --out thick --format off --wall-ratio 0.5 --quiet", dir);
   ASSERT_EQ(thick.code, 0) << thick.err;
-  const std::string tetgen = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' --self-intersections '" + (dir / "thick").string() +
-                             "' off > '" + (dir / "tetgen.json").string() + "'";
+  const std::string tetgen = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' --self-intersections '" +
+                             (dir / "thick").string() + "' off > '" + (dir / "tetgen.json").string() + "'";
   ASSERT_EQ(std::system(tetgen.c_str()), 0) << tetgen;
   EXPECT_EQ(nlohmann::json::parse(readText(dir / "tetgen.json"))["off"], 0) << "intersecting face pairs";
   // A wall needs open ends and the tubes; one kind of thickness at a time.
@@ -974,8 +979,8 @@ TEST(Mesh, HollowWallClippedToABoxStaysClosedWithOpenLumensAndTheWallsVolume) {
   const auto faces = readText(dir / "box/surface_faces.csv");
   EXPECT_NE(faces.find(",outside_box,"), std::string::npos);
   EXPECT_NE(faces.find(",box,,,+z,section,"), std::string::npos);
-  const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' --wall '" + (dir / "box").string() + "' '" +
-                          (dir / "sample/nodes.csv").string() + "' '" + (dir / "sample/edges.csv").string() + "' 0.1 " + box + " > '" +
+  const std::string cmd = "/usr/bin/python3 '" + (test::sourceDir() / "tests/check_mesh.py").string() + "' --wall '" + (dir / "box").string() +
+                          "' '" + (dir / "sample/nodes.csv").string() + "' '" + (dir / "sample/edges.csv").string() + "' 0.1 " + box + " > '" +
                           (dir / "box.json").string() + "'";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   const auto j = nlohmann::json::parse(readText(dir / "box.json"));
@@ -1099,8 +1104,9 @@ TEST(Mesh, SliverRepairKeepsTopologyVolumeAndSurface) {
     std::int64_t n = 0;
     for (const auto& tri : s.triangles) {
       const Vec3 p[3] = {s.vertices[std::size_t(tri[0])], s.vertices[std::size_t(tri[1])], s.vertices[std::size_t(tri[2])]};
-      for (int i = 0; i < 3; ++i) n += dot(p[(i + 1) % 3] - p[i], p[(i + 2) % 3] - p[i]) < std::cos(100 * std::numbers::pi / 180) *
-                                                                                          norm(p[(i + 1) % 3] - p[i]) * norm(p[(i + 2) % 3] - p[i]);
+      for (int i = 0; i < 3; ++i)
+        n += dot(p[(i + 1) % 3] - p[i], p[(i + 2) % 3] - p[i]) <
+             std::cos(100 * std::numbers::pi / 180) * norm(p[(i + 1) % 3] - p[i]) * norm(p[(i + 2) % 3] - p[i]);
     }
     return n;
   };
@@ -1248,7 +1254,8 @@ TEST(Mesh, SpecksUntanglingLeavesAreDroppedAndSmallComponentsKept) {
   const Vec3 p(0.5, 2, 0);
   const double e = 1e-12;
   for (const Vec3& d : {Vec3(0, 0, 0), Vec3(e, 0, 0), Vec3(0, e, 0), Vec3(0, 0, e)}) m.vertices.push_back(p + d);
-  for (const auto& t : {std::array<int, 3>{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}) m.triangles.push_back({first + t[0], first + t[1], first + t[2]});
+  for (const auto& t : {std::array<int, 3>{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}})
+    m.triangles.push_back({first + t[0], first + t[1], first + t[2]});
   m.triangle_tree.assign(m.triangles.size(), 0);
   m.vertex_step.assign(m.vertices.size(), 0.1f);
   const auto spheres = m.triangles.size() - 4;
@@ -1328,7 +1335,6 @@ TEST(Mesh, RemeshingMakesTheNetsTrianglesAcuteAndKeepsTheSurface) {
   EXPECT_EQ(nlohmann::json::parse(readText(dir / "tetgen.json"))["off"], 0) << "intersecting face pairs";
   std::cout << nets.triangles.size() << " -> " << m.triangles.size() << " triangles (" << rep.splits << " splits, " << rep.collapses << " collapses, "
             << rep.flips << " flips, " << rep.moves << " moves); largest angle >= 75 deg " << wide_before << " -> " << wide_after
-            << ", smallest < 15 deg " << thin_before << " -> " << thin_after << "; volume " << before.volume_mm3 << " -> " << topo.volume_mm3
-            << "\n";
+            << ", smallest < 15 deg " << thin_before << " -> " << thin_after << "; volume " << before.volume_mm3 << " -> " << topo.volume_mm3 << "\n";
   std::filesystem::remove_all(dir);
 }

@@ -34,8 +34,10 @@ TEST(Methods, EveryDeclaredDefaultIsReadableInItsUnitAndDeclaredOnce) {
             << m->name << " declares [" << p.table << "] " << p.key << " twice";
       if (!p.fallback || p.fallback[0] == '[') continue;  // "[physics] ...": another key's value
       const std::string unit = p.unit;
-      const auto dim = unit == "Pa" ? Dimension::Pressure : unit == "Pa*s" ? Dimension::Viscosity
-                     : unit == "mm^3/s" ? Dimension::Flow : Dimension::Length;
+      const auto dim = unit == "Pa"       ? Dimension::Pressure
+                       : unit == "Pa*s"   ? Dimension::Viscosity
+                       : unit == "mm^3/s" ? Dimension::Flow
+                                          : Dimension::Length;
       if (unit == "Pa" || unit == "Pa*s" || unit == "mm^3/s" || (unit == "mm" && std::string(p.fallback) != "none")) {
         EXPECT_NO_THROW(parseQuantity(p.fallback, dim, 1.0)) << m->name << " " << p.key << " = " << p.fallback;
       }
@@ -62,8 +64,9 @@ class MethodFiles : public ::testing::Test {
 
 // The defaults a CCO file leaves out are the declared ones, parsed from the declarations.
 TEST_F(MethodFiles, OmittedKeysTakeTheDeclaredDefaults) {
-  const auto sc = readTomlParameters(write("[domain]\nshape = \"sphere\"\nradius = \"10 mm\"\nvoxel_size = \"0.5 mm\"\n"
-                                           "[tree]\nmethod = \"cco\"\nterminals = 100\n"));
+  const auto sc =
+      readTomlParameters(write("[domain]\nshape = \"sphere\"\nradius = \"10 mm\"\nvoxel_size = \"0.5 mm\"\n"
+                               "[tree]\nmethod = \"cco\"\nterminals = 100\n"));
   const auto& c = dynamic_cast<const CcoSetup&>(*sc.growth).cco;
   const auto declared = [&](const char* table, const char* key, Dimension dim) {
     return parseQuantity(findParam(kCcoMethod, table, key)->fallback, dim, 0.5);
@@ -80,8 +83,9 @@ TEST_F(MethodFiles, OmittedKeysTakeTheDeclaredDefaults) {
 
 // ν stays unless max_closest_neighbours asks for more, whatever ν is.
 TEST_F(MethodFiles, NuDoublesOnlyUpToAMaximumTheFileGives) {
-  const std::string head = "[domain]\nshape = \"sphere\"\nradius = \"10 mm\"\nvoxel_size = \"0.5 mm\"\n"
-                           "[tree]\nmethod = \"cco\"\nterminals = 100\nclosest_neighbours = 10\n";
+  const std::string head =
+      "[domain]\nshape = \"sphere\"\nradius = \"10 mm\"\nvoxel_size = \"0.5 mm\"\n"
+      "[tree]\nmethod = \"cco\"\nterminals = 100\nclosest_neighbours = 10\n";
   const auto max_nu = [&](const std::string& extra) {
     const auto sc = readTomlParameters(write(head + extra));
     return dynamic_cast<const CcoSetup&>(*sc.growth).cco.max_neighbours;
@@ -98,9 +102,7 @@ TEST_F(MethodFiles, KeysAreCheckedAgainstTheDeclarations) {
   const auto message = [&](const std::string& text) {
     try {
       readTomlParameters(write(text));
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
+    } catch (const InputError& e) { return std::string(e.what()); }
     return std::string("no error");
   };
   std::string m = message(head + "[tree]\nmethod = \"cco\"\nterminals = 100\nbranching = 3\n");

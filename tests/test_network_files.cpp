@@ -118,12 +118,11 @@ TEST(NetworkFiles, NaryJunctionsAreKeptThroughEveryGraphFormat) {
   GraphFrame frame;
   frame.voxel_mm = 0.1;
   const auto write = [&](const std::string& name, auto&& writer) { return writeFile(dir, name, writer); };
-  const std::vector<std::filesystem::path> files = {
-      write("tree.gxl", [&](std::ostream& o) { writeGxl(o, t, g.forest.trees, frame, "tree"); }),
-      write("edges.csv", [&](std::ostream& o) { writeEdgesCsv(o, t, g.forest.trees); }),
-      write("centerlines.vtp", [&](std::ostream& o) { writeVtp(o, t, g.forest.trees); }),
-      write("tree.swc", [&](std::ostream& o) { writeSwc(o, t, g.forest.trees); }),
-      write("tree.cco", [&](std::ostream& o) { writeCco(o, t, g.forest.trees); })};
+  const std::vector<std::filesystem::path> files = {write("tree.gxl", [&](std::ostream& o) { writeGxl(o, t, g.forest.trees, frame, "tree"); }),
+                                                    write("edges.csv", [&](std::ostream& o) { writeEdgesCsv(o, t, g.forest.trees); }),
+                                                    write("centerlines.vtp", [&](std::ostream& o) { writeVtp(o, t, g.forest.trees); }),
+                                                    write("tree.swc", [&](std::ostream& o) { writeSwc(o, t, g.forest.trees); }),
+                                                    write("tree.cco", [&](std::ostream& o) { writeCco(o, t, g.forest.trees); })};
   write("nodes.csv", [&](std::ostream& o) { writeNodesCsv(o, t, g.forest.trees); });
   // The tree's segments (links merged) by distal point: proximal point and radius.
   const auto segments = [](const VascularTree& v) {
@@ -231,18 +230,18 @@ TEST(NetworkFiles, BadNetworkFilesNameTheLineAndWhatIsAllowed) {
     try {
       readNetwork(dir / name);
       ADD_FAILURE() << name << " was accepted";
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-    }
+    } catch (const InputError& e) { EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what(); }
   };
   // SWC and VItA's .cco.
   expectError("orphan.swc", "1 1 0 0 0 1 -1\n2 2 1 0 0 1 7\n", "orphan.swc:2: parent 7 of 2 is not defined");
   expectError("cycle.swc", "1 1 0 0 0 1 -1\n2 2 1 0 0 1 3\n3 2 2 0 0 1 2\n", "is not connected to a root");
   expectError("bad.swc", "1 1 0 0 zero 1 -1\n", "bad.swc:1: z 'zero' is not a finite number");
   expectError("x.vtk", "", "unknown network format '.vtk'; allowed: .cco (VItA), .swc");
-  expectError("gap.cco", "*Vessels\n2\n0 0 0 0 1 0 0 0 0 0 0 2 1 0 0 0 0 0 0 0 -1\n1 1 0.5 0 2 0 0 0 0 0 0 2 1 0 0 0 0 0 0 0 -1\n*Connectivity\n0 -1 1\n1 0\n",
+  expectError("gap.cco",
+              "*Vessels\n2\n0 0 0 0 1 0 0 0 0 0 0 2 1 0 0 0 0 0 0 0 -1\n1 1 0.5 0 2 0 0 0 0 0 0 2 1 0 0 0 0 0 0 0 -1\n*Connectivity\n0 -1 1\n1 0\n",
               "gap.cco:4: vessel 1 starts at 1 0.5 0, not where its parent 0 ends (1 0 0)");
-  expectError("mode.cco", "*Vessels\n1\n0 0 0 0 1 0 0 0 0 0 0 4 1 0 0 0 0 0 0 0 -1\n*Connectivity\n0 -1\n", "mode.cco:3: branching mode 4; allowed: 0 (none)");
+  expectError("mode.cco", "*Vessels\n1\n0 0 0 0 1 0 0 0 0 0 0 4 1 0 0 0 0 0 0 0 -1\n*Connectivity\n0 -1\n",
+              "mode.cco:3: branching mode 4; allowed: 0 (none)");
   // GXL, CSV and VTP.
   const std::string node0 = "<node id=\"a\"><attr name=\"position\"><tup><float>0</float><float>0</float><float>0</float></tup></attr></node>\n";
   const std::string node1 = "<node id=\"b\"><attr name=\"position\"><tup><float>1</float><float>0</float><float>0</float></tup></attr></node>\n";
@@ -250,32 +249,43 @@ TEST(NetworkFiles, BadNetworkFilesNameTheLineAndWhatIsAllowed) {
   const auto edge = [](const char* id, const char* from, const char* to) {
     return std::string("<edge id=\"") + id + "\" from=\"" + from + "\" to=\"" + to + "\"><attr name=\"radius\"><float>0.1</float></attr></edge>\n";
   };
-  expectError("cycle.gxl", "<gxl><graph>\n" + node0 + node1 + node2 + edge("e1", "a", "b") + edge("e2", "b", "c") + edge("e3", "c", "b") + "</graph></gxl>\n",
+  expectError("cycle.gxl",
+              "<gxl><graph>\n" + node0 + node1 + node2 + edge("e1", "a", "b") + edge("e2", "b", "c") + edge("e3", "c", "b") + "</graph></gxl>\n",
               "cycle.gxl:7: vessels e1 and e3 both end at 1 0 0: a node of a tree has one parent vessel");
   expectError("noradius.gxl", "<gxl><graph>\n" + node0 + node1 + "<edge id=\"e\" from=\"a\" to=\"b\"/>\n</graph></gxl>\n",
               "noradius.gxl:4: edge e has no 'radius' attribute (mm)");
-  expectError("unknown.gxl", "<gxl><graph>\n" + node0 + edge("e", "a", "z") + "</graph></gxl>\n", "unknown.gxl:3: edge e refers to node z, which is not defined");
+  expectError("unknown.gxl", "<gxl><graph>\n" + node0 + edge("e", "a", "z") + "</graph></gxl>\n",
+              "unknown.gxl:3: edge e refers to node z, which is not defined");
   expectError("vs.gxl", "<gxl><graph>\n<node id=\"n0\"><attr name=\" position\"><tup><float>0</float></tup></attr></node>\n</graph></gxl>\n",
               "vs.gxl:2: node n0 has no attribute 'position'");
   expectError("broken.gxl", "<gxl><graph>\n<node id=\"a\">\n</graph></gxl>\n", "broken.gxl:");
   std::ofstream(dir / "bad_nodes.csv") << "id,pos_x,pos_y,pos_z\n0,0,0,0\n1,1,0,0\n";
-  expectError("bad_edges.csv", "id,node1id,node2id,radius,role\n1,0,1,0.1,artery\n", "bad_edges.csv:2: role 'artery'; allowed: distribution, transport, perforator");
+  expectError("bad_edges.csv", "id,node1id,node2id,radius,role\n1,0,1,0.1,artery\n",
+              "bad_edges.csv:2: role 'artery'; allowed: distribution, transport, perforator");
   expectError("lonely_edges.csv", "id,node1id,node2id,radius\n1,0,1,0.1\n", "lonely_nodes.csv: cannot read the network file");
   expectError("table.csv", "a,b\n", "a CSV network is a pair of files whose names contain 'nodes' and 'edges'");
-  const std::string head = "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" byte_order=\"LittleEndian\">\n<PolyData>\n"
-                           "<Piece NumberOfPoints=\"2\" NumberOfLines=\"1\">\n<Points>\n"
-                           "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0</DataArray>\n</Points>\n";
-  expectError("lz4.vtp", "<VTKFile type=\"PolyData\" compressor=\"vtkLZ4DataCompressor\"></VTKFile>\n", "lz4.vtp:1: compressor vtkLZ4DataCompressor; allowed: vtkZLibDataCompressor");
-  expectError("noradius.vtp", head + "<Lines>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1</DataArray>\n"
-                                     "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">2</DataArray>\n</Lines>\n</Piece>\n</PolyData>\n</VTKFile>\n",
+  const std::string head =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" byte_order=\"LittleEndian\">\n<PolyData>\n"
+      "<Piece NumberOfPoints=\"2\" NumberOfLines=\"1\">\n<Points>\n"
+      "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0</DataArray>\n</Points>\n";
+  expectError("lz4.vtp", "<VTKFile type=\"PolyData\" compressor=\"vtkLZ4DataCompressor\"></VTKFile>\n",
+              "lz4.vtp:1: compressor vtkLZ4DataCompressor; allowed: vtkZLibDataCompressor");
+  expectError("noradius.vtp",
+              head +
+                  "<Lines>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1</DataArray>\n"
+                  "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">2</DataArray>\n</Lines>\n</Piece>\n</PolyData>\n</VTKFile>\n",
               "noradius.vtp:4: no radius: a cell or point array named Radius or radius is required");
-  expectError("short.vtp", head + "<CellData><DataArray type=\"Float64\" Name=\"radius\" format=\"binary\">AAAAAA==</DataArray></CellData>\n<Lines>\n"
-                                  "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1</DataArray>\n"
-                                  "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">2</DataArray>\n</Lines>\n</Piece>\n</PolyData>\n</VTKFile>\n",
+  expectError("short.vtp",
+              head +
+                  "<CellData><DataArray type=\"Float64\" Name=\"radius\" format=\"binary\">AAAAAA==</DataArray></CellData>\n<Lines>\n"
+                  "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1</DataArray>\n"
+                  "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">2</DataArray>\n</Lines>\n</Piece>\n</PolyData>\n</VTKFile>\n",
               "short.vtp:8: the DataArray's binary data declares 0 bytes; the Piece asks for 8");
-  expectError("point.vtp", head + "<CellData><DataArray type=\"Float64\" Name=\"radius\" format=\"ascii\">0.1</DataArray></CellData>\n<Lines>\n"
-                                  "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 5</DataArray>\n"
-                                  "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">2</DataArray>\n</Lines>\n</Piece>\n</PolyData>\n</VTKFile>\n",
+  expectError("point.vtp",
+              head +
+                  "<CellData><DataArray type=\"Float64\" Name=\"radius\" format=\"ascii\">0.1</DataArray></CellData>\n<Lines>\n"
+                  "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 5</DataArray>\n"
+                  "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">2</DataArray>\n</Lines>\n</Piece>\n</PolyData>\n</VTKFile>\n",
               "point.vtp:10: line 0 refers to a point that is not defined");
 }
 
@@ -317,8 +327,7 @@ TEST(NetworkFiles, AJunctionOfThousandsOfChildrenIsOneNode) {
   {
     std::ofstream swc(dir / "star.swc");
     swc << "1 1 0 0 0 1 -1\n2 2 0 0 10 1 1\n";
-    for (int k = 0; k < 20000; ++k)
-      swc << k + 3 << " 2 " << std::cos(k * 0.001) * 5 << ' ' << std::sin(k * 0.001) * 5 << " 10 0.01 2\n";
+    for (int k = 0; k < 20000; ++k) swc << k + 3 << " 2 " << std::cos(k * 0.001) * 5 << ' ' << std::sin(k * 0.001) * 5 << " 10 0.01 2\n";
   }
   const auto t = readNetwork(dir / "star.swc").tree;
   std::int32_t links = 0, junction = -1;

@@ -44,9 +44,7 @@ class Robustness : public ::testing::Test {
     const auto file = write(name, text);
     try {
       readNetwork(file, 1, limit);
-    } catch (const InputError& e) {
-      return e.what();
-    }
+    } catch (const InputError& e) { return e.what(); }
     return "";
   }
   // A two-vessel SWC: a root sample, a bifurcation-free chain of `samples` along x.
@@ -57,7 +55,8 @@ class Robustness : public ::testing::Test {
 // A DCCO file continuing `network` in a 2D disc (radius 20 mm), 20 terminals.
 std::string dccoWithInitial(const std::string& network, const std::string& extra = "") {
   return "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"20 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"dcco\"\n"
-         "root_radius = \"0.2 mm\"\n[initial]\nfile = \"" + network + "\"\nbranching = \"versatile\"\nrole = \"distribution\"\n" + extra +
+         "root_radius = \"0.2 mm\"\n[initial]\nfile = \"" +
+         network + "\"\nbranching = \"versatile\"\nrole = \"distribution\"\n" + extra +
          "[physics]\nperfusion_flow = \"0.33 mL/min\"\n[[stage]]\nterminals = 20\n[image]\nformats = []\n";
 }
 
@@ -133,10 +132,9 @@ TEST_F(Robustness, TemporariesOfKilledProcessesAreRemovedAndNoOtherFile) {
   EXPECT_FALSE(fs::exists(dir_ / (".kept.txt.tmp-angiosynth-" + gone)));
   EXPECT_TRUE(fs::exists(dir_ / (".other.txt.tmp-angiosynth-" + gone))) << "only the temporaries of the file written";
   EXPECT_EQ(removeAbandonedTemporaries(dir_), 1);
-  for (const std::string& kept : {".kept.txt.tmp-angiosynth-" + self + "-0123456789abcdef",
-                                   std::string(".kept.txt.tmp-angiosynth-elsewhere-1-0123456789abcdef"),
-                                   std::string(".kept.txt.tmp-angiosynth-notes"), ".link.txt.tmp-angiosynth-" + gone,
-                                   std::string("kept.txt"), std::string("target.txt")})
+  for (const std::string& kept :
+       {".kept.txt.tmp-angiosynth-" + self + "-0123456789abcdef", std::string(".kept.txt.tmp-angiosynth-elsewhere-1-0123456789abcdef"),
+        std::string(".kept.txt.tmp-angiosynth-notes"), ".link.txt.tmp-angiosynth-" + gone, std::string("kept.txt"), std::string("target.txt")})
     EXPECT_TRUE(fs::exists(fs::symlink_status(dir_ / kept))) << kept;
   EXPECT_FALSE(fs::exists(dir_ / (".other.txt.tmp-angiosynth-" + gone)));
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 6);
@@ -191,11 +189,11 @@ TEST_F(Robustness, StagingLeavesADirectoryOfItsNameThatItDidNotMakeAlone) {
 // ---- Crashes and internal errors -------------------------------------------------------------
 
 TEST_F(Robustness, PlotCalibreRefusesScoresOfAnotherShape) {
-  for (const std::string json :
-       {R"({"calibre":[{}]})", R"({"per_case":[{}]})", R"({"calibre":"x"})", R"({"calibre":[{"radius_voxels":"a","recall":1}]})",
-        R"({"calibre":[{"radius_voxels":[1],"recall":"high"}]})", R"({"calibre":[{"radius_voxels":[2],"recall":1},{"radius_voxels":[1],"recall":1}]})",
-        R"({"per_case":[{"calibre":[{"radius_voxels":[0],"recall":1}]},{"calibre":[{"radius_voxels":[1],"recall":1}]}]})", R"({"per_case":7})",
-        R"([1,2])"}) {
+  for (const std::string json : {R"({"calibre":[{}]})", R"({"per_case":[{}]})", R"({"calibre":"x"})",
+                                 R"({"calibre":[{"radius_voxels":"a","recall":1}]})", R"({"calibre":[{"radius_voxels":[1],"recall":"high"}]})",
+                                 R"({"calibre":[{"radius_voxels":[2],"recall":1},{"radius_voxels":[1],"recall":1}]})",
+                                 R"({"per_case":[{"calibre":[{"radius_voxels":[0],"recall":1}]},{"calibre":[{"radius_voxels":[1],"recall":1}]}]})",
+                                 R"({"per_case":7})", R"([1,2])"}) {
     write("bad.json", json);
     const auto r = run("plot-calibre out.png bad.json --force", dir_);
     EXPECT_EQ(r.code, 2) << json << ": " << r.err;
@@ -213,27 +211,26 @@ TEST_F(Robustness, EveryGraphReaderHoldsValuesToThePhysicalRanges) {
   };
   const auto vtp = [](const std::string& x, const std::string& radius) {
     return "<?xml version=\"1.0\"?><VTKFile type=\"PolyData\" byte_order=\"LittleEndian\"><PolyData><Piece NumberOfPoints=\"2\" "
-           "NumberOfLines=\"1\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 " + x +
-           " 0 0</DataArray></Points><CellData><DataArray type=\"Float64\" Name=\"Radius\" format=\"ascii\">" + radius +
+           "NumberOfLines=\"1\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 " +
+           x + " 0 0</DataArray></Points><CellData><DataArray type=\"Float64\" Name=\"Radius\" format=\"ascii\">" + radius +
            "</DataArray></CellData><Lines><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1</DataArray><DataArray "
            "type=\"Int64\" Name=\"offsets\" format=\"ascii\">2</DataArray></Lines></Piece></PolyData></VTKFile>";
   };
   const auto cco = [](const std::string& x, const std::string& radius) {
-    return "*Tree\n0 0 0 1 0 1 1 1 2 0.1 1e-6\n*Vessels\n1\n0 0 0 0 " + x + " 0 0 0 0 0 0 0 " + radius +
-           " 0 0 0 0 0 0 0\n*Connectivity\n0 -1\n";
+    return "*Tree\n0 0 0 1 0 1 1 1 2 0.1 1e-6\n*Vessels\n1\n0 0 0 0 " + x + " 0 0 0 0 0 0 0 " + radius + " 0 0 0 0 0 0 0\n*Connectivity\n0 -1\n";
   };
   write("t_edges.csv", "id,node1id,node2id,radius\n0,0,1,1e300\n");
-  for (const auto& [name, text, why] : std::vector<std::tuple<std::string, std::string, std::string>>{
-           {"r.swc", "1 1 0 0 0 1e300 -1\n2 3 1 0 0 1e300 1\n", "radius"},
-           {"c.swc", "1 1 0 0 0 0.1 -1\n2 3 1e300 0 0 0.1 1\n", "coordinate"},
-           {"r.gxl", gxl("1", "1e300"), "radius"},
-           {"c.gxl", gxl("1e300", "0.1"), "coordinate"},
-           {"t_nodes.csv", "id,pos_x,pos_y,pos_z\n0,0,0,0\n1,1,0,0\n", "radius"},
-           {"r.vtp", vtp("1", "1e155"), "radius"},
-           {"c.vtp", vtp("1e300", "0.1"), "coordinate"},
-           {"r.cco", cco("1", "-0.5"), "radius"},
-           {"c.cco", cco("1e300", "0.1"), "coordinate"},
-           {"one.swc", "1 1 0 0 0 0.1 -1\n", "no vessel"}}) {
+  for (const auto& [name, text, why] :
+       std::vector<std::tuple<std::string, std::string, std::string>>{{"r.swc", "1 1 0 0 0 1e300 -1\n2 3 1 0 0 1e300 1\n", "radius"},
+                                                                      {"c.swc", "1 1 0 0 0 0.1 -1\n2 3 1e300 0 0 0.1 1\n", "coordinate"},
+                                                                      {"r.gxl", gxl("1", "1e300"), "radius"},
+                                                                      {"c.gxl", gxl("1e300", "0.1"), "coordinate"},
+                                                                      {"t_nodes.csv", "id,pos_x,pos_y,pos_z\n0,0,0,0\n1,1,0,0\n", "radius"},
+                                                                      {"r.vtp", vtp("1", "1e155"), "radius"},
+                                                                      {"c.vtp", vtp("1e300", "0.1"), "coordinate"},
+                                                                      {"r.cco", cco("1", "-0.5"), "radius"},
+                                                                      {"c.cco", cco("1e300", "0.1"), "coordinate"},
+                                                                      {"one.swc", "1 1 0 0 0 0.1 -1\n", "no vessel"}}) {
     const auto e = networkError(name, text);
     EXPECT_NE(e.find(why), std::string::npos) << name << ": " << e;
     EXPECT_NE(e.find("allowed"), std::string::npos) << name << ": " << e;
@@ -241,8 +238,9 @@ TEST_F(Robustness, EveryGraphReaderHoldsValuesToThePhysicalRanges) {
   // A node of many children: read (as NetworkFiles tests), refused up front by what walks its
   // links for each of its vessels: growth from it (over a minute at 2000) and meshing.
   std::string star = "1 1 0 0 0 0.2 -1\n2 3 0 1 0 0.2 1\n";
-  for (int k = 0; k < 2000; ++k) star += std::to_string(k + 3) + " 3 " + std::to_string(std::cos(k * 0.00314) * 3) + " " +
-                                         std::to_string(1 + std::sin(k * 0.00314) * 3) + " 0 0.05 2\n";
+  for (int k = 0; k < 2000; ++k)
+    star += std::to_string(k + 3) + " 3 " + std::to_string(std::cos(k * 0.00314) * 3) + " " + std::to_string(1 + std::sin(k * 0.00314) * 3) +
+            " 0 0.05 2\n";
   write("star.swc", star);
   write("star.toml", dccoWithInitial("star.swc"));
   for (const std::string command : {"generate star.toml --out o --no-image", "mesh star.swc --out m"}) {
@@ -258,9 +256,7 @@ TEST(RobustnessFiles, AJunctionsLinksAreReadWhereverTheNodesArrayMoves) {
   const auto net = readNetwork(test::sourceDir() / "fuzz/regressions/fuzz_graph_mesh/junction-link-position-moved.swc");
   const auto& t = net.tree;
   for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
-    if (t.isLink(i)) {
-      EXPECT_EQ(t.length[i], 0.0) << "link " << i;
-    }
+    if (t.isLink(i)) { EXPECT_EQ(t.length[i], 0.0) << "link " << i; }
   }
   EXPECT_EQ(t.roots().size(), 1u);
 }
@@ -339,9 +335,10 @@ TEST_F(Robustness, DccoRepairKeepsTheTerminalCountsOfAPolylineNetwork) {
   // VItA's tree with tortuous vessels as polylines (nodes of one child): the repair's removal of
   // subtrees added a continuation's missing second child, terminals[-1] (fuzz_initial_network).
   fs::copy_file(test::sourceDir() / "tests/data/network/tree_vita_polylines.vtp", dir_ / "p.vtp");
-  write("p.toml", "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.2 mm\"\n[tree]\nmethod = \"dcco\"\n"
-                  "root_radius = \"0.2 mm\"\n[initial]\nfile = \"p.vtp\"\nbranching = \"versatile\"\nrole = \"distribution\"\n"
-                  "[physics]\nperfusion_flow = \"0.3 mL/min\"\n[[stage]]\nterminals = 12\n[image]\nformats = []\n");
+  write("p.toml",
+        "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.2 mm\"\n[tree]\nmethod = \"dcco\"\n"
+        "root_radius = \"0.2 mm\"\n[initial]\nfile = \"p.vtp\"\nbranching = \"versatile\"\nrole = \"distribution\"\n"
+        "[physics]\nperfusion_flow = \"0.3 mL/min\"\n[[stage]]\nterminals = 12\n[image]\nformats = []\n");
   GrowthReport report;
   const auto g = test::growFile(dir_ / "p.toml", 1, &report);
   const auto& t = g.forest.vessels;
@@ -366,10 +363,11 @@ TEST_F(Robustness, DccoGaussiansOutsideTheirStageAreRefusedBeforeGrowth) {
 TEST_F(Robustness, DccoRootOutsideItsFirstStagesDomainIsRefusedBeforeDrawing) {
   // The root sits on the 21 mm disc's border, 1 mm outside the ring its first stage distributes
   // in: a million draws (14 s) were refused one by one before the growth gave up.
-  write("r.toml", "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"21 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"dcco\"\n"
-                  "root_radius = \"0.6 mm\"\n[physics]\nperfusion_flow = \"4 mL/min\"\n[[region]]\nname = \"ring\"\nshape = \"annulus\"\n"
-                  "inner_radius = \"12 mm\"\nouter_radius = \"20 mm\"\n[[stage]]\nname = \"ring\"\nterminals = 30\ndomain = [\"ring\"]\n"
-                  "[image]\nformats = []\n");
+  write("r.toml",
+        "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"21 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"dcco\"\n"
+        "root_radius = \"0.6 mm\"\n[physics]\nperfusion_flow = \"4 mL/min\"\n[[region]]\nname = \"ring\"\nshape = \"annulus\"\n"
+        "inner_radius = \"12 mm\"\nouter_radius = \"20 mm\"\n[[stage]]\nname = \"ring\"\nterminals = 30\ndomain = [\"ring\"]\n"
+        "[image]\nformats = []\n");
   const auto r = run("generate r.toml --out o --no-image", dir_);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("lies 1 mm outside the stage's domain"), std::string::npos) << r.err;
@@ -382,9 +380,10 @@ TEST_F(Robustness, DccoStageThatCannotConnectGivesUpAfterItsRelaxationsAndCounts
   // connection crosses one of them. A million draws (19 s) were refused before growth gave up,
   // and the message counted a terminal the reader's restructuring made as placed.
   write("tree.swc", "1 1 0 32 0 0.2 -1\n2 2 5 24 0 0.2 1\n3 2 -11.413 11.314 0 0.15 2\n4 2 11.314 11.314 0 0.15 1\n");
-  write("r.toml", "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.2 mm\"\n[tree]\nmethod = \"dcco\"\n"
-                  "root_radius = \"0.2 mm\"\n[initial]\nfile = \"tree.swc\"\nbranching = \"versatile\"\nrole = \"distribution\"\n"
-                  "[physics]\nperfusion_flow = \"0.3 mL/min\"\n[[stage]]\nterminals = 4\n[image]\nformats = []\n");
+  write("r.toml",
+        "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.2 mm\"\n[tree]\nmethod = \"dcco\"\n"
+        "root_radius = \"0.2 mm\"\n[initial]\nfile = \"tree.swc\"\nbranching = \"versatile\"\nrole = \"distribution\"\n"
+        "[physics]\nperfusion_flow = \"0.3 mL/min\"\n[[stage]]\nterminals = 4\n[image]\nformats = []\n");
   const auto r = run("generate r.toml --out o --no-image", dir_);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("placed 0 of its 4 terminals: 10000 points in a row"), std::string::npos) << r.err;
@@ -396,12 +395,14 @@ TEST_F(Robustness, DccoRejectedTrialsLeaveNothingBehindSoACrowdedNetworkIsRefuse
   // rolls back about seventy trials. Each rollback left its vessels in the segment index and the
   // list of thick vessels, so every draw searched more than the last: over two minutes where the
   // thousand draws of the budget take under a second.
-  write("tree.swc", "1 1 0 20 0 0.3 -1\n2 2 0 13 0 0.3 1\n3 2 -8 12 0 0.2 2\n4 2 8 12 0 0.2 3\n5 2 -5 6 0 0.2 2\n"
-                    "6 2 1 11 0 0.2 2\n7 2 -1 9 0 0.2 6\n8 2 1 7 0 0.2 7\n9 2 0 5 0 0.2 8\n10 2 -4 -2 0 0.15 9\n"
-                    "11 2 7 -2 0 0.15 9\n12 2 0 -7 0 0.15 9\n");
-  write("r.toml", "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.2 mm\"\n[tree]\nmethod = \"dcco\"\n"
-                  "root_radius = \"0.2 mm\"\n[initial]\nfile = \"tree.swc\"\nbranching = \"versatile\"\nrole = \"distribution\"\n"
-                  "[physics]\nperfusion_flow = \"0.3 mL/min\"\n[[stage]]\nterminals = 2\ndraws_before_relaxing = 10\n[image]\nformats = []\n");
+  write("tree.swc",
+        "1 1 0 20 0 0.3 -1\n2 2 0 13 0 0.3 1\n3 2 -8 12 0 0.2 2\n4 2 8 12 0 0.2 3\n5 2 -5 6 0 0.2 2\n"
+        "6 2 1 11 0 0.2 2\n7 2 -1 9 0 0.2 6\n8 2 1 7 0 0.2 7\n9 2 0 5 0 0.2 8\n10 2 -4 -2 0 0.15 9\n"
+        "11 2 7 -2 0 0.15 9\n12 2 0 -7 0 0.15 9\n");
+  write("r.toml",
+        "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.2 mm\"\n[tree]\nmethod = \"dcco\"\n"
+        "root_radius = \"0.2 mm\"\n[initial]\nfile = \"tree.swc\"\nbranching = \"versatile\"\nrole = \"distribution\"\n"
+        "[physics]\nperfusion_flow = \"0.3 mL/min\"\n[[stage]]\nterminals = 2\ndraws_before_relaxing = 10\n[image]\nformats = []\n");
   const auto r = run("generate r.toml --out o --no-image", dir_);
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("placed 1 of its 2 terminals: 1000 points in a row"), std::string::npos) << r.err;
@@ -445,11 +446,13 @@ TEST_F(Robustness, VtpCountsBeyondTheLimitAreRefusedBeforeDecoding) {
     word(b + 1 < blocks ? full.size() : tail.size());
     body += b + 1 < blocks ? full : tail;
   }
-  const std::string text = "<?xml version=\"1.0\"?><VTKFile type=\"PolyData\" byte_order=\"LittleEndian\" header_type=\"UInt64\" "
-                           "compressor=\"vtkZLibDataCompressor\"><PolyData><Piece NumberOfPoints=\"" + std::to_string(points) +
-                           "\" NumberOfLines=\"1\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" "
-                           "offset=\"0\"/></Points></Piece></PolyData><AppendedData encoding=\"raw\">_" + header + body +
-                           "</AppendedData></VTKFile>";
+  const std::string text =
+      "<?xml version=\"1.0\"?><VTKFile type=\"PolyData\" byte_order=\"LittleEndian\" header_type=\"UInt64\" "
+      "compressor=\"vtkZLibDataCompressor\"><PolyData><Piece NumberOfPoints=\"" +
+      std::to_string(points) +
+      "\" NumberOfLines=\"1\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" "
+      "offset=\"0\"/></Points></Piece></PolyData><AppendedData encoding=\"raw\">_" +
+      header + body + "</AppendedData></VTKFile>";
   ASSERT_LT(text.size(), 2u << 20);
   const auto e = networkError("bomb.vtp", text, 1ULL << 30);
   EXPECT_NE(e.find("the Piece declares 50000000 points"), std::string::npos) << e;
@@ -501,9 +504,7 @@ TEST_F(Robustness, ATruncatedPredictionIsRefusedNotZeroFilled) {
     try {
       readNiftiVolume(dir_ / name, 1ULL << 30, 4, "the prediction");
       ADD_FAILURE() << name << " was read";
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("a truncated file"), std::string::npos) << e.what();
-    }
+    } catch (const InputError& e) { EXPECT_NE(std::string(e.what()).find("a truncated file"), std::string::npos) << e.what(); }
     const auto r = run(std::string("score ") + name + " s", dir_);
     EXPECT_EQ(r.code, 2) << name << ": " << r.err;
   }
@@ -512,11 +513,11 @@ TEST_F(Robustness, ATruncatedPredictionIsRefusedNotZeroFilled) {
 
 TEST_F(Robustness, ColonisationLengthsTheDomainCannotHoldAreRefused) {
   const std::string base = slurp(test::sourceDir() / "examples/colonisation_fig5_2d.toml");
-  for (const auto& [key, why] : std::vector<std::pair<std::string, std::string>>{
-           {"step = \"0 mm\"", "step 0 mm is out of range"},
-           {"step = \"1e6 mm\"", "step 1e+06 mm is out of range"},
-           {"terminal_radius = \"100 mm\"", "terminal_radius 100 mm is out of range"},
-           {"steps = 1\ndrains_per_step = 1\ndrain_spacing = \"9 mm\"", "the growth made no vessel"}}) {
+  for (const auto& [key, why] :
+       std::vector<std::pair<std::string, std::string>>{{"step = \"0 mm\"", "step 0 mm is out of range"},
+                                                        {"step = \"1e6 mm\"", "step 1e+06 mm is out of range"},
+                                                        {"terminal_radius = \"100 mm\"", "terminal_radius 100 mm is out of range"},
+                                                        {"steps = 1\ndrains_per_step = 1\ndrain_spacing = \"9 mm\"", "the growth made no vessel"}}) {
     std::string t = std::regex_replace(base, std::regex("steps = 100\ndrains_per_step = 1000\n"), "");
     replaceOnce(t, "[[stage]]\n", "[[stage]]\n" + key + "\n");
     replaceOnce(t, "formats = [\"nifti\", \"png\"]", "formats = []");
@@ -565,15 +566,18 @@ TEST_F(Robustness, GraphFilesCarryTheirWallsToTheHollowWallMesh) {
   const auto r = run("mesh w_edges.csv --out m --wall-from-graph --quiet", dir_);
   EXPECT_EQ(r.code, 0) << r.err;
   // What mesh reads back from its own graph writers: the same walls.
-  for (const auto& [name, text] : std::vector<std::pair<std::string, std::string>>{
-           {"w.gxl", R"(<?xml version="1.0"?><gxl><graph id="t"><node id="a"><attr name="position"><tup><float>0</float><float>0</float><float>0</float></tup></attr></node><node id="b"><attr name="position"><tup><float>6</float><float>0</float><float>0</float></tup></attr></node><edge from="a" to="b"><attr name="radius"><float>0.4</float></attr><attr name="radius_start"><float>0.5</float></attr><attr name="wall_start"><float>0.1</float></attr><attr name="wall"><float>0.08</float></attr></edge></graph></gxl>)"},
-           {"w.vtp", "<?xml version=\"1.0\"?><VTKFile type=\"PolyData\" byte_order=\"LittleEndian\"><PolyData><Piece NumberOfPoints=\"2\" "
-                     "NumberOfLines=\"1\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 6 0 0</DataArray>"
-                     "</Points><CellData><DataArray type=\"Float64\" Name=\"Radius\" format=\"ascii\">0.4</DataArray><DataArray type=\"Float64\" "
-                     "Name=\"RadiusStart\" format=\"ascii\">0.5</DataArray><DataArray type=\"Float64\" Name=\"WallStart\" format=\"ascii\">0.1"
-                     "</DataArray><DataArray type=\"Float64\" Name=\"Wall\" format=\"ascii\">0.08</DataArray></CellData><Lines><DataArray "
-                     "type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1</DataArray><DataArray type=\"Int64\" Name=\"offsets\" "
-                     "format=\"ascii\">2</DataArray></Lines></Piece></PolyData></VTKFile>"}}) {
+  for (
+      const auto& [name, text] : std::vector<std::pair<std::string, std::string>>{
+          {"w.gxl",
+           R"(<?xml version="1.0"?><gxl><graph id="t"><node id="a"><attr name="position"><tup><float>0</float><float>0</float><float>0</float></tup></attr></node><node id="b"><attr name="position"><tup><float>6</float><float>0</float><float>0</float></tup></attr></node><edge from="a" to="b"><attr name="radius"><float>0.4</float></attr><attr name="radius_start"><float>0.5</float></attr><attr name="wall_start"><float>0.1</float></attr><attr name="wall"><float>0.08</float></attr></edge></graph></gxl>)"},
+          {"w.vtp",
+           "<?xml version=\"1.0\"?><VTKFile type=\"PolyData\" byte_order=\"LittleEndian\"><PolyData><Piece NumberOfPoints=\"2\" "
+           "NumberOfLines=\"1\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 6 0 0</DataArray>"
+           "</Points><CellData><DataArray type=\"Float64\" Name=\"Radius\" format=\"ascii\">0.4</DataArray><DataArray type=\"Float64\" "
+           "Name=\"RadiusStart\" format=\"ascii\">0.5</DataArray><DataArray type=\"Float64\" Name=\"WallStart\" format=\"ascii\">0.1"
+           "</DataArray><DataArray type=\"Float64\" Name=\"Wall\" format=\"ascii\">0.08</DataArray></CellData><Lines><DataArray "
+           "type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1</DataArray><DataArray type=\"Int64\" Name=\"offsets\" "
+           "format=\"ascii\">2</DataArray></Lines></Piece></PolyData></VTKFile>"}}) {
     const auto n = readNetwork(write(name, text));
     ASSERT_EQ(n.tree.nodeCount(), 2) << name;
     EXPECT_DOUBLE_EQ(n.tree.wall_start[1], 0.1) << name;

@@ -130,8 +130,8 @@ TEST_F(Safety, VascuSynthRerunsOverwriteTheirFilesAndLeaveTheUsersAndRefuseDotNa
 
 TEST_F(Safety, AnInterruptRemovesTheStagingDirectory) {
   // The 4000-terminal sphere runs about 2 s: long enough to be interrupted while growing.
-  const std::string cmd = std::string(ANGIOSYNTH_EXE) + " generate " + (src_ / "examples/cco_sphere_3d.toml").string() +
-                          " --out " + (work_ / "big").string() + " --quiet";
+  const std::string cmd = std::string(ANGIOSYNTH_EXE) + " generate " + (src_ / "examples/cco_sphere_3d.toml").string() + " --out " +
+                          (work_ / "big").string() + " --quiet";
   for (const int sig : {SIGINT, SIGTERM}) {
     const pid_t pid = fork();
     ASSERT_GE(pid, 0);
@@ -151,8 +151,7 @@ TEST_F(Safety, AnInterruptRemovesTheStagingDirectory) {
     waitpid(pid, &status, 0);
     EXPECT_TRUE(WIFEXITED(status)) << sig;
     EXPECT_EQ(WEXITSTATUS(status), 128 + sig);
-    for (const auto& e : fs::directory_iterator(work_))
-      EXPECT_EQ(e.path().filename().string().find("big"), std::string::npos) << e.path();
+    for (const auto& e : fs::directory_iterator(work_)) EXPECT_EQ(e.path().filename().string().find("big"), std::string::npos) << e.path();
   }
 }
 
@@ -207,8 +206,8 @@ TEST_F(SafeDataset, ConcurrentShardsLoseNoSampleAndMatchASingleProcessRun) {
     const int shards = 2 + round % 2;  // 2 or 3 shards at once, one thread each
     std::string cmd = "cd '" + dir_.string() + "' && (";
     for (int k = 0; k < shards; ++k)
-      cmd += std::string(ANGIOSYNTH_EXE) + " dataset spec.toml --out " + out + " --shard " + std::to_string(k) + "/" +
-             std::to_string(shards) + " --threads 1 --quiet >/dev/null 2>>err.txt & ";
+      cmd += std::string(ANGIOSYNTH_EXE) + " dataset spec.toml --out " + out + " --shard " + std::to_string(k) + "/" + std::to_string(shards) +
+             " --threads 1 --quiet >/dev/null 2>>err.txt & ";
     cmd += "wait)";
     ASSERT_EQ(std::system(cmd.c_str()), 0);
     ASSERT_EQ(run("dataset finalize " + out + "/" + name_, dir_).code, 0) << slurp(dir_ / "stderr.txt");
@@ -246,15 +245,21 @@ TEST_F(SafeDataset, MalformedAndEscapingManifestLinesAreReportedAndBlockNothing)
   ASSERT_EQ(run("dataset spec.toml --out raw --quiet", dir_).code, 0);
   const fs::path ds = dir_ / "raw" / name_;
   std::ofstream part(ds / "manifest" / "evil.jsonl");
-  part << R"({"index": 3, "status": "ok"})" << "\n"                                          // no files
-       << R"({"index": 3, "status": "ok", "files": [{"sha256": "00"}]})" << "\n"             // no path
-       << R"({"index": "3", "status": "ok", "files": []})" << "\n"                           // index a string
-       << R"({"index": 99999999999, "status": "failed"})" << "\n"                            // out of range
-       << R"({"index": 2, "status": 7})" << "\n"                                             // wrong type
+  part << R"({"index": 3, "status": "ok"})"
+       << "\n"  // no files
+       << R"({"index": 3, "status": "ok", "files": [{"sha256": "00"}]})"
+       << "\n"  // no path
+       << R"({"index": "3", "status": "ok", "files": []})"
+       << "\n"  // index a string
+       << R"({"index": 99999999999, "status": "failed"})"
+       << "\n"  // out of range
+       << R"({"index": 2, "status": 7})"
+       << "\n"  // wrong type
        << R"({"index": 2, "status": "ok", "finished_unix": 1e300, "files": [{"path": "../../../../etc/hostname", "size": 3, "sha256": ")"
        << std::string(64, 'a') << "\"}]}\n"
        << "[1, 2, 3]\n"
-       << R"({"index":0,"status":"ok","files":8,"status":"failed","error":"x"})" << "\n";  // found by fuzz_manifest
+       << R"({"index":0,"status":"ok","files":8,"status":"failed","error":"x"})"
+       << "\n";  // found by fuzz_manifest
   part.close();
   const auto v = run("dataset verify raw/" + name_, dir_);
   EXPECT_EQ(v.code, 0) << v.err;  // the good entries still vouch for every sample

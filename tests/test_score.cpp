@@ -70,8 +70,8 @@ std::vector<double> directed(const std::vector<Vec3>& from, const std::vector<Ve
 TEST(Score, PercentileIsNumpysLinearInterpolation) {
   std::vector<double> v;
   for (int i = 101; i >= 1; --i) v.push_back(i);
-  EXPECT_DOUBLE_EQ(percentile95(v), 96.0);        // np.percentile(range(1, 102), 95)
-  EXPECT_DOUBLE_EQ(percentile95({0, 10}), 9.5);    // np.percentile([0, 10], 95)
+  EXPECT_DOUBLE_EQ(percentile95(v), 96.0);       // np.percentile(range(1, 102), 95)
+  EXPECT_DOUBLE_EQ(percentile95({0, 10}), 9.5);  // np.percentile([0, 10], 95)
   EXPECT_DOUBLE_EQ(percentile95({3}), 3.0);
 }
 
@@ -84,8 +84,8 @@ TEST(Score, ShiftedSpheresMatchBruteForceOverlapAndSurfaceDistances) {
       const Vec3 c = g.centre(11, 11, 11) + Vec3(0.3, 0.1, 0.2);
       const auto truth = ball(g, c, 6), pred = ball(g, c + Vec3(k * spacing.x, 0, 0), 6);
       std::int64_t tp = 0, fp = 0, fn = 0;
-      for (std::size_t i = 0; i < truth.data.size(); ++i) tp += pred.data[i] && truth.data[i], fp += pred.data[i] && !truth.data[i],
-                                                            fn += !pred.data[i] && truth.data[i];
+      for (std::size_t i = 0; i < truth.data.size(); ++i)
+        tp += pred.data[i] && truth.data[i], fp += pred.data[i] && !truth.data[i], fn += !pred.data[i] && truth.data[i];
       const Json o = Json::parse(overlapScores(pred, truth, false).dump());
       EXPECT_DOUBLE_EQ(o["dice"].get<double>(), 2.0 * tp / (2.0 * tp + fp + fn));
       EXPECT_DOUBLE_EQ(o["jaccard"].get<double>(), double(tp) / double(tp + fp + fn));
@@ -105,9 +105,7 @@ TEST(Score, ShiftedSpheresMatchBruteForceOverlapAndSurfaceDistances) {
       EXPECT_NEAR(s["masd_mm"].get<double>(), 0.5 * (sp / double(bp.size()) + st / double(bt.size())), 1e-9);
       EXPECT_NEAR(s["nsd"].get<double>(), within / double(bp.size() + bt.size()), 1e-12);
       // A ball shifted along x: the farthest border voxel lies exactly the shift away.
-      if (spacing.x == 1) {
-        EXPECT_NEAR(s["hd_mm"].get<double>(), k, 1e-9);
-      }
+      if (spacing.x == 1) { EXPECT_NEAR(s["hd_mm"].get<double>(), k, 1e-9); }
     }
   }
 }
@@ -197,7 +195,7 @@ TEST_F(ScoreRun, APredictionMissingTheThinVesselsShowsItInTheCalibreCurve) {
   EXPECT_NEAR(j["overlap"]["recall"].get<double>(), double(kept) / double(kept + dropped), 1e-12);
   const Json& lv = j["vessels"]["by_level"];
   ASSERT_GT(lv.size(), 3u);
-  EXPECT_EQ(lv[0]["detected_rate"], 1.0);  // the root vessel is thick
+  EXPECT_EQ(lv[0]["detected_rate"], 1.0);                       // the root vessel is thick
   EXPECT_LT(j["vessels"]["detected_rate"].get<double>(), 0.5);  // most vessels are thin
   const std::string csv = slurp(dir_ / "scores.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 2) << csv;
@@ -265,7 +263,8 @@ Bp, Bt = band(p), band(t)
 ref.append((Bp & Bt).sum() / (Bp | Bt).sum())
 ours.append(json.load(open('wide.json'))['boundary_iou']['boundary_iou'])
 print('max_difference', max(abs(x - y) for x, y in zip(ref, ours)), 'fp', int(fp), 'biou', b['boundary_iou'], 'jaccard', j['overlap']['jaccard'])
-)", dir_);
+)",
+                                       dir_);
   double diff = 1, biou = 0, jaccard = 0;
   int fp = 0;
   ASSERT_EQ(std::sscanf(out.c_str(), "max_difference %lf fp %d biou %lf jaccard %lf", &diff, &fp, &biou, &jaccard), 4) << out;
@@ -401,7 +400,8 @@ TEST(Score, BettiNumbersOfShapesWithKnownTopology) {
   expect(make([&](const Vec3& p) { return distance(p, c) <= 12 && distance(p, c) >= 8; }), 1, 0, 1, "hollow ball");
   expect(make([&](const Vec3& p) { return torus(p, c, 10, 3); }), 1, 1, 0, "torus");
   expect(make([&](const Vec3& p) {
-           return torus(p, Vec3(12, 20, 20), 6, 2.5) || torus(p, Vec3(28, 20, 20), 6, 2.5) || (std::abs(p.y - 20) <= 1 && std::abs(p.z - 20) <= 1 && p.x >= 16 && p.x <= 24);
+           return torus(p, Vec3(12, 20, 20), 6, 2.5) || torus(p, Vec3(28, 20, 20), 6, 2.5) ||
+                  (std::abs(p.y - 20) <= 1 && std::abs(p.z - 20) <= 1 && p.x >= 16 && p.x <= 24);
          }),
          1, 2, 0, "two tori joined by a bar");
   Volume<std::uint8_t> diagonal(g);
@@ -420,10 +420,13 @@ namespace {
 TEST_F(ScoreRun, SkeletonIsScikitImagesVoxelForVoxel) {
   const std::map<std::string, std::string> params{
       {"cco3d", "seed = 2\n[domain]\nshape = \"sphere\"\nradius = \"6 mm\"\nvoxel_size = \"0.2 mm\"\n[tree]\nmethod = \"cco\"\nterminals = 300\n"},
-      {"disc2d", "seed = 2\n[domain]\nshape = \"disc\"\nradius = \"20 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"cco\"\nterminals = 300\n[physics]\nperfusion_flow = \"2 mL/min\"\n"},
+      {"disc2d",
+       "seed = 2\n[domain]\nshape = \"disc\"\nradius = \"20 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"cco\"\nterminals = "
+       "300\n[physics]\nperfusion_flow = \"2 mL/min\"\n"},
       {"vs", "seed = 3\n[domain]\ndemand_map = '" + (src_ / "demand_maps/vascusynth_rods_100.txt").string() +
                  "'\nsupply_coefficients = [0.65, 0.34, 0.01, 7]\nvoxel_size = \"0.4 mm\"\n[tree]\nterminals = 300\nroot_voxel = [0, 50, 50]\n"
-                 "[physics]\nviscosity = \"3.6 mPa*s\"\nperfusion_pressure = \"13300 Pa\"\nterminal_pressure = \"8300 Pa\"\nperfusion_flow = \"8330 mm3/s\"\n"}};
+                 "[physics]\nviscosity = \"3.6 mPa*s\"\nperfusion_pressure = \"13300 Pa\"\nterminal_pressure = \"8300 Pa\"\nperfusion_flow = \"8330 "
+                 "mm3/s\"\n"}};
   for (const auto& [name, text] : params) {
     std::ofstream(dir_ / (name + ".toml")) << text << "[image]\nformats = [\"nifti\"]\n";
     ASSERT_EQ(run("generate " + name + ".toml --out " + name + " --quiet", dir_).code, 0) << name;
@@ -433,7 +436,8 @@ TEST_F(ScoreRun, SkeletonIsScikitImagesVoxelForVoxel) {
   for (int k = 0; k < 30; ++k)
     for (int j = 0; j < 30; ++j)
       for (int i = 0; i < 30; ++i)
-        tube.at(i, j, k) = (std::hypot(j - 8.3, k - 14.6) <= 4.5 && i >= 4 && i <= 24) || (std::hypot(i - 20.2, k - 14.6) <= 4.5 && j >= 8 && j <= 27);
+        tube.at(i, j, k) =
+            (std::hypot(j - 8.3, k - 14.6) <= 4.5 && i >= 4 && i <= 24) || (std::hypot(i - 20.2, k - 14.6) <= 4.5 && j >= 8 && j <= 27);
   writeNifti(dir_ / "tube.nii.gz", viewOf(tube, true, "tube"));
   for (const std::string mask : {"cco3d/mask.nii.gz", "disc2d/mask.nii.gz", "vs/mask.nii.gz", "tube.nii.gz"}) {
     const NiftiVolume m = readNiftiVolume(dir_ / mask, 1ULL << 32, 4, "mask");
@@ -448,7 +452,8 @@ m = np.asarray(nib.load(')" + mask + R"(').dataobj) > 0
 ref = skeletonize_3d(m.astype(np.uint8)) > 0
 ours = np.asarray(nib.load('ours.nii.gz').dataobj) > 0
 print('mask', int(m.sum()), 'skeleton', int(ref.sum()), 'different', int((ref != ours).sum()))
-)", dir_);
+)",
+                                         dir_);
     long mask_voxels = 0, skeleton = 0, different = -1;
     ASSERT_EQ(std::sscanf(out.c_str(), "mask %ld skeleton %ld different %ld", &mask_voxels, &skeleton, &different), 3) << out;
     EXPECT_EQ(different, 0) << mask << ": " << out;
@@ -475,10 +480,10 @@ TEST(Score, CalibrePlotDrawsEachCurveAtItsRecall) {
   const int pw = 720 - 90 - 110, ph = 440 - 30 - 80;
   const auto px = [&](int bin) { return 90 + int((bin + 0.5) * pw / 4.0); };
   const auto py = [&](double r) { return 30 + int((1 - r) * ph); };
-  EXPECT_EQ(rgb(px(1), py(0.5)), 0xD62728u);   // curve 1 at recall 0.5
+  EXPECT_EQ(rgb(px(1), py(0.5)), 0xD62728u);  // curve 1 at recall 0.5
   EXPECT_EQ(rgb(px(0), py(0.0) - 2), 0xD62728u);
-  EXPECT_EQ(rgb(px(3), py(1.0)), 0x1F77B4u);   // curve 2 (drawn last) at recall 1
-  EXPECT_EQ(rgb(px(3), py(0.6)), 0xFFFFFFu);   // curve 1 has no point in its empty bin (0.6: off the grid lines)
+  EXPECT_EQ(rgb(px(3), py(1.0)), 0x1F77B4u);  // curve 2 (drawn last) at recall 1
+  EXPECT_EQ(rgb(px(3), py(0.6)), 0xFFFFFFu);  // curve 1 has no point in its empty bin (0.6: off the grid lines)
 }
 
 }  // namespace

@@ -38,39 +38,44 @@ Given valueOf(const Setting<Options>& s) {
           const std::string v = s.choices.front() == now ? s.choices.back() : s.choices.front();
           return {"\"" + v + "\"", v};
         } else {
-        using T = std::remove_reference_t<decltype(Options().*member)>;
-        // Entries of a list: increasing, inside the range.
-        const auto entries = [&](std::size_t n, bool lengths) {
-          const double lo = std::max(s.range.lo, 0.0), step = std::min(s.range.hi - lo, 10.0) / double(n + 1);
-          Given g{"[", ""};
-          for (std::size_t k = 0; k < n; ++k) {
-            const std::string v = show(lo + double(k + 1) * step);
-            g.file += (k ? ", " : "") + (lengths ? "\"" + v + " mm\"" : v);
-            g.flag += (k ? "," : "") + v;
+          using T = std::remove_reference_t<decltype(Options().*member)>;
+          // Entries of a list: increasing, inside the range.
+          const auto entries = [&](std::size_t n, bool lengths) {
+            const double lo = std::max(s.range.lo, 0.0), step = std::min(s.range.hi - lo, 10.0) / double(n + 1);
+            Given g{"[", ""};
+            for (std::size_t k = 0; k < n; ++k) {
+              const std::string v = show(lo + double(k + 1) * step);
+              g.file += (k ? ", " : "") + (lengths ? "\"" + v + " mm\"" : v);
+              g.flag += (k ? "," : "") + v;
+            }
+            g.file += "]";
+            return g;
+          };
+          if constexpr (std::is_same_v<T, bool>)
+            return {defaults.*member ? "false" : "true", ""};
+          else if constexpr (std::is_same_v<T, std::optional<bool>>)
+            return {"true", "1"};
+          else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::optional<int>> || std::is_same_v<T, std::int64_t>) {
+            // The top of the range, or its bottom where the top is the default.
+            std::int64_t v = std::int64_t(s.range.hi);
+            if (defaults.*member == v) v = std::int64_t(s.range.lo);
+            return {std::to_string(v), std::to_string(v)};
+          } else if constexpr (std::is_same_v<T, std::string>)
+            return {"\"" + s.choices.back() + "\"", s.choices.back()};
+          else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+            const std::string v = s.choices.empty() ? "clean" : s.choices.back();
+            return {"[\"" + v + "\"]", v};
+          } else if constexpr (std::is_same_v<T, std::vector<double>>)
+            return entries(s.count, s.quantity.has_value());
+          else if constexpr (std::is_same_v<T, std::optional<Vec3>>)
+            return entries(3, s.quantity.has_value());
+          else {
+            // A number inside the range that its extra check (a bound with a hole) takes too.
+            double v = s.range.lo + 0.37 * (std::min(s.range.hi, s.range.lo + 100) - s.range.lo);
+            if (s.problem && !s.problem(v).empty()) v = 0.5 * (90 + s.range.hi);
+            if (s.quantity) return {"\"" + show(v) + " " + internalUnit(*s.quantity) + "\"", show(v)};
+            return {show(v), show(v)};
           }
-          g.file += "]";
-          return g;
-        };
-        if constexpr (std::is_same_v<T, bool>) return {defaults.*member ? "false" : "true", ""};
-        else if constexpr (std::is_same_v<T, std::optional<bool>>) return {"true", "1"};
-        else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::optional<int>> || std::is_same_v<T, std::int64_t>) {
-          // The top of the range, or its bottom where the top is the default.
-          std::int64_t v = std::int64_t(s.range.hi);
-          if (defaults.*member == v) v = std::int64_t(s.range.lo);
-          return {std::to_string(v), std::to_string(v)};
-        } else if constexpr (std::is_same_v<T, std::string>) return {"\"" + s.choices.back() + "\"", s.choices.back()};
-        else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
-          const std::string v = s.choices.empty() ? "clean" : s.choices.back();
-          return {"[\"" + v + "\"]", v};
-        } else if constexpr (std::is_same_v<T, std::vector<double>>) return entries(s.count, s.quantity.has_value());
-        else if constexpr (std::is_same_v<T, std::optional<Vec3>>) return entries(3, s.quantity.has_value());
-        else {
-          // A number inside the range that its extra check (a bound with a hole) takes too.
-          double v = s.range.lo + 0.37 * (std::min(s.range.hi, s.range.lo + 100) - s.range.lo);
-          if (s.problem && !s.problem(v).empty()) v = 0.5 * (90 + s.range.hi);
-          if (s.quantity) return {"\"" + show(v) + " " + internalUnit(*s.quantity) + "\"", show(v)};
-          return {show(v), show(v)};
-        }
         }
       },
       s.field);
@@ -80,8 +85,10 @@ template <class Options>
 bool sameField(const Setting<Options>& s, const Options& a, const Options& b) {
   return std::visit(
       [&](auto member) {
-        if constexpr (detail::isChoiceField<decltype(member)>) return member.get(a) == member.get(b);
-        else return a.*member == b.*member;
+        if constexpr (detail::isChoiceField<decltype(member)>)
+          return member.get(a) == member.get(b);
+        else
+          return a.*member == b.*member;
       },
       s.field);
 }
@@ -98,7 +105,8 @@ class Settings : public ::testing::Test {
   Scenario scenarioWith(const std::string& table, const std::string& lines) {
     std::ofstream(dir_ / "p.toml") << "[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"cco\"\n"
                                       "terminals = 2\n[physics]\nperfusion_flow = \"1 mL/min\"\n["
-                                   << table << "]\n" << lines;
+                                   << table << "]\n"
+                                   << lines;
     return readTomlParameters(dir_ / "p.toml");
   }
   MeshParameters fromFile(const std::string& lines) { return scenarioWith("mesh", lines).mesh; }
@@ -163,10 +171,14 @@ TEST_F(Settings, EveryMeshKeyAndItsFlagFillTheSameField) {
 // flags (--no-image, --format, --gxl-dialect) fill the same ones over a file's values.
 TEST_F(Settings, EverySampleKeyAndItsFlagFillTheSameField) {
   const auto none = [](const auto&) { return std::string(); };
-  int compared = compareFileAndFlags(imageSettings(), [](const Scenario& sc) { return sc.image; }, none);
-  compareFileAndFlags(labelSettings(), [](const Scenario& sc) { return sc.image.labels; }, none);
-  compareFileAndFlags(curveSettings(), [](const Scenario& sc) { return sc.curves; }, none);
-  compared += compareFileAndFlags(outputSettings(), [](const Scenario& sc) { return sc; }, none);
+  int compared = compareFileAndFlags(
+      imageSettings(), [](const Scenario& sc) { return sc.image; }, none);
+  compareFileAndFlags(
+      labelSettings(), [](const Scenario& sc) { return sc.image.labels; }, none);
+  compareFileAndFlags(
+      curveSettings(), [](const Scenario& sc) { return sc.curves; }, none);
+  compared += compareFileAndFlags(
+      outputSettings(), [](const Scenario& sc) { return sc; }, none);
   EXPECT_EQ(compared, 3);
 }
 
@@ -175,7 +187,8 @@ TEST_F(Settings, EverySampleKeyAndItsFlagFillTheSameField) {
 TEST_F(Settings, EveryCcoKeyFillsItsFieldAndTheSidecar) {
   const auto read = [&](const std::string& tree, const std::string& physics) {
     std::ofstream(dir_ / "p.toml") << "[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.1 mm\"\n[tree]\nmethod = \"cco\"\n"
-                                   << tree << "[physics]\n" << physics;
+                                   << tree << "[physics]\n"
+                                   << physics;
     return readTomlParameters(dir_ / "p.toml");
   };
   const auto cco = [](const Scenario& sc) { return dynamic_cast<const CcoSetup&>(*sc.growth).cco; };

@@ -46,8 +46,7 @@ inline VascularTree grow(const Example& e, GrowthReport* report = nullptr) {
 // Murray's law, flow conservation, equal terminal flows and pressures, and Poiseuille drops on
 // both sides of every bifurcation, each to 1e-9 relative; root flow (terminals × q_term, by
 // default Q_perf) at P_perf. A draining tree (a vein) gains pressure towards its terminals.
-inline void expectHemodynamicInvariants(const VascularTree& t, const PhysicsParameters& p, std::int64_t terminals,
-                                        double q_term = 0) {
+inline void expectHemodynamicInvariants(const VascularTree& t, const PhysicsParameters& p, std::int64_t terminals, double q_term = 0) {
   ASSERT_EQ(t.terminalCount(), terminals);
   ASSERT_EQ(t.nodeCount(), 2 * terminals);
   if (q_term == 0) q_term = p.perfusion_flow / double(terminals);

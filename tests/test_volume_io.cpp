@@ -123,7 +123,8 @@ TEST(GraphFiles, GraphmlLoadsInNetworkxAndMatchesTheTree) {
   }();
   const std::string out = python(R"(
 import networkx as nx
-g = nx.read_graphml(')" + file.string() + R"(')
+g = nx.read_graphml(')" + file.string() +
+                                 R"(')
 print('graph', g.number_of_nodes(), g.number_of_edges(), nx.is_tree(g.to_undirected()))
 print('root', g.nodes['n0']['type'], repr(g.edges['n0', list(g.successors('n0'))[0]]['radius']))
 )");

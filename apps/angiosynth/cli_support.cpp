@@ -13,8 +13,7 @@
 namespace angiosynth::cli {
 
 void addCommonOptions(CLI::App& cmd, CommonOptions& o) {
-  cmd.add_option("--threads", o.threads, "worker threads (0 = all cores); outputs do not depend on it")
-      ->check(CLI::Range(0, 1024));
+  cmd.add_option("--threads", o.threads, "worker threads (0 = all cores); outputs do not depend on it")->check(CLI::Range(0, 1024));
   cmd.add_option("--memory-limit", o.memory_limit_gib, "refuse maps needing more than this many GiB (default: 75% of RAM)")
       ->check(finiteIn(0.0, 1e6));
   cmd.add_option("--vascusynth-unit", o.vascusynth_unit,
@@ -30,14 +29,13 @@ std::shared_ptr<void> limitThreads(int threads) {
 }
 
 std::uint64_t memoryLimit(const CommonOptions& o) {
-  return o.memory_limit_gib > 0 ? static_cast<std::uint64_t>(o.memory_limit_gib * double(1ULL << 30))
-                                : defaultMemoryLimitBytes();
+  return o.memory_limit_gib > 0 ? static_cast<std::uint64_t>(o.memory_limit_gib * double(1ULL << 30)) : defaultMemoryLimitBytes();
 }
 
 std::uint64_t freshSeed() {
   std::random_device rd;
-  const std::uint64_t s = (std::uint64_t(rd()) << 32) ^ rd() ^
-                          static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
+  const std::uint64_t s =
+      (std::uint64_t(rd()) << 32) ^ rd() ^ static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
   return s & ((1ULL << 53) - 1);  // exact in JSON readers that use doubles
 }
 
@@ -46,8 +44,8 @@ ProgressFn progressPrinter(const CommonOptions& o, const std::string& label) {
   const auto start = std::chrono::steady_clock::now();
   return [label, start](std::int64_t done, std::int64_t total) {
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::fprintf(stderr, "\r%s: %lld / %lld terminals (%.1f s)%s", label.c_str(), static_cast<long long>(done),
-                 static_cast<long long>(total), s, done >= total ? "\n" : "");
+    std::fprintf(stderr, "\r%s: %lld / %lld terminals (%.1f s)%s", label.c_str(), static_cast<long long>(done), static_cast<long long>(total), s,
+                 done >= total ? "\n" : "");
     std::fflush(stderr);
   };
 }
@@ -59,9 +57,7 @@ CLI::Validator finiteIn(double lo, double hi) {
         std::size_t used = 0;
         try {
           v = std::stod(text, &used);
-        } catch (const std::exception&) {
-          used = 0;
-        }
+        } catch (const std::exception&) { used = 0; }
         if (used != text.size() || !std::isfinite(v) || v < lo || v > hi)
           return "'" + text + "' is not a finite number in [" + CLI::detail::to_string(lo) + ", " + CLI::detail::to_string(hi) + "]";
         return {};

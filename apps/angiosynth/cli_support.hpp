@@ -12,8 +12,8 @@
 namespace angiosynth::cli {
 
 struct CommonOptions {
-  int threads = 0;                 // 0: all cores
-  double memory_limit_gib = 0;     // 0: 75 % of physical memory
+  int threads = 0;              // 0: all cores
+  double memory_limit_gib = 0;  // 0: 75 % of physical memory
   bool quiet = false;
   std::string vascusynth_unit = "cm";
 };
@@ -29,6 +29,5 @@ ProgressFn progressPrinter(const CommonOptions& o, const std::string& label);
 std::string commandLine(int argc, char** argv);
 // Command-line numbers: finite and within [lo, hi] (CLI11's Range lets NaN through).
 CLI::Validator finiteIn(double lo, double hi);
-
 
 }  // namespace angiosynth::cli

@@ -19,8 +19,7 @@ std::int64_t parseIndex(const std::string& text, const std::string& what) {
   long long v = -1;
   try {
     v = std::stoll(text, &used);
-  } catch (const std::exception&) {
-  }
+  } catch (const std::exception&) {}
   if (text.empty() || used != text.size() || v < 0)
     throw InputError("", 0, what + ": '" + text + "' is not a whole number in 0…" + std::to_string(LLONG_MAX));
   return v;
@@ -41,8 +40,9 @@ DatasetSelection selection(const DatasetArgs& a, std::int64_t samples) {
   if (!a.index.empty()) {
     s.begin = a.index == "auto" ? indexFromEnvironment("--index") : parseIndex(a.index, "--index");
     if (s.begin >= samples)
-      throw InputError("", 0, "--index " + std::to_string(s.begin) + " is beyond the dataset's " + std::to_string(samples) +
-                                  " samples; allowed: 0…" + std::to_string(samples - 1));
+      throw InputError("", 0,
+                       "--index " + std::to_string(s.begin) + " is beyond the dataset's " + std::to_string(samples) + " samples; allowed: 0…" +
+                           std::to_string(samples - 1));
     s.end = s.begin + 1;
     s.part = "index-" + std::to_string(s.begin);
   } else if (!a.range.empty()) {
@@ -61,15 +61,19 @@ DatasetSelection selection(const DatasetArgs& a, std::int64_t samples) {
     if (s.shards < 1 || s.shard >= s.shards) throw InputError("", 0, "--shard K/M needs 0 <= K < M");
     s.part = "shard-" + std::to_string(s.shard) + "-of-" + std::to_string(s.shards);
   }
-  if (s.begin >= samples) throw InputError("", 0, "index " + std::to_string(s.begin) + " is beyond the dataset's " + std::to_string(samples) + " samples");
+  if (s.begin >= samples)
+    throw InputError("", 0, "index " + std::to_string(s.begin) + " is beyond the dataset's " + std::to_string(samples) + " samples");
   return s;
 }
 
 std::string duration(double s) {
   char buf[32];
-  if (s < 60) std::snprintf(buf, sizeof buf, "%.0fs", s);
-  else if (s < 3600) std::snprintf(buf, sizeof buf, "%dm%02ds", int(s) / 60, int(s) % 60);
-  else std::snprintf(buf, sizeof buf, "%dh%02dm", int(s) / 3600, int(s) / 60 % 60);
+  if (s < 60)
+    std::snprintf(buf, sizeof buf, "%.0fs", s);
+  else if (s < 3600)
+    std::snprintf(buf, sizeof buf, "%dm%02ds", int(s) / 60, int(s) % 60);
+  else
+    std::snprintf(buf, sizeof buf, "%dh%02dm", int(s) / 3600, int(s) / 60 % 60);
   return buf;
 }
 
@@ -139,8 +143,8 @@ int runDatasetCommand(const DatasetArgs& a, const std::string& command_line) {
     failures += e["status"] != "ok";
     if (a.common.quiet) return;
     if (!terminal) {  // one JSON line per sample for logs
-      nlohmann::json line{{"id", e["id"]}, {"index", e["index"]}, {"status", e["status"]}, {"seconds", e["seconds"]},
-                          {"done", done}, {"total", total}};
+      nlohmann::json line{{"id", e["id"]},           {"index", e["index"]}, {"status", e["status"]},
+                          {"seconds", e["seconds"]}, {"done", done},        {"total", total}};
       if (e.contains("error")) line["error"] = e["error"];
       std::cout << line.dump() << std::endl;
       return;
@@ -150,16 +154,14 @@ int runDatasetCommand(const DatasetArgs& a, const std::string& command_line) {
     const int width = 30, filled = static_cast<int>(width * done / std::max<std::int64_t>(total, 1));
     std::fprintf(stderr, "\r[%s%s] %lld/%lld  %.2f samples/s  ETA %s%s   ", std::string(filled, '#').c_str(),
                  std::string(width - filled, '.').c_str(), static_cast<long long>(done), static_cast<long long>(total), rate,
-                 duration((total - done) / std::max(rate, 1e-9)).c_str(),
-                 failures ? (" (" + std::to_string(failures) + " failed)").c_str() : "");
+                 duration((total - done) / std::max(rate, 1e-9)).c_str(), failures ? (" (" + std::to_string(failures) + " failed)").c_str() : "");
     if (done == total) std::fprintf(stderr, "\n");
     std::fflush(stderr);
   };
   const DatasetRunReport r = runDataset(spec, a.out, sel, opt);
   if (!a.common.quiet)
-    std::cerr << r.dir.string() << ": " << r.generated << " generated, " << r.skipped << " skipped (verified), " << r.failed
-              << " failed (" << r.in_flight << " at a time), "
-              << duration(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()) << "\n";
+    std::cerr << r.dir.string() << ": " << r.generated << " generated, " << r.skipped << " skipped (verified), " << r.failed << " failed ("
+              << r.in_flight << " at a time), " << duration(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()) << "\n";
   int code = r.failed ? 1 : 0;
   if (sel.part == "all") {
     const DatasetCheck c = finalizeDataset(r.dir);

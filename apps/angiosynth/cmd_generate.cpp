@@ -34,8 +34,8 @@ int runGenerate(const GenerateArgs& a, const std::string& command_line) {
   Scenario sc = readParameters(a.params, ro);
   a.image.applyTo(sc.image);
   a.output.applyTo(sc);
-  const std::filesystem::path out = a.out.empty() ? std::filesystem::path("out") / std::filesystem::path(a.params).stem()
-                                                  : std::filesystem::path(a.out);
+  const std::filesystem::path out =
+      a.out.empty() ? std::filesystem::path("out") / std::filesystem::path(a.params).stem() : std::filesystem::path(a.out);
   std::vector<std::filesystem::path> inputs = scenarioInputs(sc);
   for (const auto& p : a.profiles) inputs.push_back(p);
   StagedDirectory dir(out, a.force ? ExistingOutput::ReplaceOwn : ExistingOutput::Refuse, inputs);
@@ -55,9 +55,8 @@ int runGenerate(const GenerateArgs& a, const std::string& command_line) {
   const SampleSummary made = generateSample(req, dir.path());
   dir.commit();
   if (!a.common.quiet)
-    std::cerr << "wrote " << dir.target().string() << ": " << made.terminals << " terminals, total volume " << made.total_volume_mm3
-              << " mm^3, " << made.intersecting_pairs << " intersecting pairs, seed " << req.seed << ", " << made.grow_seconds
-              << " s growth\n";
+    std::cerr << "wrote " << dir.target().string() << ": " << made.terminals << " terminals, total volume " << made.total_volume_mm3 << " mm^3, "
+              << made.intersecting_pairs << " intersecting pairs, seed " << req.seed << ", " << made.grow_seconds << " s growth\n";
   return 0;
 }
 

@@ -30,8 +30,9 @@ void writeNew(const std::filesystem::path& file, const std::string& text) {
 }  // namespace
 
 CLI::App* addParams(CLI::App& app, ParamsArgs& a) {
-  auto* c = app.add_subcommand("params", "print every key of a parameter file with its unit, default and meaning "
-                                         "(the common keys and METHOD's, or every method's)");
+  auto* c = app.add_subcommand("params",
+                               "print every key of a parameter file with its unit, default and meaning "
+                               "(the common keys and METHOD's, or every method's)");
   c->add_option("METHOD", a.method, "a growth method (see `angiosynth methods`)");
   return c;
 }
@@ -42,8 +43,9 @@ int runParams(const ParamsArgs& a) {
 }
 
 CLI::App* addInit(CLI::App& app, InitArgs& a) {
-  auto* c = app.add_subcommand("init", "write a commented parameter file that runs as it is: a shipped example of METHOD "
-                                       "(default cco) and every other key at its default; never replaces a file");
+  auto* c = app.add_subcommand("init",
+                               "write a commented parameter file that runs as it is: a shipped example of METHOD "
+                               "(default cco) and every other key at its default; never replaces a file");
   c->add_option("ARGS", a.args, "[METHOD] FILE")->expected(1, 2)->required();
   return c;
 }
@@ -61,8 +63,8 @@ int runInit(const InitArgs& a) {
     throw InputError(data_path.string(), 0, "exists; init writes new files only (choose another name)");
   writeNew(file, text);
   if (!data_file.empty()) writeNew(data_path, data);
-  std::cerr << "wrote " << file.string() << (data_file.empty() ? "" : " and " + data_path.string()) << "; run: angiosynth generate "
-            << file.string() << "\n";
+  std::cerr << "wrote " << file.string() << (data_file.empty() ? "" : " and " + data_path.string()) << "; run: angiosynth generate " << file.string()
+            << "\n";
   return 0;
 }
 

@@ -22,8 +22,9 @@ namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
 CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
-  auto* c = app.add_subcommand("mesh", "the outer surface of a tree as a closed triangle mesh per tree (STL, OBJ, PLY, OFF, VTP), "
-                                       "from a sample directory angiosynth generate wrote or a graph file");
+  auto* c = app.add_subcommand("mesh",
+                               "the outer surface of a tree as a closed triangle mesh per tree (STL, OBJ, PLY, OFF, VTP), "
+                               "from a sample directory angiosynth generate wrote or a graph file");
   c->add_option("INPUT", a.input, "a sample directory (its nodes.csv and edges.csv are read) or a graph file: .csv, .gxl, .vtp, .swc, .cco")
       ->required();
   c->add_option("--out", a.out, "output directory (default: <INPUT>_mesh next to the input)");
@@ -39,7 +40,8 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   const fs::path in(a.input);
   if (!fs::exists(in)) throw InputError(a.input, 0, "no such sample directory or graph file");
   const fs::path graph = fs::is_directory(in) ? in / "edges.csv" : in;
-  if (!fs::exists(graph)) throw InputError(graph.string(), 0, "no such file: a sample directory holds the nodes.csv and edges.csv angiosynth generate writes");
+  if (!fs::exists(graph))
+    throw InputError(graph.string(), 0, "no such file: a sample directory holds the nodes.csv and edges.csv angiosynth generate writes");
   const auto net = readNetwork(graph, 1, memoryLimit(a.common));
   refuseLargeJunctions(net, graph.string(), "mesh takes");
   // By default beside the input, named after it: never inside it, whatever the path ends with
@@ -63,9 +65,9 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   std::ofstream(dir.path() / "mesh.json") << j.dump(2) << '\n';
   dir.commit();
   if (!a.common.quiet)
-    std::cerr << "wrote " << dir.target().string() << ": " << surface.statistics.triangles << " triangles (" << surface.statistics.trees
-              << " trees, " << surface.statistics.segments << " segments, finest step " << surface.statistics.finest_step_mm
-              << " mm), enclosed volume " << surface.statistics.topology.volume_mm3 << " mm^3\n";
+    std::cerr << "wrote " << dir.target().string() << ": " << surface.statistics.triangles << " triangles (" << surface.statistics.trees << " trees, "
+              << surface.statistics.segments << " segments, finest step " << surface.statistics.finest_step_mm << " mm), enclosed volume "
+              << surface.statistics.topology.volume_mm3 << " mm^3\n";
   return 0;
 }
 

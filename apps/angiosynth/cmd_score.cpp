@@ -34,8 +34,9 @@ void writePngAtomically(const fs::path& file, const Image8& image) {
 }  // namespace
 
 CLI::App* addScore(CLI::App& app, ScoreArgs& a) {
-  auto* c = app.add_subcommand("score", "score a segmentation (NIfTI, voxels > 0 = vessel) against a generated sample's exact truth: "
-                                        "overlap, surface distances, recall by calibre, vessels detected");
+  auto* c = app.add_subcommand("score",
+                               "score a segmentation (NIfTI, voxels > 0 = vessel) against a generated sample's exact truth: "
+                               "overlap, surface distances, recall by calibre, vessels detected");
   c->add_option("PRED", a.prediction, "the prediction (.nii or .nii.gz on the sample's grid)");
   c->add_option("SAMPLE_DIR", a.sample, "the sample directory angiosynth generate wrote");
   c->add_option("--dataset", a.dataset, "a dataset angiosynth made (DatasetNNN_Name): score every case, with --predictions");
@@ -77,8 +78,10 @@ int runScore(const ScoreArgs& a) {
     j = scores.toJson();
     csv = scoreCsvHeader() + scoreCsvRow(a.prediction, scores);
   }
-  if (a.out.empty()) std::cout << j.dump(2) << "\n";
-  else writeFileAtomically(a.out, j.dump(2) + "\n");
+  if (a.out.empty())
+    std::cout << j.dump(2) << "\n";
+  else
+    writeFileAtomically(a.out, j.dump(2) + "\n");
   if (!a.csv.empty()) writeFileAtomically(a.csv, csv);
   if (!a.plot.empty()) writePngAtomically(a.plot, plotCalibreCurves({calibreCurve(j, "")}));
   if (!a.common.quiet) {
@@ -98,8 +101,9 @@ int runScore(const ScoreArgs& a) {
 }
 
 CLI::App* addPlotCalibre(CLI::App& app, PlotCalibreArgs& a) {
-  auto* c = app.add_subcommand("plot-calibre", "draw the calibre curves of score results (JSON of `angiosynth score`, one case or a "
-                                               "dataset's mean) as one PNG: curve k in colour k, numbered in the legend");
+  auto* c = app.add_subcommand("plot-calibre",
+                               "draw the calibre curves of score results (JSON of `angiosynth score`, one case or a "
+                               "dataset's mean) as one PNG: curve k in colour k, numbered in the legend");
   c->add_option("OUT", a.out, "the PNG to write")->required();
   c->add_option("SCORES", a.scores, "score results (.json)")->required()->expected(1, 8);
   c->add_flag("--force", a.force, "replace an existing OUT");

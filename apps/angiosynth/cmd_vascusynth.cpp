@@ -13,16 +13,17 @@
 namespace angiosynth::cli {
 
 CLI::App* addVascuSynth(CLI::App& app, VascuSynthArgs& a) {
-  auto* c = app.add_subcommand("vascusynth", "run like VascuSynth: one tree per line of PARAM_LIST into the directory "
-                                             "named on the same line of NAME_LIST");
+  auto* c = app.add_subcommand("vascusynth",
+                               "run like VascuSynth: one tree per line of PARAM_LIST into the directory "
+                               "named on the same line of NAME_LIST");
   c->add_option("PARAM_LIST", a.param_list, "file listing one parameter file per line")->required();
   c->add_option("NAME_LIST", a.name_list, "file listing one output directory per line")->required();
-  c->add_option("VOXEL_WIDTH", a.output_voxel_width, "output image voxel width, in VOXEL_WIDTH's unit")
-      ->required()
-      ->check(finiteIn(1e-12, 1e12));
-  c->add_option("NOISE_FILE", a.noise_files, "VascuSynth noise files (GAUSSIAN:, UNIFORM:, SALTPEPPER:, SHADOW: lines); the i-th (from 0) gives NAME/noise_image_<i>/");
-  c->add_option("--slices", a.slices, "slice images: jpg (8-bit JPEG, what VascuSynth writes; lossy) or png (lossless); "
-                                      "the exact image is image.nii.gz beside them")
+  c->add_option("VOXEL_WIDTH", a.output_voxel_width, "output image voxel width, in VOXEL_WIDTH's unit")->required()->check(finiteIn(1e-12, 1e12));
+  c->add_option("NOISE_FILE", a.noise_files,
+                "VascuSynth noise files (GAUSSIAN:, UNIFORM:, SALTPEPPER:, SHADOW: lines); the i-th (from 0) gives NAME/noise_image_<i>/");
+  c->add_option("--slices", a.slices,
+                "slice images: jpg (8-bit JPEG, what VascuSynth writes; lossy) or png (lossless); "
+                "the exact image is image.nii.gz beside them")
       ->check(CLI::IsMember({"jpg", "png"}));
   addCommonOptions(*c, a.common);
   return c;
@@ -34,8 +35,8 @@ int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line) {
   const auto names = readTextLines(a.name_list, "name list");
   if (params.size() != names.size())
     throw InputError(a.name_list, names.empty() ? 0 : names.back().number,
-                     std::to_string(names.size()) + " names for " + std::to_string(params.size()) +
-                         " parameter files in " + a.param_list + "; give one name per parameter file");
+                     std::to_string(names.size()) + " names for " + std::to_string(params.size()) + " parameter files in " + a.param_list +
+                         "; give one name per parameter file");
   if (params.empty()) throw InputError(a.param_list, 0, "lists no parameter file");
   // Noise files are read (and every line checked) before anything is grown or written.
   std::vector<Profile> noise;
@@ -71,8 +72,7 @@ int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line) {
     req.progress = progressPrinter(a.common, names[i].text);
     req.profiles = noise;
     req.vascusynth = VascuSynthLayout{a.output_voxel_width * sc.input_units.mm_per_length, a.slices};
-    checkRange(req.vascusynth->voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, Where{"VOXEL_WIDTH", 0},
-               "VOXEL_WIDTH (mm)");
+    checkRange(req.vascusynth->voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, Where{"VOXEL_WIDTH", 0}, "VOXEL_WIDTH (mm)");
     req.extra["output_voxel_width"] = {{"value", a.output_voxel_width * sc.input_units.mm_per_length}, {"unit", "mm"}};
     generateSample(req, dir.path());
     dir.commit();

@@ -35,8 +35,10 @@ void line(std::ostream& o, const MethodParam& p) {
   o << p.key;
   if (*p.unit) o << " (" << p.unit << ")";
   o << ": " << p.meaning << "; ";
-  if (p.fallback) o << "default " << p.fallback << '\n';
-  else o << "required\n";
+  if (p.fallback)
+    o << "default " << p.fallback << '\n';
+  else
+    o << "required\n";
 }
 
 }  // namespace

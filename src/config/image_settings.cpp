@@ -14,6 +14,7 @@ std::string connectivityProblem(double n) {
 
 }  // namespace
 
+// clang-format off
 const std::vector<Setting<ImageParameters>>& imageSettings() {
   using P = ImageParameters;
   static const std::string volume_formats = "any of " + volumeFormatSummary();
@@ -47,7 +48,9 @@ const std::vector<Setting<ImageParameters>>& imageSettings() {
   };
   return settings;
 }
+// clang-format on
 
+// clang-format off
 const std::vector<Setting<LabelPolicy>>& labelSettings() {
   using P = LabelPolicy;
   static const std::vector<Setting<P>> settings{
@@ -66,7 +69,9 @@ const std::vector<Setting<LabelPolicy>>& labelSettings() {
   };
   return settings;
 }
+// clang-format on
 
+// clang-format off
 const std::vector<SettingRule<LabelPolicy>>& labelRules() {
   static const std::vector<SettingRule<LabelPolicy>> rules{
       {{"ignore_band"}, [](const LabelPolicy& p) -> std::string {
@@ -77,5 +82,6 @@ const std::vector<SettingRule<LabelPolicy>>& labelRules() {
   };
   return rules;
 }
+// clang-format on
 
 }  // namespace angiosynth

@@ -15,15 +15,15 @@ namespace angiosynth {
 // Defaults suit 8-bit images of the domain.
 struct ImageParameters {
   bool enabled = true;
-  std::optional<double> voxel_mm;          // unset: the domain's voxel
-  std::optional<Vec3> field_of_view_mm;    // unset: the domain's extent
-  int supersampling = 4;                   // S: S³ samples per partially covered voxel
-  int centerline_connectivity = 26;        // of the centreline channel: 26 or 6
-  double background = 0, vessel = 255;     // image = background + (vessel − background) × fraction
-  std::string dtype = "uint8";             // uint8, uint16, int16, float32
+  std::optional<double> voxel_mm;                                          // unset: the domain's voxel
+  std::optional<Vec3> field_of_view_mm;                                    // unset: the domain's extent
+  int supersampling = 4;                                                   // S: S³ samples per partially covered voxel
+  int centerline_connectivity = 26;                                        // of the centreline channel: 26 or 6
+  double background = 0, vessel = 255;                                     // image = background + (vessel − background) × fraction
+  std::string dtype = "uint8";                                             // uint8, uint16, int16, float32
   std::vector<std::string> formats{"nifti", "png"};                        // names of io/volume_formats.hpp
   std::vector<std::string> graph_formats{"csv", "vtp", "swc", "graphml"};  // names of io/graph_formats.hpp; GXL and DOT always
-  LabelPolicy labels;                      // the training label (label.nii.gz) beside the mask
+  LabelPolicy labels;                                                      // the training label (label.nii.gz) beside the mask
 };
 
 // Every [image] setting but the label's, in the order of the reference.

@@ -10,6 +10,7 @@ std::string maxAngleProblem(double degrees) {
   return "max_angle = " + show(degrees) + " degrees is out of range; allowed: 0 (none) or [90, 180)";
 }
 
+// clang-format off
 const std::vector<Setting<MeshParameters>>& meshSettings() {
   static const std::string formats_meaning = "any of " + meshFormatSummary() + ": surface.<format> each";
   static const char* const kFormatsMeaning = formats_meaning.c_str();
@@ -91,7 +92,9 @@ const std::vector<Setting<MeshParameters>>& meshSettings() {
   };
   return settings;
 }
+// clang-format on
 
+// clang-format off
 const std::vector<SettingRule<MeshParameters>>& meshRules() {
   using P = MeshParameters;
   static const std::vector<SettingRule<P>> rules{
@@ -129,5 +132,6 @@ const std::vector<SettingRule<MeshParameters>>& meshRules() {
   };
   return rules;
 }
+// clang-format on
 
 }  // namespace angiosynth

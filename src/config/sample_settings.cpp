@@ -4,6 +4,7 @@
 
 namespace angiosynth {
 
+// clang-format off
 const std::vector<Setting<CurveOptions>>& curveSettings() {
   using P = CurveOptions;
   static const std::vector<Setting<P>> settings{
@@ -27,7 +28,9 @@ const std::vector<Setting<CurveOptions>>& curveSettings() {
   };
   return settings;
 }
+// clang-format on
 
+// clang-format off
 const std::vector<SettingRule<CurveOptions>>& curveRules() {
   static const std::vector<SettingRule<CurveOptions>> rules{
       {{"wavelength_radii", "wavelength"}, [](const CurveOptions& o) {
@@ -38,7 +41,9 @@ const std::vector<SettingRule<CurveOptions>>& curveRules() {
   };
   return rules;
 }
+// clang-format on
 
+// clang-format off
 const std::vector<Setting<Scenario>>& outputSettings() {
   static const std::vector<Setting<Scenario>> settings{
       {.table = "degrade", .key = "profiles", .unit = "[text]", .fallback = "[]",
@@ -49,5 +54,6 @@ const std::vector<Setting<Scenario>>& outputSettings() {
   };
   return settings;
 }
+// clang-format on
 
 }  // namespace angiosynth

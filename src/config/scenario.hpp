@@ -28,24 +28,24 @@ namespace angiosynth {
 
 struct Scenario {
   std::string parameter_file;
-  std::string format;  // "vascusynth" or "toml"
-  std::shared_ptr<const GrowthSetup> growth;   // the growth method and its options
+  std::string format;                         // "vascusynth" or "toml"
+  std::shared_ptr<const GrowthSetup> growth;  // the growth method and its options
   std::optional<std::uint64_t> seed;
-  CurveOptions curves;                         // [curves]: vessels made curves after growth
+  CurveOptions curves;  // [curves]: vessels made curves after growth
   int curves_line = 0;
   ImageParameters image;
-  int image_line = 0;                          // line of [image], for errors about its size
+  int image_line = 0;  // line of [image], for errors about its size
   MeshParameters mesh;
   int mesh_line = 0;
-  std::string gxl_dialect = "gxl";             // "gxl" (GXL 1.0) or "vascusynth"
-  std::vector<std::string> profiles;           // [degrade] profiles: names or files
+  std::string gxl_dialect = "gxl";    // "gxl" (GXL 1.0) or "vascusynth"
+  std::vector<std::string> profiles;  // [degrade] profiles: names or files
   int profiles_line = 0;
-  CoherentUnits input_units;                   // only for VascuSynth files
+  CoherentUnits input_units;  // only for VascuSynth files
   std::string units_note;
 };
 
 struct ReadOptions {
-  std::string vascusynth_length_unit = "cm";   // unit of VOXEL_WIDTH in VascuSynth files
+  std::string vascusynth_length_unit = "cm";  // unit of VOXEL_WIDTH in VascuSynth files
 };
 
 // Reads a VascuSynth parameter file (2008 or 2011 keys).

@@ -44,9 +44,7 @@ std::set<std::string> keysOfAll(const Lists&... lists) {
 
 }  // namespace
 
-Scenario readTomlParameters(const std::filesystem::path& path) {
-  return readTomlParameters(parseTomlFile(path, "parameter file"), path);
-}
+Scenario readTomlParameters(const std::filesystem::path& path) { return readTomlParameters(parseTomlFile(path, "parameter file"), path); }
 
 Scenario readTomlParameters(const toml::table& root, const std::filesystem::path& path) {
   const std::string file = path.string();
@@ -55,8 +53,7 @@ Scenario readTomlParameters(const toml::table& root, const std::filesystem::path
   sc.parameter_file = file;
   sc.format = "toml";
   if (const auto* s = root.get("seed")) {
-    if (!s->is_integer() || *s->value<std::int64_t>() < 0)
-      throw InputError(file, r.lineOf(s), "seed must be a whole number >= 0");
+    if (!s->is_integer() || *s->value<std::int64_t>() < 0) throw InputError(file, r.lineOf(s), "seed must be a whole number >= 0");
     sc.seed = static_cast<std::uint64_t>(*s->value<std::int64_t>());
   }
 

@@ -14,10 +14,9 @@
 namespace angiosynth {
 namespace {
 
-const std::vector<std::string> kKeys{"SUPPLY_MAP",    "OXYGENATION_MAP", "RANDOM_SEED", "PERF_POINT",
-                                     "PERF_PRESSURE", "TERM_PRESSURE",   "PERF_FLOW",   "RHO",
-                                     "GAMMA",         "LAMBDA",          "MU",          "MIN_DISTANCE",
-                                     "NUM_NODES",     "VOXEL_WIDTH",     "CLOSEST_NEIGHBOURS"};
+const std::vector<std::string> kKeys{
+    "SUPPLY_MAP", "OXYGENATION_MAP", "RANDOM_SEED", "PERF_POINT",   "PERF_PRESSURE", "TERM_PRESSURE", "PERF_FLOW",         "RHO",
+    "GAMMA",      "LAMBDA",          "MU",          "MIN_DISTANCE", "NUM_NODES",     "VOXEL_WIDTH",   "CLOSEST_NEIGHBOURS"};
 
 std::string canonical(const std::string& key) {
   if (key == "ROW") return "RHO";
@@ -42,16 +41,14 @@ Scenario readVascuSynthParameters(const std::filesystem::path& path, const ReadO
   std::map<std::string, Entry> entries;
   for (const auto& [line, text] : readTextLines(path, "parameter")) {
     const auto colon = text.find(':');
-    if (colon == std::string::npos)
-      throw InputError(file, line, "expected 'KEY: value', got '" + text + "'; keys: " + joined(kKeys));
+    if (colon == std::string::npos) throw InputError(file, line, "expected 'KEY: value', got '" + text + "'; keys: " + joined(kKeys));
     const std::string key = canonical(trimmed(text.substr(0, colon)));
     const std::string value = trimmed(text.substr(colon + 1));
     if (std::find(kKeys.begin(), kKeys.end(), key) == kKeys.end())
-      throw InputError(file, line, "unknown key '" + trimmed(text.substr(0, colon)) + "'; allowed: " + joined(kKeys) +
-                                       " (ROW and MEW are read as RHO and MU)");
+      throw InputError(file, line,
+                       "unknown key '" + trimmed(text.substr(0, colon)) + "'; allowed: " + joined(kKeys) + " (ROW and MEW are read as RHO and MU)");
     if (const auto it = entries.find(key); it != entries.end())
-      throw InputError(file, line, key + " is given twice (first on line " + std::to_string(it->second.line) +
-                                       "); give each key once");
+      throw InputError(file, line, key + " is given twice (first on line " + std::to_string(it->second.line) + "); give each key once");
     if (value.empty()) throw InputError(file, line, key + " has no value");
     entries[key] = {value, line};
   }
@@ -79,9 +76,7 @@ Scenario readVascuSynthParameters(const std::filesystem::path& path, const ReadO
   try {
     u.length = opt.vascusynth_length_unit;
     u.mm_per_length = lengthUnitInMm(u.length);
-  } catch (const std::invalid_argument& e) {
-    throw InputError("--vascusynth-unit", 0, e.what());
-  }
+  } catch (const std::invalid_argument& e) { throw InputError("--vascusynth-unit", 0, e.what()); }
 
   const double voxel = number("VOXEL_WIDTH");
   checkRange(voxel, Limits::kMinVoxel / u.mm_per_length, false, Limits::kMaxVoxel / u.mm_per_length, false, where("VOXEL_WIDTH"),
@@ -95,8 +90,8 @@ Scenario readVascuSynthParameters(const std::filesystem::path& path, const ReadO
   if (pp.size() != 3)
     throw InputError(file, entries.at("PERF_POINT").line, "PERF_POINT takes 3 numbers (map voxels), got '" + entries.at("PERF_POINT").value + "'");
   d.root_voxel = Vec3(parseNumber(pp[0], file, entries.at("PERF_POINT").line, "PERF_POINT"),
-                       parseNumber(pp[1], file, entries.at("PERF_POINT").line, "PERF_POINT"),
-                       parseNumber(pp[2], file, entries.at("PERF_POINT").line, "PERF_POINT"));
+                      parseNumber(pp[1], file, entries.at("PERF_POINT").line, "PERF_POINT"),
+                      parseNumber(pp[2], file, entries.at("PERF_POINT").line, "PERF_POINT"));
   d.root_line = entries.at("PERF_POINT").line;
 
   const double p_perf = number("PERF_PRESSURE"), p_term = number("TERM_PRESSURE");
@@ -104,13 +99,12 @@ Scenario readVascuSynthParameters(const std::filesystem::path& path, const ReadO
   checkRange(p_term, 0, false, Limits::kMaxPressure / pa, false, where("TERM_PRESSURE"), "TERM_PRESSURE (" + u.pressureName() + ")");
   checkRange(p_perf, 0, false, Limits::kMaxPressure / pa, false, where("PERF_PRESSURE"), "PERF_PRESSURE (" + u.pressureName() + ")");
   if (!((p_perf - p_term) * pa >= Limits::kMinPressureDrop))
-    throw InputError(file, entries.at("PERF_PRESSURE").line, "PERF_PRESSURE = " + show(p_perf) +
-                                                                 " must exceed TERM_PRESSURE = " + show(p_term));
+    throw InputError(file, entries.at("PERF_PRESSURE").line, "PERF_PRESSURE = " + show(p_perf) + " must exceed TERM_PRESSURE = " + show(p_term));
   const double flow = number("PERF_FLOW"), rho = number("RHO");
   checkRange(flow, Limits::kMinFlow / u.mm3s_per_flow(), false, Limits::kMaxFlow / u.mm3s_per_flow(), false, where("PERF_FLOW"),
              "PERF_FLOW (" + u.flowName() + ")");
-  checkRange(rho, Limits::kMinViscosity / u.pas_per_viscosity(), false, Limits::kMaxViscosity / u.pas_per_viscosity(), false,
-             where("RHO"), "RHO (" + u.viscosityName() + ")");
+  checkRange(rho, Limits::kMinViscosity / u.pas_per_viscosity(), false, Limits::kMaxViscosity / u.pas_per_viscosity(), false, where("RHO"),
+             "RHO (" + u.viscosityName() + ")");
   const double gamma = number("GAMMA"), lambda = number("LAMBDA"), mu = number("MU");
   checkRange(gamma, Limits::kMinMurray, true, Limits::kMaxMurray, false, where("GAMMA"), "GAMMA");
   checkRange(lambda, 0, false, Limits::kMaxCostExponent, false, where("LAMBDA"), "LAMBDA");
@@ -146,9 +140,8 @@ Scenario readVascuSynthParameters(const std::filesystem::path& path, const ReadO
   g.physics.total_terminals = n;
   sc.growth = std::move(setup);
 
-  sc.units_note = "VascuSynth files carry no units: lengths (VOXEL_WIDTH, radii) were read in " + u.length +
-                  ", flows in " + u.flowName() + ", pressures in " + u.pressureName() + " and viscosity in " +
-                  u.viscosityName() + " (the coherent length-gram-second system" +
+  sc.units_note = "VascuSynth files carry no units: lengths (VOXEL_WIDTH, radii) were read in " + u.length + ", flows in " + u.flowName() +
+                  ", pressures in " + u.pressureName() + " and viscosity in " + u.viscosityName() + " (the coherent length-gram-second system" +
                   (u.length == "cm" ? ", i.e. CGS: dyn/cm^2 and poise" : "") +
                   "), then converted to mm, mm^3/s, Pa and Pa*s; MIN_DISTANCE and PERF_POINT are in map voxels";
   return sc;

@@ -12,8 +12,8 @@
 namespace angiosynth {
 
 struct TreeInfo {
-  std::string id;    // unique in the forest ("tree", "artery", "inlet_2", ...)
-  std::string kind;  // "artery", "vein", or a free name
+  std::string id;       // unique in the forest ("tree", "artery", "inlet_2", ...)
+  std::string kind;     // "artery", "vein", or a free name
   int class_label = 1;  // its kind's label in the classes volume (1 artery, 2 vein, further kinds on)
 };
 

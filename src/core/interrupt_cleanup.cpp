@@ -50,8 +50,7 @@ void installInterruptCleanup() {
     pthread_sigmask(SIG_BLOCK, &s, nullptr);
     std::thread([s] {
       int sig = 0;
-      while (sigwait(&s, &sig) != 0) {
-      }
+      while (sigwait(&s, &sig) != 0) {}
       {
         std::lock_guard<std::mutex> lock(registryMutex());
         for (const auto& d : registry()) {

@@ -27,21 +27,23 @@ inline constexpr int kMaxJunctionChildren = 64;
 inline void checkRadius(double r_mm, const std::string& file, int line, const std::string& what, bool zero_means_unset = false) {
   if (zero_means_unset && r_mm == 0) return;
   if (!(r_mm >= kMinRadiusMm && r_mm <= kMaxRadiusMm))
-    throw InputError(file, line, what + " " + show(r_mm) + " mm is out of range; allowed: " + show(kMinRadiusMm) + " to " +
-                                     show(kMaxRadiusMm) + " mm" + (zero_means_unset ? " (or 0: not given)" : ""));
+    throw InputError(file, line,
+                     what + " " + show(r_mm) + " mm is out of range; allowed: " + show(kMinRadiusMm) + " to " + show(kMaxRadiusMm) + " mm" +
+                         (zero_means_unset ? " (or 0: not given)" : ""));
 }
 
 inline void checkCoordinate(double v_mm, const std::string& file, int line, const std::string& what) {
   if (!(std::abs(v_mm) <= kMaxCoordinateMm))
-    throw InputError(file, line, what + " " + show(v_mm) + " mm is out of range; allowed: -" + show(kMaxCoordinateMm) + " to " +
-                                     show(kMaxCoordinateMm) + " mm");
+    throw InputError(file, line,
+                     what + " " + show(v_mm) + " mm is out of range; allowed: -" + show(kMaxCoordinateMm) + " to " + show(kMaxCoordinateMm) + " mm");
 }
 
 // A length or distance in (0, kMaxLengthMm] (or [0, …] with `zero_allowed`).
 inline void checkLength(double v_mm, const std::string& file, int line, const std::string& what, bool zero_allowed = false) {
   if (!((zero_allowed ? v_mm >= 0 : v_mm > 0) && v_mm <= kMaxLengthMm))
-    throw InputError(file, line, what + " " + show(v_mm) + " mm is out of range; allowed: " + (zero_allowed ? "0" : "more than 0") +
-                                     " to " + show(kMaxLengthMm) + " mm");
+    throw InputError(
+        file, line,
+        what + " " + show(v_mm) + " mm is out of range; allowed: " + (zero_allowed ? "0" : "more than 0") + " to " + show(kMaxLengthMm) + " mm");
 }
 
 }  // namespace angiosynth::physical

@@ -4,8 +4,6 @@
 
 namespace angiosynth {
 
-inline nlohmann::ordered_json quantityJson(double value, const char* unit) {
-  return nlohmann::ordered_json{{"value", value}, {"unit", unit}};
-}
+inline nlohmann::ordered_json quantityJson(double value, const char* unit) { return nlohmann::ordered_json{{"value", value}, {"unit", unit}}; }
 
 }  // namespace angiosynth

@@ -46,8 +46,7 @@ void SegmentIndex::insert(const VascularTree& tree, std::int32_t s) {
   const Vec3& p = tree.position[tree.parent[s]];
   const Vec3& q = tree.position[s];
   int a[3], b[3];
-  cellRange(Vec3(std::min(p.x, q.x), std::min(p.y, q.y), std::min(p.z, q.z)),
-            Vec3(std::max(p.x, q.x), std::max(p.y, q.y), std::max(p.z, q.z)), a, b);
+  cellRange(Vec3(std::min(p.x, q.x), std::min(p.y, q.y), std::min(p.z, q.z)), Vec3(std::max(p.x, q.x), std::max(p.y, q.y), std::max(p.z, q.z)), a, b);
   // A long diagonal segment touches only a thin line of its box: test each cell's distance.
   const double half_diag = 0.5 * std::sqrt(3.0) * cell_;
   const bool big = (b[0] - a[0] + 1) * (b[1] - a[1] + 1) * (b[2] - a[2] + 1) > 8;
@@ -71,8 +70,7 @@ void SegmentIndex::endTrial(bool keep) {
   journaling_ = false;
 }
 
-void SegmentIndex::nearest(const VascularTree& tree, const Vec3& p, int k,
-                           std::vector<std::pair<double, std::int32_t>>& out) {
+void SegmentIndex::nearest(const VascularTree& tree, const Vec3& p, int k, std::vector<std::pair<double, std::int32_t>>& out) {
   out.clear();
   const auto nseg = tree.segmentCount();
   if (nseg == 0 || k <= 0) return;
@@ -98,8 +96,7 @@ void SegmentIndex::nearest(const VascularTree& tree, const Vec3& p, int k,
           for (auto s : cells_[cellId(ii, jj, kk)]) {
             if (!marks_.mark(s)) continue;
             const double d = pointSegmentDistance(p, tree.position[tree.parent[s]], tree.position[s]);
-            if (static_cast<int>(out.size()) < k || d < out.back().first ||
-                (d == out.back().first && s < out.back().second)) {
+            if (static_cast<int>(out.size()) < k || d < out.back().first || (d == out.back().first && s < out.back().second)) {
               const std::pair<double, std::int32_t> e{d, s};
               out.insert(std::upper_bound(out.begin(), out.end(), e), e);
               if (static_cast<int>(out.size()) > k) out.pop_back();

@@ -17,8 +17,7 @@ namespace angiosynth {
 class SegmentIndex {
  public:
   // `planar`: the domain is a slab one cell thick (2D trees); cells follow the area.
-  SegmentIndex(const Vec3& domain_lo, const Vec3& domain_hi, bool planar = false)
-      : lo_(domain_lo), hi_(domain_hi), planar_(planar) {}
+  SegmentIndex(const Vec3& domain_lo, const Vec3& domain_hi, bool planar = false) : lo_(domain_lo), hi_(domain_hi), planar_(planar) {}
 
   // Rebuilds when the tree has doubled since the last build (or on `force`).
   void refresh(const VascularTree& tree, bool force = false);
@@ -33,8 +32,7 @@ class SegmentIndex {
   void endTrial(bool keep);
 
   // The k segments nearest to p (point–segment distance), nearest first: (distance, id).
-  void nearest(const VascularTree& tree, const Vec3& p, int k,
-               std::vector<std::pair<double, std::int32_t>>& out);
+  void nearest(const VascularTree& tree, const Vec3& p, int k, std::vector<std::pair<double, std::int32_t>>& out);
   // True if within(id, distance) holds for a segment registered in p's own cell: a look at a few
   // segments before any search.
   template <class F>

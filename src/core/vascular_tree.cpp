@@ -18,8 +18,10 @@ void VascularTree::junctionChildren(std::int32_t i, std::vector<std::int32_t>& o
   while (!stack.empty()) {
     const auto c = stack.back();
     stack.pop_back();
-    if (isLink(c)) push(c);
-    else out.push_back(c);
+    if (isLink(c))
+      push(c);
+    else
+      out.push_back(c);
   }
 }
 
@@ -57,19 +59,51 @@ bool VascularTree::hasWalls() const {
 }
 
 void VascularTree::reserve(std::size_t n) {
-  position.reserve(n); parent.reserve(n); child0.reserve(n); child1.reserve(n);
-  terminals.reserve(n); length.reserve(n); reduced_resistance.reserve(n); beta.reserve(n);
-  cost_ratio.reserve(n); radius.reserve(n); flow.reserve(n); pressure.reserve(n); depth.reserve(n); tree.reserve(n);
-  stage.reserve(n); role.reserve(n); branching.reserve(n); outflow.reserve(n);
-  radius_start.reserve(n); wall_start.reserve(n); wall.reserve(n);
+  position.reserve(n);
+  parent.reserve(n);
+  child0.reserve(n);
+  child1.reserve(n);
+  terminals.reserve(n);
+  length.reserve(n);
+  reduced_resistance.reserve(n);
+  beta.reserve(n);
+  cost_ratio.reserve(n);
+  radius.reserve(n);
+  flow.reserve(n);
+  pressure.reserve(n);
+  depth.reserve(n);
+  tree.reserve(n);
+  stage.reserve(n);
+  role.reserve(n);
+  branching.reserve(n);
+  outflow.reserve(n);
+  radius_start.reserve(n);
+  wall_start.reserve(n);
+  wall.reserve(n);
 }
 
 void VascularTree::truncate(std::size_t n) {
-  position.resize(n); parent.resize(n); child0.resize(n); child1.resize(n);
-  terminals.resize(n); length.resize(n); reduced_resistance.resize(n); beta.resize(n);
-  cost_ratio.resize(n); radius.resize(n); flow.resize(n); pressure.resize(n); depth.resize(n); tree.resize(n);
-  stage.resize(n); role.resize(n); branching.resize(n); outflow.resize(n);
-  radius_start.resize(n); wall_start.resize(n); wall.resize(n);
+  position.resize(n);
+  parent.resize(n);
+  child0.resize(n);
+  child1.resize(n);
+  terminals.resize(n);
+  length.resize(n);
+  reduced_resistance.resize(n);
+  beta.resize(n);
+  cost_ratio.resize(n);
+  radius.resize(n);
+  flow.resize(n);
+  pressure.resize(n);
+  depth.resize(n);
+  tree.resize(n);
+  stage.resize(n);
+  role.resize(n);
+  branching.resize(n);
+  outflow.resize(n);
+  radius_start.resize(n);
+  wall_start.resize(n);
+  wall.resize(n);
 }
 
 void VascularTree::setPieceOf(const VascularTree& t, std::int32_t n, int q, int k, std::int32_t id) {
@@ -110,17 +144,23 @@ std::int32_t VascularTree::addNode(const Vec3& at, std::int32_t parent_node, std
   wall_start.push_back(0);
   wall.push_back(0);
   if (parent_node >= 0) {
-    if (child0[parent_node] < 0) child0[parent_node] = id;
-    else if (child1[parent_node] < 0) child1[parent_node] = id;
-    else throw std::logic_error("node already has two children");
+    if (child0[parent_node] < 0)
+      child0[parent_node] = id;
+    else if (child1[parent_node] < 0)
+      child1[parent_node] = id;
+    else
+      throw std::logic_error("node already has two children");
   }
   return id;
 }
 
 void VascularTree::replaceChild(std::int32_t node, std::int32_t old_child, std::int32_t new_child) {
-  if (child0[node] == old_child) child0[node] = new_child;
-  else if (child1[node] == old_child) child1[node] = new_child;
-  else throw std::logic_error("replaceChild: not a child");
+  if (child0[node] == old_child)
+    child0[node] = new_child;
+  else if (child1[node] == old_child)
+    child1[node] = new_child;
+  else
+    throw std::logic_error("replaceChild: not a child");
 }
 
 bool VascularTree::hasStages() const {
@@ -244,9 +284,15 @@ void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments, con
   out.wall_start.assign(out.position.size(), 0.0);
   out.wall.assign(out.position.size(), 0.0);
   const auto m = out.position.size();
-  out.terminals.assign(m, 1); out.length.assign(m, 0); out.reduced_resistance.assign(m, 0);
-  out.beta.assign(m, 1); out.cost_ratio.assign(m, 0); out.radius.assign(m, 0);
-  out.flow.assign(m, 0); out.pressure.assign(m, 0); out.depth.assign(m, 0);
+  out.terminals.assign(m, 1);
+  out.length.assign(m, 0);
+  out.reduced_resistance.assign(m, 0);
+  out.beta.assign(m, 1);
+  out.cost_ratio.assign(m, 0);
+  out.radius.assign(m, 0);
+  out.flow.assign(m, 0);
+  out.pressure.assign(m, 0);
+  out.depth.assign(m, 0);
   const auto order = out.topDownOrder();
   for (auto i : order) {
     if (out.parent[i] < 0) continue;

@@ -17,19 +17,19 @@ namespace angiosynth {
 enum class NodeType { Root, Bifurcation, Terminal, Continuation, Junction };
 
 struct VascularTree {
-  std::vector<Vec3> position;               // mm
-  std::vector<std::int32_t> parent;         // proximal node of segment i (-1 for the root)
-  std::vector<std::int32_t> child0, child1; // segments leaving node i (-1: none)
-  std::vector<std::int32_t> terminals;      // terminals downstream of segment i
-  std::vector<double> length;               // mm
-  std::vector<double> reduced_resistance;   // R*·π/(8η) of the subtree of segment i, in mm^-3·mm^4 = mm
-  std::vector<double> beta;                 // r_i / r_parent(i); 1 for the root segment
-  std::vector<double> cost_ratio;           // Σ_subtree l^μ (r/r_i)^λ
-  std::vector<double> radius;               // mm
-  std::vector<double> flow;                 // mm^3/s
-  std::vector<double> pressure;             // Pa, at node i (distal end of segment i)
-  std::vector<std::int32_t> depth;          // segments from the root to node i
-  std::vector<std::int32_t> tree;           // index of the tree node i belongs to (0 in a single tree)
+  std::vector<Vec3> position;                // mm
+  std::vector<std::int32_t> parent;          // proximal node of segment i (-1 for the root)
+  std::vector<std::int32_t> child0, child1;  // segments leaving node i (-1: none)
+  std::vector<std::int32_t> terminals;       // terminals downstream of segment i
+  std::vector<double> length;                // mm
+  std::vector<double> reduced_resistance;    // R*·π/(8η) of the subtree of segment i, in mm^-3·mm^4 = mm
+  std::vector<double> beta;                  // r_i / r_parent(i); 1 for the root segment
+  std::vector<double> cost_ratio;            // Σ_subtree l^μ (r/r_i)^λ
+  std::vector<double> radius;                // mm
+  std::vector<double> flow;                  // mm^3/s
+  std::vector<double> pressure;              // Pa, at node i (distal end of segment i)
+  std::vector<std::int32_t> depth;           // segments from the root to node i
+  std::vector<std::int32_t> tree;            // index of the tree node i belongs to (0 in a single tree)
   // Staged growth (DCCO): the stage that made segment i (-1: none, the method has no stages), its
   // role (VesselRole) and how it may take new branches (Branching); graphs write them when set.
   std::vector<std::int16_t> stage;

@@ -103,22 +103,20 @@ std::string manifestEntryProblem(const nlohmann::json& j, std::int64_t samples) 
   if (!j.contains("files") || !j["files"].is_array() || (status == "ok" && j["files"].empty()))
     return status == "ok" ? "files is missing or empty" : "files is not a list";
   for (const auto& f : j["files"]) {
-    if (!f.is_object() || !f.contains("path") || !f["path"].is_string() || !f.contains("size") ||
-        !f["size"].is_number_unsigned() || !f.contains("sha256") || !f["sha256"].is_string())
+    if (!f.is_object() || !f.contains("path") || !f["path"].is_string() || !f.contains("size") || !f["size"].is_number_unsigned() ||
+        !f.contains("sha256") || !f["sha256"].is_string())
       return "a file needs path (string), size (whole number >= 0) and sha256 (string)";
     const auto path = f["path"].get<std::string>();
     const auto top = path.substr(0, path.find('/'));
     if (!isConfinedRelativePath(path) || (top != "imagesTr" && top != "labelsTr" && top != "groundtruth"))
       return "file path '" + path + "' leaves the dataset; allowed: relative paths under imagesTr/, labelsTr/, groundtruth/";
     const auto hash = f["sha256"].get<std::string>();
-    if (hash.size() != 64 || hash.find_first_not_of("0123456789abcdef") != std::string::npos)
-      return "sha256 of " + path + " is not 64 hex digits";
+    if (hash.size() != 64 || hash.find_first_not_of("0123456789abcdef") != std::string::npos) return "sha256 of " + path + " is not 64 hex digits";
   }
   return "";
 }
 
-std::map<std::int64_t, nlohmann::json> readManifests(const std::filesystem::path& dir, std::int64_t samples,
-                                                     std::vector<std::string>* problems) {
+std::map<std::int64_t, nlohmann::json> readManifests(const std::filesystem::path& dir, std::int64_t samples, std::vector<std::string>* problems) {
   std::vector<std::filesystem::path> files;
   if (std::filesystem::exists(dir / "manifest.jsonl")) files.push_back(dir / "manifest.jsonl");
   std::error_code ec;
@@ -138,8 +136,9 @@ std::map<std::int64_t, nlohmann::json> readManifests(const std::filesystem::path
       const auto j = nlohmann::json::parse(line, nullptr, /*allow_exceptions=*/false);
       std::string why = j.is_discarded() ? "not valid JSON" : manifestEntryProblem(j, samples);
       if (!why.empty()) {
-        if (problems) problems->push_back(shown + ":" + std::to_string(number) + ": " + why +
-                                          (torn ? " (a torn last line; ignored, and cut off at the next append)" : "; line ignored"));
+        if (problems)
+          problems->push_back(shown + ":" + std::to_string(number) + ": " + why +
+                              (torn ? " (a torn last line; ignored, and cut off at the next append)" : "; line ignored"));
         continue;
       }
       const auto i = j["index"].get<std::int64_t>();

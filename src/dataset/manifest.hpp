@@ -29,8 +29,7 @@ std::string manifestEntryProblem(const nlohmann::json& entry, std::int64_t sampl
 // Every valid entry of every part and of manifest.jsonl; per index, the one that finished last.
 // Invalid lines are skipped (one bad line blocks nothing) and described in `problems` as
 // "manifest/<part>.jsonl:<line>: <why>".
-std::map<std::int64_t, nlohmann::json> readManifests(const std::filesystem::path& dataset_dir,
-                                                     std::int64_t samples = INT64_MAX,
+std::map<std::int64_t, nlohmann::json> readManifests(const std::filesystem::path& dataset_dir, std::int64_t samples = INT64_MAX,
                                                      std::vector<std::string>* problems = nullptr);
 
 // Whether every file of a valid entry exists with its recorded size and hash; if not, `why` says

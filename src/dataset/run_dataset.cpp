@@ -30,9 +30,7 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-double nowUnix() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
+double nowUnix() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
 
 Json readJson(const fs::path& p) {
   std::ifstream in(p);
@@ -46,9 +44,7 @@ Json readJson(const fs::path& p) {
 // spec.json as written by runDataset; its fields checked before use.
 Json readSpecRecord(const fs::path& dir) {
   Json j = readJson(dir / "spec.json");
-  const auto bad = [&](const std::string& why) {
-    throw InputError((dir / "spec.json").string(), 0, why + "; the dataset directory is damaged");
-  };
+  const auto bad = [&](const std::string& why) { throw InputError((dir / "spec.json").string(), 0, why + "; the dataset directory is damaged"); };
   if (!j.contains("samples") || !j["samples"].is_number_integer() || j["samples"].get<std::int64_t>() < 1 ||
       j["samples"].get<std::int64_t>() > 100000000)
     bad("samples must be a whole number in 1…10^8");
@@ -124,8 +120,7 @@ Json generateOne(const DatasetSpec& spec, const fs::path& dir, const fs::path& p
       const std::string own = role + suffix;
       return staging / sample.file(sample.wrote(own) ? own : role);
     };
-    const fs::path label = written(spec.label_policy != "binary" ? "label" : spec.labels == "kind" ? "classes" : "mask"),
-                   image = written("image");
+    const fs::path label = written(spec.label_policy != "binary" ? "label" : spec.labels == "kind" ? "classes" : "mask"), image = written("image");
     const std::string image_rel = "imagesTr/" + r.id + "_0000.nii.gz", label_rel = "labelsTr/" + r.id + ".nii.gz";
     const std::string gt_rel = "groundtruth/" + r.id, json_rel = "groundtruth/" + r.id + ".json";
     Json meta{{"id", r.id},
@@ -196,8 +191,8 @@ namespace {
 
 // Refuses to mix specs or to overwrite silently: a directory made from another spec needs
 // --resume --regenerate-changed; samples of this selection already made need --resume.
-void checkExistingDataset(const DatasetSpec& spec, const fs::path& dir, const std::vector<std::int64_t>& todo,
-                          const DatasetRunOptions& opt, bool& spec_changed) {
+void checkExistingDataset(const DatasetSpec& spec, const fs::path& dir, const std::vector<std::int64_t>& todo, const DatasetRunOptions& opt,
+                          bool& spec_changed) {
   spec_changed = false;
   std::error_code ec;
   if (!fs::exists(dir / "spec.json", ec)) return;
@@ -206,8 +201,7 @@ void checkExistingDataset(const DatasetSpec& spec, const fs::path& dir, const st
   std::string old_hash;
   try {
     old_hash = canonicalSpecSha256(old_text, (dir / "spec.json").string());
-  } catch (const InputError&) {
-  }
+  } catch (const InputError&) {}
   spec_changed = old_hash != spec.sha256;
   if (spec_changed) {
     const auto keys = changedSpecKeys(old_text, spec.text);
@@ -215,18 +209,20 @@ void checkExistingDataset(const DatasetSpec& spec, const fs::path& dir, const st
     for (std::size_t i = 0; i < keys.size() && i < 12; ++i) list += (i ? ", " : "") + keys[i];
     if (keys.size() > 12) list += ", … (" + std::to_string(keys.size()) + " in all)";
     if (!(opt.resume && opt.regenerate_changed))
-      throw InputError(spec.file, 0, dir.string() + " was made from another version of this spec (changed: " + list +
-                                         "); generate into a new directory, or add --resume --regenerate-changed to "
-                                         "regenerate the samples the change affects and keep the others");
+      throw InputError(spec.file, 0,
+                       dir.string() + " was made from another version of this spec (changed: " + list +
+                           "); generate into a new directory, or add --resume --regenerate-changed to "
+                           "regenerate the samples the change affects and keep the others");
   }
   if (opt.resume) return;
   const auto done = readManifests(dir, spec.samples);
   std::int64_t made = 0;
   for (auto i : todo) made += done.count(i);
   if (made > 0)
-    throw InputError(dir.string(), 0, "already holds " + std::to_string(made) + " of the " + std::to_string(todo.size()) +
-                                          " samples this run would make; add --resume to keep the verified ones and "
-                                          "redo the rest, or choose another --out");
+    throw InputError(dir.string(), 0,
+                     "already holds " + std::to_string(made) + " of the " + std::to_string(todo.size()) +
+                         " samples this run would make; add --resume to keep the verified ones and "
+                         "redo the rest, or choose another --out");
 }
 
 // This process's staging directory; staging left by killed processes of this host is removed.
@@ -245,8 +241,7 @@ fs::path processStaging(const fs::path& dir) {
 
 }  // namespace
 
-DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent, const DatasetSelection& sel,
-                            const DatasetRunOptions& opt) {
+DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent, const DatasetSelection& sel, const DatasetRunOptions& opt) {
   DatasetRunReport rep;
   std::vector<std::int64_t> todo = sel.indices();
   // Every sample's draws, parameters and files, then sample 0's maps and profile: input errors
@@ -263,11 +258,7 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
   // Files of a run that was killed while writing them (SIGKILL cannot be caught).
   for (const fs::path& d : {dir, dir / "manifest"}) removeAbandonedTemporaries(d);
   // The same content from every process, so concurrent shards may all write it.
-  Json spec_record{{"name", spec.name},
-                   {"id", spec.id},
-                   {"samples", spec.samples},
-                   {"seed", spec.seed},
-                   {"channel_name", spec.channel_name},
+  Json spec_record{{"name", spec.name},          {"id", spec.id}, {"samples", spec.samples}, {"seed", spec.seed}, {"channel_name", spec.channel_name},
                    {"labels", labelValues(spec)}};
   if (spec.label_policy != "binary") spec_record["label_policy"] = spec.label_policy;  // binary datasets as before
   spec_record["licence"] = spec.licence;
@@ -276,12 +267,11 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
   spec_record["spec_sha256"] = spec.sha256;
   spec_record["spec"] = spec.text;
   writeJsonAtomically(dir / "spec.json", spec_record);
-  writeJsonAtomically(dir / "manifest" / (sel.part + ".run.json"),
-                      Json{{"tool", {{"name", "angiosynth"}, {"version", kVersion}}},
-                           {"command_line", opt.command_line},
-                           {"part", sel.part},
-                           {"machine", machine(spec.record_host)},
-                           {"started_unix", nowUnix()}});
+  writeJsonAtomically(dir / "manifest" / (sel.part + ".run.json"), Json{{"tool", {{"name", "angiosynth"}, {"version", kVersion}}},
+                                                                        {"command_line", opt.command_line},
+                                                                        {"part", sel.part},
+                                                                        {"machine", machine(spec.record_host)},
+                                                                        {"started_unix", nowUnix()}});
   if (opt.resume) {
     const auto done = readManifests(dir, spec.samples);
     std::vector<std::int64_t> left;
@@ -289,11 +279,12 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
       const auto it = done.find(i);
       // Made from the same resolved parameters (entries of older versions carry no hash: only
       // an unchanged spec vouches for them), and every file intact.
-      const bool same = it != done.end() && (it->second.contains("sample_sha256")
-                                                 ? it->second["sample_sha256"] == resolveSample(spec, i).sha256
-                                                 : !spec_changed);
-      if (same && entryVerifies(dir, it->second)) ++rep.skipped;
-      else left.push_back(i);
+      const bool same =
+          it != done.end() && (it->second.contains("sample_sha256") ? it->second["sample_sha256"] == resolveSample(spec, i).sha256 : !spec_changed);
+      if (same && entryVerifies(dir, it->second))
+        ++rep.skipped;
+      else
+        left.push_back(i);
     }
     todo = left;
   }
@@ -306,27 +297,26 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
   std::size_t next = 0;
   std::int64_t finished = 0;
   const std::int64_t total = static_cast<std::int64_t>(todo.size());
-  tbb::parallel_pipeline(
-      static_cast<std::size_t>(rep.in_flight),
-      tbb::make_filter<void, std::int64_t>(tbb::filter_mode::serial_in_order,
-                                           [&](tbb::flow_control& fc) -> std::int64_t {
-                                             if (next == todo.size()) {
-                                               fc.stop();
-                                               return 0;
-                                             }
-                                             return todo[next++];
-                                           }) &
-          tbb::make_filter<std::int64_t, void>(tbb::filter_mode::parallel, [&](std::int64_t i) {
-            const ResolvedSample r = resolveSample(spec, i);
-            Json e = generateOne(spec, dir, staging, r, opt);
-            e["part"] = sel.part;
-            std::lock_guard<std::mutex> lock(m);
-            appendManifestLine(part, e);
-            ++finished;
-            if (e["status"] == "ok") ++rep.generated;
-            else ++rep.failed;
-            if (opt.on_sample) opt.on_sample(e, finished, total);
-          }));
+  tbb::parallel_pipeline(static_cast<std::size_t>(rep.in_flight),
+                         tbb::make_filter<void, std::int64_t>(tbb::filter_mode::serial_in_order, [&](tbb::flow_control& fc) -> std::int64_t {
+                           if (next == todo.size()) {
+                             fc.stop();
+                             return 0;
+                           }
+                           return todo[next++];
+                         }) & tbb::make_filter<std::int64_t, void>(tbb::filter_mode::parallel, [&](std::int64_t i) {
+                           const ResolvedSample r = resolveSample(spec, i);
+                           Json e = generateOne(spec, dir, staging, r, opt);
+                           e["part"] = sel.part;
+                           std::lock_guard<std::mutex> lock(m);
+                           appendManifestLine(part, e);
+                           ++finished;
+                           if (e["status"] == "ok")
+                             ++rep.generated;
+                           else
+                             ++rep.failed;
+                           if (opt.on_sample) opt.on_sample(e, finished, total);
+                         }));
   // Only this process's own staging: other shards may be writing theirs.
   std::error_code ec;
   fs::remove_all(staging, ec);
@@ -411,8 +401,10 @@ DatasetCheck finalizeDataset(const fs::path& dir) {
   for (const auto& f : run_files) {
     std::ifstream in(f);
     const Json run = Json::parse(in, nullptr, /*allow_exceptions=*/false);
-    if (run.is_discarded()) c.warnings.push_back(fs::relative(f, dir).string() + ": not valid JSON; left out of provenance.json");
-    else runs.push_back(run);
+    if (run.is_discarded())
+      c.warnings.push_back(fs::relative(f, dir).string() + ": not valid JSON; left out of provenance.json");
+    else
+      runs.push_back(run);
   }
   writeJsonAtomically(dir / "provenance.json", Json{{"tool", {{"name", "angiosynth"}, {"version", kVersion}}},
                                                     {"spec_file", info["spec_file"]},

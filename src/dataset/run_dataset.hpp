@@ -31,10 +31,10 @@ struct DatasetSelection {
 };
 
 struct DatasetRunOptions {
-  bool resume = false;               // skip samples whose manifest entry verifies
-  bool regenerate_changed = false;   // with resume: accept a changed spec, redo the samples it changes
+  bool resume = false;              // skip samples whose manifest entry verifies
+  bool regenerate_changed = false;  // with resume: accept a changed spec, redo the samples it changes
   std::uint64_t memory_limit = 0;
-  int samples_in_flight = 0;         // 0: one per thread, fewer if memory is short
+  int samples_in_flight = 0;  // 0: one per thread, fewer if memory is short
   std::string command_line;
   // Called after each sample (under a lock) with its manifest entry, samples done and total.
   std::function<void(const nlohmann::json& entry, std::int64_t done, std::int64_t total)> on_sample;

@@ -77,11 +77,15 @@ Quantity quantityOf(const toml::node& n, const std::string& file, const std::str
 // from text placed on that line.
 std::unique_ptr<toml::node> valueOf(double v, const std::string& unit, bool integer, int line) {
   char buf[64];
-  if (integer) std::snprintf(buf, sizeof buf, "%lld", static_cast<long long>(v));
-  else std::snprintf(buf, sizeof buf, "%.17g", v);
+  if (integer)
+    std::snprintf(buf, sizeof buf, "%lld", static_cast<long long>(v));
+  else
+    std::snprintf(buf, sizeof buf, "%.17g", v);
   std::string text = buf;
-  if (!unit.empty()) text = "\"" + text + " " + unit + "\"";
-  else if (!integer && text.find_first_of(".en") == std::string::npos) text += ".0";  // stays a float
+  if (!unit.empty())
+    text = "\"" + text + " " + unit + "\"";
+  else if (!integer && text.find_first_of(".en") == std::string::npos)
+    text += ".0";  // stays a float
   toml::table t = toml::parse(std::string(std::max(0, line - 1), '\n') + "v = " + text);
   std::unique_ptr<toml::node> out;  // moved, not copied: a copy would lose the line
   t.get("v")->visit([&](auto& x) { out = std::make_unique<std::decay_t<decltype(x)>>(std::move(x)); });
@@ -104,9 +108,10 @@ std::unique_ptr<toml::node> draw(const toml::table& d, Rng& rng, const std::stri
     bool known = ((k == "min" || k == "max") && d.contains("normal")) || (k == "weights" && d.contains("choice"));
     for (const char* name : kDistributions) known |= k == name, kinds += k == name;
     if (!known)
-      throw InputError(file, lineOf(v), "unknown key '" + std::string(k.str()) +
-                                            "' in a distribution; allowed: uniform, log_uniform, normal (with min, max), "
-                                            "integer, choice (with weights)");
+      throw InputError(file, lineOf(v),
+                       "unknown key '" + std::string(k.str()) +
+                           "' in a distribution; allowed: uniform, log_uniform, normal (with min, max), "
+                           "integer, choice (with weights)");
   }
   if (kinds != 1) throw InputError(file, line, "a distribution names exactly one of uniform, log_uniform, normal, integer, choice");
   const double u = rng.uniform();
@@ -203,8 +208,7 @@ void readLabels(const toml::table& d, DatasetSpec& s) {
   if (!a || a->empty() || a->size() > 255) throw InputError(s.file, lineOf(*k), allowed);
   for (const auto& e : *a) {
     const auto name = e.value<std::string>();
-    if (!name || name->empty() || std::find(s.kinds.begin(), s.kinds.end(), *name) != s.kinds.end())
-      throw InputError(s.file, lineOf(*k), allowed);
+    if (!name || name->empty() || std::find(s.kinds.begin(), s.kinds.end(), *name) != s.kinds.end()) throw InputError(s.file, lineOf(*k), allowed);
     s.kinds.push_back(*name);
   }
   s.labels_line = lineOf(*k);
@@ -216,12 +220,15 @@ void readLabelPolicy(const toml::table& root, DatasetSpec& s) {
   const auto* n = im && im->is_table() ? im->as_table()->get("label_policy") : nullptr;
   if (!n) return;
   const auto v = n->value<std::string>();
-  if (!v) throw InputError(s.file, lineOf(*n), "label_policy must be one policy for the whole dataset (a string, not a distribution): "
-                                              "binary, threshold, visible, soft or ignore");
+  if (!v)
+    throw InputError(s.file, lineOf(*n),
+                     "label_policy must be one policy for the whole dataset (a string, not a distribution): "
+                     "binary, threshold, visible, soft or ignore");
   s.label_policy = *v;  // the parameter reader checks the name
   if (s.label_policy == "soft" && s.labels == "kind")
-    throw InputError(s.file, lineOf(*n), "label_policy = \"soft\" gives one float label (the partial volume); it cannot number kinds: "
-                                         "use labels = \"binary\" or another policy");
+    throw InputError(s.file, lineOf(*n),
+                     "label_policy = \"soft\" gives one float label (the partial volume); it cannot number kinds: "
+                     "use labels = \"binary\" or another policy");
   if (s.label_policy == "ignore" && s.kinds.size() >= 255)
     throw InputError(s.file, lineOf(*n), "label_policy = \"ignore\" needs a label after the last kind; allowed: at most 254 kinds");
 }
@@ -258,11 +265,12 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
   if (!ds || !ds->is_table()) throw InputError(s.file, 0, "a dataset spec needs a [dataset] table (name, id, samples, seed)");
   const auto& d = *ds->as_table();
   for (const auto& [k, v] : d)
-    if (k != "name" && k != "id" && k != "samples" && k != "seed" && k != "profile" && k != "channel_name" && k != "labels" &&
-        k != "kinds" && k != "previews" && k != "licence" && k != "record_host")
-      throw InputError(s.file, lineOf(v), "unknown key '" + std::string(k.str()) +
-                                              "' in [dataset]; allowed: name, id, samples, seed, profile, channel_name, labels, kinds, previews, "
-                                              "licence, record_host");
+    if (k != "name" && k != "id" && k != "samples" && k != "seed" && k != "profile" && k != "channel_name" && k != "labels" && k != "kinds" &&
+        k != "previews" && k != "licence" && k != "record_host")
+      throw InputError(s.file, lineOf(v),
+                       "unknown key '" + std::string(k.str()) +
+                           "' in [dataset]; allowed: name, id, samples, seed, profile, channel_name, labels, kinds, previews, "
+                           "licence, record_host");
   const auto need = [&](const char* key) -> const toml::node& {
     const auto* n = d.get(key);
     if (!n) throw InputError(s.file, lineOf(d), std::string("missing key '") + key + "' in [dataset]");
@@ -292,7 +300,8 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
   if (const auto* l = d.get("licence")) {
     const auto v = l->value<std::string>();
     if (!v || v->empty() || v->size() > 200)
-      throw InputError(s.file, lineOf(*l), "licence must be a text of 1 to 200 characters: the generated data's licence, e.g. \"CC0-1.0\" or \"CC-BY-4.0\"");
+      throw InputError(s.file, lineOf(*l),
+                       "licence must be a text of 1 to 200 characters: the generated data's licence, e.g. \"CC0-1.0\" or \"CC-BY-4.0\"");
     s.licence = *v;
   }
   if (const auto* h = d.get("record_host")) {
@@ -391,14 +400,14 @@ std::vector<std::string> changedSpecKeys(const std::string& old_text, const std:
   std::map<std::string, std::string> a, b;
   try {
     flatten(parseSpecText(old_text, "old spec"), "", a);
-  } catch (const InputError&) {
-    return {"(the recorded spec is not valid TOML)"};
-  }
+  } catch (const InputError&) { return {"(the recorded spec is not valid TOML)"}; }
   flatten(parseSpecText(new_text, "new spec"), "", b);
   std::vector<std::string> out;
   for (const auto& [k, v] : a)
-    if (!b.count(k)) out.push_back(k + " (removed)");
-    else if (b[k] != v) out.push_back(k + " (" + v + " -> " + b[k] + ")");
+    if (!b.count(k))
+      out.push_back(k + " (removed)");
+    else if (b[k] != v)
+      out.push_back(k + " (" + v + " -> " + b[k] + ")");
   for (const auto& [k, v] : b)
     if (!a.count(k)) out.push_back(k + " (added)");
   return out;
@@ -415,13 +424,13 @@ void checkSampleDraws(const DatasetSpec& spec, const std::vector<std::int64_t>& 
           std::string list;
           for (const auto& k : spec.kinds) list += (list.empty() ? "" : ", ") + k;
           throw InputError(spec.file, spec.labels_line,
-                           "the sample grows a tree of kind '" + kind + "', which has no label: kinds = [" + list +
-                               "]; add it to [dataset] kinds");
+                           "the sample grows a tree of kind '" + kind + "', which has no label: kinds = [" + list + "]; add it to [dataset] kinds");
         }
       if (profiles.insert(r.profile).second) loadProfile(r.profile, spec.file, 0);
     } catch (const InputError& e) {
-      throw InputError("", 0, std::string(e.what()) + " (sample " + std::to_string(i) + ", " + r.id +
-                                  "; see `angiosynth dataset describe " + spec.file + " --index " + std::to_string(i) + "`)");
+      throw InputError("", 0,
+                       std::string(e.what()) + " (sample " + std::to_string(i) + ", " + r.id + "; see `angiosynth dataset describe " + spec.file +
+                           " --index " + std::to_string(i) + "`)");
     }
   }
 }

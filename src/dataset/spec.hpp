@@ -23,11 +23,11 @@ class table;
 namespace angiosynth {
 
 struct DatasetSpec {
-  std::string file;          // the spec, for errors and provenance
-  std::string text;          // its content, recorded in provenance.json
-  std::string sha256;        // of its canonical form: comments, spacing and key order do not count
-  std::string name;          // nnU-Net dataset name (letters, digits, '-', '_')
-  int id = 1;                // nnU-Net dataset number, 1…999
+  std::string file;    // the spec, for errors and provenance
+  std::string text;    // its content, recorded in provenance.json
+  std::string sha256;  // of its canonical form: comments, spacing and key order do not count
+  std::string name;    // nnU-Net dataset name (letters, digits, '-', '_')
+  int id = 1;          // nnU-Net dataset number, 1…999
   std::int64_t samples = 0;
   std::uint64_t seed = 0;
   std::string channel_name;  // dataset.json channel 0 (default from the profile: "CT" for cta)
@@ -39,11 +39,11 @@ struct DatasetSpec {
   // [image] label_policy of every sample (one for the whole dataset): labelsTr holds the policy's
   // label (a float partial volume for "soft"); "ignore" adds nnU-Net's ignore label.
   std::string label_policy = "binary";
-  bool previews = false;           // MIPs (PNG) of each sample's clean and degraded image in groundtruth/
+  bool previews = false;  // MIPs (PNG) of each sample's clean and degraded image in groundtruth/
   // The licence the dataset's author gives the generated data (an SPDX identifier or any text):
   // dataset.json and provenance.json name it.
   std::string licence = "CC0-1.0";
-  bool record_host = false;        // provenance.json names the machines' host names (off: cores and memory only)
+  bool record_host = false;  // provenance.json names the machines' host names (off: cores and memory only)
 };
 
 // The label values of labelsTr, as dataset.json and each sample's meta list them.
@@ -62,11 +62,11 @@ void checkSampleDraws(const DatasetSpec& spec, const std::vector<std::int64_t>& 
 
 struct ResolvedSample {
   std::int64_t index = 0;
-  std::string id;            // <name>_<index, fixed width>
-  std::uint64_t seed = 0;    // the growth and degradation seed
-  std::string profile;       // the image channel's profile
-  std::string toml;          // the resolved parameter file (what `describe` prints)
-  std::string sha256;        // of toml and profile: what the sample's files depend on
+  std::string id;                            // <name>_<index, fixed width>
+  std::uint64_t seed = 0;                    // the growth and degradation seed
+  std::string profile;                       // the image channel's profile
+  std::string toml;                          // the resolved parameter file (what `describe` prints)
+  std::string sha256;                        // of toml and profile: what the sample's files depend on
   std::shared_ptr<const toml::table> table;  // the same, parsed
 };
 

@@ -42,7 +42,7 @@ class BSplineField {
 
  private:
   struct AxisWeights {
-    std::vector<int> first;                 // first of the four control points of each voxel
+    std::vector<int> first;  // first of the four control points of each voxel
     std::vector<std::array<float, 4>> w;
   };
   AxisWeights axisWeights(int axis) const;

@@ -26,9 +26,12 @@ double drawIntensity(const std::optional<ParamSpec>& spec, double fallback, cons
 
 void dtypeRange(const std::string& dtype, double& lo, double& hi) {
   lo = -INFINITY, hi = INFINITY;
-  if (dtype == "uint8") lo = 0, hi = 255;
-  else if (dtype == "uint16") lo = 0, hi = 65535;
-  else if (dtype == "int16") lo = -32768, hi = 32767;
+  if (dtype == "uint8")
+    lo = 0, hi = 255;
+  else if (dtype == "uint16")
+    lo = 0, hi = 65535;
+  else if (dtype == "int16")
+    lo = -32768, hi = 32767;
 }
 
 DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
@@ -68,8 +71,8 @@ DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
     double probability = 1;
     if (spec.probability) {
       Json ignored;
-      probability = drawParams({{"probability", ParamKind::Probability, 0, 1, "1", "probability"}},
-                               {{"probability", *spec.probability}}, scale, rng, ignored, profile.file, spec.line)("probability");
+      probability = drawParams({{"probability", ParamKind::Probability, 0, 1, "1", "probability"}}, {{"probability", *spec.probability}}, scale, rng,
+                               ignored, profile.file, spec.line)("probability");
     }
     const bool applied = rng.uniform() < probability;
     er["probability"] = probability;
@@ -82,13 +85,9 @@ DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
       EffectContext ctx{s, rng, er, profile.file, spec.line};
       try {
         spec.type->apply(drawn, ctx);
-      } catch (const std::invalid_argument& ex) {
-        throw InputError(profile.file, spec.line, ex.what());
-      }
+      } catch (const std::invalid_argument& ex) { throw InputError(profile.file, spec.line, ex.what()); }
       if (profile.clamp_each_step && std::isfinite(lo))
-        forEachVoxel(s.grid.voxelCount(), [&](std::int64_t v) {
-          s.image.data[v] = static_cast<float>(std::clamp(double(s.image.data[v]), lo, hi));
-        });
+        forEachVoxel(s.grid.voxelCount(), [&](std::int64_t v) { s.image.data[v] = static_cast<float>(std::clamp(double(s.image.data[v]), lo, hi)); });
       out.seconds[std::to_string(e) + "_" + tname] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     effects.push_back(er);
@@ -98,8 +97,7 @@ DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
   out.vessel = s.vessel;
   if (s.warp && !in.noise_free) {
     const auto t0 = std::chrono::steady_clock::now();
-    out.labels = warpedLabels(*s.warped_fraction, *s.warped_tree, s.segment_origin, in.truth->instances, *s.warp,
-                              in.truth->centerline_connectivity);
+    out.labels = warpedLabels(*s.warped_fraction, *s.warped_tree, s.segment_origin, in.truth->instances, *s.warp, in.truth->centerline_connectivity);
     out.tree = s.warped_tree;
     out.segment_origin = s.segment_origin;
     out.warp = s.warp;

@@ -18,7 +18,7 @@ struct DegradeInput {
   const VascularTree* tree = nullptr;
   const GroundTruthVolumes* truth = nullptr;  // clean raster of `tree`
   std::uint64_t seed = 1, sample = 0;
-  double background = 0, vessel = 255;        // defaults for profiles that do not set them
+  double background = 0, vessel = 255;  // defaults for profiles that do not set them
   std::string dtype = "uint8";
   // For the visible label's evidence: skip the noise effects (every draw stays as it is, so the
   // other effects do exactly what they do in the noisy run), and optionally image another
@@ -29,16 +29,16 @@ struct DegradeInput {
 
 struct DegradedImage {
   std::string profile;
-  Volume<float> image;                         // intensities, before conversion to dtype
+  Volume<float> image;  // intensities, before conversion to dtype
   double background = 0, vessel = 255;
   std::string dtype;
-  nlohmann::ordered_json record;               // every drawn value, for sample.json
+  nlohmann::ordered_json record;  // every drawn value, for sample.json
   // Set when the profile warps: labels and tree aligned with the warped image.
   std::optional<GroundTruthVolumes> labels;
   std::shared_ptr<VascularTree> tree;
-  std::vector<std::int32_t> segment_origin;    // clean segment of each warped-tree segment
+  std::vector<std::int32_t> segment_origin;  // clean segment of each warped-tree segment
   std::shared_ptr<const BSplineWarp> warp;
-  nlohmann::ordered_json seconds;              // time per effect (kept out of `record`)
+  nlohmann::ordered_json seconds;  // time per effect (kept out of `record`)
 };
 
 DegradedImage degradeImage(const Profile& profile, const DegradeInput& in);

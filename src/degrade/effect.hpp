@@ -21,10 +21,10 @@ class BSplineWarp;
 // and `tree` point at the clean raster and tree; a warp replaces them with warped copies.
 struct DegradeState {
   VolumeGrid grid;
-  Volume<float> image;                       // intensities in the profile's scale
-  double background = 0, vessel = 255;       // the profile's tissue and full-vessel intensities
-  const Volume<float>* fraction = nullptr;   // vessel partial volume, aligned with `image`
-  const VascularTree* tree = nullptr;        // vessels, aligned with `image`
+  Volume<float> image;                      // intensities in the profile's scale
+  double background = 0, vessel = 255;      // the profile's tissue and full-vessel intensities
+  const Volume<float>* fraction = nullptr;  // vessel partial volume, aligned with `image`
+  const VascularTree* tree = nullptr;       // vessels, aligned with `image`
   // Segment id of the clean tree for each segment of `tree` (empty: the same ids).
   std::vector<std::int32_t> segment_origin;
   // Set by a warp: the pull-back map (clean position of each warped voxel) and owned copies.
@@ -36,19 +36,19 @@ struct DegradeState {
 
 struct EffectContext {
   DegradeState& state;
-  Rng& rng;                         // the effect's own stream, after its parameters were drawn
-  nlohmann::ordered_json& record;   // drawn values go here (sample.json)
-  std::string file;                 // the profile, for errors
+  Rng& rng;                        // the effect's own stream, after its parameters were drawn
+  nlohmann::ordered_json& record;  // drawn values go here (sample.json)
+  std::string file;                // the profile, for errors
   int line = 0;
 };
 
 struct EffectType {
   const char* name;
-  const char* summary;              // one line for the docs and `--help`
+  const char* summary;  // one line for the docs and `--help`
   std::vector<ParamDecl> params;
   void (*apply)(const Drawn& p, EffectContext& ctx);
-  bool moves_geometry = false;      // a warp: at most one per profile
-  bool noise = false;               // random noise (left out of the visible label's noise-free runs)
+  bool moves_geometry = false;  // a warp: at most one per profile
+  bool noise = false;           // random noise (left out of the visible label's noise-free runs)
 };
 
 // Every effect, in the order the docs list them.

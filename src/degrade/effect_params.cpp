@@ -27,15 +27,12 @@ Amount amountOf(const toml::node& n, ParamKind kind, const std::string& name, co
   if (const auto s = n.value_exact<std::string>()) {
     try {
       return bounded(parseAmount(*s, kind, name, where));
-    } catch (const std::invalid_argument& e) {
-      throw InputError(file, lineOf(n), e.what());
-    }
+    } catch (const std::invalid_argument& e) { throw InputError(file, lineOf(n), e.what()); }
   }
   if (n.is_number()) {
     Amount a;
     a.value = *n.value<double>();
-    if (kind == ParamKind::Count && !n.is_integer())
-      throw InputError(file, lineOf(n), name + " must be a whole number");
+    if (kind == ParamKind::Count && !n.is_integer()) throw InputError(file, lineOf(n), name + " must be a whole number");
     return bounded(a);
   }
   throw InputError(file, lineOf(n), name + " must be " + describeKind(kind) + ", or a range {min = …, max = …}");
@@ -46,8 +43,7 @@ ParamRange rangeOf(const toml::node& n, ParamKind kind, const std::string& name,
   if (const auto* t = n.as_table()) {
     for (const auto& [k, v] : *t)
       if (k != "min" && k != "max" && k != "log")
-        throw InputError(file, lineOf(v), "unknown key '" + std::string(k.str()) + "' in the range of " + name +
-                                              "; allowed: min, max, log");
+        throw InputError(file, lineOf(v), "unknown key '" + std::string(k.str()) + "' in the range of " + name + "; allowed: min, max, log");
     const auto* lo = t->get("min");
     const auto* hi = t->get("max");
     if (!lo || !hi) throw InputError(file, lineOf(n), "the range of " + name + " needs both min and max");
@@ -58,8 +54,7 @@ ParamRange rangeOf(const toml::node& n, ParamKind kind, const std::string& name,
       if (!l->is_boolean()) throw InputError(file, lineOf(*l), "log must be true or false");
       r.log = *l->value<bool>();
     }
-    if (r.lo.ref == r.hi.ref && r.lo.value > r.hi.value)
-      throw InputError(file, lineOf(n), "the range of " + name + " has min > max");
+    if (r.lo.ref == r.hi.ref && r.lo.value > r.hi.value) throw InputError(file, lineOf(n), "the range of " + name + " has min > max");
     if (r.log && !(r.lo.value > 0 && r.hi.value > 0))
       throw InputError(file, lineOf(n), "a log-uniform range of " + name + " needs min > 0 and max > 0");
     return r;
@@ -95,17 +90,19 @@ Amount parseAmount(const std::string& text, ParamKind kind, const std::string& n
   if (in >> rest) throw std::invalid_argument(name + " = \"" + text + "\": write \"<number> <unit>\"");
   if (unit.empty()) return a;
   if (isLength(kind)) {
-    if (unit == "voxel" || unit == "voxels") a.ref = Amount::Ref::Voxel;
-    else if (unit == "fov") a.ref = Amount::Ref::Fov;
-    else a.value *= lengthUnitInMm(unit);  // throws with the allowed units
+    if (unit == "voxel" || unit == "voxels")
+      a.ref = Amount::Ref::Voxel;
+    else if (unit == "fov")
+      a.ref = Amount::Ref::Fov;
+    else
+      a.value *= lengthUnitInMm(unit);  // throws with the allowed units
     return a;
   }
   if (kind == ParamKind::Intensity && unit == "contrast") {
     a.ref = Amount::Ref::Contrast;
     return a;
   }
-  throw std::invalid_argument(name + " = \"" + text + "\": unit '" + unit + "' is not allowed; " + name + " is " +
-                              describeKind(kind));
+  throw std::invalid_argument(name + " = \"" + text + "\": unit '" + unit + "' is not allowed; " + name + " is " + describeKind(kind));
 }
 
 ParamSpec readParamSpec(const toml::node& n, ParamKind kind, const std::string& name, const std::string& file) {
@@ -113,8 +110,7 @@ ParamSpec readParamSpec(const toml::node& n, ParamKind kind, const std::string& 
   s.file = file;
   s.line = lineOf(n);
   if (const auto* arr = n.as_array()) {
-    if (kind != ParamKind::Length3 || arr->size() != 3)
-      throw InputError(file, lineOf(n), name + " must be " + describeKind(kind));
+    if (kind != ParamKind::Length3 || arr->size() != 3) throw InputError(file, lineOf(n), name + " must be " + describeKind(kind));
     for (const auto& e : *arr) s.components.push_back(rangeOf(e, kind, name, file));
     return s;
   }
@@ -124,8 +120,7 @@ ParamSpec readParamSpec(const toml::node& n, ParamKind kind, const std::string& 
 
 double resolveAmount(const Amount& a, const ParamScale& s, int axis) {
   const auto mean = [](const Vec3& v) { return (v.x + v.y + v.z) / 3; };
-  const Vec3 extent(s.grid.dims[0] * s.grid.spacing_mm.x, s.grid.dims[1] * s.grid.spacing_mm.y,
-                    s.grid.dims[2] * s.grid.spacing_mm.z);
+  const Vec3 extent(s.grid.dims[0] * s.grid.spacing_mm.x, s.grid.dims[1] * s.grid.spacing_mm.y, s.grid.dims[2] * s.grid.spacing_mm.z);
   switch (a.ref) {
     case Amount::Ref::Plain: return a.value;
     case Amount::Ref::Voxel: return a.value * (axis < 0 ? mean(s.grid.spacing_mm) : s.grid.spacing_mm[axis]);
@@ -162,19 +157,20 @@ void checkGridBounds(const ParamDecl& decl, double x, const VolumeGrid& g, int a
   const double voxel = axis >= 0 ? s[axis] : (s.x + s.y + s.z) / 3;
   const double fov = axis >= 0 ? g.dims[axis] * s[axis] : (g.dims[0] * s.x + g.dims[1] * s.y + g.dims[2] * s.z) / 3;
   if (decl.min_voxels > 0 && x < decl.min_voxels * voxel)
-    throw InputError(w.file, w.line, std::string(decl.name) + " = " + show(x) + " mm is finer than " + show(decl.min_voxels) +
-                                         " voxel (" + show(voxel) + " mm) of this image; allowed: >= " + show(decl.min_voxels) +
-                                         " voxel (a finer lattice holds more control points than the image has voxels)");
+    throw InputError(w.file, w.line,
+                     std::string(decl.name) + " = " + show(x) + " mm is finer than " + show(decl.min_voxels) + " voxel (" + show(voxel) +
+                         " mm) of this image; allowed: >= " + show(decl.min_voxels) +
+                         " voxel (a finer lattice holds more control points than the image has voxels)");
   if (decl.max_fov > 0 && x > decl.max_fov * fov)
-    throw InputError(w.file, w.line, std::string(decl.name) + " = " + show(x) + " mm exceeds " + show(decl.max_fov) +
-                                         " fov (" + show(decl.max_fov * fov) + " mm) of this image; allowed: <= " +
-                                         show(decl.max_fov) + " fov");
+    throw InputError(w.file, w.line,
+                     std::string(decl.name) + " = " + show(x) + " mm exceeds " + show(decl.max_fov) + " fov (" + show(decl.max_fov * fov) +
+                         " mm) of this image; allowed: <= " + show(decl.max_fov) + " fov");
 }
 
 }  // namespace
 
-Drawn drawParams(const std::vector<ParamDecl>& decls, const std::map<std::string, ParamSpec>& given,
-                 const ParamScale& scale, Rng& rng, nlohmann::ordered_json& record, const std::string& file, int line) {
+Drawn drawParams(const std::vector<ParamDecl>& decls, const std::map<std::string, ParamSpec>& given, const ParamScale& scale, Rng& rng,
+                 nlohmann::ordered_json& record, const std::string& file, int line) {
   Drawn d;
   for (const auto& decl : decls) {
     ParamSpec spec;
@@ -207,9 +203,12 @@ Drawn drawParams(const std::vector<ParamDecl>& decls, const std::map<std::string
     }
     v = Vec3(out[0], axes == 3 ? out[1] : out[0], axes == 3 ? out[2] : out[0]);
     d.values[decl.name] = v;
-    if (axes == 3) record[decl.name] = {v.x, v.y, v.z};
-    else if (decl.kind == ParamKind::Count) record[decl.name] = static_cast<std::int64_t>(v.x);
-    else record[decl.name] = v.x;
+    if (axes == 3)
+      record[decl.name] = {v.x, v.y, v.z};
+    else if (decl.kind == ParamKind::Count)
+      record[decl.name] = static_cast<std::int64_t>(v.x);
+    else
+      record[decl.name] = v.x;
   }
   return d;
 }

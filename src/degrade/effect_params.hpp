@@ -58,9 +58,9 @@ struct ParamSpec {
 struct ParamDecl {
   const char* name;
   ParamKind kind;
-  double lo, hi;              // allowed values after resolution, closed interval
-  const char* fallback;       // default, written as in a profile ("0", "vessel", "1 voxel"); nullptr: required
-  const char* meaning;        // for the docs and errors
+  double lo, hi;         // allowed values after resolution, closed interval
+  const char* fallback;  // default, written as in a profile ("0", "vessel", "1 voxel"); nullptr: required
+  const char* meaning;   // for the docs and errors
   // Lengths only: bounds relative to the image grid (0: none), per axis. A B-spline lattice finer
   // than a voxel has more control points than the image has voxels; a blur wider than the field
   // of view only costs time.
@@ -89,8 +89,8 @@ Amount parseAmount(const std::string& text, ParamKind kind, const std::string& n
 // Draws every declared parameter in declaration order (one uniform per component, drawn even
 // for fixed values so that streams stay aligned when a value becomes a range), checks the
 // allowed range, and records the values in `record`.
-Drawn drawParams(const std::vector<ParamDecl>& decls, const std::map<std::string, ParamSpec>& given,
-                 const ParamScale& scale, Rng& rng, nlohmann::ordered_json& record, const std::string& file, int line);
+Drawn drawParams(const std::vector<ParamDecl>& decls, const std::map<std::string, ParamSpec>& given, const ParamScale& scale, Rng& rng,
+                 nlohmann::ordered_json& record, const std::string& file, int line);
 
 // One amount resolved on an axis (-1: the mean over axes).
 double resolveAmount(const Amount& a, const ParamScale& s, int axis);

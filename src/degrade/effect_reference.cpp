@@ -27,8 +27,10 @@ std::string effectReference() {
     o << "- **`" << t->name << "`**: " << t->summary << ".\n";
     for (const auto& p : t->params) {
       o << "  - `" << p.name << "` (" << kindName(p.kind) << "): " << p.meaning;
-      if (p.fallback) o << "; default `" << p.fallback << "`";
-      else o << "; required";
+      if (p.fallback)
+        o << "; default `" << p.fallback << "`";
+      else
+        o << "; required";
       o << ".\n";
     }
   }

@@ -2,14 +2,12 @@
 
 namespace angiosynth {
 
-extern const EffectType kGaussianNoise, kUniformNoise, kImpulseNoise, kRicianNoise, kPoissonNoise, kBlur, kDropout,
-    kShadow, kBiasField, kContrast, kTexture, kAttenuation, kWarp;
+extern const EffectType kGaussianNoise, kUniformNoise, kImpulseNoise, kRicianNoise, kPoissonNoise, kBlur, kDropout, kShadow, kBiasField, kContrast,
+    kTexture, kAttenuation, kWarp;
 
 const std::vector<const EffectType*>& effectTypes() {
-  static const std::vector<const EffectType*> all{&kGaussianNoise, &kUniformNoise, &kImpulseNoise, &kRicianNoise,
-                                                  &kPoissonNoise,  &kBlur,         &kDropout,      &kShadow,
-                                                  &kBiasField,     &kContrast,     &kTexture,      &kAttenuation,
-                                                  &kWarp};
+  static const std::vector<const EffectType*> all{&kGaussianNoise, &kUniformNoise, &kImpulseNoise, &kRicianNoise, &kPoissonNoise, &kBlur, &kDropout,
+                                                  &kShadow,        &kBiasField,    &kContrast,     &kTexture,     &kAttenuation,  &kWarp};
   return all;
 }
 

@@ -23,29 +23,26 @@ void applyUniform(const Drawn& p, EffectContext& ctx) {
   const double lo = p("low"), hi = p("high");
   if (lo > hi) throw std::invalid_argument("uniform noise: low > high");
   auto& img = ctx.state.image.data;
-  forEachVoxel(static_cast<std::int64_t>(img.size()), [&](std::int64_t v) {
-    img[v] += static_cast<float>(lo + (hi - lo) * s.uniform(static_cast<std::uint64_t>(v)));
-  });
+  forEachVoxel(static_cast<std::int64_t>(img.size()),
+               [&](std::int64_t v) { img[v] += static_cast<float>(lo + (hi - lo) * s.uniform(static_cast<std::uint64_t>(v))); });
 }
 
 }  // namespace
 
-extern const EffectType kGaussianNoise{
-    "gaussian",
-    "additive white Gaussian noise N(mean, sigma²) (VascuSynth's GAUSSIAN)",
-    {{"mean", ParamKind::Intensity, -1e9, 1e9, "0", "mean of the added noise"},
-     {"sigma", ParamKind::Intensity, 0, 1e9, nullptr, "standard deviation of the added noise"}},
-    applyGaussian,
-    /*moves_geometry=*/false,
-    /*noise=*/true};
+extern const EffectType kGaussianNoise{"gaussian",
+                                       "additive white Gaussian noise N(mean, sigma²) (VascuSynth's GAUSSIAN)",
+                                       {{"mean", ParamKind::Intensity, -1e9, 1e9, "0", "mean of the added noise"},
+                                        {"sigma", ParamKind::Intensity, 0, 1e9, nullptr, "standard deviation of the added noise"}},
+                                       applyGaussian,
+                                       /*moves_geometry=*/false,
+                                       /*noise=*/true};
 
-extern const EffectType kUniformNoise{
-    "uniform",
-    "additive uniform noise U(low, high) (VascuSynth's UNIFORM)",
-    {{"low", ParamKind::Intensity, -1e9, 1e9, nullptr, "lower bound of the added noise"},
-     {"high", ParamKind::Intensity, -1e9, 1e9, nullptr, "upper bound of the added noise"}},
-    applyUniform,
-    /*moves_geometry=*/false,
-    /*noise=*/true};
+extern const EffectType kUniformNoise{"uniform",
+                                      "additive uniform noise U(low, high) (VascuSynth's UNIFORM)",
+                                      {{"low", ParamKind::Intensity, -1e9, 1e9, nullptr, "lower bound of the added noise"},
+                                       {"high", ParamKind::Intensity, -1e9, 1e9, nullptr, "upper bound of the added noise"}},
+                                      applyUniform,
+                                      /*moves_geometry=*/false,
+                                      /*noise=*/true};
 
 }  // namespace angiosynth

@@ -14,8 +14,10 @@ void applyImpulse(const Drawn& p, EffectContext& ctx) {
   // One uniform per voxel decides, as VascuSynth's SALTPEPPER: u < ps → salt, u < ps + pp → pepper.
   forEachVoxel(static_cast<std::int64_t>(img.size()), [&](std::int64_t v) {
     const double u = s.uniform(static_cast<std::uint64_t>(v));
-    if (u < ps) img[v] = salt;
-    else if (u < ps + pp) img[v] = pepper;
+    if (u < ps)
+      img[v] = salt;
+    else if (u < ps + pp)
+      img[v] = pepper;
   });
 }
 

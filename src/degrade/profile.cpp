@@ -35,8 +35,7 @@ EffectSpec readEffect(const toml::table& t, const std::string& file, bool& has_w
   EffectSpec e;
   e.line = lineOf(t);
   const auto* type = t.get("type");
-  if (!type || !type->is_string())
-    throw InputError(file, e.line, "an [[effect]] needs type = \"<name>\"; allowed: " + allowedEffects());
+  if (!type || !type->is_string()) throw InputError(file, e.line, "an [[effect]] needs type = \"<name>\"; allowed: " + allowedEffects());
   const std::string name = *type->value<std::string>();
   e.type = findEffectType(name);
   if (!e.type) throw InputError(file, lineOf(*type), "unknown effect '" + name + "'; allowed: " + allowedEffects());
@@ -78,8 +77,8 @@ Profile readProfileToml(const std::filesystem::path& path) {
   static const std::set<std::string> keys{"description", "background", "vessel", "dtype", "clamp_each_step", "effect"};
   for (const auto& [k, v] : root)
     if (!keys.count(std::string(k.str())))
-      throw InputError(file, lineOf(v), "unknown key '" + std::string(k.str()) +
-                                            "'; allowed: description, background, vessel, dtype, clamp_each_step, [[effect]]");
+      throw InputError(file, lineOf(v),
+                       "unknown key '" + std::string(k.str()) + "'; allowed: description, background, vessel, dtype, clamp_each_step, [[effect]]");
   if (const auto* n = root.get("description")) p.description = n->value_or<std::string>("");
   if (const auto* n = root.get("background")) p.background = plainSpec(*n, ParamKind::Intensity, "background", file);
   if (const auto* n = root.get("vessel")) p.vessel = plainSpec(*n, ParamKind::Intensity, "vessel", file);
@@ -123,7 +122,9 @@ Profile readVascuSynthNoiseFile(const std::filesystem::path& path) {
   static const Directive directives[] = {
       {"GAUSSIAN", "gaussian", {"mean", "sigma"}, "GAUSSIAN: <median> <sigma>"},
       {"UNIFORM", "uniform", {"low", "high"}, "UNIFORM: <lower bound> <upper bound>"},
-      {"SALTPEPPER", "impulse", {"salt_value", "salt_probability", "pepper_value", "pepper_probability"},
+      {"SALTPEPPER",
+       "impulse",
+       {"salt_value", "salt_probability", "pepper_value", "pepper_probability"},
        "SALTPEPPER: <salt value> <salt probability> <pepper value> <pepper probability>"},
       {"SHADOW", "shadow", {"count"}, "SHADOW: <number of shadows>"},
   };
@@ -138,14 +139,17 @@ Profile readVascuSynthNoiseFile(const std::filesystem::path& path) {
       const auto words = splitWords(line.text);
       const std::string first = words.empty() ? "" : words[0];
       std::string hint;
-      if (first == "SALTPEPER" || first == "SALTPEPER:") hint = " (VascuSynth ignores this misspelling silently; did you mean SALTPEPPER:?)";
-      else if (colon == std::string::npos) hint = " (a directive ends with ':')";
+      if (first == "SALTPEPER" || first == "SALTPEPER:")
+        hint = " (VascuSynth ignores this misspelling silently; did you mean SALTPEPPER:?)";
+      else if (colon == std::string::npos)
+        hint = " (a directive ends with ':')";
       throw InputError(file, line.number, "unknown noise directive '" + first + "'" + hint + "; allowed: " + allowed);
     }
     const auto words = splitWords(line.text.substr(colon + 1));
     if (words.size() != d->params.size())
-      throw InputError(file, line.number, std::string(d->key) + " takes " + std::to_string(d->params.size()) + " value" +
-                                              (d->params.size() == 1 ? "" : "s") + "; write " + d->usage);
+      throw InputError(
+          file, line.number,
+          std::string(d->key) + " takes " + std::to_string(d->params.size()) + " value" + (d->params.size() == 1 ? "" : "s") + "; write " + d->usage);
     EffectSpec e;
     e.type = findEffectType(d->type);
     e.line = line.number;
@@ -197,8 +201,9 @@ Profile loadProfile(const std::string& ref, const std::filesystem::path& named_i
         if (e.path().extension() == ".toml") names += (names.empty() ? "" : ", ") + e.path().stem().string();
       if (!names.empty()) break;
     }
-    throw InputError(named_in.string(), line, "no profile named '" + ref + "' (looked in " + looked + "); shipped: " + names +
-                                                  "; or give a path to a .toml profile or a VascuSynth noise file");
+    throw InputError(named_in.string(), line,
+                     "no profile named '" + ref + "' (looked in " + looked + "); shipped: " + names +
+                         "; or give a path to a .toml profile or a VascuSynth noise file");
   }
   const auto path = resolveInputPath(r, named_in, line);
   if (path.extension() == ".toml") return readProfileToml(path);

@@ -19,13 +19,13 @@ struct EffectSpec {
 };
 
 struct Profile {
-  std::string name;                       // role suffix: image_<name>
-  std::string file;                       // where it was read, for errors and sample.json
+  std::string name;  // role suffix: image_<name>
+  std::string file;  // where it was read, for errors and sample.json
   std::string description;
-  std::optional<ParamSpec> background;    // tissue intensity (default: [image] background)
-  std::optional<ParamSpec> vessel;        // full-vessel intensity (default: [image] vessel)
-  std::string dtype;                      // empty: [image] dtype
-  bool clamp_each_step = false;           // clamp to dtype's range after every effect (VascuSynth)
+  std::optional<ParamSpec> background;  // tissue intensity (default: [image] background)
+  std::optional<ParamSpec> vessel;      // full-vessel intensity (default: [image] vessel)
+  std::string dtype;                    // empty: [image] dtype
+  bool clamp_each_step = false;         // clamp to dtype's range after every effect (VascuSynth)
   std::vector<EffectSpec> effects;
 };
 

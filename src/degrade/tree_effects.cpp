@@ -63,10 +63,7 @@ void applyDropout(const Drawn& p, EffectContext& ctx) {
       auto [it, fresh] = kept.try_emplace(s.grid.flat(i, j, k), 1.0f);
       it->second *= static_cast<float>(1 - drop);
     });
-    list.push_back({{"segment", s.originalSegment(seg)},
-                    {"centre_mm", {centre.x, centre.y, centre.z}},
-                    {"length_mm", hi - lo},
-                    {"depth", depth}});
+    list.push_back({{"segment", s.originalSegment(seg)}, {"centre_mm", {centre.x, centre.y, centre.z}}, {"length_mm", hi - lo}, {"depth", depth}});
   }
   for (const auto& [v, keep] : kept) s.image.data[v] -= static_cast<float>((1 - keep) * contrast * s.fraction->data[v]);
   ctx.record["gaps"] = list;
@@ -80,9 +77,8 @@ void applyShadow(const Drawn& p, EffectContext& ctx) {
   nlohmann::ordered_json list = nlohmann::ordered_json::array();
   for (int n = 0; n < count; ++n) {
     // As VascuSynth: a random segment (uniform over segments), radius = its length.
-    const auto seg = static_cast<std::int32_t>(1 + std::min<std::uint64_t>(
-                                                       static_cast<std::uint64_t>(ctx.rng.uniform() * t.segmentCount()),
-                                                       t.segmentCount() - 1));
+    const auto seg = static_cast<std::int32_t>(
+        1 + std::min<std::uint64_t>(static_cast<std::uint64_t>(ctx.rng.uniform() * t.segmentCount()), t.segmentCount() - 1));
     const Vec3 a = t.position[t.parent[seg]], b = t.position[seg];
     const Vec3 centre = a + (b - a) * ctx.rng.uniform();
     const double radius = std::max(t.length[seg] * p("radius_scale"), 1e-9);
@@ -92,10 +88,8 @@ void applyShadow(const Drawn& p, EffectContext& ctx) {
       const double d = distance(s.grid.centre(i, j, k), centre);
       if (d < radius) s.image.at(i, j, k) *= static_cast<float>(strength + (1 - strength) * d / radius);
     });
-    list.push_back({{"segment", s.originalSegment(seg)},
-                    {"centre_mm", {centre.x, centre.y, centre.z}},
-                    {"radius_mm", radius},
-                    {"strength", strength}});
+    list.push_back(
+        {{"segment", s.originalSegment(seg)}, {"centre_mm", {centre.x, centre.y, centre.z}}, {"radius_mm", radius}, {"strength", strength}});
   }
   ctx.record["shadows"] = list;
 }
@@ -111,14 +105,13 @@ extern const EffectType kDropout{
      {"depth", ParamKind::Probability, 0, 1, "1", "fraction of the vessel contrast removed at the centre of a gap"}},
     applyDropout};
 
-extern const EffectType kShadow{
-    "shadow",
-    "VascuSynth's shadows: dark blobs on random segments, radius = segment length, gain strength at the centre rising "
-    "linearly to 1 at the rim",
-    {{"count", ParamKind::Count, 0, 1000, nullptr, "number of shadows"},
-     {"strength_min", ParamKind::Number, 0, 1, "0", "least gain at a shadow's centre"},
-     {"strength_max", ParamKind::Number, 0, 1, "1", "greatest gain at a shadow's centre"},
-     {"radius_scale", ParamKind::Number, 0, 1e3, "1", "shadow radius in segment lengths"}},
-    applyShadow};
+extern const EffectType kShadow{"shadow",
+                                "VascuSynth's shadows: dark blobs on random segments, radius = segment length, gain strength at the centre rising "
+                                "linearly to 1 at the rim",
+                                {{"count", ParamKind::Count, 0, 1000, nullptr, "number of shadows"},
+                                 {"strength_min", ParamKind::Number, 0, 1, "0", "least gain at a shadow's centre"},
+                                 {"strength_max", ParamKind::Number, 0, 1, "1", "greatest gain at a shadow's centre"},
+                                 {"radius_scale", ParamKind::Number, 0, 1e3, "1", "shadow radius in segment lengths"}},
+                                applyShadow};
 
 }  // namespace angiosynth

@@ -88,8 +88,9 @@ nlohmann::ordered_json BSplineWarp::describe() const {
   const auto& f = u_[0];
   const Vec3 o = f.latticeOrigin(), h = f.spacing();
   nlohmann::ordered_json j;
-  j["definition"] = "warped image at y = clean image at y + u(y); u is a uniform cubic B-spline with control point (a,b,c) at "
-                    "origin + (a,b,c)*spacing; displacements are listed x fastest; clean points x move to the y solving y + u(y) = x";
+  j["definition"] =
+      "warped image at y = clean image at y + u(y); u is a uniform cubic B-spline with control point (a,b,c) at "
+      "origin + (a,b,c)*spacing; displacements are listed x fastest; clean points x move to the y solving y + u(y) = x";
   j["lattice"] = {f.lattice()[0], f.lattice()[1], f.lattice()[2]};
   j["origin_mm"] = {o.x, o.y, o.z};
   j["spacing_mm"] = {h.x, h.y, h.z};
@@ -106,8 +107,7 @@ VascularTree warpTree(const VascularTree& t, const BSplineWarp& warp, double pie
   std::vector<std::int32_t> order = t.topDownOrder();
   std::vector<std::int64_t> first_point(t.nodeCount() + 1, 0);
   std::vector<int> pieces(t.nodeCount(), 0);
-  for (std::int32_t n = 0; n < t.nodeCount(); ++n)
-    pieces[n] = t.isRoot(n) ? 1 : std::max(1, static_cast<int>(std::ceil(t.length[n] / piece_mm)));
+  for (std::int32_t n = 0; n < t.nodeCount(); ++n) pieces[n] = t.isRoot(n) ? 1 : std::max(1, static_cast<int>(std::ceil(t.length[n] / piece_mm)));
   for (std::int32_t n = 0; n < t.nodeCount(); ++n) first_point[n + 1] = first_point[n] + pieces[n];
   std::vector<Vec3> moved(first_point.back());
   std::vector<double> scale(first_point.back(), 1.0);
@@ -126,7 +126,7 @@ VascularTree warpTree(const VascularTree& t, const BSplineWarp& warp, double pie
       std::array<double, 9> ju;
       warp.displacement(mid, &ju);
       const std::array<double, 9> jpsi = identityPlus(ju);  // ∂ψ/∂y = (∂φ/∂x)⁻¹
-      const Vec3 jd = solve3(jpsi, dir);                      // J·d
+      const Vec3 jd = solve3(jpsi, dir);                    // J·d
       scale[at] = std::sqrt(1.0 / (det3(jpsi) * norm(jd)));
     }
   });
@@ -233,8 +233,8 @@ void applyWarp(const Drawn& p, EffectContext& ctx) {
   for (int ax = 0; ax < 3; ++ax)
     if (m[ax] > BSplineWarp::kMaxDisplacementPerSpacing * h[ax] + 1e-12)
       throw std::invalid_argument("warp: max_displacement " + std::to_string(m[ax]) + " mm exceeds 0.4 × spacing (" +
-                                  std::to_string(BSplineWarp::kMaxDisplacementPerSpacing * h[ax]) +
-                                  " mm) on axis " + std::to_string(ax) + ", beyond which the warp may fold; allowed: <= 0.4 × spacing");
+                                  std::to_string(BSplineWarp::kMaxDisplacementPerSpacing * h[ax]) + " mm) on axis " + std::to_string(ax) +
+                                  ", beyond which the warp may fold; allowed: <= 0.4 × spacing");
   auto warp = std::make_shared<BSplineWarp>(s.grid, h, m, ctx.rng);
   s.image = warpVolume(s.image, *warp);
   s.warped_fraction = std::make_shared<Volume<float>>(warpVolume(*s.fraction, *warp));
@@ -259,8 +259,9 @@ extern const EffectType kWarp{
     "random cubic B-spline deformation of the image, the labels and the tree (curved vessels), invertible by construction",
     {{"spacing", ParamKind::Length3, 1e-9, 1e9, "0.25 fov", "control-point spacing; at least 1 voxel", 1},
      {"max_displacement", ParamKind::Length3, 0, 1e9, "0.05 fov", "largest control displacement per axis (<= 0.4 × spacing)"},
-     {"piece_length", ParamKind::Length, 0, 1e9, "0", "longest piece of a warped vessel in the warped graph (0: one voxel); "
-                                                       "never more than spacing / 8, never less than 1/16 voxel"}},
+     {"piece_length", ParamKind::Length, 0, 1e9, "0",
+      "longest piece of a warped vessel in the warped graph (0: one voxel); "
+      "never more than spacing / 8, never less than 1/16 voxel"}},
     applyWarp,
     /*moves_geometry=*/true};
 

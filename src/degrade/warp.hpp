@@ -59,8 +59,7 @@ Volume<float> warpVolume(const Volume<float>& v, const BSplineWarp& warp);
 // warped centrelines cross; centreline and radius are re-derived from the warped tree;
 // instances are taken from the clean instances (the corner of the trilinear stencil with the
 // largest weight among labelled corners), so no label value is invented.
-GroundTruthVolumes warpedLabels(const Volume<float>& warped_fraction, const VascularTree& warped_tree,
-                                const std::vector<std::int32_t>& origin, const Volume<std::uint32_t>& clean_instances,
-                                const BSplineWarp& warp, int centerline_connectivity = 26);
+GroundTruthVolumes warpedLabels(const Volume<float>& warped_fraction, const VascularTree& warped_tree, const std::vector<std::int32_t>& origin,
+                                const Volume<std::uint32_t>& clean_instances, const BSplineWarp& warp, int centerline_connectivity = 26);
 
 }  // namespace angiosynth

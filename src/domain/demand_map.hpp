@@ -20,9 +20,7 @@ struct DemandMap {
   std::vector<std::vector<double>> supply_sets;
 
   std::int64_t voxelCount() const { return std::int64_t(dims[0]) * dims[1] * dims[2]; }
-  std::int64_t flat(std::int32_t i, std::int32_t j, std::int32_t k) const {
-    return i + std::int64_t(dims[0]) * (j + std::int64_t(dims[1]) * k);
-  }
+  std::int64_t flat(std::int32_t i, std::int32_t j, std::int32_t k) const { return i + std::int64_t(dims[0]) * (j + std::int64_t(dims[1]) * k); }
   Vec3 extentMm() const { return Vec3(dims[0], dims[1], dims[2]) * voxel_mm; }
   Vec3 toVoxel(const Vec3& mm) const { return mm / voxel_mm; }
   Vec3 toMm(const Vec3& vox) const { return vox * voxel_mm; }

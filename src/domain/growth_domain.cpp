@@ -44,8 +44,10 @@ GrowthDomain GrowthDomain::analytic(DomainShape shape, double size_mm, double vo
   m.voxel_mm = voxel_mm;
   m.dims = analyticDims(shape, size_mm, voxel_mm, margin_voxels);
   d.center_ = Vec3(m.dims[0], m.dims[1], m.dims[2]) * (voxel_mm / 2);
-  if (d.dimension_ == 2) d.measure_ = round ? std::numbers::pi * h * h : 4 * h * h;
-  else d.measure_ = round ? 4.0 / 3.0 * std::numbers::pi * h * h * h : 8 * h * h * h;
+  if (d.dimension_ == 2)
+    d.measure_ = round ? std::numbers::pi * h * h : 4 * h * h;
+  else
+    d.measure_ = round ? 4.0 / 3.0 * std::numbers::pi * h * h * h : 8 * h * h * h;
   m.demand.assign(m.voxelCount(), 0.0f);
   for (int k = 0; k < m.dims[2]; ++k)
     for (int j = 0; j < m.dims[1]; ++j)
@@ -108,8 +110,7 @@ double GrowthDomain::maskDepth(const Vec3& p) const {
   double v = 0;
   for (int corner = 0; corner < 8; ++corner) {
     const int di = corner & 1, dj = (corner >> 1) & 1, dk = (corner >> 2) & 1;
-    const int i = std::min(i0[0] + di, m.dims[0] - 1), j = std::min(i0[1] + dj, m.dims[1] - 1),
-              k = std::min(i0[2] + dk, m.dims[2] - 1);
+    const int i = std::min(i0[0] + di, m.dims[0] - 1), j = std::min(i0[1] + dj, m.dims[1] - 1), k = std::min(i0[2] + dk, m.dims[2] - 1);
     const double w = (di ? f[0] : 1 - f[0]) * (dj ? f[1] : 1 - f[1]) * (dk ? f[2] : 1 - f[2]);
     if (w != 0) v += w * depth_[m.flat(i, j, k)];
   }

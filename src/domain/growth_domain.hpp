@@ -67,9 +67,9 @@ class GrowthDomain {
   double size_ = 0;  // radius, or half the side
   bool demand_weighted_ = false;
   double mean_weight_ = 1;
-  std::vector<float> depth_;  // masks: depth at voxel centres, mm
-  std::shared_ptr<const DemandSampler> sampler_;               // demand-weighted masks
-  std::shared_ptr<const std::vector<std::int64_t>> inside_;    // uniform masks: their voxels in order
+  std::vector<float> depth_;                                 // masks: depth at voxel centres, mm
+  std::shared_ptr<const DemandSampler> sampler_;             // demand-weighted masks
+  std::shared_ptr<const std::vector<std::int64_t>> inside_;  // uniform masks: their voxels in order
 };
 
 // Depth (mm, positive inside) at every voxel centre of a mask with weight > 0 inside; voxels

@@ -31,8 +31,7 @@ std::vector<float> exactDepth(const DemandMap& m) {
       for (int j = 0; j < m.dims[1]; ++j)
         for (int i = 0; i < m.dims[0]; ++i) {
           const auto v = at(i + 1, j + 1, k + off);
-          if ((inside[v] != 0) == to_outside)
-            depth[m.flat(i, j, k)] = float((to_outside ? 1.0 : -1.0) * (std::sqrt(g[v]) - 0.5) * m.voxel_mm);
+          if ((inside[v] != 0) == to_outside) depth[m.flat(i, j, k)] = float((to_outside ? 1.0 : -1.0) * (std::sqrt(g[v]) - 0.5) * m.voxel_mm);
         }
   }
   return depth;

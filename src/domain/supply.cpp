@@ -16,8 +16,7 @@ double supplyFactor(const std::vector<double>& c, double d) {
   return sum > 0 ? std::max(0.0, 1.0 - 1.0 / sum) : 0.0;
 }
 
-void perfuse(const DemandMap& map, DemandSampler& sampler, const Vec3& terminal_mm,
-             std::vector<std::pair<std::int64_t, double>>& scratch) {
+void perfuse(const DemandMap& map, DemandSampler& sampler, const Vec3& terminal_mm, std::vector<std::pair<std::int64_t, double>>& scratch) {
   const auto home = map.voxelAt(terminal_mm);
   if (home < 0) return;
   const auto& c = map.supplyAt(home);

@@ -16,7 +16,6 @@ double supplyFactor(const std::vector<double>& coefficients, double d);
 
 // Applies the law around terminal t (mm) using the supply coefficients of t's voxel; touches
 // only voxels within the cut-off.
-void perfuse(const DemandMap& map, DemandSampler& sampler, const Vec3& terminal_mm,
-             std::vector<std::pair<std::int64_t, double>>& scratch);
+void perfuse(const DemandMap& map, DemandSampler& sampler, const Vec3& terminal_mm, std::vector<std::pair<std::int64_t, double>>& scratch);
 
 }  // namespace angiosynth

@@ -65,8 +65,7 @@ int removeAbandonedTemporaries(const fs::path& dir, const std::string& target_na
 }
 
 AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
-  if (target_.empty() || !target_.has_filename())
-    throw InputError(target_.string(), 0, "is not a file name; give a file such as out/scores.json");
+  if (target_.empty() || !target_.has_filename()) throw InputError(target_.string(), 0, "is not a file name; give a file such as out/scores.json");
   const fs::path dir = target_.has_parent_path() ? target_.parent_path() : fs::path(".");
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw InputError(target_.string(), 0, "its directory " + dir.string() + " does not exist; create it first");
@@ -116,11 +115,12 @@ void AtomicFile::commit(bool replace) {
   stream_ = nullptr;
   if (!written || !closed) throw InputError(target_.string(), 0, "cannot write this file (disk full or no permission?)");
   int error = 0;
-  const bool moved = replace ? ::rename(temporary_.c_str(), target_.c_str()) == 0 || ((error = errno), false)
-                             : renameNoReplace(temporary_, target_, error);
+  const bool moved =
+      replace ? ::rename(temporary_.c_str(), target_.c_str()) == 0 || ((error = errno), false) : renameNoReplace(temporary_, target_, error);
   if (!moved)
-    throw InputError(target_.string(), 0, error == EEXIST ? std::string("exists; angiosynth does not replace it")
-                                                          : std::string("cannot move the finished file into place: ") + std::strerror(error));
+    throw InputError(target_.string(), 0,
+                     error == EEXIST ? std::string("exists; angiosynth does not replace it")
+                                     : std::string("cannot move the finished file into place: ") + std::strerror(error));
   committed_ = true;
   unregisterStaging(temporary_);
 }

@@ -48,8 +48,7 @@ void checkOutputFiles(const std::vector<OutputFile>& outputs, const std::vector<
     const auto& [out, what] = outputs[k];
     if (out.empty()) continue;
     const std::string shown = out.string();
-    if (!out.has_filename() || fs::is_directory(out, ec))
-      throw InputError(what, 0, "'" + shown + "' is a directory; give a file name");
+    if (!out.has_filename() || fs::is_directory(out, ec)) throw InputError(what, 0, "'" + shown + "' is a directory; give a file name");
     for (const auto& in : inputs) {
       if (in.empty()) continue;
       const bool same = isWithin(out, in) || (fs::exists(out, ec) && fs::exists(in, ec) && fs::equivalent(out, in, ec));
@@ -73,13 +72,14 @@ void checkOutputPath(const fs::path& out, const std::vector<fs::path>& inputs, c
     throw InputError(what, 0, "'" + shown + "' is a file, not a directory; give a new or empty directory");
   const fs::path cwd = fs::current_path(ec);
   if (!ec && isWithin(cwd, out))
-    throw InputError(what, 0, "'" + shown + "' is the working directory or contains it; angiosynth refuses to write "
-                              "there because replacing it could remove your files; give a new subdirectory such as out/run1");
+    throw InputError(what, 0,
+                     "'" + shown +
+                         "' is the working directory or contains it; angiosynth refuses to write "
+                         "there because replacing it could remove your files; give a new subdirectory such as out/run1");
   for (const auto& in : inputs) {
     if (in.empty()) continue;
     if (isWithin(in, out))
-      throw InputError(what, 0, "'" + shown + "' contains the input " + in.string() +
-                                    "; give an output directory that holds none of the inputs");
+      throw InputError(what, 0, "'" + shown + "' contains the input " + in.string() + "; give an output directory that holds none of the inputs");
   }
 }
 

@@ -10,8 +10,7 @@ namespace angiosynth {
 
 // Throws InputError (exit 2) when `out` is an existing file, is the working directory, or is an
 // ancestor of it or of any of `inputs`. `what` names the option ("--out", "name list line 3").
-void checkOutputPath(const std::filesystem::path& out, const std::vector<std::filesystem::path>& inputs,
-                     const std::string& what);
+void checkOutputPath(const std::filesystem::path& out, const std::vector<std::filesystem::path>& inputs, const std::string& what);
 
 // One output file of a command (--out, --csv, --plot, OUT) and the option that names it.
 struct OutputFile {

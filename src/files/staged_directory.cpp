@@ -46,9 +46,8 @@ std::vector<std::string> filesBelow(const fs::path& dir) {
 }
 
 void writeRecord(const fs::path& file, const std::vector<std::string>& files) {
-  nlohmann::ordered_json j{{"written_by", "angiosynth"},
-                           {"note", "files angiosynth wrote here; a rerun replaces or removes only these"},
-                           {"files", files}};
+  nlohmann::ordered_json j{
+      {"written_by", "angiosynth"}, {"note", "files angiosynth wrote here; a rerun replaces or removes only these"}, {"files", files}};
   writeTextFile(file, [&](std::ostream& o) { o << j.dump(2) << "\n"; });
 }
 
@@ -65,8 +64,7 @@ std::vector<std::string> recordedOutputFiles(const fs::path& dir) {
   return out;
 }
 
-StagedDirectory::StagedDirectory(fs::path target, ExistingOutput existing, const std::vector<fs::path>& inputs,
-                                 const std::string& what)
+StagedDirectory::StagedDirectory(fs::path target, ExistingOutput existing, const std::vector<fs::path>& inputs, const std::string& what)
     : target_(std::move(target)) {
   if (target_.has_relative_path() && target_.filename().empty()) target_ = target_.parent_path();
   checkOutputPath(target_, inputs, what);
@@ -74,11 +72,13 @@ StagedDirectory::StagedDirectory(fs::path target, ExistingOutput existing, const
   if (fs::exists(target_, ec) && !isEmptyDirectory(target_)) {
     const bool ours = fs::exists(target_ / kOutputRecord, ec);
     if (existing == ExistingOutput::Refuse)
-      throw InputError(target_.string(), 0, std::string("output directory exists and is not empty; choose another ") + what +
-                                                (ours ? " or add --force (it replaces only the files angiosynth wrote there)" : ""));
+      throw InputError(target_.string(), 0,
+                       std::string("output directory exists and is not empty; choose another ") + what +
+                           (ours ? " or add --force (it replaces only the files angiosynth wrote there)" : ""));
     if (existing == ExistingOutput::ReplaceOwn && !ours)
-      throw InputError(target_.string(), 0, std::string("holds files angiosynth did not write (it has no ") + kOutputRecord +
-                                                "); --force replaces only earlier angiosynth outputs: choose a new or empty directory");
+      throw InputError(target_.string(), 0,
+                       std::string("holds files angiosynth did not write (it has no ") + kOutputRecord +
+                           "); --force replaces only earlier angiosynth outputs: choose a new or empty directory");
   }
   const fs::path parent = target_.has_parent_path() ? target_.parent_path() : fs::path(".");
   fs::create_directories(parent, ec);
@@ -95,13 +95,14 @@ StagedDirectory::StagedDirectory(fs::path target, ExistingOutput existing, const
     staging_ = parent / name;
     const auto status = fs::symlink_status(staging_, ec);
     if (fs::exists(status)) {
-      if (k == 0 && fs::is_directory(status) && fs::exists(staging_ / kStagingMarker, ec)) fs::remove_all(staging_, ec);
-      else continue;
+      if (k == 0 && fs::is_directory(status) && fs::exists(staging_ / kStagingMarker, ec))
+        fs::remove_all(staging_, ec);
+      else
+        continue;
     }
     ec.clear();
     if (fs::create_directory(staging_, ec)) break;
-    if (ec != std::errc::file_exists || k > 64)
-      throw InputError(parent.string(), 0, "cannot create an output directory here: " + ec.message());
+    if (ec != std::errc::file_exists || k > 64) throw InputError(parent.string(), 0, "cannot create an output directory here: " + ec.message());
   }
   registerStaging(staging_);
   std::ofstream(staging_ / kStagingMarker).put('\n');
@@ -134,8 +135,7 @@ void StagedDirectory::commit() {
   for (const auto& rel : written) {
     const fs::path to = target_ / rel;
     fs::create_directories(to.parent_path(), ec);
-    if (fs::is_directory(to, ec))
-      throw InputError(to.string(), 0, "is a directory where angiosynth writes a file; move it away and run again");
+    if (fs::is_directory(to, ec)) throw InputError(to.string(), 0, "is a directory where angiosynth writes a file; move it away and run again");
     fs::rename(staging_ / rel, to, ec);
     if (ec) throw InputError(to.string(), 0, "cannot move the finished file into place: " + ec.message());
   }

@@ -22,8 +22,7 @@ std::vector<TextLine> readTextLines(const std::filesystem::path& file, const std
   std::ifstream in(file, std::ios::binary);
   if (!in) {
     const bool exists = std::filesystem::exists(file);
-    throw InputError(file.string(), 0, std::string(exists ? "cannot read " : "no such ") + what +
-                                           (exists ? " (permission?)" : " file"));
+    throw InputError(file.string(), 0, std::string(exists ? "cannot read " : "no such ") + what + (exists ? " (permission?)" : " file"));
   }
   std::vector<TextLine> lines;
   std::string raw;
@@ -57,8 +56,7 @@ std::int64_t parseInteger(const std::string& word, const std::string& file, int 
   const char* b = word.data();
   if (!word.empty() && word[0] == '+') ++b;
   const auto [ptr, ec] = std::from_chars(b, word.data() + word.size(), v);
-  if (ec != std::errc() || ptr != word.data() + word.size())
-    throw InputError(file, line, what + ": '" + word + "' is not a whole number");
+  if (ec != std::errc() || ptr != word.data() + word.size()) throw InputError(file, line, what + ": '" + word + "' is not a whole number");
   return v;
 }
 

@@ -23,7 +23,7 @@ class TomlReader;
 
 // One key of a method's tables, as docs/methods.md and `angiosynth methods` list it.
 struct MethodParam {
-  const char* table;     // "domain", "tree", "physics", or a sub-table such as "tree.inlet"
+  const char* table;  // "domain", "tree", "physics", or a sub-table such as "tree.inlet"
   const char* key;
   const char* unit;      // "mm", "Pa", "mm^3/s", "Pa*s", "" for numbers, "text", "true/false", "[x, y, z] mm", ...
   const char* fallback;  // the default as written in a file ("3.6 mPa*s"); nullptr: required
@@ -69,7 +69,7 @@ class GrowthSetup {
 
 struct GrowthMethod {
   const char* name;
-  const char* summary;            // one line for the docs and `angiosynth methods`
+  const char* summary;  // one line for the docs and `angiosynth methods`
   std::vector<MethodParam> params;
   // Reads [domain], [tree] and [physics] of a TOML parameter file.
   std::shared_ptr<const GrowthSetup> (*read)(const TomlReader& reader, const GrowthMethod& self);

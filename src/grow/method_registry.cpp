@@ -45,8 +45,10 @@ std::string methodReference() {
       o << "  - `[" << p.table << "] " << p.key << "`";
       if (*p.unit) o << " (" << p.unit << ")";
       o << ": " << p.meaning;
-      if (p.fallback) o << "; default `" << p.fallback << "`";
-      else o << "; required";
+      if (p.fallback)
+        o << "; default `" << p.fallback << "`";
+      else
+        o << "; required";
       o << ".\n";
     }
   }

@@ -12,8 +12,7 @@ namespace angiosynth {
 void deflateInto(std::ostream& out, const void* data, std::size_t bytes, DeflateFraming framing, const std::filesystem::path& file) {
   z_stream zs{};
   const int window_bits = framing == DeflateFraming::Gzip ? 15 + 16 : 15;
-  if (deflateInit2(&zs, 6, Z_DEFLATED, window_bits, 8, Z_DEFAULT_STRATEGY) != Z_OK)
-    throw InputError(file.string(), 0, "cannot start compression");
+  if (deflateInit2(&zs, 6, Z_DEFLATED, window_bits, 8, Z_DEFAULT_STRATEGY) != Z_OK) throw InputError(file.string(), 0, "cannot start compression");
   const auto* in = static_cast<const unsigned char*>(data);
   std::size_t left = bytes;
   std::vector<unsigned char> buf(1 << 20);

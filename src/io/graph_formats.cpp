@@ -14,11 +14,8 @@ constexpr GraphFile kCco[] = {{"tree", ".cco", "cco", &writeCco}};
 constexpr GraphFile kGraphml[] = {{"tree", ".graphml", "graphml", &writeGraphml}};
 
 const GraphFormat kGraphFormats[] = {
-    {"csv", "VesselGraph-style node and edge tables", kCsv},
-    {"vtp", "VTK PolyData centrelines", kVtp},
-    {"swc", "SWC rows", kSwc},
-    {"graphml", "GraphML for NetworkX", kGraphml},
-    {"cco", "VItA's .cco tree", kCco},
+    {"csv", "VesselGraph-style node and edge tables", kCsv}, {"vtp", "VTK PolyData centrelines", kVtp}, {"swc", "SWC rows", kSwc},
+    {"graphml", "GraphML for NetworkX", kGraphml},           {"cco", "VItA's .cco tree", kCco},
 };
 
 }  // namespace

@@ -12,8 +12,8 @@
 namespace angiosynth {
 
 struct GraphFrame {
-  double voxel_mm = 1;       // for position_voxel (map voxels)
-  CoherentUnits vs_units;    // VascuSynth dialect: radii in this length unit, flows in its ^3/s
+  double voxel_mm = 1;     // for position_voxel (map voxels)
+  CoherentUnits vs_units;  // VascuSynth dialect: radii in this length unit, flows in its ^3/s
 };
 
 // Every writer but VascuSynth's dialect names each node's and segment's tree (its id) and kind
@@ -23,8 +23,7 @@ const TreeInfo& treeOf(const std::vector<TreeInfo>& trees, const VascularTree& t
 // Valid GXL 1.0: nodes carry type, tree, kind, position (mm), position_voxel; edges tree, kind,
 // radius (mm), length (mm), flow (mm^3/s), pressure_proximal and pressure_distal (Pa). Edge e<i>
 // ends at node n<i>.
-void writeGxl(std::ostream& out, const VascularTree& tree, const std::vector<TreeInfo>& trees, const GraphFrame& frame,
-              const std::string& graph_id);
+void writeGxl(std::ostream& out, const VascularTree& tree, const std::vector<TreeInfo>& trees, const GraphFrame& frame, const std::string& graph_id);
 // VascuSynth 2011's dialect, byte for byte in layout (leading spaces in names and values,
 // " bifurication ", 6 significant digits, positions in map voxels) for users' existing scripts.
 void writeVascuSynthGxl(std::ostream& out, const VascularTree& tree, const GraphFrame& frame, const std::string& graph_id);

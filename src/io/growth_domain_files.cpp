@@ -20,9 +20,9 @@ constexpr std::uint64_t kMaskBytesPerVoxel = 4 + 4 + 2 + 16 + 4;
 void checkDomainMemory(std::int64_t voxels, std::uint64_t limit, const std::string& file, int line, const std::string& what) {
   const std::uint64_t need = std::uint64_t(voxels) * kMaskBytesPerVoxel;
   if (need > limit)
-    throw InputError(file, line, what + " of " + std::to_string(voxels) + " voxels needs " + formatBytes(need) +
-                                     " to grow in, more than the limit of " + formatBytes(limit) +
-                                     "; use a coarser voxel_size or raise --memory-limit");
+    throw InputError(file, line,
+                     what + " of " + std::to_string(voxels) + " voxels needs " + formatBytes(need) + " to grow in, more than the limit of " +
+                         formatBytes(limit) + "; use a coarser voxel_size or raise --memory-limit");
 }
 
 bool isNifti(const std::filesystem::path& p) {

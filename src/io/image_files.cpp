@@ -17,9 +17,7 @@
 namespace angiosynth {
 namespace {
 
-[[noreturn]] void fail(const std::filesystem::path& file, const std::string& why) {
-  throw InputError(file.string(), 0, "cannot write: " + why);
-}
+[[noreturn]] void fail(const std::filesystem::path& file, const std::string& why) { throw InputError(file.string(), 0, "cannot write: " + why); }
 
 struct FileCloser {
   void operator()(std::FILE* f) const { std::fclose(f); }
@@ -55,7 +53,8 @@ void writeTiff(const std::filesystem::path& file, const VolumeView& v) {
   const int format = v.type == VoxelType::Float32 ? SAMPLEFORMAT_IEEEFP : v.type == VoxelType::Int16 ? SAMPLEFORMAT_INT : SAMPLEFORMAT_UINT;
   const std::size_t row = std::size_t(g.dims[0]) * bytes, slice = row * std::size_t(g.dims[1]);
   // Strips of about 64 KiB: small enough to stream, large enough to compress well.
-  const std::uint32_t rows_per_strip = std::uint32_t(std::max<std::size_t>(1, std::min<std::size_t>(g.dims[1], 65536 / std::max<std::size_t>(row, 1))));
+  const std::uint32_t rows_per_strip =
+      std::uint32_t(std::max<std::size_t>(1, std::min<std::size_t>(g.dims[1], 65536 / std::max<std::size_t>(row, 1))));
   for (std::int32_t z = 0; z < g.dims[2]; ++z) {
     TIFF* t = tif.get();
     TIFFSetField(t, TIFFTAG_IMAGEWIDTH, std::uint32_t(g.dims[0]));

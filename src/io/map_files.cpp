@@ -15,12 +15,11 @@ struct Box {
   std::int32_t lo[3], hi[3];
 };
 
-std::array<std::int32_t, 3> readDims(const TextLine& l, const std::string& file, std::size_t words_expected,
-                                     const std::string& what) {
+std::array<std::int32_t, 3> readDims(const TextLine& l, const std::string& file, std::size_t words_expected, const std::string& what) {
   const auto w = splitWords(l.text);
   if (w.size() != words_expected)
-    throw InputError(file, l.number, "the first line of a " + what + " must be '" +
-                                         (words_expected == 3 ? "DX DY DZ" : "DX DY DZ K") + "', got '" + l.text + "'");
+    throw InputError(file, l.number,
+                     "the first line of a " + what + " must be '" + (words_expected == 3 ? "DX DY DZ" : "DX DY DZ K") + "', got '" + l.text + "'");
   std::array<std::int32_t, 3> d{};
   for (int ax = 0; ax < 3; ++ax) {
     const auto v = parseInteger(w[ax], file, l.number, "map size");
@@ -39,9 +38,9 @@ Box readBox(const TextLine& l, const std::string& file, const std::array<std::in
     b.lo[ax] = static_cast<std::int32_t>(std::clamp<std::int64_t>(lo, -1, dims[ax] + 1));  // out of range stays out of range
     b.hi[ax] = static_cast<std::int32_t>(std::clamp<std::int64_t>(hi, -1, dims[ax] + 1));
     if (lo < 0 || hi > dims[ax] || lo >= hi)
-      throw InputError(file, l.number, "box '" + l.text + "' lies outside the map or is empty; allowed: 0 <= x0 < x1 <= " +
-                                           std::to_string(dims[0]) + ", 0 <= y0 < y1 <= " + std::to_string(dims[1]) +
-                                           ", 0 <= z0 < z1 <= " + std::to_string(dims[2]) + " (half-open boxes)");
+      throw InputError(file, l.number,
+                       "box '" + l.text + "' lies outside the map or is empty; allowed: 0 <= x0 < x1 <= " + std::to_string(dims[0]) +
+                           ", 0 <= y0 < y1 <= " + std::to_string(dims[1]) + ", 0 <= z0 < z1 <= " + std::to_string(dims[2]) + " (half-open boxes)");
   }
   return b;
 }
@@ -68,10 +67,10 @@ DemandMap loadDomain(const BoxMapSpec& sc, std::uint64_t memory_limit) {
   m.voxel_mm = sc.voxel_mm;
   const auto need = growthBytesFor(m.voxelCount());
   if (need > memory_limit)
-    throw InputError(file, lines[0].number, "a " + std::to_string(m.dims[0]) + "x" + std::to_string(m.dims[1]) + "x" +
-                                                std::to_string(m.dims[2]) + " map needs " + formatBytes(need) +
-                                                " to grow in, more than the limit of " + formatBytes(memory_limit) +
-                                                "; use a coarser map or raise --memory-limit");
+    throw InputError(file, lines[0].number,
+                     "a " + std::to_string(m.dims[0]) + "x" + std::to_string(m.dims[1]) + "x" + std::to_string(m.dims[2]) + " map needs " +
+                         formatBytes(need) + " to grow in, more than the limit of " + formatBytes(memory_limit) +
+                         "; use a coarser map or raise --memory-limit");
   m.demand.assign(static_cast<std::size_t>(m.voxelCount()), 0.0f);
   if ((lines.size() - 1) % 2 != 0)
     throw InputError(file, lines.back().number, "a box line has no value line after it; expected pairs of 'x0 y0 z0 x1 y1 z1' and 'value'");
@@ -94,13 +93,13 @@ DemandMap loadDomain(const BoxMapSpec& sc, std::uint64_t memory_limit) {
     const auto w0 = splitWords(sl[0].text);
     const auto sdims = readDims(sl[0], sfile, 4, "supply map");
     if (sdims != m.dims)
-      throw InputError(sfile, sl[0].number, "supply map size differs from the demand map's " + std::to_string(m.dims[0]) + " " +
-                                                std::to_string(m.dims[1]) + " " + std::to_string(m.dims[2]));
+      throw InputError(sfile, sl[0].number,
+                       "supply map size differs from the demand map's " + std::to_string(m.dims[0]) + " " + std::to_string(m.dims[1]) + " " +
+                           std::to_string(m.dims[2]));
     const auto K = parseInteger(w0[3], sfile, sl[0].number, "K");
     if (K < 1 || K > 16) throw InputError(sfile, sl[0].number, "K = " + w0[3] + " is out of range; allowed: 1 to 16 values per voxel");
     m.supply_sets = {{}};  // index 0: not covered by any box, no reduction
-    if ((sl.size() - 1) % 2 != 0)
-      throw InputError(sfile, sl.back().number, "a box line has no coefficient line after it");
+    if ((sl.size() - 1) % 2 != 0) throw InputError(sfile, sl.back().number, "a box line has no coefficient line after it");
     for (std::size_t i = 1; i + 1 < sl.size(); i += 2) {
       const Box b = readBox(sl[i], sfile, m.dims);
       const auto w = splitWords(sl[i + 1].text);
@@ -124,11 +123,12 @@ DemandMap loadDomain(const BoxMapSpec& sc, std::uint64_t memory_limit) {
   const Vec3 r = sc.root_voxel;
   const std::string size = std::to_string(m.dims[0]) + " x " + std::to_string(m.dims[1]) + " x " + std::to_string(m.dims[2]);
   if (r.x < 0 || r.y < 0 || r.z < 0 || r.x >= m.dims[0] || r.y >= m.dims[1] || r.z >= m.dims[2])
-    throw InputError(sc.parameter_file, sc.root_line, "the root (" + show3(r) + " map voxels) lies outside the " + size +
-                                                          " demand map; allowed: 0 <= x < " + std::to_string(m.dims[0]) + " etc.");
+    throw InputError(
+        sc.parameter_file, sc.root_line,
+        "the root (" + show3(r) + " map voxels) lies outside the " + size + " demand map; allowed: 0 <= x < " + std::to_string(m.dims[0]) + " etc.");
   if (!m.perfusable(m.toMm(r)))
-    throw InputError(sc.parameter_file, sc.root_line, "the root (" + show3(r) + " map voxels) lies in a zero-demand voxel of " +
-                                                          file + "; place it where the demand is > 0");
+    throw InputError(sc.parameter_file, sc.root_line,
+                     "the root (" + show3(r) + " map voxels) lies in a zero-demand voxel of " + file + "; place it where the demand is > 0");
   double total = 0;
   for (float d : m.demand) total += d;
   if (!(total > 0)) throw InputError(file, 0, "the demand map is zero everywhere; give some box a demand > 0");

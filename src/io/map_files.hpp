@@ -12,13 +12,13 @@ namespace angiosynth {
 
 // A box-map domain as a parameter file names it.
 struct BoxMapSpec {
-  std::string parameter_file;                  // where the root was given, for errors
+  std::string parameter_file;  // where the root was given, for errors
   std::filesystem::path demand_map;
-  std::filesystem::path supply_map;            // empty: supply_coefficients everywhere
+  std::filesystem::path supply_map;  // empty: supply_coefficients everywhere
   std::vector<double> supply_coefficients{0.65, 0.34, 0.01, 7};
   int supply_line = 0;
   double voxel_mm = 0;
-  Vec3 root_voxel;                             // map-voxel coordinates
+  Vec3 root_voxel;  // map-voxel coordinates
   int root_line = 0;
 };
 

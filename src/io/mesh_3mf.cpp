@@ -87,7 +87,8 @@ void writeThreeMf(std::ostream& out, const SurfaceMesh& m) {
   day.tm_year = 80, day.tm_mday = 1, day.tm_hour = 12;
   const std::time_t fixed = std::mktime(&day);
   for (const auto& [name, text] : {std::pair<const char*, std::string_view>{"[Content_Types].xml", kContentTypes},
-                                   {"_rels/.rels", kRelationships}, {"3D/3dmodel.model", model}}) {
+                                   {"_rels/.rels", kRelationships},
+                                   {"3D/3dmodel.model", model}}) {
     zip_source_t* s = zip_source_buffer(za, text.data(), text.size(), 0);
     check(s != nullptr, "cannot add a file", za);
     const zip_int64_t index = zip_file_add(za, name, s, ZIP_FL_ENC_UTF_8);

@@ -101,12 +101,8 @@ void writeMeshVtp(std::ostream& out, const SurfaceMesh& m) {
 namespace {
 
 constexpr MeshFormat kMeshFormats[] = {
-    {"stl", "binary STL", &writeStl},
-    {"obj", "Wavefront OBJ", &writeObj},
-    {"ply", "binary PLY", &writePly},
-    {"off", "OFF", &writeOff},
-    {"vtp", "VTK PolyData", &writeMeshVtp},
-    {"3mf", "3MF, one object per tree", &writeThreeMf},
+    {"stl", "binary STL", &writeStl}, {"obj", "Wavefront OBJ", &writeObj},    {"ply", "binary PLY", &writePly},
+    {"off", "OFF", &writeOff},        {"vtp", "VTK PolyData", &writeMeshVtp}, {"3mf", "3MF, one object per tree", &writeThreeMf},
 };
 
 }  // namespace

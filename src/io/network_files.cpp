@@ -44,8 +44,7 @@ double number(const std::string& file, const Line& l, std::size_t k, const char*
     std::size_t used = 0;
     const double v = std::stod(l.tokens[k], &used);
     if (used == l.tokens[k].size() && std::isfinite(v)) return v;
-  } catch (const std::exception&) {
-  }
+  } catch (const std::exception&) {}
   throw InputError(file, l.number, std::string(what) + " '" + l.tokens[k] + "' is not a finite number");
 }
 
@@ -54,7 +53,6 @@ long long whole(const std::string& file, const Line& l, std::size_t k, const cha
   if (v != std::floor(v) || std::abs(v) > 1e15) throw InputError(file, l.number, std::string(what) + " '" + l.tokens[k] + "' is not an integer");
   return static_cast<long long>(v);
 }
-
 
 }  // namespace
 
@@ -71,8 +69,9 @@ ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, 
     if (r.radius_start != -1) physical::checkRadius(r.radius_start * unit_mm, file, r.line, of + ": its radius at the start", true);
     for (const double w : {r.wall_start, r.wall})
       if (!(w * unit_mm >= 0 && w * unit_mm <= physical::kMaxRadiusMm))
-        throw InputError(file, r.line, of + ": a wall thickness of " + show(w * unit_mm) + " mm is out of range; allowed: 0 (none) to " +
-                                           show(physical::kMaxRadiusMm) + " mm");
+        throw InputError(
+            file, r.line,
+            of + ": a wall thickness of " + show(w * unit_mm) + " mm is out of range; allowed: 0 (none) to " + show(physical::kMaxRadiusMm) + " mm");
   }
   std::vector<std::vector<std::size_t>> kids(rows.size());
   std::vector<std::size_t> roots;
@@ -138,8 +137,9 @@ ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, 
         if (!swc) {
           const double tol = 1e-9 * (1 + norm(rows[k].dist));
           if (distance(row.prox, rows[k].dist) > tol)
-            throw InputError(file, row.line, "vessel " + row.id + " starts at " + show3(row.prox) + ", not where its parent " + rows[k].id +
-                                                 " ends (" + show3(rows[k].dist) + ")");
+            throw InputError(file, row.line,
+                             "vessel " + row.id + " starts at " + show3(row.prox) + ", not where its parent " + rows[k].id + " ends (" +
+                                 show3(rows[k].dist) + ")");
         }
         node[c] = t.addNode(row.dist * unit_mm, from);
         note(node[c], row);
@@ -153,8 +153,7 @@ ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, 
       if (node[k] < 0) throw InputError(file, rows[k].line, rows[k].id + " is not connected to a root: its parents form a cycle");
   for (std::int32_t i = 0; i < t.nodeCount(); ++i)
     if (!t.isRoot(i) && !(t.length[i] > 0) && !net.ids[i].empty()) throw InputError(file, net.lines[i], net.ids[i] + " has zero length");
-  if (t.segmentCount() == 0)
-    throw InputError(file, rows.front().line, "no vessel; allowed: a network of at least one vessel (two connected nodes)");
+  if (t.segmentCount() == 0) throw InputError(file, rows.front().line, "no vessel; allowed: a network of at least one vessel (two connected nodes)");
   return net;
 }
 
@@ -165,8 +164,9 @@ std::uint8_t branchingFromVita(const std::string& file, int line, long long code
     case 2: return std::uint8_t(Branching::Versatile);
     case 3: return std::uint8_t(Branching::Distal);
     default:
-      throw InputError(file, line, "branching mode " + std::to_string(code) +
-                                       "; allowed: 0 (none), 1 (fixed), 2 (versatile), 3 (distal); 4 (hotspots) is not supported");
+      throw InputError(
+          file, line,
+          "branching mode " + std::to_string(code) + "; allowed: 0 (none), 1 (fixed), 2 (versatile), 3 (distal); 4 (hotspots) is not supported");
   }
 }
 
@@ -202,8 +202,9 @@ std::vector<Row> rowsFromPoints(const std::string& file, const std::vector<Vec3>
       throw InputError(file, s.row.line, "vessel " + s.row.id + " refers to a point that is not defined");
     if (s.from == s.to) throw InputError(file, s.row.line, "vessel " + s.row.id + " starts and ends at the same point");
     if (ending[s.to] != kNone)
-      throw InputError(file, s.row.line, "vessels " + segments[ending[s.to]].row.id + " and " + s.row.id + " both end at " + show3(points[s.to]) +
-                                             ": a node of a tree has one parent vessel (a cycle, or vessels that merge)");
+      throw InputError(file, s.row.line,
+                       "vessels " + segments[ending[s.to]].row.id + " and " + s.row.id + " both end at " + show3(points[s.to]) +
+                           ": a node of a tree has one parent vessel (a cycle, or vessels that merge)");
     ending[s.to] = k;
   }
   std::vector<Row> rows;
@@ -214,8 +215,9 @@ std::vector<Row> rowsFromPoints(const std::string& file, const std::vector<Vec3>
     if (ending[s.from] != kNone) {
       s.row.parent = segments[ending[s.from]].row.id;
     } else if (++root_starts[s.from] > 1) {
-      throw InputError(file, s.row.line, "vessel " + s.row.id + " starts at the root point " + show3(points[s.from]) +
-                                             ", which starts another vessel: a tree's root has one vessel");
+      throw InputError(file, s.row.line,
+                       "vessel " + s.row.id + " starts at the root point " + show3(points[s.from]) +
+                           ", which starts another vessel: a tree's root has one vessel");
     }
     rows.push_back(s.row);
   }
@@ -256,8 +258,8 @@ ExistingNetwork readCco(const std::string& file, double unit_mm) {
   for (long long v = 0; v < count; ++v) {
     const auto& l = lines[k + 2 + std::size_t(v)];
     if (l.tokens.size() != 20 && l.tokens.size() != 21)
-      throw InputError(file, l.number, "a vessel row has 20 or 21 columns (id, proximal and distal points, ..., stage), not " +
-                                           std::to_string(l.tokens.size()));
+      throw InputError(file, l.number,
+                       "a vessel row has 20 or 21 columns (id, proximal and distal points, ..., stage), not " + std::to_string(l.tokens.size()));
     Row r;
     r.line = l.number;
     r.id = std::to_string(whole(file, l, 0, "vessel id"));
@@ -351,10 +353,10 @@ void refuseLargeJunctions(const ExistingNetwork& net, const std::string& file, c
     kids.clear();
     t.junctionChildren(i, kids);
     if (kids.size() > std::size_t(physical::kMaxJunctionChildren))
-      throw InputError(file, net.lines[std::size_t(i)], "node " + (net.ids[std::size_t(i)].empty() ? std::to_string(i) : net.ids[std::size_t(i)]) +
-                                                           " has " + std::to_string(kids.size()) + " children; " + use + " at most " +
-                                                           std::to_string(physical::kMaxJunctionChildren) +
-                                                           " (a vascular junction has two to four; a node of many is a skeletonisation artefact: split it)");
+      throw InputError(file, net.lines[std::size_t(i)],
+                       "node " + (net.ids[std::size_t(i)].empty() ? std::to_string(i) : net.ids[std::size_t(i)]) + " has " +
+                           std::to_string(kids.size()) + " children; " + use + " at most " + std::to_string(physical::kMaxJunctionChildren) +
+                           " (a vascular junction has two to four; a node of many is a skeletonisation artefact: split it)");
   }
 }
 
@@ -377,8 +379,9 @@ ExistingNetwork readNetwork(const std::filesystem::path& file, double unit_mm, s
     }
     const std::uint64_t need = (bytes / 16 + 1) * kNetworkBytesPerVessel;
     if (!ec && need > memory_limit)
-      throw InputError(file.string(), 0, "a network file of " + formatBytes(bytes) + " needs up to " + formatBytes(need) +
-                                             " to read, more than the limit of " + formatBytes(memory_limit) + "; raise --memory-limit");
+      throw InputError(file.string(), 0,
+                       "a network file of " + formatBytes(bytes) + " needs up to " + formatBytes(need) + " to read, more than the limit of " +
+                           formatBytes(memory_limit) + "; raise --memory-limit");
   }
   if (ext == ".cco") return readCco(file.string(), unit_mm);
   if (ext == ".swc") return readSwc(file.string(), unit_mm);
@@ -416,11 +419,10 @@ void writeCco(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
     if (t.isRoot(i) || t.isLink(i)) continue;
     const Vec3 &a = t.position[t.parent[i]], &b = t.position[i];
     const double dp = t.pressure[t.parent[i]] - t.pressure[i];
-    out << i << ' ' << exactNumber(a.x) << ' ' << exactNumber(a.y) << ' ' << exactNumber(a.z) << ' ' << exactNumber(b.x) << ' '
-        << exactNumber(b.y) << ' ' << exactNumber(b.z) << " 0 0 0 " << exactNumber(i < std::int32_t(t.outflow.size()) ? t.outflow[i] : 0.0) << ' '
-        << vitaBranching(t.branching[i]) << ' ' << exactNumber(t.radius[i]) << ' '
-        << exactNumber(t.flow[i] > 0 ? dp / t.flow[i] : 0.0) << " 0 0 " << exactNumber(t.pressure[t.parent[i]]) << ' '
-        << vitaFunction(t.role[i]) << " 0 0 " << t.stage[i] << '\n';
+    out << i << ' ' << exactNumber(a.x) << ' ' << exactNumber(a.y) << ' ' << exactNumber(a.z) << ' ' << exactNumber(b.x) << ' ' << exactNumber(b.y)
+        << ' ' << exactNumber(b.z) << " 0 0 0 " << exactNumber(i < std::int32_t(t.outflow.size()) ? t.outflow[i] : 0.0) << ' '
+        << vitaBranching(t.branching[i]) << ' ' << exactNumber(t.radius[i]) << ' ' << exactNumber(t.flow[i] > 0 ? dp / t.flow[i] : 0.0) << " 0 0 "
+        << exactNumber(t.pressure[t.parent[i]]) << ' ' << vitaFunction(t.role[i]) << " 0 0 " << t.stage[i] << '\n';
   }
   out << "\n*Connectivity\n";
   std::vector<std::int32_t> kids;

@@ -13,9 +13,9 @@ namespace angiosynth {
 // A network as its file gives it. Every node but a root ends the segment of the same id; a
 // segment's stage, role, branching and outflow are the file's (0 / -1 where it has none).
 struct ExistingNetwork {
-  VascularTree tree;                 // positions in mm; radii as in the file (mm), not solved
-  std::vector<std::string> ids;      // per node: its id in the file (a .cco vessel's, an SWC sample's)
-  std::vector<int> lines;            // per node: the line of the file that defines it
+  VascularTree tree;             // positions in mm; radii as in the file (mm), not solved
+  std::vector<std::string> ids;  // per node: its id in the file (a .cco vessel's, an SWC sample's)
+  std::vector<int> lines;        // per node: the line of the file that defines it
   // .cco header: the tree's inflow (file units^3/s), reference pressure and root radius.
   double flow = 0, reference_pressure = 0, root_radius = 0;
 };

@@ -19,8 +19,7 @@ double finite(const std::string& file, int line, const char* text, const std::st
     const std::string s = text ? text : "";
     const double v = std::stod(s, &used);
     if (used == s.size() && std::isfinite(v)) return v;
-  } catch (const std::exception&) {
-  }
+  } catch (const std::exception&) {}
   throw InputError(file, line, what + " '" + (text ? text : "") + "' is not a finite number");
 }
 
@@ -47,9 +46,10 @@ ExistingNetwork readGxl(const std::string& file, double unit_mm) {
     if (!id) throw InputError(file, line, "a node without an id");
     const auto* tup = gxlAttr(n, "position");
     if (!tup || std::string(tup->Name()) != "tup")
-      throw InputError(file, line, std::string("node ") + id +
-                                       " has no attribute 'position' (a tup of three floats in mm, as angiosynth writes; VascuSynth's "
-                                       "' position' in voxels is not read: convert it to SWC)");
+      throw InputError(file, line,
+                       std::string("node ") + id +
+                           " has no attribute 'position' (a tup of three floats in mm, as angiosynth writes; VascuSynth's "
+                           "' position' in voxels is not read: convert it to SWC)");
     double c[3];
     const auto* f = tup->FirstChildElement("float");
     for (int a = 0; a < 3; ++a, f = f ? f->NextSiblingElement("float") : nullptr) {
@@ -166,7 +166,8 @@ ExistingNetwork readCsv(const std::string& file, double unit_mm) {
     s.row.id = eid >= 0 ? c[eid] : std::to_string(line);
     for (const auto& [col, at] : {std::pair{from, &s.from}, {to, &s.to}}) {
       const auto p = point_of.find(c[col]);
-      if (p == point_of.end()) throw InputError(f, line, "edge " + s.row.id + " refers to node " + c[col] + ", which " + nodes.file + " does not define");
+      if (p == point_of.end())
+        throw InputError(f, line, "edge " + s.row.id + " refers to node " + c[col] + ", which " + nodes.file + " does not define");
       *at = p->second;
     }
     s.row.radius = finite(f, line, c[radius].c_str(), "radius");

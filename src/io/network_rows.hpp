@@ -14,7 +14,7 @@ struct Row {
   std::string parent;  // empty: a root vessel (.cco) or root sample (SWC)
   Vec3 prox, dist;     // .cco: both ends; SWC: dist only
   double radius = 0, outflow = 0;
-  double radius_start = -1;  // a tapered vessel's radius at its proximal end (CSV column radius_start); -1: none
+  double radius_start = -1;         // a tapered vessel's radius at its proximal end (CSV column radius_start); -1: none
   double wall_start = 0, wall = 0;  // its wall thickness at the proximal and distal end (0: none given)
   std::int16_t stage = -1;
   std::uint8_t role = 0, branching = 0;

@@ -31,8 +31,7 @@ int base64Value(char c) {
 // A stream of bytes: raw, or base64 text whose blocks VTK encodes one after another.
 class ByteStream {
  public:
-  ByteStream(std::string_view data, bool base64, std::string file, int line)
-      : data_(data), base64_(base64), file_(std::move(file)), line_(line) {}
+  ByteStream(std::string_view data, bool base64, std::string file, int line) : data_(data), base64_(base64), file_(std::move(file)), line_(line) {}
   // The next n bytes; a base64 block of n bytes takes 4·⌈n/3⌉ characters.
   std::vector<unsigned char> take(std::size_t n) {
     std::vector<unsigned char> out;
@@ -129,8 +128,7 @@ std::vector<unsigned char> binaryArray(ByteStream& in, const Encoding& enc, std:
     uLongf got = expect;
     const auto at = out.size();
     out.resize(at + expect);
-    if (uncompress(out.data() + at, &got, packed.data(), uLong(packed.size())) != Z_OK || got != expect)
-      in.fail("is not valid zlib data");
+    if (uncompress(out.data() + at, &got, packed.data(), uLong(packed.size())) != Z_OK || got != expect) in.fail("is not valid zlib data");
   }
   return out;
 }
@@ -142,7 +140,7 @@ struct ArrayInfo {
 };
 
 std::size_t typeSize(const std::string& file, int line, const std::string& type) {
-  static const std::map<std::string, std::size_t> sizes{{"Int8", 1},  {"UInt8", 1},  {"Int16", 2},   {"UInt16", 2},  {"Int32", 4},
+  static const std::map<std::string, std::size_t> sizes{{"Int8", 1},   {"UInt8", 1}, {"Int16", 2},  {"UInt16", 2},  {"Int32", 4},
                                                         {"UInt32", 4}, {"Int64", 8}, {"UInt64", 8}, {"Float32", 4}, {"Float64", 8}};
   const auto it = sizes.find(type);
   if (it == sizes.end()) throw InputError(file, line, "DataArray type '" + type + "'; allowed: Int8 to UInt64, Float32, Float64");
@@ -181,7 +179,8 @@ class VtpFile {
       const auto underscore = tag_end == std::string::npos ? tag_end : bytes_.find('_', tag_end);
       if (underscore == std::string::npos) throw InputError(file, 0, "<AppendedData> without its '_' marker");
       const auto close = bytes_.rfind("</AppendedData>");
-      appended_ = std::string_view(bytes_).substr(underscore + 1, (close == std::string::npos || close < underscore ? bytes_.size() : close) - underscore - 1);
+      appended_ = std::string_view(bytes_).substr(underscore + 1,
+                                                  (close == std::string::npos || close < underscore ? bytes_.size() : close) - underscore - 1);
       const std::string tag = bytes_.substr(at, tag_end - at + 1);
       appended_base64_ = tag.find("encoding=\"base64\"") != std::string::npos;
       if (appended_base64_)
@@ -259,8 +258,7 @@ class VtpFile {
         if (!std::isfinite(out.back())) throw InputError(file_, line, "a value is not finite");
       }
     }
-    if (out.size() != count)
-      throw InputError(file_, line, std::to_string(out.size()) + " values; the Piece asks for " + std::to_string(count));
+    if (out.size() != count) throw InputError(file_, line, std::to_string(out.size()) + " values; the Piece asks for " + std::to_string(count));
     return out;
   }
 
@@ -287,9 +285,9 @@ ExistingNetwork readVtp(const std::string& file, double unit_mm, std::uint64_t m
   // vessel at least).
   const auto refuseBeyondLimit = [&](std::uint64_t need) {
     if (need > memory_limit)
-      throw InputError(file, piece->GetLineNum(), "the Piece declares " + std::to_string(points_n) + " points and " + std::to_string(lines_n) +
-                                                      " lines, which need about " + formatBytes(need) + " to read, more than the limit of " +
-                                                      formatBytes(memory_limit) + "; raise --memory-limit");
+      throw InputError(file, piece->GetLineNum(),
+                       "the Piece declares " + std::to_string(points_n) + " points and " + std::to_string(lines_n) + " lines, which need about " +
+                           formatBytes(need) + " to read, more than the limit of " + formatBytes(memory_limit) + "; raise --memory-limit");
   };
   refuseBeyondLimit(points_n * 256 + lines_n * (kNetworkBytesPerVessel + 64));
   const auto* pts = vtp.array("Points", nullptr);
@@ -301,7 +299,8 @@ ExistingNetwork readVtp(const std::string& file, double unit_mm, std::uint64_t m
   const auto offsets = vtp.values(offs, lines_n);
   const double ends = offsets.back();
   if (!(ends >= 2 && ends <= 2.0 * double(points_n) + 2 * double(lines_n) && ends == std::floor(ends)))
-    throw InputError(file, offs->GetLineNum(), "the last offset must be the connectivity's length: a whole number, at most one point per line and point");
+    throw InputError(file, offs->GetLineNum(),
+                     "the last offset must be the connectivity's length: a whole number, at most one point per line and point");
   refuseBeyondLimit(points_n * 256 + lines_n * 64 + std::uint64_t(ends) * (kNetworkBytesPerVessel + 8));
   const auto connectivity = vtp.values(conn, std::size_t(ends));
   // Coincident points are one node (VItA writes each vessel's own two points).
@@ -377,8 +376,9 @@ ExistingNetwork readVtp(const std::string& file, double unit_mm, std::uint64_t m
     }
     const auto last = std::size_t(end);
     if (last - begin > 2 && (radius_start_name || wall_start_name))
-      throw InputError(file, line, "line " + std::to_string(c) + " has " + std::to_string(last - begin) +
-                                       " points and a RadiusStart or WallStart: a tapered vessel is a line of two points");
+      throw InputError(file, line,
+                       "line " + std::to_string(c) + " has " + std::to_string(last - begin) +
+                           " points and a RadiusStart or WallStart: a tapered vessel is a line of two points");
     for (std::size_t k = begin; k + 1 < last; ++k) {
       const double a = connectivity[k], b = connectivity[k + 1];
       if (!(a >= 0 && b >= 0 && a < double(points_n) && b < double(points_n)))

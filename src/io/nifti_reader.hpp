@@ -10,12 +10,11 @@
 namespace angiosynth {
 
 struct NiftiVolume {
-  Volume<float> values;            // scaled by scl_slope/scl_inter when the header sets them
-  std::array<double, 12> affine{}; // rows of the voxel-to-world (mm) matrix: sform, else qform
+  Volume<float> values;             // scaled by scl_slope/scl_inter when the header sets them
+  std::array<double, 12> affine{};  // rows of the voxel-to-world (mm) matrix: sform, else qform
 };
 
 // `bytes_per_voxel`: what the caller will hold per voxel, for the memory check against `limit`.
-NiftiVolume readNiftiVolume(const std::filesystem::path& file, std::uint64_t limit, std::uint64_t bytes_per_voxel,
-                            const char* what);
+NiftiVolume readNiftiVolume(const std::filesystem::path& file, std::uint64_t limit, std::uint64_t bytes_per_voxel, const char* what);
 
 }  // namespace angiosynth

@@ -20,8 +20,7 @@ void writeNrrd(const std::filesystem::path& file, const VolumeView& v) {
     << "space directions: (" << exactNumber(-g.spacing_mm.x) << ",0,0) (0," << exactNumber(-g.spacing_mm.y) << ",0) (0,0,"
     << exactNumber(g.spacing_mm.z) << ")\n"
     << "kinds: domain domain domain\nendian: little\nencoding: gzip\n"
-    << "space origin: (" << exactNumber(-g.origin_mm.x) << "," << exactNumber(-g.origin_mm.y) << ","
-    << exactNumber(g.origin_mm.z) << ")\n";
+    << "space origin: (" << exactNumber(-g.origin_mm.x) << "," << exactNumber(-g.origin_mm.y) << "," << exactNumber(g.origin_mm.z) << ")\n";
   if (v.label) h << "# label map\n";
   h << "\n";
   std::ofstream out(file, std::ios::binary);

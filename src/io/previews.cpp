@@ -44,8 +44,8 @@ Image8 maximumProjection(const Volume<float>& v, int axis, double lo, double hi)
   return img;
 }
 
-Image8 maximumProjection(const Volume<float>& v, const Volume<std::uint8_t>& labels, std::uint32_t (*colour_of)(int),
-                         int axis, double lo, double hi) {
+Image8 maximumProjection(const Volume<float>& v, const Volume<std::uint8_t>& labels, std::uint32_t (*colour_of)(int), int axis, double lo,
+                         double hi) {
   Image8 img;
   img.channels = 3;
   std::vector<float> best;

@@ -10,8 +10,8 @@ void writeSvg(std::ostream& o, const Forest& forest, const GrowthDomain& d) {
   const Vec3 hi = d.hi();
   o << std::setprecision(9);
   o << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-    << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << hi.x << "mm\" height=\"" << hi.y << "mm\" viewBox=\"0 0 "
-    << hi.x << ' ' << hi.y << "\">\n"
+    << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << hi.x << "mm\" height=\"" << hi.y << "mm\" viewBox=\"0 0 " << hi.x << ' ' << hi.y
+    << "\">\n"
     << "<title>angiosynth CCO tree, " << t.totalTerminals() << " terminals, lengths in mm</title>\n"
     << "<g transform=\"matrix(1 0 0 -1 0 " << hi.y << ")\">\n";
   const Vec3 c = d.center();
@@ -21,8 +21,8 @@ void writeSvg(std::ostream& o, const Forest& forest, const GrowthDomain& d) {
         << d.size() / 400 << "\"/>\n";
       break;
     case DomainShape::Square:
-      o << "<rect x=\"" << c.x - d.size() << "\" y=\"" << c.y - d.size() << "\" width=\"" << 2 * d.size() << "\" height=\""
-        << 2 * d.size() << "\" fill=\"#f4f1ea\" stroke=\"#b0a898\" stroke-width=\"" << d.size() / 400 << "\"/>\n";
+      o << "<rect x=\"" << c.x - d.size() << "\" y=\"" << c.y - d.size() << "\" width=\"" << 2 * d.size() << "\" height=\"" << 2 * d.size()
+        << "\" fill=\"#f4f1ea\" stroke=\"#b0a898\" stroke-width=\"" << d.size() / 400 << "\"/>\n";
       break;
     default: {
       const auto& m = d.frame();
@@ -35,8 +35,8 @@ void writeSvg(std::ostream& o, const Forest& forest, const GrowthDomain& d) {
           }
           int run = i;
           while (run < m.dims[0] && m.demand[m.flat(run, j, 0)] > 0) ++run;
-          o << "<rect x=\"" << i * m.voxel_mm << "\" y=\"" << j * m.voxel_mm << "\" width=\"" << (run - i) * m.voxel_mm
-            << "\" height=\"" << m.voxel_mm << "\"/>\n";
+          o << "<rect x=\"" << i * m.voxel_mm << "\" y=\"" << j * m.voxel_mm << "\" width=\"" << (run - i) * m.voxel_mm << "\" height=\""
+            << m.voxel_mm << "\"/>\n";
           i = run;
         }
       o << "</g>\n";
@@ -54,8 +54,7 @@ void writeSvg(std::ostream& o, const Forest& forest, const GrowthDomain& d) {
     }
     const Vec3& a = t.position[t.parent[i]];
     const Vec3& b = t.position[i];
-    o << "<line x1=\"" << a.x << "\" y1=\"" << a.y << "\" x2=\"" << b.x << "\" y2=\"" << b.y << "\" stroke-width=\""
-      << 2 * t.radius[i] << "\"/>\n";
+    o << "<line x1=\"" << a.x << "\" y1=\"" << a.y << "\" x2=\"" << b.x << "\" y2=\"" << b.y << "\" stroke-width=\"" << 2 * t.radius[i] << "\"/>\n";
   }
   o << "</g>\n</g>\n</svg>\n";
 }

@@ -25,8 +25,8 @@ void writeNodesCsv(std::ostream& out, const VascularTree& t, const std::vector<T
     if (t.isLink(i)) continue;
     const Vec3& p = t.position[i];
     const TreeInfo& tr = treeOf(trees, t, i);
-    out << i << ',' << exactNumber(p.x) << ',' << exactNumber(p.y) << ',' << exactNumber(p.z) << ','
-        << nodeTypeName(t.graphType(i)) << ',' << exactNumber(t.pressure[i]) << ',' << tr.id << ',' << tr.kind << '\n';
+    out << i << ',' << exactNumber(p.x) << ',' << exactNumber(p.y) << ',' << exactNumber(p.z) << ',' << nodeTypeName(t.graphType(i)) << ','
+        << exactNumber(t.pressure[i]) << ',' << tr.id << ',' << tr.kind << '\n';
   }
 }
 
@@ -150,9 +150,8 @@ void writeSwc(std::ostream& out, const VascularTree& t, const std::vector<TreeIn
   for (auto i : order) {
     const Vec3& p = t.position[i];
     const bool root = t.isRoot(i);
-    out << id[i] << ' ' << (root ? 1 : 1 + treeOf(trees, t, i).class_label) << ' ' << exactNumber(p.x) << ' '
-        << exactNumber(p.y) << ' ' << exactNumber(p.z) << ' ' << exactNumber(nodeRadius(t, i)) << ' '
-        << (root ? -1 : id[t.junction(t.parent[i])]) << '\n';
+    out << id[i] << ' ' << (root ? 1 : 1 + treeOf(trees, t, i).class_label) << ' ' << exactNumber(p.x) << ' ' << exactNumber(p.y) << ' '
+        << exactNumber(p.z) << ' ' << exactNumber(nodeRadius(t, i)) << ' ' << (root ? -1 : id[t.junction(t.parent[i])]) << '\n';
   }
 }
 
@@ -199,11 +198,11 @@ void writeGraphml(std::ostream& out, const VascularTree& t, const std::vector<Tr
         << exactNumber(t.length[i]) << "</data><data key=\"radius\">" << exactNumber(t.radius[i]) << "</data><data key=\"flow\">"
         << exactNumber(t.flow[i]) << "</data><data key=\"tree\">" << tr.id << "</data><data key=\"kind\">" << tr.kind << "</data>";
     if (staged)
-      out << "<data key=\"stage\">" << t.stage[i] << "</data><data key=\"role\">" << roleName(t.role[i])
-          << "</data><data key=\"branching\">" << branchingName(t.branching[i]) << "</data>";
+      out << "<data key=\"stage\">" << t.stage[i] << "</data><data key=\"role\">" << roleName(t.role[i]) << "</data><data key=\"branching\">"
+          << branchingName(t.branching[i]) << "</data>";
     if (tapered)
-      out << "<data key=\"radius_start\">" << exactNumber(t.startRadius(i)) << "</data><data key=\"wall_start\">"
-          << exactNumber(t.wall_start[i]) << "</data><data key=\"wall\">" << exactNumber(t.wall[i]) << "</data>";
+      out << "<data key=\"radius_start\">" << exactNumber(t.startRadius(i)) << "</data><data key=\"wall_start\">" << exactNumber(t.wall_start[i])
+          << "</data><data key=\"wall\">" << exactNumber(t.wall[i]) << "</data>";
     out << "</edge>\n";
   }
   out << "  </graph>\n</graphml>\n";

@@ -13,8 +13,8 @@ struct AngiosynthVdbApi {
   void* (*create)();
   void (*add_leaf)(void* w, std::int32_t x, std::int32_t y, std::int32_t z, const float* fraction, const std::uint32_t* ids);
   // 0 on success; else the reason in `error`.
-  int (*write)(void* w, const char* file, const double spacing[3], const double origin[3], std::int64_t* leaves,
-               std::int64_t* active_voxels, char* error, std::size_t error_size);
+  int (*write)(void* w, const char* file, const double spacing[3], const double origin[3], std::int64_t* leaves, std::int64_t* active_voxels,
+               char* error, std::size_t error_size);
   void (*destroy)(void* w);
 };
 

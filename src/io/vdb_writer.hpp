@@ -20,7 +20,7 @@ struct VdbReport {
 // Writes `fraction` (FloatGrid, partial volume in [0,1], background 0) and `instances`
 // (Int32Grid, segment id on voxels with fraction >= 0.5) with the grid's voxel size and origin
 // (world = origin + index × spacing, RAS mm).
-VdbReport writeVdb(const std::filesystem::path& file, const VascularTree& tree, const VolumeGrid& grid,
-                   const BrickBins& bins, const RasterOptions& opt);
+VdbReport writeVdb(const std::filesystem::path& file, const VascularTree& tree, const VolumeGrid& grid, const BrickBins& bins,
+                   const RasterOptions& opt);
 
 }  // namespace angiosynth

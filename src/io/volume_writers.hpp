@@ -22,17 +22,32 @@ struct VolumeView {
   const VolumeGrid* grid = nullptr;
   const void* data = nullptr;
   VoxelType type = VoxelType::Float32;
-  bool label = false;            // label map: NIfTI intent LABEL, nearest-neighbour semantics
-  std::string description;       // ≤ 79 characters, stored in the header
+  bool label = false;       // label map: NIfTI intent LABEL, nearest-neighbour semantics
+  std::string description;  // ≤ 79 characters, stored in the header
 };
 
 template <class T>
 constexpr VoxelType voxelTypeOf();
-template <> constexpr VoxelType voxelTypeOf<std::uint8_t>() { return VoxelType::UInt8; }
-template <> constexpr VoxelType voxelTypeOf<std::int16_t>() { return VoxelType::Int16; }
-template <> constexpr VoxelType voxelTypeOf<std::uint16_t>() { return VoxelType::UInt16; }
-template <> constexpr VoxelType voxelTypeOf<std::uint32_t>() { return VoxelType::UInt32; }
-template <> constexpr VoxelType voxelTypeOf<float>() { return VoxelType::Float32; }
+template <>
+constexpr VoxelType voxelTypeOf<std::uint8_t>() {
+  return VoxelType::UInt8;
+}
+template <>
+constexpr VoxelType voxelTypeOf<std::int16_t>() {
+  return VoxelType::Int16;
+}
+template <>
+constexpr VoxelType voxelTypeOf<std::uint16_t>() {
+  return VoxelType::UInt16;
+}
+template <>
+constexpr VoxelType voxelTypeOf<std::uint32_t>() {
+  return VoxelType::UInt32;
+}
+template <>
+constexpr VoxelType voxelTypeOf<float>() {
+  return VoxelType::Float32;
+}
 
 template <class T>
 VolumeView viewOf(const Volume<T>& v, bool label, std::string description) {
@@ -68,8 +83,7 @@ Image8 maximumProjection(const Volume<float>& v, int axis, double lo, double hi)
 // The same projection in colour: each pixel takes the colour (0xRRGGBB, from `colour_of(label)`)
 // of the label of the voxel that gave its maximum (the first along the axis on ties), scaled by
 // its intensity; label 0 stays grey.
-Image8 maximumProjection(const Volume<float>& v, const Volume<std::uint8_t>& labels, std::uint32_t (*colour_of)(int),
-                         int axis, double lo, double hi);
+Image8 maximumProjection(const Volume<float>& v, const Volume<std::uint8_t>& labels, std::uint32_t (*colour_of)(int), int axis, double lo, double hi);
 // Slice z of a volume, mapping [lo, hi] to [0, 255].
 Image8 sliceZ(const Volume<float>& v, std::int32_t z, double lo, double hi);
 // Lossless 8-bit PNG through libpng.

@@ -226,8 +226,7 @@ void LeafSplitter::tetrahedra(const OctreeLeaf& leaf, std::vector<std::array<Hal
     static constexpr int kTets[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
     for (const auto& t : kTets) {
       std::array<HalfPoint, 4> tet;
-      for (int q = 0; q < 4; ++q)
-        tet[std::size_t(q)] = {o[0] + size * (t[q] & 1), o[1] + size * ((t[q] >> 1) & 1), o[2] + size * ((t[q] >> 2) & 1)};
+      for (int q = 0; q < 4; ++q) tet[std::size_t(q)] = {o[0] + size * (t[q] & 1), o[1] + size * ((t[q] >> 1) & 1), o[2] + size * ((t[q] >> 2) & 1)};
       out.push_back(tet);
     }
     return;

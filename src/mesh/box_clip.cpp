@@ -163,8 +163,10 @@ void moveSliverEndsOntoPlane(SurfaceMesh& m, std::vector<double>& s, int axis, d
       if (!((sa < 0 && sb > 0) || (sa > 0 && sb < 0))) continue;
       const double t = sa / (sa - sb);
       const Vec3 p = m.vertices[std::size_t(a)] + (m.vertices[std::size_t(b)] - m.vertices[std::size_t(a)]) * t;
-      if (t < kSliver) moveOnto(a, p);
-      else if (t > 1 - kSliver) moveOnto(b, p);
+      if (t < kSliver)
+        moveOnto(a, p);
+      else if (t > 1 - kSliver)
+        moveOnto(b, p);
     }
 }
 
@@ -213,9 +215,10 @@ ClippedWall clipWall(SurfaceMesh& m, std::vector<double>& s, int axis, double c,
       continue;
     }
     clipTriangleToPlane(
-        tri, [&](std::int32_t v) { return s[std::size_t(v)]; }, pointOn,
-        [&](std::int32_t v) -> const Vec3& { return m.vertices[std::size_t(v)]; },
-        [&](std::int32_t p, std::int32_t q, std::int32_t r) { keep({p, q, r}); });
+        tri, [&](std::int32_t v) { return s[std::size_t(v)]; }, pointOn, [&](std::int32_t v) -> const Vec3& { return m.vertices[std::size_t(v)]; },
+        [&](std::int32_t p, std::int32_t q, std::int32_t r) {
+          keep({p, q, r});
+        });
   }
   return w;
 }
@@ -259,8 +262,9 @@ SectionLoops findSectionLoops(SurfaceMesh& m, const std::vector<double>& s, Clip
   return l;
 }
 
-std::vector<std::array<std::int32_t, 3>> triangulateSection(const SurfaceMesh& m, const std::vector<std::pair<std::int32_t, std::int32_t>>& loop_edges,
-                                                           int axis, double sigma, int side) {
+std::vector<std::array<std::int32_t, 3>> triangulateSection(const SurfaceMesh& m,
+                                                            const std::vector<std::pair<std::int32_t, std::int32_t>>& loop_edges, int axis,
+                                                            double sigma, int side) {
   // The section: a constrained Delaunay triangulation of the loops, inside where it lies behind
   // an odd number of loops seen from outside them all.
   const int u = (axis + 1) % 3, w = (axis + 2) % 3;  // e_u × e_w = e_axis
@@ -323,7 +327,8 @@ std::vector<std::array<std::int32_t, 3>> triangulateSection(const SurfaceMesh& m
   std::size_t matched = 0;
   for (const auto& t : section)
     for (int i = 0; i < 3; ++i)
-      if (auto it = loop_reverse.find(directedKey(t[std::size_t(i)], t[std::size_t((i + 1) % 3)])); it != loop_reverse.end() && !it->second++) ++matched;
+      if (auto it = loop_reverse.find(directedKey(t[std::size_t(i)], t[std::size_t((i + 1) % 3)])); it != loop_reverse.end() && !it->second++)
+        ++matched;
   if (matched != loop_edges.size())
     throw std::runtime_error(std::string("clipping to the box: the section of side ") + kBoxSideNames[side] + " does not close the cut");
   return section;

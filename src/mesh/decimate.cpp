@@ -171,8 +171,17 @@ struct Candidate {
 // block; a worker changes only what lies in its block.
 struct State {
   State(SurfaceMesh& mesh, const DecimateOptions& options, const std::function<double(std::int32_t, const Vec3&)>& dist)
-      : m(mesh), o(options), distance(dist), around(mesh.vertices.size()), quadric(mesh.vertices.size()), version(mesh.vertices.size(), 0),
-        vertex_alive(mesh.vertices.size(), 1), locked(mesh.vertices.size(), 0), triangle_alive(mesh.triangles.size(), 1), boundary(mesh.vertices.size(), 0), block(mesh.vertices.size(), 0),
+      : m(mesh),
+        o(options),
+        distance(dist),
+        around(mesh.vertices.size()),
+        quadric(mesh.vertices.size()),
+        version(mesh.vertices.size(), 0),
+        vertex_alive(mesh.vertices.size(), 1),
+        locked(mesh.vertices.size(), 0),
+        triangle_alive(mesh.triangles.size(), 1),
+        boundary(mesh.vertices.size(), 0),
+        block(mesh.vertices.size(), 0),
         visited(mesh.triangles.size(), 0) {
     for (std::size_t k = 0; k < m.triangles.size(); ++k) {
       const auto& t = m.triangles[k];
@@ -244,8 +253,18 @@ struct State {
 class Worker {
  public:
   Worker(State& s, std::int64_t block)
-      : st_(s), m_(s.m), o_(s.o), distance_(s.distance), around_(s.around), quadric_(s.quadric), version_(s.version), vertex_alive_(s.vertex_alive),
-        locked_(s.locked), triangle_alive_(s.triangle_alive), block_(s.block), mine_(block) {
+      : st_(s),
+        m_(s.m),
+        o_(s.o),
+        distance_(s.distance),
+        around_(s.around),
+        quadric_(s.quadric),
+        version_(s.version),
+        vertex_alive_(s.vertex_alive),
+        locked_(s.locked),
+        triangle_alive_(s.triangle_alive),
+        block_(s.block),
+        mine_(block) {
     cos_turn_ = std::cos(o_.max_turn_deg * std::numbers::pi / 180);
     cos_min_angle_ = std::cos(o_.min_angle_deg * std::numbers::pi / 180);
     cos_sliver_ = std::cos(o_.sliver_deg * std::numbers::pi / 180);
@@ -519,7 +538,7 @@ class Worker {
       if (turnsOver(before, after, star)) return false;
       moved_.push_back({t, {after[0], after[1], after[2]}});
     }
-    const bool better = aim == Aim::smallest ? new_cos < old_cos - 1e-3
+    const bool better = aim == Aim::smallest  ? new_cos < old_cos - 1e-3
                         : aim == Aim::largest ? new_big > old_big + 1e-3 && new_cos <= std::max(cos_min_angle_, old_cos)
                                               : new_q > old_q + 1e-4 && new_cos <= std::max(cos_min_angle_, old_cos);
     if (!better) return false;
@@ -779,9 +798,12 @@ class Worker {
     if (!mine(ring_u_) || !mine(ring_v_)) return false;
     int common = 0;
     for (std::size_t i = 0, j = 0; i < ring_u_.size() && j < ring_v_.size();) {
-      if (ring_u_[i] < ring_v_[j]) ++i;
-      else if (ring_v_[j] < ring_u_[i]) ++j;
-      else ++common, ++i, ++j;
+      if (ring_u_[i] < ring_v_[j])
+        ++i;
+      else if (ring_v_[j] < ring_u_[i])
+        ++j;
+      else
+        ++common, ++i, ++j;
     }
     if (common != ns) return false;
     Quadric q = quadric_[std::size_t(u)];
@@ -801,7 +823,8 @@ class Worker {
     for (const std::int32_t end : {u, v})
       for (auto k : around_[std::size_t(end)]) {
         const auto& t = m_.triangles[std::size_t(k)];
-        old_cos = std::max(old_cos, smallestAngleCosine(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]));
+        old_cos =
+            std::max(old_cos, smallestAngleCosine(m_.vertices[std::size_t(t[0])], m_.vertices[std::size_t(t[1])], m_.vertices[std::size_t(t[2])]));
       }
     const double floor = std::max(cos_min_angle_, old_cos);  // as a cosine
     const Vec3 star = starNormal(u, v);
@@ -983,7 +1006,8 @@ std::int64_t runPass(State& st, DecimateReport& rep, double size, double shift, 
   const double cos_bound = std::cos((kind == Pass::obtuse ? st.o.obtuse_deg : st.o.sliver_deg) * std::numbers::pi / 180);
   const auto blocks = partition(st, size, shift, kind, cos_bound);
   ++st.pass;
-  if ((kind == Pass::sliver || kind == Pass::obtuse) && st.changed.empty()) st.changed.assign(st.m.vertices.size(), 0), st.failed.assign(st.m.triangles.size(), 0);
+  if ((kind == Pass::sliver || kind == Pass::obtuse) && st.changed.empty())
+    st.changed.assign(st.m.vertices.size(), 0), st.failed.assign(st.m.triangles.size(), 0);
   std::vector<Worker> workers;
   workers.reserve(blocks.size());
   for (const auto& b : blocks) workers.emplace_back(st, st.block[std::size_t(st.m.triangles[std::size_t(b.front())][0])]);
@@ -991,9 +1015,12 @@ std::int64_t runPass(State& st, DecimateReport& rep, double size, double shift, 
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       const auto* first = blocks[i].data();
       const auto* last = first + blocks[i].size();
-      if (kind == Pass::flip) workers[i].flipPass(first, last);
-      else if (kind == Pass::collapse) workers[i].collapsePass(first, last);
-      else workers[i].repairPass(first, last, kind);
+      if (kind == Pass::flip)
+        workers[i].flipPass(first, last);
+      else if (kind == Pass::collapse)
+        workers[i].collapsePass(first, last);
+      else
+        workers[i].repairPass(first, last, kind);
     }
   });
   std::int64_t made = 0;

@@ -18,11 +18,11 @@
 namespace angiosynth {
 
 struct DecimateOptions {
-  double max_error = 0.1;         // share of the local step: largest distance of a new vertex or centroid from the surface
-  double min_angle_deg = 15;      // a new triangle's angles stay above this (or above the smallest they replace)
-  double max_turn_deg = 45;       // largest turn of a triangle's normal by one collapse
-  double sliver_deg = 10;         // a triangle with an angle below this is repaired where the checks allow (0: none)
-  double obtuse_deg = 0;          // with sliver_deg: then a triangle with an angle above this is improved where the checks allow (0: none)
+  double max_error = 0.1;     // share of the local step: largest distance of a new vertex or centroid from the surface
+  double min_angle_deg = 15;  // a new triangle's angles stay above this (or above the smallest they replace)
+  double max_turn_deg = 45;   // largest turn of a triangle's normal by one collapse
+  double sliver_deg = 10;     // a triangle with an angle below this is repaired where the checks allow (0: none)
+  double obtuse_deg = 0;      // with sliver_deg: then a triangle with an angle above this is improved where the checks allow (0: none)
 };
 
 struct DecimateReport {

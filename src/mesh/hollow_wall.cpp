@@ -10,9 +10,7 @@
 #include "mesh/vessel_ends.hpp"
 
 namespace angiosynth {
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 SurfaceMesh hollowWall(const VascularTree& tree, const TubeSurfaceOptions& options, const WallThickness& wall, HollowWallReport* report,
                        const std::function<void(std::int64_t, std::int64_t)>& progress) {
@@ -27,8 +25,9 @@ SurfaceMesh hollowWall(const VascularTree& tree, const TubeSurfaceOptions& optio
     const double own = start && tree.wall_start[s] > 0 ? tree.wall_start[s] : tree.wall[s];
     const double w = wall.at(r, own);
     if (!(w > 0) || !std::isfinite(w))
-      throw InputError("", 0, "vessel " + std::to_string(s) + " has no wall thickness (" + std::to_string(w) +
-                                  " mm); allowed: a thickness > 0 for every vessel (a graph's wall values, a ratio or a constant)");
+      throw InputError("", 0,
+                       "vessel " + std::to_string(s) + " has no wall thickness (" + std::to_string(w) +
+                           " mm); allowed: a thickness > 0 for every vessel (a graph's wall values, a ratio or a constant)");
     thickest = std::max(thickest, r / w);
     return w;
   };
@@ -77,8 +76,10 @@ SurfaceMesh hollowWall(const VascularTree& tree, const TubeSurfaceOptions& optio
     lumen_loops = starLoops(lumen, lumen_o.ends);
     std::vector<std::size_t> still;
     for (std::size_t k = 0; k < open.size(); ++k) {
-      if (!outer_loops[k].empty() && !lumen_loops[k].empty()) still.push_back(open[k]);
-      else rep.not_joined.push_back(std::int32_t(open[k]));
+      if (!outer_loops[k].empty() && !lumen_loops[k].empty())
+        still.push_back(open[k]);
+      else
+        rep.not_joined.push_back(std::int32_t(open[k]));
     }
     if (still.size() == open.size()) break;
     open = std::move(still);

@@ -25,7 +25,7 @@ struct WallThickness {
 
 struct HollowWallReport {
   TubeSurfaceReport outer, lumen;
-  std::int64_t rings = 0;              // ends joined
+  std::int64_t rings = 0;  // ends joined
   // Ends (indices into the options' ends) one side could not open (a vessel ending against
   // another): the other side is capped flat there and the lumen ends.
   std::vector<std::int32_t> not_joined;

@@ -17,9 +17,7 @@ namespace {
 
 // Cell corners are numbered by their offsets: bit a set is +1 along axis a. Edge e runs along
 // axis e / 4 from the corner whose other two bits are those of e % 4 (axis a + 1 in bit 0, a + 2 in bit 1).
-int edgeId(int axis, int low_corner) {
-  return 4 * axis + ((low_corner >> ((axis + 1) % 3)) & 1) + 2 * ((low_corner >> ((axis + 2) % 3)) & 1);
-}
+int edgeId(int axis, int low_corner) { return 4 * axis + ((low_corner >> ((axis + 1) % 3)) & 1) + 2 * ((low_corner >> ((axis + 2) % 3)) & 1); }
 int edgeLow(int e) {
   const int a = e / 4, r = e % 4;
   return ((r & 1) << ((a + 1) % 3)) | (((r >> 1) & 1) << ((a + 2) % 3));
@@ -272,8 +270,7 @@ std::optional<SurfaceMesh> netSurface(const VascularTree& t, const SurfaceOption
   for (auto s : vessels) {
     solids.emplace_back(capsuleOf(t, s), kFillet * h);
     const double r = t.maxRadius(s);
-    for (const Vec3& p : {t.position[t.parent[s]], t.position[s]})
-      lo = componentMin(lo, p - Vec3(r, r, r)), hi = componentMax(hi, p + Vec3(r, r, r));
+    for (const Vec3& p : {t.position[t.parent[s]], t.position[s]}) lo = componentMin(lo, p - Vec3(r, r, r)), hi = componentMax(hi, p + Vec3(r, r, r));
   }
   // Two steps of room (and the fillet's stand-off) keep the surface off the grid's border.
   const double room = 2 * h + kFillet * h;

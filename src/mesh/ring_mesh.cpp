@@ -24,9 +24,11 @@ double angleAround(const Vec3& p, const Vec3& c, const Vec3& e1, const Vec3& e2)
 // no triangle over, else into its second (both lie in the plane). True when the loop's angles
 // then rise all the way round.
 bool makeStarShaped(SurfaceMesh& m, std::vector<std::int32_t>& loop, std::unordered_map<std::int32_t, std::vector<std::int32_t>>& around,
-                           std::vector<char>& keep, const Vec3& centre, const Vec3& u, double r) {
+                    std::vector<char>& keep, const Vec3& centre, const Vec3& u, double r) {
   constexpr double kHair = 0.05;
-  const auto rises = [&](std::int32_t a, std::int32_t b) { return dot(cross(m.vertices[std::size_t(a)] - centre, m.vertices[std::size_t(b)] - centre), u) > 0; };
+  const auto rises = [&](std::int32_t a, std::int32_t b) {
+    return dot(cross(m.vertices[std::size_t(a)] - centre, m.vertices[std::size_t(b)] - centre), u) > 0;
+  };
   // Loop edges shorter than this go too (where they can): the triangles on either side would be
   // slivers (a cut point beside a vertex just off the plane), and single-precision formats
   // could round their ends onto one point (8 of its units at the loop's coordinates).
@@ -99,7 +101,7 @@ bool makeStarShaped(SurfaceMesh& m, std::vector<std::int32_t>& loop, std::unorde
       std::swap(gone, kept);
     }
     loop.erase(loop.begin() + std::ptrdiff_t(gone));
-    if (kept > gone) --kept;  // the survivor moved down one
+    if (kept > gone) --kept;      // the survivor moved down one
     i = kept > 0 ? kept - 1 : 0;  // the step before it may have changed
   }
   for (std::size_t i = 0; i < loop.size(); ++i)
@@ -165,7 +167,9 @@ void frameOf(const Vec3& u, Vec3& e1, Vec3& e2) {
 namespace {
 
 // A point lies in an end's plane: on it, within two radii of its centre.
-bool inPlane(const Vec3& p, const VesselEnd& e) { return std::abs(dot(p - e.centre, e.normal)) <= 1e-9 * e.radius && distance(p, e.centre) < 2 * e.radius; }
+bool inPlane(const Vec3& p, const VesselEnd& e) {
+  return std::abs(dot(p - e.centre, e.normal)) <= 1e-9 * e.radius && distance(p, e.centre) < 2 * e.radius;
+}
 
 // The planes binned on cubes of their largest diameter, each in the 27 around its centre's
 // (neighbours by index: cubes found from shifted points could skip one to rounding): the planes
@@ -285,7 +289,8 @@ std::vector<std::vector<std::int32_t>> starLoops(SurfaceMesh& m, const std::vect
       if (!near) continue;
       for (auto k : *near) {
         if (loop_of[std::size_t(k)] >= 0 || (!skip.empty() && skip[std::size_t(k)])) continue;
-        if (std::all_of(loops[l].begin(), loops[l].end(), [&](std::int32_t p) { return inPlane(m.vertices[std::size_t(p)], planes[std::size_t(k)]); }))
+        if (std::all_of(loops[l].begin(), loops[l].end(),
+                        [&](std::int32_t p) { return inPlane(m.vertices[std::size_t(p)], planes[std::size_t(k)]); }))
           loop_of[std::size_t(k)] = std::int32_t(l);
       }
     }
@@ -299,8 +304,10 @@ std::vector<std::vector<std::int32_t>> starLoops(SurfaceMesh& m, const std::vect
       turn += dot(cross(m.vertices[std::size_t(loop[i])] - e.centre, m.vertices[std::size_t(loop[(i + 1) % loop.size()])] - e.centre), e.normal);
     std::vector<std::int32_t> ccw = loop;
     if (turn < 0) std::reverse(ccw.begin(), ccw.end());
-    if (makeStarShaped(m, ccw, around, keep, e.centre, e.normal, e.radius)) out[k] = std::move(ccw);
-    else if (bent) (*bent)[k] = std::move(ccw);
+    if (makeStarShaped(m, ccw, around, keep, e.centre, e.normal, e.radius))
+      out[k] = std::move(ccw);
+    else if (bent)
+      (*bent)[k] = std::move(ccw);
   }
   // Drop what the repairs removed, and renumber the loops.
   std::vector<std::int32_t> renumber;

@@ -45,7 +45,7 @@ void frameOf(const Vec3& u, Vec3& e1, Vec3& e2);
 // first around the axis; the triangles face away from the axis (in one plane: along u). Each
 // gets `tree` and `face`. `by_shape`: at each step the triangle whose largest angle is the
 // smaller (a contoured loop's irregular spacing makes obtuse triangles by the angles' order).
-void zipRings(SurfaceMesh& m, const Vec3& c, const Vec3& u, const std::vector<std::int32_t>& A, const std::vector<std::int32_t>& B,
-              std::int32_t tree, std::int32_t face = 0, bool by_shape = false);
+void zipRings(SurfaceMesh& m, const Vec3& c, const Vec3& u, const std::vector<std::int32_t>& A, const std::vector<std::int32_t>& B, std::int32_t tree,
+              std::int32_t face = 0, bool by_shape = false);
 
 }  // namespace angiosynth

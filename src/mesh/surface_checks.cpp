@@ -54,7 +54,8 @@ bool closedManifold(const SurfaceMesh& m) {
   std::vector<std::pair<std::int32_t, std::int32_t>> link(static_cast<std::size_t>(start[nv]));
   std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
   for (const auto& t : m.triangles)
-    for (int k = 0; k < 3; ++k) link[std::size_t(fill[std::size_t(t[std::size_t(k)])]++)] = {t[std::size_t((k + 1) % 3)], t[std::size_t((k + 2) % 3)]};
+    for (int k = 0; k < 3; ++k)
+      link[std::size_t(fill[std::size_t(t[std::size_t(k)])]++)] = {t[std::size_t((k + 1) % 3)], t[std::size_t((k + 2) % 3)]};
   for (std::size_t v = 0; v < nv; ++v) {
     const auto first = link.begin() + start[v], last = link.begin() + start[v + 1];
     const auto n = last - first;
@@ -75,8 +76,7 @@ bool closedManifold(const SurfaceMesh& m) {
   return true;
 }
 
-std::vector<std::int32_t> crossingTriangles(const SurfaceMesh& m, const Vec3& origin, double cell, bool first_only,
-                                             const std::vector<char>* dirty) {
+std::vector<std::int32_t> crossingTriangles(const SurfaceMesh& m, const Vec3& origin, double cell, bool first_only, const std::vector<char>* dirty) {
   // Each triangle has a level: the bins of cell × 2^level hold its box in at most 2 per axis. A
   // pair is tested in the bins of the coarser one's level (which hold the finer one too), and
   // only in the bin of its boxes' overlap's low corner: the one where, along each axis, one of
@@ -142,7 +142,9 @@ std::vector<std::int32_t> crossingTriangles(const SurfaceMesh& m, const Vec3& or
       bool take = (*dirty)[k] != 0;
       const int l = std::max(dirty_top, level[k]);
       const auto& keys = dirty_keys[std::size_t(l)];
-      if (!take) forBins(k, cell * double(std::int64_t(1) << l), [&](std::uint64_t key, std::uint8_t) { take = take || std::binary_search(keys.begin(), keys.end(), key); });
+      if (!take)
+        forBins(k, cell * double(std::int64_t(1) << l),
+                [&](std::uint64_t key, std::uint8_t) { take = take || std::binary_search(keys.begin(), keys.end(), key); });
       if (take) candidates.push_back(std::int32_t(k));
     }
   } else {

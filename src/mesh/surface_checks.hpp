@@ -19,6 +19,6 @@ bool freeOfCrossings(const SurfaceMesh& m, const Vec3& origin, double cell);
 // (a flag per triangle), only of pairs with a dirty triangle: after moving some vertices, the
 // triangles at them and those that crossed before are dirty, and the rest's pairs stand.
 std::vector<std::int32_t> crossingTriangles(const SurfaceMesh& m, const Vec3& origin, double cell, bool first_only = false,
-                                             const std::vector<char>* dirty = nullptr);
+                                            const std::vector<char>* dirty = nullptr);
 
 }  // namespace angiosynth

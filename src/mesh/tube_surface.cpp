@@ -59,15 +59,15 @@ struct Vessel {
   std::int32_t node[2] = {-1, -1};  // junction nodes at its proximal (0) and distal (1) end
   Vec3 a, b, u;                     // ends and unit axis a → b, mm
   double len = 0, ra = 0, rb = 0;
-  double sin_a = 0, cos_a = 1;      // a round cone's side slope
-  bool nested = false;              // a cone with no side (one sphere holds the other)
+  double sin_a = 0, cos_a = 1;  // a round cone's side slope
+  bool nested = false;          // a cone with no side (one sphere holds the other)
   // Distances of the tube's ends from a (side 0) and from b (side 1) along the axis: a cut's
   // plane, or a CFD end's plane beyond the node (negative).
   double plane[2] = {0, 0};
-  int end[2] = {-1, -1};            // the CFD end (options.ends index) at each side, or -1
-  bool round[2] = {false, false};   // a round end of the tree (no other vessel at that node)
+  int end[2] = {-1, -1};           // the CFD end (options.ends index) at each side, or -1
+  bool round[2] = {false, false};  // a round end of the tree (no other vessel at that node)
   bool tube = false;
-  bool looped = false;              // its tube runs from a contoured part back to the same part
+  bool looped = false;  // its tube runs from a contoured part back to the same part
 
   double rmax() const { return std::max(ra, rb); }
   // How far side k's CFD end prolongs the axis beyond its node (0 without one), and the distance
@@ -118,7 +118,6 @@ double cutDistance(const Vessel& v, int k, const std::vector<const Vessel*>& oth
   return plane;
 }
 
-
 // A tube's end as a cluster cuts it.
 struct Stub {
   std::int32_t vessel;  // index into the vessels
@@ -158,25 +157,24 @@ struct Cluster {
   // not: its union then has from `parts` to `parts_apart` components, each contact that closes
   // joining two of them or making a handle.
   std::int32_t parts_apart = 1, contacts = 0;
-  std::vector<GapSpan> gap_spans;   // whole vessels that need finer cells along a stretch
+  std::vector<GapSpan> gap_spans;  // whole vessels that need finer cells along a stretch
 };
-
 
 // What a cluster gives: its surface (its own vertex numbering) and each stub's loop, counter-
 // clockwise around the vessel's axis a → b, or empty if its cut failed.
 struct ClusterMesh {
   SurfaceMesh mesh;
   std::vector<std::vector<std::int32_t>> loops;
-  std::vector<std::int32_t> end_ids;     // CFD ends cut here (options.ends indices)
-  EndCutReport ends;                     // for those, in that order
+  std::vector<std::int32_t> end_ids;  // CFD ends cut here (options.ends indices)
+  EndCutReport ends;                  // for those, in that order
   double estimated_bytes = 0, step = 0;
   std::int64_t cavities_removed = 0;
   DecimateReport decimation, slivers, remeshing;
-  std::int64_t contoured = 0;            // triangles contoured, with those cut away and contours made again
-  int refinements = 0;                   // contoured again, finer, to lose a handle
-  std::vector<double> planes;            // each stub's cut distance from its node, as made
-  int cut_retries = 0;                   // contoured again with cuts further into their tubes
-  bool netted = false;                   // by surface nets (net_surface.hpp), else marching tetrahedra
+  std::int64_t contoured = 0;  // triangles contoured, with those cut away and contours made again
+  int refinements = 0;         // contoured again, finer, to lose a handle
+  std::vector<double> planes;  // each stub's cut distance from its node, as made
+  int cut_retries = 0;         // contoured again with cuts further into their tubes
+  bool netted = false;         // by surface nets (net_surface.hpp), else marching tetrahedra
 };
 
 class TubeMesher {
@@ -204,8 +202,10 @@ class TubeMesher {
       std::vector<std::size_t> todo;
       for (std::size_t c = 0; c < next.size(); ++c) {
         const auto it = before.find(keyOf(next[c]));
-        if (it != before.end()) next_meshes[c] = std::move(meshes[it->second]);
-        else todo.push_back(c);
+        if (it != before.end())
+          next_meshes[c] = std::move(meshes[it->second]);
+        else
+          todo.push_back(c);
       }
       clusters = std::move(next);
       meshes = std::move(next_meshes);
@@ -255,7 +255,8 @@ class TubeMesher {
 
   // Vertices of a vessel's rings.
   int ringVertices(const Vessel& v) const {
-    int n = o_.ring_vertices > 0 ? o_.ring_vertices : std::max(o_.min_ring_vertices, int(std::ceil(std::numbers::pi * std::max(1, o_.junction.samples_across))));
+    int n = o_.ring_vertices > 0 ? o_.ring_vertices
+                                 : std::max(o_.min_ring_vertices, int(std::ceil(std::numbers::pi * std::max(1, o_.junction.samples_across))));
     // A chord of a ring of n stands r (1 − cos π/n) inside the wall at its middle.
     if (o_.ring_tolerance_mm > 0 && o_.ring_tolerance_mm < v.rmax())
       n = std::max(n, int(std::ceil(std::numbers::pi / std::acos(1 - o_.ring_tolerance_mm / v.rmax()))));
@@ -276,9 +277,10 @@ class TubeMesher {
     }
     const double bytes = triangles * kBytesPerTriangle;
     if (bytes > double(o_.junction.memory_limit))
-      throw InputError("", 0, "the vessels' tubes make about " + std::to_string(std::llround(triangles)) + " triangles, which need about " +
-                                  formatBytes(std::uint64_t(bytes)) + " of memory, more than the limit of " + formatBytes(o_.junction.memory_limit) +
-                                  "; allowed: rings further apart (--ring-spacing), fewer --samples-across, or a larger --memory-limit");
+      throw InputError("", 0,
+                       "the vessels' tubes make about " + std::to_string(std::llround(triangles)) + " triangles, which need about " +
+                           formatBytes(std::uint64_t(bytes)) + " of memory, more than the limit of " + formatBytes(o_.junction.memory_limit) +
+                           "; allowed: rings further apart (--ring-spacing), fewer --samples-across, or a larger --memory-limit");
   }
 
   void collectVessels() {
@@ -440,8 +442,8 @@ class TubeMesher {
           pr.touching = false, pr.via = std::int32_t(m - vessels_.data());
           pr.past_i = cutPast(v, pr.side_i, p0, p1, w, q0, q1);
           pr.past_j = cutPast(w, pr.side_j, q0, q1, v, p0, p1);
-        }
-        else if (cell * kFinestGapCells >= own) pr.gap_cell = cell, pr.touching = false;
+        } else if (cell * kFinestGapCells >= own)
+          pr.gap_cell = cell, pr.touching = false;
         if (pr.gap_cell > 0) {
           const double within = v.rmax() + w.rmax() + 2 * own;
           closeSpan(v, p0, p1, si, q0, q1, within, pr.span_i);
@@ -498,8 +500,10 @@ class TubeMesher {
             double lo = 0, hi = 1;
             for (int k = 0; k < 40; ++k) {
               const double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
-              if (outside(at(m1)) < outside(at(m2))) hi = m2;
-              else lo = m1;
+              if (outside(at(m1)) < outside(at(m2)))
+                hi = m2;
+              else
+                lo = m1;
             }
             if (outside(at(0.5 * (lo + hi))) < 0) return found();
           }
@@ -525,12 +529,14 @@ class TubeMesher {
   }
   Vec3 boxLo() const {
     Vec3 lo(INFINITY, INFINITY, INFINITY);
-    for (const auto& v : vessels_) lo = componentMin(lo, componentMin(v.a, v.b) - Vec3(1, 1, 1) * (v.rmax() + std::max(v.prolonged(0), v.prolonged(1))));
+    for (const auto& v : vessels_)
+      lo = componentMin(lo, componentMin(v.a, v.b) - Vec3(1, 1, 1) * (v.rmax() + std::max(v.prolonged(0), v.prolonged(1))));
     return lo;
   }
   Vec3 boxHi() const {
     Vec3 hi(-INFINITY, -INFINITY, -INFINITY);
-    for (const auto& v : vessels_) hi = componentMax(hi, componentMax(v.a, v.b) + Vec3(1, 1, 1) * (v.rmax() + std::max(v.prolonged(0), v.prolonged(1))));
+    for (const auto& v : vessels_)
+      hi = componentMax(hi, componentMax(v.a, v.b) + Vec3(1, 1, 1) * (v.rmax() + std::max(v.prolonged(0), v.prolonged(1))));
     return hi;
   }
 
@@ -696,7 +702,7 @@ class TubeMesher {
       m.partners.insert(m.partners.end(), g.partners.begin(), g.partners.end());
     }
     std::vector<std::pair<std::int32_t, double>> fine;  // sub segment, its largest cell
-    std::map<std::int32_t, std::int32_t> fine_piece;     // vessel → its fine piece
+    std::map<std::int32_t, std::int32_t> fine_piece;    // vessel → its fine piece
     for (auto i : c.whole) {
       const auto& v = vessels_[std::size_t(i)];
       const auto it = span_of.find(i);
@@ -792,9 +798,12 @@ class TubeMesher {
       }
       // Decimated, or only its slivers repaired: the loops keep their vertices, renumbered.
       std::vector<std::int32_t> renumber;
-      if (o_.decimate) out.decimation = decimate(mesh, o_.decimation, distance, &renumber);
-      else if (o_.remesh) out.remeshing = remeshIsotropic(mesh, o_.decimation, kRemeshTarget, kRemeshRounds, distance, &renumber);
-      else if (repair) out.slivers += repairSlivers(mesh, o_.decimation, distance, &renumber, true);
+      if (o_.decimate)
+        out.decimation = decimate(mesh, o_.decimation, distance, &renumber);
+      else if (o_.remesh)
+        out.remeshing = remeshIsotropic(mesh, o_.decimation, kRemeshTarget, kRemeshRounds, distance, &renumber);
+      else if (repair)
+        out.slivers += repairSlivers(mesh, o_.decimation, distance, &renumber, true);
       if (!renumber.empty())
         for (auto& loop : loops) {
           for (auto& p : loop) p = renumber[std::size_t(p)];
@@ -848,8 +857,7 @@ class TubeMesher {
     }
     for (auto e : cut.left_closed)
       if (std::size_t(e) >= ns) out.ends.left_closed.push_back(out.end_ids[std::size_t(e) - ns]), --out.ends.cut;
-    for (auto& f : out.mesh.triangle_face)
-      f = f > std::int32_t(ns) ? out.end_ids[std::size_t(f) - 1 - ns] + 1 : 0;
+    for (auto& f : out.mesh.triangle_face) f = f > std::int32_t(ns) ? out.end_ids[std::size_t(f) - 1 - ns] + 1 : 0;
     // Each stub's loop: the boundary loop in its plane, near its axis, made star-shaped around it.
     out.loops.assign(ns, {});
     if (loops.size() != ns) loops = starLoops(out.mesh, planes, skipped(cut, ns, planes.size()));
@@ -950,14 +958,18 @@ class TubeMesher {
     m.vertex_step.push_back(float(step * r));
     // Ring after ring away from the node; zip takes the ring nearer a first.
     for (std::size_t j = 0; j + 1 < rings.size(); ++j) {
-      if (k == 1) zipRings(m, v.a, v.u, rings[j], rings[j + 1], v.tree);
-      else zipRings(m, v.a, v.u, rings[j + 1], rings[j], v.tree);
+      if (k == 1)
+        zipRings(m, v.a, v.u, rings[j], rings[j + 1], v.tree);
+      else
+        zipRings(m, v.a, v.u, rings[j + 1], rings[j], v.tree);
     }
     const auto& last = rings.back();
     for (std::size_t q = 0; q < last.size(); ++q) {
       const auto p0 = last[q], p1 = last[(q + 1) % last.size()];
-      if (k == 1) m.triangles.push_back({p0, p1, pole});
-      else m.triangles.push_back({pole, p1, p0});
+      if (k == 1)
+        m.triangles.push_back({p0, p1, pole});
+      else
+        m.triangles.push_back({pole, p1, p0});
       m.triangle_tree.push_back(v.tree);
       m.triangle_face.push_back(0);
     }
@@ -1026,7 +1038,8 @@ class TubeMesher {
       rep.decimation_largest_error_mm = std::max(rep.decimation_largest_error_mm, cm.decimation.largest_error_mm);
       rep.estimated_bytes = std::max(rep.estimated_bytes, cm.estimated_bytes);
       rep.finest_step_mm = rep.finest_step_mm > 0 ? std::min(rep.finest_step_mm, cm.step) : cm.step;
-      rep.largest_cluster_vessels = std::max<std::int64_t>(rep.largest_cluster_vessels, std::int64_t(clusters[c].whole.size() + clusters[c].stubs.size()));
+      rep.largest_cluster_vessels =
+          std::max<std::int64_t>(rep.largest_cluster_vessels, std::int64_t(clusters[c].whole.size() + clusters[c].stubs.size()));
       for (std::size_t k = 0; k < clusters[c].stubs.size(); ++k) {
         auto& l = loops[std::size_t(clusters[c].stubs[k].vessel)][std::size_t(clusters[c].stubs[k].side)];
         for (auto p : cm.loops[k]) l.push_back(p + base);
@@ -1072,7 +1085,8 @@ class TubeMesher {
       std::vector<RingAt> at;
       for (const auto& [y, n] : graded0) at.push_back({y, n, true});
       if (band0 && graded0.empty()) at.push_back({lo, n_ring, true});
-      const double spacing = (o_.ring_spacing_radii > 0 ? o_.ring_spacing_radii : kCfdRingSpacing * kTwoPi / n_ring) * 0.5 * (v.radiusAt(y0) + v.radiusAt(y1));
+      const double spacing =
+          (o_.ring_spacing_radii > 0 ? o_.ring_spacing_radii : kCfdRingSpacing * kTwoPi / n_ring) * 0.5 * (v.radiusAt(y0) + v.radiusAt(y1));
       const int pieces = std::max(1, int(std::ceil((hi - lo) / std::max(spacing, 1e-12))));
       for (int q = 1; q < pieces; ++q) at.push_back({lo + (hi - lo) * q / pieces, n_ring, false});
       if (band1 && graded1.empty()) at.push_back({hi, n_ring, true});
@@ -1101,8 +1115,10 @@ class TubeMesher {
         for (std::size_t q = 0; q < l.size(); ++q) {
           const auto p0 = l[q], p1 = l[(q + 1) % l.size()];
           // Outward: +u at the distal end, −u at the proximal one.
-          if (k == 1) m.triangles.push_back({centre, p0, p1});
-          else m.triangles.push_back({centre, p1, p0});
+          if (k == 1)
+            m.triangles.push_back({centre, p0, p1});
+          else
+            m.triangles.push_back({centre, p1, p0});
           m.triangle_tree.push_back(v.tree);
           m.triangle_face.push_back(v.end[k] + 1);
           area += 0.5 * norm(cross(m.vertices[std::size_t(p0)] - e.centre, m.vertices[std::size_t(p1)] - e.centre));
@@ -1111,8 +1127,10 @@ class TubeMesher {
       }
       A = loops[i][0];
       for (std::size_t q = 0; q <= at.size(); ++q) {
-        if (q < at.size()) ring(m, v, at[q].y, at[q].n, phase(q + 1), B, at[q].exact);
-        else B = loops[i][1];
+        if (q < at.size())
+          ring(m, v, at[q].y, at[q].n, phase(q + 1), B, at[q].exact);
+        else
+          B = loops[i][1];
         const bool at_loop = (band0 && q == 0) || (band1 && q == at.size());
         zipRings(m, v.a, v.u, A, B, v.tree, 0, o_.remesh && at_loop);
         A = B;

@@ -15,7 +15,7 @@ namespace angiosynth {
 struct Solid {
   Capsule c;
   double k;
-  Vec3 centre;         // a ball that holds the solid: its distance bounds the solid's from below
+  Vec3 centre;  // a ball that holds the solid: its distance bounds the solid's from below
   double bound = 0;
   Solid() = default;
   Solid(const Capsule& capsule, double fillet) : c(capsule), k(fillet), centre(capsule.a + capsule.d * 0.5) {

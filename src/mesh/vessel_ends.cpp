@@ -269,7 +269,9 @@ ClippedEnd clipProlongation(const CutState& st, const EndRegion& reg, std::vecto
     cut_point.emplace(key, id);
     return id;
   };
-  const auto at_of = [&](std::int32_t v) -> const Vec3& { return v >= c.base ? c.new_vertices[std::size_t(v - c.base)] : m.vertices[std::size_t(v)]; };
+  const auto at_of = [&](std::int32_t v) -> const Vec3& {
+    return v >= c.base ? c.new_vertices[std::size_t(v - c.base)] : m.vertices[std::size_t(v)];
+  };
   std::sort(cut.begin(), cut.end());
   for (auto k : cut)
     clipTriangleToPlane(
@@ -302,8 +304,10 @@ std::vector<std::int32_t> traceLoop(const CutState& st, const ClippedEnd& c, con
   for (std::int32_t v = start; ok && v >= 0;) {
     loop.push_back(v);
     const auto it = next.find(v);
-    if (it == next.end()) ok = false;
-    else v = it->second == start ? -1 : it->second;
+    if (it == next.end())
+      ok = false;
+    else
+      v = it->second == start ? -1 : it->second;
     if (loop.size() > next.size()) ok = false;
   }
   if (!ok || loop.size() < 3 || loop.size() != next.size()) return {};
@@ -315,7 +319,9 @@ std::vector<std::int32_t> traceLoop(const CutState& st, const ClippedEnd& c, con
 // when ear clipping finds no triangulation.
 bool capLoop(const SurfaceMesh& m, ClippedEnd& c, const std::vector<std::int32_t>& loop, const VesselEnd& end, const EndRegion& reg,
              std::vector<std::array<std::int32_t, 3>>& cap, double& area) {
-  const auto at_of = [&](std::int32_t v) -> const Vec3& { return v >= c.base ? c.new_vertices[std::size_t(v - c.base)] : m.vertices[std::size_t(v)]; };
+  const auto at_of = [&](std::int32_t v) -> const Vec3& {
+    return v >= c.base ? c.new_vertices[std::size_t(v - c.base)] : m.vertices[std::size_t(v)];
+  };
   const auto centre = c.base + std::int32_t(c.new_vertices.size());
   bool star = true;
   for (std::size_t i = 0; i < loop.size(); ++i) {
@@ -326,7 +332,8 @@ bool capLoop(const SurfaceMesh& m, ClippedEnd& c, const std::vector<std::int32_t
   if (star) {
     for (std::size_t i = 0; i < loop.size(); ++i) cap.push_back({loop[(i + 1) % loop.size()], loop[i], centre});
     float step = INFINITY;
-    for (auto v : loop) step = std::min(step, v >= c.base ? c.new_steps[std::size_t(v - c.base)] : m.vertex_step.empty() ? 0.f : m.vertex_step[std::size_t(v)]);
+    for (auto v : loop)
+      step = std::min(step, v >= c.base ? c.new_steps[std::size_t(v - c.base)] : m.vertex_step.empty() ? 0.f : m.vertex_step[std::size_t(v)]);
     c.new_vertices.push_back(end.centre);
     c.new_steps.push_back(step);
   } else {

@@ -18,14 +18,14 @@ namespace angiosynth {
 struct VesselEnd {
   std::int32_t vessel = -1;  // the segment (its distal node id) whose end this is
   std::int32_t tree = 0;
-  bool root = false;         // the tree's root end (else a leaf)
-  Vec3 node;                 // the end node of the vessel, mm
-  Vec3 centre;               // the cut plane's point on the axis (node + normal × extension), mm
-  Vec3 normal;               // unit, pointing out of the vessel
-  double radius = 0;         // the vessel's radius at that end, mm
-  bool open = false;         // never capped (a tube's cut, joined to its rings later)
-  bool tight = false;        // read only a step around the tube (the caller keeps other vessels out of it)
-  double step = 0;           // tight: that step (mm), else each vertex's own
+  bool root = false;   // the tree's root end (else a leaf)
+  Vec3 node;           // the end node of the vessel, mm
+  Vec3 centre;         // the cut plane's point on the axis (node + normal × extension), mm
+  Vec3 normal;         // unit, pointing out of the vessel
+  double radius = 0;   // the vessel's radius at that end, mm
+  bool open = false;   // never capped (a tube's cut, joined to its rings later)
+  bool tight = false;  // read only a step around the tube (the caller keeps other vessels out of it)
+  double step = 0;     // tight: that step (mm), else each vertex's own
 };
 
 // The space an end's cut reads around its axis: from `before` behind its plane to `beyond` past
@@ -47,9 +47,9 @@ std::vector<VesselEnd> openEnds(const VascularTree& t, double extension_radii);
 VascularTree prolongEnds(const VascularTree& t, const std::vector<VesselEnd>& ends);
 
 struct EndCutReport {
-  std::int64_t cut = 0;                 // ends cut (and capped in capped mode)
-  std::vector<std::int32_t> left_closed;  // ends (indices) whose prolongation merged with another vessel: left round
-  std::vector<double> cap_area_mm2;     // per end: the cap's area (0 if open or left closed)
+  std::int64_t cut = 0;                     // ends cut (and capped in capped mode)
+  std::vector<std::int32_t> left_closed;    // ends (indices) whose prolongation merged with another vessel: left round
+  std::vector<double> cap_area_mm2;         // per end: the cap's area (0 if open or left closed)
   std::vector<std::int32_t> loop_vertices;  // per end: vertices of its boundary loop
 };
 

@@ -50,10 +50,10 @@ struct KeyedTriangle {
 // the surface crosses, the leaf's sheet there and the leaf's direction around the edge.
 struct DualRecord {
   std::int32_t tree;
-  std::int64_t edge;   // the edge's midpoint in quarter steps, packed
-  double angle;        // of the leaf's centre around the edge (counter-clockwise about its axis)
-  std::int32_t vertex; // in the unit
-  bool low_inside;     // the edge's lower end lies inside
+  std::int64_t edge;    // the edge's midpoint in quarter steps, packed
+  double angle;         // of the leaf's centre around the edge (counter-clockwise about its axis)
+  std::int32_t vertex;  // in the unit
+  bool low_inside;      // the edge's lower end lies inside
 };
 // Where one leaf's sheet crosses one of its faces in two or more separate arcs, each arc: the two
 // grid edges it ends on (keys, lo < hi) and a point of it on the surface. If the leaf across the
@@ -63,8 +63,8 @@ struct ArcRecord {
   std::int32_t tree;
   std::int64_t lo, hi;
   std::int64_t plane;  // the face's: axis + 3 × its coordinate in half steps
-  Vec3 position;  // mm
-  float step;     // mm: the leaf's size
+  Vec3 position;       // mm
+  float step;          // mm: the leaf's size
 };
 struct DualUnit {
   std::vector<Vec3> vertices;
@@ -74,7 +74,7 @@ struct DualUnit {
 };
 
 struct UnitMesh {
-  std::vector<EdgeVertex> vertices;  // one per (tree, edge) the unit's tetrahedra cross, in key order
+  std::vector<EdgeVertex> vertices;                    // one per (tree, edge) the unit's tetrahedra cross, in key order
   std::vector<std::array<std::int32_t, 3>> triangles;  // into vertices
   std::vector<std::int32_t> triangle_tree;
 };
@@ -97,8 +97,8 @@ constexpr int kUnitLevel = 3;
 // every capsule within a band of the bin, so the value is exact inside vessels and near their
 // surface and positive wherever the union's distance is.
 struct Lattice {
-  Vec3 origin;   // mm, lattice point 0
-  double h = 0;  // mm, one step
+  Vec3 origin;      // mm, lattice point 0
+  double h = 0;     // mm, one step
   VolumeGrid grid;  // bins: voxel centres at the lattice's whole steps
   BrickBins bins;
 
@@ -317,7 +317,8 @@ class UnitMesher {
                           asVec(o) + Vec3(double(size) - margin, double(size) - margin, double(size) - margin));
     };
     for (const auto& [sum, count] : sums_) {
-      const Vec3 q = ontoSurface(sum / double(count), [&](const Vec3& x) { return distance(x); }, 1e-3, 1e-7 * lat_.h, inLeaf);
+      const Vec3 q = ontoSurface(
+          sum / double(count), [&](const Vec3& x) { return distance(x); }, 1e-3, 1e-7 * lat_.h, inLeaf);
       out.vertices.push_back(lat_.origin + q * (0.5 * lat_.h));
       out.steps.push_back(float(double(size) * 0.5 * lat_.h));
     }
@@ -389,10 +390,10 @@ class UnitMesher {
           (a == 0 ? c.x : a == 1 ? c.y : c.z) = double(o[std::size_t(a)] + (face % 2) * size);
           return c;
         };
-        const Vec3 q = ontoSurface(arc.sum / double(arc.crossings), [&](const Vec3& x) { return distance(x); }, 1e-3, 1e-7 * lat_.h, inFace);
-        out.arcs.push_back({tree, std::min(arc.end[0], arc.end[1]), std::max(arc.end[0], arc.end[1]),
-                            a + 3 * (o[std::size_t(a)] + (face % 2) * size), lat_.origin + q * (0.5 * lat_.h),
-                            float(double(size) * 0.5 * lat_.h)});
+        const Vec3 q = ontoSurface(
+            arc.sum / double(arc.crossings), [&](const Vec3& x) { return distance(x); }, 1e-3, 1e-7 * lat_.h, inFace);
+        out.arcs.push_back({tree, std::min(arc.end[0], arc.end[1]), std::max(arc.end[0], arc.end[1]), a + 3 * (o[std::size_t(a)] + (face % 2) * size),
+                            lat_.origin + q * (0.5 * lat_.h), float(double(size) * 0.5 * lat_.h)});
       }
     }
   }
@@ -492,8 +493,8 @@ class UnitMesher {
     std::int32_t parent;  // union-find: edges joined across the boundary's triangles
   };
   struct Segment {
-    int face;                // 2 × axis + side
-    std::int32_t a, b;       // its crossed edges
+    int face;           // 2 × axis + side
+    std::int32_t a, b;  // its crossed edges
   };
   struct LeafArc {
     std::int32_t root, sheet;  // in the face's union-find; the leaf's sheet
@@ -545,7 +546,8 @@ std::int64_t dropComponents(SurfaceMesh& m, const std::vector<std::int32_t>& com
 std::int64_t removeCavities(SurfaceMesh& m) {
   const auto component = componentOf(m);
   std::vector<double> volume(m.vertices.size(), 0.0);  // per component representative: 6 × its signed volume
-  for (const auto& t : m.triangles) volume[std::size_t(component[std::size_t(t[0])])] += dot(m.vertices[t[0]], cross(m.vertices[t[1]], m.vertices[t[2]]));
+  for (const auto& t : m.triangles)
+    volume[std::size_t(component[std::size_t(t[0])])] += dot(m.vertices[t[0]], cross(m.vertices[t[1]], m.vertices[t[2]]));
   std::vector<char> drop(volume.size(), 0);
   for (std::size_t v = 0; v < volume.size(); ++v) drop[v] = component[v] == std::int32_t(v) && volume[v] < 0;
   return dropComponents(m, component, drop);
@@ -594,7 +596,8 @@ ChordGaps chordGaps(const SurfaceMesh& m, const std::function<double(std::int32_
               std::vector<double>(m.vertices.size(), 0.0)};
   for (std::size_t k = 0; k < nt; ++k) {
     const auto& t = m.triangles[k];
-    const Vec3 n = cross(m.vertices[std::size_t(t[1])] - m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[2])] - m.vertices[std::size_t(t[0])]);
+    const Vec3 n =
+        cross(m.vertices[std::size_t(t[1])] - m.vertices[std::size_t(t[0])], m.vertices[std::size_t(t[2])] - m.vertices[std::size_t(t[0])]);
     const double a = norm(n);
     for (auto v : t) g.normal[std::size_t(v)] += n, g.weighted[std::size_t(v)] += a * gap[k], g.area[std::size_t(v)] += a;
   }
@@ -630,7 +633,6 @@ double restoreVolume(SurfaceMesh& m, const std::vector<Vec3>& along, std::vector
   }
   return largest;
 }
-
 
 // Runs fn(mesher, unit index, the unit's leaves) over the units in parallel, in batches so that
 // progress is reported from the calling thread.
@@ -683,13 +685,15 @@ std::int64_t relax(SurfaceMesh& m, const std::vector<std::int32_t>& tree_of, con
   for (const auto& t : m.triangles)
     for (int q = 0; q < 3; ++q)
       if (bad[std::size_t(t[std::size_t(q)])])
-        for (int r = 1; r < 3; ++r) sum[std::size_t(t[std::size_t(q)])] += m.vertices[std::size_t(t[std::size_t((q + r) % 3)])], ++count[std::size_t(t[std::size_t(q)])];
+        for (int r = 1; r < 3; ++r)
+          sum[std::size_t(t[std::size_t(q)])] += m.vertices[std::size_t(t[std::size_t((q + r) % 3)])], ++count[std::size_t(t[std::size_t(q)])];
   std::int64_t moved = 0;
   for (std::size_t v = 0; v < nv; ++v) {
     if (!bad[v] || count[v] == 0) continue;
     const auto tree = tree_of[v];
-    const Vec3 p = ontoSurface(sum[v] / double(count[v]), [&](const Vec3& x) { return distance(tree, x); }, 1e-3 * m.vertex_step[v],
-                               1e-6 * m.vertex_step[v], [](const Vec3& x) { return x; });
+    const Vec3 p = ontoSurface(
+        sum[v] / double(count[v]), [&](const Vec3& x) { return distance(tree, x); }, 1e-3 * m.vertex_step[v], 1e-6 * m.vertex_step[v],
+        [](const Vec3& x) { return x; });
     m.vertices[v] = p;
     ++moved;
   }
@@ -803,7 +807,8 @@ void untangle(SurfaceMesh& m, const std::vector<std::int32_t>& tree_of, const st
       const double h = m.vertex_step[v], most = kUntangleOffset * h, d = distance(tree, to[i]);
       if (std::abs(d) > most) {
         const double offset = d > 0 ? most : -most;
-        to[i] = ontoSurface(to[i], [&](const Vec3& x) { return distance(tree, x) - offset; }, 1e-3 * h, 1e-3 * h, [](const Vec3& x) { return x; });
+        to[i] = ontoSurface(
+            to[i], [&](const Vec3& x) { return distance(tree, x) - offset; }, 1e-3 * h, 1e-3 * h, [](const Vec3& x) { return x; });
       }
       m.vertices[v] = to[i];
     }
@@ -878,9 +883,9 @@ bool splitSharedPairs(SurfaceMesh& mesh, std::vector<DualPolygon>& held, const s
     for (int k = 0; k < held[p].n; ++k) uses.push_back({held[p].v[k], held[p].v[(k + 1) % held[p].n], std::int32_t(p), k});
   std::sort(uses.begin(), uses.end(), [](const Use& x, const Use& y) { return std::tie(x.a, x.b, x.polygon) < std::tie(y.a, y.b, y.polygon); });
   const auto range = [&](std::int32_t a, std::int32_t b) {
-    const auto lo = std::lower_bound(uses.begin(), uses.end(), std::make_pair(a, b), [](const Use& u, const std::pair<std::int32_t, std::int32_t>& k) {
-      return std::tie(u.a, u.b) < std::tie(k.first, k.second);
-    });
+    const auto lo = std::lower_bound(
+        uses.begin(), uses.end(), std::make_pair(a, b),
+        [](const Use& u, const std::pair<std::int32_t, std::int32_t>& k) { return std::tie(u.a, u.b) < std::tie(k.first, k.second); });
     auto hi = lo;
     while (hi != uses.end() && hi->a == a && hi->b == b) ++hi;
     return std::make_pair(lo, hi);
@@ -888,7 +893,9 @@ bool splitSharedPairs(SurfaceMesh& mesh, std::vector<DualPolygon>& held, const s
   // The arcs (of any face) between grid edges e and f.
   const auto arcsOf = [&](std::int32_t tree, std::int64_t e, std::int64_t f) {
     const auto key = std::make_tuple(tree, std::min(e, f), std::max(e, f));
-    const auto cmp = [](const ArcRecord& r, const std::tuple<std::int32_t, std::int64_t, std::int64_t>& k) { return std::tie(r.tree, r.lo, r.hi) < k; };
+    const auto cmp = [](const ArcRecord& r, const std::tuple<std::int32_t, std::int64_t, std::int64_t>& k) {
+      return std::tie(r.tree, r.lo, r.hi) < k;
+    };
     auto lo = std::lower_bound(arcs.begin(), arcs.end(), key, cmp), hi = lo;
     while (hi != arcs.end() && std::tie(hi->tree, hi->lo, hi->hi) == key) ++hi;
     return std::make_pair(lo, hi);
@@ -994,9 +1001,8 @@ std::optional<SurfaceMesh> dualContour(const VascularTree& t, const Lattice& lat
     arcs.insert(arcs.end(), d.arcs.begin(), d.arcs.end());
     DualUnit().records.swap(d.records);
   }
-  tbb::parallel_sort(records.begin(), records.end(), [](const DualRecord& a, const DualRecord& b) {
-    return std::tie(a.tree, a.edge, a.angle) < std::tie(b.tree, b.edge, b.angle);
-  });
+  tbb::parallel_sort(records.begin(), records.end(),
+                     [](const DualRecord& a, const DualRecord& b) { return std::tie(a.tree, a.edge, a.angle) < std::tie(b.tree, b.edge, b.angle); });
   // Each arc once (both leaves of its face may record it; the first by position, whatever the
   // units' order), and the grid edges arcs end on: only polygons around those can share a pair.
   const auto arcKey = [](const ArcRecord& a) { return std::tie(a.tree, a.lo, a.hi, a.plane); };
@@ -1131,8 +1137,9 @@ ContourPlan planContour(const VascularTree& t, const SurfaceOptions& o, SurfaceR
   for (int a = 0; a < 3; ++a) {
     const double n = std::ceil((hi[a] - lo[a] + 2 * room) / h) + 1;
     if (!(n < double(std::int64_t(1) << 19)))
-      throw InputError("", 0, "a surface step of " + std::to_string(h) + " mm needs " + std::to_string(n) +
-                                  " grid points along an axis; allowed: at most 2^19 (choose a larger voxel)");
+      throw InputError("", 0,
+                       "a surface step of " + std::to_string(h) + " mm needs " + std::to_string(n) +
+                           " grid points along an axis; allowed: at most 2^19 (choose a larger voxel)");
     steps[a] = std::int64_t(n);
   }
   // Bins list each vessel within one cell of its level (and a step) of the bin: the distance
@@ -1161,9 +1168,10 @@ ContourPlan planContour(const VascularTree& t, const SurfaceOptions& o, SurfaceR
   const double estimate = brickPairBound(inflated, lat.grid) * 12 + area_over_cell2 * (4 * 64 + 8 * 170);
   if (report) report->voxel_mm = h, report->coarsest_mm = cellSize(top), report->estimated_bytes = estimate;
   if (o.memory_limit > 0 && estimate > double(o.memory_limit))
-    throw InputError("", 0, "the surface at a step of " + std::to_string(h) + " mm needs about " + formatBytes(std::uint64_t(estimate)) +
-                                " of memory, more than the limit of " + formatBytes(o.memory_limit) +
-                                "; allowed: a larger voxel or a higher --memory-limit");
+    throw InputError("", 0,
+                     "the surface at a step of " + std::to_string(h) + " mm needs about " + formatBytes(std::uint64_t(estimate)) +
+                         " of memory, more than the limit of " + formatBytes(o.memory_limit) +
+                         "; allowed: a larger voxel or a higher --memory-limit");
   lat.bins = binSegments(inflated, lat.grid);
   inflated = VascularTree();
   plan.vessels = std::move(vessels);
@@ -1188,7 +1196,8 @@ std::vector<std::vector<std::uint64_t>> requestedCells(const VascularTree& t, co
   // descending from the top level.
   std::vector<std::vector<std::uint64_t>> requests(std::size_t(top + 1));
   {
-    tbb::enumerable_thread_specific<std::vector<std::vector<std::uint64_t>>> local([&] { return std::vector<std::vector<std::uint64_t>>(std::size_t(top + 1)); });
+    tbb::enumerable_thread_specific<std::vector<std::vector<std::uint64_t>>> local(
+        [&] { return std::vector<std::vector<std::uint64_t>>(std::size_t(top + 1)); });
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vessels.size(), 16), [&](const tbb::blocked_range<std::size_t>& r) {
       auto& out = local.local();
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -1215,7 +1224,8 @@ std::vector<std::vector<std::uint64_t>> requestedCells(const VascularTree& t, co
           c0[ax] = std::int64_t(std::floor((std::min(a[ax], b[ax]) - reach - lat.origin[ax]) / cellSize(top)));
           c1[ax] = std::int64_t(std::floor((std::max(a[ax], b[ax]) + reach - lat.origin[ax]) / cellSize(top)));
         }
-        const std::function<void(int, std::int64_t, std::int64_t, std::int64_t)> descend = [&](int m, std::int64_t x, std::int64_t y, std::int64_t z) {
+        const std::function<void(int, std::int64_t, std::int64_t, std::int64_t)> descend = [&](int m, std::int64_t x, std::int64_t y,
+                                                                                               std::int64_t z) {
           const double c = cellSize(m);
           const Vec3 centre = lat.origin + Vec3((double(x) + 0.5) * c, (double(y) + 0.5) * c, (double(z) + 0.5) * c);
           if (std::abs(cap.depth(centre)) > 0.8660254037844387 * c + margin) return;
@@ -1231,7 +1241,8 @@ std::vector<std::vector<std::uint64_t>> requestedCells(const VascularTree& t, co
       }
     });
     for (auto& per_thread : local)
-      for (int l = 0; l <= top; ++l) requests[std::size_t(l)].insert(requests[std::size_t(l)].end(), per_thread[std::size_t(l)].begin(), per_thread[std::size_t(l)].end());
+      for (int l = 0; l <= top; ++l)
+        requests[std::size_t(l)].insert(requests[std::size_t(l)].end(), per_thread[std::size_t(l)].begin(), per_thread[std::size_t(l)].end());
     for (auto& r : requests) {
       std::sort(r.begin(), r.end());
       r.erase(std::unique(r.begin(), r.end()), r.end());
@@ -1308,10 +1319,12 @@ void weldUnits(std::vector<UnitMesh>& meshes, SurfaceMesh& mesh, std::vector<Vec
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, meshes.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t u = r.begin(); u != r.end(); ++u) {
       global[u].resize(meshes[u].vertices.size());
-      for (std::size_t v = 0; v < meshes[u].vertices.size(); ++v) copies[first_copy[u] + v] = {meshes[u].vertices[v].key, std::uint32_t(u), std::uint32_t(v)};
+      for (std::size_t v = 0; v < meshes[u].vertices.size(); ++v)
+        copies[first_copy[u] + v] = {meshes[u].vertices[v].key, std::uint32_t(u), std::uint32_t(v)};
     }
   });
-  tbb::parallel_sort(copies.begin(), copies.end(), [](const Copy& a, const Copy& b) { return std::tie(a.key, a.unit, a.local) < std::tie(b.key, b.unit, b.local); });
+  tbb::parallel_sort(copies.begin(), copies.end(),
+                     [](const Copy& a, const Copy& b) { return std::tie(a.key, a.unit, a.local) < std::tie(b.key, b.unit, b.local); });
   // The first copy of each key is the vertex, numbered in key order (by a running count; the
   // rest in parallel: on a part of 20 M triangles this loop was a sixth of its time).
   const auto leads = [&](std::size_t i) { return i == 0 || !(copies[i - 1].key == copies[i].key); };
@@ -1382,8 +1395,12 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
         if ((t.tree.empty() ? 0 : t.tree[s]) == tree) here.push_back(solids[std::size_t(s)]);
     return here;
   };
-  const std::function<double(std::int32_t, const Vec3&)> distance = [&](std::int32_t tree, const Vec3& p) { return unionDistance(solidsAt(tree, p), p); };
-  const std::function<double(std::int32_t, const Vec3&)> strict = [&](std::int32_t tree, const Vec3& p) { return strictDistance(solidsAt(tree, p), p); };
+  const std::function<double(std::int32_t, const Vec3&)> distance = [&](std::int32_t tree, const Vec3& p) {
+    return unionDistance(solidsAt(tree, p), p);
+  };
+  const std::function<double(std::int32_t, const Vec3&)> strict = [&](std::int32_t tree, const Vec3& p) {
+    return strictDistance(solidsAt(tree, p), p);
+  };
   if (o.dual) {
     const char* refused = nullptr;
     if (auto dual = dualContour(t, lat, octree, units, fillet, refused, progress)) {
@@ -1396,8 +1413,10 @@ SurfaceMesh vesselSurface(const VascularTree& t, const SurfaceOptions& o, Surfac
         refused = "not a closed manifold";
       } else {
         const std::vector<std::int32_t> crossing = relaxAndUntangle(*dual, lat.origin, h, distance);
-        if (!crossing.empty()) refused = "self-intersecting";
-        else removed += removeSpecks(*dual);
+        if (!crossing.empty())
+          refused = "self-intersecting";
+        else
+          removed += removeSpecks(*dual);
       }
       if (!refused) {
         if (report)
@@ -1501,9 +1520,12 @@ MeshTopology meshTopology(const SurfaceMesh& m) {
     for (auto i = b; i != e;) {
       auto j = i;
       while (j != e && (*j >> 1) == (*i >> 1)) ++j;
-      if (j - i == 1) ++out.boundary_edges;
-      else if (j - i > 2) ++out.nonmanifold_edges;
-      else if ((*i & 1) == (*(i + 1) & 1)) ++out.misoriented_edges;
+      if (j - i == 1)
+        ++out.boundary_edges;
+      else if (j - i > 2)
+        ++out.nonmanifold_edges;
+      else if ((*i & 1) == (*(i + 1) & 1))
+        ++out.misoriented_edges;
       out.tree_euler[std::size_t(tree_of[v])] -= 1;  // E
       i = j;
     }

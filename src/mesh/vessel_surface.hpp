@@ -25,9 +25,9 @@ constexpr int kMaxSurfaceLevel = 10;
 constexpr double kGapCells = 3;
 
 struct SurfaceOptions {
-  double voxel_mm = 0;         // finest grid step; 0: the thinnest vessel's diameter / samples_across
-  int samples_across = 4;      // samples across each vessel's thinnest end (at least)
-  double max_cell_mm = 0;      // and cells no larger than this (0: no bound; a hollow wall's thickness)
+  double voxel_mm = 0;     // finest grid step; 0: the thinnest vessel's diameter / samples_across
+  int samples_across = 4;  // samples across each vessel's thinnest end (at least)
+  double max_cell_mm = 0;  // and cells no larger than this (0: no bound; a hollow wall's thickness)
   // Per segment id of the tree given (empty, or 0 for none): cells around that vessel no larger
   // than this (two vessels that come close without touching: cells that resolve their gap).
   std::vector<double> vessel_max_cell_mm;
@@ -35,7 +35,7 @@ struct SurfaceOptions {
   // only near them: a cell of its own level or finer stays no larger than 1/kGapCells of its
   // distance to their surface, so the cells grade down to the gap where it is thinnest.
   std::vector<std::vector<std::int32_t>> vessel_gap_partners;
-  bool adaptive = true;        // false: every vessel at the finest step
+  bool adaptive = true;  // false: every vessel at the finest step
   // Move vertices off the surface by ¾ of their triangles' mean gap (a fraction of the chords'
   // sagitta) so the enclosed volume is the vessels'; false: every vertex on the surface.
   bool restore_volume = true;
@@ -55,9 +55,9 @@ struct SurfaceReport {
   std::int64_t cells = 0, units = 0;
   double estimated_bytes = 0;
   std::int64_t cavities_removed = 0;
-  double largest_volume_move_mm = 0;  // closed pockets of outside space below the grid's resolution
-  bool dual = false;                  // contoured by surface nets (options.dual and its checks passed)
-  const char* dual_refused = nullptr; // options.dual, but marching tetrahedra: why
+  double largest_volume_move_mm = 0;   // closed pockets of outside space below the grid's resolution
+  bool dual = false;                   // contoured by surface nets (options.dual and its checks passed)
+  const char* dual_refused = nullptr;  // options.dual, but marching tetrahedra: why
 };
 
 // Throws InputError (no file) when the grid would exceed the memory limit or the index range.

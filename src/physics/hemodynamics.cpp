@@ -29,8 +29,7 @@ void solveTree(VascularTree& t, const PhysicsParameters& p) {
     t.beta[b] = s.beta_b;
     t.terminals[i] = t.terminals[a] + t.terminals[b];
     t.reduced_resistance[i] = combinedResistance(t.length[i], s, t.reduced_resistance[a], t.reduced_resistance[b]);
-    t.cost_ratio[i] = k.lengthCost(t.length[i]) + k.radiusCost(s.beta_a) * t.cost_ratio[a] +
-                      k.radiusCost(s.beta_b) * t.cost_ratio[b];
+    t.cost_ratio[i] = k.lengthCost(t.length[i]) + k.radiusCost(s.beta_a) * t.cost_ratio[a] + k.radiusCost(s.beta_b) * t.cost_ratio[b];
   }
   const double q_term = p.terminalFlow();
   const auto root = t.rootSegment();

@@ -11,10 +11,10 @@
 namespace angiosynth {
 
 struct PhysicsParameters {
-  double murray_exponent = 3;     // γ
-  double cost_radius_exponent = 2;  // λ
-  double cost_length_exponent = 1;  // μ
-  double viscosity = 3.6e-3;      // Pa*s
+  double murray_exponent = 3;         // γ
+  double cost_radius_exponent = 2;    // λ
+  double cost_length_exponent = 1;    // μ
+  double viscosity = 3.6e-3;          // Pa*s
   double perfusion_pressure = 13300;  // Pa, at the root (a vein's outlet)
   double terminal_pressure = 8300;    // Pa
   double perfusion_flow = 8330;       // mm^3/s, split equally among the final terminals
@@ -41,15 +41,21 @@ inline double inverseCbrt(double x) {
 class PowerKernel {
  public:
   explicit PowerKernel(const PhysicsParameters& p)
-      : gamma_(p.murray_exponent), lambda_(p.cost_radius_exponent), mu_(p.cost_length_exponent),
-        gamma3_(gamma_ == 3.0), lambda2_(lambda_ == 2.0), mu1_(mu_ == 1.0) {}
+      : gamma_(p.murray_exponent),
+        lambda_(p.cost_radius_exponent),
+        mu_(p.cost_length_exponent),
+        gamma3_(gamma_ == 3.0),
+        lambda2_(lambda_ == 2.0),
+        mu1_(mu_ == 1.0) {}
 
-  struct Split { double beta_a, beta_b; };
+  struct Split {
+    double beta_a, beta_b;
+  };
   // Radius ratios of two children a, b to their parent: r_a/r_b = (n_a R̃_a / n_b R̃_b)^¼ (eq. 12)
   // and β = (1 + (r_other/r_self)^γ)^(-1/γ) (eq. 11).
   Split split(double n_a, double R_a, double n_b, double R_b) const {
     const double y = (n_b * R_b) / (n_a * R_a);  // (r_b/r_a)^4
-    const double q = std::sqrt(std::sqrt(y));     // r_b/r_a
+    const double q = std::sqrt(std::sqrt(y));    // r_b/r_a
     const double u = gamma3_ ? q * q * q : std::pow(q, gamma_);
     const double beta_a = gamma3_ ? inverseCbrt(1.0 + u) : std::pow(1.0 + u, -1.0 / gamma_);
     return {beta_a, beta_a * q};

@@ -11,8 +11,6 @@ double priesViscosity(double radius_mm, double exponent) {
   return 1.125e-3 * (k + k * k * (eta045 - 1.0));
 }
 
-double Viscosity::at(double radius_mm) const {
-  return model == ViscosityModel::Pries ? priesViscosity(radius_mm, exponent) : constant;
-}
+double Viscosity::at(double radius_mm) const { return model == ViscosityModel::Pries ? priesViscosity(radius_mm, exponent) : constant; }
 
 }  // namespace angiosynth

@@ -10,8 +10,8 @@ enum class ViscosityModel { Constant, Pries };
 
 struct Viscosity {
   ViscosityModel model = ViscosityModel::Constant;
-  double constant = 3.6e-3;   // Pa*s (model Constant; also Algorithm 1's starting value)
-  double exponent = 0.645;    // e of the Pries law
+  double constant = 3.6e-3;  // Pa*s (model Constant; also Algorithm 1's starting value)
+  double exponent = 0.645;   // e of the Pries law
   // Pa*s at radius r (mm).
   double at(double radius_mm) const;
 };

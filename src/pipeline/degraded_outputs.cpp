@@ -25,9 +25,9 @@ std::uint64_t degradedImageBytes(const Profile& p, const VolumeGrid& g) {
   return per_voxel * static_cast<std::uint64_t>(g.voxelCount());
 }
 
-void writeDegradedImages(const Forest& forest, const std::vector<std::uint8_t>& segment_classes, const GroundTruthVolumes& gt, const VolumeRequest& req,
-                         const std::filesystem::path& dir, nlohmann::ordered_json& files, nlohmann::ordered_json& degradation,
-                         nlohmann::ordered_json* seconds) {
+void writeDegradedImages(const Forest& forest, const std::vector<std::uint8_t>& segment_classes, const GroundTruthVolumes& gt,
+                         const VolumeRequest& req, const std::filesystem::path& dir, nlohmann::ordered_json& files,
+                         nlohmann::ordered_json& degradation, nlohmann::ordered_json* seconds) {
   const ImageParameters& ip = req.image;
   for (const Profile& profile : req.profiles) {
     DegradeInput in;
@@ -69,7 +69,8 @@ void writeDegradedImages(const Forest& forest, const std::vector<std::uint8_t>& 
         channels.push_back(labelChannel(label, ip.labels, "label" + suffix));
       }
       writeChannels(channels, ip.formats, dir, files);
-      if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end()) writeMips(d.image, previewClasses(forest.trees, d.labels ? *d.labels : gt), lo, hi, suffix, dir, files);
+      if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end())
+        writeMips(d.image, previewClasses(forest.trees, d.labels ? *d.labels : gt), lo, hi, suffix, dir, files);
     }
     if (d.tree) {
       const std::string gxl = "tree" + suffix + ".gxl";

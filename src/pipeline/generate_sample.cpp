@@ -64,17 +64,16 @@ PreparedSample prepareSample(const SampleRequest& req) {
   ps.volumes = ip.enabled;
   VolumeRequest& vr = ps.vr;
   std::vector<Profile>& profiles = ps.profiles;
-  if (req.profiles) profiles = *req.profiles;
+  if (req.profiles)
+    profiles = *req.profiles;
   else
     for (const auto& ref : sc.profiles) profiles.push_back(loadProfile(ref, sc.parameter_file, sc.profiles_line));
   for (std::size_t i = 0; i < profiles.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (profiles[i].name == profiles[j].name)
-        throw InputError(profiles[i].file, 0, "two profiles are named '" + profiles[i].name +
-                                                  "' (roles image_<name> must differ); rename one file");
+        throw InputError(profiles[i].file, 0, "two profiles are named '" + profiles[i].name + "' (roles image_<name> must differ); rename one file");
   if (ps.volumes) {
-    vr.grid = req.vascusynth ? vascusynthGrid(map, req.vascusynth->voxel_mm, "VOXEL_WIDTH", 0)
-                             : imageGrid(map, ip, sc.parameter_file, sc.image_line);
+    vr.grid = req.vascusynth ? vascusynthGrid(map, req.vascusynth->voxel_mm, "VOXEL_WIDTH", 0) : imageGrid(map, ip, sc.parameter_file, sc.image_line);
     vr.image = ip;
     vr.memory_limit = req.memory_limit;
     vr.parameter_file = sc.parameter_file;
@@ -118,17 +117,13 @@ Forest growForest(const PreparedSample& ps, const SampleRequest& req, GrowthRepo
     const auto& grown = forest.vessels;
     if (std::none_of(grown.parent.begin(), grown.parent.end(), [](std::int32_t p) { return p >= 0; }))
       throw GrowthError("the growth made no vessel: check the method's lengths against the domain (its step, its spacing) and its counts");
-  } catch (const GrowthError& e) {
-    throw InputError(sc.parameter_file, 0, e.what());
-  }
+  } catch (const GrowthError& e) { throw InputError(sc.parameter_file, 0, e.what()); }
   timing["grow"] = seconds(t0);
   if (sc.curves.enabled) {
     t0 = Clock::now();
     try {
       forest.vessels = curveVessels(forest.vessels, sc.curves, ps.growth->domain(), *ps.map, req.seed, req.sample, curves, req.memory_limit);
-    } catch (const InputError& e) {
-      throw InputError(sc.parameter_file, sc.curves_line, e.what());
-    }
+    } catch (const InputError& e) { throw InputError(sc.parameter_file, sc.curves_line, e.what()); }
     timing["curves"] = seconds(t0);
   }
   return forest;
@@ -140,8 +135,10 @@ void writeGraphs(const Forest& forest, const PreparedSample& ps, const SampleReq
   if (req.vascusynth) return writeVascuSynthGraphs(forest, frame, req.graph_id, dir, files);
   const VascularTree& tree = forest.vessels;
   writeTextFile(dir / "tree.gxl", [&](std::ostream& o) {
-    if (req.gxl_dialect == "vascusynth") writeVascuSynthGxl(o, tree, frame, req.graph_id);
-    else writeGxl(o, tree, forest.trees, frame, req.graph_id);
+    if (req.gxl_dialect == "vascusynth")
+      writeVascuSynthGxl(o, tree, frame, req.graph_id);
+    else
+      writeGxl(o, tree, forest.trees, frame, req.graph_id);
   });
   files["gxl"] = "tree.gxl";
   writeTextFile(dir / "tree.dot", [&](std::ostream& o) { writeDot(o, tree, forest.trees, frame); });
@@ -188,9 +185,8 @@ void addTreeStatistics(const VascularTree& tree, const PreparedSample& ps, const
   stats["cost"] = Json{{"value", cost},
                        {"unit", "mm^" + exactNumber(p.cost_length_exponent + p.cost_radius_exponent)},
                        {"definition", "sum over segments of length^mu * radius^lambda"}};
-  stats["cost_" + sc.input_units.length] =
-      Json{{"value", cost / std::pow(len_unit, p.cost_length_exponent + p.cost_radius_exponent)},
-           {"unit", sc.input_units.length + "^" + exactNumber(p.cost_length_exponent + p.cost_radius_exponent)}};
+  stats["cost_" + sc.input_units.length] = Json{{"value", cost / std::pow(len_unit, p.cost_length_exponent + p.cost_radius_exponent)},
+                                                {"unit", sc.input_units.length + "^" + exactNumber(p.cost_length_exponent + p.cost_radius_exponent)}};
   stats["depth_max"] = depth_max;
   stats["depth_mean"] = terminals ? depth_sum / double(terminals) : 0.0;
   stats["root_radius"] = quantityJson(report.root_radius_mm, "mm");
@@ -259,8 +255,12 @@ Json describeTrees(const Forest& forest) {
     double terminal_pressure = tree.pressure[root];
     for (std::int32_t i = seg; i >= 0; i = tree.child0[i]) terminal_pressure = tree.pressure[i];
     const Vec3& at = tree.position[root];
-    trees.push_back(Json{{"index", k}, {"id", t.id}, {"kind", t.kind}, {"class", t.class_label},
-                         {"root_node", root}, {"root_position", Json{{"value", {at.x, at.y, at.z}}, {"unit", "mm"}}},
+    trees.push_back(Json{{"index", k},
+                         {"id", t.id},
+                         {"kind", t.kind},
+                         {"class", t.class_label},
+                         {"root_node", root},
+                         {"root_position", Json{{"value", {at.x, at.y, at.z}}, {"unit", "mm"}}},
                          {"terminals", seg >= 0 ? tree.terminals[seg] : 0},
                          {"root_radius", quantityJson(seg >= 0 ? tree.startRadius(seg) : 0.0, "mm")},
                          {"flow", quantityJson(seg >= 0 ? tree.flow[seg] : 0.0, "mm^3/s")},
@@ -337,10 +337,14 @@ SampleSummary generateSample(const SampleRequest& req, const std::filesystem::pa
   j["sample"] = req.sample;
   j["parameter_file"] = sc.parameter_file;
   j["parameter_format"] = sc.format;
-  j["units"] = Json{{"length", "mm"}, {"flow", "mm^3/s"}, {"pressure", "Pa"}, {"viscosity", "Pa*s"},
+  j["units"] = Json{{"length", "mm"},
+                    {"flow", "mm^3/s"},
+                    {"pressure", "Pa"},
+                    {"viscosity", "Pa*s"},
                     {"input", sc.units_note},
-                    {"frame", "positions in mm from the corner of map voxel (0,0,0), axes along the map's x, y, z; "
-                              "position_voxel in map voxels"}};
+                    {"frame",
+                     "positions in mm from the corner of map voxel (0,0,0), axes along the map's x, y, z; "
+                     "position_voxel in map voxels"}};
   j["parameters"] = describeParameters(sc);
   j["trees"] = describeTrees(forest);
   j["classes"] = classLegend(forest);

@@ -17,17 +17,17 @@ namespace angiosynth {
 struct SampleRequest {
   const Scenario* scenario = nullptr;
   std::uint64_t seed = 1;
-  std::string gxl_dialect = "gxl";        // "gxl" or "vascusynth"
+  std::string gxl_dialect = "gxl";             // "gxl" or "vascusynth"
   std::optional<VascuSynthLayout> vascusynth;  // VascuSynth's own directory layout instead of angiosynth's
   std::string graph_id = "tree";
   std::string command_line;
   std::uint64_t memory_limit = 0;
-  nlohmann::ordered_json extra;           // more resolved parameters for sample.json
+  nlohmann::ordered_json extra;  // more resolved parameters for sample.json
   ProgressFn progress;
-  std::uint64_t sample = 0;               // index within a dataset (part of every random stream)
+  std::uint64_t sample = 0;  // index within a dataset (part of every random stream)
   // Degradation profiles overriding the parameter file's [degrade] profiles when set.
   std::optional<std::vector<Profile>> profiles;
-  bool record_timing = true;              // false: sample.json depends on seed and parameters only
+  bool record_timing = true;  // false: sample.json depends on seed and parameters only
   // The kinds in class-label order (1, 2, ...), when a dataset fixes them; empty: artery 1, vein 2.
   std::vector<std::string> class_kinds;
 };
@@ -38,7 +38,7 @@ struct SampleSummary {
   double total_volume_mm3 = 0;
   std::int64_t intersecting_pairs = 0;  // segment capsules that overlap, more than two segments apart
   double grow_seconds = 0;
-  nlohmann::ordered_json sidecar;       // sample.json as written
+  nlohmann::ordered_json sidecar;  // sample.json as written
   // The file written for `role` ("image", "mask", "image_cta", …), relative to the sample's directory.
   std::filesystem::path file(const std::string& role) const;
   bool wrote(const std::string& role) const;

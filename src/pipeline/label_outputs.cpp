@@ -33,8 +33,7 @@ double orderedSum(std::int64_t n, F&& term) {
 
 }  // namespace
 
-ProfileVisibility profileVisibility(const Profile& profile, const DegradeInput& in, const Volume<float>& degraded,
-                                    const Volume<float>& fraction) {
+ProfileVisibility profileVisibility(const Profile& profile, const DegradeInput& in, const Volume<float>& degraded, const Volume<float>& fraction) {
   ProfileVisibility out;
   DegradeInput quiet = in;
   quiet.noise_free = true;

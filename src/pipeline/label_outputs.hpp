@@ -20,8 +20,7 @@ struct ProfileVisibility {
   Volume<float> contrast;
   double noise_sigma = 0;
 };
-ProfileVisibility profileVisibility(const Profile& profile, const DegradeInput& in, const Volume<float>& degraded,
-                                    const Volume<float>& fraction);
+ProfileVisibility profileVisibility(const Profile& profile, const DegradeInput& in, const Volume<float>& degraded, const Volume<float>& fraction);
 
 // Extra bytes per voxel the label policy needs while a profile runs (its label, and for visible
 // the noise-free runs and their images).

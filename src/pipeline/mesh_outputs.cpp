@@ -40,10 +40,14 @@ void writeFaces(std::ostream& os, const std::vector<VesselEnd>& ends, const EndC
     const auto& e = ends[k];
     const bool vein = std::size_t(e.tree) < kinds.size() && kinds[std::size_t(e.tree)] == "vein";
     os << k + 2 << ',' << ((e.root != vein) ? "inlet" : "outlet") << ',' << e.tree << ','
-       << (std::size_t(e.vessel) < vessel_ids.size() ? vessel_ids[std::size_t(e.vessel)] : std::to_string(e.vessel)) << ',' << (e.root ? "root" : "leaf") << ','
-       << (outside(e.centre) ? "outside_box" : closed[k] ? "left_closed" : mode) << ',' << exactNumber(e.centre.x) << ',' << exactNumber(e.centre.y) << ',' << exactNumber(e.centre.z) << ','
-       << exactNumber(e.normal.x) << ',' << exactNumber(e.normal.y) << ',' << exactNumber(e.normal.z) << ',' << exactNumber(e.radius) << ','
-       << exactNumber(cut.cap_area_mm2[k]) << ',' << cut.loop_vertices[k] << '\n';
+       << (std::size_t(e.vessel) < vessel_ids.size() ? vessel_ids[std::size_t(e.vessel)] : std::to_string(e.vessel)) << ','
+       << (e.root ? "root" : "leaf") << ','
+       << (outside(e.centre) ? "outside_box"
+           : closed[k]       ? "left_closed"
+                             : mode)
+       << ',' << exactNumber(e.centre.x) << ',' << exactNumber(e.centre.y) << ',' << exactNumber(e.centre.z) << ',' << exactNumber(e.normal.x) << ','
+       << exactNumber(e.normal.y) << ',' << exactNumber(e.normal.z) << ',' << exactNumber(e.radius) << ',' << exactNumber(cut.cap_area_mm2[k]) << ','
+       << cut.loop_vertices[k] << '\n';
   }
   if (box.empty()) return;
   for (int side = 0; side < 6; ++side) {
@@ -70,7 +74,8 @@ std::vector<double> endFaceAreas(const SurfaceMesh& m, std::size_t n, std::vecto
     if (f <= 0 || std::size_t(f) > n) continue;
     const auto& t = m.triangles[k];
     area[std::size_t(f - 1)] += triangleArea(m, t);
-    for (int i = 0; i < 3; ++i) edges.push_back({f, std::min(t[std::size_t(i)], t[std::size_t((i + 1) % 3)]), std::max(t[std::size_t(i)], t[std::size_t((i + 1) % 3)])});
+    for (int i = 0; i < 3; ++i)
+      edges.push_back({f, std::min(t[std::size_t(i)], t[std::size_t((i + 1) % 3)]), std::max(t[std::size_t(i)], t[std::size_t((i + 1) % 3)])});
   }
   if (loop_vertices) {
     loop_vertices->assign(n, 0);
@@ -93,8 +98,9 @@ void checkVoxelAgainstThinnest(const VascularTree& tree, const MeshParameters& p
   for (std::int32_t i = 0; i < tree.nodeCount(); ++i)
     if (!tree.isRoot(i) && !tree.isLink(i)) thinnest = std::min({thinnest, tree.radius[i], tree.startRadius(i)});
   if (*p.voxel_mm > thinnest)
-    throw InputError("", 0, "a mesh voxel of " + exactNumber(*p.voxel_mm) + " mm is coarser than half the thinnest vessel's diameter (" +
-                                exactNumber(2 * thinnest) + " mm); allowed: at most " + exactNumber(thinnest) + " mm, two steps across it");
+    throw InputError("", 0,
+                     "a mesh voxel of " + exactNumber(*p.voxel_mm) + " mm is coarser than half the thinnest vessel's diameter (" +
+                         exactNumber(2 * thinnest) + " mm); allowed: at most " + exactNumber(thinnest) + " mm, two steps across it");
 }
 
 // The meshers' options, from the settings.
@@ -173,8 +179,10 @@ BuiltSurface buildSurface(const VascularTree& tree, const MeshParameters& p, Sur
       // Slivers before the cut too (tube_surface.cpp says why).
       if (d.sliver_deg > 0) b.slivers = repairSlivers(m, d, distance);
       if (plan.cut_ends) b.cut = cutEnds(m, ends, p.ends == "capped");
-      if (p.decimate) b.reduced = decimate(m, d, distance);
-      else if (d.sliver_deg > 0) b.slivers += repairSlivers(m, d, distance, nullptr, true);
+      if (p.decimate)
+        b.reduced = decimate(m, d, distance);
+      else if (d.sliver_deg > 0)
+        b.slivers += repairSlivers(m, d, distance, nullptr, true);
     };
     b.mesh = vesselSurface(plan.cut_ends ? prolongEnds(tree, ends) : tree, plan.contour, &b.contour, progress);
     plan.contour.finish = nullptr;  // it refers to this function's locals
@@ -202,7 +210,8 @@ SurfaceSummary summarise(const VascularTree& tree, const MeshParameters& p, cons
     s.contour = SurfaceSummary::Contour{b.contour.coarsest_mm, b.contour.levels, b.contour.cells, b.contour.largest_volume_move_mm};
   } else {
     const auto& t = b.tube;
-    s.tube = SurfaceSummary::Tubes{t.tubes, t.clusters, t.netted, t.largest_cluster_vessels, t.tube_triangles, t.contour_triangles, t.fallbacks, t.cut_retries};
+    s.tube = SurfaceSummary::Tubes{t.tubes,          t.clusters,          t.netted,    t.largest_cluster_vessels,
+                                   t.tube_triangles, t.contour_triangles, t.fallbacks, t.cut_retries};
   }
   if (plan.walls) s.wall_ends_joined = b.wall.rings;
   s.estimated_bytes = b.contour.estimated_bytes;
@@ -224,34 +233,36 @@ SurfaceSummary summarise(const VascularTree& tree, const MeshParameters& p, cons
 // The settings as the meshers took them (defaults resolved) and how the surface is made.
 Json resolvedParameters(const MeshParameters& p, const SurfacePlan& plan) {
   const bool tubes = plan.tubes, walls = plan.walls;
-  return {{"formats", p.formats},
-          {"method", p.method},
-          {"junctions", tubes ? Json(p.junctions) : Json(nullptr)},
-          {"voxel_mm", p.voxel_mm ? Json(*p.voxel_mm) : Json(nullptr)},
-          {"samples_across", plan.contour.samples_across},
-          {"ring_spacing_radii", tubes && p.ringSpacing() > 0 ? Json(p.ringSpacing()) : Json(nullptr)},
-          {"ring_spacing_vertex_spacings", tubes && p.ringSpacing() == 0 ? Json(kCfdRingSpacing) : Json(nullptr)},
-          {"wall", !walls ? Json(nullptr)
-                          : p.wall_thickness > 0 ? Json({{"thickness_mm", p.wall_thickness}})
-                          : p.wall_ratio > 0     ? Json({{"ratio_of_radius", p.wall_ratio}})
-                                                 : Json({{"from", "the graph's wall values"}})},
-          {"adaptive", !p.uniform},
-          {"volume_restored", !p.on_surface},
-          {"ends", walls ? std::string("open") : p.ends},
-          {"flow_extension_radii", p.flow_extension},
-          {"clip_box_mm", p.clip_box.empty() ? Json(nullptr) : Json(p.clip_box)},
-          {"decimate", p.decimate},
-          {"max_error_steps", p.max_error},
-          {"sliver_angle_deg", p.sliverAngle()},
-          {"max_angle_deg", p.maxAngle()},
-          {"remesh", tubes && p.remeshes()},
-          {"description", tubes ? "each vessel's free middle a tube of rings on its exact wall (at most ring_spacing_radii radii "
-                                  "apart, aligned; or ring_spacing_vertex_spacings apart, each turned by half a vertex spacing); where vessels meet, the signed distance to the union of their capsules and round cones "
-                                  "contoured by surface nets on a uniform grid or on the octree (junctions = nets, where the part passes its checks) or "
-                                  "by marching tetrahedra (2:1-balanced octree of cells sized to each vessel's radius), cut by "
-                                  "planes across the tubes and joined to their rings"
-                                : "marching tetrahedra of the signed distance to the union of each tree's capsules and round cones, on a "
-                                  "2:1-balanced octree of cells sized to each vessel's radius, split into conforming tetrahedra"}};
+  return {
+      {"formats", p.formats},
+      {"method", p.method},
+      {"junctions", tubes ? Json(p.junctions) : Json(nullptr)},
+      {"voxel_mm", p.voxel_mm ? Json(*p.voxel_mm) : Json(nullptr)},
+      {"samples_across", plan.contour.samples_across},
+      {"ring_spacing_radii", tubes && p.ringSpacing() > 0 ? Json(p.ringSpacing()) : Json(nullptr)},
+      {"ring_spacing_vertex_spacings", tubes && p.ringSpacing() == 0 ? Json(kCfdRingSpacing) : Json(nullptr)},
+      {"wall", !walls                 ? Json(nullptr)
+               : p.wall_thickness > 0 ? Json({{"thickness_mm", p.wall_thickness}})
+               : p.wall_ratio > 0     ? Json({{"ratio_of_radius", p.wall_ratio}})
+                                      : Json({{"from", "the graph's wall values"}})},
+      {"adaptive", !p.uniform},
+      {"volume_restored", !p.on_surface},
+      {"ends", walls ? std::string("open") : p.ends},
+      {"flow_extension_radii", p.flow_extension},
+      {"clip_box_mm", p.clip_box.empty() ? Json(nullptr) : Json(p.clip_box)},
+      {"decimate", p.decimate},
+      {"max_error_steps", p.max_error},
+      {"sliver_angle_deg", p.sliverAngle()},
+      {"max_angle_deg", p.maxAngle()},
+      {"remesh", tubes && p.remeshes()},
+      {"description", tubes ? "each vessel's free middle a tube of rings on its exact wall (at most ring_spacing_radii radii "
+                              "apart, aligned; or ring_spacing_vertex_spacings apart, each turned by half a vertex spacing); where vessels meet, the "
+                              "signed distance to the union of their capsules and round cones "
+                              "contoured by surface nets on a uniform grid or on the octree (junctions = nets, where the part passes its checks) or "
+                              "by marching tetrahedra (2:1-balanced octree of cells sized to each vessel's radius), cut by "
+                              "planes across the tubes and joined to their rings"
+                            : "marching tetrahedra of the signed distance to the union of each tree's capsules and round cones, on a "
+                              "2:1-balanced octree of cells sized to each vessel's radius, split into conforming tetrahedra"}};
 }
 
 void writeFile(const std::filesystem::path& file, const std::function<void(std::ostream&)>& write) {

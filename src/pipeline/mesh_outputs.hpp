@@ -50,7 +50,7 @@ struct SurfaceSummary {
 struct SurfaceFiles {
   nlohmann::ordered_json parameters;  // the settings as the meshers took them (defaults resolved)
   SurfaceSummary statistics;
-  nlohmann::ordered_json files;       // format → file name
+  nlohmann::ordered_json files;  // format → file name
 };
 
 // Throws InputError (nothing written) when the surface would exceed the memory limit.
@@ -58,7 +58,7 @@ struct SurfaceFiles {
 // outlet and its leaves the inlets; other trees flow from the root. `vessel_ids` (per node, may
 // be empty): the ids surface_faces.csv names vessels by (a graph file's own), else node ids.
 SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p, std::uint64_t memory_limit, const std::filesystem::path& dir,
-                               const std::function<void(std::int64_t, std::int64_t)>& progress = {},
-                               const std::vector<std::string>& tree_kinds = {}, const std::vector<std::string>& vessel_ids = {});
+                               const std::function<void(std::int64_t, std::int64_t)>& progress = {}, const std::vector<std::string>& tree_kinds = {},
+                               const std::vector<std::string>& vessel_ids = {});
 
 }  // namespace angiosynth

@@ -10,8 +10,7 @@ namespace angiosynth {
 
 VolumeGrid vascusynthGrid(const DemandMap& map, double output_voxel_mm, const std::string& file, int line) {
   VolumeGrid g;
-  for (int ax = 0; ax < 3; ++ax)
-    g.dims[ax] = axisVoxels(std::floor(map.dims[ax] * map.voxel_mm / output_voxel_mm + 1e-9) + 1, file, line);
+  for (int ax = 0; ax < 3; ++ax) g.dims[ax] = axisVoxels(std::floor(map.dims[ax] * map.voxel_mm / output_voxel_mm + 1e-9) + 1, file, line);
   g.spacing_mm = Vec3(output_voxel_mm, output_voxel_mm, output_voxel_mm);
   g.origin_mm = Vec3(0, 0, 0);
   return g;
@@ -34,8 +33,10 @@ void writeVascuSynthSlices(const VolumeView& image, const Volume<float>& shown, 
   for (std::int32_t z = 0; z < shown.grid.dims[2]; ++z) {
     char name[32];
     std::snprintf(name, sizeof name, "image%03d.%s", z, png ? "png" : "jpg");
-    if (png) writePng(dir / sub / name, sliceZ(shown, z, lo, hi));
-    else writeJpeg(dir / sub / name, sliceZ(shown, z, lo, hi));
+    if (png)
+      writePng(dir / sub / name, sliceZ(shown, z, lo, hi));
+    else
+      writeJpeg(dir / sub / name, sliceZ(shown, z, lo, hi));
   }
   files[sub + "_slices"] = sub + "/image%03d." + (png ? "png" : "jpg");
 }

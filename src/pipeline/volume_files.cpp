@@ -35,9 +35,9 @@ void writeKeypoints(std::ostream& out, const VascularTree& t, const std::vector<
     if (t.isLink(i)) continue;  // an N-ary junction is one key point
     const Vec3& p = t.position[i];
     const Vec3 v = g.index(p);
-    out << i << ',' << nodeTypeName(t.graphType(i)) << ',' << exactNumber(v.x) << ',' << exactNumber(v.y) << ',' << exactNumber(v.z)
-        << ',' << exactNumber(p.x) << ',' << exactNumber(p.y) << ',' << exactNumber(p.z) << ',' << exactNumber(nodeRadius(t, i))
-        << ',' << treeOf(trees, t, i).id << ',' << treeOf(trees, t, i).kind << '\n';
+    out << i << ',' << nodeTypeName(t.graphType(i)) << ',' << exactNumber(v.x) << ',' << exactNumber(v.y) << ',' << exactNumber(v.z) << ','
+        << exactNumber(p.x) << ',' << exactNumber(p.y) << ',' << exactNumber(p.z) << ',' << exactNumber(nodeRadius(t, i)) << ','
+        << treeOf(trees, t, i).id << ',' << treeOf(trees, t, i).kind << '\n';
   }
 }
 
@@ -45,10 +45,14 @@ void writeKeypoints(std::ostream& out, const VascularTree& t, const std::vector<
 
 void makeTypedImage(TypedImage& out, const Volume<float>& src, double offset, double scale, const std::string& dtype,
                     const std::string& description) {
-  if (dtype == "uint8") convert(out.u8, src, offset, scale), out.view = viewOf(out.u8, false, description);
-  else if (dtype == "uint16") convert(out.u16, src, offset, scale), out.view = viewOf(out.u16, false, description);
-  else if (dtype == "int16") convert(out.s16, src, offset, scale), out.view = viewOf(out.s16, false, description);
-  else convert(out.f32, src, offset, scale), out.view = viewOf(out.f32, false, description);
+  if (dtype == "uint8")
+    convert(out.u8, src, offset, scale), out.view = viewOf(out.u8, false, description);
+  else if (dtype == "uint16")
+    convert(out.u16, src, offset, scale), out.view = viewOf(out.u16, false, description);
+  else if (dtype == "int16")
+    convert(out.s16, src, offset, scale), out.view = viewOf(out.s16, false, description);
+  else
+    convert(out.f32, src, offset, scale), out.view = viewOf(out.f32, false, description);
 }
 
 std::vector<Channel> labelChannels(const GroundTruthVolumes& gt, const std::string& suffix) {
@@ -60,8 +64,7 @@ std::vector<Channel> labelChannels(const GroundTruthVolumes& gt, const std::stri
   return c;
 }
 
-void writeChannels(const std::vector<Channel>& channels, const std::vector<std::string>& formats,
-                   const std::filesystem::path& dir, Json& files) {
+void writeChannels(const std::vector<Channel>& channels, const std::vector<std::string>& formats, const std::filesystem::path& dir, Json& files) {
   bool first = true;
   for (const auto& name : formats) {
     const VolumeFormat* format = findVolumeFormat(name);

@@ -24,11 +24,10 @@ struct TypedImage {
   VolumeView view;
 };
 // offset + scale × src, as dtype (uint8, uint16, int16, float32).
-void makeTypedImage(TypedImage& out, const Volume<float>& src, double offset, double scale, const std::string& dtype,
-                    const std::string& description);
+void makeTypedImage(TypedImage& out, const Volume<float>& src, double offset, double scale, const std::string& dtype, const std::string& description);
 
 struct Channel {
-  std::string role;   // also the file stem
+  std::string role;  // also the file stem
   VolumeView view;
 };
 
@@ -37,8 +36,8 @@ struct Channel {
 std::vector<Channel> labelChannels(const GroundTruthVolumes& gt, const std::string& suffix);
 
 // Writes the channels in each per-channel volume format (projections and sparse grids are written elsewhere).
-void writeChannels(const std::vector<Channel>& channels, const std::vector<std::string>& formats,
-                   const std::filesystem::path& dir, nlohmann::ordered_json& files);
+void writeChannels(const std::vector<Channel>& channels, const std::vector<std::string>& formats, const std::filesystem::path& dir,
+                   nlohmann::ordered_json& files);
 // Maximum-intensity projections along x, y, z as mip_<axis><suffix>.png, [lo, hi] → [0, 255]; in
 // colour by the kind of the brightest voxel (artery red, vein blue, ...) when `classes` is given.
 void writeMips(const Volume<float>& v, const Volume<std::uint8_t>* classes, double lo, double hi, const std::string& suffix,

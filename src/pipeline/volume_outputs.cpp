@@ -25,8 +25,10 @@ using Json = nlohmann::ordered_json;
 
 std::int32_t axisVoxels(double n, const std::string& file, int line) {
   if (!(n <= 1e5))
-    throw InputError(file, line, "the image would be " + show(n) + " voxels along one axis; allowed: at most 100000 "
-                                 "(raise [image] voxel_size or shrink field_of_view)");
+    throw InputError(file, line,
+                     "the image would be " + show(n) +
+                         " voxels along one axis; allowed: at most 100000 "
+                         "(raise [image] voxel_size or shrink field_of_view)");
   return std::max<std::int32_t>(1, static_cast<std::int32_t>(n));
 }
 
@@ -44,7 +46,8 @@ VolumeGrid imageGrid(const DemandMap& map, const ImageParameters& p, const std::
 }
 
 bool needsDense(const VolumeRequest& req) {
-  return req.vascusynth || !req.profiles.empty() || std::any_of(req.image.formats.begin(), req.image.formats.end(), [](const std::string& f) { return f != "vdb"; });
+  return req.vascusynth || !req.profiles.empty() ||
+         std::any_of(req.image.formats.begin(), req.image.formats.end(), [](const std::string& f) { return f != "vdb"; });
 }
 
 void checkVolumeMemory(const VolumeRequest& req) {
@@ -62,12 +65,11 @@ void checkVolumeMemory(const VolumeRequest& req) {
   if (need > req.memory_limit)
     throw InputError(req.parameter_file, req.image_line,
                      "an image of " + size + " voxels needs " + formatBytes(need) + " of memory, more than the limit of " +
-                         formatBytes(req.memory_limit) +
-                         "; raise [image] voxel_size, shrink [image] field_of_view, or raise --memory-limit");
+                         formatBytes(req.memory_limit) + "; raise [image] voxel_size, shrink [image] field_of_view, or raise --memory-limit");
 }
 
-void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::filesystem::path& dir, Json& files,
-                  Json& stats, Json& degradation, Json* seconds) {
+void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::filesystem::path& dir, Json& files, Json& stats, Json& degradation,
+                  Json* seconds) {
   const VascularTree& tree = forest.vessels;
   const VolumeGrid& g = req.grid;
   const ImageParameters& ip = req.image;
@@ -77,14 +79,13 @@ void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::fil
     if (pairs * 12 > double(req.memory_limit))
       throw InputError(req.parameter_file, req.image_line,
                        "the sparse volume's bricks need about " + formatBytes(std::uint64_t(std::min(pairs * 12, 1e18))) +
-                           " to sort, more than the limit of " + formatBytes(req.memory_limit) +
-                           "; raise [image] voxel_size or --memory-limit");
+                           " to sort, more than the limit of " + formatBytes(req.memory_limit) + "; raise [image] voxel_size or --memory-limit");
     const BrickBins bins = binSegments(tree, g);
     const auto need = sparseRasterBytes(bins);
     if (need > req.memory_limit)
       throw InputError(req.parameter_file, req.image_line,
-                       "the sparse volume needs about " + formatBytes(need) + ", more than the limit of " +
-                           formatBytes(req.memory_limit) + "; raise [image] voxel_size or --memory-limit");
+                       "the sparse volume needs about " + formatBytes(need) + ", more than the limit of " + formatBytes(req.memory_limit) +
+                           "; raise [image] voxel_size or --memory-limit");
     const VdbReport r = writeVdb(dir / "volume.vdb", tree, g, bins, RasterOptions{ip.supersampling, ip.centerline_connectivity});
     files["vdb"] = "volume.vdb";
     stats["vdb_leaves"] = r.leaves;
@@ -115,7 +116,8 @@ void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::fil
       stats["label"] = labelLengthKept(&gt.mask, nullptr, ip.labels, req.label_numbering, tree);
     }
     writeChannels(channels, ip.formats, dir, files);
-    if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end()) writeMips(gt.fraction, previewClasses(forest.trees, gt), 0, 1, "", dir, files);
+    if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end())
+      writeMips(gt.fraction, previewClasses(forest.trees, gt), 0, 1, "", dir, files);
     if (req.vascusynth) writeVascuSynthSlices(image.view, gt.fraction, 0, 1, "original_image", *req.vascusynth, dir, files);
   }
   std::int64_t mask_voxels = 0;

@@ -27,13 +27,13 @@ struct VolumeRequest {
   VolumeGrid grid;
   ImageParameters image;
   std::uint64_t memory_limit = 0;
-  std::string parameter_file;     // for size errors
+  std::string parameter_file;  // for size errors
   int image_line = 0;
   std::optional<VascuSynthLayout> vascusynth;  // VascuSynth's layout: slices of each image
   // Degradation: one image per profile (role image_<profile>), drawn from (seed, sample).
   std::vector<Profile> profiles;
   std::uint64_t seed = 1, sample = 0;
-  GraphFrame frame;               // for the GXL of warped trees
+  GraphFrame frame;                // for the GXL of warped trees
   LabelNumbering label_numbering;  // vessel 1 (or each kind's class), ignore value
 };
 
@@ -42,8 +42,7 @@ void checkVolumeMemory(const VolumeRequest& req);
 
 // Writes the volumes and graph files into dir; adds {role: path} to `files` and figures to
 // `stats`, and the drawn values of each profile to `degradation`. Throws InputError before allocating when the volumes would exceed the memory limit.
-void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::filesystem::path& dir,
-                  nlohmann::ordered_json& files, nlohmann::ordered_json& stats, nlohmann::ordered_json& degradation,
-                  nlohmann::ordered_json* seconds = nullptr);
+void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::filesystem::path& dir, nlohmann::ordered_json& files,
+                  nlohmann::ordered_json& stats, nlohmann::ordered_json& degradation, nlohmann::ordered_json* seconds = nullptr);
 
 }  // namespace angiosynth

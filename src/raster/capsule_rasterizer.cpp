@@ -14,9 +14,8 @@ namespace {
 // same arithmetic in the same order, written over arrays so that it vectorises.
 // Wider vectors where the processor has them (chosen at run time); no FMA contraction (not
 // enabled by "avx2"), so every lane computes the same IEEE value as the baseline build.
-__attribute__((target_clones("avx2", "default")))
-void cylinderDistances(const Capsule& cap, const Vec3& c, const double* ox, const double* oy, const double* oz, int n,
-                       double half_var, double* sd) {
+__attribute__((target_clones("avx2", "default"))) void cylinderDistances(const Capsule& cap, const Vec3& c, const double* ox, const double* oy,
+                                                                         const double* oz, int n, double half_var, double* sd) {
   const double ax = cap.a.x, ay = cap.a.y, az = cap.a.z, dx = cap.d.x, dy = cap.d.y, dz = cap.d.z, inv = cap.inv_len2, r = cap.r;
   const double k_side = half_var * (1.0 / r), k_cap = half_var * (2.0 / r);
   if (!(inv > 0)) {  // a sphere
@@ -36,7 +35,6 @@ void cylinderDistances(const Capsule& cap, const Vec3& c, const double* ox, cons
     sd[q] = std::min(sd[q], v);
   }
 }
-
 
 }  // namespace
 
@@ -102,8 +100,7 @@ BrickBins binSegments(const VascularTree& tree, const VolumeGrid& g) {
   return bins;
 }
 
-void rasterizeBricks(const VascularTree& tree, const VolumeGrid& g, const BrickBins& bins, const RasterOptions& opt,
-                     const BrickVisitor& visit) {
+void rasterizeBricks(const VascularTree& tree, const VolumeGrid& g, const BrickBins& bins, const RasterOptions& opt, const BrickVisitor& visit) {
   const int S = std::max(1, opt.supersampling);
   const Vec3 sp = g.spacing_mm;
   // A voxel lies wholly inside (outside) a capsule if its centre is deeper (farther) than the
@@ -112,12 +109,11 @@ void rasterizeBricks(const VascularTree& tree, const VolumeGrid& g, const BrickB
   std::vector<Vec3> offsets;
   for (int c = 0; c < S; ++c)
     for (int b = 0; b < S; ++b)
-      for (int a = 0; a < S; ++a)
-        offsets.emplace_back(((a + 0.5) / S - 0.5) * sp.x, ((b + 0.5) / S - 0.5) * sp.y, ((c + 0.5) / S - 0.5) * sp.z);
+      for (int a = 0; a < S; ++a) offsets.emplace_back(((a + 0.5) / S - 0.5) * sp.x, ((b + 0.5) / S - 0.5) * sp.y, ((c + 0.5) / S - 0.5) * sp.z);
   const double inv_samples = 1.0 / double(offsets.size());
   const double sub_width = std::cbrt(sp.x * sp.y * sp.z) / S;  // subvoxel edge
   const double inv_sub_width = 1.0 / sub_width;
-  const double half_var = sub_width * sub_width / 24.0;      // σ²/2 with σ² = w²/12
+  const double half_var = sub_width * sub_width / 24.0;  // σ²/2 with σ² = w²/12
   std::vector<double> ox, oy, oz;
   for (const Vec3& o : offsets) ox.push_back(o.x), oy.push_back(o.y), oz.push_back(o.z);
   constexpr int kVoxels = kBrick * kBrick * kBrick;

@@ -26,8 +26,8 @@ constexpr int kBrick = 8;  // brick edge in voxels (an OpenVDB leaf node)
 // Segments that may touch each brick, in brick order; built once per tree and grid.
 struct BrickBins {
   std::array<std::int32_t, 3> bricks{0, 0, 0};
-  std::vector<std::int64_t> brick_ids;                 // non-empty bricks, ascending
-  std::vector<std::vector<std::int32_t>> segments;     // per non-empty brick, ascending ids
+  std::vector<std::int64_t> brick_ids;              // non-empty bricks, ascending
+  std::vector<std::vector<std::int32_t>> segments;  // per non-empty brick, ascending ids
 };
 // Upper bound on the (brick, segment) pairs binSegments collects: the bricks of every capsule's
 // bounding box. Cheap (no allocation), so the sparse path can be refused before binning.
@@ -38,8 +38,7 @@ BrickBins binSegments(const VascularTree& tree, const VolumeGrid& grid);
 // fraction is in [0,1]; instance is the segment id whose capsule surface is deepest around the
 // voxel (0 where the fraction is 0). Voxels outside the grid are left 0.
 using BrickVisitor = std::function<void(std::int64_t brick, const float* fraction, const std::uint32_t* instance)>;
-void rasterizeBricks(const VascularTree& tree, const VolumeGrid& grid, const BrickBins& bins, const RasterOptions& opt,
-                     const BrickVisitor& visit);
+void rasterizeBricks(const VascularTree& tree, const VolumeGrid& grid, const BrickBins& bins, const RasterOptions& opt, const BrickVisitor& visit);
 
 // Dense fraction and instance volumes.
 void rasterizeDense(const VascularTree& tree, const VolumeGrid& grid, const RasterOptions& opt, Volume<float>& fraction,

@@ -90,8 +90,7 @@ void fillClasses(GroundTruthVolumes& gt, const VascularTree& t, const std::vecto
       gt.classes.data[crossings[i].voxel] = class_of_segment[std::size_t(crossings[i].label)];
 }
 
-void centerlineVoxels(const VolumeGrid& g, const Vec3& a_mm, const Vec3& b_mm,
-                      std::vector<std::array<std::int64_t, 3>>& out) {
+void centerlineVoxels(const VolumeGrid& g, const Vec3& a_mm, const Vec3& b_mm, std::vector<std::array<std::int64_t, 3>>& out) {
   out.clear();
   const Vec3 a = g.index(a_mm), b = g.index(b_mm);
   std::int64_t p[3], q[3], d[3], s[3];
@@ -129,8 +128,7 @@ void addCenterlines(const VascularTree& t, GroundTruthVolumes& gt, const std::ve
       if (gt.fraction.data[v] >= 0.5f) return;  // labelled by the partial volume
       std::atomic_ref<std::uint32_t> id(gt.instances.data[v]);
       std::uint32_t cur = id.load(std::memory_order_relaxed);
-      while ((cur == 0 || s < cur) && !id.compare_exchange_weak(cur, s, std::memory_order_relaxed)) {
-      }
+      while ((cur == 0 || s < cur) && !id.compare_exchange_weak(cur, s, std::memory_order_relaxed)) {}
     };
     for (std::int32_t s = r.begin(); s != r.end(); ++s) {
       if (t.isRoot(s)) continue;
@@ -161,8 +159,7 @@ void addCenterlines(const VascularTree& t, GroundTruthVolumes& gt, const std::ve
         std::atomic_ref<std::uint8_t>(gt.centerline.data[v]).store(1, std::memory_order_relaxed);
         std::atomic_ref<std::uint32_t> rad(*reinterpret_cast<std::uint32_t*>(&gt.radius.data[v]));
         std::uint32_t cur = rad.load(std::memory_order_relaxed);
-        while (rbits > cur && !rad.compare_exchange_weak(cur, rbits, std::memory_order_relaxed)) {
-        }
+        while (rbits > cur && !rad.compare_exchange_weak(cur, rbits, std::memory_order_relaxed)) {}
         claim(v, s);
       }
     }

@@ -48,8 +48,7 @@ void addCenterlines(const VascularTree& tree, GroundTruthVolumes& gt, const std:
 
 // The 26-connected voxel curve (3D Bresenham) between the voxels containing a and b (mm),
 // clipped to the grid.
-void centerlineVoxels(const VolumeGrid& grid, const Vec3& a_mm, const Vec3& b_mm,
-                      std::vector<std::array<std::int64_t, 3>>& out);
+void centerlineVoxels(const VolumeGrid& grid, const Vec3& a_mm, const Vec3& b_mm, std::vector<std::array<std::int64_t, 3>>& out);
 // Calls f(i, j, k) for every voxel the segment a–b (mm) passes through.
 template <class F>
 void forEachCrossedVoxel(const VolumeGrid& grid, const Vec3& a_mm, const Vec3& b_mm, F&& f);

@@ -65,8 +65,10 @@ Label makeLabel(const LabelPolicy& p, const GroundTruthVolumes& gt, const LabelN
       const double c = evidence && evidence->contrast ? evidence->contrast->data[v] : pv[v];
       l = gt.mask.data[v] && pv[v] > 0 && c > 0 && c >= p.visible_snr * sigma ? vessel(v) : 0;
     } else {  // ignore
-      if (pv[v] >= p.ignoreHigh()) l = vessel(v);
-      else if (pv[v] > p.ignoreLow() || gt.centerline.data[v]) l = n.ignore_value;
+      if (pv[v] >= p.ignoreHigh())
+        l = vessel(v);
+      else if (pv[v] > p.ignoreLow() || gt.centerline.data[v])
+        l = n.ignore_value;
     }
     out.values.data[v] = l;
   });
@@ -108,8 +110,10 @@ Json labelLengthKept(const Volume<std::uint8_t>* values, const Volume<float>* so
           acc[3 * bin + 1] += piece * soft->data[v];
         } else {
           const std::uint8_t l = values->data[v];
-          if (l == n.ignore_value && p.name == "ignore") acc[3 * bin + 2] += piece;
-          else if (l) acc[3 * bin + 1] += piece;
+          if (l == n.ignore_value && p.name == "ignore")
+            acc[3 * bin + 2] += piece;
+          else if (l)
+            acc[3 * bin + 1] += piece;
         }
       }
     }
@@ -128,8 +132,10 @@ Json labelLengthKept(const Volume<std::uint8_t>* values, const Volume<float>* so
     if (p.name == "ignore") e["ignore"] = l > 0 ? Json(sum[3 * b + 2] / l) : Json(nullptr);
     bins.push_back(e);
   }
-  Json j{{"definition", std::string("fraction of the centreline length (sampled every quarter voxel, radius in voxels of the smallest edge) on voxels labelled vessel") +
-                            (p.isSoft() ? " (soft: the mean label value)" : "") + (p.name == "ignore" ? ", and on the ignore label" : "")},
+  Json j{{"definition",
+          std::string(
+              "fraction of the centreline length (sampled every quarter voxel, radius in voxels of the smallest edge) on voxels labelled vessel") +
+              (p.isSoft() ? " (soft: the mean label value)" : "") + (p.name == "ignore" ? ", and on the ignore label" : "")},
          {"length_mm", total},
          {"vessel", total > 0 ? Json(kept / total) : Json(nullptr)}};
   if (p.name == "ignore") j["ignore"] = total > 0 ? Json(ignored / total) : Json(nullptr);

@@ -55,17 +55,15 @@ struct Label {
 
 // The label of `gt` (clean or warped) under the policy. `evidence` is needed by `visible` only;
 // without it (no profile) every mask voxel with some partial volume is visible.
-Label makeLabel(const LabelPolicy& p, const GroundTruthVolumes& gt, const LabelNumbering& n,
-                const VisibilityEvidence* evidence = nullptr);
+Label makeLabel(const LabelPolicy& p, const GroundTruthVolumes& gt, const LabelNumbering& n, const VisibilityEvidence* evidence = nullptr);
 
 // The fraction of the tree's centreline length (sampled every quarter of the smallest voxel
 // edge) that lands on vessel-labelled voxels, and on ignore-labelled ones, by calibre: radius bins
 // in voxels (the smallest edge). For soft labels the mean label value along the centreline.
-nlohmann::ordered_json labelLengthKept(const Label& label, const LabelPolicy& p, const LabelNumbering& n,
-                                       const VascularTree& tree);
+nlohmann::ordered_json labelLengthKept(const Label& label, const LabelPolicy& p, const LabelNumbering& n, const VascularTree& tree);
 // The same on label values held elsewhere (`values`, or `soft` for the soft policy): the binary
 // label is the mask itself and needs no copy.
-nlohmann::ordered_json labelLengthKept(const Volume<std::uint8_t>* values, const Volume<float>* soft, const LabelPolicy& p,
-                                       const LabelNumbering& n, const VascularTree& tree);
+nlohmann::ordered_json labelLengthKept(const Volume<std::uint8_t>* values, const Volume<float>* soft, const LabelPolicy& p, const LabelNumbering& n,
+                                       const VascularTree& tree);
 
 }  // namespace angiosynth

@@ -13,14 +13,14 @@ namespace angiosynth {
 
 // Positions in mm (so distances are in mm).
 struct Capsule {
-  Vec3 a, d;            // start and axis (mm)
-  double inv_len2 = 0;  // 1/|d|²
-  double r = 0, r2 = 0; // the cylinder's radius; a cone's larger one
+  Vec3 a, d;             // start and axis (mm)
+  double inv_len2 = 0;   // 1/|d|²
+  double r = 0, r2 = 0;  // the cylinder's radius; a cone's larger one
   std::uint32_t id = 0;
   bool cone = false;
-  Vec3 e;                   // unit axis
+  Vec3 e;                                                // unit axis
   double ra = 0, rb = 0, len = 0, sin_a = 0, cos_a = 1;  // sin α = (ra − rb)/len: the side's slope
-  bool nested = false;      // |ra − rb| ≥ len: one sphere holds the other, no side
+  bool nested = false;                                   // |ra − rb| ≥ len: one sphere holds the other, no side
   // Signed distance to the surface, moved inwards by half_var·κ (κ: the mean curvature ×2 of
   // the nearest surface part: 1/r on a cylinder, cos α/ρ on a cone's side, 2/r on the caps).
   double signedDistance(const Vec3& p, double half_var) const {
@@ -55,7 +55,6 @@ struct Capsule {
     return y * sin_a + x * cos_a - ra + half_var * cos_a / rho;
   }
 };
-
 
 inline Capsule capsuleOf(const VascularTree& t, std::int32_t s) {
   const Vec3 a = t.position[t.parent[s]], b = t.position[s];

@@ -17,7 +17,7 @@ namespace angiosynth {
 
 struct VolumeGrid {
   std::array<std::int32_t, 3> dims{0, 0, 0};
-  Vec3 origin_mm;   // centre of voxel (0,0,0)
+  Vec3 origin_mm;  // centre of voxel (0,0,0)
   Vec3 spacing_mm{1, 1, 1};
 
   std::int64_t voxelCount() const { return std::int64_t(dims[0]) * dims[1] * dims[2]; }
@@ -67,9 +67,13 @@ struct ZeroAllocator {
   template <class U>
   void construct(U* p) {}  // the memory is already zero
   template <class U, class... A>
-  void construct(U* p, A&&... a) { ::new (static_cast<void*>(p)) U(std::forward<A>(a)...); }
+  void construct(U* p, A&&... a) {
+    ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
+  }
   template <class U>
-  bool operator==(const ZeroAllocator<U>&) const { return true; }
+  bool operator==(const ZeroAllocator<U>&) const {
+    return true;
+  }
 };
 
 template <class T>

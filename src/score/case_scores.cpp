@@ -100,8 +100,7 @@ std::map<int, std::string> classLegend(const nlohmann::ordered_json& sample) {
       try {
         const int value = std::stoi(k);
         if (value > 0 && value < 256) legend[value] = v.get<std::string>();
-      } catch (const std::exception&) {
-      }
+      } catch (const std::exception&) {}
     }
   return legend;
 }
@@ -113,11 +112,13 @@ std::map<int, std::string> classLegend(const std::filesystem::path& sample_json)
 }
 
 TruthFiles sampleTruth(const std::filesystem::path& dir) {
-  if (!std::filesystem::is_directory(dir)) throw InputError(dir.string(), 0, "is not a directory; allowed: a sample directory angiosynth generate wrote");
+  if (!std::filesystem::is_directory(dir))
+    throw InputError(dir.string(), 0, "is not a directory; allowed: a sample directory angiosynth generate wrote");
   const auto need = [&](const char* name) {
     const auto f = dir / name;
     if (!std::filesystem::is_regular_file(f))
-      throw InputError(dir.string(), 0, std::string("no ") + name + " in the sample directory; allowed: a directory angiosynth generate wrote (with volumes)");
+      throw InputError(dir.string(), 0,
+                       std::string("no ") + name + " in the sample directory; allowed: a directory angiosynth generate wrote (with volumes)");
     return f;
   };
   TruthFiles t;
@@ -152,8 +153,7 @@ CaseScores scoreCase(const std::filesystem::path& pred_file, const TruthFiles& f
     CaseScores::Block b{m, std::move(block), {}};
     for (const auto& h : m->headline) {
       const Json::json_pointer p(h.pointer);
-      b.headline.push_back(b.detail.contains(p) && b.detail.at(p).is_number() ? std::optional<double>(b.detail.at(p).get<double>())
-                                                                            : std::nullopt);
+      b.headline.push_back(b.detail.contains(p) && b.detail.at(p).is_number() ? std::optional<double>(b.detail.at(p).get<double>()) : std::nullopt);
     }
     s.blocks.push_back(std::move(b));
   }

@@ -20,7 +20,7 @@ enum class ScoreConventions {
 };
 
 struct ScoreOptions {
-  std::optional<double> tolerance_mm;                // NSD's τ; unset: the smallest voxel edge
+  std::optional<double> tolerance_mm;  // NSD's τ; unset: the smallest voxel edge
   ScoreConventions conventions = ScoreConventions::Default;
   std::vector<double> bins_voxels{0, 0.5, 1, 2, 4};  // calibre bins: lower edges, radius in voxels
   std::vector<double> bins_mm;                       // calibre bins in mm (none unless given)
@@ -36,7 +36,7 @@ struct ScoreOptions {
 // file (with nodes beside it; empty: no vessel scores).
 struct TruthFiles {
   std::filesystem::path mask, centerline, radius, edges, keypoints;  // edges, keypoints: optional
-  std::string name;  // how the output names the truth
+  std::string name;                                                  // how the output names the truth
   // Optional: the kind of each mask voxel and the legend of its values (1 artery, 2 vein, …).
   std::filesystem::path classes;
   std::map<int, std::string> legend;

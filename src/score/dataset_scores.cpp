@@ -81,8 +81,9 @@ TruthFiles datasetCaseTruth(const fs::path& ds, const std::string& id) {
     const Json spec = readJson(ds / "spec.json");
     const bool binary = !spec.contains("label_policy") && spec.contains("labels") && spec["labels"].contains("vessel");
     if (!binary)
-      throw InputError(g.string(), 0, "no mask of the case's image: this dataset's labelsTr holds labels by kind or by a label policy, "
-                                      "not the mask; allowed: datasets made by this version (they keep the mask in groundtruth/)");
+      throw InputError(g.string(), 0,
+                       "no mask of the case's image: this dataset's labelsTr holds labels by kind or by a label policy, "
+                       "not the mask; allowed: datasets made by this version (they keep the mask in groundtruth/)");
     t.mask = ds / "labelsTr" / (id + ".nii.gz");
   }
   for (const auto* f : {&t.mask, &t.centerline, &t.radius})
@@ -91,8 +92,10 @@ TruthFiles datasetCaseTruth(const fs::path& ds, const std::string& id) {
   if (fs::is_regular_file(file("keypoints", ".csv"))) t.keypoints = file("keypoints", ".csv");
   // Kinds: the classes volume where the case keeps it, else labelsTr when it holds the classes.
   t.legend = classLegend(sample);
-  if (fs::is_regular_file(file("classes", ".nii.gz"))) t.classes = file("classes", ".nii.gz");
-  else if (meta.contains("label_values") && !meta["label_values"].contains("vessel")) t.classes = ds / "labelsTr" / (id + ".nii.gz");
+  if (fs::is_regular_file(file("classes", ".nii.gz")))
+    t.classes = file("classes", ".nii.gz");
+  else if (meta.contains("label_values") && !meta["label_values"].contains("vessel"))
+    t.classes = ds / "labelsTr" / (id + ".nii.gz");
   return t;
 }
 

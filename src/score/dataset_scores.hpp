@@ -18,8 +18,8 @@ TruthFiles datasetCaseTruth(const std::filesystem::path& dataset_dir, const std:
 
 // Scores PREDICTIONS/<id>.nii.gz for every case of the dataset (a missing prediction is an
 // error naming the case). `csv` receives one row per case and the summary rows.
-nlohmann::ordered_json scoreDataset(const std::filesystem::path& dataset_dir, const std::filesystem::path& predictions,
-                                    const ScoreOptions& opt, const ProgressFn& progress, std::string& csv);
+nlohmann::ordered_json scoreDataset(const std::filesystem::path& dataset_dir, const std::filesystem::path& predictions, const ScoreOptions& opt,
+                                    const ProgressFn& progress, std::string& csv);
 
 // One CSV header and row of a case's headline numbers, in the same columns.
 std::string scoreCsvHeader();

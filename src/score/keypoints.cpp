@@ -34,26 +34,26 @@ KeyPoints skeletonKeyPoints(const Volume<std::uint8_t>& s) {
       }
   // Each 26-connected cluster of junction voxels is one bifurcation, at its centroid.
   for (const auto& [i, j, k] : junctions) {
-        if (!junction.at(i, j, k)) continue;
-        Vec3 sum(0, 0, 0);
-        int n = 0;
-        junction.at(i, j, k) = 0;
-        stack.push_back({i, j, k});
-        while (!stack.empty()) {
-          const auto [a, b, c] = stack.back();
-          stack.pop_back();
-          sum += g.centre(a, b, c);
-          ++n;
-          for (int dz = -1; dz <= 1; ++dz)
-            for (int dy = -1; dy <= 1; ++dy)
-              for (int dx = -1; dx <= 1; ++dx)
-                if (g.contains(a + dx, b + dy, c + dz) && junction.at(a + dx, b + dy, c + dz)) {
-                  junction.at(a + dx, b + dy, c + dz) = 0;
-                  stack.push_back({a + dx, b + dy, c + dz});
-                }
-        }
-        out.bifurcations.push_back({sum / double(n), 0});
-      }
+    if (!junction.at(i, j, k)) continue;
+    Vec3 sum(0, 0, 0);
+    int n = 0;
+    junction.at(i, j, k) = 0;
+    stack.push_back({i, j, k});
+    while (!stack.empty()) {
+      const auto [a, b, c] = stack.back();
+      stack.pop_back();
+      sum += g.centre(a, b, c);
+      ++n;
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx)
+            if (g.contains(a + dx, b + dy, c + dz) && junction.at(a + dx, b + dy, c + dz)) {
+              junction.at(a + dx, b + dy, c + dz) = 0;
+              stack.push_back({a + dx, b + dy, c + dz});
+            }
+    }
+    out.bifurcations.push_back({sum / double(n), 0});
+  }
   return out;
 }
 
@@ -84,8 +84,10 @@ KeyPoints truthKeyPoints(const std::filesystem::path& file, const VolumeGrid& g)
                      parseNumber(cells[r], file.string(), number, "radius_mm")};
     const Vec3 v = g.index(p.mm);
     if (!g.contains(std::llround(v.x), std::llround(v.y), std::llround(v.z))) continue;
-    if (cells[type] == "bifurcation" || cells[type] == "junction") out.bifurcations.push_back(p);  // a junction: one branch point
-    else if (cells[type] == "terminal" || cells[type] == "root") out.endpoints.push_back(p);
+    if (cells[type] == "bifurcation" || cells[type] == "junction")
+      out.bifurcations.push_back(p);  // a junction: one branch point
+    else if (cells[type] == "terminal" || cells[type] == "root")
+      out.endpoints.push_back(p);
   }
   return out;
 }
@@ -106,10 +108,13 @@ nlohmann::ordered_json matchKeyPoints(const std::vector<KeyPoint>& pred, const s
   std::int64_t matched = 0;
   for (const auto& [d, t, p] : pairs)
     if (!t_used[t] && !p_used[p]) t_used[t] = p_used[p] = true, ++matched;
-  nlohmann::ordered_json j{{"truth", truth.size()}, {"predicted", pred.size()}, {"matched", matched},
+  nlohmann::ordered_json j{{"truth", truth.size()},
+                           {"predicted", pred.size()},
+                           {"matched", matched},
                            {"precision", ratio(double(matched), double(pred.size()))},
                            {"recall", ratio(double(matched), double(truth.size()))}};
-  j["f1"] = pred.size() + truth.size() > 0 ? nlohmann::ordered_json(2.0 * matched / double(pred.size() + truth.size())) : nlohmann::ordered_json(nullptr);
+  j["f1"] =
+      pred.size() + truth.size() > 0 ? nlohmann::ordered_json(2.0 * matched / double(pred.size() + truth.size())) : nlohmann::ordered_json(nullptr);
   return j;
 }
 

@@ -105,7 +105,9 @@ Json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>&
     for (double x : v) s += x;
     return s;
   };
-  const auto within = [&](const std::vector<double>& v) { return double(std::count_if(v.begin(), v.end(), [&](double x) { return x <= tolerance_mm; })); };
+  const auto within = [&](const std::vector<double>& v) {
+    return double(std::count_if(v.begin(), v.end(), [&](double x) { return x <= tolerance_mm; }));
+  };
   j["hd_mm"] = std::max(max(p_to_t), max(t_to_p));
   j["hd95_mm"] = std::max(percentile95(p_to_t), percentile95(t_to_p));
   j["assd_mm"] = (sum(p_to_t) + sum(t_to_p)) / double(np + nt);
@@ -115,7 +117,7 @@ Json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>&
 }
 
 Json clDice(const Volume<std::uint8_t>& pred_skeleton, const Volume<std::uint8_t>& truth, const Volume<std::uint8_t>& truth_skeleton,
-           const Volume<std::uint8_t>& pred) {
+            const Volume<std::uint8_t>& pred) {
   std::int64_t sp = 0, sp_in = 0, st = 0, st_in = 0;
   for (std::size_t i = 0; i < pred.data.size(); ++i) {
     if (pred_skeleton.data[i]) ++sp, sp_in += truth.data[i] != 0;
@@ -123,7 +125,8 @@ Json clDice(const Volume<std::uint8_t>& pred_skeleton, const Volume<std::uint8_t
   }
   const Json tprec = ratio(double(sp_in), double(sp)), tsens = ratio(double(st_in), double(st));
   Json j{{"topology_precision", tprec}, {"topology_sensitivity", tsens}};
-  if (tprec.is_null() || tsens.is_null()) j["cldice"] = nullptr;
+  if (tprec.is_null() || tsens.is_null())
+    j["cldice"] = nullptr;
   else {
     const double a = tprec.get<double>(), b = tsens.get<double>();
     j["cldice"] = a + b > 0 ? 2 * a * b / (a + b) : 0.0;
@@ -138,8 +141,9 @@ void checkSameGrid(const NiftiVolume& pred, const NiftiVolume& truth, const std:
     return std::to_string(g.dims[0]) + " x " + std::to_string(g.dims[1]) + " x " + std::to_string(g.dims[2]);
   };
   if (a.dims != b.dims)
-    throw InputError(pred_file, 0, "the prediction has " + size(a) + " voxels, the truth (" + truth_file + ") " + size(b) +
-                                       "; allowed: the truth's grid (resample the prediction onto it)");
+    throw InputError(pred_file, 0,
+                     "the prediction has " + size(a) + " voxels, the truth (" + truth_file + ") " + size(b) +
+                         "; allowed: the truth's grid (resample the prediction onto it)");
   const double tol = 1e-3 * smallestEdge(b);
   for (std::size_t k = 0; k < 12; ++k)
     if (!(std::abs(pred.affine[k] - truth.affine[k]) <= tol)) {
@@ -149,8 +153,9 @@ void checkSameGrid(const NiftiVolume& pred, const NiftiVolume& truth, const std:
         pa += show(pred.affine[q]);
         ta += show(truth.affine[q]);
       }
-      throw InputError(pred_file, 0, "the prediction's voxel-to-world affine [" + pa + "] is not the truth's [" + ta + "] (" + truth_file +
-                                         "); allowed: the same to 1e-3 voxel (mm)");
+      throw InputError(pred_file, 0,
+                       "the prediction's voxel-to-world affine [" + pa + "] is not the truth's [" + ta + "] (" + truth_file +
+                           "); allowed: the same to 1e-3 voxel (mm)");
     }
 }
 
@@ -166,8 +171,8 @@ Json binRange(double lo, double hi) { return Json::array({lo, std::isfinite(hi) 
 
 }  // namespace
 
-Json calibreRecall(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, const Volume<float>& centre,
-                   const Volume<float>& radius, const std::vector<double>& lower, double scale, const char* unit) {
+Json calibreRecall(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, const Volume<float>& centre, const Volume<float>& radius,
+                   const std::vector<double>& lower, double scale, const char* unit) {
   const auto edges = binEdges(lower);
   std::vector<std::int64_t> n(lower.size()), hit(lower.size()), covered(lower.size());
   for (std::size_t i = 0; i < centre.data.size(); ++i) {

@@ -36,8 +36,7 @@ std::vector<double> directedBorderDistances(const Volume<std::uint8_t>& from_bor
 // HD, HD95 (the larger of the two directed 95th percentiles, linear interpolation between order
 // statistics as NumPy's default), ASSD, MASD and NSD at tolerance τ between the borders of two
 // volumes. Empty masks: both empty give 0 mm and NSD 1; one empty gives null (TopCoW: 90 mm).
-nlohmann::ordered_json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, double tolerance_mm,
-                                     bool topcow);
+nlohmann::ordered_json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, double tolerance_mm, bool topcow);
 
 // clDice (Shit et al. 2021) from the two skeletons and masks: topology precision, sensitivity,
 // their harmonic mean (null when a skeleton is empty).

@@ -5,9 +5,10 @@
 
 namespace angiosynth {
 
-extern const ScoreMetric kOverlapMetric, kSurfaceMetric, kCentrelineMetric, kVesselsMetric, kClDiceMetric, kTopologyMetric,
-    kKeyPointsMetric, kCalibreMetric, kCalibreMmMetric, kPerClassMetric, kBoundaryIoUMetric;
+extern const ScoreMetric kOverlapMetric, kSurfaceMetric, kCentrelineMetric, kVesselsMetric, kClDiceMetric, kTopologyMetric, kKeyPointsMetric,
+    kCalibreMetric, kCalibreMmMetric, kPerClassMetric, kBoundaryIoUMetric;
 
+// clang-format off
 const std::vector<const ScoreMetric*>& scoreMetrics() {
   // New metrics go last, so that the CSV's existing columns keep their places.
   static const std::vector<const ScoreMetric*> all{&kOverlapMetric,   &kSurfaceMetric, &kCentrelineMetric, &kVesselsMetric,
@@ -15,6 +16,7 @@ const std::vector<const ScoreMetric*>& scoreMetrics() {
                                                    &kCalibreMmMetric, &kPerClassMetric, &kBoundaryIoUMetric};
   return all;
 }
+// clang-format on
 
 const ScoreMetric* findScoreMetric(const std::string& key) {
   for (const auto* m : scoreMetrics())

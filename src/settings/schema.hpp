@@ -49,10 +49,10 @@ ChoiceField<Options> enumChoice() {
 }
 
 template <class Options>
-using SettingField = std::variant<bool Options::*, int Options::*, std::int64_t Options::*, double Options::*,
-                                  std::optional<double> Options::*, std::optional<bool> Options::*, std::string Options::*,
-                                  std::vector<double> Options::*, std::vector<std::string> Options::*,
-                                  std::optional<Vec3> Options::*, std::optional<int> Options::*, ChoiceField<Options>>;
+using SettingField =
+    std::variant<bool Options::*, int Options::*, std::int64_t Options::*, double Options::*, std::optional<double> Options::*,
+                 std::optional<bool> Options::*, std::string Options::*, std::vector<double> Options::*, std::vector<std::string> Options::*,
+                 std::optional<Vec3> Options::*, std::optional<int> Options::*, ChoiceField<Options>>;
 
 // The internal unit of a quantity, as sidecars record it.
 inline const char* internalUnit(Dimension d) {
@@ -70,9 +70,7 @@ struct SettingRange {
   double lo = -1e300, hi = 1e300;
   bool lo_open = false, hi_open = false;
   bool holds(double v) const { return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi); }
-  std::string text() const {
-    return std::string(lo_open ? "(" : "[") + show(lo) + ", " + (hi >= 1e300 ? "inf" : show(hi)) + (hi_open ? ")" : "]");
-  }
+  std::string text() const { return std::string(lo_open ? "(" : "[") + show(lo) + ", " + (hi >= 1e300 ? "inf" : show(hi)) + (hi_open ? ")" : "]"); }
 };
 
 template <class Options>
@@ -112,8 +110,8 @@ struct Setting {
   const char* flag = nullptr;
   // Further refusal of a value in range ("", or the whole message naming the key): a bound with a hole in it.
   std::string (*problem)(double) = nullptr;
-  SettingCondition only_with{};        // given only with this choice of another setting of the table
-  const char* range_unit = nullptr;    // the unit of the range when `unit` describes a list ("mm" for "[mm × 6]")
+  SettingCondition only_with{};      // given only with this choice of another setting of the table
+  const char* range_unit = nullptr;  // the unit of the range when `unit` describes a list ("mm" for "[mm × 6]")
   // The fallback is the value itself ("100 mmHg", "20"): read into the field when the key is
   // absent, so the declaration alone holds the default (methods that share a setting declare
   // their own defaults).
@@ -180,17 +178,17 @@ std::vector<double> listOfNumbers(const TomlReader& r, const toml::node* n, cons
   if (!s.quantity) return r.numbers(n, s.key, s.count);
   const auto* a = n->as_array();
   if (!a || (s.count && a->size() != s.count) || a->empty())
-    throw InputError(r.file(), r.lineOf(n), std::string(s.key) + " must be an array of " + (s.count ? std::to_string(s.count) + " " : "") +
-                                                "lengths \"<number> <unit>\"");
+    throw InputError(r.file(), r.lineOf(n),
+                     std::string(s.key) + " must be an array of " + (s.count ? std::to_string(s.count) + " " : "") + "lengths \"<number> <unit>\"");
   std::vector<double> out;
   for (const auto& e : *a) {
     const auto text = e.value<std::string>();
-    if (!text) throw InputError(r.file(), r.lineOf(&e), std::string(s.key) + " must hold strings \"<number> <unit>\"; units: " + allowedUnits(Dimension::Length));
+    if (!text)
+      throw InputError(r.file(), r.lineOf(&e),
+                       std::string(s.key) + " must hold strings \"<number> <unit>\"; units: " + allowedUnits(Dimension::Length));
     try {
       out.push_back(parseQuantity(*text, Dimension::Length, voxel_mm));
-    } catch (const std::invalid_argument& err) {
-      throw InputError(r.file(), r.lineOf(&e), std::string(s.key) + ": " + err.what());
-    }
+    } catch (const std::invalid_argument& err) { throw InputError(r.file(), r.lineOf(&e), std::string(s.key) + ": " + err.what()); }
   }
   return out;
 }
@@ -228,8 +226,8 @@ constexpr bool isChoiceField<ChoiceField<Options>> = true;
 // take the voxel as a unit. A required setting (no fallback) missing is an error; an absent one
 // whose fallback is its value gets that value.
 template <class Options>
-void readSettingsFrom(const TomlReader& r, const toml::table& t, const char* table, const std::vector<Setting<Options>>& settings,
-                      Options& o, double voxel_mm) {
+void readSettingsFrom(const TomlReader& r, const toml::table& t, const char* table, const std::vector<Setting<Options>>& settings, Options& o,
+                      double voxel_mm) {
   const auto here = [&](const Setting<Options>& s) { return std::string(table) == s.table; };
   for (const auto& s : settings) {
     if (!here(s)) continue;
@@ -251,45 +249,45 @@ void readSettingsFrom(const TomlReader& r, const toml::table& t, const char* tab
             member.set(o, v);
             return;
           } else {
-          using T = std::remove_reference_t<decltype(o.*member)>;
-          if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::optional<bool>>) {
-            o.*member = r.boolean(t, s.key, false);
-          } else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::optional<int>>) {
-            const int v = r.smallInteger(t, table, s.key, std::int64_t(s.range.lo), std::int64_t(s.range.hi));
-            if (s.problem)
-              if (const auto why = s.problem(v); !why.empty()) throw InputError(where.file, where.line, why);
-            o.*member = v;
-          } else if constexpr (std::is_same_v<T, std::int64_t>) {
-            const std::int64_t v = r.integer(t, table, s.key);
-            checkSettingNumber(s, double(v), where, name);
-            o.*member = v;
-          } else if constexpr (std::is_same_v<T, double> || std::is_same_v<T, std::optional<double>>) {
-            o.*member = number();
-          } else if constexpr (std::is_same_v<T, std::string>) {
-            const std::string v = r.string(t, table, s.key);
-            checkSettingChoice(s, v, where, name);
-            o.*member = v;
-          } else if constexpr (std::is_same_v<T, std::vector<double>>) {
-            const auto v = detail::listOfNumbers(r, n, s, voxel_mm);
-            for (double x : v) checkSettingNumber(s, x, where, name + " entry");
-            o.*member = v;
-          } else if constexpr (std::is_same_v<T, std::optional<Vec3>>) {
-            const auto v = detail::listOfNumbers(r, n, s, voxel_mm);
-            for (double x : v) checkSettingNumber(s, x, where, name + " entry");
-            o.*member = Vec3(v[0], v[1], v[2]);
-          } else {
-            static_assert(std::is_same_v<T, std::vector<std::string>>);
-            const auto* a = n->as_array();
-            if (!a) throw InputError(where.file, where.line, name + " must be a list of strings; allowed: " + detail::allowedTexts(s));
-            std::vector<std::string> v;
-            for (const auto& e : *a) {
-              const auto text = e.value<std::string>();
-              if (!text) throw InputError(where.file, r.lineOf(&e), name + ": '?' is not allowed; allowed: " + detail::allowedTexts(s));
-              checkSettingChoice(s, *text, {where.file, r.lineOf(&e)}, name);
-              v.push_back(*text);
+            using T = std::remove_reference_t<decltype(o.*member)>;
+            if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, std::optional<bool>>) {
+              o.*member = r.boolean(t, s.key, false);
+            } else if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::optional<int>>) {
+              const int v = r.smallInteger(t, table, s.key, std::int64_t(s.range.lo), std::int64_t(s.range.hi));
+              if (s.problem)
+                if (const auto why = s.problem(v); !why.empty()) throw InputError(where.file, where.line, why);
+              o.*member = v;
+            } else if constexpr (std::is_same_v<T, std::int64_t>) {
+              const std::int64_t v = r.integer(t, table, s.key);
+              checkSettingNumber(s, double(v), where, name);
+              o.*member = v;
+            } else if constexpr (std::is_same_v<T, double> || std::is_same_v<T, std::optional<double>>) {
+              o.*member = number();
+            } else if constexpr (std::is_same_v<T, std::string>) {
+              const std::string v = r.string(t, table, s.key);
+              checkSettingChoice(s, v, where, name);
+              o.*member = v;
+            } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+              const auto v = detail::listOfNumbers(r, n, s, voxel_mm);
+              for (double x : v) checkSettingNumber(s, x, where, name + " entry");
+              o.*member = v;
+            } else if constexpr (std::is_same_v<T, std::optional<Vec3>>) {
+              const auto v = detail::listOfNumbers(r, n, s, voxel_mm);
+              for (double x : v) checkSettingNumber(s, x, where, name + " entry");
+              o.*member = Vec3(v[0], v[1], v[2]);
+            } else {
+              static_assert(std::is_same_v<T, std::vector<std::string>>);
+              const auto* a = n->as_array();
+              if (!a) throw InputError(where.file, where.line, name + " must be a list of strings; allowed: " + detail::allowedTexts(s));
+              std::vector<std::string> v;
+              for (const auto& e : *a) {
+                const auto text = e.value<std::string>();
+                if (!text) throw InputError(where.file, r.lineOf(&e), name + ": '?' is not allowed; allowed: " + detail::allowedTexts(s));
+                checkSettingChoice(s, *text, {where.file, r.lineOf(&e)}, name);
+                v.push_back(*text);
+              }
+              o.*member = v;
             }
-            o.*member = v;
-          }
           }
         },
         s.field);
@@ -302,8 +300,10 @@ void readSettingsFrom(const TomlReader& r, const toml::table& t, const char* tab
         [&](auto member) {
           if constexpr (!detail::isChoiceField<decltype(member)>) {
             using T = std::remove_reference_t<decltype(o.*member)>;
-            if constexpr (std::is_same_v<T, std::string>) o.*member = s.fallback;
-            else if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) o.*member = T(detail::fallbackNumber(s, voxel_mm));
+            if constexpr (std::is_same_v<T, std::string>)
+              o.*member = s.fallback;
+            else if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>)
+              o.*member = T(detail::fallbackNumber(s, voxel_mm));
             else if constexpr (std::is_same_v<T, std::optional<double>> || std::is_same_v<T, std::optional<int>>)
               o.*member = typename T::value_type(detail::fallbackNumber(s, voxel_mm));
           } else {
@@ -316,15 +316,15 @@ void readSettingsFrom(const TomlReader& r, const toml::table& t, const char* tab
     if (!s.only_with.key || !here(s) || !t.get(s.key)) continue;
     const std::string chosen = detail::textOf(settings, o, s.only_with.key);
     if (chosen != s.only_with.value)
-      throw InputError(r.file(), r.at(t, s.key).line, std::string(s.key) + " is a parameter of " + s.only_with.key + " = \"" + s.only_with.value +
-                                                          "\", not of \"" + chosen + "\"; set that " + s.only_with.key + " or remove the key");
+      throw InputError(r.file(), r.at(t, s.key).line,
+                       std::string(s.key) + " is a parameter of " + s.only_with.key + " = \"" + s.only_with.value + "\", not of \"" + chosen +
+                           "\"; set that " + s.only_with.key + " or remove the key");
   }
 }
 
 // Fills `o` from the file's table `table` (see readSettingsFrom).
 template <class Options>
-void readSettings(const TomlReader& r, const char* table, const std::vector<Setting<Options>>& settings, Options& o,
-                  double voxel_mm) {
+void readSettings(const TomlReader& r, const char* table, const std::vector<Setting<Options>>& settings, Options& o, double voxel_mm) {
   readSettingsFrom(r, r.tableOrEmpty(table), table, settings, o, voxel_mm);
 }
 
@@ -353,9 +353,7 @@ struct SettingRow {
 template <class Options>
 std::vector<SettingRow> referenceRows(const std::vector<Setting<Options>>& settings) {
   std::vector<SettingRow> rows;
-  for (const auto& s : settings) {
-    rows.push_back({s.table, s.key, s.unit, s.fallback, s.meaning, s.flag ? s.flag : ""});
-  }
+  for (const auto& s : settings) { rows.push_back({s.table, s.key, s.unit, s.fallback, s.meaning, s.flag ? s.flag : ""}); }
   return rows;
 }
 

@@ -28,18 +28,22 @@ nlohmann::ordered_json settingsJson(const std::vector<Setting<Options>>& setting
           if constexpr (detail::isChoiceField<decltype(member)>) {
             return Json(member.get(o));
           } else {
-          using T = std::remove_cvref_t<decltype(o.*member)>;
-          const auto& v = o.*member;
-          if constexpr (std::is_same_v<T, double>) return number(v);
-          else if constexpr (std::is_same_v<T, std::optional<double>>) return v ? number(*v) : Json(s.fallback);
-          else if constexpr (std::is_same_v<T, std::optional<bool>> || std::is_same_v<T, std::optional<int>>) return v ? Json(*v) : Json(s.fallback);
-          else if constexpr (std::is_same_v<T, std::optional<Vec3>>) {
-            if (!v) return Json(s.fallback);
-            return length ? Json{{"value", {v->x, v->y, v->z}}, {"unit", "mm"}} : Json{v->x, v->y, v->z};
-          } else if constexpr (std::is_same_v<T, std::vector<double>>) {
-            if (v.empty()) return Json(s.fallback);
-            return length || (s.range_unit && std::string(s.range_unit) == "mm") ? Json{{"value", v}, {"unit", "mm"}} : Json(v);
-          } else return Json(v);
+            using T = std::remove_cvref_t<decltype(o.*member)>;
+            const auto& v = o.*member;
+            if constexpr (std::is_same_v<T, double>)
+              return number(v);
+            else if constexpr (std::is_same_v<T, std::optional<double>>)
+              return v ? number(*v) : Json(s.fallback);
+            else if constexpr (std::is_same_v<T, std::optional<bool>> || std::is_same_v<T, std::optional<int>>)
+              return v ? Json(*v) : Json(s.fallback);
+            else if constexpr (std::is_same_v<T, std::optional<Vec3>>) {
+              if (!v) return Json(s.fallback);
+              return length ? Json{{"value", {v->x, v->y, v->z}}, {"unit", "mm"}} : Json{v->x, v->y, v->z};
+            } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+              if (v.empty()) return Json(s.fallback);
+              return length || (s.range_unit && std::string(s.range_unit) == "mm") ? Json{{"value", v}, {"unit", "mm"}} : Json(v);
+            } else
+              return Json(v);
           }
         },
         s.field);

@@ -52,16 +52,13 @@ class TomlReader {
     return n;
   }
 
-  double quantity(const toml::table& t, const std::string& section, const std::string& key, Dimension dim,
-                  double voxel_mm = 0) const {
+  double quantity(const toml::table& t, const std::string& section, const std::string& key, Dimension dim, double voxel_mm = 0) const {
     const toml::node* n = need(t, section, key);
     const auto s = n->value<std::string>();
     if (!s) throw InputError(file_, lineOf(n), key + " must be a string \"<number> <unit>\"; units: " + allowedUnits(dim));
     try {
       return parseQuantity(*s, dim, voxel_mm);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(file_, lineOf(n), key + ": " + e.what());
-    }
+    } catch (const std::invalid_argument& e) { throw InputError(file_, lineOf(n), key + ": " + e.what()); }
   }
 
   double number(const toml::table& t, const std::string& section, const std::string& key) const {
@@ -81,8 +78,8 @@ class TomlReader {
   int smallInteger(const toml::table& t, const std::string& section, const std::string& key, std::int64_t lo, std::int64_t hi) const {
     const std::int64_t v = integer(t, section, key);
     if (v < lo || v > hi)
-      throw InputError(file_, lineOf(t.get(key)), key + " = " + std::to_string(v) + " is out of range; allowed: [" +
-                                                      std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      throw InputError(file_, lineOf(t.get(key)),
+                       key + " = " + std::to_string(v) + " is out of range; allowed: [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return static_cast<int>(v);
   }
 

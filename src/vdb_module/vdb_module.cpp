@@ -49,8 +49,8 @@ void addLeaf(void* p, std::int32_t x, std::int32_t y, std::int32_t z, const floa
   if (il->onVoxelCount() > 0) w.instances->tree().addLeaf(il.release());
 }
 
-int write(void* p, const char* file, const double spacing[3], const double origin[3], std::int64_t* leaves, std::int64_t* active,
-          char* error, std::size_t error_size) {
+int write(void* p, const char* file, const double spacing[3], const double origin[3], std::int64_t* leaves, std::int64_t* active, char* error,
+          std::size_t error_size) {
   auto& w = *static_cast<Writer*>(p);
   // OpenVDB matrices act on row vectors: scale on the diagonal, translation in the last row.
   openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();

@@ -79,10 +79,10 @@ bool terminalCrossesInPlane(const VascularTree& T, const Connection& c, const st
 struct Trial {
   Connection c[2];
   bool kamiya_failed = false;
-  bool merged_at_parent = false;  // Kamiya's optimum is the split segment's proximal node
-  bool at_node = false;  // and the exact one too: not refined
-  bool hidden = false;  // not tried: a vessel separates it from the point (separatedInPlane)
-  bool crowded = false;  // not tried: the new terminal's vessel would overlap one near the point
+  bool merged_at_parent = false;     // Kamiya's optimum is the split segment's proximal node
+  bool at_node = false;              // and the exact one too: not refined
+  bool hidden = false;               // not tried: a vessel separates it from the point (separatedInPlane)
+  bool crowded = false;              // not tried: the new terminal's vessel would overlap one near the point
   bool crosses[2] = {false, false};  // c[i]'s terminal segment crosses a vessel (terminalCrossesInPlane)
 };
 
@@ -108,9 +108,9 @@ struct TreeGrowth {
   int system;
   std::int64_t quota = 0;  // fixed number of terminals; 0: the territory it wins
   VascularTree tree;
-  std::vector<double> rel{1.0};  // ρ: radius / root radius
-  std::vector<double> checked;         // radius (final units) at which each segment was last found clear
-  std::vector<std::uint8_t> blocks;    // connections each segment refused, as an ancestor, by hitting a vessel
+  std::vector<double> rel{1.0};            // ρ: radius / root radius
+  std::vector<double> checked;             // radius (final units) at which each segment was last found clear
+  std::vector<std::uint8_t> blocks;        // connections each segment refused, as an ancestor, by hitting a vessel
   std::array<std::int32_t, 4> blockers{};  // the last ancestors that refused a connection (0: none)
   std::uint32_t next_blocker = 0;
   std::vector<std::int32_t> thick{1};  // segments with ρ >= kThick (the first is the root segment)
@@ -121,8 +121,8 @@ struct TreeGrowth {
   // Terminal points for the spacing test of draws, in cells of δ when built; rebuilt when the
   // terminals double (δ shrinks) and after a repair (nodes renumbered and moved).
   std::unique_ptr<PointHash> terminal_grid;
-  std::int32_t grid_nodes = 0;         // nodes [0, grid_nodes) are in the grid
-  std::int64_t grid_built = 0;         // terminals when it was built
+  std::int32_t grid_nodes = 0;  // nodes [0, grid_nodes) are in the grid
+  std::int64_t grid_built = 0;  // terminals when it was built
   std::int32_t terminalCount() const { return tree.terminalCount(); }
 };
 
@@ -209,9 +209,7 @@ class CcoGrower {
   // Regrowth after the final repair fills holes in the final domain: in a forest it keeps the
   // final scale, since the inflated radii of a domain that is "still growing" would make every
   // trunk collide with the other tree's vessels beside it. (A single tree keeps the scaling.)
-  double shrink(const System& s, std::int64_t n) const {
-    return repairing_ && trees_.size() > 1 ? 1.0 : std::pow(scale(s, n), -0.75);
-  }
+  double shrink(const System& s, std::int64_t n) const { return repairing_ && trees_.size() > 1 ? 1.0 : std::pow(scale(s, n), -0.75); }
   static double rootRadiusFinal(const TreeGrowth& g, std::int64_t n, double R, double shrink_n) {
     return rootRadius(g.params, double(n) * g.params.terminalFlow(), R) * shrink_n;
   }
@@ -308,7 +306,8 @@ class CcoGrower {
       g.index.refresh(g.tree, true);
       return;
     }
-    throw GrowthError("no first terminal could be connected to the root" + std::string(trees_.size() > 1 ? " of inlet " + std::to_string(k + 1) : "") +
+    throw GrowthError("no first terminal could be connected to the root" +
+                      std::string(trees_.size() > 1 ? " of inlet " + std::to_string(k + 1) : "") +
                       ": every segment from it leaves the domain, is shorter than twice its radius" +
                       (trees_.size() > 1 ? " or crosses another tree" : "") + "; move the root inside the domain");
   }
@@ -317,8 +316,7 @@ class CcoGrower {
   // no other vessel (run in parallel on a tree that does not change): Kamiya's fixed point, and
   // with BifurcationPoint::Exact the exact minimum of the tree's volume near it. Both are ranked:
   // where the lighter one collides, the other may not.
-  Trial evaluate(const TreeGrowth& g, std::int32_t s, const Vec3& p, std::int64_t n_new, double shrink_new,
-                 const BifurcationOptimizer& opt) const {
+  Trial evaluate(const TreeGrowth& g, std::int32_t s, const Vec3& p, std::int64_t n_new, double shrink_new, const BifurcationOptimizer& opt) const {
     Trial t;
     const auto& T = g.tree;
     KamiyaProblem kp;
@@ -354,8 +352,7 @@ class CcoGrower {
 
   // Records c's path and cost at its bifurcation and sets c.valid if its three segments are
   // longer than twice their radii (in final-domain units) and inside the domain.
-  bool fits(const TreeGrowth& g, Connection& c, std::int64_t n_new, double shrink_new, const BifurcationOptimizer& opt,
-            double margin = 1) const {
+  bool fits(const TreeGrowth& g, Connection& c, std::int64_t n_new, double shrink_new, const BifurcationOptimizer& opt, double margin = 1) const {
     const auto& T = g.tree;
     if (dom_.dimension() == 2) c.bifurcation.z = dom_.planeZ();  // in the plane to the last bit
     const Vec3 x0 = T.position[T.parent[c.segment]], x1 = T.position[c.segment], b = c.bifurcation;
@@ -457,15 +454,12 @@ class CcoGrower {
   }
   // The most terminals a vessel beside trunk x may have for the repair to regrow it rather than
   // let it stop the trunk.
-  static std::int32_t smallBeside(const VascularTree& T, std::int32_t x) {
-    return std::max(kMaxClearedTerminals, T.terminals[x] / kSmallBeside);
-  }
+  static std::int32_t smallBeside(const VascularTree& T, std::int32_t x) { return std::max(kMaxClearedTerminals, T.terminals[x] / kSmallBeside); }
   // Ancestor x refused a connection: counted towards its deferral, and listed to be checked
   // first next time.
   static void countRefusal(TreeGrowth& g, std::int32_t x) {
     if (g.blocks[x] < 255) ++g.blocks[x];
-    if (std::find(g.blockers.begin(), g.blockers.end(), x) == g.blockers.end())
-      g.blockers[g.next_blocker++ % g.blockers.size()] = x;
+    if (std::find(g.blockers.begin(), g.blockers.end(), x) == g.blockers.end()) g.blockers[g.next_blocker++ % g.blockers.size()] = x;
   }
   // True if ancestor x of tree k's committed connection, at root radius rr, overlaps a vessel of
   // its own tree more than two segments away that blocks it (collides' check of one ancestor of
@@ -555,34 +549,37 @@ class CcoGrower {
         // One task per segment: the other thread is often asleep when a candidate arrives and
         // wakes too late to take half of the list.
         const bool planar = dom_.dimension() == 2;
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(g.done, g.near.size(), 1), [&](const auto& r) {
-          for (auto j = r.begin(); j != r.end(); ++j) {
-            // Half the ν nearest segments are hidden so on the disc (separatedInPlane).
-            const bool hidden = planar && separatedInPlane(g.tree, g.near[j].second, p, g.near, kOccluders);
-            if (hidden || crowdedOut(g, g.near[j].second)) {
-              trials[j] = Trial();
-              trials[j].hidden = hidden;
-              trials[j].crowded = !hidden;
-              continue;
-            }
-            trials[j] = evaluate(g, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
-            // The exact point where Kamiya found a valid one, and on the kRefineNearest nearest
-            // segments where he found none (merged or l <= 2r: there the exact optimum often
-            // lies inside): nearly the volume of refining every segment at a fraction of its cost.
-            // In the plane, not where his point merged into the proximal node and the exact
-            // optimum lies there too (the weighted Fermat condition, one walk): the steps would
-            // only slide towards the node, where the parent part is short, and skipping them saves
-            // time at no cost in volume. In space such steps, stopped short of the node, are often
-            // valid, and without them the trees come out heavier (docs/benchmarks.md, as above).
-            const auto& k = trials[j].c[0];
-            trials[j].at_node = planar && opt_.bifurcation == BifurcationPoint::Exact && j < kRefineNearest && trials[j].merged_at_parent &&
-                                opts[i].optimumAtProximalNode(g.near[j].second, p);
-            if (opt_.bifurcation == BifurcationPoint::Exact && (k.valid || (j < kRefineNearest && !trials[j].at_node)))
-              trials[j].c[1] = refine(g, k, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
-            if (planar)
-              for (int w : {0, 1}) trials[j].crosses[w] = trials[j].c[w].valid && terminalCrossesInPlane(g.tree, trials[j].c[w], g.near);
-          }
-        }, tbb::simple_partitioner());
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(g.done, g.near.size(), 1),
+            [&](const auto& r) {
+              for (auto j = r.begin(); j != r.end(); ++j) {
+                // Half the ν nearest segments are hidden so on the disc (separatedInPlane).
+                const bool hidden = planar && separatedInPlane(g.tree, g.near[j].second, p, g.near, kOccluders);
+                if (hidden || crowdedOut(g, g.near[j].second)) {
+                  trials[j] = Trial();
+                  trials[j].hidden = hidden;
+                  trials[j].crowded = !hidden;
+                  continue;
+                }
+                trials[j] = evaluate(g, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
+                // The exact point where Kamiya found a valid one, and on the kRefineNearest nearest
+                // segments where he found none (merged or l <= 2r: there the exact optimum often
+                // lies inside): nearly the volume of refining every segment at a fraction of its cost.
+                // In the plane, not where his point merged into the proximal node and the exact
+                // optimum lies there too (the weighted Fermat condition, one walk): the steps would
+                // only slide towards the node, where the parent part is short, and skipping them saves
+                // time at no cost in volume. In space such steps, stopped short of the node, are often
+                // valid, and without them the trees come out heavier (docs/benchmarks.md, as above).
+                const auto& k = trials[j].c[0];
+                trials[j].at_node = planar && opt_.bifurcation == BifurcationPoint::Exact && j < kRefineNearest && trials[j].merged_at_parent &&
+                                    opts[i].optimumAtProximalNode(g.near[j].second, p);
+                if (opt_.bifurcation == BifurcationPoint::Exact && (k.valid || (j < kRefineNearest && !trials[j].at_node)))
+                  trials[j].c[1] = refine(g, k, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
+                if (planar)
+                  for (int w : {0, 1}) trials[j].crosses[w] = trials[j].c[w].valid && terminalCrossesInPlane(g.tree, trials[j].c[w], g.near);
+              }
+            },
+            tbb::simple_partitioner());
         for (std::size_t j = g.done; j < g.near.size(); ++j) {
           if (trials[j].kamiya_failed) ++report_.kamiya_failures;
           if (trials[j].hidden) ++report_.hidden_segments;
@@ -683,11 +680,12 @@ class CcoGrower {
       double delta = std::pow(dom_.measure() / double(n), 1.0 / dom_.dimension());
       for (std::int64_t failures = 1;; ++failures) {
         if (failures > opt_.max_draws)
-          throw GrowthError("could place only " + std::to_string(n) + " of " + std::to_string(sys.target) +
-                            " terminals" + (systems_.size() > 1 ? " of system " + std::to_string(si + 1) : std::string()) + ": " +
-                            std::to_string(opt_.max_draws) + " points in a row found no valid connection "
-                            "(too close " + std::to_string(report_.rejected_too_close) + ", unconnectable " +
-                            std::to_string(report_.rejected_unreachable) + "); lower the number of terminals or enlarge the domain");
+          throw GrowthError("could place only " + std::to_string(n) + " of " + std::to_string(sys.target) + " terminals" +
+                            (systems_.size() > 1 ? " of system " + std::to_string(si + 1) : std::string()) + ": " + std::to_string(opt_.max_draws) +
+                            " points in a row found no valid connection "
+                            "(too close " +
+                            std::to_string(report_.rejected_too_close) + ", unconnectable " + std::to_string(report_.rejected_unreachable) +
+                            "); lower the number of terminals or enlarge the domain");
         // An ancestor on every path (a trunk) that thickened against another tree's vessel would
         // refuse every connection of its tree for ever: after a long run of failures, ancestors
         // are no longer checked against other trees; the exact final check and repair see them.
@@ -740,8 +738,7 @@ class CcoGrower {
   // (radii with 2 % margin).
   // With `regrow`, a vessel of the same tree with at most `small` terminals does not count: it
   // is appended there, for the repair to remove and regrow.
-  bool segmentFits(int k, std::int32_t x, const Vec3& a, const Vec3& e, std::vector<std::int32_t>* regrow = nullptr,
-                   std::int32_t small = 0) {
+  bool segmentFits(int k, std::int32_t x, const Vec3& a, const Vec3& e, std::vector<std::int32_t>* regrow = nullptr, std::int32_t small = 0) {
     auto& g = trees_[k];
     const auto& T = g.tree;
     const double rx = 1.02 * T.radius[x];
@@ -874,8 +871,7 @@ class CcoGrower {
     for (const std::int32_t v : {s, T.parent[s]}) {
       if (v <= 0) continue;
       const Vec3 p = T.position[v];
-      Vec3 g(dom_.depth(p + Vec3(h, 0, 0)) - dom_.depth(p - Vec3(h, 0, 0)),
-             dom_.depth(p + Vec3(0, h, 0)) - dom_.depth(p - Vec3(0, h, 0)),
+      Vec3 g(dom_.depth(p + Vec3(h, 0, 0)) - dom_.depth(p - Vec3(h, 0, 0)), dom_.depth(p + Vec3(0, h, 0)) - dom_.depth(p - Vec3(0, h, 0)),
              dom_.dimension() == 2 ? 0.0 : dom_.depth(p + Vec3(0, 0, h)) - dom_.depth(p - Vec3(0, 0, h)));
       if (!(norm(g) > 0)) continue;
       g = g / norm(g);
@@ -905,7 +901,9 @@ class CcoGrower {
     return false;
   }
 
-  bool tooLargeToRegrow(int k, std::int32_t s) const { return trees_[k].tree.terminals[s] > kMaxRepairShare * double(systems_[trees_[k].system].target); }
+  bool tooLargeToRegrow(int k, std::int32_t s) const {
+    return trees_[k].tree.terminals[s] > kMaxRepairShare * double(systems_[trees_[k].system].target);
+  }
 
   // Segments of the solved forest that break a constraint, per tree: intersecting pairs (within
   // and across trees), length <= 2r, or leaving the domain. Short trunks are lengthened in
@@ -934,8 +932,10 @@ class CcoGrower {
         ++report_.moved_nodes;
         continue;
       }
-      if (x_goes) out[kx].push_back(x);
-      else out[ky].push_back(y);
+      if (x_goes)
+        out[kx].push_back(x);
+      else
+        out[ky].push_back(y);
     }
     report_.short_segments = report_.outside_segments = 0;
     for (std::size_t k = 0; k < trees_.size(); ++k) trees_[k].index.refresh(trees_[k].tree, true);
@@ -958,8 +958,10 @@ class CcoGrower {
         }
         if (!dom_.capsuleInside(T.position[T.parent[s]], T.position[s], T.radius[s], startsAtRoot(trees_[k], s))) {
           ++report_.outside_segments;
-          if (tooLargeToRegrow(k, s) && pushInside(k, s)) ++report_.moved_nodes;
-          else out[k].push_back(s);
+          if (tooLargeToRegrow(k, s) && pushInside(k, s))
+            ++report_.moved_nodes;
+          else
+            out[k].push_back(s);
         }
       }
       auto& o = out[k];
@@ -1004,7 +1006,7 @@ class CcoGrower {
       solveAll();
       for (auto& g : trees_) {
         refreshRelativeRadii(g);
-        g.checked = g.tree.radius;  // the exact check just passed every kept segment
+        g.checked = g.tree.radius;               // the exact check just passed every kept segment
         g.blocks.assign(g.tree.nodeCount(), 0);  // ids change when subtrees go
         g.index.refresh(g.tree, true);
         g.terminal_grid.reset();
@@ -1031,15 +1033,13 @@ class CcoGrower {
 
 }  // namespace
 
-std::vector<VascularTree> growCcoForest(const GrowthDomain& domain, const CcoOptions& options,
-                                        const std::vector<CcoInlet>& inlets, GrowthReport& report,
-                                        const ProgressFn& progress) {
+std::vector<VascularTree> growCcoForest(const GrowthDomain& domain, const CcoOptions& options, const std::vector<CcoInlet>& inlets,
+                                        GrowthReport& report, const ProgressFn& progress) {
   CcoGrower g(domain, options, inlets, report);
   return g.run(progress);
 }
 
-VascularTree growCco(const GrowthDomain& domain, const CcoOptions& options, GrowthReport& report,
-                     const ProgressFn& progress) {
+VascularTree growCco(const GrowthDomain& domain, const CcoOptions& options, GrowthReport& report, const ProgressFn& progress) {
   CcoInlet in;
   in.root_mm = options.root_mm;
   in.root_pressure = options.physics.perfusion_pressure;

@@ -39,38 +39,37 @@ enum class TerminalSpacing { Terminals, Segments };
 enum class BifurcationPoint { Exact, Kamiya };
 
 struct CcoOptions {
-  std::int64_t terminals = 4000;      // N
-  Vec3 root_mm;                       // in the domain's frame
-  int closest_neighbours = 20;        // ν
-  int max_neighbours = 20;            // in 3D ν doubles up to this, then the point is dropped (at
-                                      // most ν: it does not double; see connect)
+  std::int64_t terminals = 4000;  // N
+  Vec3 root_mm;                   // in the domain's frame
+  int closest_neighbours = 20;    // ν
+  int max_neighbours = 20;        // in 3D ν doubles up to this, then the point is dropped (at
+                                  // most ν: it does not double; see connect)
   int kamiya_iterations = 100;
-  double kamiya_tolerance = 1e-6;     // of the bifurcation's step, relative to its three lengths
+  double kamiya_tolerance = 1e-6;  // of the bifurcation's step, relative to its three lengths
   int draws_before_relaxing = 100;
   double relaxation = 0.9;
   TerminalSpacing spacing_from = TerminalSpacing::Terminals;
   BifurcationPoint bifurcation = BifurcationPoint::Exact;
-  PhysicsParameters physics;          // λ = 2 and μ = 1 (volume) are imposed
+  PhysicsParameters physics;  // λ = 2 and μ = 1 (volume) are imposed
   std::uint64_t seed = 1;
   std::uint64_t sample = 0;
   int max_repair_rounds = 30;
-  std::int64_t max_draws = 2000000;   // consecutive failed draws before giving up
+  std::int64_t max_draws = 2000000;  // consecutive failed draws before giving up
 };
 
 // One tree of a forest.
 struct CcoInlet {
-  Vec3 root_mm;                 // in the domain's frame
-  int system = 0;               // inlets of one system share its N terminals
-  double share = 0;             // fixed share of its system's terminals (and flow); 0: the territory it wins
-  double root_pressure = 0;     // Pa; below terminal_pressure the tree drains (a vein)
-  double terminal_pressure = 0; // Pa
+  Vec3 root_mm;                  // in the domain's frame
+  int system = 0;                // inlets of one system share its N terminals
+  double share = 0;              // fixed share of its system's terminals (and flow); 0: the territory it wins
+  double root_pressure = 0;      // Pa; below terminal_pressure the tree drains (a vein)
+  double terminal_pressure = 0;  // Pa
 };
 
 // Grows one tree per inlet (each system with options.terminals terminals; the inlet's pressures
 // replace those of options.physics); the trees in inlet order.
-std::vector<VascularTree> growCcoForest(const GrowthDomain& domain, const CcoOptions& options,
-                                        const std::vector<CcoInlet>& inlets, GrowthReport& report,
-                                        const ProgressFn& progress = {});
+std::vector<VascularTree> growCcoForest(const GrowthDomain& domain, const CcoOptions& options, const std::vector<CcoInlet>& inlets,
+                                        GrowthReport& report, const ProgressFn& progress = {});
 // The physics of one tree: `p` with the inlet's root and terminal pressures.
 PhysicsParameters inletPhysics(PhysicsParameters p, double root_pressure, double terminal_pressure);
 // Terminal quotas of a system's inlets from their fixed shares (largest remainder; shares that sum
@@ -78,7 +77,6 @@ PhysicsParameters inletPhysics(PhysicsParameters p, double root_pressure, double
 std::vector<std::int64_t> terminalQuotas(const std::vector<double>& shares, std::int64_t n);
 
 // Grows one tree from options.root_mm; throws GrowthError when the domain cannot take N terminals.
-VascularTree growCco(const GrowthDomain& domain, const CcoOptions& options, GrowthReport& report,
-                     const ProgressFn& progress = {});
+VascularTree growCco(const GrowthDomain& domain, const CcoOptions& options, GrowthReport& report, const ProgressFn& progress = {});
 
 }  // namespace angiosynth

@@ -18,6 +18,7 @@ constexpr const char* kSpacingWords[] = {"terminals", "segments", nullptr};
 constexpr const char* kBifurcationWords[] = {"exact", "kamiya", nullptr};
 
 // [tree]'s settings of one tree or of each kind of a forest.
+// clang-format off
 const std::vector<Setting<CcoOptions>>& ccoSettings() {
   using O = CcoOptions;
   static const std::vector<Setting<O>> settings{
@@ -48,7 +49,9 @@ const std::vector<Setting<CcoOptions>>& ccoSettings() {
   };
   return settings;
 }
+// clang-format on
 
+// clang-format off
 const std::vector<SettingRule<CcoOptions>>& ccoRules() {
   static const std::vector<SettingRule<CcoOptions>> rules{
       {{"max_closest_neighbours"}, [](const CcoOptions& o) {
@@ -59,14 +62,17 @@ const std::vector<SettingRule<CcoOptions>>& ccoRules() {
        }}};
   return rules;
 }
+// clang-format on
 
 // Kerautret et al. (OpenCCO) §5 after Karch 1999: 3.6 cP, written in Pa*s, since "3.6 cP" parses one ulp off 3.6e-3.
+// clang-format off
 const std::vector<Setting<PhysicsParameters>>& ccoPhysics() {
   static const std::vector<Setting<PhysicsParameters>> settings{
       physicsSetting("murray_exponent", "3"), physicsSetting("viscosity", "0.0036 Pa*s"), physicsSetting("perfusion_pressure", "100 mmHg"),
       physicsSetting("terminal_pressure", "60 mmHg"), physicsSetting("perfusion_flow", "500 mL/min")};
   return settings;
 }
+// clang-format on
 
 namespace {
 
@@ -165,13 +171,15 @@ class PreparedCco final : public PreparedGrowth {
                             {"radius_mm", x.radius}});
       stats["short_segments_left"] = list;
       stats["short_segments_left_why"] =
-          "the final check could neither lengthen these (moving either end, or the distal one along or around the vessel, collides or leaves the domain) nor remove the side branch that merges them with a child (more than 15 % of the terminals)";
+          "the final check could neither lengthen these (moving either end, or the distal one along or around the vessel, collides or leaves the "
+          "domain) nor remove the side branch that merges them with a child (more than 15 % of the terminals)";
     }
     stats["outside_segments"] = report.outside_segments;
     if (setup_.inlets.size() > 1) {
       stats["lenient_connections"] = report.lenient_connections;
       stats["lenient_connections_definition"] =
-          "connections whose thickened ancestors were checked only in part: an ancestor that refused 8 connections is then blocked only by vessels too large to regrow, and after a long run of failures ancestors skip other trees (the exact final check and repair cover both)";
+          "connections whose thickened ancestors were checked only in part: an ancestor that refused 8 connections is then blocked only by vessels "
+          "too large to regrow, and after a long run of failures ancestors skip other trees (the exact final check and repair cover both)";
     }
     stats["domain_dimension"] = domain_.dimension();
     stats["domain_measure"] = quantityJson(domain_.measure(), domain_.dimension() == 2 ? "mm^2" : "mm^3");
@@ -189,9 +197,11 @@ class PreparedCco final : public PreparedGrowth {
 void readInletPressures(const TomlReader& r, const toml::table& t, const PhysicsParameters& ph, CcoInletSpec& in) {
   const bool vein = in.kind == "vein";
   in.root_pressure = t.get("root_pressure") ? r.quantity(t, "tree.inlet", "root_pressure", Dimension::Pressure)
-                                            : vein ? parseQuantity(kVeinRootPressure, Dimension::Pressure) : ph.perfusion_pressure;
+                     : vein                 ? parseQuantity(kVeinRootPressure, Dimension::Pressure)
+                                            : ph.perfusion_pressure;
   in.terminal_pressure = t.get("terminal_pressure") ? r.quantity(t, "tree.inlet", "terminal_pressure", Dimension::Pressure)
-                                                    : vein ? parseQuantity(kVeinTerminalPressure, Dimension::Pressure) : ph.terminal_pressure;
+                         : vein                     ? parseQuantity(kVeinTerminalPressure, Dimension::Pressure)
+                                                    : ph.terminal_pressure;
   checkRange(in.root_pressure, 0, false, Limits::kMaxPressure, false, r.at(t, "root_pressure"), "root_pressure (Pa)");
   checkRange(in.terminal_pressure, 0, false, Limits::kMaxPressure, false, r.at(t, "terminal_pressure"), "terminal_pressure (Pa)");
   const int line = r.lineOf(t.get("root_pressure") ? t.get("root_pressure") : t.get("terminal_pressure") ? t.get("terminal_pressure") : &t);
@@ -221,7 +231,8 @@ void readInlets(const TomlReader& r, const GrowthMethod& m, const toml::table& t
     throw InputError(r.file(), r.lineOf(list), "inlet must be an array of tables: write each tree as [[tree.inlet]]");
   for (const char* key : {"root_offset", "root", "root_voxel"})
     if (tree.get(key))
-      throw InputError(r.file(), r.lineOf(tree.get(key)), std::string("'") + key + "' in [tree] with [[tree.inlet]] tables: give each inlet its root in its table");
+      throw InputError(r.file(), r.lineOf(tree.get(key)),
+                       std::string("'") + key + "' in [tree] with [[tree.inlet]] tables: give each inlet its root in its table");
   s.inlet_tables = true;
   std::map<std::string, int> per_kind;
   for (const auto& node : *arr) {
@@ -231,7 +242,8 @@ void readInlets(const TomlReader& r, const GrowthMethod& m, const toml::table& t
     in.line = r.lineOf(&t);
     in.kind = t.get("kind") ? r.string(t, "tree.inlet", "kind") : "artery";
     if (in.kind.empty() || in.kind.size() > 40 || in.kind.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_-") != std::string::npos)
-      throw InputError(r.file(), r.lineOf(t.get("kind")), "kind '" + in.kind + "'; allowed: artery, vein, or a name of 1–40 lower-case letters, digits, '_' and '-'");
+      throw InputError(r.file(), r.lineOf(t.get("kind")),
+                       "kind '" + in.kind + "'; allowed: artery, vein, or a name of 1–40 lower-case letters, digits, '_' and '-'");
     ++per_kind[in.kind];
     in.root = readRootOf(r, t, "tree.inlet", s.domain, arr->size() > 1);
     if (const auto* sh = t.get("share")) {
@@ -272,23 +284,26 @@ void readInlets(const TomlReader& r, const GrowthMethod& m, const toml::table& t
         territory |= in.share == 0;
         last = in.line;
         if (in.share > 0 && in.share * double(s.cco.terminals) < 1)
-          throw InputError(r.file(), in.line, "inlet '" + in.id + "' has share " + show(in.share) + " of " + std::to_string(s.cco.terminals) +
-                                                   " terminals: less than one terminal; raise its share or the number of terminals");
+          throw InputError(r.file(), in.line,
+                           "inlet '" + in.id + "' has share " + show(in.share) + " of " + std::to_string(s.cco.terminals) +
+                               " terminals: less than one terminal; raise its share or the number of terminals");
       }
     if (!territory && std::abs(sum - 1) > 1e-9)
-      throw InputError(r.file(), last, "the shares of the " + kind + " inlets sum to " + show(sum) +
-                                           "; fixed shares of one kind must sum to 1 (or leave one inlet share = \"territory\")");
+      throw InputError(r.file(), last,
+                       "the shares of the " + kind + " inlets sum to " + show(sum) +
+                           "; fixed shares of one kind must sum to 1 (or leave one inlet share = \"territory\")");
     if (territory && sum >= 1 - 1e-9)
-      throw InputError(r.file(), last, "the fixed shares of the " + kind + " inlets already sum to " + show(sum) +
-                                           ", leaving nothing for the inlets that win territory");
+      throw InputError(
+          r.file(), last,
+          "the fixed shares of the " + kind + " inlets already sum to " + show(sum) + ", leaving nothing for the inlets that win territory");
   }
   // The capillary bed between arteries and veins needs a pressure drop.
   for (const auto& a : s.inlets)
     for (const auto& v : s.inlets)
       if (a.kind == "artery" && v.kind == "vein" && !(v.terminal_pressure < a.terminal_pressure))
-        throw InputError(r.file(), v.line, "vein '" + v.id + "' has terminal_pressure " + show(v.terminal_pressure) +
-                                               " Pa, not below the " + show(a.terminal_pressure) + " Pa of artery '" + a.id +
-                                               "': blood would not cross the capillaries from artery to vein");
+        throw InputError(r.file(), v.line,
+                         "vein '" + v.id + "' has terminal_pressure " + show(v.terminal_pressure) + " Pa, not below the " +
+                             show(a.terminal_pressure) + " Pa of artery '" + a.id + "': blood would not cross the capillaries from artery to vein");
 }
 
 std::shared_ptr<const GrowthSetup> readCcoToml(const TomlReader& r, const GrowthMethod& m) {
@@ -326,8 +341,10 @@ Json CcoSetup::describe() const {
   j["shape"] = domainShapeName(d.shape);
   const auto describeRoot = [&](const RootSpec& root, Json& out) {
     if (d.shape == DomainShape::Mask) {
-      if (root.root_in_mm) out["root"] = Json{{"value", {root.root_mm.x, root.root_mm.y, root.root_mm.z}}, {"unit", "mm"}};
-      else out["root_voxel"] = {root.root_voxel.x, root.root_voxel.y, root.root_voxel.z};
+      if (root.root_in_mm)
+        out["root"] = Json{{"value", {root.root_mm.x, root.root_mm.y, root.root_mm.z}}, {"unit", "mm"}};
+      else
+        out["root_voxel"] = {root.root_voxel.x, root.root_voxel.y, root.root_voxel.z};
     } else {
       out["root_offset"] = root.has_root_offset
                                ? Json{{"value", {root.root_offset_mm.x, root.root_offset_mm.y, root.root_offset_mm.z}}, {"unit", "mm"}}
@@ -368,6 +385,7 @@ std::unique_ptr<PreparedGrowth> CcoSetup::prepare(std::uint64_t memory_limit) co
   return std::make_unique<PreparedCco>(*this, loadDomainSpec(domain, parameter_file, inlets.front().root, memory_limit));
 }
 
+// clang-format off
 const GrowthMethod kCcoMethod{
     "cco",
     "constrained constructive optimisation (Karch 1999; Kerautret et al., OpenCCO) in a sphere, cube, disc, square or mask: the "
@@ -385,5 +403,6 @@ const GrowthMethod kCcoMethod{
         {"tree.inlet", "terminal_pressure", "Pa", "[physics] terminal_pressure; vein 20 mmHg", "pressure at its terminals (above the root: it drains)"},
     }, settingRows(ccoPhysics())})),
     &readCcoToml};
+// clang-format on
 
 }  // namespace angiosynth

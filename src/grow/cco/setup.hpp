@@ -14,8 +14,8 @@ namespace angiosynth {
 
 // One tree of the forest: [[tree.inlet]], or [tree] itself for a single tree.
 struct CcoInletSpec {
-  std::string id = "tree";       // unique in the forest
-  std::string kind = "artery";   // inlets of one kind compete for that kind's terminals
+  std::string id = "tree";      // unique in the forest
+  std::string kind = "artery";  // inlets of one kind compete for that kind's terminals
   RootSpec root;
   double share = 0;              // fixed share of its kind's terminals and flow; 0: the territory it wins
   double root_pressure = 0;      // Pa, at the root (a vein's outlet)
@@ -26,7 +26,7 @@ struct CcoInletSpec {
 struct CcoSetup final : GrowthSetup {
   std::string parameter_file;
   DomainSpec domain;
-  CcoOptions cco;          // everything but the roots, seed and sample
+  CcoOptions cco;                    // everything but the roots, seed and sample
   std::vector<CcoInletSpec> inlets;  // one per tree
   bool inlet_tables = false;         // the trees come from [[tree.inlet]] (else [tree] holds the one root)
   int terminals_line = 0;

@@ -65,32 +65,37 @@ Vec3 dominantAxis(const double m[3][3]) {
 // One system of trees (arterial or venous): its nodes, its drains and their indices.
 struct System {
   bool vein = false;
-  std::vector<Vec3> pos, dir;               // dir: unit direction of the edge ending at the node (root: its heading)
+  std::vector<Vec3> pos, dir;  // dir: unit direction of the edge ending at the node (root: its heading)
   std::vector<std::int32_t> parent, child0, child1, root_of;
-  std::vector<double> leaf_radius;           // the radius a leaf carries
-  std::vector<double> leaf_rk;               // leaf_radius^κ
-  std::vector<double> rk;                    // Σ leaf_radius^κ over the leaves below: the edge's radius^κ (Murray)
-  std::vector<double> radius;                // exact Murray radii, set by finishRadii()
-  std::vector<std::int32_t> roots;           // the root nodes
+  std::vector<double> leaf_radius;  // the radius a leaf carries
+  std::vector<double> leaf_rk;      // leaf_radius^κ
+  std::vector<double> rk;           // Σ leaf_radius^κ over the leaves below: the edge's radius^κ (Murray)
+  std::vector<double> radius;       // exact Murray radii, set by finishRadii()
+  std::vector<std::int32_t> roots;  // the root nodes
   double kappa = 2.55;
-  PointHash nodes;   // cells of the perception distance
-  PointHash close;   // cells of the satisfaction distance: "is a node this close?"
-  PointHash drains;  // cells of the drain spacing
+  PointHash nodes;         // cells of the perception distance
+  PointHash close;         // cells of the satisfaction distance: "is a node this close?"
+  PointHash drains;        // cells of the drain spacing
   NeighbourhoodCount far;  // cells of the longest query distance: most "no node near" answers in one read
   std::vector<Vec3> drain;
-  std::vector<std::int32_t> born;           // the step a drain appeared
+  std::vector<std::int32_t> born;  // the step a drain appeared
   // A drain's nearest node within the perception distance (−1: none), found when it was made,
   // and the node count then: still exact while the step and the nodes are the same, and in the
   // same step it settles satisfaction by the nodes made before.
   std::vector<std::int32_t> near, near_count;
   bool flat = false;
-  std::vector<std::int32_t> cone_stamp;      // per node: the step its perception bounds were computed
+  std::vector<std::int32_t> cone_stamp;  // per node: the step its perception bounds were computed
   std::vector<double> cos_lo, cos_hi;
-  std::vector<double> lateral_angle;         // an inter-node's Murray angle of a lateral branch, same step
+  std::vector<double> lateral_angle;  // an inter-node's Murray angle of a lateral branch, same step
 
   System(const Vec3& lo, const Vec3& hi, double node_cell, double close_cell, double drain_cell, bool is_flat)
-      : nodes(lo, hi, node_cell, is_flat), close(lo, hi, close_cell, is_flat), drains(lo, hi, drain_cell, is_flat),
-        flat(is_flat), lo_(lo), hi_(hi), scale_(1) {}
+      : nodes(lo, hi, node_cell, is_flat),
+        close(lo, hi, close_cell, is_flat),
+        drains(lo, hi, drain_cell, is_flat),
+        flat(is_flat),
+        lo_(lo),
+        hi_(hi),
+        scale_(1) {}
 
   // The grids' cells follow the step's lengths (× σ_T/σ_t, up to 3× the last step's early in a
   // run): a query then scans a few cells, not dozens. Queries answer the same on any cells.
@@ -170,9 +175,7 @@ struct System {
     });
   }
   // The cached nearest node of drain k, if still exact at `step`.
-  bool knowsNearest(std::size_t k, std::int32_t step) const {
-    return near[k] != -2 && born[k] == step && near_count[k] == std::int32_t(pos.size());
-  }
+  bool knowsNearest(std::size_t k, std::int32_t step) const { return near[k] != -2 && born[k] == step && near_count[k] == std::int32_t(pos.size()); }
   bool anyDrainWithin(const Vec3& p, double r) const {
     const double r2 = r * r;
     return drains.anyNear(p, r, [&](std::int32_t id) {
@@ -185,9 +188,12 @@ struct System {
     radius.assign(pos.size(), 0);
     for (std::size_t k = pos.size(); k-- > 0;) {
       const auto a = child0[k], b = child1[k];
-      if (a < 0) radius[k] = leaf_radius[k];
-      else if (b < 0) radius[k] = radius[a];
-      else radius[k] = std::pow(std::pow(radius[a], kappa) + std::pow(radius[b], kappa), 1.0 / kappa);
+      if (a < 0)
+        radius[k] = leaf_radius[k];
+      else if (b < 0)
+        radius[k] = radius[a];
+      else
+        radius[k] = std::pow(std::pow(radius[a], kappa) + std::pow(radius[b], kappa), 1.0 / kappa);
     }
   }
   // Keeps the drains listed (ascending), renumbered from 0: ids stay small and storage warm.
@@ -220,7 +226,10 @@ struct StepScale {
 class Grower {
  public:
   Grower(const ColonisationOptions& o, GrowthReport& report, ColonisationReport& cr)
-      : o_(o), report_(report), cr_(cr), world_(*o.world),
+      : o_(o),
+        report_(report),
+        cr_(cr),
+        world_(*o.world),
         art_(world_.lo(), world_.hi(), cell(o, 0), cell(o, 1), cell(o, 2), world_.dimension() == 2),
         ven_(world_.lo(), world_.hi(), cell(o, 0), cell(o, 1), cell(o, 2), world_.dimension() == 2) {
     art_.vein = false;
@@ -342,7 +351,9 @@ class Grower {
   static double cell(const ColonisationOptions& o, int which) {
     double c = INFINITY;
     for (const auto& st : o.stages)
-      c = std::min(c, which == 0 ? st.perception_distance / 2 : which == 1 ? st.satisfaction_distance : std::max(st.drain_spacing, st.perception_distance / 2));
+      c = std::min(c, which == 0   ? st.perception_distance / 2
+                      : which == 1 ? st.satisfaction_distance
+                                   : std::max(st.drain_spacing, st.perception_distance / 2));
     return std::max(c, 1e-6);
   }
 
@@ -645,9 +656,12 @@ class Grower {
       for (std::size_t q = b.begin(); q != b.end(); ++q) {
         if (!(art_flags_[q] & (Supplied | Oxygenated))) continue;
         const Vec3 p = candidates_[q];
-        if (ven_.nodeWithin(p, t.sat)) ven_flags_[q] = Drained;
-        else if (ven_.anyDrainWithin(p, t.spacing)) ven_flags_[q] = NearVeinDrain;
-        else ven_near_[q] = ven_.nearestNode(p, t.delta);
+        if (ven_.nodeWithin(p, t.sat))
+          ven_flags_[q] = Drained;
+        else if (ven_.anyDrainWithin(p, t.spacing))
+          ven_flags_[q] = NearVeinDrain;
+        else
+          ven_near_[q] = ven_.nearestNode(p, t.delta);
       }
     });
   }
@@ -701,8 +715,7 @@ class Grower {
 
 }  // namespace
 
-std::vector<VascularTree> growColonisation(const ColonisationOptions& o, GrowthReport& report, ColonisationReport& cr,
-                                           const ProgressFn& progress) {
+std::vector<VascularTree> growColonisation(const ColonisationOptions& o, GrowthReport& report, ColonisationReport& cr, const ProgressFn& progress) {
   Grower g(o, report, cr);
   g.run(progress);
   return g.trees();

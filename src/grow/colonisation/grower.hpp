@@ -33,21 +33,21 @@ struct ColonisationStage {
   std::string name = "stage_1";
   int steps = 100;
   int drains_per_step = 1000;
-  int drain_lifetime = 1;             // steps an unsatisfied drain lives (0: until satisfied)
-  double delta_sigma = 0.02;          // Δσ, tissue growth per step
-  double step = 0;                    // d, mm (last step's value)
-  double perception_distance = 0;     // δ, mm
-  double perception_angle = 90;       // γ, degrees: full cone angle
-  double satisfaction_distance = 0;   // mm: a drain this close to a node of its system is supplied
-  double co2_distance = 0;            // mm: tissue this close to an artery makes CO₂ (a vein drain)
-  double drain_spacing = 0;           // mm: minimum distance between drains
-  double terminal_radius = 0;         // r of leaves, mm
-  double bias = 0.5;                  // ω in [0, 1]
-  double bifurcation_spread = 10;     // φ, degrees
+  int drain_lifetime = 1;            // steps an unsatisfied drain lives (0: until satisfied)
+  double delta_sigma = 0.02;         // Δσ, tissue growth per step
+  double step = 0;                   // d, mm (last step's value)
+  double perception_distance = 0;    // δ, mm
+  double perception_angle = 90;      // γ, degrees: full cone angle
+  double satisfaction_distance = 0;  // mm: a drain this close to a node of its system is supplied
+  double co2_distance = 0;           // mm: tissue this close to an artery makes CO₂ (a vein drain)
+  double drain_spacing = 0;          // mm: minimum distance between drains
+  double terminal_radius = 0;        // r of leaves, mm
+  double bias = 0.5;                 // ω in [0, 1]
+  double bifurcation_spread = 10;    // φ, degrees
   SpreadStatistic spread = SpreadStatistic::StandardDeviation;
-  bool lateral = true;                // inter-nodes may take lateral branches
+  bool lateral = true;  // inter-nodes may take lateral branches
   DrainSource source = DrainSource::Volume;
-  double surface_depth = 0;           // surface drains: within this depth of the border, mm
+  double surface_depth = 0;              // surface drains: within this depth of the border, mm
   const GrowthDomain* drains = nullptr;  // where its drains are sampled (a region of the world, or the world)
 };
 
@@ -64,27 +64,26 @@ struct ColonisationOptions {
   const GrowthDomain* world = nullptr;  // every node and centreline stays inside
   std::vector<ColonisationStage> stages;
   std::vector<ColonisationRoot> roots;
-  double murray_exponent = 2.55;        // κ in (2, 4)
-  double sigma0 = 1;                    // σ_0, the tissue's initial size
-  bool veins = true;                    // grow the venous system (needs a vein root)
-  bool avoid_crossing = false;          // no new vessel closer to another than their radii
+  double murray_exponent = 2.55;  // κ in (2, 4)
+  double sigma0 = 1;              // σ_0, the tissue's initial size
+  bool veins = true;              // grow the venous system (needs a vein root)
+  bool avoid_crossing = false;    // no new vessel closer to another than their radii
   std::uint64_t seed = 1, sample = 0;
 };
 
 struct ColonisationReport {
   std::int64_t arterial_drains = 0, venous_drains = 0;  // sampled / converted over the run
-  std::int64_t satisfied = 0;                          // arterial drains satisfied
+  std::int64_t satisfied = 0;                           // arterial drains satisfied
   std::int64_t bifurcations = 0, lateral_branches = 0, elongations = 0;
   std::int64_t outside_rejected = 0, crossing_rejected = 0;
-  std::int64_t pruned = 0;                              // avoid_crossing: branches removed after growth
-  std::vector<std::int64_t> nodes_per_step;             // nodes of both systems after each step
-  double check_seconds = 0;                             // the final crossing count (not growth)
+  std::int64_t pruned = 0;                   // avoid_crossing: branches removed after growth
+  std::vector<std::int64_t> nodes_per_step;  // nodes of both systems after each step
+  double check_seconds = 0;                  // the final crossing count (not growth)
 };
 
 // The trees, one per root in `roots` order (each a single tree with node 0 its root), with
 // positions, Murray radii (κ), depth and lengths set; flows and pressures are the caller's.
-std::vector<VascularTree> growColonisation(const ColonisationOptions& o, GrowthReport& report, ColonisationReport& cr,
-                                           const ProgressFn& progress);
+std::vector<VascularTree> growColonisation(const ColonisationOptions& o, GrowthReport& report, ColonisationReport& cr, const ProgressFn& progress);
 
 // The scale factor σ_T/σ_t of every step of the run (all stages), in order.
 std::vector<double> colonisationScales(const ColonisationOptions& o);

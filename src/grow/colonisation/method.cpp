@@ -25,6 +25,7 @@ using Json = nlohmann::ordered_json;
 constexpr const char* kSpreadWords[] = {"sd", "rms", nullptr};
 constexpr const char* kSourceWords[] = {"volume", "surface", nullptr};
 
+// clang-format off
 const std::vector<Setting<ColonisationOptions>>& colonisationSettings() {
   using O = ColonisationOptions;
   static const std::vector<Setting<O>> settings{
@@ -37,8 +38,10 @@ const std::vector<Setting<ColonisationOptions>>& colonisationSettings() {
   };
   return settings;
 }
+// clang-format on
 
 // A [[stage]]'s settings but its lengths.
+// clang-format off
 const std::vector<Setting<ColonisationStage>>& stageSettings() {
   using O = ColonisationStage;
   static const std::vector<Setting<O>> settings{
@@ -71,8 +74,10 @@ const std::vector<Setting<ColonisationStage>>& stageSettings() {
   };
   return settings;
 }
+// clang-format on
 
 // A [[stage]]'s lengths: given in mm, or a share of the domain's diameter (the fallback's "× f").
+// clang-format off
 const std::vector<Setting<ColonisationStageSpec>>& stageLengthSettings() {
   using O = ColonisationStageSpec;
   const auto length = [](const char* key, const char* fallback, const char* meaning, std::optional<double> O::*field) {
@@ -91,6 +96,7 @@ const std::vector<Setting<ColonisationStageSpec>>& stageLengthSettings() {
   };
   return settings;
 }
+// clang-format on
 
 // A stage length in mm: as given, or its declared share of the domain's diameter.
 double stageLength(const ColonisationStageSpec& spec, std::optional<double> ColonisationStageSpec::*field, double diameter) {
@@ -103,6 +109,7 @@ double stageLength(const ColonisationStageSpec& spec, std::optional<double> Colo
   throw std::logic_error("an undeclared stage length");
 }
 
+// clang-format off
 const std::vector<Setting<PhysicsParameters>>& colonisationPhysics() {
   static const std::vector<Setting<PhysicsParameters>> settings = [] {
     auto murray = physicsSetting("murray_exponent", "2.55");
@@ -121,6 +128,7 @@ const std::vector<Setting<PhysicsParameters>>& colonisationPhysics() {
   }();
   return settings;
 }
+// clang-format on
 
 class PreparedColonisation final : public PreparedGrowth {
  public:
@@ -128,10 +136,9 @@ class PreparedColonisation final : public PreparedGrowth {
     const auto list = [&](const std::vector<std::string>& names) { return regionsNamed(s.regions, names); };
     const auto fail = [&](int line, const GrowthError& e) { return InputError(s.parameter_file, line, e.what()); };
     try {  // the world: the domain without its avascular regions
-      if (!s.avascular.empty()) world_ = std::make_unique<GrowthDomain>(regionDomain(loaded_, {}, list(s.avascular), "the domain without its avascular regions"));
-    } catch (const GrowthError& e) {
-      throw fail(0, e);
-    }
+      if (!s.avascular.empty())
+        world_ = std::make_unique<GrowthDomain>(regionDomain(loaded_, {}, list(s.avascular), "the domain without its avascular regions"));
+    } catch (const GrowthError& e) { throw fail(0, e); }
     const GrowthDomain& world = *(world_ ? world_.get() : &loaded_);
     options_ = s.options;
     options_.world = &world;
@@ -150,10 +157,9 @@ class PreparedColonisation final : public PreparedGrowth {
         st.drains = &world;
       } else {
         try {
-          drains_.push_back(std::make_unique<GrowthDomain>(regionDomain(world, list(spec.domain), {}, "the drain region of stage '" + st.name + "'")));
-        } catch (const GrowthError& e) {
-          throw fail(spec.line, e);
-        }
+          drains_.push_back(
+              std::make_unique<GrowthDomain>(regionDomain(world, list(spec.domain), {}, "the drain region of stage '" + st.name + "'")));
+        } catch (const GrowthError& e) { throw fail(spec.line, e); }
         st.drains = drains_.back().get();
       }
       // Lengths the domain can hold: a step beyond half its diameter leaves it at once, a step
@@ -161,16 +167,18 @@ class PreparedColonisation final : public PreparedGrowth {
       // fifth of it at a few thousand leaves (Murray's law).
       const auto where = [&](const char* key) { return spec.lines.count(key) ? spec.lines.at(key) : spec.line; };
       if (!(st.step >= physical::kMinStepMm && st.step <= diameter / 2))
-        throw InputError(s.parameter_file, where("step"), "stage '" + st.name + "': step " + show(st.step) + " mm is out of range; allowed: " +
-                                                          show(physical::kMinStepMm) + " mm to half the domain's diameter (" + show(diameter / 2) + " mm)");
+        throw InputError(s.parameter_file, where("step"),
+                         "stage '" + st.name + "': step " + show(st.step) + " mm is out of range; allowed: " + show(physical::kMinStepMm) +
+                             " mm to half the domain's diameter (" + show(diameter / 2) + " mm)");
       if (!(st.terminal_radius >= physical::kMinRadiusMm && st.terminal_radius <= diameter / 100))
-        throw InputError(s.parameter_file, where("terminal_radius"), "stage '" + st.name + "': terminal_radius " + show(st.terminal_radius) +
-                                                                     " mm is out of range; allowed: " + show(physical::kMinRadiusMm) +
-                                                                     " mm to a hundredth of the domain's diameter (" + show(diameter / 100) + " mm)");
+        throw InputError(s.parameter_file, where("terminal_radius"),
+                         "stage '" + st.name + "': terminal_radius " + show(st.terminal_radius) + " mm is out of range; allowed: " +
+                             show(physical::kMinRadiusMm) + " mm to a hundredth of the domain's diameter (" + show(diameter / 100) + " mm)");
       if (!(st.perception_distance > st.satisfaction_distance))
-        throw InputError(s.parameter_file, spec.line, "stage '" + st.name + "': perception_distance (" + show(st.perception_distance) +
-                                                          " mm) must exceed satisfaction_distance (" + show(st.satisfaction_distance) +
-                                                          " mm), or no drain is ever perceived before it is satisfied");
+        throw InputError(s.parameter_file, spec.line,
+                         "stage '" + st.name + "': perception_distance (" + show(st.perception_distance) +
+                             " mm) must exceed satisfaction_distance (" + show(st.satisfaction_distance) +
+                             " mm), or no drain is ever perceived before it is satisfied");
       options_.stages.push_back(st);
     }
     // Roots: placed in the domain, heading to its centre unless given a direction.
@@ -183,7 +191,8 @@ class PreparedColonisation final : public PreparedGrowth {
         Vec3 p = a + Vec3(0.05 * diameter, 0, 0);
         for (int it = 0; it < 1000 && world.depth(p) < 0; ++it) p = p + (c - p) * 0.01;
         if (world.depth(p) < 0)
-          throw InputError(s.parameter_file, r.line, "no default vein root beside the artery's fits the domain; give the roots as [[tree.inlet]] tables");
+          throw InputError(s.parameter_file, r.line,
+                           "no default vein root beside the artery's fits the domain; give the roots as [[tree.inlet]] tables");
         root.position = p;
       } else {
         root.position = placeRoot(s.parameter_file, r.root, world);
@@ -223,7 +232,8 @@ class PreparedColonisation final : public PreparedGrowth {
             if (c >= 0) queue.push_back(c);
         }
         if (net.child1[root] >= 0)
-          throw InputError(s.initial_file.string(), s.initial.lines[std::size_t(root)], "a root of the network starts two vessels; a tree's root has one");
+          throw InputError(s.initial_file.string(), s.initial.lines[std::size_t(root)],
+                           "a root of the network starts two vessels; a tree's root has one");
         stumps_.push_back(std::make_unique<VascularTree>(std::move(t)));
         ColonisationRoot r;
         r.position = stumps_.back()->position[0];
@@ -265,7 +275,8 @@ class PreparedColonisation final : public PreparedGrowth {
     cr_.check_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     report.root_radius_mm = 0;
     for (std::int32_t i = 0; i < f.vessels.nodeCount(); ++i)
-      if (f.vessels.isRoot(i) && f.vessels.child0[i] >= 0) report.root_radius_mm = std::max(report.root_radius_mm, f.vessels.radius[f.vessels.child0[i]]);
+      if (f.vessels.isRoot(i) && f.vessels.child0[i] >= 0)
+        report.root_radius_mm = std::max(report.root_radius_mm, f.vessels.radius[f.vessels.child0[i]]);
     return f;
   }
   void addStatistics(const GrowthReport&, Json& stats) const override {
@@ -280,9 +291,13 @@ class PreparedColonisation final : public PreparedGrowth {
     // Each stage's lengths in mm, as the domain's diameter resolved them (the sidecar's parameters give the rule).
     Json lengths = Json::array();
     for (const auto& st : options_.stages)
-      lengths.push_back(Json{{"stage", st.name}, {"step", quantityJson(st.step, "mm")}, {"perception_distance", quantityJson(st.perception_distance, "mm")},
-                             {"satisfaction_distance", quantityJson(st.satisfaction_distance, "mm")}, {"co2_distance", quantityJson(st.co2_distance, "mm")},
-                             {"drain_spacing", quantityJson(st.drain_spacing, "mm")}, {"terminal_radius", quantityJson(st.terminal_radius, "mm")},
+      lengths.push_back(Json{{"stage", st.name},
+                             {"step", quantityJson(st.step, "mm")},
+                             {"perception_distance", quantityJson(st.perception_distance, "mm")},
+                             {"satisfaction_distance", quantityJson(st.satisfaction_distance, "mm")},
+                             {"co2_distance", quantityJson(st.co2_distance, "mm")},
+                             {"drain_spacing", quantityJson(st.drain_spacing, "mm")},
+                             {"terminal_radius", quantityJson(st.terminal_radius, "mm")},
                              {"surface_depth", quantityJson(st.surface_depth, "mm")}});
     stats["stage_lengths"] = lengths;
     if (setup_.options.avoid_crossing) {
@@ -360,8 +375,7 @@ class PreparedColonisation final : public PreparedGrowth {
   mutable ColonisationReport cr_;
 };
 
-ColonisationStageSpec readStage(const TomlReader& r, const GrowthMethod& m, const toml::table& t, int index,
-                                const std::set<std::string>& regions) {
+ColonisationStageSpec readStage(const TomlReader& r, const GrowthMethod& m, const toml::table& t, int index, const std::set<std::string>& regions) {
   checkMethodKeys(r, m, t, "stage");
   ColonisationStageSpec spec;
   spec.line = r.lineOf(&t);
@@ -382,7 +396,8 @@ void readRoots(const TomlReader& r, const GrowthMethod& m, const toml::table& tr
     if (s.initial_kind == "vein")
       throw InputError(r.file(), r.lineOf(&tree), "no artery root: with [initial] kind = \"vein\" give the arteries' roots as [[tree.inlet]] tables");
     if (s.options.veins)
-      throw InputError(r.file(), r.lineOf(&tree), "no vein root: with [initial] give the veins' roots as [[tree.inlet]] tables (kind = \"vein\"), or set [tree] veins = false");
+      throw InputError(r.file(), r.lineOf(&tree),
+                       "no vein root: with [initial] give the veins' roots as [[tree.inlet]] tables (kind = \"vein\"), or set [tree] veins = false");
     return;
   }
   if (!list || !list->is_array()) {
@@ -394,7 +409,8 @@ void readRoots(const TomlReader& r, const GrowthMethod& m, const toml::table& tr
     s.roots.push_back(a);
     if (s.options.veins) {
       if (s.domain.shape == DomainShape::Mask)
-        throw InputError(r.file(), r.lineOf(&tree), "a mask domain has no default vein root: give the roots as [[tree.inlet]] tables (kind = \"vein\")");
+        throw InputError(r.file(), r.lineOf(&tree),
+                         "a mask domain has no default vein root: give the roots as [[tree.inlet]] tables (kind = \"vein\")");
       ColonisationRootSpec v = a;
       v.id = "vein";
       v.kind = "vein";
@@ -404,9 +420,12 @@ void readRoots(const TomlReader& r, const GrowthMethod& m, const toml::table& tr
     return;
   }
   for (const char* key : {"root_offset", "root", "root_voxel"})
-    if (tree.get(key)) throw InputError(r.file(), r.lineOf(tree.get(key)), std::string("'") + key + "' in [tree] with [[tree.inlet]] tables: give each root in its table");
+    if (tree.get(key))
+      throw InputError(r.file(), r.lineOf(tree.get(key)),
+                       std::string("'") + key + "' in [tree] with [[tree.inlet]] tables: give each root in its table");
   const auto* arr = list->as_array();
-  if (!arr->is_array_of_tables() || arr->empty()) throw InputError(r.file(), r.lineOf(list), "inlet must be an array of tables: write each as [[tree.inlet]]");
+  if (!arr->is_array_of_tables() || arr->empty())
+    throw InputError(r.file(), r.lineOf(list), "inlet must be an array of tables: write each as [[tree.inlet]]");
   std::map<std::string, int> per_kind, seen;
   for (const auto& node : *arr) {
     const auto& t = *node.as_table();
@@ -465,7 +484,8 @@ std::shared_ptr<const GrowthSetup> readColonisationToml(const TomlReader& r, con
   s->avascular = regionNames(r, tree, "avascular", names);
   if (const auto* list = r.root().get("stage")) {
     const auto* arr = list->as_array();
-    if (!arr || arr->empty() || !arr->is_array_of_tables()) throw InputError(r.file(), r.lineOf(list), "stage must be an array of tables: write each as [[stage]]");
+    if (!arr || arr->empty() || !arr->is_array_of_tables())
+      throw InputError(r.file(), r.lineOf(list), "stage must be an array of tables: write each as [[stage]]");
     std::set<std::string> stage_names;
     for (const auto& node : *arr) {
       s->stages.push_back(readStage(r, m, *node.as_table(), int(s->stages.size()), names));
@@ -503,19 +523,26 @@ Json ColonisationSetup::describe() const {
   Json roots_json = Json::array();
   for (const auto& r : roots) {
     Json e{{"id", r.id}, {"kind", r.kind}};
-    if (r.beside_artery) e["root_offset"] = "beside the artery's root (0.05 of the diameter along x, moved in until inside)";
+    if (r.beside_artery)
+      e["root_offset"] = "beside the artery's root (0.05 of the diameter along x, moved in until inside)";
     else if (r.root.has_root_offset)
       e["root_offset"] = Json{{"value", {r.root.root_offset_mm.x, r.root.root_offset_mm.y, r.root.root_offset_mm.z}}, {"unit", "mm"}};
-    else if (r.root.root_in_mm) e["root"] = Json{{"value", {r.root.root_mm.x, r.root.root_mm.y, r.root.root_mm.z}}, {"unit", "mm"}};
-    else if (domain.shape == DomainShape::Mask) e["root_voxel"] = {r.root.root_voxel.x, r.root.root_voxel.y, r.root.root_voxel.z};
-    else e["root_offset"] = "the top of the domain (+y)";
+    else if (r.root.root_in_mm)
+      e["root"] = Json{{"value", {r.root.root_mm.x, r.root.root_mm.y, r.root.root_mm.z}}, {"unit", "mm"}};
+    else if (domain.shape == DomainShape::Mask)
+      e["root_voxel"] = {r.root.root_voxel.x, r.root.root_voxel.y, r.root.root_voxel.z};
+    else
+      e["root_offset"] = "the top of the domain (+y)";
     if (r.has_direction) e["direction"] = {r.direction.x, r.direction.y, r.direction.z};
     roots_json.push_back(e);
   }
   j["roots"] = roots_json;
   if (!initial_file.empty())
-    j["initial"] = Json{{"file", initial_file.string()}, {"kind", initial_kind}, {"origin", initial_from_corner ? "corner" : "centre"},
-                        {"vessels", initial.tree.segmentCount()}, {"roots", initial.tree.roots().size()}};
+    j["initial"] = Json{{"file", initial_file.string()},
+                        {"kind", initial_kind},
+                        {"origin", initial_from_corner ? "corner" : "centre"},
+                        {"vessels", initial.tree.segmentCount()},
+                        {"roots", initial.tree.roots().size()}};
   Json st = Json::array();
   for (const auto& spec : stages) {
     Json e = settingsJson(stageSettings(), spec.stage);
@@ -534,6 +561,7 @@ std::unique_ptr<PreparedGrowth> ColonisationSetup::prepare(std::uint64_t memory_
   return std::make_unique<PreparedColonisation>(*this, std::move(loaded));
 }
 
+// clang-format off
 const GrowthMethod kColonisationMethod{
     "colonisation",
     "space colonisation with physiological constraints (Rauch & Harders 2021): arterial and venous trees grow "
@@ -557,5 +585,6 @@ const GrowthMethod kColonisationMethod{
         {"stage", "domain", "region names", "the whole domain", "the regions its drains are sampled in (a plexus)"},
     }})), "the region's name, used by [tree] avascular and [[stage]] domain"),
     &readColonisationToml};
+// clang-format on
 
 }  // namespace angiosynth

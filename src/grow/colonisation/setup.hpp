@@ -36,17 +36,17 @@ struct ColonisationRootSpec {
 struct ColonisationSetup final : GrowthSetup {
   std::string parameter_file;
   DomainSpec domain;
-  ColonisationOptions options;                 // stages, roots, world set by prepare() and grow()
+  ColonisationOptions options;  // stages, roots, world set by prepare() and grow()
   std::vector<ColonisationStageSpec> stages;
   std::vector<ColonisationRootSpec> roots;
   std::vector<RegionSpec> regions;
-  std::vector<std::string> avascular;          // regions no vessel enters
+  std::vector<std::string> avascular;  // regions no vessel enters
   // [initial]: stumps of an existing network (each root a tree of `initial_kind`) that grow on.
   std::filesystem::path initial_file;
   ExistingNetwork initial;
   bool initial_from_corner = false;
   std::string initial_kind = "artery";
-  PhysicsParameters physics_summary;           // κ, η, pressures and flow: flows and pressures of the trees
+  PhysicsParameters physics_summary;  // κ, η, pressures and flow: flows and pressures of the trees
 
   const char* method() const override { return "colonisation"; }
   nlohmann::ordered_json describe() const override;

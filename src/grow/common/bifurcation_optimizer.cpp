@@ -19,8 +19,7 @@ BifurcationOptimizer::Subtree BifurcationOptimizer::shortened(std::int32_t s, do
   return v;
 }
 
-double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, double l_term,
-                                  std::vector<PathLevel>* record) const {
+double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, double l_term, std::vector<PathLevel>* record) const {
   const auto& t = tree_;
   const auto& k = kernel_;
   // The old segment s keeps its subtree but now starts at b.
@@ -96,14 +95,12 @@ Vec3 BifurcationOptimizer::keepLengths(Vec3 b, const std::array<Vec3, 3>& ends, 
   return b;
 }
 
-BifurcationOptimizer::Level0 BifurcationOptimizer::level0(std::int32_t s, double l_up, double l_down,
-                                                          double l_term) const {
+BifurcationOptimizer::Level0 BifurcationOptimizer::level0(std::int32_t s, double l_up, double l_down, double l_term) const {
   const auto& k = kernel_;
   const auto [R_s, V_s] = shortened(s, l_down);
   const double R_t = l_term, V_t = k.lengthCost(l_term);
   const auto sp = k.split(tree_.terminals[s], R_s, 1.0, R_t);
-  return {combinedResistance(l_up, sp, R_s, R_t),
-          k.lengthCost(l_up) + k.radiusCost(sp.beta_a) * V_s + k.radiusCost(sp.beta_b) * V_t};
+  return {combinedResistance(l_up, sp, R_s, R_t), k.lengthCost(l_up) + k.radiusCost(sp.beta_a) * V_s + k.radiusCost(sp.beta_b) * V_t};
 }
 
 BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, const double (&l)[3]) const {
@@ -140,7 +137,7 @@ BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, 
   Evaluation e;
   e.cost = rl * V;
   const double gR = lambda / 4.0 * e.cost / R * a + rl * bR;  // ∂C/∂R0
-  const double gV = rl * cV;                                   // ∂C/∂V0
+  const double gV = rl * cV;                                  // ∂C/∂V0
   // Level 0 depends on the three lengths in O(1): differentiate it numerically.
   for (int j = 0; j < 3; ++j) {
     double lp[3] = {l[0], l[1], l[2]};
@@ -181,14 +178,13 @@ Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int 
   return c;
 }
 
-Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const MinLengths& m, int max_iterations,
-                                        const Vec3* given) const {
+Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const MinLengths& m, int max_iterations, const Vec3* given) const {
   const std::array<Vec3, 3> ends{tree_.position[tree_.parent[s]], tree_.position[s], term};
   Connection best;
   best.segment = s;
   best.terminal = term;
   best.min_lengths = m;
-  const auto lengths = [&](const Vec3& x, double (&l)[3]) {
+  const auto lengths = [&](const Vec3& x, double(&l)[3]) {
     for (int j = 0; j < 3; ++j) l[j] = std::max(distance(x, ends[j]), min_length_);
   };
   // Start at VascuSynth's midpoint, moved a third of the way to the terminal; fall back to the
@@ -217,7 +213,7 @@ Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const 
   best.bifurcation = b;
   const double tol = 1e-6 * (distance(ends[0], ends[1]) + distance(ends[1], ends[2]) + 1e-12);
   // Gradient ∇C = Σ_j w_j (b − x_j)/l_j with w_j = ∂C/∂l_j, and the Weiszfeld metric 1/Σ(w_j/l_j).
-  const auto gradient = [&](const Evaluation& ev, const Vec3& x, const double (&lx)[3], double* metric) {
+  const auto gradient = [&](const Evaluation& ev, const Vec3& x, const double(&lx)[3], double* metric) {
     Vec3 g;
     double den = 0;
     for (int j = 0; j < 3; ++j) {
@@ -276,8 +272,7 @@ Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const 
         yHy += y_[i] * Hy[i];
       }
       for (int i = 0; i < 3; ++i)
-        for (int k = 0; k < 3; ++k)
-          H[i][k] += rho * ((1 + rho * yHy) * s_[i] * s_[k] - Hy[i] * s_[k] - s_[i] * Hy[k]);
+        for (int k = 0; k < 3; ++k) H[i][k] += rho * ((1 + rho * yHy) * s_[i] * s_[k] - Hy[i] * s_[k] - s_[i] * Hy[k]);
     }
   }
   best.cost = e.cost;
@@ -325,8 +320,7 @@ void BifurcationOptimizer::polish(Connection& c) const {
 void BifurcationOptimizer::record(Connection& c) const {
   c.path.clear();
   const Vec3& b = c.bifurcation;
-  cost(c.segment, distance(tree_.position[tree_.parent[c.segment]], b), distance(b, tree_.position[c.segment]),
-       distance(b, c.terminal), &c.path);
+  cost(c.segment, distance(tree_.position[tree_.parent[c.segment]], b), distance(b, tree_.position[c.segment]), distance(b, c.terminal), &c.path);
   const auto& top = c.path.back();
   c.root_radius = rootRadius(params_, top.terminals * params_.terminalFlow(), top.reduced_resistance);
 }

@@ -29,9 +29,9 @@ struct DemandMap;
 
 // New values of one segment on the path from the bifurcation to the root after a connection.
 struct PathLevel {
-  std::int32_t segment;     // the existing ancestor (level 0: -1, the new bifurcation segment)
-  std::int32_t child;       // the child on the path (level 0: s)
-  std::int32_t other;       // the other child (level 0: -1, the new terminal)
+  std::int32_t segment;  // the existing ancestor (level 0: -1, the new bifurcation segment)
+  std::int32_t child;    // the child on the path (level 0: s)
+  std::int32_t other;    // the other child (level 0: -1, the new terminal)
   double beta_child, beta_other;
   double reduced_resistance, cost_ratio;
   std::int32_t terminals;
@@ -41,11 +41,11 @@ struct Connection {
   std::int32_t segment = -1;  // s, the segment that is split
   Vec3 bifurcation;
   Vec3 terminal;
-  double cost = 0;            // whole-tree cost after the connection, mm^(μ+λ)
-  double root_radius = 0;     // mm
+  double cost = 0;              // whole-tree cost after the connection, mm^(μ+λ)
+  double root_radius = 0;       // mm
   std::vector<PathLevel> path;  // filled by `record`
   bool valid = false;
-  bool converged = false;     // the quasi-Newton iteration reached a stationary point
+  bool converged = false;               // the quasi-Newton iteration reached a stationary point
   std::array<double, 3> min_lengths{};  // parent part, distal part, terminal (mm), set by optimise
 };
 
@@ -54,11 +54,16 @@ class BifurcationOptimizer {
   // length_ratio k: segments at least k × radius × radius_scale long (0: only the absolute
   // minimum); a new root segment k × radius × root_radius_scale. The scales stand for the growth
   // a vessel's radius has still to come.
-  BifurcationOptimizer(const VascularTree& tree, const PhysicsParameters& p, const DemandMap& map,
-                       double min_segment_length_mm, double length_ratio = 0, double radius_scale = 1,
-                       double root_radius_scale = 1)
-      : tree_(tree), params_(p), kernel_(p), map_(map), min_length_(min_segment_length_mm),
-        length_ratio_(length_ratio), radius_scale_(radius_scale), root_radius_scale_(root_radius_scale) {}
+  BifurcationOptimizer(const VascularTree& tree, const PhysicsParameters& p, const DemandMap& map, double min_segment_length_mm,
+                       double length_ratio = 0, double radius_scale = 1, double root_radius_scale = 1)
+      : tree_(tree),
+        params_(p),
+        kernel_(p),
+        map_(map),
+        min_length_(min_segment_length_mm),
+        length_ratio_(length_ratio),
+        radius_scale_(radius_scale),
+        root_radius_scale_(root_radius_scale) {}
 
   // Best valid bifurcation on segment s for terminal t; valid = false when every trial point
   // makes a segment cross a zero-demand voxel or shorter than the minimum length.
@@ -82,7 +87,9 @@ class BifurcationOptimizer {
   bool optimumAtProximalNode(std::int32_t s, const Vec3& t) const;
   // Cost of the connection at point b (no constraint checks).
   double costAt(std::int32_t s, const Vec3& b, const Vec3& t) const;
-  struct Subtree { double reduced_resistance, cost_ratio; };
+  struct Subtree {
+    double reduced_resistance, cost_ratio;
+  };
   // Values of segment s if it started at distance l_down from its distal node.
   Subtree shortened(std::int32_t s, double l_down) const;
   // Compass-search polish of an optimised connection: escapes where the quasi-Newton step stalls
@@ -102,7 +109,9 @@ class BifurcationOptimizer {
   std::array<double, 3> radiiAt(std::int32_t s, const Vec3& b, const Vec3& t) const;
 
  private:
-  struct Level0 { double R, V; };
+  struct Level0 {
+    double R, V;
+  };
   MinLengths minimumsAt(std::int32_t s, const Vec3& b, const Vec3& t) const;
   Connection search(std::int32_t s, const Vec3& t, const MinLengths& m, int max_iterations, const Vec3* start) const;
   Vec3 keepLengths(Vec3 b, const std::array<Vec3, 3>& ends, const MinLengths& m) const;

@@ -9,8 +9,8 @@ void save(ConnectionUndo& u, const VascularTree& t, const std::vector<double>& r
 
 }  // namespace
 
-ConnectionUndo commitConnection(VascularTree& t, const Connection& c, const BifurcationOptimizer& opt,
-                                const PowerKernel& k, std::vector<double>& rel) {
+ConnectionUndo commitConnection(VascularTree& t, const Connection& c, const BifurcationOptimizer& opt, const PowerKernel& k,
+                                std::vector<double>& rel) {
   const auto s = c.segment, P = t.parent[s];
   ConnectionUndo u{s, P, t.length[s], {}};
   save(u, t, rel, s);

@@ -22,8 +22,8 @@ struct ConnectionUndo {
   std::vector<Saved> saved;
 };
 
-ConnectionUndo commitConnection(VascularTree& tree, const Connection& c, const BifurcationOptimizer& opt,
-                                const PowerKernel& kernel, std::vector<double>& rel);
+ConnectionUndo commitConnection(VascularTree& tree, const Connection& c, const BifurcationOptimizer& opt, const PowerKernel& kernel,
+                                std::vector<double>& rel);
 // Undoes the last commit (its two nodes must be the last two of the tree).
 void rollbackConnection(VascularTree& tree, const ConnectionUndo& undo, std::vector<double>& rel);
 // ρ of every segment from the stored β, top-down: O(N).

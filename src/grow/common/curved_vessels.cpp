@@ -46,15 +46,15 @@ constexpr int kLevels = 7;  // amplitude halvings before a vessel is left as gro
 struct VesselCurve {
   const VascularTree* t = nullptr;
   VesselPath path;
-  std::vector<Vec3> base;        // path points: start, then each segment's distal node
-  std::vector<double> arc;       // arc length of the path at each point
-  std::vector<int> pieces;       // pieces of each segment
-  std::vector<Vec3> knot;        // displacement at the knots per unit amplitude (0 at both ends)
+  std::vector<Vec3> base;   // path points: start, then each segment's distal node
+  std::vector<double> arc;  // arc length of the path at each point
+  std::vector<int> pieces;  // pieces of each segment
+  std::vector<Vec3> knot;   // displacement at the knots per unit amplitude (0 at both ends)
   double chord = 0, target = 1, amplitude = 0;
-  int level = 0;                 // halvings applied
+  int level = 0;  // halvings applied
   bool moved = false, own_path_enough = false, flattened_by_domain = false, flattened_by_overlap = false;
-  std::vector<Vec3> points;      // the curve: every piece's distal point, in order
-  std::vector<double> piece_u;   // path arc length at each of them
+  std::vector<Vec3> points;     // the curve: every piece's distal point, in order
+  std::vector<double> piece_u;  // path arc length at each of them
 
   double length() const { return arc.back(); }
   Vec3 pathAt(double u, std::size_t& seg) const {
@@ -214,8 +214,8 @@ struct PieceOverlaps {
 
 }  // namespace
 
-VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const GrowthDomain* domain, const DemandMap& frame,
-                          std::uint64_t seed, std::uint64_t sample, CurveReport& rep, std::uint64_t memory_limit) {
+VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const GrowthDomain* domain, const DemandMap& frame, std::uint64_t seed,
+                          std::uint64_t sample, CurveReport& rep, std::uint64_t memory_limit) {
   rep = CurveReport{};
   rep.nodes_before = t.nodeCount();
   const auto paths = vesselPaths(t);
@@ -245,9 +245,10 @@ VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const Gr
   }
   constexpr double kBytesPerPiece = 400;  // its points (curve, straight copy, overlap index) and its node in the tree
   if (pieces > double(std::numeric_limits<std::int32_t>::max() / 2) || (memory_limit > 0 && pieces * kBytesPerPiece > double(memory_limit)))
-    throw InputError("", 0, "[curves] piece_length " + std::to_string(piece) + " mm draws the vessels in about " + std::to_string(std::llround(pieces)) +
-                                " pieces, which need about " + formatBytes(std::uint64_t(pieces * kBytesPerPiece)) + ", more than the limit of " +
-                                formatBytes(memory_limit) + "; allowed: a longer piece_length (default: one voxel) or a larger --memory-limit");
+    throw InputError("", 0,
+                     "[curves] piece_length " + std::to_string(piece) + " mm draws the vessels in about " + std::to_string(std::llround(pieces)) +
+                         " pieces, which need about " + formatBytes(std::uint64_t(pieces * kBytesPerPiece)) + ", more than the limit of " +
+                         formatBytes(memory_limit) + "; allowed: a longer piece_length (default: one voxel) or a larger --memory-limit");
 
   std::vector<VesselCurve> curves(paths.size());
   const auto build = [&](VesselCurve& c) {

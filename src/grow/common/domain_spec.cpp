@@ -18,7 +18,7 @@ RootSpec readRootOf(const TomlReader& r, const toml::table& t, const std::string
     r.forbid(t, name, {"root_offset"}, "is for analytic shapes; give the root of a mask domain as root (mm) or root_voxel");
     // A NIfTI mask's voxel size is known only once it is read: its root stays in mm until then.
     if (const auto mm = readRoot(r, t, root.root_voxel, root.root_line, "mask voxels", ": a mask domain has no default root",
-                                   name == "tree" ? name : "[" + name + "]")) {
+                                 name == "tree" ? name : "[" + name + "]")) {
       if (isNifti(d.mask)) {
         root.root_mm = *mm;
         root.root_in_mm = true;
@@ -35,8 +35,8 @@ RootSpec readRootOf(const TomlReader& r, const toml::table& t, const std::string
     root.has_root_offset = true;
     root.root_line = r.lineOf(n);
   } else if (required) {
-    throw InputError(r.file(), r.lineOf(&t), "missing key 'root_offset' (mm from the centre) in [[" + name +
-                                                 "]]: with several inlets each needs its own root");
+    throw InputError(r.file(), r.lineOf(&t),
+                     "missing key 'root_offset' (mm from the centre) in [[" + name + "]]: with several inlets each needs its own root");
   }
   return root;
 }
@@ -50,6 +50,7 @@ MethodFileTables readMethodFileTables(const TomlReader& r, const GrowthMethod& m
   return {dom, tree, ph, std::move(spec), flat};
 }
 
+// clang-format off
 std::vector<MethodParam> withDomainParams(const char* shape_meaning, const char* sampling_meaning, std::vector<MethodParam> rows) {
   std::vector<MethodParam> out{
       {"domain", "shape", "text", "sphere", shape_meaning},
@@ -71,6 +72,7 @@ std::vector<MethodParam> withDomainParams(const char* shape_meaning, const char*
   out.insert(out.end(), rows.begin() + std::ptrdiff_t(k), rows.end());
   return out;
 }
+// clang-format on
 
 std::vector<std::filesystem::path> domainInputs(const DomainSpec& spec) {
   if (spec.mask.empty()) return {};
@@ -82,8 +84,10 @@ DomainSpec readDomainSpec(const TomlReader& r, const toml::table& dom, const std
   const std::string file = r.file();
   d.line = r.lineOf(&dom);
   const std::string shape = dom.get("shape") ? r.string(dom, "domain", "shape") : "sphere";
-  const std::pair<const char*, DomainShape> shapes[] = {{"sphere", DomainShape::Sphere}, {"cube", DomainShape::Cube},
-                                                        {"disc", DomainShape::Disc},     {"square", DomainShape::Square},
+  const std::pair<const char*, DomainShape> shapes[] = {{"sphere", DomainShape::Sphere},
+                                                        {"cube", DomainShape::Cube},
+                                                        {"disc", DomainShape::Disc},
+                                                        {"square", DomainShape::Square},
                                                         {"mask", DomainShape::Mask}};
   bool known = false;
   for (const auto& [name, value] : shapes)
@@ -98,8 +102,7 @@ DomainSpec readDomainSpec(const TomlReader& r, const toml::table& dom, const std
     d.mask = resolveInputPath(r.string(dom, "domain", "mask"), path, r.lineOf(dom.get("mask")));
     const bool nifti = isNifti(d.mask);
     if (nifti) {
-      if (dom.get("voxel_size"))
-        throw InputError(file, r.lineOf(dom.get("voxel_size")), "a NIfTI mask carries its voxel size; remove voxel_size");
+      if (dom.get("voxel_size")) throw InputError(file, r.lineOf(dom.get("voxel_size")), "a NIfTI mask carries its voxel size; remove voxel_size");
     } else {
       d.voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
       checkRange(d.voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, r.at(dom, "voxel_size"), "voxel_size (mm)");
@@ -117,8 +120,8 @@ DomainSpec readDomainSpec(const TomlReader& r, const toml::table& dom, const std
     d.size_mm = r.quantity(dom, "domain", size_key, Dimension::Length);
     checkRange(d.size_mm, Limits::kMinVoxel, false, Limits::kMaxLength, false, r.at(dom, size_key), std::string(size_key) + " (mm)");
     d.voxel_mm = r.quantity(dom, "domain", "voxel_size", Dimension::Length);
-    checkRange(d.voxel_mm, std::max(Limits::kMinVoxel, d.size_mm / Limits::kMaxVoxelsPerAxis), false, d.size_mm, true,
-               r.at(dom, "voxel_size"), "voxel_size (mm)");
+    checkRange(d.voxel_mm, std::max(Limits::kMinVoxel, d.size_mm / Limits::kMaxVoxelsPerAxis), false, d.size_mm, true, r.at(dom, "voxel_size"),
+               "voxel_size (mm)");
   }
   return d;
 }
@@ -126,8 +129,7 @@ DomainSpec readDomainSpec(const TomlReader& r, const toml::table& dom, const std
 GrowthDomain loadDomainSpec(const DomainSpec& spec, const std::string& parameter_file, const RootSpec& root, std::uint64_t limit) {
   if (spec.shape != DomainShape::Mask) {
     const auto n = GrowthDomain::analyticDims(spec.shape, spec.size_mm, spec.voxel_mm);
-    checkDomainMemory(std::int64_t(n[0]) * n[1] * n[2], limit, parameter_file, spec.line,
-                      std::string("a ") + domainShapeName(spec.shape) + " frame");
+    checkDomainMemory(std::int64_t(n[0]) * n[1] * n[2], limit, parameter_file, spec.line, std::string("a ") + domainShapeName(spec.shape) + " frame");
     return GrowthDomain::analytic(spec.shape, spec.size_mm, spec.voxel_mm);
   }
   DemandMap m;
@@ -161,8 +163,8 @@ Vec3 placeRoot(const std::string& parameter_file, const RootSpec& spec, const Gr
   const double tolerance = d.frame().voxel_mm * 1e-6;
   if (d.depth(root) < -tolerance)
     throw InputError(parameter_file, spec.root_line,
-                     "the root (" + show3(root) + " mm in the frame) lies outside the " + domainShapeName(d.shape()) +
-                         " domain (" + show(-d.depth(root)) + " mm beyond its border); place it inside or on the border");
+                     "the root (" + show3(root) + " mm in the frame) lies outside the " + domainShapeName(d.shape()) + " domain (" +
+                         show(-d.depth(root)) + " mm beyond its border); place it inside or on the border");
   return root;
 }
 
@@ -171,8 +173,10 @@ void describeDomainAndRoot(const DomainSpec& d, const RootSpec& root, nlohmann::
   j["shape"] = domainShapeName(d.shape);
   if (d.shape == DomainShape::Mask) {
     j["mask"] = d.mask.string();
-    if (root.root_in_mm) j["root"] = Json{{"value", {root.root_mm.x, root.root_mm.y, root.root_mm.z}}, {"unit", "mm"}};
-    else j["root_voxel"] = {root.root_voxel.x, root.root_voxel.y, root.root_voxel.z};
+    if (root.root_in_mm)
+      j["root"] = Json{{"value", {root.root_mm.x, root.root_mm.y, root.root_mm.z}}, {"unit", "mm"}};
+    else
+      j["root_voxel"] = {root.root_voxel.x, root.root_voxel.y, root.root_voxel.z};
   } else {
     j[d.shape == DomainShape::Sphere || d.shape == DomainShape::Disc ? "radius" : "side"] = quantityJson(d.size_mm, "mm");
     j["root_offset"] = root.has_root_offset ? Json{{"value", {root.root_offset_mm.x, root.root_offset_mm.y, root.root_offset_mm.z}}, {"unit", "mm"}}

@@ -14,8 +14,6 @@
 
 namespace angiosynth {
 
-
-
 // The [domain] of a CCO-family method: an analytic shape or a mask file.
 struct DomainSpec {
   DomainShape shape = DomainShape::Sphere;
@@ -30,9 +28,9 @@ struct DomainSpec {
 struct RootSpec {
   bool has_root_offset = false;  // analytic shapes: root = centre + offset (default: the top, +y)
   Vec3 root_offset_mm;
-  bool root_in_mm = false;       // masks: `root` (mm in the frame) rather than root_voxel
+  bool root_in_mm = false;  // masks: `root` (mm in the frame) rather than root_voxel
   Vec3 root_mm;
-  Vec3 root_voxel;               // masks: the root in mask voxels
+  Vec3 root_voxel;  // masks: the root in mask voxels
   int root_line = 0;
 };
 
@@ -60,8 +58,7 @@ DomainSpec readDomainSpec(const TomlReader& r, const toml::table& dom, const std
 RootSpec readRootOf(const TomlReader& r, const toml::table& t, const std::string& name, const DomainSpec& d, bool required);
 // The growth domain: the analytic shape on its voxel frame, a NIfTI mask, or a VascuSynth box
 // map (whose reader checks `root` too); checks the memory before allocating.
-GrowthDomain loadDomainSpec(const DomainSpec& spec, const std::string& parameter_file, const RootSpec& root,
-                            std::uint64_t memory_limit_bytes);
+GrowthDomain loadDomainSpec(const DomainSpec& spec, const std::string& parameter_file, const RootSpec& root, std::uint64_t memory_limit_bytes);
 // A root in the domain's frame (mm): the offset from the centre for analytic shapes; must lie
 // inside or on the border.
 Vec3 placeRoot(const std::string& parameter_file, const RootSpec& root, const GrowthDomain& d);

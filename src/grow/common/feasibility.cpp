@@ -12,8 +12,7 @@ RadiusEstimate estimateRadii(const PhysicsParameters& p, std::int64_t terminals,
   const double n = double(terminals), levels = std::log2(std::max(1.0, n));
   const double root_length = std::pow(measure, 1.0 / dim) / 2;
   double path = 0;  // Σ over levels of 2^-k · 2^(-k/d) · 2^(4k/γ)
-  for (int k = 0; k <= int(levels); ++k)
-    path += std::pow(2.0, -k - double(k) / dim + 4.0 * k / p.murray_exponent);
+  for (int k = 0; k <= int(levels); ++k) path += std::pow(2.0, -k - double(k) / dim + 4.0 * k / p.murray_exponent);
   const double dp = std::abs(p.perfusion_pressure - p.terminal_pressure);
   RadiusEstimate e;
   e.root = std::pow(8 * p.viscosity * p.perfusion_flow * root_length * path / (std::numbers::pi * dp), 0.25);
@@ -28,8 +27,8 @@ void checkPacking(std::int64_t n, double min_distance_mm, double measure, const 
   const double capacity = 0.74 * measure / ball;
   if (double(n) > capacity)
     throw InputError(file, line,
-                     std::to_string(n) + " terminals cannot lie " + show(min_distance_mm) + " mm apart in the " +
-                         show(measure) + " mm^3 of non-zero demand: at most about " + std::to_string(std::int64_t(capacity)) +
+                     std::to_string(n) + " terminals cannot lie " + show(min_distance_mm) + " mm apart in the " + show(measure) +
+                         " mm^3 of non-zero demand: at most about " + std::to_string(std::int64_t(capacity)) +
                          " fit (sphere packing); use fewer terminals, a smaller minimum distance, or a larger domain");
 }
 
@@ -41,12 +40,14 @@ void checkVesselRoom(const PhysicsParameters& p, std::int64_t n, double measure,
   // past it, while the shipped examples sit far below it (docs/benchmarks.md, "Figures behind
   // design choices").
   if (2 * e.terminal > e.spacing / 4)
-    throw InputError(file, line,
-                     "vessels too thick for the domain: this flow, pressure drop and viscosity give terminal vessels of "
-                     "diameter about " + show(2 * e.terminal) + " mm (root radius about " + show(e.root) + " mm), but " +
-                         std::to_string(n) + " terminals in " + show(measure) + unit + " lie about " + show(e.spacing) +
-                         " mm apart, and growth needs diameters below a quarter of that; lower perfusion_flow or viscosity, raise the pressure drop, or use "
-                         "fewer terminals (vessel radius scales with flow^(1/4))");
+    throw InputError(
+        file, line,
+        "vessels too thick for the domain: this flow, pressure drop and viscosity give terminal vessels of "
+        "diameter about " +
+            show(2 * e.terminal) + " mm (root radius about " + show(e.root) + " mm), but " + std::to_string(n) + " terminals in " + show(measure) +
+            unit + " lie about " + show(e.spacing) +
+            " mm apart, and growth needs diameters below a quarter of that; lower perfusion_flow or viscosity, raise the pressure drop, or use "
+            "fewer terminals (vessel radius scales with flow^(1/4))");
 }
 
 }  // namespace angiosynth

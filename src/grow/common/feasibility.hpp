@@ -20,7 +20,6 @@ RadiusEstimate estimateRadii(const PhysicsParameters& p, std::int64_t terminals,
 // Balls of diameter min_distance around the terminals cannot fill more than 74 % of space.
 void checkPacking(std::int64_t terminals, double min_distance_mm, double measure_mm3, const std::string& file, int line);
 // Terminal vessels must be thinner than a quarter of the spacing between terminals.
-void checkVesselRoom(const PhysicsParameters& p, std::int64_t terminals, double measure, int dim, const std::string& file,
-                     int line);
+void checkVesselRoom(const PhysicsParameters& p, std::int64_t terminals, double measure, int dim, const std::string& file, int line);
 
 }  // namespace angiosynth

@@ -19,7 +19,7 @@ struct GrowthReport {
   std::int64_t repaired_terminals = 0;     // terminals removed and regrown by the final check
   std::int64_t relaxed_bifurcations = 0;   // vascusynth: bifurcation moves of the final relaxation sweeps
   int repair_rounds = 0;
-  std::int64_t intersecting_pairs = 0;     // in the final tree (target 0)
+  std::int64_t intersecting_pairs = 0;  // in the final tree (target 0)
   // CCO only.
   std::int64_t threshold_relaxations = 0;  // δ_max × 0.9 after a run of failed draws
   std::int64_t neighbour_doublings = 0;    // ν doubled because every candidate failed
@@ -35,8 +35,8 @@ struct GrowthReport {
     double proximal[3], distal[3], length, radius;
   };
   std::vector<ShortSegment> short_list;
-  std::int64_t outside_segments = 0;       // final segments leaving the domain (target 0)
-  std::int64_t lenient_connections = 0;    // forests: connections whose thickened ancestors were checked only in part
+  std::int64_t outside_segments = 0;     // final segments leaving the domain (target 0)
+  std::int64_t lenient_connections = 0;  // forests: connections whose thickened ancestors were checked only in part
   double root_radius_mm = 0;
 };
 

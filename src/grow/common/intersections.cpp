@@ -57,8 +57,8 @@ bool crossInPlane(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return ((s1 > 0 && s2 < 0) || (s1 < 0 && s2 > 0)) && ((s3 > 0 && s4 < 0) || (s3 < 0 && s4 > 0));
 }
 
-bool separatedInPlane(const VascularTree& t, std::int32_t s, const Vec3& p,
-                      const std::vector<std::pair<double, std::int32_t>>& near, std::size_t occluders) {
+bool separatedInPlane(const VascularTree& t, std::int32_t s, const Vec3& p, const std::vector<std::pair<double, std::int32_t>>& near,
+                      std::size_t occluders) {
   const Vec3& x0 = t.position[t.parent[s]];
   const Vec3& x1 = t.position[s];
   const std::size_t n = std::min(near.size(), occluders);
@@ -72,8 +72,7 @@ bool separatedInPlane(const VascularTree& t, std::int32_t s, const Vec3& p,
   return false;
 }
 
-std::vector<std::pair<std::int32_t, std::int32_t>> intersectingPairs(const VascularTree& t, const Vec3& lo,
-                                                                     const Vec3& hi) {
+std::vector<std::pair<std::int32_t, std::int32_t>> intersectingPairs(const VascularTree& t, const Vec3& lo, const Vec3& hi) {
   std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
   if (t.segmentCount() < 2) return pairs;
   SegmentIndex index(lo, hi);

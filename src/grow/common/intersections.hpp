@@ -28,8 +28,8 @@ inline bool capsulesOverlap(const Vec3& a0, const Vec3& a1, double ra, const Vec
 // vessel more than two segments from x. `for_each_candidate(f)` calls f(y) for the segments to
 // consider (e.g. SegmentIndex::forEachNearSegment); `radius_of(y)` gives y's radius.
 template <class Candidates, class Radius>
-bool overlapsOtherVessel(const VascularTree& t, std::int32_t x, const Vec3& a, const Vec3& e, double r,
-                         Candidates&& for_each_candidate, Radius&& radius_of) {
+bool overlapsOtherVessel(const VascularTree& t, std::int32_t x, const Vec3& a, const Vec3& e, double r, Candidates&& for_each_candidate,
+                         Radius&& radius_of) {
   bool hit = false;
   for_each_candidate([&](std::int32_t y) {
     if (hit || y == x || y >= t.nodeCount() || withinTwoSegments(t, x, y)) return;
@@ -49,12 +49,11 @@ bool crossInPlane(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 // that crosses it. CCO tries bifurcations in the triangle only: Kamiya's point is a weighted
 // mean of the three ends, and the tree's volume grows with each of the three lengths, so its
 // minimum lies there too (projecting b onto the triangle shortens all three).
-bool separatedInPlane(const VascularTree& t, std::int32_t s, const Vec3& p,
-                      const std::vector<std::pair<double, std::int32_t>>& near, std::size_t occluders);
+bool separatedInPlane(const VascularTree& t, std::int32_t s, const Vec3& p, const std::vector<std::pair<double, std::int32_t>>& near,
+                      std::size_t occluders);
 
 // Every intersecting pair of the tree with its current radii, (smaller id, larger id), sorted.
 // O(N) expected with a uniform grid over [lo, hi].
-std::vector<std::pair<std::int32_t, std::int32_t>> intersectingPairs(const VascularTree& tree, const Vec3& lo,
-                                                                     const Vec3& hi);
+std::vector<std::pair<std::int32_t, std::int32_t>> intersectingPairs(const VascularTree& tree, const Vec3& lo, const Vec3& hi);
 
 }  // namespace angiosynth

@@ -62,7 +62,7 @@ KamiyaResult kamiyaBifurcation(const KamiyaProblem& p, int max_iterations, doubl
     const Eigen::Vector3d ne(n3.x / norm(n3), n3.y / norm(n3), n3.z / norm(n3));
     normal_outer = ne * ne.transpose();
   }
-  const auto lengths = [&](const Vec3& at, double (&l)[3]) {
+  const auto lengths = [&](const Vec3& at, double(&l)[3]) {
     for (int i = 0; i < 3; ++i) l[i] = std::max(distance(xs[i], at), floor_len);
   };
   for (int it = 1; it <= max_iterations; ++it) {
@@ -120,9 +120,7 @@ KamiyaResult kamiyaBifurcation(const KamiyaProblem& p, int max_iterations, doubl
       }
       const Eigen::Vector3d d = H.ldlt().solve(-g);
       const Vec3 newton = x + Vec3(d[0], d[1], d[2]);
-      const auto objective = [&](const Vec3& at) {
-        return a[0] * distance(at, xs[0]) + a[1] * distance(at, xs[1]) + a[2] * distance(at, xs[2]);
-      };
+      const auto objective = [&](const Vec3& at) { return a[0] * distance(at, xs[0]) + a[1] * distance(at, xs[1]) + a[2] * distance(at, xs[2]); };
       if (d.allFinite() && objective(newton) < objective(next)) next = newton;
     }
     const double step = distance(next, x);

@@ -16,17 +16,17 @@ namespace angiosynth {
 
 struct KamiyaProblem {
   Vec3 x0, x1, x2;
-  double f1 = 1, f2 = 1;                // f0 = f1 + f2
-  double r0 = 1, r1 = 1, r2 = 1;        // starting radii (Kerautret et al. (OpenCCO): all equal, from the current tree)
+  double f1 = 1, f2 = 1;          // f0 = f1 + f2
+  double r0 = 1, r1 = 1, r2 = 1;  // starting radii (Kerautret et al. (OpenCCO): all equal, from the current tree)
   double murray_exponent = 3;
 };
 
 struct KamiyaResult {
-  Vec3 x;                        // bifurcation point, in the plane of x0, x1, x2
+  Vec3 x;  // bifurcation point, in the plane of x0, x1, x2
   double r0 = 0, r1 = 0, r2 = 0;
   int iterations = 0;
-  bool converged = false;        // x settled and every radius solve reached its equations
-  bool merged = false;           // the optimum is one of x0, x1, x2 (a zero-length segment)
+  bool converged = false;  // x settled and every radius solve reached its equations
+  bool merged = false;     // the optimum is one of x0, x1, x2 (a zero-length segment)
 };
 
 KamiyaResult kamiyaBifurcation(const KamiyaProblem& p, int max_iterations = 100, double tolerance = 1e-6);

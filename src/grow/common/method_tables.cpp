@@ -24,8 +24,9 @@ void checkMethodKeys(const TomlReader& r, const GrowthMethod& m, const toml::tab
     if (findParam(m, name, key) || (name == "tree" && key == "method")) continue;
     if (!declaredKeys(m, name + "." + key).empty()) continue;  // a sub-table the method declares: [[tree.inlet]], [[stage.gaussian]]
     if (const GrowthMethod* other = methodDeclaring(name, key, &m))
-      throw InputError(r.file(), r.lineOf(&v), "'" + key + "' in [" + name + "] is for method " + other->name +
-                                                   "; this file grows with method " + m.name + " ([tree] method)");
+      throw InputError(
+          r.file(), r.lineOf(&v),
+          "'" + key + "' in [" + name + "] is for method " + other->name + "; this file grows with method " + m.name + " ([tree] method)");
     std::string list;
     for (const auto& a : declaredKeys(m, name)) list += (list.empty() ? "" : ", ") + a;
     throw InputError(r.file(), r.lineOf(&v), "unknown key '" + key + "' in [" + name + "] of method " + m.name + "; allowed: " + list);
@@ -52,22 +53,21 @@ const char* fallbackOf(const GrowthMethod& m, const std::string& table, const st
 
 }  // namespace
 
-double declaredQuantity(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table,
-                        const std::string& key, Dimension dim, double voxel_mm) {
+double declaredQuantity(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table, const std::string& key,
+                        Dimension dim, double voxel_mm) {
   const char* fallback = fallbackOf(m, table, key);
   if (t.get(key) || !fallback) return r.quantity(t, table, key, dim, voxel_mm);
   return parseQuantity(fallback, dim, voxel_mm);
 }
 
-double declaredNumber(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table,
-                      const std::string& key) {
+double declaredNumber(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table, const std::string& key) {
   const char* fallback = fallbackOf(m, table, key);
   if (t.get(key) || !fallback) return r.number(t, table, key);
   return std::stod(fallback);
 }
 
-int declaredCount(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table,
-                  const std::string& key, std::int64_t lo, std::int64_t hi) {
+int declaredCount(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table, const std::string& key, std::int64_t lo,
+                  std::int64_t hi) {
   const char* fallback = fallbackOf(m, table, key);
   if (t.get(key) || !fallback) return r.smallInteger(t, table, key, lo, hi);
   return std::stoi(fallback);
@@ -79,6 +79,7 @@ std::vector<MethodParam> joinRows(std::initializer_list<std::vector<MethodParam>
   return rows;
 }
 
+// clang-format off
 Setting<PhysicsParameters> physicsSetting(const char* key, const char* fallback) {
   using P = PhysicsParameters;
   static const std::vector<Setting<P>> shared{
@@ -106,7 +107,9 @@ Setting<PhysicsParameters> physicsSetting(const char* key, const char* fallback)
     }
   throw std::logic_error(std::string("no shared [physics] setting ") + key);
 }
+// clang-format on
 
+// clang-format off
 const std::vector<SettingRule<PhysicsParameters>>& physicsRules() {
   static const std::vector<SettingRule<PhysicsParameters>> rules{
       {{"perfusion_pressure", "terminal_pressure"}, [](const PhysicsParameters& p) {
@@ -116,17 +119,19 @@ const std::vector<SettingRule<PhysicsParameters>>& physicsRules() {
        }}};
   return rules;
 }
+// clang-format on
 
 PhysicsParameters readPhysics(const TomlReader& r, const std::vector<Setting<PhysicsParameters>>& settings, const toml::table& ph) {
   PhysicsParameters p;
   readSettingsFrom(r, ph, "physics", settings, p, 0);
   const auto keys = settingKeys(settings);
-  if (keys.count("perfusion_pressure") && keys.count("terminal_pressure")) checkRules(physicsRules(), p, keysIn(r, ph), Where{r.file(), r.lineOf(&ph)});
+  if (keys.count("perfusion_pressure") && keys.count("terminal_pressure"))
+    checkRules(physicsRules(), p, keysIn(r, ph), Where{r.file(), r.lineOf(&ph)});
   return p;
 }
 
-std::optional<Vec3> readRoot(const TomlReader& r, const toml::table& tree, Vec3& root_voxel, int& root_line,
-                             const std::string& voxels, const std::string& why_required, const std::string& table) {
+std::optional<Vec3> readRoot(const TomlReader& r, const toml::table& tree, Vec3& root_voxel, int& root_line, const std::string& voxels,
+                             const std::string& why_required, const std::string& table) {
   if (tree.get("root_voxel") && tree.get("root"))
     throw InputError(r.file(), r.lineOf(tree.get("root")), "give root (mm) or root_voxel (" + voxels + "), not both");
   if (const auto* n = tree.get("root_voxel")) {
@@ -140,7 +145,6 @@ std::optional<Vec3> readRoot(const TomlReader& r, const toml::table& tree, Vec3&
   }
   throw InputError(r.file(), r.lineOf(&tree), "missing key 'root' (mm) or 'root_voxel' (" + voxels + ") in [" + table + "]" + why_required);
 }
-
 
 void describePhysics(const std::vector<Setting<PhysicsParameters>>& settings, const PhysicsParameters& p, std::int64_t terminals,
                      nlohmann::ordered_json& j) {

@@ -41,15 +41,14 @@ E choice(const TomlReader& r, const toml::table& t, const std::string& table, co
 }
 
 // table.key as a quantity, or the declared default (an error naming the key when it has none).
-double declaredQuantity(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table,
-                        const std::string& key, Dimension dim, double voxel_mm = 0);
+double declaredQuantity(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table, const std::string& key,
+                        Dimension dim, double voxel_mm = 0);
 // table.key as a plain number, or the declared default.
-double declaredNumber(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table,
-                      const std::string& key);
+double declaredNumber(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table, const std::string& key);
 
 // table.key as a whole number in [lo, hi] (checked before it is narrowed), or the declared default.
-int declaredCount(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table,
-                  const std::string& key, std::int64_t lo, std::int64_t hi);
+int declaredCount(const TomlReader& r, const GrowthMethod& m, const toml::table& t, const std::string& table, const std::string& key, std::int64_t lo,
+                  std::int64_t hi);
 
 // The reference rows of declared settings, for key checks and `angiosynth methods`.
 template <class Options>
@@ -83,8 +82,8 @@ inline auto keysIn(const TomlReader& r, const toml::table& t) {
 
 // The root from [tree] (or the named table): root_voxel (in `voxels`) is stored in root_voxel; root (mm) is returned.
 // Exactly one of them is required.
-std::optional<Vec3> readRoot(const TomlReader& r, const toml::table& tree, Vec3& root_voxel, int& root_line,
-                             const std::string& voxels, const std::string& why_required, const std::string& table = "tree");
+std::optional<Vec3> readRoot(const TomlReader& r, const toml::table& tree, Vec3& root_voxel, int& root_line, const std::string& voxels,
+                             const std::string& why_required, const std::string& table = "tree");
 // The declared [physics] settings with units, and the flow of each terminal, as sample.json records them.
 void describePhysics(const std::vector<Setting<PhysicsParameters>>& settings, const PhysicsParameters& p, std::int64_t terminals,
                      nlohmann::ordered_json& j);

@@ -23,8 +23,8 @@ std::vector<std::string> regionNames(const TomlReader& r, const toml::table& t, 
     if (!known.count(name)) {
       std::string list;
       for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-      throw InputError(r.file(), r.lineOf(n), "region '" + name + "' in " + key + " is not defined; [[region]] names: " +
-                                                  (list.empty() ? "none" : list));
+      throw InputError(r.file(), r.lineOf(n),
+                       "region '" + name + "' in " + key + " is not defined; [[region]] names: " + (list.empty() ? "none" : list));
     }
   return out;
 }
@@ -45,8 +45,11 @@ std::vector<RegionSpec> readRegions(const TomlReader& r, const GrowthMethod& m, 
     if (g.name.empty() || !seen.insert(g.name).second)
       throw InputError(r.file(), r.lineOf(t.get("name")), "region name '" + g.name + "' is empty or defined twice; names must be unique");
     g.shape = choice<RegionShape>(r, t, "region", "shape", flat ? RegionShape::Disc : RegionShape::Sphere,
-                                  {{"sphere", RegionShape::Sphere}, {"disc", RegionShape::Disc}, {"shell", RegionShape::Shell},
-                                   {"annulus", RegionShape::Annulus}, {"box", RegionShape::Box}});
+                                  {{"sphere", RegionShape::Sphere},
+                                   {"disc", RegionShape::Disc},
+                                   {"shell", RegionShape::Shell},
+                                   {"annulus", RegionShape::Annulus},
+                                   {"box", RegionShape::Box}});
     const bool shape_flat = g.shape == RegionShape::Disc || g.shape == RegionShape::Annulus;
     if (flat != shape_flat && g.shape != RegionShape::Box)
       throw InputError(r.file(), r.lineOf(t.get("shape") ? t.get("shape") : &t),
@@ -74,16 +77,14 @@ std::vector<RegionSpec> readRegions(const TomlReader& r, const GrowthMethod& m, 
         only({"inner_radius", "outer_radius"});
         g.inner = length("inner_radius");
         g.outer = length("outer_radius");
-        if (!(g.outer > g.inner))
-          throw InputError(r.file(), r.lineOf(t.get("outer_radius")), "outer_radius must exceed inner_radius");
+        if (!(g.outer > g.inner)) throw InputError(r.file(), r.lineOf(t.get("outer_radius")), "outer_radius must exceed inner_radius");
         break;
       case RegionShape::Box: {
         only({"size"});
         const auto* n = r.need(t, "region", "size");
         const auto v = r.point(n, "size ([x, y(, z)] mm)", flat);
         g.size = Vec3(v.x, v.y, flat ? 0.0 : v.z);
-        if (!(g.size.x > 0 && g.size.y > 0 && (flat || g.size.z > 0)))
-          throw InputError(r.file(), r.lineOf(n), "size must be positive on every axis");
+        if (!(g.size.x > 0 && g.size.y > 0 && (flat || g.size.z > 0))) throw InputError(r.file(), r.lineOf(n), "size must be positive on every axis");
         break;
       }
     }
@@ -108,13 +109,14 @@ InitialNetwork readInitialNetwork(const TomlReader& r, const GrowthMethod& m, co
     for (std::int32_t i = 0; i < t.nodeCount(); ++i)
       if (std::abs(t.position[i].z - z0) > 1e-9 * (1 + std::abs(z0)))
         throw InputError(in.file.string(), in.network.lines[std::size_t(i)],
-                         "node " + (in.network.ids[std::size_t(i)].empty() ? std::to_string(i) : in.network.ids[std::size_t(i)]) + " has z = " +
-                             show(t.position[i].z) + " mm where the first has " + show(z0) +
+                         "node " + (in.network.ids[std::size_t(i)].empty() ? std::to_string(i) : in.network.ids[std::size_t(i)]) +
+                             " has z = " + show(t.position[i].z) + " mm where the first has " + show(z0) +
                              " mm; a 2D domain takes a network in one plane: allowed: every node at the same z");
   }
   return in;
 }
 
+// clang-format off
 std::vector<MethodParam> withRegionParams(std::vector<MethodParam> rows, const char* used_by) {
   const std::vector<MethodParam> regions{
       {"region", "name", "text", nullptr, used_by},
@@ -128,5 +130,6 @@ std::vector<MethodParam> withRegionParams(std::vector<MethodParam> rows, const c
   rows.insert(rows.end(), regions.begin(), regions.end());
   return rows;
 }
+// clang-format on
 
 }  // namespace angiosynth

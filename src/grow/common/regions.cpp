@@ -51,8 +51,8 @@ double regionMeasure(const RegionSpec& r) {
   return 0;
 }
 
-GrowthDomain regionDomain(const GrowthDomain& world, const std::vector<const RegionSpec*>& in,
-                          const std::vector<const RegionSpec*>& out, const std::string& what) {
+GrowthDomain regionDomain(const GrowthDomain& world, const std::vector<const RegionSpec*>& in, const std::vector<const RegionSpec*>& out,
+                          const std::string& what) {
   DemandMap m = world.frame();
   const Vec3 c = world.center();
   std::int64_t kept = 0;

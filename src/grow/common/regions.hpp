@@ -17,10 +17,10 @@ const char* regionShapeName(RegionShape s);
 struct RegionSpec {
   std::string name;
   RegionShape shape = RegionShape::Sphere;
-  Vec3 centre;               // mm from the domain's centre
-  double radius = 0;         // sphere, disc
+  Vec3 centre;                  // mm from the domain's centre
+  double radius = 0;            // sphere, disc
   double inner = 0, outer = 0;  // shell, annulus
-  Vec3 size;                 // box: sides, mm
+  Vec3 size;                    // box: sides, mm
   int line = 0;
 };
 
@@ -35,7 +35,7 @@ double regionMeasure(const RegionSpec& r);
 // The voxels of `world` inside any region of `in` (all of the world when `in` is empty) and
 // inside none of `out`, as a mask domain on the world's frame (terminals drawn uniformly).
 // Throws GrowthError naming `what` when no voxel is left.
-GrowthDomain regionDomain(const GrowthDomain& world, const std::vector<const RegionSpec*>& in,
-                          const std::vector<const RegionSpec*>& out, const std::string& what);
+GrowthDomain regionDomain(const GrowthDomain& world, const std::vector<const RegionSpec*>& in, const std::vector<const RegionSpec*>& out,
+                          const std::string& what);
 
 }  // namespace angiosynth

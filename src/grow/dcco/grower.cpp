@@ -71,7 +71,7 @@ struct Trial {
   double cost = 0;
   double r[3] = {0, 0, 0};  // proximal part, distal part, new vessel (distal: s, its child, new vessel)
   bool valid = false;
-  bool distal = false;      // the new vessel leaves s's distal end (s is not split)
+  bool distal = false;  // the new vessel leaves s's distal end (s is not split)
 };
 
 class DccoGrower {
@@ -116,10 +116,13 @@ class DccoGrower {
       if (shortest < 0 || t_.length[i] / t_.radius[i] < t_.length[shortest] / t_.radius[shortest]) shortest = i;
     }
     if (shortest < 0) return;  // nothing may branch: the stages' own checks say so
-    const std::string name = std::size_t(shortest) < o_.initial_names.size() ? o_.initial_names[std::size_t(shortest)] : "vessel " + std::to_string(shortest);
-    throw GrowthError("no vessel of the initial network can take a branch: each one that may is shorter than its radius at the flow it "
-                      "carries (" + name + ": " + show(t_.length[shortest]) + " mm long, radius " + show(t_.radius[shortest]) +
-                      " mm); allowed: pieces at least as long as their radius (join a polyline's samples)");
+    const std::string name =
+        std::size_t(shortest) < o_.initial_names.size() ? o_.initial_names[std::size_t(shortest)] : "vessel " + std::to_string(shortest);
+    throw GrowthError(
+        "no vessel of the initial network can take a branch: each one that may is shorter than its radius at the flow it "
+        "carries (" +
+        name + ": " + show(t_.length[shortest]) + " mm long, radius " + show(t_.radius[shortest]) +
+        " mm); allowed: pieces at least as long as their radius (join a polyline's samples)");
   }
 
   VascularTree run(const ProgressFn& progress) {
@@ -142,8 +145,8 @@ class DccoGrower {
     for (std::int32_t i = 1; i < t_.nodeCount(); ++i) lowest = std::min(lowest, t_.pressure[i]);
     if (!(lowest > 0))
       throw GrowthError("the tree carries perfusion_flow " + std::to_string(o_.flow) + " mm^3/s with a pressure drop of " +
-                        std::to_string(o_.root_pressure - lowest) + " Pa, more than perfusion_pressure (" +
-                        std::to_string(o_.root_pressure) + " Pa): lower perfusion_flow (pressures scale with it; the tree does not change) "
+                        std::to_string(o_.root_pressure - lowest) + " Pa, more than perfusion_pressure (" + std::to_string(o_.root_pressure) +
+                        " Pa): lower perfusion_flow (pressures scale with it; the tree does not change) "
                         "or raise root_radius");
     return std::move(t_);
   }
@@ -193,7 +196,8 @@ class DccoGrower {
     // times in a row is a region the Gaussians barely reach (a relaxation of nothing).
     for (std::int64_t misses = 0;; ++misses) {
       if (misses >= kGaussianMisses)
-        throw GrowthError("stage '" + st.name + "': " + std::to_string(kGaussianMisses) + " points drawn in a row from its Gaussians fell outside its terminal region; "
+        throw GrowthError("stage '" + st.name + "': " + std::to_string(kGaussianMisses) +
+                          " points drawn in a row from its Gaussians fell outside its terminal region; "
                           "move their means into it or widen them");
       double u = rng_.uniform() * total;
       const GaussianComponent* g = &st.gaussians.back();
@@ -205,8 +209,10 @@ class DccoGrower {
       Vec3 p = o_.world->center() + g->mean;
       p.x += g->sigma.x * rng_.normal();
       p.y += g->sigma.y * rng_.normal();
-      if (d.dimension() == 3) p.z += g->sigma.z * rng_.normal();
-      else p.z = d.planeZ();
+      if (d.dimension() == 3)
+        p.z += g->sigma.z * rng_.normal();
+      else
+        p.z = d.planeZ();
       if (d.depth(p) > 0) return p;
     }
   }
@@ -225,10 +231,9 @@ class DccoGrower {
     const double r = kMargin * o_.root_radius;
     const double outside = -st.vessels->depth(o_.root_mm);
     if (outside <= r + st.vessels->frame().voxel_mm) return;
-    throw GrowthError("stage '" + st.name + "': the root at (" + show(o_.root_mm.x) + ", " + show(o_.root_mm.y) + ", " +
-                      show(o_.root_mm.z) + ") mm lies " + show(outside) +
-                      " mm outside the stage's domain, where its vessels must run; allowed: a root at most " + show(r) +
-                      " mm (the root vessel's radius) outside it; move the root or widen the domain");
+    throw GrowthError("stage '" + st.name + "': the root at (" + show(o_.root_mm.x) + ", " + show(o_.root_mm.y) + ", " + show(o_.root_mm.z) +
+                      ") mm lies " + show(outside) + " mm outside the stage's domain, where its vessels must run; allowed: a root at most " +
+                      show(r) + " mm (the root vessel's radius) outside it; move the root or widen the domain");
   }
 
   // Failed draws in a row before a stage gives up. After this many relaxations the spacing limit
@@ -254,8 +259,8 @@ class DccoGrower {
       // root may sit on the domain's border, where a rasterised region is inset by half a voxel).
       const double r = kMargin * o_.root_radius;
       const Vec3 from = o_.root_mm + (p - o_.root_mm) * (std::min(2 * r, l) / l);
-      const bool inside = o_.world->capsuleInside(o_.root_mm, p, r, true) &&
-                          (st.role != VesselRole::Distribution || st.vessels->capsuleInside(from, p, r, false));
+      const bool inside =
+          o_.world->capsuleInside(o_.root_mm, p, r, true) && (st.role != VesselRole::Distribution || st.vessels->capsuleInside(from, p, r, false));
       if (l > lim && l > 2 * kMargin * o_.root_radius && inside) {
         const auto n = t_.addNode(p, 0);
         t_.stage[n] = std::int16_t(stage_);
@@ -279,7 +284,8 @@ class DccoGrower {
         ++dr_.threshold_relaxations;
       }
     }
-    throw GrowthError("stage '" + st.name + "': no root vessel could be placed: every point drawn lies too close to the root, "
+    throw GrowthError("stage '" + st.name +
+                      "': no root vessel could be placed: every point drawn lies too close to the root, "
                       "makes a vessel shorter than twice the root radius or leaves the domain; move the root or enlarge the domain");
   }
 
@@ -306,7 +312,8 @@ class DccoGrower {
     } else {  // s's end becomes a bifurcation of its child and the new vessel
       const auto c = T.child0[s];
       const auto sp = kernels_[stage_].split(load_[c], T.reduced_resistance[c], 1, R_t);
-      path.push_back(Level{s, c, -1, sp.beta_a, sp.beta_b, es * T.length[s] + 1.0 / (pow4(sp.beta_a) / T.reduced_resistance[c] + pow4(sp.beta_b) / R_t),
+      path.push_back(Level{s, c, -1, sp.beta_a, sp.beta_b,
+                           es * T.length[s] + 1.0 / (pow4(sp.beta_a) / T.reduced_resistance[c] + pow4(sp.beta_b) / R_t),
                            T.length[s] + sp.beta_a * sp.beta_a * T.cost_ratio[c] + sp.beta_b * sp.beta_b * V_t, T.terminals[s] + 1, load_[s] + 1});
     }
     const std::int32_t dn = path[0].n - T.terminals[s];
@@ -324,8 +331,8 @@ class DccoGrower {
       const auto spl = kernelAt(T, y, kernels_).split(below.w, below.R, load_[other], T.reduced_resistance[other]);
       path.push_back(Level{y, child, other, spl.beta_a, spl.beta_b,
                            e(y) * T.length[y] + 1.0 / (pow4(spl.beta_a) / below.R + pow4(spl.beta_b) / T.reduced_resistance[other]),
-                           T.length[y] + spl.beta_a * spl.beta_a * below.V + spl.beta_b * spl.beta_b * T.cost_ratio[other],
-                           T.terminals[y] + dn, load_[y] + dw});
+                           T.length[y] + spl.beta_a * spl.beta_a * below.V + spl.beta_b * spl.beta_b * T.cost_ratio[other], T.terminals[y] + dn,
+                           load_[y] + dw});
     }
     double rho = 1;
     for (std::size_t k = path.size(); k-- > 1;) rho *= path[k].beta_child;
@@ -384,8 +391,7 @@ class DccoGrower {
     if (VesselRole(T.role[s]) == VesselRole::Perforator && !(st.vessels->depth(b) > 0)) return false;
     // The bifurcation point where its vessels may lie (contained() checks their whole capsules).
     if (st.role == VesselRole::Distribution && !(st.vessels->depth(b) >= kMargin * tr.r[2])) return false;
-    if (VesselRole(T.role[s]) == VesselRole::Distribution && T.stage[s] >= 0 &&
-        !(o_.stages[T.stage[s]].vessels->depth(b) >= kMargin * tr.r[1]))
+    if (VesselRole(T.role[s]) == VesselRole::Distribution && T.stage[s] >= 0 && !(o_.stages[T.stage[s]].vessels->depth(b) >= kMargin * tr.r[1]))
       return false;
     // A vessel of the initial network is split only inside the world.
     if (T.stage[s] < 0 && !(o_.world->depth(b) >= 0)) return false;
@@ -531,12 +537,13 @@ class DccoGrower {
 
   // True if the capsule a–e of radius r overlaps a vessel other than `skip` and `share` (which
   // meet it), with `near` (one segment away) held only to the rule for near neighbours.
-  bool capsuleHits(const Vec3& a, const Vec3& e, double r, std::int32_t skip, std::span<const std::int32_t> share,
-                   std::span<const std::int32_t> near, double from_prox, double from_dist) {
+  bool capsuleHits(const Vec3& a, const Vec3& e, double r, std::int32_t skip, std::span<const std::int32_t> share, std::span<const std::int32_t> near,
+                   double from_prox, double from_dist) {
     const auto in = [](std::span<const std::int32_t> list, std::int32_t y) { return std::find(list.begin(), list.end(), y) != list.end(); };
     return hitsVessel(
-        a, e, r,
-        [&](std::int32_t y) { return y == skip || in(share, y) ? Neighbour::Meets : in(near, y) ? Neighbour::Near : Neighbour::Apart; },
+        a, e, r, [&](std::int32_t y) { return y == skip || in(share, y) ? Neighbour::Meets
+                                              : in(near, y)             ? Neighbour::Near
+                                                                        : Neighbour::Apart; },
         [&](std::int32_t y, double reach) { return joinedAlongVessel(t_, skip, y, reach, from_prox, from_dist); });
   }
 
@@ -648,8 +655,10 @@ class DccoGrower {
     std::int32_t cut = n;
     if (tr.distal) {
       const auto s = T.parent[n];
-      if (T.child1[s] == n) T.child1[s] = -1;
-      else T.child0[s] = -1;
+      if (T.child1[s] == n)
+        T.child1[s] = -1;
+      else
+        T.child0[s] = -1;
     } else {
       const auto b = n - 1;
       const auto s = T.child0[b], q = T.parent[b];
@@ -739,7 +748,8 @@ class DccoGrower {
         if (tr.valid) out.push_back(tr);
       }
     };
-    if (nc >= 4) tbb::parallel_for(std::size_t(0), nc, evaluate);
+    if (nc >= 4)
+      tbb::parallel_for(std::size_t(0), nc, evaluate);
     else
       for (std::size_t c = 0; c < nc; ++c) evaluate(c);
     ranked_.clear();
@@ -860,8 +870,10 @@ class DccoGrower {
       if (!(T.length[s] > 2 * T.radius[s]) && !(fix && lengthen(s))) {
         ++dr_.short_segments;
         const auto a = T.child0[s], b = T.child1[s];
-        if (b < 0) out.push_back(a >= 0 && ownSubtree(a) ? a : s);
-        else out.push_back(T.isTerminal(s) || !(ownSubtree(a) || ownSubtree(b)) ? s : pick(a, b));
+        if (b < 0)
+          out.push_back(a >= 0 && ownSubtree(a) ? a : s);
+        else
+          out.push_back(T.isTerminal(s) || !(ownSubtree(a) || ownSubtree(b)) ? s : pick(a, b));
       }
       if (!segmentFits(s, T.position[T.parent[s]], T.position[s], T.radius[s])) {
         ++dr_.outside_segments;
@@ -981,8 +993,10 @@ class DccoGrower {
           ownBranchesBelow(s, below);
           std::int64_t shed = 0;
           for (auto b : below) shed += t_.terminals[b];
-          if (double(shed) <= std::max(1.0, cap * double(stage().terminal_count))) fix.insert(fix.end(), below.begin(), below.end());
-          else held = true;
+          if (double(shed) <= std::max(1.0, cap * double(stage().terminal_count)))
+            fix.insert(fix.end(), below.begin(), below.end());
+          else
+            held = true;
         }
         if (!fix.empty() || !held || cap >= 1) break;
       }
@@ -1053,8 +1067,10 @@ int solveDccoTree(VascularTree& t, std::vector<double>& eta, const DccoOptions& 
   double reserved = 0;
   for (std::int32_t i = 0; i < t.nodeCount(); ++i)
     if (t.isTerminal(i)) {
-      if (t.outflow[i] > 0) reserved += t.outflow[i];
-      else ++common;
+      if (t.outflow[i] > 0)
+        reserved += t.outflow[i];
+      else
+        ++common;
     }
   if (common == 0) throw GrowthError("every terminal of the tree has a prescribed outflow: none is left to perfuse the domain");
   const auto outletLoad = [&](std::int32_t i) { return t.outflow[i] * double(common) / (1 - reserved); };

@@ -50,25 +50,25 @@ struct DccoStage {
   std::int64_t terminal_count = 0;          // N^t_T_final, added by this stage
   TerminalPdf pdf = TerminalPdf::Uniform;
   std::vector<GaussianComponent> gaussians;
-  double gamma = 3;                         // Murray exponent of the bifurcations this stage makes
-  std::vector<double> delta{0.0};           // symmetry limit per bifurcation level (the last repeats)
+  double gamma = 3;                // Murray exponent of the bifurcations this stage makes
+  std::vector<double> delta{0.0};  // symmetry limit per bifurcation level (the last repeats)
   double nu = 1, f_r = 0.9, f_n = 8;
   int delta_v = 7;
   StageCost cost = StageCost::Volume;
-  double c_v = 1, c_p = 0, c_d = 0;         // eq. 15
-  double theta_min = 0, theta_max = 180;    // degrees (eq. 17)
-  double phi_min = 0, phi_max = 90;         // degrees (eq. 18)
+  double c_v = 1, c_p = 0, c_d = 0;       // eq. 15
+  double theta_min = 0, theta_max = 180;  // degrees (eq. 17)
+  double phi_min = 0, phi_max = 90;       // degrees (eq. 18)
   VesselRole role = VesselRole::Distribution;
-  int draws_before_relaxing = 100;          // N_fail
-  int max_candidates = 64;                  // nearest candidates tried per terminal (VItA: all in the box)
+  int draws_before_relaxing = 100;  // N_fail
+  int max_candidates = 64;          // nearest candidates tried per terminal (VItA: all in the box)
   double deltaAt(int level) const { return delta[std::min<std::size_t>(std::size_t(std::max(level, 0)), delta.size() - 1)]; }
 };
 
 struct DccoOptions {
-  Vec3 root_mm;                       // in the frame
-  double root_radius = 1;             // mm, fixed (r_1)
-  double flow = 8330;                 // mm^3/s, Q
-  double root_pressure = 13300;       // Pa at the root (pressures downstream follow)
+  Vec3 root_mm;                  // in the frame
+  double root_radius = 1;        // mm, fixed (r_1)
+  double flow = 8330;            // mm^3/s, Q
+  double root_pressure = 13300;  // Pa at the root (pressures downstream follow)
   Viscosity viscosity;
   const GrowthDomain* world = nullptr;  // every vessel stays inside (minus the avascular regions of its stage)
   // The network growth continues (Maso Talou et al.'s vascular completion; null: the first stage plants a
@@ -81,15 +81,15 @@ struct DccoOptions {
   std::vector<DccoStage> stages;
   std::uint64_t seed = 1, sample = 0;
   int max_repair_rounds = 30;
-  std::int64_t max_draws = 1000000;   // draws in a row without a connection before giving up
+  std::int64_t max_draws = 1000000;  // draws in a row without a connection before giving up
 };
 
 // What DCCO reports beside the common counts.
 struct DccoReport {
   std::vector<std::int64_t> stage_terminals;  // terminals each stage added
   std::int64_t threshold_relaxations = 0;
-  std::int64_t trial_points = 0;              // lattice points costed
-  std::int64_t viscosity_iterations = 0;      // of the last fixed point
+  std::int64_t trial_points = 0;                                                       // lattice points costed
+  std::int64_t viscosity_iterations = 0;                                               // of the last fixed point
   std::int64_t short_segments = 0, outside_segments = 0, asymmetric_bifurcations = 0;  // final, target 0
   std::int64_t folded_pairs = 0;  // final: vessels one segment apart whose centrelines cross (target 0)
   double volume_mm3 = 0;

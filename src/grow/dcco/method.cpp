@@ -21,12 +21,12 @@ using Json = nlohmann::ordered_json;
 
 Json vectorJson(const Vec3& v) { return Json{{"value", {v.x, v.y, v.z}}, {"unit", "mm"}}; }
 
-
 constexpr const char* kPdfWords[] = {"uniform", "demand", "gaussian", nullptr};
 constexpr const char* kCostWords[] = {"volume", "sprout", nullptr};
 constexpr const char* kRoleWords[] = {"", "distribution", "transport", "perforator", nullptr};
 
 // A [[stage]]'s settings but its regions, symmetry and Gaussians.
+// clang-format off
 const std::vector<Setting<DccoStage>>& stageSettings() {
   using O = DccoStage;
   const auto degrees = [](const char* key, const char* fallback, double hi, const char* meaning, double O::*field) {
@@ -76,7 +76,9 @@ const std::vector<Setting<DccoStage>>& stageSettings() {
   };
   return settings;
 }
+// clang-format on
 
+// clang-format off
 const std::vector<SettingRule<DccoStage>>& stageRules() {
   static const std::vector<SettingRule<DccoStage>> rules{
       {{"theta_max", "theta_min"}, [](const DccoStage& st) { return st.theta_max > st.theta_min ? std::string() : "theta_max must exceed theta_min"; }},
@@ -84,7 +86,9 @@ const std::vector<SettingRule<DccoStage>>& stageRules() {
   };
   return rules;
 }
+// clang-format on
 
+// clang-format off
 const std::vector<Setting<DccoOptions>>& dccoSettings() {
   static const std::vector<Setting<DccoOptions>> settings{
       {.table = "tree", .key = "root_radius", .unit = "mm", .fallback = "[initial]: each root vessel's radius in its file; required without it",
@@ -93,8 +97,10 @@ const std::vector<Setting<DccoOptions>>& dccoSettings() {
   };
   return settings;
 }
+// clang-format on
 
 // perfusion_flow and perfusion_pressure; the viscosity, a quantity or "pries", is read beside them.
+// clang-format off
 const std::vector<Setting<PhysicsParameters>>& dccoPhysics() {
   static const std::vector<Setting<PhysicsParameters>> settings = [] {
     auto flow = physicsSetting("perfusion_flow", "500 mL/min");
@@ -105,6 +111,7 @@ const std::vector<Setting<PhysicsParameters>>& dccoPhysics() {
   }();
   return settings;
 }
+// clang-format on
 
 // The domains of one stage on the world's frame; identical region sets share one domain.
 struct StageDomains {
@@ -140,9 +147,7 @@ class PreparedDcco final : public PreparedGrowth {
         if (it == cache_.end()) {
           try {
             it = cache_.emplace(k, std::make_unique<GrowthDomain>(regionDomain(world_, list(st.domain), list(out), what))).first;
-          } catch (const GrowthError& e) {
-            throw InputError(s.parameter_file, st.line, e.what());
-          }
+          } catch (const GrowthError& e) { throw InputError(s.parameter_file, st.line, e.what()); }
         }
         return it->second.get();
       };
@@ -208,14 +213,17 @@ class PreparedDcco final : public PreparedGrowth {
         Vec3 p = world_.center() + g->mean;
         p.x += g->sigma.x * normal(pick);
         p.y += g->sigma.y * normal(pick);
-        if (d.dimension() == 3) p.z += g->sigma.z * normal(pick);
-        else p.z = d.planeZ();
+        if (d.dimension() == 3)
+          p.z += g->sigma.z * normal(pick);
+        else
+          p.z = d.planeZ();
         inside += d.depth(p) > 0;
       }
       if (double(inside) < kLeast * kDraws)
         throw InputError(setup_.parameter_file, setup_.stages[k].line,
-                         "stage '" + st.name + "': its Gaussians put " + show(100.0 * inside / kDraws) + " % of their mass inside its terminal region (" +
-                             std::to_string(inside) + " of " + std::to_string(kDraws) + " draws); allowed: at least " + show(100 * kLeast) +
+                         "stage '" + st.name + "': its Gaussians put " + show(100.0 * inside / kDraws) +
+                             " % of their mass inside its terminal region (" + std::to_string(inside) + " of " + std::to_string(kDraws) +
+                             " draws); allowed: at least " + show(100 * kLeast) +
                              " % (means inside the region, relative to the domain's centre, or wider sigmas)");
     }
   }
@@ -281,7 +289,9 @@ class PreparedDcco final : public PreparedGrowth {
 // δ: one number for every level, or a list by bifurcation level (the last repeats).
 std::vector<double> readSymmetry(const TomlReader& r, const toml::table& t) {
   const auto* n = t.get("symmetry");
-  std::vector<double> v = !n ? std::vector<double>{0.0} : n->is_array() ? r.numbers(n, "symmetry", 0) : std::vector<double>{r.number(t, "stage", "symmetry")};
+  std::vector<double> v = !n              ? std::vector<double>{0.0}
+                          : n->is_array() ? r.numbers(n, "symmetry", 0)
+                                          : std::vector<double>{r.number(t, "stage", "symmetry")};
   for (double d : v)
     if (!(d >= 0 && d < 1)) throw InputError(r.file(), r.lineOf(n), "symmetry (δ) values must lie in [0, 1)");
   return v;
@@ -300,7 +310,8 @@ std::vector<GaussianComponent> readGaussians(const TomlReader& r, const GrowthMe
     c.mean = g.get("mean") ? r.point(g.get("mean"), "mean (mm from the domain's centre)", flat) : Vec3();
     c.sigma = r.point(r.need(g, "stage.gaussian", "sigma"), "sigma (mm per axis)", flat);
     if (flat) c.sigma.z = 1;
-    if (!(c.sigma.x > 0 && c.sigma.y > 0 && c.sigma.z > 0)) throw InputError(r.file(), r.lineOf(g.get("sigma")), "sigma must be positive on every axis");
+    if (!(c.sigma.x > 0 && c.sigma.y > 0 && c.sigma.z > 0))
+      throw InputError(r.file(), r.lineOf(g.get("sigma")), "sigma must be positive on every axis");
     c.weight = declaredNumber(r, m, g, "stage.gaussian", "weight");
     checkRange(c.weight, 0, true, 1e12, false, r.at(g, "weight"), "weight");
     out.push_back(c);
@@ -319,8 +330,10 @@ DccoStageSpec readStage(const TomlReader& r, const GrowthMethod& m, const toml::
   s.domain = regionNames(r, t, "domain", regions);
   s.avascular = regionNames(r, t, "avascular", regions);
   s.carriage = regionNames(r, t, "carriage", regions);
-  if (st.pdf == TerminalPdf::Gaussian) st.gaussians = readGaussians(r, m, t, flat);
-  else if (t.get("gaussian")) throw InputError(r.file(), r.lineOf(t.get("gaussian")), "[[stage.gaussian]] needs pdf = \"gaussian\"");
+  if (st.pdf == TerminalPdf::Gaussian)
+    st.gaussians = readGaussians(r, m, t, flat);
+  else if (t.get("gaussian"))
+    throw InputError(r.file(), r.lineOf(t.get("gaussian")), "[[stage.gaussian]] needs pdf = \"gaussian\"");
   st.delta = readSymmetry(r, t);
   // Maso Talou et al. 2021 Fig. 3: c_v 0.5e2 in 2D, 1e4 in 3D.
   if (st.cost == StageCost::Sprout && !t.get("c_v")) st.c_v = flat ? 50.0 : 1e4;
@@ -343,12 +356,14 @@ void readInitial(const TomlReader& r, const GrowthMethod& m, DccoSetup& s, bool 
   s.initial_from_corner = in.from_corner;
   auto& tree = s.initial.tree;
   const auto branchingOf = [&](const toml::table& tab, const std::string& table, Branching fallback) {
-    return choice<Branching>(r, tab, table, "branching", fallback,
-                             {{"none", Branching::None}, {"distal", Branching::Distal}, {"fixed", Branching::Fixed}, {"versatile", Branching::Versatile}});
+    return choice<Branching>(
+        r, tab, table, "branching", fallback,
+        {{"none", Branching::None}, {"distal", Branching::Distal}, {"fixed", Branching::Fixed}, {"versatile", Branching::Versatile}});
   };
   const auto roleOf = [&](const toml::table& tab, const std::string& table, VesselRole fallback) {
-    return choice<VesselRole>(r, tab, table, "role", fallback,
-                              {{"distribution", VesselRole::Distribution}, {"transport", VesselRole::Transport}, {"perforator", VesselRole::Perforator}});
+    return choice<VesselRole>(
+        r, tab, table, "role", fallback,
+        {{"distribution", VesselRole::Distribution}, {"transport", VesselRole::Transport}, {"perforator", VesselRole::Perforator}});
   };
   const auto default_branching = branchingOf(*t, "initial", Branching::None);
   const auto default_role = roleOf(*t, "initial", VesselRole::Transport);
@@ -362,7 +377,8 @@ void readInitial(const TomlReader& r, const GrowthMethod& m, DccoSetup& s, bool 
     if (!tree.isRoot(i)) by_id[s.initial.ids[std::size_t(i)]] = i;
   if (const auto* list = t->get("vessel")) {
     const auto* arr = list->as_array();
-    if (!arr || !arr->is_array_of_tables()) throw InputError(r.file(), r.lineOf(list), "vessel must be an array of tables: write each as [[initial.vessel]]");
+    if (!arr || !arr->is_array_of_tables())
+      throw InputError(r.file(), r.lineOf(list), "vessel must be an array of tables: write each as [[initial.vessel]]");
     std::map<std::string, int> given;  // id → the line of its [[initial.vessel]]
     for (const auto& v : *arr) {
       const auto& vt = *v.as_table();
@@ -370,12 +386,14 @@ void readInitial(const TomlReader& r, const GrowthMethod& m, DccoSetup& s, bool 
       const auto* idn = r.need(vt, "initial.vessel", "id");
       const std::string id = idn->is_integer() ? std::to_string(*idn->value<std::int64_t>()) : r.string(vt, "initial.vessel", "id");
       if (const auto [at, added] = given.emplace(id, r.lineOf(idn)); !added)
-        throw InputError(r.file(), r.lineOf(idn), "vessel id " + id + " is set again (first on line " + std::to_string(at->second) +
-                                                      "); allowed: one [[initial.vessel]] per vessel");
+        throw InputError(
+            r.file(), r.lineOf(idn),
+            "vessel id " + id + " is set again (first on line " + std::to_string(at->second) + "); allowed: one [[initial.vessel]] per vessel");
       const auto it = by_id.find(id);
       if (it == by_id.end())
-        throw InputError(r.file(), r.lineOf(idn), "vessel id " + id + " is not a vessel of " + s.initial_file.string() +
-                                                      " (ids: a .cco vessel's, an SWC sample's that ends the segment)");
+        throw InputError(
+            r.file(), r.lineOf(idn),
+            "vessel id " + id + " is not a vessel of " + s.initial_file.string() + " (ids: a .cco vessel's, an SWC sample's that ends the segment)");
       const auto i = it->second;
       tree.branching[i] = std::uint8_t(branchingOf(vt, "initial.vessel", Branching(tree.branching[i])));
       tree.role[i] = std::uint8_t(roleOf(vt, "initial.vessel", VesselRole(tree.role[i])));
@@ -390,14 +408,17 @@ void readInitial(const TomlReader& r, const GrowthMethod& m, DccoSetup& s, bool 
   std::int64_t common = 0;
   for (std::int32_t i = 0; i < tree.nodeCount(); ++i) {
     if (tree.outflow[i] > 0 && !tree.isTerminal(i))
-      throw InputError(s.initial_file.string(), s.initial.lines[std::size_t(i)], "vessel " + s.initial.ids[std::size_t(i)] +
-                                                                                     " has an outflow but branches; outflows are for terminal vessels");
-    if (tree.outflow[i] > 0) reserved += tree.outflow[i];
-    else common += tree.isTerminal(i);
+      throw InputError(s.initial_file.string(), s.initial.lines[std::size_t(i)],
+                       "vessel " + s.initial.ids[std::size_t(i)] + " has an outflow but branches; outflows are for terminal vessels");
+    if (tree.outflow[i] > 0)
+      reserved += tree.outflow[i];
+    else
+      common += tree.isTerminal(i);
   }
   if (!(reserved < 1) || common == 0)
-    throw InputError(r.file(), r.lineOf(node), "the outflows add up to " + show(reserved) +
-                                                   " of Q with " + std::to_string(common) + " terminals left to perfuse the domain; they must add up to less than 1 and leave a terminal without outflow");
+    throw InputError(r.file(), r.lineOf(node),
+                     "the outflows add up to " + show(reserved) + " of Q with " + std::to_string(common) +
+                         " terminals left to perfuse the domain; they must add up to less than 1 and leave a terminal without outflow");
   // Each root's fixed radius: [tree] root_radius for all, else the file's root vessel radius.
   for (auto root : tree.roots()) {
     const auto seg = tree.child0[root];
@@ -453,8 +474,11 @@ std::shared_ptr<const GrowthSetup> readDccoToml(const TomlReader& r, const Growt
     s->stages.push_back(readStage(r, m, *node.as_table(), int(s->stages.size()), flat, region_names));
     const auto& st = s->stages.back();
     if (!stage_names.insert(st.stage.name).second) throw InputError(r.file(), st.line, "a second stage named '" + st.stage.name + "'");
-    if (st.stage.pdf == TerminalPdf::Demand && (s->domain.shape != DomainShape::Mask || !st.domain.empty() || !st.avascular.empty() || !st.carriage.empty()))
-      throw InputError(r.file(), st.line, "pdf = \"demand\" draws terminals ∝ the mask value of the whole domain: it needs shape = \"mask\" and a stage without domain, avascular or carriage regions");
+    if (st.stage.pdf == TerminalPdf::Demand &&
+        (s->domain.shape != DomainShape::Mask || !st.domain.empty() || !st.avascular.empty() || !st.carriage.empty()))
+      throw InputError(r.file(), st.line,
+                       "pdf = \"demand\" draws terminals ∝ the mask value of the whole domain: it needs shape = \"mask\" and a stage without domain, "
+                       "avascular or carriage regions");
   }
   if (s->stages.size() > 30000) throw InputError(r.file(), s->stages.back().line, "more than 30000 stages");
   auto& p = s->physics_summary;
@@ -480,7 +504,9 @@ Json DccoSetup::describe() const {
   describeDomainAndRoot(d, root, j);
   j["kind"] = kind;
   if (!initial_file.empty()) {
-    Json init{{"file", initial_file.string()}, {"origin", initial_from_corner ? "corner" : "centre"}, {"vessels", initial.tree.segmentCount()},
+    Json init{{"file", initial_file.string()},
+              {"origin", initial_from_corner ? "corner" : "centre"},
+              {"vessels", initial.tree.segmentCount()},
               {"roots", root_radii.size()}};
     Json radii = Json::array(), outlets = Json::array();
     for (double v : root_radii) radii.push_back(v);
@@ -520,9 +546,7 @@ Json DccoSetup::describe() const {
     if (!sp.carriage.empty()) e["carriage"] = sp.carriage;
     if (st.pdf == TerminalPdf::Gaussian) {
       Json gs = Json::array();
-      for (const auto& g : st.gaussians)
-        gs.push_back(Json{{"mean", vectorJson(g.mean)},
-                          {"sigma", vectorJson(g.sigma)}, {"weight", g.weight}});
+      for (const auto& g : st.gaussians) gs.push_back(Json{{"mean", vectorJson(g.mean)}, {"sigma", vectorJson(g.sigma)}, {"weight", g.weight}});
       e["gaussians"] = gs;
     }
     e["symmetry"] = st.delta;
@@ -542,6 +566,7 @@ std::unique_ptr<PreparedGrowth> DccoSetup::prepare(std::uint64_t memory_limit) c
   return std::make_unique<PreparedDcco>(*this, loadDomainSpec(domain, parameter_file, root, memory_limit));
 }
 
+// clang-format off
 const GrowthMethod kDccoMethod{
     "dcco",
     "domain-constrained CCO in stages (Maso Talou et al. 2021): each [[stage]] adds its terminals in its own "
@@ -572,5 +597,6 @@ const GrowthMethod kDccoMethod{
         {"stage.gaussian", "weight", "", "1", "its weight in the mixture"},
     }})), "the region's name, used by [[stage]] domain, avascular and carriage"),
     &readDccoToml};
+// clang-format on
 
 }  // namespace angiosynth

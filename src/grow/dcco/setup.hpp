@@ -14,10 +14,10 @@ namespace angiosynth {
 
 // One [[stage]] as the file gives it: its parameters and the names of its regions.
 struct DccoStageSpec {
-  DccoStage stage;                      // domain pointers are set when the domain is prepared
-  std::vector<std::string> domain;      // region names (empty: the whole [domain])
-  std::vector<std::string> avascular;   // no vessel enters
-  std::vector<std::string> carriage;    // vessels pass, no terminal lies there
+  DccoStage stage;                     // domain pointers are set when the domain is prepared
+  std::vector<std::string> domain;     // region names (empty: the whole [domain])
+  std::vector<std::string> avascular;  // no vessel enters
+  std::vector<std::string> carriage;   // vessels pass, no terminal lies there
   int line = 0;
 };
 
@@ -26,16 +26,16 @@ struct DccoSetup final : GrowthSetup {
   DomainSpec domain;
   RootSpec root;
   std::string kind = "artery";
-  DccoOptions options;                  // root, world, stages, seed are set per sample
+  DccoOptions options;  // root, world, stages, seed are set per sample
   std::vector<RegionSpec> regions;
   std::vector<DccoStageSpec> stages;
-  PhysicsParameters physics_summary;    // γ of the first stage, η, Q: for the statistics
+  PhysicsParameters physics_summary;  // γ of the first stage, η, Q: for the statistics
   // [initial]: the network growth continues (empty path: none); positions relative to the
   // domain's centre or its grid's corner, branching, role and outflow as the file and [[initial.vessel]] set them.
   std::filesystem::path initial_file;
   ExistingNetwork initial;
-  bool initial_from_corner = false;     // [initial] origin = "corner": positions as angiosynth's graphs give them
-  std::vector<double> root_radii;       // per root of the initial network
+  bool initial_from_corner = false;  // [initial] origin = "corner": positions as angiosynth's graphs give them
+  std::vector<double> root_radii;    // per root of the initial network
 
   const char* method() const override { return "dcco"; }
   nlohmann::ordered_json describe() const override;

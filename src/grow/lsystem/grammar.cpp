@@ -24,9 +24,7 @@ Vec3 rotate(const Vec3& v, const Vec3& k, double a) {
 }
 
 // A unit vector perpendicular to e.
-Vec3 perpendicular(const Vec3& e) {
-  return unit(std::abs(e.x) < 0.9 ? cross(e, Vec3(1, 0, 0)) : cross(e, Vec3(0, 1, 0)));
-}
+Vec3 perpendicular(const Vec3& e) { return unit(std::abs(e.x) < 0.9 ? cross(e, Vec3(1, 0, 0)) : cross(e, Vec3(0, 1, 0))); }
 
 // A branch waiting to be drawn: where it starts (a committed node), its heading and the
 // turtle's up vector (turns are yaws about it), the heading of its parent at the bifurcation
@@ -40,8 +38,7 @@ struct Branch {
 class GrammarGrower {
  public:
   GrammarGrower(const GrammarOptions& o, GrammarReport& r)
-      : o_(o), r_(r), rng_(o.seed, o.sample, Stage::Growth),
-        grid_(o.domain->lo(), o.domain->hi(), cellSize(o), o.domain->dimension() == 2) {}
+      : o_(o), r_(r), rng_(o.seed, o.sample, Stage::Growth), grid_(o.domain->lo(), o.domain->hi(), cellSize(o), o.domain->dimension() == 2) {}
 
   VascularTree run(const ProgressFn& progress) {
     t_.addNode(o_.root, -1);
@@ -53,8 +50,10 @@ class GrammarGrower {
       for (const auto& b : gen) {
         const auto end = drawStem(b);
         if (end < 0) continue;
-        if (g == o_.iterations) ++r_.tips;  // a stem of the last generation ends in a tip
-        else bifurcate(end, b.d, next);
+        if (g == o_.iterations)
+          ++r_.tips;  // a stem of the last generation ends in a tip
+        else
+          bifurcate(end, b.d, next);
       }
       gen.swap(next);
       if (progress) progress(g + 1, o_.iterations + 1);
@@ -144,10 +143,14 @@ class GrammarGrower {
       const std::int32_t py = t_.parent[std::size_t(y)];
       // The path from `from` to segment y: 0 if y touches it, one segment's length if one lies between.
       double path = INFINITY;
-      if (y == from || py == from) path = 0;
-      else if (from > 0 && y == t_.parent[std::size_t(from)]) path = t_.length[std::size_t(from)];
-      else if (py >= 0 && t_.parent[std::size_t(py)] == from) path = t_.length[std::size_t(py)];
-      else if (from > 0 && py == t_.parent[std::size_t(from)]) path = t_.length[std::size_t(from)];
+      if (y == from || py == from)
+        path = 0;
+      else if (from > 0 && y == t_.parent[std::size_t(from)])
+        path = t_.length[std::size_t(from)];
+      else if (py >= 0 && t_.parent[std::size_t(py)] == from)
+        path = t_.length[std::size_t(py)];
+      else if (from > 0 && py == t_.parent[std::size_t(from)])
+        path = t_.length[std::size_t(from)];
       const double ry = t_.radius[std::size_t(y)];
       if ((i - 1) * piece + path <= r + ry) return false;
       return capsulesOverlap(a, e, r, t_.position[std::size_t(py)], t_.position[std::size_t(y)], ry);
@@ -167,8 +170,10 @@ class GrammarGrower {
     } else {
       d1 = d2 = b.d * o_.radius_ratio;
     }
-    if (o_.zamir_angles) zamirAngles(d1, d2, th1, th2);
-    else th1 = th2 = o_.branch_angle * kDeg;
+    if (o_.zamir_angles)
+      zamirAngles(d1, d2, th1, th2);
+    else
+      th1 = th2 = o_.branch_angle * kDeg;
     th1 = std::clamp(th1 + o_.angle_sd * kDeg * normal(), 0.0, std::numbers::pi / 2);
     th2 = std::clamp(th2 + o_.angle_sd * kDeg * normal(), 0.0, std::numbers::pi / 2);
     const double roll = (o_.roll_angle + o_.roll_sd * normal()) * kDeg;
@@ -186,7 +191,7 @@ class GrammarGrower {
   GrammarReport& r_;
   Rng rng_;
   VascularTree t_;
-  SegmentGrid grid_;  // committed segments
+  SegmentGrid grid_;         // committed segments
   Vec3 last_dir_, last_up_;  // the turtle at the end of the last stem drawn
 };
 
@@ -205,8 +210,8 @@ VascularTree growGrammar(const GrammarOptions& o, GrammarReport& report, const P
   char fraction[32];
   std::snprintf(fraction, sizeof fraction, "%g", o.min_tip_fraction);
   if (double(report.tips) < need)
-    throw GrowthError("the grammar grew " + std::to_string(report.tips) + " of the " + std::to_string(report.asked_tips) +
-                      " tips its " + std::to_string(o.iterations) + " iterations ask for (" + std::to_string(report.dropped_outside) +
+    throw GrowthError("the grammar grew " + std::to_string(report.tips) + " of the " + std::to_string(report.asked_tips) + " tips its " +
+                      std::to_string(o.iterations) + " iterations ask for (" + std::to_string(report.dropped_outside) +
                       " branches left the domain, " + std::to_string(report.dropped_collision) +
                       " overlapped vessels in every try); at least min_tip_fraction = " + std::string(fraction) +
                       " of them must grow: enlarge the domain, lower root_diameter or length_ratio, or ask fewer iterations");

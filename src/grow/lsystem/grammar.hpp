@@ -19,35 +19,35 @@
 namespace angiosynth {
 
 struct GrammarOptions {
-  int iterations = 6;              // n: generations of bifurcations
+  int iterations = 6;                   // n: generations of bifurcations
   std::optional<double> root_diameter;  // d0, mm (unset: a share of the domain's diameter, set when prepared)
-  double length_ratio = 10;        // ε: a stem is ε·d long
-  double length_margin = 0.2;      // m: relative half-width of the stem length
-  double diameter_sd = 0.2;        // d1's standard deviation relative to d/2^(1/k) (0: exact)
-  double murray_exponent = 3;      // k
-  bool murray = true;              // false: both daughters d·radius_ratio
+  double length_ratio = 10;             // ε: a stem is ε·d long
+  double length_margin = 0.2;           // m: relative half-width of the stem length
+  double diameter_sd = 0.2;             // d1's standard deviation relative to d/2^(1/k) (0: exact)
+  double murray_exponent = 3;           // k
+  bool murray = true;                   // false: both daughters d·radius_ratio
   double radius_ratio = 0.7937;
-  bool zamir_angles = true;        // false: ±branch_angle
-  double branch_angle = 35;        // deg
-  double angle_sd = 0;             // deg, added to each daughter's angle
-  double roll_angle = 70;          // deg
-  double roll_sd = 0;              // deg
+  bool zamir_angles = true;  // false: ±branch_angle
+  double branch_angle = 35;  // deg
+  double angle_sd = 0;       // deg, added to each daughter's angle
+  double roll_angle = 70;    // deg
+  double roll_sd = 0;        // deg
   int stem_segments = 5;
-  double stem_angle = 25;          // deg
+  double stem_angle = 25;  // deg
   bool avoid_collisions = true;
-  double wall_clearance = 0;       // mm beyond the vessel's radius
+  double wall_clearance = 0;  // mm beyond the vessel's radius
   int tries = 8;
   double min_tip_fraction = 0.9;
-  Vec3 root, direction;            // mm in the frame; unit heading of the first stem
+  Vec3 root, direction;  // mm in the frame; unit heading of the first stem
   const GrowthDomain* domain = nullptr;
   std::uint64_t seed = 1, sample = 0;
 };
 
 struct GrammarReport {
   std::int64_t asked_tips = 0, tips = 0;
-  std::int64_t redrawn = 0;             // stems drawn again
-  std::int64_t dropped_outside = 0;     // branches dropped: no draw stayed in the domain
-  std::int64_t dropped_collision = 0;   // branches dropped: every draw overlapped a vessel
+  std::int64_t redrawn = 0;            // stems drawn again
+  std::int64_t dropped_outside = 0;    // branches dropped: no draw stayed in the domain
+  std::int64_t dropped_collision = 0;  // branches dropped: every draw overlapped a vessel
 };
 
 // Zamir's optimal angles of daughters with diameters d1, d2 to the parent (radians), as V-System

@@ -5,7 +5,6 @@
 #include <numbers>
 #include <sstream>
 
-
 namespace angiosynth {
 
 namespace {
@@ -46,7 +45,8 @@ LzhPlan planLzh(const LzhParameters& p) {
   LzhPlan plan;
   plan.middle_height = (p.height - 2 * p.start_length - p.capillary_length) / 2;
   if (!(plan.middle_height > 0))
-    throw LzhError("block_height", "block_height " + mm(p.height) + " leaves no room for the trees: it must exceed 2·start_length + capillary_length = " +
+    throw LzhError("block_height", "block_height " + mm(p.height) +
+                                       " leaves no room for the trees: it must exceed 2·start_length + capillary_length = " +
                                        mm(2 * p.start_length + p.capillary_length));
   // The capillaries keep half the spacing from the block's sides: they span c = w_b − d.
   plan.leaf_span = p.block_width - p.spacing;
@@ -66,8 +66,8 @@ LzhPlan planLzh(const LzhParameters& p) {
   if (nodes > kMaxNodes) {
     std::ostringstream o;
     o << "capillary_spacing " << mm(p.spacing) << " needs " << levels << " levels (" << (levels > 30 ? "over 6e9" : std::to_string(nodes))
-      << " nodes, about " << (levels > 30 ? std::string("too many") : sig6(double(nodes) * 150 / 1048576) + " MiB")
-      << "); at most " << kMaxNodes << " nodes: a larger spacing or a smaller block";
+      << " nodes, about " << (levels > 30 ? std::string("too many") : sig6(double(nodes) * 150 / 1048576) + " MiB") << "); at most " << kMaxNodes
+      << " nodes: a larger spacing or a smaller block";
     throw LzhError("capillary_spacing", o.str());
   }
   plan.levels_2d = levels_2d;
@@ -94,8 +94,10 @@ Forest buildLzhNetwork(const LzhParameters& p, const LzhPlan& plan, const Vec3& 
   const double cos_t = std::cos(plan.theta);
   Vec3 top = corner;
   top.x += p.block_width / 2;
-  if (p.dimension == 3) top.y += p.block_width / 2;
-  else top.z = plane_z;
+  if (p.dimension == 3)
+    top.y += p.block_width / 2;
+  else
+    top.z = plane_z;
   axis(top, up) += p.height;
   const double mid = corner[up] + p.height / 2;  // the mirror plane
 

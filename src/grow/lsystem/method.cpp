@@ -62,7 +62,7 @@ class PreparedLsystem final : public PreparedGrowth {
     stats["theta"] = quantityJson(plan.theta * 180 / std::numbers::pi, "deg");
     stats["capillaries"] = plan.leaves;
     stats["capillary_grid"] = setup_.lzh.dimension == 3 ? Json::array({std::int64_t(1) << plan.levels_2d, std::int64_t(1) << plan.levels_2d})
-                                                         : Json::array({std::int64_t(1) << plan.levels_2d});
+                                                        : Json::array({std::int64_t(1) << plan.levels_2d});
     stats["capillary_pitch"] = quantityJson(plan.leaf_spacing, "mm");
     stats["capillary_span"] = quantityJson(plan.leaf_span, "mm");
     stats["middle_tree_height"] = quantityJson(plan.middle_height, "mm");
@@ -78,11 +78,12 @@ class PreparedLsystem final : public PreparedGrowth {
   Vec3 corner_;
 };
 
-constexpr const char* kRadiiWords[] = {"ratio", "murray", nullptr};       // GrammarOptions::murray false, true
-constexpr const char* kAnglesWords[] = {"fixed", "zamir", nullptr};        // GrammarOptions::zamir_angles false, true
+constexpr const char* kRadiiWords[] = {"ratio", "murray", nullptr};           // GrammarOptions::murray false, true
+constexpr const char* kAnglesWords[] = {"fixed", "zamir", nullptr};           // GrammarOptions::zamir_angles false, true
 constexpr const char* kLevelRuleWords[] = {"corrected", "printed", nullptr};  // LzhParameters::printed_level_rule false, true
 
 // Mode grammar's [tree] settings.
+// clang-format off
 const std::vector<Setting<GrammarOptions>>& grammarSettings() {
   using O = GrammarOptions;
   static const std::vector<Setting<O>> settings{
@@ -131,8 +132,10 @@ const std::vector<Setting<GrammarOptions>>& grammarSettings() {
   };
   return settings;
 }
+// clang-format on
 
 // Mode lzh's [tree] settings (Lázaro 2011's high-level parameters).
+// clang-format off
 const std::vector<Setting<LzhParameters>>& lzhSettings() {
   using O = LzhParameters;
   const auto length = [](const char* key, const char* meaning, double O::*field) {
@@ -163,7 +166,9 @@ const std::vector<Setting<LzhParameters>>& lzhSettings() {
   };
   return settings;
 }
+// clang-format on
 
+// clang-format off
 const std::vector<Setting<PhysicsParameters>>& lsystemPhysics() {
   static const std::vector<Setting<PhysicsParameters>> settings = [] {
     auto murray = physicsSetting("murray_exponent", "3");
@@ -179,6 +184,7 @@ const std::vector<Setting<PhysicsParameters>>& lsystemPhysics() {
   }();
   return settings;
 }
+// clang-format on
 
 // The keys only mode grammar reads (its domain, root and settings, and Murray's exponent): such
 // a key in an lzh file, or a key of lzh's settings in a grammar file, is an error naming its mode.
@@ -199,8 +205,8 @@ void forbidOtherModeKeys(const TomlReader& r, const GrowthMethod& m, bool gramma
       if (shared && !grammar_key) continue;
       if (grammar_key != grammar)
         throw InputError(r.file(), r.lineOf(t->get(p.key)),
-                         "'" + std::string(p.key) + "' in [" + name + "] is for mode " + (grammar_key ? "grammar" : "lzh") + "; this file's mode is " +
-                             (grammar ? "grammar" : "lzh") + " ([tree] mode)");
+                         "'" + std::string(p.key) + "' in [" + name + "] is for mode " + (grammar_key ? "grammar" : "lzh") +
+                             "; this file's mode is " + (grammar ? "grammar" : "lzh") + " ([tree] mode)");
     }
 }
 
@@ -244,9 +250,7 @@ class PreparedGrammar final : public PreparedGrowth {
     VascularTree t;
     try {
       t = growGrammar(o, gr_, progress);
-    } catch (const GrowthError& e) {
-      throw InputError(setup_.parameter_file, setup_.tree_line, e.what());
-    }
+    } catch (const GrowthError& e) { throw InputError(setup_.parameter_file, setup_.tree_line, e.what()); }
     flowsAndPressures(t, setup_.physics_summary, gr_.tips > 0 ? setup_.physics_summary.perfusion_flow / double(gr_.tips) : 0.0);
     const auto t0 = std::chrono::steady_clock::now();
     report.intersecting_pairs = std::int64_t(crossingPairs(t).size());
@@ -262,7 +266,8 @@ class PreparedGrammar final : public PreparedGrowth {
     stats["branches_dropped_outside"] = gr_.dropped_outside;
     stats["branches_dropped_collision"] = gr_.dropped_collision;
     stats["timing_seconds"] = Json{{"crossing_check", check_seconds_}};  // a time: not sample data
-    stats["intersecting_pairs_note"] = "lsystem: segments whose capsules overlap, unless the path between them along the tree is shorter than their radii";
+    stats["intersecting_pairs_note"] =
+        "lsystem: segments whose capsules overlap, unless the path between them along the tree is shorter than their radii";
   }
 
  private:
@@ -297,9 +302,7 @@ std::shared_ptr<const GrowthSetup> readLsystemToml(const TomlReader& r, const Gr
   p.perfusion_flow = phys.perfusion_flow;
   try {
     s->plan = planLzh(p);
-  } catch (const LzhError& e) {
-    throw InputError(r.file(), tree.get(e.key) ? r.lineOf(tree.get(e.key)) : r.lineOf(&tree), e.what());
-  }
+  } catch (const LzhError& e) { throw InputError(r.file(), tree.get(e.key) ? r.lineOf(tree.get(e.key)) : r.lineOf(&tree), e.what()); }
   phys.total_terminals = s->plan.leaves;
   // The outlet's pressure follows from the inflow and the resistances (checked non-negative).
   const Forest f = buildLzhNetwork(p, s->plan, Vec3(0, 0, 0));
@@ -326,7 +329,6 @@ Json LsystemSetup::describe() const {
     j.update(settingsJson(grammarSettings(), g));
     j.update(settingsJson(lsystemPhysics(), physics_summary));
     return j;
-
   }
   j["mode"] = "lzh";
   j["voxel_size"] = quantityJson(voxel_mm, "mm");
@@ -343,6 +345,7 @@ std::unique_ptr<PreparedGrowth> LsystemSetup::prepare(std::uint64_t memory_limit
   return std::make_unique<PreparedLsystem>(*this);
 }
 
+// clang-format off
 const GrowthMethod kLsystemMethod{
     "lsystem",
     "L-system vessel networks. Mode lzh (Lázaro 2011): a printable closed network from high-level parameters "
@@ -364,5 +367,6 @@ const GrowthMethod kLsystemMethod{
         {"tree", "direction", "[x, y(, z)]", "toward the domain's centre", "grammar: the first stem's heading"},
     }, settingRows(grammarSettings()), settingRows(lzhSettings()), settingRows(lsystemPhysics())}),
     &readLsystemToml};
+// clang-format on
 
 }  // namespace angiosynth

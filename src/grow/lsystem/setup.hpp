@@ -13,11 +13,11 @@ namespace angiosynth {
 
 struct LsystemSetup final : GrowthSetup {
   std::string parameter_file;
-  bool grammar = false;       // the mode
+  bool grammar = false;  // the mode
   LzhParameters lzh;
-  LzhPlan plan;               // solved when the file is read: a bad block is a reading error
+  LzhPlan plan;                    // solved when the file is read: a bad block is a reading error
   GrammarOptions grammar_options;  // domain, root, direction, d0 and seed set by prepare() and grow()
-  DomainSpec domain;          // grammar: where it grows
+  DomainSpec domain;               // grammar: where it grows
   RootSpec root;
   bool has_direction = false;
   Vec3 direction;

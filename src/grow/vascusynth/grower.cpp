@@ -33,8 +33,13 @@ constexpr double kMaxRepairShare = 0.05;
 class Grower {
  public:
   Grower(const DemandMap& map, const GrowthOptions& o, GrowthReport& report)
-      : map_(map), opt_(o), report_(report), params_(o.physics), sampler_(map.demand),
-        index_(Vec3(0, 0, 0), map.extentMm()), rng_(o.seed, o.sample, Stage::Growth) {
+      : map_(map),
+        opt_(o),
+        report_(report),
+        params_(o.physics),
+        sampler_(map.demand),
+        index_(Vec3(0, 0, 0), map.extentMm()),
+        rng_(o.seed, o.sample, Stage::Growth) {
     params_.total_terminals = o.terminals;
     min_length_ = o.minSegmentLength(map.voxel_mm);
     tree_.reserve(2 * o.terminals + 1);
@@ -50,8 +55,7 @@ class Grower {
     relaxBifurcations();
     if (checked) repair(progress);  // the re-solved radii may leave a vessel just short of the ratio
     report_.short_segments = static_cast<std::int64_t>(shortSegments().size());
-    report_.intersecting_pairs =
-        static_cast<std::int64_t>(intersectingPairs(tree_, Vec3(0, 0, 0), map_.extentMm()).size());
+    report_.intersecting_pairs = static_cast<std::int64_t>(intersectingPairs(tree_, Vec3(0, 0, 0), map_.extentMm()).size());
     report_.root_radius_mm = tree_.radius[tree_.rootSegment()];
     return std::move(tree_);
   }
@@ -79,12 +83,11 @@ class Grower {
         next_report = tree_.terminalCount() + std::max<std::int64_t>(1, target / 200);
       }
       if (consecutive >= opt_.max_consecutive_rejections || !(sampler_.total() > 0))
-        throw GrowthError("could place only " + std::to_string(tree_.terminalCount()) + " of " +
-                          std::to_string(target) + " terminals: " + std::to_string(consecutive) +
-                          " candidates in a row were rejected (demand left: " + std::to_string(sampler_.total()) +
+        throw GrowthError("could place only " + std::to_string(tree_.terminalCount()) + " of " + std::to_string(target) + " terminals: " +
+                          std::to_string(consecutive) + " candidates in a row were rejected (demand left: " + std::to_string(sampler_.total()) +
                           "; too close " + std::to_string(report_.rejected_too_close) + ", unreachable " +
-                          std::to_string(report_.rejected_unreachable) + ", colliding " +
-                          std::to_string(report_.rejected_intersection) + "); lower the number of terminals or MIN_DISTANCE, or enlarge the demand map");
+                          std::to_string(report_.rejected_unreachable) + ", colliding " + std::to_string(report_.rejected_intersection) +
+                          "); lower the number of terminals or MIN_DISTANCE, or enlarge the demand map");
       ++consecutive;
       ++report_.candidates;
       const Vec3 cand = drawCandidate();
@@ -125,9 +128,8 @@ class Grower {
         ++report_.rejected_unreachable;
         continue;
       }
-      std::sort(order.begin(), order.end(), [&](auto a, auto b) {
-        return std::tie(trials[a].cost, trials[a].segment) < std::tie(trials[b].cost, trials[b].segment);
-      });
+      std::sort(order.begin(), order.end(),
+                [&](auto a, auto b) { return std::tie(trials[a].cost, trials[a].segment) < std::tie(trials[b].cost, trials[b].segment); });
       bool accepted = false;
       for (auto i : order) {
         Connection& c = trials[i];
@@ -189,7 +191,7 @@ class Grower {
 
   void rollback(const ConnectionUndo& u) { rollbackConnection(tree_, u, rel_); }
 
-  double relax_ = 1.0;                  // < 1 after runs of collision rejections
+  double relax_ = 1.0;  // < 1 after runs of collision rejections
   std::int64_t collisions_in_a_row_ = 0;
   static constexpr std::int64_t kCollisionsBeforeRelaxing = 500;
 
@@ -219,8 +221,7 @@ class Grower {
       const Vec3& a1 = t.position[x];
       const double rx = rel_[x] * scale;
       if (overlapsOtherVessel(
-              t, x, a0, a1, rx, [&](auto&& f) { index_.forEachNearSegment(a0, a1, rx + r_max, f); },
-              [&](std::int32_t y) { return rel_[y] * scale; }))
+              t, x, a0, a1, rx, [&](auto&& f) { index_.forEachNearSegment(a0, a1, rx + r_max, f); }, [&](std::int32_t y) { return rel_[y] * scale; }))
         return true;
     }
     return false;
@@ -313,7 +314,11 @@ class Grower {
     }
     n = n / norm(n);
     const double overlap = 1.03 * (tree_.radius[x] + tree_.radius[y]) - d;
-    struct Move { std::int32_t node; double weight; double sign; };
+    struct Move {
+      std::int32_t node;
+      double weight;
+      double sign;
+    };
     const Move moves[4] = {{x, sx, 1}, {tree_.parent[x], 1 - sx, 1}, {y, sy, -1}, {tree_.parent[y], 1 - sy, -1}};
     for (const auto& m : moves) {
       if (m.node <= 0 || m.weight < 0.25) continue;
@@ -324,9 +329,7 @@ class Grower {
   }
 
   // The shortest segment s may be in the solved tree.
-  double minLength(std::int32_t s) const {
-    return std::max(min_length_, opt_.min_length_ratio * tree_.radius[s] * 1.01);
-  }
+  double minLength(std::int32_t s) const { return std::max(min_length_, opt_.min_length_ratio * tree_.radius[s] * 1.01); }
 
   // Segments of the solved tree shorter than min_length_ratio × radius.
   std::vector<std::int32_t> shortSegments() const {
@@ -465,8 +468,10 @@ class Grower {
         }
         const Removal r = std::min(removalOf(x), removalOf(y));
         if (r.lost > kMaxRepairShare * double(opt_.terminals)) continue;  // left and reported
-        if (r.segment >= 0) remove.push_back(r.segment);
-        else prune.push_back(r.prune);
+        if (r.segment >= 0)
+          remove.push_back(r.segment);
+        else
+          prune.push_back(r.prune);
       }
       for (const auto s : too_short) {
         if (tree_.length[s] >= opt_.min_length_ratio * tree_.radius[s]) continue;  // lengthened with a neighbour
@@ -476,13 +481,15 @@ class Grower {
         }
         // A terminal goes with its bifurcation; a trunk merges with its larger child when the
         // smaller child's subtree goes.
-        const auto gone = tree_.isTerminal(s) ? s
+        const auto gone = tree_.isTerminal(s)                                                    ? s
                           : tree_.terminals[tree_.child0[s]] <= tree_.terminals[tree_.child1[s]] ? tree_.child0[s]
                                                                                                  : tree_.child1[s];
         const Removal r = removalOf(gone);
         if (r.lost > kMaxRepairShare * double(opt_.terminals)) continue;  // left and reported
-        if (r.segment >= 0) remove.push_back(r.segment);
-        else prune.push_back(r.prune);
+        if (r.segment >= 0)
+          remove.push_back(r.segment);
+        else
+          prune.push_back(r.prune);
       }
       for (auto* v : {&remove, &prune}) {
         std::sort(v->begin(), v->end());
@@ -528,8 +535,8 @@ class Grower {
   SegmentIndex index_;
   Rng rng_;
   VascularTree tree_;
-  std::vector<double> rel_{1.0};        // radius / root radius, refreshed along every new path
-  std::vector<double> root_history_;    // root radius when the tree had n terminals
+  std::vector<double> rel_{1.0};      // radius / root radius, refreshed along every new path
+  std::vector<double> root_history_;  // root radius when the tree had n terminals
   std::vector<std::pair<std::int64_t, double>> scratch_;
   double min_length_ = 0;
   double r_max_ = 0;
@@ -537,8 +544,7 @@ class Grower {
 
 }  // namespace
 
-VascularTree growVascuSynth(const DemandMap& map, const GrowthOptions& options, GrowthReport& report,
-                            const ProgressFn& progress) {
+VascularTree growVascuSynth(const DemandMap& map, const GrowthOptions& options, GrowthReport& report, const ProgressFn& progress) {
   Grower g(map, options, report);
   return g.run(progress);
 }

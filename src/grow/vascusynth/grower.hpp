@@ -20,16 +20,16 @@
 namespace angiosynth {
 
 struct GrowthOptions {
-  std::int64_t terminals = 1000;       // N
-  Vec3 root_mm;                        // perforation point
-  double min_distance_mm = 0;          // candidates closer than this to any segment are rejected
-  int closest_neighbours = 5;          // segments tried per candidate
+  std::int64_t terminals = 1000;                // N
+  Vec3 root_mm;                                 // perforation point
+  double min_distance_mm = 0;                   // candidates closer than this to any segment are rejected
+  int closest_neighbours = 5;                   // segments tried per candidate
   std::optional<double> min_segment_length_mm;  // no segment shorter than this (unset: voxel/20)
-  double min_length_ratio = 2;         // no segment shorter than this × its radius (0: VascuSynth's rule, none)
-  int relax_sweeps = 4;                // final sweeps moving each bifurcation to its optimum for the final radii
-  PhysicsParameters physics;           // total_terminals is set from `terminals`
+  double min_length_ratio = 2;                  // no segment shorter than this × its radius (0: VascuSynth's rule, none)
+  int relax_sweeps = 4;                         // final sweeps moving each bifurcation to its optimum for the final radii
+  PhysicsParameters physics;                    // total_terminals is set from `terminals`
   std::uint64_t seed = 1;
-  std::uint64_t sample = 0;            // sample index within a dataset
+  std::uint64_t sample = 0;  // sample index within a dataset
   bool avoid_intersections = true;
   int max_repair_rounds = 30;
   // Give up after this many consecutive rejected candidates.
@@ -39,7 +39,6 @@ struct GrowthOptions {
 };
 
 // Grows the tree; throws GrowthError when the domain cannot take N terminals.
-VascularTree growVascuSynth(const DemandMap& map, const GrowthOptions& options, GrowthReport& report,
-                            const ProgressFn& progress = {});
+VascularTree growVascuSynth(const DemandMap& map, const GrowthOptions& options, GrowthReport& report, const ProgressFn& progress = {});
 
 }  // namespace angiosynth

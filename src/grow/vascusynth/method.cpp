@@ -14,6 +14,7 @@ namespace {
 using Json = nlohmann::ordered_json;
 
 // [tree]'s settings.
+// clang-format off
 const std::vector<Setting<GrowthOptions>>& vascuSynthSettings() {
   using O = GrowthOptions;
   static const std::vector<Setting<O>> settings{
@@ -36,8 +37,10 @@ const std::vector<Setting<GrowthOptions>>& vascuSynthSettings() {
   };
   return settings;
 }
+// clang-format on
 
 // VascuSynth's files carry every physical value: none has a default but the exponents.
+// clang-format off
 const std::vector<Setting<PhysicsParameters>>& vascuSynthPhysics() {
   static const std::vector<Setting<PhysicsParameters>> settings{
       physicsSetting("murray_exponent", "3"),        physicsSetting("cost_radius_exponent", "2"), physicsSetting("cost_length_exponent", "1"),
@@ -45,6 +48,7 @@ const std::vector<Setting<PhysicsParameters>>& vascuSynthPhysics() {
       physicsSetting("perfusion_flow", nullptr)};
   return settings;
 }
+// clang-format on
 
 class PreparedVascuSynth final : public PreparedGrowth {
  public:
@@ -119,8 +123,10 @@ Json VascuSynthSetup::describe() const {
   Json j;
   j["method"] = "vascusynth";
   j["demand_map"] = d.demand_map.string();
-  if (d.supply_map.empty()) j["supply_coefficients"] = d.supply_coefficients;
-  else j["supply_map"] = d.supply_map.string();
+  if (d.supply_map.empty())
+    j["supply_coefficients"] = d.supply_coefficients;
+  else
+    j["supply_map"] = d.supply_map.string();
   j["voxel_size"] = quantityJson(d.voxel_mm, "mm");
   j["root"] = Json{{"value", {d.root_voxel.x * d.voxel_mm, d.root_voxel.y * d.voxel_mm, d.root_voxel.z * d.voxel_mm}}, {"unit", "mm"}};
   j["root_voxel"] = {d.root_voxel.x, d.root_voxel.y, d.root_voxel.z};
@@ -139,6 +145,7 @@ std::unique_ptr<PreparedGrowth> VascuSynthSetup::prepare(std::uint64_t memory_li
   return std::make_unique<PreparedVascuSynth>(*this, loadDomain(domain, memory_limit));
 }
 
+// clang-format off
 const GrowthMethod kVascuSynthMethod{
     "vascusynth",
     "VascuSynth's oxygen-demand CCO (Hamarneh & Jassi 2010) on box maps: terminals drawn ∝ the remaining demand, each joined to the "
@@ -152,5 +159,6 @@ const GrowthMethod kVascuSynthMethod{
         {"tree", "root", "[x, y, z] mm", nullptr, "the perforation point in mm from the map's corner (or root_voxel)"},
     }, settingRows(vascuSynthSettings()), settingRows(vascuSynthPhysics())}),
     &readVascuSynthToml};
+// clang-format on
 
 }  // namespace angiosynth

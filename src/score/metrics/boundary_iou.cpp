@@ -20,8 +20,8 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
-constexpr double kDiagonalShare = 0.02;      // Cheng et al.'s default band: 2 % of the image diagonal
-constexpr double kBoxBoundaryRatio = 0.2;    // TopCoW 2024: the box's shell is 20 % of its size per axis (rounded up)
+constexpr double kDiagonalShare = 0.02;    // Cheng et al.'s default band: 2 % of the image diagonal
+constexpr double kBoxBoundaryRatio = 0.2;  // TopCoW 2024: the box's shell is 20 % of its size per axis (rounded up)
 
 struct Box {
   std::array<std::int64_t, 3> lo{}, hi{};  // inclusive voxel indices

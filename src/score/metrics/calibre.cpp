@@ -9,9 +9,7 @@ extern const ScoreMetric kCalibreMetric{
     "centreline voxels binned by the exact radius there (radius.nii.gz; in voxels of the smallest edge): recall = share in "
     "the prediction, truth_coverage = share in the truth mask",
     {},
-    [](const ScoringCase& c) {
-      return calibreRecall(c.prediction, c.truth, c.centreline, c.radius, c.options.bins_voxels, c.voxel_mm, "voxels");
-    }};
+    [](const ScoringCase& c) { return calibreRecall(c.prediction, c.truth, c.centreline, c.radius, c.options.bins_voxels, c.voxel_mm, "voxels"); }};
 
 extern const ScoreMetric kCalibreMmMetric{
     "calibre_mm", "the calibre bins with the radius in mm (when bins in mm are given)", {}, [](const ScoringCase& c) {

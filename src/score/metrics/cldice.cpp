@@ -11,9 +11,8 @@ extern const ScoreMetric kClDiceMetric{
     "`exact_centreline` takes the exact centreline as the truth's skeleton; null when a skeleton is empty",
     {{"cldice", "/skeletons/cldice"}, {"cldice_exact_centreline", "/exact_centreline/cldice"}},
     [](const ScoringCase& c) {
-      return nlohmann::ordered_json{
-          {"skeletons", clDice(c.predictionSkeleton(), c.truth, c.truthSkeleton(), c.prediction)},
-          {"exact_centreline", clDice(c.predictionSkeleton(), c.truth, binaryMask(c.centreline), c.prediction)}};
+      return nlohmann::ordered_json{{"skeletons", clDice(c.predictionSkeleton(), c.truth, c.truthSkeleton(), c.prediction)},
+                                    {"exact_centreline", clDice(c.predictionSkeleton(), c.truth, binaryMask(c.centreline), c.prediction)}};
     }};
 
 }  // namespace angiosynth

@@ -39,8 +39,7 @@ Json perClass(const ScoringCase& c) {
     k["calibre"] = calibreRecall(pk, tk, ck, c.radius, c.options.bins_voxels, c.voxel_mm, "voxels");
     per[name] = k;
   }
-  return Json{{"prediction", labelled ? "labelled by kind (the truth's class values)" : "binary: recall-type scores only"},
-              {"classes", per}};
+  return Json{{"prediction", labelled ? "labelled by kind (the truth's class values)" : "binary: recall-type scores only"}, {"classes", per}};
 }
 
 }  // namespace
