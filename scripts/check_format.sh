@@ -3,7 +3,7 @@
 # as the test Lint.SourcesAreFormatted does in CI; `--fix` formats them instead.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-mapfile -t files < <(find src apps tests bench fuzz \( -name '*.cpp' -o -name '*.hpp' \) | sort)
+mapfile -t files < <(find src apps python tests bench fuzz \( -name '*.cpp' -o -name '*.hpp' \) | sort)
 if [ "${1:-}" = --fix ]; then
   clang-format-14 -i "${files[@]}"
 else

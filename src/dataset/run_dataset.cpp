@@ -74,6 +74,31 @@ std::uint64_t sampleBytes(const DatasetSpec& spec, std::uint64_t limit) {
   return denseRasterBytes(g) + 4ULL * g.voxelCount() + 24ULL * g.voxelCount() + map.demand.size() * 16;
 }
 
+SampleRequest sampleRequest(const DatasetSpec& spec, const ResolvedSample& r, const Scenario& sc, std::uint64_t memory_limit) {
+  SampleRequest req;
+  req.scenario = &sc;
+  req.seed = r.seed;
+  req.sample = static_cast<std::uint64_t>(r.index);
+  req.graph_id = r.id;
+  req.memory_limit = memory_limit;
+  req.record_timing = false;  // sample files depend on (spec, index) only
+  if (spec.labels == "kind") req.class_kinds = spec.kinds;
+  return req;
+}
+
+// The roles of imagesTr and labelsTr: the image of the profile, and as label the policy's label,
+// the classes or the mask, of the warped image when the profile warps. Roles carry the profile's
+// name (a profile file's stem), not its reference.
+struct SampleRoles {
+  std::string image, label;
+};
+SampleRoles sampleRoles(const DatasetSpec& spec, const ResolvedSample& r, const std::function<bool(const std::string&)>& made) {
+  std::string suffix(1, '_');  // (appended: GCC 12 warns falsely, -Wrestrict, on "_" + string)
+  suffix += loadProfile(r.profile, spec.file, 0).name;
+  const auto own = [&](const std::string& role) { return made(role + suffix) ? role + suffix : role; };
+  return {own("image"), own(spec.label_policy != "binary" ? "label" : spec.labels == "kind" ? "classes" : "mask")};
+}
+
 Json fileEntry(const fs::path& dir, const std::string& rel) {
   return Json{{"path", rel}, {"sha256", sha256File(dir / rel)}, {"size", fs::file_size(dir / rel)}};
 }
@@ -103,24 +128,11 @@ Json generateOne(const DatasetSpec& spec, const fs::path& dir, const fs::path& p
     fs::remove_all(staging);
     fs::create_directories(staging);
     const Scenario sc = scenarioOf(spec, r);
-    SampleRequest req;
-    req.scenario = &sc;
-    req.seed = r.seed;
-    req.sample = static_cast<std::uint64_t>(r.index);
-    req.graph_id = r.id;
-    req.memory_limit = opt.memory_limit;
-    req.record_timing = false;  // sample files depend on (spec, index) only
-    if (spec.labels == "kind") req.class_kinds = spec.kinds;
+    const SampleRequest req = sampleRequest(spec, r, sc, opt.memory_limit);
     const SampleSummary sample = generateSample(req, staging);
-    // The image of the profile, and as label the mask or the classes: of the warped image when the
-    // profile warps. Roles carry the profile's name (a profile file's stem), not its reference.
-    std::string suffix(1, '_');  // (appended: GCC 12 warns falsely, -Wrestrict, on "_" + string)
-    suffix += loadProfile(r.profile, spec.file, 0).name;
-    const auto written = [&](const std::string& role) {
-      const std::string own = role + suffix;
-      return staging / sample.file(sample.wrote(own) ? own : role);
-    };
-    const fs::path label = written(spec.label_policy != "binary" ? "label" : spec.labels == "kind" ? "classes" : "mask"), image = written("image");
+    const SampleRoles roles = sampleRoles(spec, r, [&](const std::string& role) { return sample.wrote(role); });
+    const auto written = [&](const std::string& role) { return staging / sample.file(role); };
+    const fs::path label = written(roles.label), image = written(roles.image);
     const std::string image_rel = "imagesTr/" + r.id + "_0000.nii.gz", label_rel = "labelsTr/" + r.id + ".nii.gz";
     const std::string gt_rel = "groundtruth/" + r.id, json_rel = "groundtruth/" + r.id + ".json";
     Json meta{{"id", r.id},
@@ -179,6 +191,27 @@ std::string citation() {
 }
 
 }  // namespace
+
+DatasetSampleInMemory datasetSampleInMemory(const DatasetSpec& spec, std::int64_t index, std::uint64_t memory_limit,
+                                            const std::function<bool()>& cancelled) {
+  if (index < 0 || index >= spec.samples)
+    throw InputError(spec.file, 0, "sample " + std::to_string(index) + " is not in the dataset; allowed: 0 … " + std::to_string(spec.samples - 1));
+  DatasetSampleInMemory out;
+  out.resolved = resolveSample(spec, index);
+  const Scenario sc = scenarioOf(spec, out.resolved);
+  SampleRequest req = sampleRequest(spec, out.resolved, sc, memory_limit);
+  req.capture = &out.capture;
+  req.write_files = false;
+  req.cancelled = cancelled;
+  out.summary = generateSample(req, {});
+  // Without files the roles are those the volumes were kept under.
+  const SampleRoles roles = sampleRoles(spec, out.resolved, [&](const std::string& role) {
+    return std::any_of(out.capture.volumes.begin(), out.capture.volumes.end(), [&](const CapturedVolume& v) { return v.role == role; });
+  });
+  out.image_role = roles.image;
+  out.label_role = roles.label;
+  return out;
+}
 
 std::vector<std::int64_t> DatasetSelection::indices() const {
   std::vector<std::int64_t> out;

@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "dataset/spec.hpp"
+#include "pipeline/generate_sample.hpp"
 
 namespace angiosynth {
 
@@ -48,6 +49,18 @@ struct DatasetRunReport {
 
 DatasetRunReport runDataset(const DatasetSpec& spec, const std::filesystem::path& out_parent, const DatasetSelection& sel,
                             const DatasetRunOptions& opt);
+
+// Sample `index` of a dataset made in memory, channel for channel what `runDataset` writes for it
+// (the Python module's Spec[i]): the image of imagesTr is capture's volume `image_role`, the
+// label of labelsTr `label_role`.
+struct DatasetSampleInMemory {
+  ResolvedSample resolved;
+  SampleSummary summary;
+  SampleCapture capture;
+  std::string image_role, label_role;
+};
+DatasetSampleInMemory datasetSampleInMemory(const DatasetSpec& spec, std::int64_t index, std::uint64_t memory_limit,
+                                            const std::function<bool()>& cancelled = {});
 
 struct DatasetCheck {
   std::int64_t samples = 0, ok = 0;

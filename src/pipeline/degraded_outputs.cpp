@@ -25,6 +25,37 @@ std::uint64_t degradedImageBytes(const Profile& p, const VolumeGrid& g) {
   return per_voxel * static_cast<std::uint64_t>(g.voxelCount());
 }
 
+namespace {
+
+// The files of one degraded image: its volumes (or VascuSynth's slices), previews, and for a warp
+// the warped tree's graphs and the warp itself.
+void writeDegradedFiles(const DegradedImage& d, const TypedImage& image, const std::vector<Channel>& channels, const Forest& forest,
+                        const GroundTruthVolumes& gt, const std::string& profile, const VolumeRequest& req, const std::filesystem::path& dir,
+                        nlohmann::ordered_json& files) {
+  const ImageParameters& ip = req.image;
+  const std::string suffix = "_" + profile;
+  // Previews span the profile's background to vessel intensities.
+  const double lo = std::min(d.background, d.vessel), hi = std::max(d.background, d.vessel);
+  if (req.vascusynth) {
+    writeVascuSynthSlices(image.view, d.image, lo, hi, profile, *req.vascusynth, dir, files);
+  } else {
+    writeChannels(channels, ip.formats, dir, files);
+    if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end())
+      writeMips(d.image, previewClasses(forest.trees, d.labels ? *d.labels : gt), lo, hi, suffix, dir, files);
+  }
+  if (d.tree) {
+    const std::string gxl = "tree" + suffix + ".gxl";
+    writeTextFile(dir / gxl, [&](std::ostream& o) { writeGxl(o, *d.tree, forest.trees, req.frame, "tree" + suffix); });
+    files["gxl" + suffix] = gxl;
+    const std::string warp = "warp" + suffix + ".json";
+    writeTextFile(dir / warp, [&](std::ostream& o) { o << d.warp->describe().dump(1) << "\n"; });
+    files["warp" + suffix] = warp;
+    writeGraphFiles(*d.tree, forest.trees, gt.fraction.grid, ip.graph_formats, suffix, dir, files);
+  }
+}
+
+}  // namespace
+
 void writeDegradedImages(const Forest& forest, const std::vector<std::uint8_t>& segment_classes, const GroundTruthVolumes& gt,
                          const VolumeRequest& req, const std::filesystem::path& dir, nlohmann::ordered_json& files,
                          nlohmann::ordered_json& degradation, nlohmann::ordered_json* seconds) {
@@ -42,44 +73,33 @@ void writeDegradedImages(const Forest& forest, const std::vector<std::uint8_t>& 
     const std::string suffix = "_" + profile.name;
     TypedImage image;
     makeTypedImage(image, d.image, 0, 1, d.dtype, "angiosynth image, profile " + profile.name);
-    // Previews span the profile's background to vessel intensities.
-    const double lo = std::min(d.background, d.vessel), hi = std::max(d.background, d.vessel);
-    if (req.vascusynth) {
-      writeVascuSynthSlices(image.view, d.image, lo, hi, profile.name, *req.vascusynth, dir, files);
-    } else {
-      std::vector<Channel> channels{{"image" + suffix, image.view}};
-      if (d.labels) {
-        fillClasses(*d.labels, *d.tree, segment_classes, &d.segment_origin);  // labels: clean segment ids
-        for (auto& c : labelChannels(*d.labels, suffix)) channels.push_back(c);
-      }
-      // The policy's label of this image, where it is not the clean one.
-      Label label;
-      if (ip.labels.perProfile() || (ip.labels.writesLabel() && d.labels)) {
-        const GroundTruthVolumes& truth = d.labels ? *d.labels : gt;
-        std::optional<ProfileVisibility> vis;  // visible: this image's contrast and noise
-        VisibilityEvidence evidence;
-        if (ip.labels.perProfile()) {
-          vis = profileVisibility(profile, in, d.image, truth.fraction);
-          evidence = {&vis->contrast, vis->noise_sigma};
-        }
-        label = makeLabel(ip.labels, truth, req.label_numbering, vis ? &evidence : nullptr);
-        Json& rec = d.record["label"];
-        rec = labelLengthKept(label, ip.labels, req.label_numbering, d.tree ? *d.tree : forest.vessels);
-        if (vis) rec["noise_sigma"] = vis->noise_sigma;
-        channels.push_back(labelChannel(label, ip.labels, "label" + suffix));
-      }
-      writeChannels(channels, ip.formats, dir, files);
-      if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end())
-        writeMips(d.image, previewClasses(forest.trees, d.labels ? *d.labels : gt), lo, hi, suffix, dir, files);
+    std::vector<Channel> channels{{"image" + suffix, image.view}};
+    if (d.labels && !req.vascusynth) {
+      fillClasses(*d.labels, *d.tree, segment_classes, &d.segment_origin);  // labels: clean segment ids
+      for (auto& c : labelChannels(*d.labels, suffix)) channels.push_back(c);
     }
+    // The policy's label of this image, where it is not the clean one.
+    Label label;
+    if (!req.vascusynth && (ip.labels.perProfile() || (ip.labels.writesLabel() && d.labels))) {
+      const GroundTruthVolumes& truth = d.labels ? *d.labels : gt;
+      std::optional<ProfileVisibility> vis;  // visible: this image's contrast and noise
+      VisibilityEvidence evidence;
+      if (ip.labels.perProfile()) {
+        vis = profileVisibility(profile, in, d.image, truth.fraction);
+        evidence = {&vis->contrast, vis->noise_sigma};
+      }
+      label = makeLabel(ip.labels, truth, req.label_numbering, vis ? &evidence : nullptr);
+      Json& rec = d.record["label"];
+      rec = labelLengthKept(label, ip.labels, req.label_numbering, d.tree ? *d.tree : forest.vessels);
+      if (vis) rec["noise_sigma"] = vis->noise_sigma;
+      channels.push_back(labelChannel(label, ip.labels, "label" + suffix));
+    }
+    if (req.capture) {
+      req.capture->keep(channels);
+      if (d.tree) req.capture->warped.push_back(WarpedTree{profile.name, *d.tree, d.warp->describe()});
+    }
+    if (req.write_files) writeDegradedFiles(d, image, channels, forest, gt, profile.name, req, dir, files);
     if (d.tree) {
-      const std::string gxl = "tree" + suffix + ".gxl";
-      writeTextFile(dir / gxl, [&](std::ostream& o) { writeGxl(o, *d.tree, forest.trees, req.frame, "tree" + suffix); });
-      files["gxl" + suffix] = gxl;
-      const std::string warp = "warp" + suffix + ".json";
-      writeTextFile(dir / warp, [&](std::ostream& o) { o << d.warp->describe().dump(1) << "\n"; });
-      files["warp" + suffix] = warp;
-      writeGraphFiles(*d.tree, forest.trees, gt.fraction.grid, ip.graph_formats, suffix, dir, files);
       std::int64_t mask_voxels = 0;
       for (auto m : d.labels->mask.data) mask_voxels += m;
       d.record["mask_voxels"] = mask_voxels;

@@ -87,6 +87,8 @@ PreparedSample prepareSample(const SampleRequest& req) {
     // ignore label comes after the last kind.
     vr.label_numbering.by_kind = !req.class_kinds.empty();
     vr.label_numbering.ignore_value = static_cast<std::uint8_t>(req.class_kinds.empty() ? 2 : req.class_kinds.size() + 1);
+    vr.capture = req.capture;
+    vr.write_files = req.write_files;
     checkVolumeMemory(vr);
   }
   ps.growth->checkFeasibility();
@@ -110,7 +112,13 @@ Forest growForest(const PreparedSample& ps, const SampleRequest& req, GrowthRepo
   auto t0 = Clock::now();
   Forest forest;
   try {
-    forest = ps.growth->grow(req.seed, req.sample, report, req.progress);
+    ProgressFn progress = req.progress;
+    if (req.cancelled)
+      progress = [&](std::int64_t done, std::int64_t total) {
+        if (req.cancelled()) throw Cancelled();
+        if (req.progress) req.progress(done, total);
+      };
+    forest = ps.growth->grow(req.seed, req.sample, report, progress);
     if (!req.class_kinds.empty()) assignClassLabels(forest.trees, req.class_kinds);
     // A sample without a vessel has no truth to label: a method whose parameters leave nothing to
     // grow (a step that leaves the domain, drains that all die) says so instead of writing one.
@@ -300,8 +308,16 @@ SampleSummary generateSample(const SampleRequest& req, const std::filesystem::pa
   const VascularTree& tree = forest.vessels;
 
   t0 = Clock::now();
+  const auto checkCancelled = [&] {
+    if (req.cancelled && req.cancelled()) throw Cancelled();
+  };
+  checkCancelled();
+  if (req.capture) {
+    req.capture->forest = forest;
+    req.capture->frame = GraphFrame{ps.map->voxel_mm, sc.input_units};
+  }
   Json files, stats, degradation;
-  writeGraphs(forest, ps, req, dir, files);
+  if (req.write_files) writeGraphs(forest, ps, req, dir, files);
   timing["write_graphs"] = seconds(t0);
   if (ps.volumes) {
     t0 = Clock::now();
@@ -309,14 +325,15 @@ SampleSummary generateSample(const SampleRequest& req, const std::filesystem::pa
     writeVolumes(forest, ps.vr, dir, files, stats, degradation, &degrade_seconds);
     if (!degrade_seconds.empty()) timing["degrade_effects"] = degrade_seconds;
     timing["rasterize_and_write_volumes"] = seconds(t0);
-  } else if (!req.vascusynth) {
+  } else if (!req.vascusynth && req.write_files) {
     // Without volumes the graphs asked for are written all the same; voxel coordinates in the
     // key points refer to the grid the image would have had.
     t0 = Clock::now();
     writeGraphFiles(tree, forest.trees, imageGrid(*ps.map, sc.image, sc.parameter_file, sc.image_line), sc.image.graph_formats, "", dir, files);
     timing["write_graphs"] = timing["write_graphs"].get<double>() + seconds(t0);
   }
-  if (sc.mesh.enabled) {
+  checkCancelled();
+  if (sc.mesh.enabled && req.write_files) {
     t0 = Clock::now();
     writeSurface(forest, req, dir, files, stats);
     timing["mesh"] = seconds(t0);
@@ -353,7 +370,7 @@ SampleSummary generateSample(const SampleRequest& req, const std::filesystem::pa
   j["statistics"] = stats;
   j["files"] = files;
   if (req.record_timing) j["timing_seconds"] = timing;
-  writeTextFile(dir / "sample.json", [&](std::ostream& o) { o << j.dump(2) << "\n"; });
+  if (req.write_files) writeTextFile(dir / "sample.json", [&](std::ostream& o) { o << j.dump(2) << "\n"; });
   return summary;
 }
 

@@ -1,6 +1,8 @@
 #pragma once
 // One sample through the pipeline: scenario → domain → growth → graph files and sample.json.
 #include <cstdint>
+#include <functional>
+#include <stdexcept>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -11,6 +13,7 @@
 #include "grow/common/growth_report.hpp"
 #include "config/scenario.hpp"
 #include "pipeline/vascusynth_layout.hpp"
+#include "pipeline/volume_outputs.hpp"
 
 namespace angiosynth {
 
@@ -30,6 +33,17 @@ struct SampleRequest {
   bool record_timing = true;  // false: sample.json depends on seed and parameters only
   // The kinds in class-label order (1, 2, ...), when a dataset fixes them; empty: artery 1, vein 2.
   std::vector<std::string> class_kinds;
+  // The Python module's samples: every volume, the forest and warped trees kept in memory, and
+  // with write_files false nothing written (the sidecar is made all the same).
+  SampleCapture* capture = nullptr;
+  bool write_files = true;
+  // Polled at growth's progress points and between stages: true stops the sample with Cancelled.
+  std::function<bool()> cancelled;
+};
+
+// Thrown when SampleRequest::cancelled asks the sample to stop.
+struct Cancelled : std::runtime_error {
+  Cancelled() : std::runtime_error("cancelled") {}
 };
 
 // What a sample made: the numbers a command reports, and its sidecar.

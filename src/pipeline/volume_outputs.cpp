@@ -45,8 +45,16 @@ VolumeGrid imageGrid(const DemandMap& map, const ImageParameters& p, const std::
   return g;
 }
 
+void SampleCapture::keep(const std::vector<Channel>& channels) {
+  for (const Channel& c : channels) {
+    const auto n = static_cast<std::size_t>(c.view.grid->voxelCount()) * voxelBytes(c.view.type);
+    const auto* from = static_cast<const std::uint8_t*>(c.view.data);
+    volumes.push_back(CapturedVolume{c.role, *c.view.grid, c.view.type, c.view.label, std::vector<std::uint8_t>(from, from + n)});
+  }
+}
+
 bool needsDense(const VolumeRequest& req) {
-  return req.vascusynth || !req.profiles.empty() ||
+  return req.vascusynth || !req.profiles.empty() || req.capture ||
          std::any_of(req.image.formats.begin(), req.image.formats.end(), [](const std::string& f) { return f != "vdb"; });
 }
 
@@ -74,7 +82,7 @@ void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::fil
   const VolumeGrid& g = req.grid;
   const ImageParameters& ip = req.image;
   checkVolumeMemory(req);
-  if (std::find(ip.formats.begin(), ip.formats.end(), "vdb") != ip.formats.end()) {
+  if (req.write_files && std::find(ip.formats.begin(), ip.formats.end(), "vdb") != ip.formats.end()) {
     const double pairs = brickPairBound(tree, g);  // 12 bytes each while binning
     if (pairs * 12 > double(req.memory_limit))
       throw InputError(req.parameter_file, req.image_line,
@@ -96,7 +104,11 @@ void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::fil
   stats["image_origin"] = Json{{"value", {g.origin_mm.x, g.origin_mm.y, g.origin_mm.z}},
                                {"unit", "mm"},
                                {"definition", "centre of voxel (0,0,0); world frame RAS+ (NIfTI, VDB), LPS in NRRD"}};
-  writeGraphFiles(tree, forest.trees, g, ip.graph_formats, "", dir, files);
+  if (req.write_files) writeGraphFiles(tree, forest.trees, g, ip.graph_formats, "", dir, files);
+  if (req.capture) {
+    req.capture->grid = g;
+    req.capture->has_grid = true;
+  }
   if (!needsDense(req)) return;
   GroundTruthVolumes gt = rasterizeGroundTruth(tree, g, RasterOptions{ip.supersampling, ip.centerline_connectivity});
   const std::vector<std::uint8_t> classes = segmentClasses(tree, forest.trees);
@@ -115,10 +127,13 @@ void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::fil
     } else {
       stats["label"] = labelLengthKept(&gt.mask, nullptr, ip.labels, req.label_numbering, tree);
     }
-    writeChannels(channels, ip.formats, dir, files);
-    if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end())
-      writeMips(gt.fraction, previewClasses(forest.trees, gt), 0, 1, "", dir, files);
-    if (req.vascusynth) writeVascuSynthSlices(image.view, gt.fraction, 0, 1, "original_image", *req.vascusynth, dir, files);
+    if (req.capture) req.capture->keep(channels);
+    if (req.write_files) {
+      writeChannels(channels, ip.formats, dir, files);
+      if (std::find(ip.formats.begin(), ip.formats.end(), "png") != ip.formats.end())
+        writeMips(gt.fraction, previewClasses(forest.trees, gt), 0, 1, "", dir, files);
+      if (req.vascusynth) writeVascuSynthSlices(image.view, gt.fraction, 0, 1, "original_image", *req.vascusynth, dir, files);
+    }
   }
   std::int64_t mask_voxels = 0;
   for (auto m : gt.mask.data) mask_voxels += m;

@@ -12,6 +12,7 @@
 #include "io/graph_writers.hpp"
 #include "config/scenario.hpp"
 #include "pipeline/vascusynth_layout.hpp"
+#include "pipeline/volume_files.hpp"
 #include "raster/label_policy.hpp"
 #include "raster/volume.hpp"
 
@@ -23,6 +24,31 @@ VolumeGrid imageGrid(const DemandMap& map, const ImageParameters& p, const std::
 // Voxels along one axis of an image, refused past 10^5 before any integer conversion.
 std::int32_t axisVoxels(double n, const std::string& file, int line);
 
+// A sample's products kept in memory as the pipeline makes them (the Python module's samples):
+// each volume by its role (the file stem the CLI writes it under), the final forest, and the tree
+// and warp of every profile that moves the geometry.
+struct CapturedVolume {
+  std::string role;
+  VolumeGrid grid;
+  VoxelType type = VoxelType::Float32;
+  bool label = false;
+  std::vector<std::uint8_t> bytes;  // x fastest, as in the files
+};
+struct WarpedTree {
+  std::string profile;
+  VascularTree tree;
+  nlohmann::ordered_json warp;  // the warp's description (warp_<profile>.json)
+};
+struct SampleCapture {
+  std::vector<CapturedVolume> volumes;
+  Forest forest;
+  VolumeGrid grid;  // of the clean volumes (unset when no volume was made)
+  bool has_grid = false;
+  GraphFrame frame;
+  std::vector<WarpedTree> warped;
+  void keep(const std::vector<Channel>& channels);
+};
+
 struct VolumeRequest {
   VolumeGrid grid;
   ImageParameters image;
@@ -33,8 +59,10 @@ struct VolumeRequest {
   // Degradation: one image per profile (role image_<profile>), drawn from (seed, sample).
   std::vector<Profile> profiles;
   std::uint64_t seed = 1, sample = 0;
-  GraphFrame frame;                // for the GXL of warped trees
-  LabelNumbering label_numbering;  // vessel 1 (or each kind's class), ignore value
+  GraphFrame frame;                  // for the GXL of warped trees
+  LabelNumbering label_numbering;    // vessel 1 (or each kind's class), ignore value
+  SampleCapture* capture = nullptr;  // also keep every volume in memory
+  bool write_files = true;           // false: nothing goes to disk (capture holds the products)
 };
 
 // Throws InputError when the request's volumes would exceed its memory limit.

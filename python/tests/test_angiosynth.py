@@ -1,0 +1,194 @@
+"""The Python module against the program's own files, read by nibabel and networkx."""
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import networkx as nx
+import nibabel as nib
+import numpy as np
+import pytest
+
+import angiosynth
+
+# A small CCO forest of two kinds, with a profile and the CSV graph: every kind of volume.
+SMALL = {
+    "seed": 4,
+    "domain": {"shape": "sphere", "radius": "6 mm", "voxel_size": "0.25 mm"},
+    "tree": {
+        "method": "cco",
+        "terminals": 60,
+        "inlet": [{"kind": "artery", "root_offset": [-1.5, 5.8, 0]}, {"kind": "vein", "root_offset": [1.5, 5.8, 0]}],
+    },
+    "physics": {"perfusion_pressure": "100 mmHg", "terminal_pressure": "60 mmHg", "perfusion_flow": "10 mL/min"},
+    "image": {"voxel_size": "0.25 mm", "supersampling": 2, "graph_formats": ["csv"]},
+    "degrade": {"profiles": ["cta"]},
+}
+
+
+def run(program, *args, cwd=None):
+    done = subprocess.run([program, *args], cwd=cwd, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return done
+
+
+def nifti(path):
+    img = nib.load(str(path))
+    return np.asanyarray(img.dataobj), img.affine
+
+
+def test_every_channel_equals_the_programs_file(program, tmp_path):
+    params = tmp_path / "small.toml"
+    params.write_text(angiosynth._toml_text(SMALL))
+    sample = angiosynth.generate(SMALL)
+    run(program, "generate", str(params), "--out", str(tmp_path / "cli"), "--quiet")
+    files = json.loads((tmp_path / "cli/sample.json").read_text())["files"]
+    assert set(sample.volumes) == {r for r, f in files.items() if f.endswith(".nii.gz")}
+    for role, array in sample.volumes.items():
+        data, affine = nifti(tmp_path / "cli" / files[role])
+        assert array.dtype == data.dtype, role
+        assert np.array_equal(array, data), role
+        assert np.allclose(sample.affine, affine), role
+    assert sample.seed == 4
+    assert sample.statistics == json.loads((tmp_path / "cli/sample.json").read_text())["statistics"]
+    assert sample.classes_legend == {0: "background", 1: "artery", 2: "vein"}
+    # The graph's columns are the CSV's rows.
+    with open(tmp_path / "cli/edges.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == len(sample.graph)
+    for col in ("id", "node1id", "node2id"):
+        assert [int(r[col]) for r in rows] == list(sample.graph.edges[col])
+    for col in ("length", "radius", "flow", "volume"):
+        assert [float(r[col]) for r in rows] == list(sample.graph.edges[col])
+    assert [r["kind"] for r in rows] == sample.graph.edges["kind"]
+
+
+def test_write_gives_the_programs_files(program, tmp_path):
+    params = tmp_path / "small.toml"
+    params.write_text(angiosynth._toml_text(SMALL))
+    sample = angiosynth.generate(params)
+    sample.write(tmp_path / "py")
+    run(program, "generate", str(params), "--out", str(tmp_path / "cli"), "--quiet")
+    cli = sorted(p.name for p in (tmp_path / "cli").iterdir())
+    assert sorted(p.name for p in (tmp_path / "py").iterdir()) == cli
+    for name in cli:
+        if name in ("sample.json", ".angiosynth-files.json"):
+            continue  # the command line and timings differ
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
+    # An existing output is refused, as the program refuses it.
+    with pytest.raises(angiosynth.InputError, match="out"):
+        sample.write(tmp_path / "py")
+
+
+def test_spec_items_equal_the_datasets_files(program, source, tmp_path):
+    spec_file = source / "tests/data/dataset_av.toml"  # distributions, labels by kind, a warping profile
+    run(program, "dataset", str(spec_file), "--out", str(tmp_path), "--quiet")
+    spec = angiosynth.Spec(spec_file)
+    root = tmp_path / "Dataset903_ArteryVeinTiny"
+    assert len(spec) == 3
+    warped = 0
+    for i in range(len(spec)):
+        s = spec[i]
+        assert s.id == spec.sample_id(i)
+        image, affine = nifti(root / f"imagesTr/{s.id}_0000.nii.gz")
+        label, _ = nifti(root / f"labelsTr/{s.id}.nii.gz")
+        assert np.array_equal(s.image, image) and s.image.dtype == image.dtype
+        assert np.array_equal(s.label, label) and s.label.dtype == label.dtype
+        assert np.allclose(s.affine, affine)
+        for role in ("mask", "centerline", "radius", "instances"):  # (classes went to labelsTr)
+            truth, _ = nifti(root / f"groundtruth/{s.id}/{role}.nii.gz")
+            assert np.array_equal(s.volumes[role], truth), (i, role)
+        warped += s.image_role == "image_profile_warp"
+    assert warped >= 1, "the spec's draws should give at least one warped sample"
+
+
+def test_a_spec_sample_is_the_same_whatever_the_threads(source):
+    one = angiosynth.Spec(source / "tests/data/dataset_tiny.toml", threads=1)[2]
+    two = angiosynth.Spec(source / "tests/data/dataset_tiny.toml", threads=2)[2]
+    for role in one.volumes:
+        assert np.array_equal(one.volumes[role], two.volumes[role]), role
+
+
+def test_graph_to_networkx_is_a_forest_of_the_trees():
+    s = angiosynth.generate(SMALL)
+    g = s.graph.to_networkx()
+    assert g.number_of_nodes() == len(s.graph.nodes["id"]) and g.number_of_edges() == len(s.graph)
+    assert nx.is_forest(g.to_undirected())
+    assert nx.number_weakly_connected_components(g) == len(s.trees) == 2
+    # Flow is conserved at every bifurcation: a parent carries its daughters' flow.
+    for n in g.nodes:
+        out = list(g.out_edges(n, data=True))
+        into = list(g.in_edges(n, data=True))
+        if len(out) == 2 and into:
+            assert abs(into[0][2]["flow"] - out[0][2]["flow"] - out[1][2]["flow"]) <= 1e-9 * into[0][2]["flow"]
+
+
+def test_score_agrees_with_the_program(program, tmp_path):
+    params = tmp_path / "small.toml"
+    params.write_text(angiosynth._toml_text(SMALL))
+    s = angiosynth.generate(params, out=tmp_path / "sample")
+    perfect = angiosynth.score(s.mask, s)
+    assert perfect["overlap"]["dice"] == 1.0
+    # A prediction that misses the thinnest vessels: the same numbers from memory and from the files.
+    pred = (s.mask > 0) & ~((s.radius > 0) & (s.radius < 0.15))
+    pred_file = tmp_path / "pred.nii.gz"
+    nib.save(nib.Nifti1Image(pred.astype(np.uint8), s.affine), str(pred_file))
+    run(program, "score", str(pred_file), str(tmp_path / "sample"), "--out", str(tmp_path / "scores.json"))
+    cli = json.loads((tmp_path / "scores.json").read_text())
+    mine = angiosynth.score(pred, s)
+    for block in ("overlap", "centreline", "cldice", "calibre", "topology"):
+        assert mine[block] == cli[block], block
+    assert angiosynth.score(pred_file, tmp_path / "sample")["overlap"] == cli["overlap"]
+
+
+def test_bad_input_raises_the_programs_message(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[domain]\nshape = \"sphere\"\nradius = \"6 mm\"\nvoxel_size = \"0.25 mm\"\n\n[tree]\nmethod = \"cco\"\nterminals = -3\n")
+    with pytest.raises(angiosynth.InputError, match=r"bad.toml:8: .*terminals"):
+        angiosynth.generate(bad)
+    with pytest.raises(angiosynth.InputError, match=r"<string>:1: not valid TOML"):
+        angiosynth.generate("[tree\nterminals = 5\n")
+    with pytest.raises(angiosynth.InputError, match="no such parameter file"):
+        angiosynth.generate("no_such_file.toml")
+    with pytest.raises(ValueError):  # InputError is a ValueError
+        angiosynth.Spec(tmp_path / "bad.toml")
+    with pytest.raises(angiosynth.InputError, match="shape"):
+        angiosynth.score(np.zeros((3, 3, 3)), angiosynth.generate(SMALL))
+
+
+def test_ctrl_c_returns_promptly_and_stops_the_work(tmp_path):
+    # A growth of minutes, interrupted after a second: KeyboardInterrupt within a second, and the
+    # process uses no more CPU afterwards (no thread left working).
+    script = tmp_path / "long.py"
+    script.write_text(textwrap.dedent(f"""
+        import sys, time, os
+        sys.path.insert(0, {str(angiosynth.__file__.rsplit('/angiosynth/', 1)[0])!r})
+        import angiosynth
+        params = {{"domain": {{"shape": "sphere", "radius": "20 mm", "voxel_size": "0.2 mm"}},
+                  "tree": {{"method": "cco", "terminals": 400000}},
+                  "physics": {{"perfusion_pressure": "100 mmHg", "terminal_pressure": "60 mmHg", "perfusion_flow": "500 mL/min"}},
+                  "image": {{"enabled": False}}}}
+        print("started", flush=True)
+        try:
+            angiosynth.generate(params, seed=1)
+        except KeyboardInterrupt:
+            t = time.monotonic()
+            cpu = time.process_time()
+            time.sleep(1.0)
+            print("interrupted", time.process_time() - cpu, flush=True)
+    """))
+    p = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "started"
+    time.sleep(2.0)
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    line = p.stdout.readline().split()
+    assert line and line[0] == "interrupted", p.stderr.read()
+    assert time.monotonic() - sent < 3.0  # 1 s of it is the script's own sleep
+    assert float(line[1]) < 0.05, "CPU was used after the interrupt returned"
+    assert p.wait(timeout=10) == 0
