@@ -265,8 +265,26 @@ class Spec:
         return DatasetSample(made)
 
     def __iter__(self):
-        for i in range(len(self)):
-            yield self[i]
+        return self.iterate()
+
+    def iterate(self, indices=None, in_flight: int | None = None):
+        """Samples of `indices` (default: all) in order, `in_flight` of them made at once on threads
+        of this process (default: one per core, each on one core): the GIL is released while they
+        are made, so this uses every core without worker processes."""
+        from concurrent.futures import ThreadPoolExecutor
+
+        indices = range(len(self)) if indices is None else list(indices)
+        in_flight = in_flight or os.cpu_count() or 1
+        threads = self.threads or max(1, (os.cpu_count() or 1) // in_flight)
+        make = lambda i: DatasetSample(self._spec.sample(int(i), threads=threads, memory_limit=self.memory_limit))
+        with ThreadPoolExecutor(in_flight) as pool:
+            pending = []
+            for i in indices:
+                pending.append(pool.submit(make, i))
+                if len(pending) > in_flight:
+                    yield pending.pop(0).result()
+            for f in pending:
+                yield f.result()
 
     def __getstate__(self):
         return {"path": self.path, "threads": self.threads, "memory_limit": self.memory_limit}

@@ -192,3 +192,25 @@ def test_ctrl_c_returns_promptly_and_stops_the_work(tmp_path):
     assert time.monotonic() - sent < 3.0  # 1 s of it is the script's own sleep
     assert float(line[1]) < 0.05, "CPU was used after the interrupt returned"
     assert p.wait(timeout=10) == 0
+
+
+def test_the_docs_python_blocks_run(source, tmp_path, monkeypatch):
+    # Every ```python block of docs/python.md and the README, in order, in one namespace, in a
+    # directory laid out like the source tree.
+    for d in ("examples", "demand_maps", "noise_profiles"):
+        (tmp_path / d).symlink_to(source / d)
+    monkeypatch.chdir(tmp_path)
+    for page in ("docs/python.md", "README.md"):
+        text = (source / page).read_text()
+        blocks = [b.split("```", 1)[0] for b in text.split("```python\n")[1:]]
+        assert blocks, page
+        namespace = {}
+        for block in blocks:
+            exec(compile(block, f"{page} block", "exec"), namespace)
+
+
+def test_iterate_gives_the_samples_in_order(source):
+    spec = angiosynth.Spec(source / "tests/data/dataset_tiny.toml")
+    made = list(spec.iterate([4, 1, 2], in_flight=2))
+    assert [s.id for s in made] == [spec.sample_id(i) for i in (4, 1, 2)]
+    assert np.array_equal(made[1].image, spec[1].image)
