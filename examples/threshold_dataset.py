@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """A stand-in segmenter for trying `angiosynth score --dataset`: each image of a dataset's
-imagesTr thresholded by the triangle method (Zack et al. 1977, as scikit-image computes it; it
-suits a histogram whose vessel tail is small), written as PRED_DIR/<case>.nii.gz, the names
+imagesTr thresholded at its mean intensity (scikit-image's threshold_mean: vessels are few and
+bright, so the mean lies just above the background), written as PRED_DIR/<case>.nii.gz, the names
 nnU-Net's predictions have. Replace it with your model's predictions.
 
     /usr/bin/python3 examples/threshold_dataset.py DATASET_DIR PRED_DIR
