@@ -5,7 +5,8 @@
     loader = torch.utils.data.DataLoader(data, batch_size=2, num_workers=2)
     for batch in loader:
         batch["image"]   # float32, (B, 1, X, Y, Z): channel first, as nnU-Net and MONAI expect
-        batch["label"]   # int64 (B, 1, X, Y, Z): labelsTr's values (float32 for the soft label policy)
+        batch["label"]   # uint8 (B, 1, X, Y, Z): labelsTr's values (float32 for the soft label policy);
+                         # .long() for a cross-entropy loss, .float() for Dice or BCE
 
 Seeding rule: item k is sample k // patches_per_sample of the spec, which depends on the spec and
 that index alone (its seed is drawn from [dataset] seed and the index). The patch of item k is
@@ -96,18 +97,18 @@ class SyntheticVessels(torch.utils.data.Dataset):
         self.spec.threads = self._threads()
         s = self.spec[index]
         where = self._patch(s.image.shape, index, k)
+        # Arrays keep the module's layout (x fastest): the tensors are strided views, which
+        # collation and convolution accept; no copy is made but the image's float conversion.
         image = self._padded(np.asarray(s.image[where], dtype=np.float32), self.patch_size)
         label = self._padded(s.label[where], self.patch_size)
-        label = label.astype(np.float32 if label.dtype == np.float32 else np.int64)
         out = {
-            "image": torch.from_numpy(np.ascontiguousarray(image)[None]),
-            "label": torch.from_numpy(np.ascontiguousarray(label)[None]),
+            "image": torch.from_numpy(image[None]),
+            "label": torch.from_numpy(label[None]),
             "index": index,
             "id": s.id,
             "patch_origin": torch.tensor([w.start or 0 for w in where]),
             "affine": torch.from_numpy(s.affine),
         }
         for role in self.extra:
-            v = self._padded(s.volumes[role][where], self.patch_size)
-            out[role] = torch.from_numpy(np.ascontiguousarray(v)[None].astype(np.float32 if v.dtype == np.float32 else np.int64))
+            out[role] = torch.from_numpy(self._padded(s.volumes[role][where], self.patch_size)[None])
         return self.transform(out) if self.transform else out

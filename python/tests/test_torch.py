@@ -27,11 +27,11 @@ def test_items_are_the_same_with_zero_and_two_workers(source):
     assert np.array_equal(serial[2][1][0].numpy(), s.image[x : x + 16, y : y + 16, z : z + 16].astype(np.float32))
 
 
-def test_whole_volumes_are_channel_first_with_labels_as_integers(source):
+def test_whole_volumes_are_channel_first_with_labels_as_stored(source):
     data = SyntheticVessels(source / "tests/data/dataset_tiny.toml", extra=["centerline"])
     item = data[1]
     assert item["image"].dtype == torch.float32 and item["image"].shape == (1, 32, 32, 32)
-    assert item["label"].dtype == torch.int64 and set(item["label"].unique().tolist()) <= {0, 1}
+    assert item["label"].dtype == torch.uint8 and set(item["label"].unique().tolist()) <= {0, 1}
     assert item["centerline"].shape == (1, 32, 32, 32)
     data.set_epoch(1)
     assert torch.equal(data[1]["image"], item["image"])  # whole volumes: the epoch draws nothing
