@@ -32,6 +32,7 @@
 #include "io/nifti_reader.hpp"
 #include "io/volume_writers.hpp"
 #include "pipeline/generate_sample.hpp"
+#include "pipeline/mesh_outputs.hpp"
 #include "score/case_scores.hpp"
 
 namespace py = pybind11;
@@ -310,6 +311,36 @@ void writePrediction(const py::array& prediction, const std::filesystem::path& m
   writeNifti(out, viewOf(v, true, "angiosynth.score prediction"));
 }
 
+// The surface of a sample's forest (as [mesh] makes it during generate) into a new directory, with
+// mesh.json as `angiosynth mesh` writes it; returns mesh.json's JSON.
+std::string writeMesh(const NativeSample& s, const std::string& settings_toml, const std::filesystem::path& out, bool force, int threads) {
+  return runReleased<std::string>(
+      [&](const Cancel&) {
+        toml::table root;
+        try {
+          root = toml::parse(settings_toml, std::string("<mesh settings>"));
+        } catch (const toml::parse_error& e) {
+          throw InputError("<mesh settings>", static_cast<int>(e.source().begin.line),
+                           std::string("not valid TOML: ") + std::string(e.description()));
+        }
+        const double voxel_mm = s.has_grid ? s.grid.spacing_mm.x : 1.0;
+        const MeshParameters p = readMeshParameters(root, "<mesh settings>", voxel_mm);
+        StagedDirectory dir(out, force ? ExistingOutput::ReplaceOwn : ExistingOutput::Refuse, {}, "directory");
+        std::vector<std::string> kinds;
+        for (const auto& t : s.forest.trees) kinds.push_back(t.kind);
+        const auto surface = writeSurfaceFiles(s.forest.vessels, p, defaultMemoryLimitBytes(), dir.path(), {}, kinds);
+        const nlohmann::ordered_json j = {{"tool", "angiosynth " + std::string(kVersion)},
+                                          {"input", "a sample in memory (Python)"},
+                                          {"parameters", surface.parameters},
+                                          {"statistics", surface.statistics.toJson()},
+                                          {"files", surface.files}};
+        std::ofstream(dir.path() / "mesh.json") << j.dump(2) << '\n';
+        dir.commit();
+        return j.dump();
+      },
+      threads);
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_core, m) {
@@ -368,6 +399,7 @@ PYBIND11_MODULE(_core, m) {
 
   m.def("write_truth", [](const NativeSample& s, const py::dict& volumes, const std::filesystem::path& dir) { writeTruth(s, volumes, dir); });
   m.def("write_prediction", &writePrediction);
+  m.def("write_mesh", &writeMesh, py::arg("native"), py::arg("settings"), py::arg("out"), py::arg("force") = false, py::arg("threads") = 0);
   m.def(
       "score",
       [](const std::filesystem::path& prediction, const std::filesystem::path& sample_dir, bool topcow, std::optional<double> tolerance_mm,

@@ -189,6 +189,13 @@ class Sample:
         _core.generate(**r)
         return os.fspath(directory)
 
+    def mesh(self, directory: str | os.PathLike, force: bool = False, threads: int = 0, **settings) -> dict:
+        """The closed surface of the sample's vessels, as `angiosynth mesh` makes it, written into a
+        new directory (surface.<format> and mesh.json); settings are the keys of [mesh]
+        (docs/parameters.md), e.g. formats=["stl", "vtp"], ends="capped". Returns mesh.json as a dict."""
+        text = _toml_text({"mesh": settings}) if settings else "[mesh]\n"
+        return json.loads(_core.write_mesh(self._native, text, os.fspath(directory), force=force, threads=threads))
+
     def __repr__(self) -> str:
         return f"Sample(seed={self.seed}, shape={self.shape}, volumes={sorted(self.volumes)}, {self.graph!r})"
 

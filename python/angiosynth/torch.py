@@ -34,7 +34,9 @@ class SyntheticVessels(torch.utils.data.Dataset):
 
     spec                a dataset spec (path or angiosynth.Spec)
     patch_size          (x, y, z) voxels of a random patch per item, or None for the whole volume
-    patches_per_sample  items per sample (each its own patch)
+    patches_per_sample  items per sample (each its own patch); consecutive items of one sample are
+                        cut from one generation of it, so keep them together (shuffle=False: the
+                        samples are independent draws already, or a sampler that keeps runs)
     indices             the spec's samples to use (default: all); e.g. a train/validation split
     extra               more volumes of the sample to return, by role: "centerline", "radius", "classes", ...
     threads             TBB threads per call (default: every core in the main process, 1 in a DataLoader worker)
@@ -63,6 +65,7 @@ class SyntheticVessels(torch.utils.data.Dataset):
         self.threads = threads
         self.transform = transform
         self.epoch = 0
+        self._last = None  # (index, sample): the patches of one sample share it when they come in a row
 
     def set_epoch(self, epoch: int) -> None:
         """New patches (of the same samples) for another epoch."""
@@ -94,8 +97,10 @@ class SyntheticVessels(torch.utils.data.Dataset):
             raise IndexError(f"item {item} of {len(self)}")
         index = self.indices[item // self.patches_per_sample]
         k = item % self.patches_per_sample
-        self.spec.threads = self._threads()
-        s = self.spec[index]
+        if self._last is None or self._last[0] != index:
+            self.spec.threads = self._threads()
+            self._last = (index, self.spec[index])
+        s = self._last[1]
         where = self._patch(s.image.shape, index, k)
         # Arrays keep the module's layout (x fastest): the tensors are strided views, which
         # collation and convolution accept; no copy is made but the image's float conversion.

@@ -214,3 +214,17 @@ def test_iterate_gives_the_samples_in_order(source):
     made = list(spec.iterate([4, 1, 2], in_flight=2))
     assert [s.id for s in made] == [spec.sample_id(i) for i in (4, 1, 2)]
     assert np.array_equal(made[1].image, spec[1].image)
+
+
+def test_mesh_of_a_sample_in_memory_is_the_surface_generate_writes(program, tmp_path):
+    with_mesh = dict(SMALL, mesh={"formats": ["stl"]})
+    params = tmp_path / "mesh.toml"
+    params.write_text(angiosynth._toml_text(with_mesh))
+    run(program, "generate", str(params), "--out", str(tmp_path / "cli"), "--quiet")
+    info = angiosynth.generate(SMALL).mesh(tmp_path / "py", formats=["stl"])
+    assert (tmp_path / "py/surface.stl").read_bytes() == (tmp_path / "cli/surface.stl").read_bytes()
+    st = info["statistics"]
+    assert st["boundary_edges"] == 0 and st["nonmanifold_edges"] == 0 and st["trees"] == 2
+    assert st["tree_euler_characteristic"] == [2, 2]  # each tree's surface a sphere: closed, no handle
+    with pytest.raises(angiosynth.InputError, match="formats"):
+        angiosynth.generate(SMALL).mesh(tmp_path / "bad", formats=["xyz"])

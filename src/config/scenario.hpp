@@ -54,6 +54,9 @@ Scenario readVascuSynthParameters(const std::filesystem::path& file, const ReadO
 Scenario readTomlParameters(const std::filesystem::path& file);
 // The same from a parsed table; relative paths are resolved beside `file` (a dataset spec).
 Scenario readTomlParameters(const toml::table& root, const std::filesystem::path& file);
+// A [mesh] table alone (the Python module's Sample.mesh), read, defaulted and checked as in a
+// parameter file; `voxel_mm` is the unit of settings given in voxels.
+MeshParameters readMeshParameters(const toml::table& root, const std::filesystem::path& file, double voxel_mm);
 // Chooses by extension: .toml is native, anything else VascuSynth.
 Scenario readParameters(const std::filesystem::path& file, const ReadOptions& opt = {});
 

@@ -44,6 +44,15 @@ std::set<std::string> keysOfAll(const Lists&... lists) {
 
 }  // namespace
 
+MeshParameters readMeshParameters(const toml::table& root, const std::filesystem::path& path, double voxel_mm) {
+  TomlReader r(root, path.string());
+  r.checkKeys(root, {"mesh"}, "the top level");
+  Scenario sc;
+  readEnablingTable(r, "mesh", meshSettings(), meshRules(), sc.mesh, sc.mesh_line, voxel_mm);
+  sc.mesh.enabled = true;
+  return sc.mesh;
+}
+
 Scenario readTomlParameters(const std::filesystem::path& path) { return readTomlParameters(parseTomlFile(path, "parameter file"), path); }
 
 Scenario readTomlParameters(const toml::table& root, const std::filesystem::path& path) {
