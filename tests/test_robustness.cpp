@@ -15,7 +15,7 @@
 #include "cli_run.hpp"
 #include "core/error.hpp"
 #include "core/physical_ranges.hpp"
-#include "grow/common/segment_grid.hpp"
+#include "core/segment_grid.hpp"
 #include "core/interrupt_cleanup.hpp"
 #include "files/atomic_file.hpp"
 #include "io/network_files.hpp"

@@ -5,7 +5,7 @@
 #include <numbers>
 
 #include "grow/common/intersections.hpp"
-#include "grow/common/segment_grid.hpp"
+#include "core/segment_grid.hpp"
 
 namespace angiosynth {
 

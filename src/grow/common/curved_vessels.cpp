@@ -12,7 +12,7 @@
 #include "core/rng.hpp"
 #include "domain/growth_domain.hpp"
 #include "grow/common/intersections.hpp"
-#include "grow/common/segment_grid.hpp"
+#include "core/segment_grid.hpp"
 
 namespace angiosynth {
 

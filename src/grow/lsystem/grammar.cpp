@@ -9,7 +9,7 @@
 
 #include "core/rng.hpp"
 #include "grow/common/intersections.hpp"
-#include "grow/common/segment_grid.hpp"
+#include "core/segment_grid.hpp"
 
 namespace angiosynth {
 
