@@ -707,6 +707,54 @@ TEST(Mesh, CommandWritesTheSurfaceAndRefusesWhatItCannotDo) {
   std::filesystem::remove_all(dir);
 }
 
+// A flow extension is added geometry: in this 40-terminal disc, unchecked, two outlets' extensions
+// ran into other vessels and fused with them (a capped surface of Euler characteristic -2, two
+// handles). Each is now shortened, named in a warning and in surface_faces.csv, and the tree keeps
+// the topology of its graph. A surface that does not (a graph whose walls overlap) is named with
+// the vessels that cause it.
+TEST(Mesh, FlowExtensionsStopShortOfOtherVesselsAndTheTopologyIsChecked) {
+  const auto dir = std::filesystem::temp_directory_path() / ("angiosynth_mesh_extension_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto text = readText(test::sourceDir() / "examples/cco_disc_2d.toml");
+  text.replace(text.find("terminals = 4000"), 16, "terminals = 40");
+  std::ofstream(dir / "disc.toml") << text;
+  ASSERT_EQ(run("generate disc.toml --seed 3 --out sample --no-image --quiet", dir).code, 0);
+  const auto capped = run("mesh sample --out capped --ends capped --flow-extension 5 --quiet", dir);
+  ASSERT_EQ(capped.code, 0) << capped.err;
+  const auto st = nlohmann::json::parse(readText(dir / "capped/mesh.json"))["statistics"];
+  EXPECT_EQ(st["tree_euler_characteristic"], nlohmann::json::array({2}));
+  EXPECT_EQ(st["tree_euler_expected"], nlohmann::json::array({2}));
+  EXPECT_EQ(st["boundary_edges"], 0);
+  const auto shortened = st["ends_extension_shortened"].get<int>();
+  EXPECT_GE(shortened, 1);
+  EXPECT_EQ(st["warnings"].size(), std::size_t(shortened + st["ends_left_closed"].get<int>()));
+  EXPECT_NE(capped.err.find("flow extension shortened to"), std::string::npos) << capped.err;
+  // surface_faces.csv: the extension each end got, 5 radii or less where it was shortened.
+  std::istringstream rows(readText(dir / "capped/surface_faces.csv"));
+  std::string row;
+  std::getline(rows, row);
+  EXPECT_EQ(row.substr(row.rfind(',') + 1), "extension_radii");
+  int short_rows = 0;
+  while (std::getline(rows, row)) {
+    const auto last = row.substr(row.rfind(',') + 1);
+    if (last.empty()) continue;  // the wall
+    EXPECT_LE(std::stod(last), 5.0);
+    short_rows += std::stod(last) < 5;
+  }
+  EXPECT_EQ(short_rows, shortened);
+  // A ring of four vessels whose last ends against the first: one handle, named with its vessels.
+  std::ofstream(dir / "ring.swc") << "1 1 0 0 0 1 -1\n2 3 0 10 0 1 1\n3 3 10 10 0 1 2\n4 3 10 0 0 1 3\n5 3 1.5 0 0 1 4\n";
+  const auto ring = run("mesh ring.swc --out ring --quiet", dir);
+  ASSERT_EQ(ring.code, 0) << ring.err;
+  const auto rs = nlohmann::json::parse(readText(dir / "ring/mesh.json"))["statistics"];
+  EXPECT_EQ(rs["tree_euler_characteristic"], nlohmann::json::array({0}));
+  EXPECT_EQ(rs["tree_euler_expected"], nlohmann::json::array({2}));
+  EXPECT_NE(ring.err.find("tree 0: the surface has Euler characteristic 0 in 1 piece, not 2"), std::string::npos) << ring.err;
+  EXPECT_NE(ring.err.find("1 handle where vessels fuse (walls within a contour step of each other: vessel 2 and vessel 5)"), std::string::npos)
+      << ring.err;
+  std::filesystem::remove_all(dir);
+}
+
 // [mesh] in a parameter file: generate writes the surface beside the graphs, describes it in
 // sample.json, gives the same surface as `angiosynth mesh` on the written graph, and refuses
 // a bad value with its line, writing nothing.
@@ -808,12 +856,13 @@ TEST(Mesh, CappedAndOpenEndsArePlanarLabelledAndWatertight) {
     const auto tetgen = check("capped", "--self-intersections");
     for (const auto& [ext, pairs] : tetgen.items()) EXPECT_EQ(pairs, 0) << method << ", " << ext << ": intersecting face pairs";
     const auto faces = readText(dir / "capped/surface_faces.csv");
-    EXPECT_EQ(faces.substr(0, faces.find('\n')),
-              "face_id,kind,tree,vessel,end,state,centre_x,centre_y,centre_z,normal_x,normal_y,normal_z,radius,cap_area,loop_vertices");
+    EXPECT_EQ(
+        faces.substr(0, faces.find('\n')),
+        "face_id,kind,tree,vessel,end,state,centre_x,centre_y,centre_z,normal_x,normal_y,normal_z,radius,cap_area,loop_vertices,extension_radii");
   }
   // Capped, the contour's slivers are repaired by default, and TetGen meshes the volume with
   // quality (radius–edge ratio 1.414) at its default tolerance, undecimated.
-  EXPECT_GT(st["slivers_repaired"].get<int>(), 100);
+  EXPECT_GT(st["sliver_repair_changes"].get<int>(), 100);
   const std::string tetgen_fine = "cd '" + (dir / "capped").string() + "' && tetgen -pq1.414 -Q surface.off > tetgen.log 2>&1";
   EXPECT_EQ(std::system(tetgen_fine.c_str()), 0) << readText(dir / "capped/tetgen.log");
   EXPECT_TRUE(std::filesystem::exists(dir / "capped/surface.1.ele"));

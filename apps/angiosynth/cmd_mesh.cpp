@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "setting_flags.hpp"
 #include "core/error.hpp"
+#include "core/format.hpp"
 #include "core/physical_ranges.hpp"
 #include "io/mesh_writers.hpp"
 #include "io/network_files.hpp"
@@ -23,7 +24,7 @@ using Json = nlohmann::ordered_json;
 
 CLI::App* addMesh(CLI::App& app, MeshArgs& a) {
   auto* c = app.add_subcommand("mesh",
-                               "the outer surface of a tree as a closed triangle mesh per tree (STL, OBJ, PLY, OFF, VTP), "
+                               "the outer surface of a tree as a closed triangle mesh per tree (in the formats of --format), "
                                "from a sample directory angiosynth generate wrote or a graph file");
   c->add_option("INPUT", a.input, "a sample directory (its nodes.csv and edges.csv are read) or a graph file: .csv, .gxl, .vtp, .swc, .cco")
       ->required();
@@ -64,10 +65,13 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
             {"timing_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()}};
   std::ofstream(dir.path() / "mesh.json") << j.dump(2) << '\n';
   dir.commit();
+  const auto& s = surface.statistics;
   if (!a.common.quiet)
-    std::cerr << "wrote " << dir.target().string() << ": " << surface.statistics.triangles << " triangles (" << surface.statistics.trees << " trees, "
-              << surface.statistics.segments << " segments, finest step " << surface.statistics.finest_step_mm << " mm), enclosed volume "
-              << surface.statistics.topology.volume_mm3 << " mm^3\n";
+    std::cerr << "wrote " << dir.target().string() << ": " << s.triangles << " triangles (" << counted(s.trees, "tree") << ", "
+              << counted(s.segments, "segment") << ", finest step " << show(s.finest_step_mm) << " mm), enclosed volume "
+              << show(s.topology.volume_mm3) << " mm^3\n";
+  // Also with --quiet: a surface not as asked is wrong for what comes next.
+  for (const auto& w : s.warnings) std::cerr << "warning: " << w << "\n";
   return 0;
 }
 

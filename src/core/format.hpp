@@ -12,11 +12,14 @@ inline std::string exactNumber(double v) {
   return std::string(buf, r.ptr);
 }
 
-// Numbers in messages: six significant digits.
-inline std::string show(double v) {
+// Numbers in messages: six significant digits, or `digits`.
+inline std::string show(double v, int digits = 6) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
   return buf;
 }
+
+// "1 tree", "3 trees".
+inline std::string counted(long long n, const std::string& noun) { return std::to_string(n) + " " + noun + (n == 1 ? "" : "s"); }
 
 }  // namespace angiosynth

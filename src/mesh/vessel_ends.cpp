@@ -1,5 +1,6 @@
 #include "mesh/vessel_ends.hpp"
 
+#include "core/segment_grid.hpp"
 #include "mesh/plane_clip.hpp"
 #include "mesh/ring_mesh.hpp"
 
@@ -116,7 +117,94 @@ EndCutExtent endCutExtent(double r, double step, bool tight) {
   return {r + h, (kOvershootRadii + 1) * r + h, 1.5 * r + h};
 }
 
-std::vector<VesselEnd> openEnds(const VascularTree& t, double extension_radii) {
+namespace {
+
+// Shortens each end's extension where it, or its cut's region, would come nearer another vessel
+// than the end already is (within the region's reach of another vessel's wall): the distance of
+// a segment from the node grows shorter with its length only, so the longest extension allowed
+// is found by bisection.
+void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, double extension_radii, double step_radii) {
+  Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
+  double widest = 0;
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i) {
+    lo = componentMin(lo, t.position[i]), hi = componentMax(hi, t.position[i]);
+    if (!t.isRoot(i)) widest = std::max({widest, t.radius[i], t.startRadius(i)});
+  }
+  std::vector<double> lengths;
+  for (const auto& e : ends) {
+    const auto x = endCutExtent(e.radius, step_radii * e.radius);
+    lengths.push_back(extension_radii * e.radius + x.beyond + x.reach);
+  }
+  const double grow = *std::max_element(lengths.begin(), lengths.end()) + widest;
+  std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2), lengths.end());
+  SegmentGrid grid(lo - Vec3(grow, grow, grow), hi + Vec3(grow, grow, grow), lengths[lengths.size() / 2], hi.z - lo.z <= 0);
+  for (std::int32_t i = 0; i < t.nodeCount(); ++i)
+    if (!t.isRoot(i) && !t.isLink(i)) grid.insert(i, t.position[t.parent[i]], t.position[i], std::max(t.radius[i], t.startRadius(i)));
+
+  struct Near {
+    std::int32_t vessel;
+    Vec3 a, b;
+    double clearance;  // what the end keeps from its axis: its wall plus the region's reach, or less if already nearer
+  };
+  std::vector<Near> near;
+  // The extensions decided so far (ids nodeCount + k in the grid): two ends that face each other
+  // must not both reach into the gap. Each keeps the other out of its cut's reach.
+  struct Extension {
+    Vec3 a, b;
+    double radius, reach;
+  };
+  std::vector<Extension> decided(ends.size());
+  const std::int32_t first_extension = t.nodeCount();
+  for (std::size_t k = 0; k < ends.size(); ++k) {
+    auto& e = ends[k];
+    const auto x = endCutExtent(e.radius, step_radii * e.radius);
+    const auto reachOf = [&](double radii) { return e.node + e.normal * (radii * e.radius + x.beyond); };
+    near.clear();
+    grid.any(e.node, reachOf(extension_radii), x.reach, [&](std::int32_t y) {
+      if (y == e.vessel) return false;
+      Vec3 a, b;
+      double wall;
+      std::int32_t vessel = y;
+      if (y >= first_extension) {
+        const auto& other = decided[std::size_t(y - first_extension)];
+        a = other.a, b = other.b;
+        wall = std::max(other.radius + x.reach, e.radius + other.reach);
+        vessel = ends[std::size_t(y - first_extension)].vessel;
+      } else {
+        a = t.position[t.parent[y]], b = t.position[y];
+        wall = std::max(t.radius[y], t.startRadius(y)) + x.reach;
+      }
+      near.push_back({vessel, a, b, std::min(wall, segmentSegmentDistance(e.node, reachOf(0), a, b))});
+      return false;
+    });
+    // The vessel that stops an extension of `radii`, or -1.
+    const auto stop = [&](double radii) {
+      for (const auto& n : near)
+        if (segmentSegmentDistance(e.node, reachOf(radii), n.a, n.b) < n.clearance) return n.vessel;
+      return std::int32_t(-1);
+    };
+    double given = extension_radii;
+    if (const auto first = stop(given); first >= 0) {
+      double clear = 0, blocked = given;
+      e.extension_stop = first;
+      for (int k = 0; k < 40; ++k) {
+        const double mid = 0.5 * (clear + blocked);
+        const auto s = stop(mid);
+        (s >= 0 ? blocked : clear) = mid;
+        if (s >= 0) e.extension_stop = s;
+      }
+      given = clear;
+    }
+    e.extension_radii = given;
+    e.centre = e.node + e.normal * (given * e.radius);
+    decided[k] = {e.node, reachOf(given), e.radius, x.reach};
+    grid.insert(first_extension + std::int32_t(k), decided[k].a, decided[k].b, e.radius + x.reach);
+  }
+}
+
+}  // namespace
+
+std::vector<VesselEnd> openEnds(const VascularTree& t, double extension_radii, double step_radii) {
   std::vector<VesselEnd> ends;
   const auto add = [&](std::int32_t vessel, bool root) {
     const std::int32_t node = root ? t.parent[vessel] : vessel, other = root ? vessel : t.parent[vessel];
@@ -130,6 +218,7 @@ std::vector<VesselEnd> openEnds(const VascularTree& t, double extension_radii) {
     e.normal = unit(d);
     e.radius = root ? t.startRadius(vessel) : t.radius[vessel];
     e.centre = e.node + e.normal * (extension_radii * e.radius);
+    e.extension_radii = extension_radii;
     if (e.radius > 0) ends.push_back(e);
   };
   for (std::int32_t i = 0; i < t.nodeCount(); ++i)
@@ -141,6 +230,7 @@ std::vector<VesselEnd> openEnds(const VascularTree& t, double extension_radii) {
   std::sort(ends.begin(), ends.end(), [](const VesselEnd& a, const VesselEnd& b) {
     return std::make_tuple(a.tree, !a.root, a.node.x, a.node.y, a.node.z) < std::make_tuple(b.tree, !b.root, b.node.x, b.node.y, b.node.z);
   });
+  if (extension_radii > 0 && !ends.empty()) keepExtensionsClear(t, ends, extension_radii, step_radii);
   return ends;
 }
 

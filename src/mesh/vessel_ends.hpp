@@ -18,14 +18,16 @@ namespace angiosynth {
 struct VesselEnd {
   std::int32_t vessel = -1;  // the segment (its distal node id) whose end this is
   std::int32_t tree = 0;
-  bool root = false;   // the tree's root end (else a leaf)
-  Vec3 node;           // the end node of the vessel, mm
-  Vec3 centre;         // the cut plane's point on the axis (node + normal × extension), mm
-  Vec3 normal;         // unit, pointing out of the vessel
-  double radius = 0;   // the vessel's radius at that end, mm
-  bool open = false;   // never capped (a tube's cut, joined to its rings later)
-  bool tight = false;  // read only a step around the tube (the caller keeps other vessels out of it)
-  double step = 0;     // tight: that step (mm), else each vertex's own
+  bool root = false;                 // the tree's root end (else a leaf)
+  Vec3 node;                         // the end node of the vessel, mm
+  Vec3 centre;                       // the cut plane's point on the axis (node + normal × extension), mm
+  Vec3 normal;                       // unit, pointing out of the vessel
+  double radius = 0;                 // the vessel's radius at that end, mm
+  bool open = false;                 // never capped (a tube's cut, joined to its rings later)
+  bool tight = false;                // read only a step around the tube (the caller keeps other vessels out of it)
+  double step = 0;                   // tight: that step (mm), else each vertex's own
+  double extension_radii = 0;        // the flow extension it got: the one asked, or less where that would reach another vessel
+  std::int32_t extension_stop = -1;  // then the vessel (its distal node id) that stopped it
 };
 
 // The space an end's cut reads around its axis: from `before` behind its plane to `beyond` past
@@ -39,8 +41,11 @@ EndCutExtent endCutExtent(double radius, double step, bool tight = false);
 
 // The open ends of a tree: each root with a single vessel leaving it and every leaf; per tree,
 // the root first, then the leaves by position (x, y, z); `extension_radii` ≥ 0 moves each plane
-// that many radii beyond its node.
-std::vector<VesselEnd> openEnds(const VascularTree& t, double extension_radii);
+// that many radii beyond its node. An extension is added geometry: where it, or its cut's
+// region (endCutExtent, for a contour step of `step_radii` of the end's radius), would come
+// nearer another vessel than the end itself already is, it is shortened to the longest that does
+// not (the mesher would fuse the two into a handle, or leave the end closed).
+std::vector<VesselEnd> openEnds(const VascularTree& t, double extension_radii, double step_radii = 1);
 
 // The tree with every end prolonged along its axis at its end radius, a radius past its plane
 // (what the cut removes again).

@@ -159,12 +159,13 @@ void writeGraphs(const Forest& forest, const PreparedSample& ps, const SampleReq
 }
 
 // The surface of each tree ([mesh]), its files and statistics.
-void writeSurface(const Forest& forest, const SampleRequest& req, const std::filesystem::path& dir, Json& files, Json& stats) {
+std::vector<std::string> writeSurface(const Forest& forest, const SampleRequest& req, const std::filesystem::path& dir, Json& files, Json& stats) {
   std::vector<std::string> kinds;
   for (const auto& t : forest.trees) kinds.push_back(t.kind);
   const auto surface = writeSurfaceFiles(forest.vessels, req.scenario->mesh, req.memory_limit, dir, {}, kinds);
   for (const auto& [format, name] : surface.files.items()) files["surface_" + format] = name;
   stats["surface"] = surface.statistics.toJson();
+  return surface.statistics.warnings;
 }
 
 // The final tree's size, cost, radii and depths, growth's counts and the method's own.
@@ -333,12 +334,14 @@ SampleSummary generateSample(const SampleRequest& req, const std::filesystem::pa
     timing["write_graphs"] = timing["write_graphs"].get<double>() + seconds(t0);
   }
   checkCancelled();
+  std::vector<std::string> warnings;
   if (sc.mesh.enabled && req.write_files) {
     t0 = Clock::now();
-    writeSurface(forest, req, dir, files, stats);
+    warnings = writeSurface(forest, req, dir, files, stats);
     timing["mesh"] = seconds(t0);
   }
   SampleSummary summary;
+  summary.warnings = std::move(warnings);
   summary.terminals = tree.totalTerminals();
   summary.total_volume_mm3 = treeVolume(tree);
   summary.intersecting_pairs = report.intersecting_pairs;

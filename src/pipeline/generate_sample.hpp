@@ -52,7 +52,8 @@ struct SampleSummary {
   double total_volume_mm3 = 0;
   std::int64_t intersecting_pairs = 0;  // segment capsules that overlap, more than two segments apart
   double grow_seconds = 0;
-  nlohmann::ordered_json sidecar;  // sample.json as written
+  std::vector<std::string> warnings;  // what a user must read before using the files (a [mesh] surface not as asked)
+  nlohmann::ordered_json sidecar;     // sample.json as written
   // The file written for `role` ("image", "mask", "image_cta", …), relative to the sample's directory.
   std::filesystem::path file(const std::string& role) const;
   bool wrote(const std::string& role) const;

@@ -5,10 +5,13 @@
 #include <cmath>
 #include <fstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "io/mesh_writers.hpp"
 #include "core/format.hpp"
+#include "core/segment_grid.hpp"
+#include "grow/common/intersections.hpp"
 #include "mesh/box_clip.hpp"
 #include "mesh/decimate.hpp"
 #include "mesh/hollow_wall.hpp"
@@ -29,8 +32,8 @@ namespace {
 void writeFaces(std::ostream& os, const std::vector<VesselEnd>& ends, const EndCutReport& cut, const std::string& mode,
                 const std::vector<std::string>& kinds, const std::vector<std::string>& vessel_ids, const std::vector<double>& box,
                 const BoxClipReport& clipped) {
-  os << "face_id,kind,tree,vessel,end,state,centre_x,centre_y,centre_z,normal_x,normal_y,normal_z,radius,cap_area,loop_vertices\n";
-  os << "1,wall,,,,,,,,,,,,,\n";
+  os << "face_id,kind,tree,vessel,end,state,centre_x,centre_y,centre_z,normal_x,normal_y,normal_z,radius,cap_area,loop_vertices,extension_radii\n";
+  os << "1,wall,,,,,,,,,,,,,,\n";
   std::vector<char> closed(ends.size(), 0);
   for (auto e : cut.left_closed) closed[std::size_t(e)] = 1;
   const auto outside = [&](const Vec3& c) {
@@ -47,7 +50,7 @@ void writeFaces(std::ostream& os, const std::vector<VesselEnd>& ends, const EndC
                              : mode)
        << ',' << exactNumber(e.centre.x) << ',' << exactNumber(e.centre.y) << ',' << exactNumber(e.centre.z) << ',' << exactNumber(e.normal.x) << ','
        << exactNumber(e.normal.y) << ',' << exactNumber(e.normal.z) << ',' << exactNumber(e.radius) << ',' << exactNumber(cut.cap_area_mm2[k]) << ','
-       << cut.loop_vertices[k] << '\n';
+       << cut.loop_vertices[k] << ',' << exactNumber(e.extension_radii) << '\n';
   }
   if (box.empty()) return;
   for (int side = 0; side < 6; ++side) {
@@ -60,7 +63,7 @@ void writeFaces(std::ostream& os, const std::vector<VesselEnd>& ends, const EndC
     os << ends.size() + 2 + std::size_t(side) << ",box,,," << kBoxSideNames[side] << ",section";
     for (double v : c) os << ',' << exactNumber(v);
     for (double v : n) os << ',' << exactNumber(v);
-    os << ",," << exactNumber(clipped.section_area_mm2[std::size_t(side)]) << ",\n";
+    os << ",," << exactNumber(clipped.section_area_mm2[std::size_t(side)]) << ",,\n";
   }
 }
 
@@ -103,6 +106,14 @@ void checkVoxelAgainstThinnest(const VascularTree& tree, const MeshParameters& p
                          exactNumber(2 * thinnest) + " mm); allowed: at most " + exactNumber(thinnest) + " mm, two steps across it");
 }
 
+double smallestAngleDeg(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const auto corner = [](const Vec3& p, const Vec3& q, const Vec3& r) {
+    const double l = norm(q - p) * norm(r - p);
+    return l > 0 ? std::acos(std::clamp(dot(q - p, r - p) / l, -1.0, 1.0)) : 0.0;
+  };
+  return std::min({corner(a, b, c), corner(b, c, a), corner(c, a, b)}) * 180 / M_PI;
+}
+
 // The meshers' options, from the settings.
 struct SurfacePlan {
   bool tubes = false, walls = false, cut_ends = false;
@@ -126,7 +137,8 @@ SurfacePlan planSurface(const VascularTree& tree, const MeshParameters& p, std::
   o.memory_limit = memory_limit;
   plan.cut_ends = p.ends != "closed" || plan.walls;  // a hollow wall's ends are open
   TubeSurfaceOptions& to = plan.tube;
-  if (plan.cut_ends) to.ends = openEnds(tree, p.flow_extension);
+  // An end's step: its diameter over the samples across it (what the adaptive contour gives it).
+  if (plan.cut_ends) to.ends = openEnds(tree, p.flow_extension, 2.0 / o.samples_across);
   DecimateOptions& d = to.decimation;
   d.max_error = p.max_error;
   d.sliver_deg = p.sliverAngle();
@@ -220,14 +232,115 @@ SurfaceSummary summarise(const VascularTree& tree, const MeshParameters& p, cons
   if (p.decimate) s.triangles_before_decimation = b.reduced.before;
   s.decimation_collapses = b.reduced.collapses;
   s.decimation_largest_error_mm = b.reduced.largest_error_mm;
-  s.slivers_repaired = tubes ? b.tube.slivers_repaired : b.slivers.changes();
+  s.sliver_repair_changes = tubes ? b.tube.slivers_repaired : b.slivers.changes();
+  s.smallest_angle_deg = 180;
+  for (const auto& t : b.mesh.triangles) {
+    const double a = smallestAngleDeg(b.mesh.vertices[std::size_t(t[0])], b.mesh.vertices[std::size_t(t[1])], b.mesh.vertices[std::size_t(t[2])]);
+    s.smallest_angle_deg = std::min(s.smallest_angle_deg, a);
+    s.triangles_below_sliver_angle += p.sliverAngle() > 0 && a < p.sliverAngle();
+  }
   s.remesh_splits = b.tube.remesh_splits;
   s.remesh_changes = b.tube.remesh_changes;
   s.ends = std::int64_t(plan.ends().size());
   s.ends_cut = b.cut.cut;
   s.ends_left_closed = std::int64_t(b.cut.left_closed.size());
+  for (const auto& e : plan.ends()) s.ends_extension_shortened += e.extension_stop >= 0;
   if (clip) s.clip = b.clipped;
+  if (!plan.walls && !clip) {
+    s.tree_euler_expected.assign(s.topology.tree_euler.size(), 2);
+    std::vector<char> closed(plan.ends().size(), 0);
+    for (auto e : b.cut.left_closed) closed[std::size_t(e)] = 1;
+    for (std::size_t k = 0; k < plan.ends().size(); ++k)
+      if (p.ends == "open" && !closed[k] && std::size_t(plan.ends()[k].tree) < s.tree_euler_expected.size())
+        --s.tree_euler_expected[std::size_t(plan.ends()[k].tree)];
+  }
   return s;
+}
+
+std::string vesselName(std::int32_t v, const std::vector<std::string>& vessel_ids) {
+  return "vessel " + (std::size_t(v) < vessel_ids.size() ? vessel_ids[std::size_t(v)] : std::to_string(v));
+}
+
+std::string endName(std::size_t k, const VesselEnd& e, const std::vector<std::string>& vessel_ids) {
+  return std::string(e.root ? "the root" : "the leaf") + " end of " + vesselName(e.vessel, vessel_ids) + " at (" + show(e.node.x) + ", " +
+         show(e.node.y) + ", " + show(e.node.z) + ") mm (face_id " + std::to_string(k + 2) + ")";
+}
+
+// Vessel pairs of a tree, more than two segments apart, whose walls come within a contour step
+// of each other (the thinner one's: its diameter over `samples_across`), the nearest first: the
+// surface joins them into a handle though their capsules need not overlap.
+std::vector<std::pair<std::int32_t, std::int32_t>> nearlyTouching(const VascularTree& tree, double samples_across) {
+  Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
+  std::vector<double> lengths;
+  for (std::int32_t i = 0; i < tree.nodeCount(); ++i) {
+    lo = componentMin(lo, tree.position[i]), hi = componentMax(hi, tree.position[i]);
+    if (!tree.isRoot(i) && !tree.isLink(i)) lengths.push_back(distance(tree.position[i], tree.position[tree.parent[i]]));
+  }
+  std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
+  std::vector<std::tuple<double, std::int32_t, std::int32_t>> found;  // (gap in steps, x, y)
+  if (lengths.empty()) return pairs;
+  std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2), lengths.end());
+  const auto wall = [&](std::int32_t i) { return std::max(tree.radius[i], tree.startRadius(i)); };
+  const auto step = [&](std::int32_t i) { return 2 * wall(i) / samples_across; };
+  SegmentGrid grid(lo, hi, std::max(lengths[lengths.size() / 2], 1e-6), hi.z - lo.z <= 0);
+  for (std::int32_t i = 0; i < tree.nodeCount(); ++i)
+    if (!tree.isRoot(i) && !tree.isLink(i)) grid.insert(i, tree.position[tree.parent[i]], tree.position[i], wall(i) + step(i));
+  for (std::int32_t x = 0; x < tree.nodeCount(); ++x) {
+    if (tree.isRoot(x) || tree.isLink(x)) continue;
+    const Vec3 a = tree.position[tree.parent[x]], b = tree.position[x];
+    grid.any(a, b, wall(x) + step(x), [&](std::int32_t y) {
+      if (y <= x || (!tree.tree.empty() && tree.tree[x] != tree.tree[y]) || withinTwoSegments(tree, x, y)) return false;
+      const double gap = segmentSegmentDistance(a, b, tree.position[tree.parent[y]], tree.position[y]) - wall(x) - wall(y);
+      const double share = gap / std::min(step(x), step(y));
+      if (share < 1 && !joinedAlongVessel(tree, x, y, wall(x) + wall(y))) found.push_back({share, x, y});
+      return false;
+    });
+  }
+  std::sort(found.begin(), found.end());  // the nearest first
+  for (const auto& [share, x, y] : found) pairs.emplace_back(x, y);
+  return pairs;
+}
+
+// The summary's warnings: ends the mesher could not do as asked, and trees whose surface has
+// another topology than their graph, with the vessel pairs whose walls overlap in that tree.
+std::vector<std::string> surfaceWarnings(const VascularTree& tree, const SurfacePlan& plan, const BuiltSurface& b, const SurfaceSummary& s,
+                                         const std::vector<std::string>& vessel_ids, double samples_across) {
+  std::vector<std::string> out;
+  const auto& ends = plan.ends();
+  for (std::size_t k = 0; k < ends.size(); ++k)
+    if (ends[k].extension_stop >= 0)
+      out.push_back(endName(k, ends[k], vessel_ids) + ": flow extension shortened to " + show(ends[k].extension_radii, 3) +
+                    " radii; a longer one comes within its cut's reach of " + vesselName(ends[k].extension_stop, vessel_ids));
+  for (auto k : b.cut.left_closed)
+    out.push_back(endName(std::size_t(k), ends[std::size_t(k)], vessel_ids) +
+                  ": left closed (round, face 'left_closed' in surface_faces.csv): another vessel's wall lies within its cut's reach");
+  std::vector<std::pair<std::int32_t, std::int32_t>> overlaps;
+  bool computed = false;
+  for (std::size_t t = 0; t < s.tree_euler_expected.size(); ++t) {
+    const auto chi = s.topology.tree_euler[t], want = s.tree_euler_expected[t];
+    const auto parts = t < s.topology.tree_components.size() ? s.topology.tree_components[t] : 0;
+    if (parts == 0 || (chi == want && parts == 1)) continue;
+    std::string w = "tree " + std::to_string(t) + ": the surface has Euler characteristic " + std::to_string(chi) + " in " + counted(parts, "piece") +
+                    ", not " + std::to_string(want) + " in one piece as its graph implies";
+    if (chi < want) w += ": " + counted((want - chi + 1) / 2, "handle") + " where vessels fuse";
+    if (!computed) {
+      overlaps = nearlyTouching(tree, samples_across);
+      computed = true;
+    }
+    std::vector<std::string> named;
+    std::size_t in_tree = 0;
+    for (const auto& [x, y] : overlaps)
+      if (std::size_t(tree.tree.empty() ? 0 : tree.tree[x]) == t && in_tree++ < 5)
+        named.push_back(vesselName(x, vessel_ids) + " and " + vesselName(y, vessel_ids));
+    if (in_tree > named.size()) named.push_back(std::to_string(in_tree - named.size()) + " more pairs");
+    if (!named.empty()) {
+      w += " (walls within a contour step of each other:";
+      for (std::size_t i = 0; i < named.size(); ++i) w += (i ? ", " : " ") + named[i];
+      w += ")";
+    }
+    out.push_back(w + "; do not mesh its volume before removing them");
+  }
+  return out;
 }
 
 // The settings as the meshers took them (defaults resolved) and how the surface is made.
@@ -305,17 +418,22 @@ Json SurfaceSummary::toJson() const {
           {"triangles_before_decimation", opt(triangles_before_decimation, [](std::int64_t v) { return v; })},
           {"decimation_collapses", decimation_collapses},
           {"decimation_largest_error_mm", decimation_largest_error_mm},
-          {"slivers_repaired", slivers_repaired},
+          {"sliver_repair_changes", sliver_repair_changes},
+          {"smallest_angle_deg", smallest_angle_deg},
+          {"triangles_below_sliver_angle", triangles_below_sliver_angle},
           {"remesh_splits", remesh_splits},
           {"remesh_changes", remesh_changes},
           {"ends", ends},
           {"ends_cut", ends_cut},
           {"ends_left_closed", ends_left_closed},
+          {"ends_extension_shortened", ends_extension_shortened},
           {"clip_box_removed_triangles", opt(clip, [](const BoxClipReport& c) { return c.removed_triangles; })},
           {"clip_box_section_loops", opt(clip, [](const BoxClipReport& c) { return c.section_loops; })},
           {"clip_box_section_area_mm2", opt(clip, [](const BoxClipReport& c) { return c.section_area_mm2; })},
           {"tree_components", t.tree_components},
-          {"tree_euler_characteristic", t.tree_euler}};
+          {"tree_euler_characteristic", t.tree_euler},
+          {"tree_euler_expected", tree_euler_expected.empty() ? Json(nullptr) : Json(tree_euler_expected)},
+          {"warnings", warnings}};
 }
 
 SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p, std::uint64_t memory_limit, const std::filesystem::path& dir,
@@ -339,6 +457,7 @@ SurfaceFiles writeSurfaceFiles(const VascularTree& tree, const MeshParameters& p
   }
   out.parameters = resolvedParameters(p, plan);
   out.statistics = summarise(tree, p, plan, built);
+  out.statistics.warnings = surfaceWarnings(tree, plan, built, out.statistics, vessel_ids, plan.contour.samples_across);
   return out;
 }
 

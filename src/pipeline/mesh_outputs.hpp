@@ -40,9 +40,18 @@ struct SurfaceSummary {
   std::optional<std::int64_t> triangles_before_decimation;  // with decimation
   std::int64_t decimation_collapses = 0;
   double decimation_largest_error_mm = 0;
-  std::int64_t slivers_repaired = 0, remesh_splits = 0, remesh_changes = 0;
-  std::int64_t ends = 0, ends_cut = 0, ends_left_closed = 0;
+  std::int64_t sliver_repair_changes = 0, remesh_splits = 0, remesh_changes = 0;
+  double smallest_angle_deg = 0;                  // of the final triangles
+  std::int64_t triangles_below_sliver_angle = 0;  // with a sliver repair: what it left
+  std::int64_t ends = 0, ends_cut = 0, ends_left_closed = 0, ends_extension_shortened = 0;
   std::optional<BoxClipReport> clip;  // with a clip box
+  // Per tree, the Euler characteristic its vessel graph implies: 2 for one closed surface, less one
+  // per open end (unknown, empty, for hollow walls and clipped surfaces). A surface of another
+  // one has a handle where vessels fuse, or has fallen apart.
+  std::vector<std::int64_t> tree_euler_expected;
+  // What a user must know before using the surface: each end left closed or extension
+  // shortened, each tree of another topology than its graph's, with the vessels that cause it.
+  std::vector<std::string> warnings;
   // As sample.json's statistics.surface and mesh.json's statistics record it.
   nlohmann::ordered_json toJson() const;
 };
