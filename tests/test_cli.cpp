@@ -290,6 +290,16 @@ TEST_F(Cli, EveryRegisteredFormatIsListedByParamsAndTakenByFileAndFlag) {
   const auto help = runPrinted("generate --help", dir_), mesh_help = runPrinted("mesh --help", dir_);
   EXPECT_NE(help.err.find("mha (MetaImage"), std::string::npos) << help.err;
   EXPECT_NE(mesh_help.err.find("3mf (3MF"), std::string::npos) << mesh_help.err;
+  // The description names no list of its own that could drift from the registry's.
+  EXPECT_EQ(mesh_help.err.find("(STL, OBJ, PLY, OFF, VTP)"), std::string::npos) << mesh_help.err;
+  // Options a command does not use are not offered: only the commands reading VascuSynth files
+  // take their length unit.
+  for (const char* command : {"score", "mesh", "dataset"}) {
+    const auto h = runPrinted(std::string(command) + " --help", dir_);
+    EXPECT_EQ(h.err.find("--vascusynth-unit"), std::string::npos) << command;
+    EXPECT_EQ(h.err.find("refuse maps"), std::string::npos) << command;
+  }
+  EXPECT_NE(runPrinted("vascusynth --help", dir_).err.find("--vascusynth-unit"), std::string::npos);
   // A format the registry lacks is refused by the file reader, naming what is allowed.
   std::ifstream in(src_ / "examples/cco_disc_2d.toml");
   std::stringstream text;

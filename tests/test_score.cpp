@@ -303,6 +303,19 @@ TEST_F(ScoreRun, DatasetModeScoresEveryCaseAgainstItsImagesTruth) {
   EXPECT_GT(warped, 0);  // the spec's profile file warps: some case was scored against warped labels
   const std::string csv = slurp(dir_ / "all.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 3 + 3) << csv;  // header, cases, mean/median/sd
+  // Case names as the statistics' names, unquoted (RFC 4180 quotes only what needs it); every
+  // number to six significant digits.
+  EXPECT_NE(csv.find("\nArteryVeinTiny_0000,"), std::string::npos) << csv;
+  EXPECT_EQ(csv.find('"'), std::string::npos) << csv;
+  std::istringstream fields(csv);
+  for (std::string field; std::getline(fields, field, ',');) {
+    field = field.substr(0, field.find('\n'));
+    if (field.empty() || !(std::isdigit(static_cast<unsigned char>(field[0])) || field[0] == '-')) continue;
+    std::string mantissa = field.substr(0, field.find('e'));
+    mantissa.erase(std::remove(mantissa.begin(), mantissa.end(), '.'), mantissa.end());
+    mantissa.erase(0, mantissa.find_first_not_of("-0"));
+    EXPECT_LE(mantissa.size(), 6u) << field;
+  }
   fs::remove(dir_ / "pred/ArteryVeinTiny_0001.nii.gz");
   const auto bad = run("score --dataset raw/Dataset903_ArteryVeinTiny --predictions pred --out bad.json", dir_);
   EXPECT_EQ(bad.code, 2);

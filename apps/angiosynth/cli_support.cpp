@@ -12,14 +12,16 @@
 
 namespace angiosynth::cli {
 
-void addCommonOptions(CLI::App& cmd, CommonOptions& o) {
+void addCommonOptions(CLI::App& cmd, CommonOptions& o, CommonInputs inputs) {
   cmd.add_option("--threads", o.threads, "worker threads (0 = all cores); outputs do not depend on it")->check(CLI::Range(0, 1024));
-  cmd.add_option("--memory-limit", o.memory_limit_gib, "refuse maps needing more than this many GiB (default: 75% of RAM)")
+  cmd.add_option("--memory-limit", o.memory_limit_gib,
+                 "refuse work whose estimated memory exceeds this many GiB, before allocating it (default: 75% of RAM)")
       ->check(finiteIn(0.0, 1e6));
-  cmd.add_option("--vascusynth-unit", o.vascusynth_unit,
-                 "length unit of VOXEL_WIDTH in VascuSynth parameter files; flows and pressures follow the "
-                 "coherent (length, g, s) system, i.e. CGS for cm")
-      ->check(CLI::IsMember({"um", "mm", "cm", "m"}));
+  if (inputs == CommonInputs::WithVascuSynthFiles)
+    cmd.add_option("--vascusynth-unit", o.vascusynth_unit,
+                   "length unit of VOXEL_WIDTH in VascuSynth parameter files; flows and pressures follow the "
+                   "coherent (length, g, s) system, i.e. CGS for cm")
+        ->check(CLI::IsMember({"um", "mm", "cm", "m"}));
   cmd.add_flag("--quiet", o.quiet, "no progress output");
 }
 

@@ -18,7 +18,9 @@ struct CommonOptions {
   std::string vascusynth_unit = "cm";
 };
 
-void addCommonOptions(CLI::App& cmd, CommonOptions& o);
+// Commands that read VascuSynth parameter files also take their length unit.
+enum class CommonInputs { Plain, WithVascuSynthFiles };
+void addCommonOptions(CLI::App& cmd, CommonOptions& o, CommonInputs inputs = CommonInputs::Plain);
 // Applies --threads for the lifetime of the returned object.
 std::shared_ptr<void> limitThreads(int threads);
 std::uint64_t memoryLimit(const CommonOptions& o);

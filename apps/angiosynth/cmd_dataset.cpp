@@ -120,7 +120,7 @@ int runDatasetCommand(const DatasetArgs& a, const std::string& command_line) {
     const auto i = parseIndex(a.index, "--index");
     if (i >= spec.samples) throw InputError(a.spec, 0, "--index " + a.index + " is beyond the " + std::to_string(spec.samples) + " samples");
     const ResolvedSample r = resolveSample(spec, i);
-    std::cout << "# sample " << r.index << " (" << r.id << "), seed " << r.seed << ", image profile " << r.profile << "\n" << r.toml;
+    std::cout << "# sample " << r.index << " (" << r.id << "), seed " << r.seed << ", image profile " << r.profile << "\n" << readableParameters(r);
     return 0;
   }
   if (a.finalize->parsed()) return report(finalizeDataset(a.dir), "finalize");

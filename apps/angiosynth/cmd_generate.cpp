@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "core/format.hpp"
 #include "core/error.hpp"
 #include "files/staged_directory.hpp"
 #include "config/sample_settings.hpp"
@@ -23,7 +24,7 @@ CLI::App* addGenerate(CLI::App& app, GenerateArgs& a) {
       ->delimiter(',');
   c->add_flag("--no-profiles", a.no_profiles, "write the clean image only, ignoring [degrade] profiles");
   c->add_flag("--force", a.force, "replace an earlier angiosynth output in --out (only the files it wrote there)");
-  addCommonOptions(*c, a.common);
+  addCommonOptions(*c, a.common, CommonInputs::WithVascuSynthFiles);
   return c;
 }
 
@@ -56,7 +57,8 @@ int runGenerate(const GenerateArgs& a, const std::string& command_line) {
   dir.commit();
   if (!a.common.quiet)
     std::cerr << "wrote " << dir.target().string() << ": " << made.terminals << " terminals, total volume " << made.total_volume_mm3 << " mm^3, "
-              << made.intersecting_pairs << " intersecting pairs, seed " << req.seed << ", " << made.grow_seconds << " s growth\n";
+              << made.intersecting_pairs << " intersecting pairs, seed " << req.seed << ", " << show(made.grow_seconds) << " s growth\n";
+  for (const auto& w : made.warnings) std::cerr << "warning: " << w << "\n";
   return 0;
 }
 

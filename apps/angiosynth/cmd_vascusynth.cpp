@@ -25,7 +25,7 @@ CLI::App* addVascuSynth(CLI::App& app, VascuSynthArgs& a) {
                 "slice images: jpg (8-bit JPEG, what VascuSynth writes; lossy) or png (lossless); "
                 "the exact image is image.nii.gz beside them")
       ->check(CLI::IsMember({"jpg", "png"}));
-  addCommonOptions(*c, a.common);
+  addCommonOptions(*c, a.common, CommonInputs::WithVascuSynthFiles);
   return c;
 }
 

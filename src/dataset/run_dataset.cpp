@@ -354,6 +354,7 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
   std::error_code ec;
   fs::remove_all(staging, ec);
   unregisterStaging(staging);
+  fs::remove(dir / ".staging", ec);  // if no other shard's staging is in it (else ENOTEMPTY)
   return rep;
 }
 

@@ -1,8 +1,12 @@
 #include "dataset/spec.hpp"
 
+#include "core/format.hpp"
+
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cstdlib>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -328,6 +332,45 @@ std::string datasetDirName(const DatasetSpec& spec) {
   char buf[16];
   std::snprintf(buf, sizeof buf, "Dataset%03d_", spec.id);
   return buf + spec.name;
+}
+
+std::string readableParameters(const ResolvedSample& r) {
+  const std::string& in = r.toml;
+  std::string out;
+  const auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  std::size_t i = 0;
+  while (i < in.size()) {
+    // A number starts at a digit not preceded by a letter, digit, '_' or '.'.
+    const bool starts = digit(in[i]) && (i == 0 || !(std::isalnum(static_cast<unsigned char>(in[i - 1])) || in[i - 1] == '_' || in[i - 1] == '.'));
+    if (!starts) {
+      out += in[i++];
+      continue;
+    }
+    std::size_t j = i;
+    while (j < in.size() && digit(in[j])) ++j;
+    std::size_t decimals = 0;
+    if (j < in.size() && in[j] == '.')
+      for (++j; j < in.size() && digit(in[j]); ++j) ++decimals;
+    if (j < in.size() && (in[j] == 'e' || in[j] == 'E')) {
+      std::size_t k = j + 1;
+      if (k < in.size() && (in[k] == '+' || in[k] == '-')) ++k;
+      if (k < in.size() && digit(in[k])) {
+        j = k;
+        while (j < in.size() && digit(in[j])) ++j;
+      }
+    }
+    const std::string token = in.substr(i, j - i);
+    std::string shorter = token;
+    if (decimals >= 10 && (j == in.size() || !(std::isalnum(static_cast<unsigned char>(in[j])) || in[j] == '_'))) {
+      const double v = std::strtod(token.c_str(), nullptr);
+      shorter = exactNumber(v);
+      if (shorter.find_first_of(".e") == std::string::npos) shorter += ".0";  // stays a float
+      if (std::strtod(shorter.c_str(), nullptr) != v || shorter.size() >= token.size()) shorter = token;
+    }
+    out += shorter;
+    i = j;
+  }
+  return out;
 }
 
 ResolvedSample resolveSample(const DatasetSpec& spec, std::int64_t index) {

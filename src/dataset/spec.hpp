@@ -71,6 +71,10 @@ struct ResolvedSample {
 };
 
 ResolvedSample resolveSample(const DatasetSpec& spec, std::int64_t index);
+// The resolved parameter file for people: each number written with 17 digits (how toml++ and the
+// draws write doubles, and what the sample's hash is of) in its shortest form that reads back
+// to the same double (0.65000000000000002 → 0.65). The same sample when generated.
+std::string readableParameters(const ResolvedSample& r);
 // Fixed-width id of sample i: at least 4 digits, enough for every index of the dataset.
 std::string sampleId(const DatasetSpec& spec, std::int64_t index);
 std::string datasetDirName(const DatasetSpec& spec);  // DatasetNNN_Name

@@ -1,5 +1,7 @@
 #include "score/dataset_scores.hpp"
 
+#include "core/format.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -13,11 +15,16 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
-std::string number(double v) {
-  std::ostringstream o;
-  o.precision(17);
-  o << v;
-  return o.str();
+// Scores to six significant digits (the JSON keeps every digit): ratios of voxel counts, read by
+// people and spreadsheets.
+std::string number(double v) { return show(v, 6); }
+
+// RFC 4180: a field is quoted only when it holds a comma, a quote or a line break.
+std::string csvField(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + '"';
 }
 
 Json readJson(const fs::path& f) {
@@ -55,7 +62,7 @@ std::string scoreCsvHeader() {
 }
 
 std::string scoreCsvRow(const std::string& name, const CaseScores& scores) {
-  std::string r = '"' + name + '"';
+  std::string r = csvField(name);
   for (const auto& column : headlineColumns()) {
     r += ',';
     if (const auto v = scores.headline(column)) r += number(*v);
