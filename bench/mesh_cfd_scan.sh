@@ -4,7 +4,7 @@
 # that were left closed, and whether each tree's surface has the Euler characteristic its graph
 # implies. Writes OUT/scan.md (a Markdown table) and each example's sample and mesh in OUT.
 #
-#     bench/mesh_cfd_scan.sh [BUILD_DIR] [OUT]     (defaults: build, out/mesh_cfd_scan)
+#     [MESH_SECONDS=900] bench/mesh_cfd_scan.sh [BUILD_DIR] [OUT]     (defaults: build, out/mesh_cfd_scan)
 #
 # Left out: the dataset specs (not single samples) and large_100k.toml (100,000 terminals: a
 # memory-bound mesh of its own, see bench/mesh_cco_50000.toml).
@@ -22,10 +22,16 @@ for params in "$SOURCE"/examples/*.toml; do
   rm -rf "$OUT/$name" "$OUT/${name}_mesh"
   (cd "$SOURCE/examples" && "$BUILD/angiosynth" generate "$params" --out "$OUT/$name" --no-image --quiet)
   start=$(date +%s.%N)
-  "$BUILD/angiosynth" mesh "$OUT/$name" --out "$OUT/${name}_mesh" --ends capped --flow-extension 5 --quiet 2> "$OUT/${name}_mesh.warnings" || {
+  status=0
+  timeout "${MESH_SECONDS:-900}" "$BUILD/angiosynth" mesh "$OUT/$name" --out "$OUT/${name}_mesh" --ends capped --flow-extension 5 --quiet \
+    2> "$OUT/${name}_mesh.warnings" || status=$?
+  if [ "$status" = 124 ]; then
+    printf '| %s | not finished in %s s |||||||\n' "$name" "${MESH_SECONDS:-900}" >> "$table"
+    continue
+  elif [ "$status" != 0 ]; then
     printf '| %s | refused: %s |||||||\n' "$name" "$(tail -1 "$OUT/${name}_mesh.warnings")" >> "$table"
     continue
-  }
+  fi
   end=$(date +%s.%N)
   /usr/bin/python3 - "$OUT/${name}_mesh/mesh.json" "$name" "$start" "$end" >> "$table" <<'PY'
 import json, sys

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <random>
 
 #include "core/memory.hpp"
@@ -32,6 +33,11 @@ std::shared_ptr<void> limitThreads(int threads) {
 
 std::uint64_t memoryLimit(const CommonOptions& o) {
   return o.memory_limit_gib > 0 ? static_cast<std::uint64_t>(o.memory_limit_gib * double(1ULL << 30)) : defaultMemoryLimitBytes();
+}
+
+void printWarnings(const std::vector<std::string>& warnings, const std::string& where, std::size_t shown) {
+  for (std::size_t k = 0; k < warnings.size() && k < shown; ++k) std::cerr << "warning: " << warnings[k] << "\n";
+  if (warnings.size() > shown) std::cerr << "warning: " << warnings.size() - shown << " more in " << where << "\n";
 }
 
 std::uint64_t freshSeed() {

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "grow/common/growth_report.hpp"
 
@@ -24,6 +25,8 @@ void addCommonOptions(CLI::App& cmd, CommonOptions& o, CommonInputs inputs = Com
 // Applies --threads for the lifetime of the returned object.
 std::shared_ptr<void> limitThreads(int threads);
 std::uint64_t memoryLimit(const CommonOptions& o);
+// "warning: …" lines on stderr, the first `shown` of them, then how many more `where` holds.
+void printWarnings(const std::vector<std::string>& warnings, const std::string& where, std::size_t shown = 12);
 // A seed when none was given: fresh entropy, recorded in sample.json so the run can be repeated.
 std::uint64_t freshSeed();
 // Progress line on stderr when it is a terminal (and not --quiet); empty function otherwise.

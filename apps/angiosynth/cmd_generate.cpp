@@ -58,7 +58,7 @@ int runGenerate(const GenerateArgs& a, const std::string& command_line) {
   if (!a.common.quiet)
     std::cerr << "wrote " << dir.target().string() << ": " << made.terminals << " terminals, total volume " << made.total_volume_mm3 << " mm^3, "
               << made.intersecting_pairs << " intersecting pairs, seed " << req.seed << ", " << show(made.grow_seconds) << " s growth\n";
-  for (const auto& w : made.warnings) std::cerr << "warning: " << w << "\n";
+  printWarnings(made.warnings, (dir.target() / "sample.json").string() + " (statistics.surface.warnings)");
   return 0;
 }
 

@@ -71,7 +71,7 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
               << counted(s.segments, "segment") << ", finest step " << show(s.finest_step_mm) << " mm), enclosed volume "
               << show(s.topology.volume_mm3) << " mm^3\n";
   // Also with --quiet: a surface not as asked is wrong for what comes next.
-  for (const auto& w : s.warnings) std::cerr << "warning: " << w << "\n";
+  printWarnings(s.warnings, (dir.target() / "mesh.json").string() + " (warnings)");
   return 0;
 }
 

@@ -119,10 +119,10 @@ EndCutExtent endCutExtent(double r, double step, bool tight) {
 
 namespace {
 
-// Shortens each end's extension where it, or its cut's region, would come nearer another vessel
-// than the end already is (within the region's reach of another vessel's wall): the distance of
-// a segment from the node grows shorter with its length only, so the longest extension allowed
-// is found by bisection.
+// Shortens each end's extension where what it adds (beyond the prolongation every cut end has)
+// comes within its cut's reach of another vessel's wall: the distance of a growing segment only
+// shrinks, so the longest extension allowed is found by bisection. An end already that near
+// another vessel gets none: running along it would lengthen their contact.
 void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, double extension_radii, double step_radii) {
   Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
   double widest = 0;
@@ -144,7 +144,7 @@ void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, do
   struct Near {
     std::int32_t vessel;
     Vec3 a, b;
-    double clearance;  // what the end keeps from its axis: its wall plus the region's reach, or less if already nearer
+    double clearance;  // what the added part keeps from its axis: its wall plus the region's reach
   };
   std::vector<Near> near;
   // The extensions decided so far (ids nodeCount + k in the grid): two ends that face each other
@@ -174,13 +174,13 @@ void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, do
         a = t.position[t.parent[y]], b = t.position[y];
         wall = std::max(t.radius[y], t.startRadius(y)) + x.reach;
       }
-      near.push_back({vessel, a, b, std::min(wall, segmentSegmentDistance(e.node, reachOf(0), a, b))});
+      near.push_back({vessel, a, b, wall});
       return false;
     });
     // The vessel that stops an extension of `radii`, or -1.
     const auto stop = [&](double radii) {
       for (const auto& n : near)
-        if (segmentSegmentDistance(e.node, reachOf(radii), n.a, n.b) < n.clearance) return n.vessel;
+        if (segmentSegmentDistance(reachOf(0), reachOf(radii), n.a, n.b) < n.clearance) return n.vessel;
       return std::int32_t(-1);
     };
     double given = extension_radii;

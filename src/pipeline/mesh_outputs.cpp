@@ -305,15 +305,15 @@ std::vector<std::pair<std::int32_t, std::int32_t>> nearlyTouching(const Vascular
 // another topology than their graph, with the vessel pairs whose walls overlap in that tree.
 std::vector<std::string> surfaceWarnings(const VascularTree& tree, const SurfacePlan& plan, const BuiltSurface& b, const SurfaceSummary& s,
                                          const std::vector<std::string>& vessel_ids, double samples_across) {
-  std::vector<std::string> out;
+  std::vector<std::string> out, per_end;  // the trees' first: an end's warning explains less
   const auto& ends = plan.ends();
   for (std::size_t k = 0; k < ends.size(); ++k)
     if (ends[k].extension_stop >= 0)
-      out.push_back(endName(k, ends[k], vessel_ids) + ": flow extension shortened to " + show(ends[k].extension_radii, 3) +
-                    " radii; a longer one comes within its cut's reach of " + vesselName(ends[k].extension_stop, vessel_ids));
+      per_end.push_back(endName(k, ends[k], vessel_ids) + ": flow extension shortened to " + show(ends[k].extension_radii, 3) +
+                        " radii; a longer one comes within its cut's reach of " + vesselName(ends[k].extension_stop, vessel_ids));
   for (auto k : b.cut.left_closed)
-    out.push_back(endName(std::size_t(k), ends[std::size_t(k)], vessel_ids) +
-                  ": left closed (round, face 'left_closed' in surface_faces.csv): another vessel's wall lies within its cut's reach");
+    per_end.push_back(endName(std::size_t(k), ends[std::size_t(k)], vessel_ids) +
+                      ": left closed (round, face 'left_closed' in surface_faces.csv): another vessel's wall lies within its cut's reach");
   std::vector<std::pair<std::int32_t, std::int32_t>> overlaps;
   bool computed = false;
   for (std::size_t t = 0; t < s.tree_euler_expected.size(); ++t) {
@@ -340,6 +340,7 @@ std::vector<std::string> surfaceWarnings(const VascularTree& tree, const Surface
     }
     out.push_back(w + "; do not mesh its volume before removing them");
   }
+  out.insert(out.end(), per_end.begin(), per_end.end());
   return out;
 }
 
