@@ -5,12 +5,15 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <sstream>
 
 #include "cli_run.hpp"
+#include "core/format.hpp"
 #include "grow/method.hpp"
 #include "config/scenario.hpp"
+#include "pipeline/generate_sample.hpp"
 #include "io/graph_formats.hpp"
 #include "io/mesh_writers.hpp"
 #include "io/volume_formats.hpp"
@@ -242,19 +245,58 @@ TEST_F(Cli, VascuSynthNoiseFilesGiveNoiseImagesAndMisspellingsStopEverything) {
 }
 
 // `init METHOD FILE` writes a template of every method that the reader takes and that grows;
-// every key it lists commented out is a key the reader knows; it never replaces a file.
-TEST_F(Cli, InitTemplatesRunAsTheyAreAndParamsListEveryKey) {
+// every key is listed, in its own table; each `key = value` line, uncommented alone, gives a file
+// whose sample's inputs pass every check before growth and, but for tables whose presence turns
+// a stage on ([curves], [mesh]), the same resolved parameters: the value is the default. It
+// never replaces a file.
+TEST_F(Cli, InitTemplatesRunAsTheyAreAndEveryCommentedKeyUncommentedAlone) {
   for (const auto* m : angiosynth::growthMethods()) {
     const std::string name = m->name, file = name + ".toml";
     const auto r = run("init " + name + " " + file, dir_);
     ASSERT_EQ(r.code, 0) << name << ": " << r.err;
     const angiosynth::Scenario sc = angiosynth::readTomlParameters(dir_ / file);
     EXPECT_EQ(std::string(sc.growth->method()), name);
-    // Every key of the method is listed (commented out, at its default).
+    // Compared at 12 significant digits: "0.05 voxel" of 0.4 mm is 0.020000000000000004 mm
+    // where the default is computed as 0.02.
+    const auto rounded = [](const angiosynth::Scenario& s) {
+      std::function<void(Json&)> round = [&](Json& j) {
+        if (j.is_number_float()) j = std::stod(angiosynth::show(j.get<double>(), 12));
+        if (j.is_structured())
+          for (auto& v : j) round(v);
+      };
+      Json j = Json::parse(angiosynth::describeParameters(s).dump());
+      round(j);
+      return j.dump();
+    };
+    const std::string resolved = rounded(sc);
     const std::string text = slurp(dir_ / file);
+    // Every key of the method is listed: set by the example, a line to uncomment, or described.
     std::size_t listed = 0;
-    for (const auto& p : m->params) listed += text.find("# " + std::string(p.key) + " = ") != std::string::npos;
+    for (const auto& p : m->params) {
+      const std::string key = p.key, dotted = std::string(p.table) + "." + key;
+      listed += text.find("\n" + key + " = ") != std::string::npos || text.find("# " + key + " = ") != std::string::npos ||
+                text.find("#   " + key + ": ") != std::string::npos || text.find("# " + dotted + " = ") != std::string::npos ||
+                text.find("#   " + dotted + ": ") != std::string::npos;
+    }
     EXPECT_EQ(listed, m->params.size()) << name;
+    std::istringstream lines(text);
+    int uncommentable = 0;
+    for (std::string line; std::getline(lines, line);) {
+      const auto eq = line.find(" = ");
+      if (line.rfind("# ", 0) != 0 || line.rfind("#  ", 0) == 0 || eq == std::string::npos) continue;
+      const std::string key = line.substr(2, eq - 2);
+      if (key.find_first_not_of("abcdefghijklmnopqrstuvwxyz_.0123456789") != std::string::npos) continue;  // prose
+      ++uncommentable;
+      std::string trial = text;
+      trial.replace(trial.find(line), line.size(), line.substr(2));
+      std::ofstream(dir_ / ("uncommented_" + file)) << trial;
+      try {
+        const angiosynth::Scenario u = angiosynth::readTomlParameters(dir_ / ("uncommented_" + file));
+        angiosynth::checkSampleInputs(u, 8ull << 30);
+        if (key.rfind("curves.", 0) != 0 && key.rfind("mesh.", 0) != 0) { EXPECT_TRUE(rounded(u) == resolved) << name << ": " << line; }
+      } catch (const std::exception& e) { ADD_FAILURE() << name << ": uncommenting '" << line << "': " << e.what(); }
+    }
+    EXPECT_GT(uncommentable, 20) << name;
     const auto again = run("init " + name + " " + file, dir_);
     EXPECT_EQ(again.code, 2);
     EXPECT_NE(again.err.find("exists"), std::string::npos) << again.err;

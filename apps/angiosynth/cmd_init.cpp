@@ -57,12 +57,26 @@ int runInit(const InitArgs& a) {
     throw InputError("", 0, "FILE '" + file.string() + "' is not a file name; give the parameter file to write, such as my_tree.toml");
   const GrowthMethod& m = methodNamed(method);
   std::string data_file, data;
-  const std::string text = parameterTemplate(m, file.stem().string(), data_file, data);
+  std::string text = parameterTemplate(m, file, data_file, data);
   const std::filesystem::path data_path = file.parent_path() / data_file;
-  if (!data_file.empty() && std::filesystem::exists(data_path))
-    throw InputError(data_path.string(), 0, "exists; init writes new files only (choose another name)");
-  writeNew(file, text);
-  if (!data_file.empty()) writeNew(data_path, data);
+  if (!data_file.empty()) {
+    // The template's keys are checked against its data, so that is written first (and removed
+    // again if the template cannot be).
+    if (std::filesystem::exists(data_path)) throw InputError(data_path.string(), 0, "exists; init writes new files only (choose another name)");
+    if (std::filesystem::exists(std::filesystem::symlink_status(file)))
+      throw InputError(file.string(), 0, "exists; init writes new files only (choose another name)");
+    writeNew(data_path, data);
+    try {
+      text = parameterTemplate(m, file, data_file, data);
+      writeNew(file, text);
+    } catch (...) {
+      std::error_code ec;
+      std::filesystem::remove(data_path, ec);
+      throw;
+    }
+  } else {
+    writeNew(file, text);
+  }
   std::cerr << "wrote " << file.string() << (data_file.empty() ? "" : " and " + data_path.string()) << "; run: angiosynth generate " << file.string()
             << "\n";
   return 0;

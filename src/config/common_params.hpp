@@ -1,6 +1,7 @@
 #pragma once
 // The keys every parameter file may hold besides its method's ([image], [curves], [degrade],
 // [output], seed), and the references and templates `angiosynth params` and `init` print.
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -15,10 +16,12 @@ const std::vector<MethodParam>& commonParams();
 // and meaning, one line each.
 std::string parameterReference(const GrowthMethod* method);
 
-// A parameter file for `method` that runs as it is: a shipped example with its comments, then
-// every other key commented out at its default. `data_file`, when not empty after the call, must
-// be written beside it with `data_content` (vascusynth: a uniform demand map), under the name
-// the template gives it (`<stem>_demand.txt` for a template named <stem>.toml).
-std::string parameterTemplate(const GrowthMethod& method, const std::string& stem, std::string& data_file, std::string& data_content);
+// A parameter file `file` for `method` that runs as it is: a shipped example with its comments,
+// and every other key commented out at its default in the table it belongs to, each
+// `key = value` line one the reader takes when uncommented alone (checked here; keys whose
+// default is a rule are described instead). `data_file`, when not empty after the call, must be
+// written beside it with `data_content` (vascusynth: a uniform demand map), under the name the
+// template gives it (`<stem>_demand.txt`); the check reads it when it exists.
+std::string parameterTemplate(const GrowthMethod& method, const std::filesystem::path& file, std::string& data_file, std::string& data_content);
 
 }  // namespace angiosynth
