@@ -23,6 +23,10 @@ void addCommonOptions(CLI::App& cmd, CommonOptions& o, CommonInputs inputs) {
                    "length unit of VOXEL_WIDTH in VascuSynth parameter files; flows and pressures follow the "
                    "coherent (length, g, s) system, i.e. CGS for cm")
         ->check(CLI::IsMember({"um", "mm", "cm", "m"}));
+  if (inputs == CommonInputs::WithVascuSynthFiles)
+    cmd.add_flag("--vascusynth-rules", o.vascusynth_rules,
+                 "grow VascuSynth parameter files under VascuSynth's own constraints (no minimum length in radii, no final relaxation, "
+                 "overlapping vessels allowed), as [tree] rules = \"vascusynth\" does in a .toml file");
   cmd.add_flag("--quiet", o.quiet, "no progress output");
 }
 

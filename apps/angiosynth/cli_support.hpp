@@ -17,6 +17,7 @@ struct CommonOptions {
   double memory_limit_gib = 0;  // 0: 75 % of physical memory
   bool quiet = false;
   std::string vascusynth_unit = "cm";
+  bool vascusynth_rules = false;
 };
 
 // Commands that read VascuSynth parameter files also take their length unit.

@@ -32,6 +32,9 @@ int runGenerate(const GenerateArgs& a, const std::string& command_line) {
   const auto threads = limitThreads(a.common.threads);
   ReadOptions ro;
   ro.vascusynth_length_unit = a.common.vascusynth_unit;
+  ro.vascusynth_rules = a.common.vascusynth_rules;
+  if (a.common.vascusynth_rules && std::filesystem::path(a.params).extension() == ".toml")
+    throw InputError(a.params, 0, "--vascusynth-rules is for VascuSynth parameter files; in a .toml file write [tree] rules = \"vascusynth\"");
   Scenario sc = readParameters(a.params, ro);
   a.image.applyTo(sc.image);
   a.output.applyTo(sc);
@@ -57,7 +60,12 @@ int runGenerate(const GenerateArgs& a, const std::string& command_line) {
   dir.commit();
   if (!a.common.quiet)
     std::cerr << "wrote " << dir.target().string() << ": " << made.terminals << " terminals, total volume " << made.total_volume_mm3 << " mm^3, "
-              << made.intersecting_pairs << " intersecting pairs, seed " << req.seed << ", " << show(made.grow_seconds) << " s growth\n";
+              << made.intersecting_pairs << " intersecting pairs, seed " << req.seed << ", " << show(made.grow_seconds) << " s growth"
+              << (made.image_grid ? "; image " + std::to_string(made.image_grid->dims[0]) + " x " + std::to_string(made.image_grid->dims[1]) + " x " +
+                                        std::to_string(made.image_grid->dims[2]) + " voxels of " + show(made.image_grid->spacing_mm.x) +
+                                        " mm, centres (i + 1/2) voxels from the frame's corner"
+                                  : std::string())
+              << "\n";
   printWarnings(made.warnings, (dir.target() / "sample.json").string() + " (statistics.surface.warnings)");
   return 0;
 }

@@ -47,6 +47,7 @@ int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line) {
   }
   ReadOptions ro;
   ro.vascusynth_length_unit = a.common.vascusynth_unit;
+  ro.vascusynth_rules = a.common.vascusynth_rules;
   // Read every parameter file before writing anything, so a typo in the last one costs nothing.
   // Maps too, and every output name checked, so nothing is written when any of them is wrong.
   std::vector<Scenario> scenarios;
@@ -74,9 +75,15 @@ int runVascuSynth(const VascuSynthArgs& a, const std::string& command_line) {
     req.vascusynth = VascuSynthLayout{a.output_voxel_width * sc.input_units.mm_per_length, a.slices};
     checkRange(req.vascusynth->voxel_mm, Limits::kMinVoxel, false, Limits::kMaxVoxel, false, Where{"VOXEL_WIDTH", 0}, "VOXEL_WIDTH (mm)");
     req.extra["output_voxel_width"] = {{"value", a.output_voxel_width * sc.input_units.mm_per_length}, {"unit", "mm"}};
-    generateSample(req, dir.path());
+    const SampleSummary made = generateSample(req, dir.path());
     dir.commit();
-    if (!a.common.quiet) std::cerr << "wrote " << names[i].text << "/tree_structure.xml (seed " << req.seed << ")\n";
+    if (!a.common.quiet) {
+      std::cerr << "wrote " << names[i].text << "/tree_structure.xml (seed " << req.seed << ")";
+      if (made.image_grid)
+        std::cerr << "; image " << made.image_grid->dims[0] << " x " << made.image_grid->dims[1] << " x " << made.image_grid->dims[2]
+                  << " voxels centred on the map voxels' corners (VascuSynth's grid)";
+      std::cerr << "\n";
+    }
   }
   return 0;
 }

@@ -46,6 +46,7 @@ struct Scenario {
 
 struct ReadOptions {
   std::string vascusynth_length_unit = "cm";  // unit of VOXEL_WIDTH in VascuSynth files
+  bool vascusynth_rules = false;              // VascuSynth files grown under VascuSynth's own constraints ([tree] rules)
 };
 
 // Reads a VascuSynth parameter file (2008 or 2011 keys).

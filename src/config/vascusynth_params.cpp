@@ -128,6 +128,7 @@ Scenario readVascuSynthParameters(const std::filesystem::path& path, const ReadO
   setup->terminals_line = entries.at("NUM_NODES").line;
   g.terminals = n;
   g.closest_neighbours = static_cast<int>(k);
+  if (opt.vascusynth_rules) g.useVascuSynthRules();
   g.min_distance_mm = min_dist * d.voxel_mm;
   g.min_segment_length_mm = g.minSegmentLength(d.voxel_mm);  // the default (voxel / 20), recorded in the sidecar
   g.physics.murray_exponent = gamma;

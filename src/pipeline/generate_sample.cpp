@@ -1,4 +1,5 @@
 #include "pipeline/generate_sample.hpp"
+#include "pipeline/vascusynth_layout.hpp"
 #include "pipeline/mesh_outputs.hpp"
 
 #include <algorithm>
@@ -342,6 +343,10 @@ SampleSummary generateSample(const SampleRequest& req, const std::filesystem::pa
   }
   SampleSummary summary;
   summary.warnings = std::move(warnings);
+  if (ps.volumes) {
+    summary.image_grid = ps.vr.grid;
+    summary.image_grid_rule = req.vascusynth ? kVascuSynthGridRule : kImageGridRule;
+  }
   summary.terminals = tree.totalTerminals();
   summary.total_volume_mm3 = treeVolume(tree);
   summary.intersecting_pairs = report.intersecting_pairs;
@@ -365,10 +370,19 @@ SampleSummary generateSample(const SampleRequest& req, const std::filesystem::pa
                     {"frame",
                      "positions in mm from the corner of map voxel (0,0,0), axes along the map's x, y, z; "
                      "position_voxel in map voxels"}};
+  if (summary.image_grid) {
+    const auto& g = *summary.image_grid;
+    j["units"]["image_grid"] = Json{{"voxels", g.dims}, {"voxel_size_mm", g.spacing_mm.x}, {"rule", summary.image_grid_rule}};
+  }
   j["parameters"] = describeParameters(sc);
   j["trees"] = describeTrees(forest);
   j["classes"] = classLegend(forest);
   for (const auto& [k, v] : req.extra.items()) j["parameters"][k] = v;
+  // VascuSynth's layout writes slices and image.nii.gz beside them, whatever [image] formats says.
+  if (req.vascusynth && j["parameters"].contains("image") && j["parameters"]["image"].is_object()) {
+    j["parameters"]["image"]["formats"] = Json::array({"nifti"});
+    j["parameters"]["image"]["slices"] = req.vascusynth->slice_format;
+  }
   if (!ps.profiles.empty()) j["degradation"] = degradation;
   j["statistics"] = stats;
   j["files"] = files;

@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "raster/volume.hpp"
+
 #include "degrade/profile.hpp"
 #include "grow/common/growth_report.hpp"
 #include "config/scenario.hpp"
@@ -52,8 +54,10 @@ struct SampleSummary {
   double total_volume_mm3 = 0;
   std::int64_t intersecting_pairs = 0;  // segment capsules that overlap, more than two segments apart
   double grow_seconds = 0;
-  std::vector<std::string> warnings;  // what a user must read before using the files (a [mesh] surface not as asked)
-  nlohmann::ordered_json sidecar;     // sample.json as written
+  std::vector<std::string> warnings;     // what a user must read before using the files (a [mesh] surface not as asked)
+  std::optional<VolumeGrid> image_grid;  // with volumes: their grid
+  std::string image_grid_rule;           // and how it follows from the map (sample.json units.image_grid)
+  nlohmann::ordered_json sidecar;        // sample.json as written
   // The file written for `role` ("image", "mask", "image_cta", …), relative to the sample's directory.
   std::filesystem::path file(const std::string& role) const;
   bool wrote(const std::string& role) const;

@@ -24,6 +24,9 @@ struct VascuSynthLayout {
 // VascuSynth's output grid: floor(map size × VOXEL_WIDTH / OUTPUT_VOXEL_WIDTH) + 1 samples per
 // axis at i·OUTPUT_VOXEL_WIDTH (map-voxel corners), so a 100³ map at 0.04/0.04 gives 101³.
 VolumeGrid vascusynthGrid(const DemandMap& map, double output_voxel_mm, const std::string& file = "", int line = 0);
+inline constexpr const char* kVascuSynthGridRule =
+    "VascuSynth's: floor(map size x VOXEL_WIDTH / OUTPUT_VOXEL_WIDTH) + 1 voxels per axis, centred on the map voxels' corners "
+    "(i x OUTPUT_VOXEL_WIDTH from the map's corner); a 100^3 map at 0.04/0.04 gives 101^3";
 
 // tree_structure.xml (VascuSynth's GXL, the graph named `graph_id`) and tree.dot.
 void writeVascuSynthGraphs(const Forest& forest, const GraphFrame& frame, const std::string& graph_id, const std::filesystem::path& dir,

@@ -20,6 +20,9 @@ namespace angiosynth {
 
 // The image grid over the demand map: voxel size and field of view from the parameters, by
 // default the map's own; voxel centres at (i + ½)·voxel from the map's corner.
+inline constexpr const char* kImageGridRule =
+    "field_of_view / voxel_size voxels per axis (rounded up), centred at (i + 1/2) x voxel_size from the frame's corner: the map voxels' "
+    "centres when voxel_size is the map's (`angiosynth vascusynth` writes VascuSynth's grid of corners instead)";
 VolumeGrid imageGrid(const DemandMap& map, const ImageParameters& p, const std::string& file = "", int line = 0);
 // Voxels along one axis of an image, refused past 10^5 before any integer conversion.
 std::int32_t axisVoxels(double n, const std::string& file, int line);

@@ -10,6 +10,7 @@
 // - no segment shorter than min_length_ratio × its radius (CCO's l > 2r), so that no bifurcation
 //   collapses into a disguised multifurcation (VascuSynth leaves such stubs where bifurcations merge).
 #include <optional>
+#include <string>
 #include <cstdint>
 
 #include "core/vascular_tree.hpp"
@@ -31,11 +32,20 @@ struct GrowthOptions {
   std::uint64_t seed = 1;
   std::uint64_t sample = 0;  // sample index within a dataset
   bool avoid_intersections = true;
+  // "vascusynth": VascuSynth's own constraints (Hamarneh & Jassi 2010), to reproduce its trees'
+  // statistics: no minimum length in radii, no final relaxation, vessels allowed to overlap.
+  std::string rules = "angiosynth";
   int max_repair_rounds = 30;
   // Give up after this many consecutive rejected candidates.
   std::int64_t max_consecutive_rejections = 200000;
 
   double minSegmentLength(double voxel_mm) const { return min_segment_length_mm ? *min_segment_length_mm : voxel_mm / 20; }
+  void useVascuSynthRules() {
+    rules = "vascusynth";
+    min_length_ratio = 0;
+    relax_sweeps = 0;
+    avoid_intersections = false;
+  }
 };
 
 // Grows the tree; throws GrowthError when the domain cannot take N terminals.

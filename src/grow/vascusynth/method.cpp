@@ -34,6 +34,10 @@ const std::vector<Setting<GrowthOptions>>& vascuSynthSettings() {
        .field = &O::relax_sweeps, .range = {0, 100}, .fallback_is_value = true},
       {.table = "tree", .key = "avoid_intersections", .unit = "true/false", .fallback = "true", .meaning = "refuse connections whose vessels would overlap",
        .field = &O::avoid_intersections},
+      {.table = "tree", .key = "rules", .unit = "angiosynth/vascusynth", .fallback = "angiosynth",
+       .meaning = "vascusynth: VascuSynth's own constraints, to reproduce its trees (min_length_ratio 0, relax_sweeps 0, avoid_intersections "
+       "false; those keys are then not given); the bifurcation search stays this program's exact-cost one from the midpoint",
+       .field = &O::rules, .choices = {"angiosynth", "vascusynth"}},
   };
   return settings;
 }
@@ -107,6 +111,14 @@ std::shared_ptr<const GrowthSetup> readVascuSynthToml(const TomlReader& r, const
 
   if (const auto mm = readRoot(r, tree, d.root_voxel, d.root_line, "map voxels", "")) d.root_voxel = *mm / d.voxel_mm;
   readSettingsFrom(r, tree, "tree", vascuSynthSettings(), g, d.voxel_mm);
+  if (g.rules == "vascusynth") {
+    for (const char* fixed : {"min_length_ratio", "relax_sweeps", "avoid_intersections"})
+      if (const auto* given = tree.get(fixed))
+        throw InputError(
+            file, r.lineOf(given),
+            std::string(fixed) + " is set by rules = \"vascusynth\" (VascuSynth's own value); allowed: leave it out, or rules = \"angiosynth\"");
+    g.useVascuSynthRules();
+  }
   if (!g.min_segment_length_mm) g.min_segment_length_mm = g.minSegmentLength(d.voxel_mm);
   s->terminals_line = r.lineOf(tree.get("terminals"));
   g.physics = readPhysics(r, vascuSynthPhysics(), methodTable(r, m, "physics"));
