@@ -125,3 +125,22 @@ TEST_F(Docs, ReadmeCommandsRun) {
 }
 
 }  // namespace
+
+// The scoring page's worked example holds what its script prints now: each row of the table it
+// prints is a row of docs/scoring.md (a table of older numbers once stayed after the scores moved).
+TEST_F(Docs, ScoringWorkedExampleHoldsWhatItsScriptPrints) {
+  const fs::path src = angiosynth::test::sourceDir();
+  const std::string printed = shellOutput("ANGIOSYNTH='" + std::string(ANGIOSYNTH_EXE) + "' bash '" +
+                                              (src / "examples/score_thresholds.sh").string() + "' '" + (dir_ / "work").string() + "'",
+                                          dir_);
+  const std::string page = slurpText(src / "docs/scoring.md");
+  std::istringstream rows(printed);
+  int checked = 0;
+  for (std::string row; std::getline(rows, row);) {
+    if (row.rfind("| ", 0) != 0) continue;
+    EXPECT_NE(page.find(row + "\n"), std::string::npos) << "docs/scoring.md lacks the row\n" << row;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 4);  // the header and three thresholds
+  EXPECT_TRUE(fs::exists(dir_ / "work/calibre.png"));
+}

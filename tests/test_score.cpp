@@ -482,21 +482,31 @@ namespace {
 // The calibre plot puts each curve's points where its recall says, in its colour, and leaves a
 // bin without voxels empty.
 TEST(Score, CalibrePlotDrawsEachCurveAtItsRecall) {
-  const CalibreCurve a{{0, 0.5, 1, 2}, {0.0, 0.5, 1.0, NAN}}, b{{0, 0.5, 1, 2}, {1.0, 1.0, 1.0, 1.0}};
+  // Bins as the program writes them: doubling in width, the last open.
+  CalibreCurve a{{0, 0.5, 1, 2}, {0.0, 0.5, 1.0, NAN}, {0.5, 1, 2, INFINITY}, "threshold_150"};
+  CalibreCurve b{{0, 0.5, 1, 2}, {1.0, 1.0, 1.0, 1.0}, {0.5, 1, 2, INFINITY}, ""};
   const Image8 img = plotCalibreCurves({a, b});
+  const CalibrePlotFrame f = calibrePlotFrame({a, b});
   ASSERT_EQ(img.channels, 3);
-  // The plot area: 720 × 440 with margins 90 left, 110 right, 30 top, 80 bottom (4 bins).
+  ASSERT_EQ(img.width, f.width);
   const auto rgb = [&](int x, int y) {
     const auto* p = &img.pixels[(std::size_t(y) * img.width + x) * 3];
     return (std::uint32_t(p[0]) << 16) | (std::uint32_t(p[1]) << 8) | p[2];
   };
-  const int pw = 720 - 90 - 110, ph = 440 - 30 - 80;
-  const auto px = [&](int bin) { return 90 + int((bin + 0.5) * pw / 4.0); };
-  const auto py = [&](double r) { return 30 + int((1 - r) * ph); };
-  EXPECT_EQ(rgb(px(1), py(0.5)), 0xD62728u);  // curve 1 at recall 0.5
-  EXPECT_EQ(rgb(px(0), py(0.0) - 2), 0xD62728u);
-  EXPECT_EQ(rgb(px(3), py(1.0)), 0x1F77B4u);  // curve 2 (drawn last) at recall 1
-  EXPECT_EQ(rgb(px(3), py(0.6)), 0xFFFFFFu);  // curve 1 has no point in its empty bin (0.6: off the grid lines)
+  // Each bin a step across its true extent on the square-root axis: [0.5, 1) at recall 0.5 from
+  // just after 0.5 to just before 1 voxel; the open bin drawn to twice its lower edge.
+  EXPECT_EQ(f.x_max, 4.0);
+  EXPECT_EQ(rgb(f.x(0.55), f.y(0.5)), 0xD62728u);
+  EXPECT_EQ(rgb(f.x(0.95), f.y(0.5)), 0xD62728u);
+  EXPECT_EQ(rgb(f.x(0.25), f.y(0.0) - 2), 0xD62728u);
+  EXPECT_EQ(rgb(f.x(3.5), f.y(1.0)), 0x1F77B4u);  // curve 2 (drawn last) at recall 1 in the open bin
+  EXPECT_EQ(rgb(f.x(3.0), f.y(0.6)), 0xFFFFFFu);  // curve 1 has no step in its empty bin (0.6: off the grid lines)
+  // The axis is not one of equal bins: [0, 0.5) takes as much width as sqrt(0.5) of the axis's sqrt(4).
+  EXPECT_NEAR(f.x(0.5) - f.left, f.plot_width * std::sqrt(0.5 / 4), 1);
+  // The legend names the curves: a longer name widens the picture by its characters.
+  CalibreCurve longer = a;
+  longer.name = "threshold_150_longer";
+  EXPECT_EQ(calibrePlotFrame({longer, b}).width - f.width, 12 * 7);
 }
 
 }  // namespace

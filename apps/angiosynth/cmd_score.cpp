@@ -83,7 +83,11 @@ int runScore(const ScoreArgs& a) {
   else
     writeFileAtomically(a.out, j.dump(2) + "\n");
   if (!a.csv.empty()) writeFileAtomically(a.csv, csv);
-  if (!a.plot.empty()) writePngAtomically(a.plot, plotCalibreCurves({calibreCurve(j, "")}));
+  if (!a.plot.empty()) {
+    CalibreCurve curve = calibreCurve(j, "");
+    curve.name = std::filesystem::path(dataset ? a.predictions : a.prediction).filename().string();
+    writePngAtomically(a.plot, plotCalibreCurves({curve}));
+  }
   if (!a.common.quiet) {
     const Json& s = dataset ? j["summary"] : j;
     const auto show = [&](const char* pointer) {
@@ -103,15 +107,20 @@ int runScore(const ScoreArgs& a) {
 CLI::App* addPlotCalibre(CLI::App& app, PlotCalibreArgs& a) {
   auto* c = app.add_subcommand("plot-calibre",
                                "draw the calibre curves of score results (JSON of `angiosynth score`, one case or a "
-                               "dataset's mean) as one PNG: curve k in colour k, numbered in the legend");
+                               "dataset's mean) as one PNG: curve k in colour k, named in the legend");
   c->add_option("OUT", a.out, "the PNG to write")->required();
   c->add_option("SCORES", a.scores, "score results (.json)")->required()->expected(1, 8);
+  c->add_option("--labels", a.labels, "the legend's name of each curve, in order (default: each file's name without .json)")->delimiter(',');
   c->add_flag("--force", a.force, "replace an existing OUT");
   return c;
 }
 
 int runPlotCalibre(const PlotCalibreArgs& a) {
   checkOutputFiles({{a.out, "OUT"}}, {a.scores.begin(), a.scores.end()}, a.force);
+  if (!a.labels.empty() && a.labels.size() != a.scores.size())
+    throw InputError(
+        "", 0,
+        "--labels gives " + std::to_string(a.labels.size()) + " names for " + std::to_string(a.scores.size()) + " score results; give one per file");
   std::vector<CalibreCurve> curves;
   for (const auto& f : a.scores) {
     std::ifstream in(f);
@@ -122,9 +131,9 @@ int runPlotCalibre(const PlotCalibreArgs& a) {
     if (c.lower.empty()) throw InputError(f, 0, "holds no calibre bins; allowed: the JSON angiosynth score writes");
     if (!curves.empty() && c.lower != curves.front().lower) throw InputError(f, 0, "has other calibre bins than " + a.scores.front());
     curves.push_back(c);
+    curves.back().name = a.labels.empty() ? std::filesystem::path(f).stem().string() : a.labels[curves.size() - 1];
   }
   writePngAtomically(a.out, plotCalibreCurves(curves));
-  for (std::size_t k = 0; k < a.scores.size(); ++k) std::cerr << "curve " << k + 1 << ": " << a.scores[k] << "\n";
   return 0;
 }
 

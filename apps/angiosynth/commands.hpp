@@ -88,6 +88,7 @@ int runMesh(const MeshArgs& a, const std::string& command_line);
 struct PlotCalibreArgs {
   std::string out;
   std::vector<std::string> scores;
+  std::vector<std::string> labels;  // the legend's names (default: each file's name)
   bool force = false;
 };
 CLI::App* addPlotCalibre(CLI::App& app, PlotCalibreArgs& a);

@@ -1,6 +1,7 @@
 #include "score/calibre_plot.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -39,7 +40,26 @@ const std::map<char, std::array<std::uint8_t, 7>>& font() {
                                                              {'v', {0x00, 0x00, 0x11, 0x11, 0x11, 0x0A, 0x04}},
                                                              {'o', {0x00, 0x00, 0x0E, 0x11, 0x11, 0x11, 0x0E}},
                                                              {'x', {0x00, 0x00, 0x11, 0x0A, 0x04, 0x0A, 0x11}},
-                                                             {'n', {0x00, 0x00, 0x16, 0x19, 0x11, 0x11, 0x11}}};
+                                                             {'n', {0x00, 0x00, 0x16, 0x19, 0x11, 0x11, 0x11}},
+                                                             {'b', {0x10, 0x10, 0x16, 0x19, 0x11, 0x11, 0x1E}},
+                                                             {'f', {0x06, 0x09, 0x08, 0x1C, 0x08, 0x08, 0x08}},
+                                                             {'g', {0x00, 0x0F, 0x11, 0x11, 0x0F, 0x01, 0x0E}},
+                                                             {'h', {0x10, 0x10, 0x16, 0x19, 0x11, 0x11, 0x11}},
+                                                             {'j', {0x02, 0x00, 0x06, 0x02, 0x02, 0x12, 0x0C}},
+                                                             {'k', {0x10, 0x10, 0x12, 0x14, 0x18, 0x14, 0x12}},
+                                                             {'m', {0x00, 0x00, 0x1A, 0x15, 0x15, 0x11, 0x11}},
+                                                             {'p', {0x00, 0x00, 0x1E, 0x11, 0x1E, 0x10, 0x10}},
+                                                             {'q', {0x00, 0x00, 0x0D, 0x13, 0x0F, 0x01, 0x01}},
+                                                             {'t', {0x08, 0x08, 0x1C, 0x08, 0x08, 0x09, 0x06}},
+                                                             {'w', {0x00, 0x00, 0x11, 0x11, 0x15, 0x15, 0x0A}},
+                                                             {'y', {0x00, 0x00, 0x11, 0x11, 0x0F, 0x01, 0x0E}},
+                                                             {'z', {0x00, 0x00, 0x1F, 0x02, 0x04, 0x08, 0x1F}},
+                                                             {'_', {0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x1F}},
+                                                             {':', {0x00, 0x0C, 0x0C, 0x00, 0x0C, 0x0C, 0x00}},
+                                                             {'/', {0x00, 0x01, 0x02, 0x04, 0x08, 0x10, 0x00}},
+                                                             {'(', {0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02}},
+                                                             {')', {0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08}},
+                                                             {'+', {0x00, 0x04, 0x04, 0x1F, 0x04, 0x04, 0x00}}};
   return f;
 }
 
@@ -70,7 +90,8 @@ struct Canvas {
     const int scale = 2, advance = 6 * scale, len = int(s.size()) * advance;
     if (centred) (vertical ? y : x) += (vertical ? len : -len) / 2;
     for (std::size_t c = 0; c < s.size(); ++c) {
-      const auto it = font().find(s[c]);
+      auto it = font().find(s[c]);
+      if (it == font().end()) it = font().find(char(std::tolower(static_cast<unsigned char>(s[c]))));
       if (it == font().end()) continue;
       for (int row = 0; row < 7; ++row)
         for (int col = 0; col < 5; ++col) {
@@ -119,7 +140,11 @@ CalibreCurve checkedBins(const Json& bins, const std::string& file, const std::s
     if (recall == bin.end() || !(recall->is_null() || recall->is_number())) throw bad(at + " has no recall (a number, or null)");
     const double r = recall->is_number() ? recall->get<double>() : NAN;
     if (recall->is_number() && !(r >= 0 && r <= 1)) throw bad(at + "'s recall " + std::to_string(r) + " is not in [0, 1]");
+    double upper = INFINITY;  // "inf", null or absent: the open last bin
+    if (edges->size() > 1 && (*edges)[1].is_number()) upper = (*edges)[1].get<double>();
+    if (!(upper > lower)) throw bad(at + "'s upper edge is not above its lower edge");
     c.lower.push_back(lower);
+    c.upper.push_back(upper);
     c.recall.push_back(r);
   }
   return c;
@@ -144,6 +169,7 @@ CalibreCurve calibreCurve(const Json& scores, const std::string& file) {
     const CalibreCurve one = checkedBins(cases[k]["calibre"], file, where);
     if (k == 0) {
       c.lower = one.lower;
+      c.upper = one.upper;
       sum.assign(one.lower.size(), 0);
       n.assign(one.lower.size(), 0);
     } else if (one.lower != c.lower) {
@@ -156,42 +182,79 @@ CalibreCurve calibreCurve(const Json& scores, const std::string& file) {
   return c;
 }
 
+namespace {
+
+constexpr std::uint32_t kColours[] = {0xD62728, 0x1F77B4, 0x2CA02C, 0xFF7F0E, 0x9467BD, 0x8C564B, 0x17BECF, 0x7F7F7F};
+constexpr std::size_t kLongestName = 32;  // characters of a legend entry
+
+std::string legendName(const CalibreCurve& c, std::size_t k) {
+  std::string n = c.name.empty() ? "curve " + std::to_string(k + 1) : c.name;
+  return n.size() > kLongestName ? n.substr(0, kLongestName - 2) + ".." : n;
+}
+
+}  // namespace
+
+int CalibrePlotFrame::x(double r) const { return left + int(std::sqrt(std::max(r, 0.0) / x_max) * plot_width); }
+int CalibrePlotFrame::y(double recall) const { return top + int((1 - recall) * plot_height); }
+double CalibrePlotFrame::binEnd(const CalibreCurve& c, std::size_t b) const {
+  const double end = b < c.upper.size() ? c.upper[b] : b + 1 < c.lower.size() ? c.lower[b + 1] : INFINITY;
+  if (std::isfinite(end)) return end;
+  return c.lower[b] > 0 ? 2 * c.lower[b] : 1;
+}
+
+CalibrePlotFrame calibrePlotFrame(const std::vector<CalibreCurve>& curves) {
+  CalibrePlotFrame f;
+  std::size_t longest = 0;
+  for (std::size_t k = 0; k < curves.size(); ++k) longest = std::max(longest, legendName(curves[k], k).size());
+  f.left = 100, f.top = 30, f.plot_width = 560, f.plot_height = 330;
+  f.width = f.left + f.plot_width + 40 + 24 + 12 * int(longest) + 20;
+  f.height = f.top + f.plot_height + 80;
+  f.x_max = 1;
+  for (const auto& c : curves)
+    if (!c.lower.empty()) f.x_max = std::max(f.x_max, f.binEnd(c, c.lower.size() - 1));
+  return f;
+}
+
 Image8 plotCalibreCurves(const std::vector<CalibreCurve>& curves) {
-  static const std::uint32_t colours[] = {0xD62728, 0x1F77B4, 0x2CA02C, 0xFF7F0E, 0x9467BD, 0x8C564B, 0x17BECF, 0x7F7F7F};
-  const int W = 720, H = 440, left = 90, right = 110, top = 30, bottom = 80;
-  Canvas c(W, H);
-  const int pw = W - left - right, ph = H - top - bottom;
-  std::size_t bins = 0;
-  for (const auto& cv : curves) bins = std::max(bins, cv.lower.size());
-  const auto px = [&](std::size_t b) { return left + int((b + 0.5) * pw / double(std::max<std::size_t>(bins, 1))); };
-  const auto py = [&](double r) { return top + int((1 - r) * ph); };
-  for (int k = 0; k <= 4; ++k) c.line(left, py(k / 4.0), left + pw, py(k / 4.0), 0xE0E0E0, 1);  // grid
+  const CalibrePlotFrame f = calibrePlotFrame(curves);
+  Canvas c(f.width, f.height);
+  const int left = f.left, top = f.top, pw = f.plot_width, ph = f.plot_height;
+  for (int k = 0; k <= 4; ++k) c.line(left, f.y(k / 4.0), left + pw, f.y(k / 4.0), 0xE0E0E0, 1);  // grid
   c.line(left, top, left, top + ph, 0x000000, 2);
   c.line(left, top + ph, left + pw, top + ph, 0x000000, 2);
-  for (double r : {0.0, 0.5, 1.0}) c.text(label(r), left - 14 - int(label(r).size()) * 12, py(r) - 7);
-  if (!curves.empty())
-    for (std::size_t b = 0; b < curves.front().lower.size(); ++b) {  // each bin's lower edge, at the bin's start
-      const int x = left + int(double(b) * pw / double(std::max<std::size_t>(bins, 1)));
+  for (double r : {0.0, 0.5, 1.0}) c.text(label(r), left - 10 - int(label(r).size()) * 12, f.y(r) - 7);  // right-aligned
+  if (!curves.empty()) {
+    const CalibreCurve& first = curves.front();
+    for (std::size_t b = 0; b < first.lower.size(); ++b) {  // each bin's edges, where they are
+      const int x = f.x(first.lower[b]);
       c.line(x, top + ph, x, top + ph + 6, 0x000000, 2);
-      c.text(label(curves.front().lower[b]), x - int(label(curves.front().lower[b]).size()) * 6, top + ph + 12);
+      c.text(label(first.lower[b]), x - int(label(first.lower[b]).size()) * 6, top + ph + 12);
     }
-  c.text("radius in voxels", left + pw / 2, H - 34, true);
-  c.text("recall", 20, top + ph / 2, true, true);
+    if (!first.upper.empty() && std::isinf(first.upper.back()))  // the open bin: "4+" at its middle
+      c.text(label(first.lower.back()) + "+", (f.x(first.lower.back()) + left + pw) / 2 - 6, top + ph + 30);
+  }
+  c.text("radius in voxels (square-root axis)", left + pw / 2, f.height - 30, true);
+  c.text("recall", 8, top + ph / 2, true, true);
   for (std::size_t k = 0; k < curves.size(); ++k) {
-    const auto colour = colours[k % 8];
+    const auto colour = kColours[k % 8];
     const auto& cv = curves[k];
     int last_x = -1, last_y = -1;
     for (std::size_t b = 0; b < cv.recall.size(); ++b) {
-      if (!std::isfinite(cv.recall[b])) continue;
-      const int x = px(b), y = py(std::clamp(cv.recall[b], 0.0, 1.0));
-      if (last_x >= 0) c.line(last_x, last_y, x, y, colour, 3);
-      c.box(x - 4, y - 4, x + 4, y + 4, colour);
-      last_x = x, last_y = y;
+      if (!std::isfinite(cv.recall[b])) {
+        last_x = -1;
+        continue;
+      }
+      const int x0 = f.x(cv.lower[b]), x1 = f.x(f.binEnd(cv, b)), y = f.y(std::clamp(cv.recall[b], 0.0, 1.0));
+      if (last_x >= 0) c.line(last_x, last_y, x0, y, colour, 1);  // the step between neighbouring bins
+      c.line(x0, y, x1, y, colour, 3);                            // the bin's extent
+      const int xm = f.x(0.5 * (cv.lower[b] + f.binEnd(cv, b)));
+      c.box(xm - 4, y - 4, xm + 4, y + 4, colour);
+      last_x = x1, last_y = y;
     }
-    // Legend: the curve's number beside its colour.
-    const int ly = top + 10 + int(k) * 24;
-    c.box(W - right + 20, ly, W - right + 34, ly + 14, colour);
-    c.text(std::to_string(k + 1), W - right + 42, ly);
+    // Legend: the curve's name beside its colour.
+    const int lx = left + pw + 40, ly = top + 10 + int(k) * 24;
+    c.box(lx, ly, lx + 14, ly + 14, colour);
+    c.text(legendName(cv, k), lx + 24, ly);
   }
   return c.img;
 }
