@@ -119,10 +119,13 @@ EndCutExtent endCutExtent(double r, double step, bool tight) {
 
 namespace {
 
-// Shortens each end's extension where what it adds (beyond the prolongation every cut end has)
-// comes within its cut's reach of another vessel's wall: the distance of a growing segment only
-// shrinks, so the longest extension allowed is found by bisection. An end already that near
-// another vessel gets none: running along it would lengthen their contact.
+// Shortens each end's extension where what it adds to the prolongation every cut end has (a
+// radius past its plane) would come near enough another vessel, or an extension decided before
+// it, for the contour to join them into a handle (their walls within a step of the end's
+// contour; the meshers keep wider gaps open): the distance of a growing segment from the
+// same start only shrinks, so the longest extension allowed is found by bisection. An end whose
+// prolongation is already that near gets none. Whether the cut then finds its region clear is
+// the cut's to report (ends left closed).
 void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, double extension_radii, double step_radii) {
   Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
   double widest = 0;
@@ -130,64 +133,61 @@ void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, do
     lo = componentMin(lo, t.position[i]), hi = componentMax(hi, t.position[i]);
     if (!t.isRoot(i)) widest = std::max({widest, t.radius[i], t.startRadius(i)});
   }
+  const auto apart = [&](double r, double other) { return r + other + step_radii * r; };
   std::vector<double> lengths;
+  double thickest_end = 0;
   for (const auto& e : ends) {
-    const auto x = endCutExtent(e.radius, step_radii * e.radius);
-    lengths.push_back(extension_radii * e.radius + x.beyond + x.reach);
+    lengths.push_back((extension_radii + kOvershootRadii) * e.radius);
+    thickest_end = std::max(thickest_end, e.radius);
   }
-  const double grow = *std::max_element(lengths.begin(), lengths.end()) + widest;
+  const double grow = *std::max_element(lengths.begin(), lengths.end()) + apart(thickest_end, widest);
   std::nth_element(lengths.begin(), lengths.begin() + std::ptrdiff_t(lengths.size() / 2), lengths.end());
-  SegmentGrid grid(lo - Vec3(grow, grow, grow), hi + Vec3(grow, grow, grow), lengths[lengths.size() / 2], hi.z - lo.z <= 0);
+  SegmentGrid grid(lo - Vec3(grow, grow, grow), hi + Vec3(grow, grow, grow), std::max(lengths[lengths.size() / 2], 1e-6), hi.z - lo.z <= 0);
   for (std::int32_t i = 0; i < t.nodeCount(); ++i)
     if (!t.isRoot(i) && !t.isLink(i)) grid.insert(i, t.position[t.parent[i]], t.position[i], std::max(t.radius[i], t.startRadius(i)));
 
   struct Near {
     std::int32_t vessel;
     Vec3 a, b;
-    double clearance;  // what the added part keeps from its axis: its wall plus the region's reach
+    double clearance;  // the least distance of the added part's axis from this one's
   };
   std::vector<Near> near;
   // The extensions decided so far (ids nodeCount + k in the grid): two ends that face each other
-  // must not both reach into the gap. Each keeps the other out of its cut's reach.
+  // must not both reach into the gap.
   struct Extension {
     Vec3 a, b;
-    double radius, reach;
+    double radius;
   };
   std::vector<Extension> decided(ends.size());
   const std::int32_t first_extension = t.nodeCount();
   for (std::size_t k = 0; k < ends.size(); ++k) {
     auto& e = ends[k];
-    const auto x = endCutExtent(e.radius, step_radii * e.radius);
-    const auto reachOf = [&](double radii) { return e.node + e.normal * (radii * e.radius + x.beyond); };
+    const double r = e.radius;
+    // The added part of an extension of `radii`: from the prolongation's tip on.
+    const Vec3 start = e.node + e.normal * (kOvershootRadii * r);
+    const auto tipOf = [&](double radii) { return e.node + e.normal * ((radii + kOvershootRadii) * r); };
     near.clear();
-    grid.any(e.node, reachOf(extension_radii), x.reach, [&](std::int32_t y) {
+    grid.any(start, tipOf(extension_radii), apart(r, widest), [&](std::int32_t y) {
       if (y == e.vessel) return false;
-      Vec3 a, b;
-      double wall;
-      std::int32_t vessel = y;
       if (y >= first_extension) {
         const auto& other = decided[std::size_t(y - first_extension)];
-        a = other.a, b = other.b;
-        wall = std::max(other.radius + x.reach, e.radius + other.reach);
-        vessel = ends[std::size_t(y - first_extension)].vessel;
+        near.push_back({ends[std::size_t(y - first_extension)].vessel, other.a, other.b, apart(r, other.radius)});
       } else {
-        a = t.position[t.parent[y]], b = t.position[y];
-        wall = std::max(t.radius[y], t.startRadius(y)) + x.reach;
+        near.push_back({y, t.position[t.parent[y]], t.position[y], apart(r, std::max(t.radius[y], t.startRadius(y)))});
       }
-      near.push_back({vessel, a, b, wall});
       return false;
     });
     // The vessel that stops an extension of `radii`, or -1.
     const auto stop = [&](double radii) {
       for (const auto& n : near)
-        if (segmentSegmentDistance(reachOf(0), reachOf(radii), n.a, n.b) < n.clearance) return n.vessel;
+        if (segmentSegmentDistance(start, tipOf(radii), n.a, n.b) < n.clearance) return n.vessel;
       return std::int32_t(-1);
     };
     double given = extension_radii;
     if (const auto first = stop(given); first >= 0) {
       double clear = 0, blocked = given;
       e.extension_stop = first;
-      for (int k = 0; k < 40; ++k) {
+      for (int step = 0; step < 40; ++step) {
         const double mid = 0.5 * (clear + blocked);
         const auto s = stop(mid);
         (s >= 0 ? blocked : clear) = mid;
@@ -196,9 +196,9 @@ void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, do
       given = clear;
     }
     e.extension_radii = given;
-    e.centre = e.node + e.normal * (given * e.radius);
-    decided[k] = {e.node, reachOf(given), e.radius, x.reach};
-    grid.insert(first_extension + std::int32_t(k), decided[k].a, decided[k].b, e.radius + x.reach);
+    e.centre = e.node + e.normal * (given * r);
+    decided[k] = {start, tipOf(given), r};
+    grid.insert(first_extension + std::int32_t(k), decided[k].a, decided[k].b, r + apart(r, widest));
   }
 }
 
