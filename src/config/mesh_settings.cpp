@@ -84,7 +84,7 @@ const std::vector<Setting<MeshParameters>>& meshSettings() {
        .field = &MeshParameters::remesh, .flag = "--remesh"},
       {.table = "mesh", .key = "flow_extension", .unit = "radii", .fallback = "0",
        .meaning = "open/capped: each end prolonged straight by this many radii of its vessel before the cut (0 … 100); shorter "
-                  "where its wall would come within a contour step of another vessel's, none where the end already is (a warning names the end)",
+                  "where it would come near enough another vessel for the surface to join them (a warning names the end)",
        .field = &MeshParameters::flow_extension, .range = {0, 100}, .flag = "--flow-extension"},
       {.table = "mesh", .key = "clip_box", .unit = "[mm × 6]", .fallback = "none",
        .meaning = "[x0, y0, z0, x1, y1, z1]: the closed surface (closed or capped ends, or a hollow wall) clipped to this box, each side's section "

@@ -120,12 +120,11 @@ EndCutExtent endCutExtent(double r, double step, bool tight) {
 namespace {
 
 // Shortens each end's extension where what it adds to the prolongation every cut end has (a
-// radius past its plane) would come near enough another vessel, or an extension decided before
-// it, for the contour to join them into a handle (their walls within a step of the end's
-// contour; the meshers keep wider gaps open): the distance of a growing segment from the
-// same start only shrinks, so the longest extension allowed is found by bisection. An end whose
-// prolongation is already that near gets none. Whether the cut then finds its region clear is
-// the cut's to report (ends left closed).
+// radius past its plane) would come within its cut's reach of another vessel or of an extension
+// decided before it: unchecked, the contour joined them into a handle. An extension that starts
+// that near a vessel (a sibling it diverges from) but not joined to it (walls more than a contour
+// step apart) may go on while it gets no nearer and its tip is not joined to it either. Whether the cut then finds its
+// region clear is the cut's to report (ends left closed).
 void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, double extension_radii, double step_radii) {
   Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
   double widest = 0;
@@ -133,7 +132,10 @@ void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, do
     lo = componentMin(lo, t.position[i]), hi = componentMax(hi, t.position[i]);
     if (!t.isRoot(i)) widest = std::max({widest, t.radius[i], t.startRadius(i)});
   }
-  const auto apart = [&](double r, double other) { return r + other + step_radii * r; };
+  // Within its cut's reach: what an extension keeps from the vessels it nears.
+  const auto apart = [&](double r, double other) { return other + endCutExtent(r, step_radii * r).reach; };
+  // Walls within the end's contour step: joined, the surface has a handle.
+  const auto joined = [&](double r, double other) { return r + other + step_radii * r; };
   std::vector<double> lengths;
   double thickest_end = 0;
   for (const auto& e : ends) {
@@ -150,6 +152,8 @@ void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, do
     std::int32_t vessel;
     Vec3 a, b;
     double clearance;  // the least distance of the added part's axis from this one's
+    double joined;     // nearer, the contour joins the two
+    double at_start;   // the distance of its start from this one
   };
   std::vector<Near> near;
   // The extensions decided so far (ids nodeCount + k in the grid): two ends that face each other
@@ -169,31 +173,47 @@ void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, do
     near.clear();
     grid.any(start, tipOf(extension_radii), apart(r, widest), [&](std::int32_t y) {
       if (y == e.vessel) return false;
+      Near n;
+      double other_radius;
       if (y >= first_extension) {
         const auto& other = decided[std::size_t(y - first_extension)];
-        near.push_back({ends[std::size_t(y - first_extension)].vessel, other.a, other.b, apart(r, other.radius)});
+        n = {ends[std::size_t(y - first_extension)].vessel, other.a, other.b, 0, 0, 0};
+        other_radius = other.radius;
       } else {
-        near.push_back({y, t.position[t.parent[y]], t.position[y], apart(r, std::max(t.radius[y], t.startRadius(y)))});
+        n = {y, t.position[t.parent[y]], t.position[y], 0, 0, 0};
+        other_radius = std::max(t.radius[y], t.startRadius(y));
       }
+      n.clearance = apart(r, other_radius);
+      n.joined = joined(r, other_radius);
+      n.at_start = segmentSegmentDistance(start, start, n.a, n.b);
+      near.push_back(n);
       return false;
     });
-    // The vessel that stops an extension of `radii`, or -1.
+    // The vessel that stops an extension of `radii`, or -1: one it comes within its cut's reach
+    // of, unless it started nearer (a sibling it diverges from), gets no nearer and its tip is
+    // clear of being joined to it.
     const auto stop = [&](double radii) {
-      for (const auto& n : near)
-        if (segmentSegmentDistance(start, tipOf(radii), n.a, n.b) < n.clearance) return n.vessel;
+      const Vec3 tip = tipOf(radii);
+      for (const auto& n : near) {
+        const double d = segmentSegmentDistance(start, tip, n.a, n.b);
+        if (d >= n.clearance) continue;
+        if (n.at_start >= n.joined && d >= (1 - 1e-9) * n.at_start && segmentSegmentDistance(tip, tip, n.a, n.b) >= n.joined) continue;
+        return n.vessel;
+      }
       return std::int32_t(-1);
     };
+    // The longest of 16 lengths down from the one asked that nothing stops (a diverging
+    // extension may be stopped short and not long, so no bisection).
+    constexpr int kLengths = 16;
     double given = extension_radii;
     if (const auto first = stop(given); first >= 0) {
-      double clear = 0, blocked = given;
       e.extension_stop = first;
-      for (int step = 0; step < 40; ++step) {
-        const double mid = 0.5 * (clear + blocked);
-        const auto s = stop(mid);
-        (s >= 0 ? blocked : clear) = mid;
-        if (s >= 0) e.extension_stop = s;
-      }
-      given = clear;
+      given = 0;
+      for (int k = kLengths - 1; k > 0; --k)
+        if (stop(extension_radii * k / kLengths) < 0) {
+          given = extension_radii * k / kLengths;
+          break;
+        }
     }
     e.extension_radii = given;
     e.centre = e.node + e.normal * (given * r);

@@ -42,9 +42,10 @@ EndCutExtent endCutExtent(double radius, double step, bool tight = false);
 // The open ends of a tree: each root with a single vessel leaving it and every leaf; per tree,
 // the root first, then the leaves by position (x, y, z); `extension_radii` ≥ 0 moves each plane
 // that many radii beyond its node. An extension is added geometry: where what it adds would
-// come near enough another vessel, or an extension decided before it, for the contour to join
-// them (walls within the end's contour step, `step_radii` of its radius), it is shortened to the
-// longest that does not; an end already that near gets none.
+// come within its cut's reach (endCutExtent, for a contour step of `step_radii` of the end's
+// radius) of another vessel or of an extension decided before it, it is shortened to the
+// longest of 16 lengths that does not (one that starts that near a vessel it diverges from may
+// go on while its wall stays more than a step from that vessel's).
 std::vector<VesselEnd> openEnds(const VascularTree& t, double extension_radii, double step_radii = 1);
 
 // The tree with every end prolonged along its axis at its end radius, a radius past its plane

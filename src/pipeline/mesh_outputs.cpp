@@ -310,7 +310,8 @@ std::vector<std::string> surfaceWarnings(const VascularTree& tree, const Surface
   for (std::size_t k = 0; k < ends.size(); ++k)
     if (ends[k].extension_stop >= 0)
       per_end.push_back(endName(k, ends[k], vessel_ids) + ": flow extension shortened to " + show(ends[k].extension_radii, 3) +
-                        " radii; a longer one would come within a contour step of the wall of " + vesselName(ends[k].extension_stop, vessel_ids));
+                        " radii; a longer one would come near enough for the surface to join it to " +
+                        vesselName(ends[k].extension_stop, vessel_ids));
   for (auto k : b.cut.left_closed)
     per_end.push_back(endName(std::size_t(k), ends[std::size_t(k)], vessel_ids) +
                       ": left closed (round, face 'left_closed' in surface_faces.csv): another vessel's wall lies within its cut's reach");
