@@ -27,6 +27,17 @@ class Cli : public ::testing::Test {
  protected:
   void SetUp() override { dir_ = freshTestDir("angiosynth_cli_"); }
   void TearDown() override { fs::remove_all(dir_); }
+  // VascuSynth's 1000-terminal example as p.txt (its maps found from here), listed in params.txt
+  // with the output name img in names.txt: the arguments of `angiosynth vascusynth`.
+  void writeVascuSynthBatch() {
+    fs::copy_file(src_ / "examples/vascusynth/param_rods_1000.txt", dir_ / "p.txt");
+    std::string t = slurp(dir_ / "p.txt");
+    for (auto pos = t.find("../../demand_maps"); pos != std::string::npos; pos = t.find("../../demand_maps"))
+      t.replace(pos, 17, (src_ / "demand_maps").string());
+    std::ofstream(dir_ / "p.txt", std::ios::binary) << t;
+    std::ofstream(dir_ / "params.txt") << "p.txt\n";
+    std::ofstream(dir_ / "names.txt") << "img\n";
+  }
   fs::path dir_;
   const fs::path src_ = ANGIOSYNTH_SOURCE_DIR;
 };
@@ -221,13 +232,7 @@ TEST_F(Cli, ProfilesGiveOneDegradedImageEachWithWarpedLabelsAndTheSameBytesForAn
 // map-voxel corners (101^3 for a 100^3 map) and generate's of voxel centres (100^3); the sidecar
 // lists only the formats written.
 TEST_F(Cli, VascuSynthRulesReproduceItsConstraintsAndEachCommandStatesItsGrid) {
-  fs::copy_file(src_ / "examples/vascusynth/param_rods_1000.txt", dir_ / "p.txt");
-  std::string t = slurp(dir_ / "p.txt");
-  for (auto pos = t.find("../../demand_maps"); pos != std::string::npos; pos = t.find("../../demand_maps"))
-    t.replace(pos, 17, (src_ / "demand_maps").string());
-  std::ofstream(dir_ / "p.txt", std::ios::binary) << t;
-  std::ofstream(dir_ / "params.txt") << "p.txt\n";
-  std::ofstream(dir_ / "names.txt") << "img\n";
+  writeVascuSynthBatch();
   const auto ok = run("vascusynth params.txt names.txt 0.04 --vascusynth-rules", dir_);
   ASSERT_EQ(ok.code, 0) << ok.err;
   EXPECT_NE(ok.err.find("image 101 x 101 x 101 voxels centred on the map voxels' corners"), std::string::npos) << ok.err;
@@ -267,13 +272,7 @@ TEST_F(Cli, VascuSynthRulesReproduceItsConstraintsAndEachCommandStatesItsGrid) {
 }
 
 TEST_F(Cli, VascuSynthNoiseFilesGiveNoiseImagesAndMisspellingsStopEverything) {
-  fs::copy_file(src_ / "examples/vascusynth/param_rods_1000.txt", dir_ / "p.txt");
-  std::string t = slurp(dir_ / "p.txt");
-  for (auto pos = t.find("../../demand_maps"); pos != std::string::npos; pos = t.find("../../demand_maps"))
-    t.replace(pos, 17, (src_ / "demand_maps").string());
-  std::ofstream(dir_ / "p.txt", std::ios::binary) << t;
-  std::ofstream(dir_ / "params.txt") << "p.txt\n";
-  std::ofstream(dir_ / "names.txt") << "img\n";
+  writeVascuSynthBatch();
   std::ofstream(dir_ / "noise.txt") << "GAUSSIAN: 0 20\nSHADOW: 2\n";
   std::ofstream(dir_ / "typo.txt") << "GAUSSIAN: 0 20\nSALTPEPER 255 0.05 0 0.05\n";
   const auto bad = run("vascusynth params.txt names.txt 0.04 noise.txt typo.txt", dir_);

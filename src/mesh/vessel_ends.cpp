@@ -123,8 +123,8 @@ namespace {
 // radius past its plane) would come within its cut's reach of another vessel or of an extension
 // decided before it: unchecked, the contour joined them into a handle. An extension that starts
 // that near a vessel (a sibling it diverges from) but not joined to it (walls more than a contour
-// step apart) may go on while it gets no nearer and its tip is not joined to it either. Whether the cut then finds its
-// region clear is the cut's to report (ends left closed).
+// step apart) may go on while it gets no nearer and its tip is not joined to it either. Whether
+// the cut then finds its region clear is the cut's to report (ends left closed).
 void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, double extension_radii, double step_radii) {
   Vec3 lo(INFINITY, INFINITY, INFINITY), hi(-INFINITY, -INFINITY, -INFINITY);
   double widest = 0;
@@ -185,7 +185,7 @@ void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, do
       }
       n.clearance = apart(r, other_radius);
       n.joined = joined(r, other_radius);
-      n.at_start = segmentSegmentDistance(start, start, n.a, n.b);
+      n.at_start = pointSegmentDistance(start, n.a, n.b);
       near.push_back(n);
       return false;
     });
@@ -197,7 +197,7 @@ void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, do
       for (const auto& n : near) {
         const double d = segmentSegmentDistance(start, tip, n.a, n.b);
         if (d >= n.clearance) continue;
-        if (n.at_start >= n.joined && d >= (1 - 1e-9) * n.at_start && segmentSegmentDistance(tip, tip, n.a, n.b) >= n.joined) continue;
+        if (n.at_start >= n.joined && d >= (1 - 1e-9) * n.at_start && pointSegmentDistance(tip, n.a, n.b) >= n.joined) continue;
         return n.vessel;
       }
       return std::int32_t(-1);
@@ -209,9 +209,9 @@ void keepExtensionsClear(const VascularTree& t, std::vector<VesselEnd>& ends, do
     if (const auto first = stop(given); first >= 0) {
       e.extension_stop = first;
       given = 0;
-      for (int k = kLengths - 1; k > 0; --k)
-        if (stop(extension_radii * k / kLengths) < 0) {
-          given = extension_radii * k / kLengths;
+      for (int part = kLengths - 1; part > 0; --part)
+        if (stop(extension_radii * part / kLengths) < 0) {
+          given = extension_radii * part / kLengths;
           break;
         }
     }

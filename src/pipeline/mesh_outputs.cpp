@@ -25,6 +25,13 @@ using Json = nlohmann::ordered_json;
 
 namespace {
 
+// Per end: 1 where the cut left it closed.
+std::vector<char> leftClosed(const EndCutReport& cut, std::size_t ends) {
+  std::vector<char> closed(ends, 0);
+  for (auto e : cut.left_closed) closed[std::size_t(e)] = 1;
+  return closed;
+}
+
 // surface_faces.csv: one row per face label (the wall, then each end), as the ids the VTP and
 // PLY files carry (ModelFaceID = CellEntityIds = face + 1).
 // With a clip box, an end outside it is `outside_box`, and each side of the box has a row (kind
@@ -34,8 +41,7 @@ void writeFaces(std::ostream& os, const std::vector<VesselEnd>& ends, const EndC
                 const BoxClipReport& clipped) {
   os << "face_id,kind,tree,vessel,end,state,centre_x,centre_y,centre_z,normal_x,normal_y,normal_z,radius,cap_area,loop_vertices,extension_radii\n";
   os << "1,wall,,,,,,,,,,,,,,\n";
-  std::vector<char> closed(ends.size(), 0);
-  for (auto e : cut.left_closed) closed[std::size_t(e)] = 1;
+  const auto closed = leftClosed(cut, ends.size());
   const auto outside = [&](const Vec3& c) {
     return !box.empty() && (c.x < box[0] || c.y < box[1] || c.z < box[2] || c.x > box[3] || c.y > box[4] || c.z > box[5]);
   };
@@ -248,8 +254,7 @@ SurfaceSummary summarise(const VascularTree& tree, const MeshParameters& p, cons
   if (clip) s.clip = b.clipped;
   if (!plan.walls && !clip) {
     s.tree_euler_expected.assign(s.topology.tree_euler.size(), 2);
-    std::vector<char> closed(plan.ends().size(), 0);
-    for (auto e : b.cut.left_closed) closed[std::size_t(e)] = 1;
+    const auto closed = leftClosed(b.cut, plan.ends().size());
     for (std::size_t k = 0; k < plan.ends().size(); ++k)
       if (p.ends == "open" && !closed[k] && std::size_t(plan.ends()[k].tree) < s.tree_euler_expected.size())
         --s.tree_euler_expected[std::size_t(plan.ends()[k].tree)];
