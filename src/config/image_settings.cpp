@@ -55,7 +55,8 @@ const std::vector<Setting<LabelPolicy>>& labelSettings() {
   using P = LabelPolicy;
   static const std::vector<Setting<P>> settings{
       {.table = "image", .key = "label_policy", .unit = "text", .fallback = "binary",
-       .meaning = "the training label (label.nii.gz; the mask stays as it is): binary (the mask), threshold, visible, soft or ignore",
+       .meaning = "the training label (label.nii.gz; the mask stays as it is): binary (the mask), threshold, visible, soft or ignore "
+                  "(a dataset with a degraded image: visible unless set)",
        .field = &P::name, .choices = labelPolicyNames()},
       {.table = "image", .key = "label_threshold", .unit = "", .fallback = "0.5",
        .meaning = "label_policy = threshold: vessel where the partial volume is at least this (0 … 1]",

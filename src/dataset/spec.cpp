@@ -218,11 +218,20 @@ void readLabels(const toml::table& d, DatasetSpec& s) {
   s.labels_line = lineOf(*k);
 }
 
-// [image] label_policy as the dataset sees it: one plain policy for every sample.
+// [image] label_policy as the dataset sees it: one plain policy for every sample. Unset, a
+// dataset with a degraded image labels what that image shows ("visible"): a network cannot learn
+// vessels the noise hides, and labels of them teach it to guess.
 void readLabelPolicy(const toml::table& root, DatasetSpec& s) {
   const auto* im = root.get("image");
   const auto* n = im && im->is_table() ? im->as_table()->get("label_policy") : nullptr;
-  if (!n) return;
+  if (!n) {
+    const auto* ds = root.get("dataset");
+    const auto* profile = ds && ds->is_table() ? ds->as_table()->get("profile") : nullptr;
+    const bool clean = !profile || profile->value<std::string>() == std::optional<std::string>("clean");
+    s.label_policy = clean ? "binary" : "visible";
+    s.label_policy_by_default = true;
+    return;
+  }
   const auto v = n->value<std::string>();
   if (!v)
     throw InputError(s.file, lineOf(*n),
@@ -392,6 +401,10 @@ ResolvedSample resolveSample(const DatasetSpec& spec, std::int64_t index) {
   }
   t->erase("dataset");
   resolveTable(*t, rng, spec.file);
+  if (spec.label_policy_by_default && spec.label_policy != "binary") {
+    if (!t->contains("image")) t->insert("image", toml::table{});
+    t->get("image")->as_table()->insert_or_assign("label_policy", spec.label_policy);
+  }
   t->insert_or_assign("seed", static_cast<std::int64_t>(r.seed));
   std::ostringstream o;
   o << *t << "\n";

@@ -37,9 +37,11 @@ struct DatasetSpec {
   std::vector<std::string> kinds;  // labels = "kind": default artery, vein
   int labels_line = 0;             // of `kinds`, else of `labels`, for errors about a sample's kinds
   // [image] label_policy of every sample (one for the whole dataset): labelsTr holds the policy's
-  // label (a float partial volume for "soft"); "ignore" adds nnU-Net's ignore label.
+  // label (a float partial volume for "soft"); "ignore" adds nnU-Net's ignore label. Unset:
+  // "visible" with a degraded image, "binary" with the clean one.
   std::string label_policy = "binary";
-  bool previews = false;  // MIPs (PNG) of each sample's clean and degraded image in groundtruth/
+  bool label_policy_by_default = false;  // unset in the spec: the sample files are given the default
+  bool previews = false;                 // MIPs (PNG) of each sample's clean and degraded image in groundtruth/
   // The licence the dataset's author gives the generated data (an SPDX identifier or any text):
   // dataset.json and provenance.json name it.
   std::string licence = "CC0-1.0";
