@@ -279,7 +279,7 @@ namespace {
 
 // `score --dataset`: every case of a dataset against its own image's truth (the warped labels
 // and graph for the profile that warps, the mask where labelsTr holds the classes); labelsTr as
-// predictions score Dice 1 everywhere; a missing prediction names its case.
+// predictions score Dice 1 everywhere, against the training label and the exact mask alike.
 TEST_F(ScoreRun, DatasetModeScoresEveryCaseAgainstItsImagesTruth) {
   fs::copy_file(src_ / "tests/data/profile_warp.toml", dir_ / "profile_warp.toml");
   fs::copy_file(src_ / "tests/data/dataset_av.toml", dir_ / "spec.toml");
@@ -287,10 +287,12 @@ TEST_F(ScoreRun, DatasetModeScoresEveryCaseAgainstItsImagesTruth) {
   const fs::path ds = dir_ / "raw/Dataset903_ArteryVeinTiny";
   fs::create_directories(dir_ / "pred");
   for (const auto& e : fs::directory_iterator(ds / "labelsTr")) fs::copy_file(e.path(), dir_ / "pred" / e.path().filename());
-  const auto r = run("score --dataset raw/Dataset903_ArteryVeinTiny --predictions pred --out all.json --csv all.csv --quiet", dir_);
+  const auto r = run("score --dataset raw/Dataset903_ArteryVeinTiny --predictions pred --truth exact --out all.json --csv all.csv --quiet", dir_);
   ASSERT_EQ(r.code, 0) << r.err;
   const Json j = Json::parse(slurp(dir_ / "all.json"));
   ASSERT_EQ(j["cases"], 3);
+  EXPECT_EQ(j["truth"], "exact");
+  EXPECT_NE(j["truth_is"].get<std::string>().find("exact mask"), std::string::npos) << j["truth_is"];
   EXPECT_EQ(j["summary"]["dice"]["mean"], 1.0);
   EXPECT_EQ(j["summary"]["hd_mm"]["max"], 0.0);
   int warped = 0;
@@ -316,11 +318,58 @@ TEST_F(ScoreRun, DatasetModeScoresEveryCaseAgainstItsImagesTruth) {
     mantissa.erase(0, mantissa.find_first_not_of("-0"));
     EXPECT_LE(mantissa.size(), 6u) << field;
   }
+  // The default truth is the training label (labelsTr, here labelled by kind), named as such;
+  // each class summarised over the cases, in JSON and CSV.
+  ASSERT_EQ(run("score --dataset raw/Dataset903_ArteryVeinTiny --predictions pred --out train.json --class-csv classes.csv --quiet", dir_).code, 0);
+  const Json t = Json::parse(slurp(dir_ / "train.json"));
+  EXPECT_EQ(t["truth"], "training");
+  EXPECT_NE(t["truth_is"].get<std::string>().find("training label"), std::string::npos) << t["truth_is"];
+  EXPECT_EQ(t["summary"]["dice"]["mean"], 1.0);
+  EXPECT_EQ(t["summary"]["class_avg_dice"]["mean"], 1.0);
+  for (const char* kind : {"artery", "vein"}) {
+    EXPECT_EQ(t["aggregates"]["per_class"]["classes"][kind]["cases_present"], 3) << kind;
+    EXPECT_EQ(t["aggregates"]["per_class"]["classes"][kind]["dice"]["mean"], 1.0) << kind;
+  }
+  const std::string classes = slurp(dir_ / "classes.csv");
+  EXPECT_EQ(classes.rfind("class,cases_present,dice_mean,dice_sd,", 0), 0u) << classes;
+  EXPECT_NE(classes.find("\nartery,3,1,"), std::string::npos) << classes;
+  EXPECT_NE(classes.find("\nvein,3,1,"), std::string::npos) << classes;
+  EXPECT_NE(classes.find("\nclass average,3,1,"), std::string::npos) << classes;
+
+  // A fold: the cases that have predictions are scored, the others named.
   fs::remove(dir_ / "pred/ArteryVeinTiny_0001.nii.gz");
-  const auto bad = run("score --dataset raw/Dataset903_ArteryVeinTiny --predictions pred --out bad.json", dir_);
-  EXPECT_EQ(bad.code, 2);
-  EXPECT_NE(bad.err.find("ArteryVeinTiny_0001.nii.gz: missing: no prediction for case ArteryVeinTiny_0001"), std::string::npos) << bad.err;
-  EXPECT_FALSE(fs::exists(dir_ / "bad.json"));
+  const auto fold = run("score --dataset raw/Dataset903_ArteryVeinTiny --predictions pred --out fold.json", dir_);
+  ASSERT_EQ(fold.code, 0) << fold.err;
+  const Json f = Json::parse(slurp(dir_ / "fold.json"));
+  EXPECT_EQ(f["cases"], 2);
+  EXPECT_EQ(f["missing_predictions"], Json::array({"ArteryVeinTiny_0001"}));
+  EXPECT_NE(fold.err.find("no prediction for 1 of the 3 cases selected: ArteryVeinTiny_0001"), std::string::npos) << fold.err;
+  // nnU-Net's splits: the validation cases of one fold.
+  std::ofstream(dir_ / "splits_final.json") << R"([{"train": ["ArteryVeinTiny_0001", "ArteryVeinTiny_0002"], "val": ["ArteryVeinTiny_0000"]},
+    {"train": ["ArteryVeinTiny_0000", "ArteryVeinTiny_0002"], "val": ["ArteryVeinTiny_0001"]},
+    {"train": ["ArteryVeinTiny_0000", "ArteryVeinTiny_0001"], "val": ["ArteryVeinTiny_0002"]}])";
+  ASSERT_EQ(
+      run("score --dataset raw/Dataset903_ArteryVeinTiny --predictions pred --splits splits_final.json --fold 2 --out f2.json --quiet", dir_).code,
+      0);
+  const Json f2 = Json::parse(slurp(dir_ / "f2.json"));
+  EXPECT_EQ(f2["cases"], 1);
+  EXPECT_EQ(f2["per_case"][0]["case"], "ArteryVeinTiny_0002");
+  EXPECT_EQ(f2["missing_predictions"], Json::array());
+  const auto none = run("score --dataset raw/Dataset903_ArteryVeinTiny --predictions pred --splits splits_final.json --fold 1 --out f1.json", dir_);
+  EXPECT_EQ(none.code, 2);
+  EXPECT_NE(none.err.find("holds no prediction for the validation cases of fold 1"), std::string::npos) << none.err;
+  EXPECT_FALSE(fs::exists(dir_ / "f1.json"));
+  const auto bad_fold = run("score --dataset raw/Dataset903_ArteryVeinTiny --predictions pred --splits splits_final.json --fold 3", dir_);
+  EXPECT_EQ(bad_fold.code, 2);
+  EXPECT_NE(bad_fold.err.find("has folds 0 to 2; --fold 3 is not one"), std::string::npos) << bad_fold.err;
+  // One case of the dataset.
+  const auto one =
+      run("score pred/ArteryVeinTiny_0002.nii.gz --dataset raw/Dataset903_ArteryVeinTiny --case ArteryVeinTiny_0002 --out one.json --quiet", dir_);
+  ASSERT_EQ(one.code, 0) << one.err;
+  EXPECT_EQ(Json::parse(slurp(dir_ / "one.json"))["overlap"]["dice"], 1.0);
+  const auto unknown = run("score pred/ArteryVeinTiny_0002.nii.gz --dataset raw/Dataset903_ArteryVeinTiny --case Nope_0002", dir_);
+  EXPECT_EQ(unknown.code, 2);
+  EXPECT_NE(unknown.err.find("has no case Nope_0002"), std::string::npos) << unknown.err;
 }
 
 }  // namespace
@@ -577,7 +626,7 @@ TEST(Score, TubeWithAGapLosesItsGapAndItsConnectivity) {
   EXPECT_EQ(bt.b0, 1);
   EXPECT_EQ(bp.b0, 2);
   EXPECT_EQ(bp.b1 + bt.b1 + bp.b2 + bt.b2, 0);
-  const Json c = Json::parse(clDice(skeletonize(pred), truth, skeletonize(truth), pred).dump());
+  const Json c = Json::parse(clDice(skeletonize(pred), truth, skeletonize(truth), pred, false).dump());
   ASSERT_TRUE(c["topology_precision"].is_number() && c["topology_sensitivity"].is_number()) << c.dump();
   EXPECT_EQ(c["topology_precision"].get<double>(), 1.0);
   EXPECT_LT(c["topology_sensitivity"].get<double>(), 0.95);
@@ -591,6 +640,245 @@ TEST(Score, TubeWithAGapLosesItsGapAndItsConnectivity) {
       for (int i = 5; i <= 34; ++i) even.at(i, j, k) = std::hypot(j - 19.5, k - 19.5) <= 3;
   const auto s = skeletonize(even);
   EXPECT_EQ(std::count(s.data.begin(), s.data.end(), 1), 0);
+}
+
+}  // namespace
+
+namespace {
+
+// Labelled volumes written as NIfTI for `score PRED TRUTH`: bars one voxel thick along x.
+struct Phantom {
+  Volume<std::uint8_t> v;
+  explicit Phantom(int n, const Vec3& origin = Vec3(0, 0, 0))
+      : v([&] {
+          VolumeGrid g;
+          g.dims = {n, n, n};
+          g.origin_mm = origin;
+          return g;
+        }()) {}
+  Phantom& bar(int value, int x0, int x1, int y, int z) {
+    for (int x = x0; x <= x1; ++x) v.at(x, y, z) = std::uint8_t(value);
+    return *this;
+  }
+  Phantom& column(int value, int x, int y0, int y1, int z) {
+    for (int y = y0; y <= y1; ++y) v.at(x, y, z) = std::uint8_t(value);
+    return *this;
+  }
+  void write(const fs::path& f) const { writeNifti(f, viewOf(v, true, "phantom")); }
+};
+
+// A plain pair of labelled NIfTI volumes, every number derived by hand: class 1 a bar of 10
+// voxels predicted as its first 8; class 2 the same predicted in two pieces of 4 (a 2-voxel
+// gap); class 3 in the legend and in neither volume; class 4 one voxel of the truth only; class
+// 5 one voxel of the prediction only (4 and 5 not in the legend).
+TEST_F(ScoreRun, PlainLabelledPairScoresEveryClassAsDerivedByHand) {
+  Phantom truth(20), pred(20);
+  truth.bar(1, 2, 11, 5, 5).bar(2, 2, 11, 12, 12).bar(4, 15, 15, 15, 15);
+  pred.bar(1, 2, 9, 5, 5).bar(2, 2, 5, 12, 12).bar(2, 8, 11, 12, 12).bar(5, 17, 17, 3, 3);
+  truth.write(dir_ / "truth.nii.gz");
+  pred.write(dir_ / "pred.nii.gz");
+  const auto r = run("score pred.nii.gz truth.nii.gz --legend 1=first,2=second,3=third --out d.json", dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: label 4 occurs in the truth but not in the legend"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("warning: label 5 occurs in the prediction but not in the legend"), std::string::npos) << r.err;
+  const Json d = Json::parse(slurp(dir_ / "d.json"));
+  EXPECT_NE(d["truth_is"].get<std::string>().find("annotation truth.nii.gz"), std::string::npos);
+  EXPECT_FALSE(d.contains("centreline"));  // no centreline given: no centreline metrics
+  EXPECT_FALSE(d.contains("calibre"));
+  EXPECT_DOUBLE_EQ(d["overlap"]["dice"].get<double>(), 32.0 / 38.0);  // the classes merged: 21 and 17 voxels, 16 common
+  const Json& k = d["per_class"]["classes"];
+  EXPECT_DOUBLE_EQ(k["first"]["overlap"]["dice"].get<double>(), 16.0 / 18.0);
+  EXPECT_DOUBLE_EQ(k["first"]["cldice"]["cldice"].get<double>(), 2 * 0.8 / 1.8);  // Tprec 1, Tsens 8/10
+  EXPECT_NEAR(k["first"]["surface"]["hd95_mm"].get<double>(), 1.55, 1e-12);       // truth to prediction 0 ×8, 1, 2
+  EXPECT_DOUBLE_EQ(k["first"]["surface"]["hd_mm"].get<double>(), 2.0);
+  EXPECT_EQ(k["first"]["b0"]["error"], 0);
+  EXPECT_DOUBLE_EQ(k["second"]["overlap"]["dice"].get<double>(), 16.0 / 18.0);
+  EXPECT_EQ(k["second"]["b0"], Json({{"truth", 1}, {"prediction", 2}, {"error", 1}}));
+  EXPECT_DOUBLE_EQ(k["second"]["surface"]["hd95_mm"].get<double>(), 1.0);
+  EXPECT_EQ(k["third"]["absent"], true);
+  EXPECT_EQ(k["label 4"]["overlap"]["dice"], 0.0);
+  EXPECT_TRUE(k["label 4"]["surface"]["hd95_mm"].is_null());
+  EXPECT_TRUE(k["label 4"]["cldice"]["cldice"].is_null());
+  EXPECT_EQ(k["label 5"]["overlap"]["dice"], 0.0);
+  EXPECT_EQ(k["label 5"]["b0"]["error"], 1);
+  const Json& avg = d["per_class"]["class_average"];
+  EXPECT_EQ(avg["classes"], 4);  // present in either volume: 1, 2, 4, 5
+  EXPECT_DOUBLE_EQ(avg["dice"].get<double>(), (16.0 / 18.0) * 2 / 4);
+  EXPECT_DOUBLE_EQ(avg["b0_error"].get<double>(), 0.75);
+  EXPECT_NEAR(avg["hd95_mm"].get<double>(), (1.55 + 1.0) / 2, 1e-12);  // defined for 2 classes only
+  EXPECT_EQ(avg["hd95_mm_classes"], 2);
+  // TopCoW: a class on one side only scores HD95 90 mm and clDice 0, and is averaged.
+  ASSERT_EQ(run("score pred.nii.gz truth.nii.gz --legend 1=first,2=second,3=third --topcow --out t.json --quiet", dir_).code, 0);
+  const Json t = Json::parse(slurp(dir_ / "t.json"));
+  const Json& ta = t["per_class"]["class_average"];
+  EXPECT_NEAR(ta["hd95_mm"].get<double>(), (1.55 + 1.0 + 90 + 90) / 4, 1e-12);
+  EXPECT_DOUBLE_EQ(ta["cldice"].get<double>(), (2 * 0.8 / 1.8) * 2 / 4);
+  EXPECT_EQ(t["per_class"]["classes"]["label 4"]["cldice"]["cldice"], 0.0);
+  EXPECT_EQ(t["per_class"]["classes"]["label 4"]["surface"]["hd95_mm"], 90.0);
+  // The CSV carries the class averages.
+  ASSERT_EQ(run("score pred.nii.gz truth.nii.gz --csv d.csv --quiet", dir_).code, 0);
+  const std::string csv = slurp(dir_ / "d.csv");
+  EXPECT_NE(csv.find("class_avg_dice"), std::string::npos) << csv;
+}
+
+// TopCoW's conventions in every empty case (its evaluation, topcow24_eval): both masks empty,
+// the prediction empty, the truth empty; binary and with the scheme's classes.
+TEST_F(ScoreRun, TopCowConventionsHoldInEveryEmptyCase) {
+  Phantom some(16), none(16);
+  some.bar(1, 2, 12, 8, 8);
+  some.write(dir_ / "some.nii.gz");
+  none.write(dir_ / "none.nii.gz");
+  struct Case {
+    const char *pred, *truth;
+    double hd95;  // TopCoW's
+  };
+  for (const Case& c : {Case{"none", "none", 0.0}, Case{"none", "some", 90.0}, Case{"some", "none", 90.0}}) {
+    const std::string what = std::string(c.pred) + " against " + c.truth;
+    ASSERT_EQ(
+        run(std::string("score ") + c.pred + ".nii.gz " + c.truth + ".nii.gz --topcow --label-scheme topcow2024 --out t.json --force --quiet", dir_)
+            .code,
+        0)
+        << what;
+    const Json t = Json::parse(slurp(dir_ / "t.json"));
+    EXPECT_EQ(t["overlap"]["dice"], 0.0) << what;
+    EXPECT_EQ(t["cldice"]["skeletons"]["cldice"], 0.0) << what;
+    EXPECT_EQ(t["surface"]["hd95_mm"], c.hd95) << what;
+    EXPECT_EQ(t["boundary_iou"]["boundary_iou"], 0.0) << what;
+    EXPECT_EQ(t["boundary_iou"]["bounding_box"]["iou"], 0.0) << what;
+    const Json& avg = t["per_class"]["class_average"];
+    EXPECT_EQ(avg["dice"], 0.0) << what;  // no class at all: every class average 0
+    if (std::string(c.pred) == "none" && std::string(c.truth) == "none") {
+      EXPECT_EQ(avg["classes"], 0);
+      EXPECT_EQ(avg["hd95_mm"], 0.0);
+      EXPECT_EQ(avg["b0_error"], 0.0);
+    } else {
+      EXPECT_EQ(avg["classes"], 1) << what;  // BA on one side only
+      EXPECT_EQ(avg["hd95_mm"], 90.0) << what;
+      EXPECT_EQ(avg["b0_error"], 1.0) << what;
+      EXPECT_EQ(t["per_class"]["classes"]["BA"]["cldice"]["cldice"], 0.0) << what;
+    }
+    ASSERT_EQ(run(std::string("score ") + c.pred + ".nii.gz " + c.truth + ".nii.gz --out d.json --force --quiet", dir_).code, 0) << what;
+    const Json d = Json::parse(slurp(dir_ / "d.json"));
+    EXPECT_EQ(d["overlap"]["dice"], std::string(c.pred) == std::string(c.truth) ? 1.0 : 0.0) << what;
+    EXPECT_TRUE(d["cldice"]["skeletons"]["cldice"].is_null()) << what;
+  }
+}
+
+// The Circle of Willis drawn as touching bars (patient left at smaller world x): BA, both PCAs,
+// the right Pcom, both ICAs, both ACAs and the Acom. Anterior variant (L-A1, Acom, 3rd-A2, R-A1)
+// 1 1 0 1, posterior (L-Pcom, L-P1, R-P1, R-Pcom) 0 1 1 1. The prediction misses the Acom.
+TEST_F(ScoreRun, TopCowSchemeClassifiesVariantsAndMatchesTopology) {
+  Phantom truth(30);
+  truth.column(1, 15, 5, 10, 10).bar(3, 8, 14, 10, 10).bar(2, 16, 22, 11, 10).column(8, 22, 12, 16, 10);
+  truth.column(4, 22, 17, 20, 10).column(6, 8, 17, 20, 10).bar(12, 8, 13, 21, 10).bar(11, 17, 22, 21, 10).bar(10, 14, 16, 21, 10);
+  Phantom pred = truth;
+  for (auto& v : pred.v.data)
+    if (v == 10) v = 0;
+  truth.write(dir_ / "truth.nii.gz");
+  pred.write(dir_ / "pred.nii.gz");
+  ASSERT_EQ(run("score pred.nii.gz truth.nii.gz --label-scheme topcow2024 --topcow --out t.json --quiet", dir_).code, 0);
+  const Json t = Json::parse(slurp(dir_ / "t.json"));
+  const Json& cow = t["label_scheme"]["circle_of_willis"];
+  EXPECT_EQ(cow["truth"]["anterior"], "Var_Ant_1_1_0_1");
+  EXPECT_EQ(cow["truth"]["posterior"], "Var_Pos_0_1_1_1");
+  EXPECT_EQ(cow["prediction"]["anterior"], "Var_Ant_1_0_0_1");
+  EXPECT_EQ(cow["variant_match"], Json({{"anterior", false}, {"posterior", true}}));
+  EXPECT_EQ(cow["topology"]["anterior"]["match"], false);
+  EXPECT_EQ(cow["topology"]["anterior"]["why_not"], "Acom detection FN");
+  EXPECT_EQ(cow["topology"]["posterior"]["match"], true) << cow["topology"]["posterior"];
+  EXPECT_EQ(cow["topology"]["posterior"]["left_right_flipped"], false);
+  EXPECT_EQ(cow["topology"]["anterior"]["labels"]["L-ACA"]["neighbours_truth"], Json::array({6, 10}));
+  const Json& det = t["label_scheme"]["detection"]["labels"];
+  EXPECT_EQ(det["R-Pcom"]["detection"], "TP");
+  EXPECT_EQ(det["L-Pcom"]["detection"], "TN");
+  EXPECT_EQ(det["Acom"]["detection"], "FN");
+  EXPECT_EQ(det["3rd-A2"]["detection"], "TN");
+  EXPECT_EQ(t["per_class"]["classes"]["Acom"]["overlap"]["dice"], 0.0);
+  EXPECT_EQ(t["per_class"]["class_average"]["classes"], 9);
+  // Over cases: detection F1 per vessel from the counts (undefined as 0, as TopCoW averages);
+  // balanced accuracies over the true variants.
+  const ScoreMetric* m = findScoreMetric("label_scheme");
+  ASSERT_NE(m, nullptr);
+  ASSERT_NE(m->aggregate, nullptr);
+  const nlohmann::ordered_json one = nlohmann::ordered_json::parse(t["label_scheme"].dump());
+  nlohmann::ordered_json right = one;
+  right["circle_of_willis"]["prediction"]["anterior"] = "Var_Ant_1_1_0_1";
+  right["circle_of_willis"]["topology"]["anterior"]["match"] = true;
+  right["detection"]["labels"]["Acom"]["detection"] = "TP";
+  nlohmann::ordered_json other = right;  // a third case of another anterior variant, classified right
+  other["circle_of_willis"]["truth"]["anterior"] = "Var_Ant_1_0_0_1";
+  other["circle_of_willis"]["prediction"]["anterior"] = "Var_Ant_1_0_0_1";
+  const auto agg = m->aggregate({&one, &right, &other});
+  EXPECT_DOUBLE_EQ(agg["detection"]["labels"]["Acom"]["f1"].get<double>(), 2.0 * 2 / (2 * 2 + 0 + 1));  // TP 2, FN 1
+  EXPECT_EQ(agg["detection"]["labels"]["L-Pcom"]["f1"], 0.0);                                           // TN only
+  EXPECT_DOUBLE_EQ(agg["detection"]["f1"]["mean"].get<double>(), (1.0 + 0.0 + 0.8 + 0.0) / 4);
+  // Variant 1 1 0 1: one of two right; variant 1 0 0 1: one of one.
+  EXPECT_DOUBLE_EQ(agg["circle_of_willis"]["variant_balanced_accuracy"]["anterior"].get<double>(), (0.5 + 1.0) / 2);
+  EXPECT_DOUBLE_EQ(agg["circle_of_willis"]["topology_match_rate"]["anterior"].get<double>(), (0.5 + 1.0) / 2);
+  EXPECT_DOUBLE_EQ(agg["circle_of_willis"]["topology_match_rate"]["posterior"].get<double>(), 1.0);
+}
+
+// TopBrain's invalid neighbours: the basilar artery touching the right M1, a pair its anatomy
+// does not allow, is an error for both; the right M1 touching the right ICA is allowed.
+TEST_F(ScoreRun, TopBrainSchemeCountsInvalidNeighbours) {
+  Phantom truth(16), pred(16);
+  truth.bar(1, 2, 6, 8, 8).bar(5, 9, 12, 8, 8).bar(4, 13, 14, 8, 8);
+  pred.bar(1, 2, 7, 8, 8).bar(5, 8, 12, 8, 8).bar(4, 13, 14, 8, 8);
+  truth.write(dir_ / "truth.nii.gz");
+  pred.write(dir_ / "pred.nii.gz");
+  ASSERT_EQ(run("score pred.nii.gz truth.nii.gz --label-scheme topbrain2025-ct --topcow --out t.json --quiet", dir_).code, 0);
+  const Json t = Json::parse(slurp(dir_ / "t.json"));
+  const Json& nb = t["label_scheme"]["invalid_neighbours"];
+  EXPECT_EQ(nb["labels"]["BA"]["invalid"], Json::array({"R-M1"}));
+  EXPECT_EQ(nb["labels"]["R-M1"]["invalid"], Json::array({"BA"}));
+  EXPECT_EQ(nb["labels"]["R-ICA"]["error"], 0);
+  EXPECT_DOUBLE_EQ(nb["class_average"].get<double>(), 2.0 / 3);
+  EXPECT_EQ(t["label_scheme"]["detection"]["vessels"], "side road");
+}
+
+// Grids: a prediction whose header places the voxels 0.005 voxel away (float rounding) is
+// accepted; 0.05 voxel is refused, naming the distance and the option that allows it.
+TEST_F(ScoreRun, GridToleranceAcceptsHeaderRoundingAndRefusesAShift) {
+  Phantom truth(12), near(12, Vec3(0.005, 0, 0)), far(12, Vec3(0.05, 0, 0));
+  for (auto* p : {&truth, &near, &far}) p->bar(1, 2, 9, 6, 6);
+  truth.write(dir_ / "truth.nii.gz");
+  near.write(dir_ / "near.nii.gz");
+  far.write(dir_ / "far.nii.gz");
+  EXPECT_EQ(run("score near.nii.gz truth.nii.gz --out near.json --quiet", dir_).code, 0);
+  const auto bad = run("score far.nii.gz truth.nii.gz --out far.json", dir_);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("a corner voxel lies 0.05 mm (0.05 voxels) away; allowed: within 0.01 voxels (--grid-tolerance)"), std::string::npos)
+      << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ / "far.json"));
+  EXPECT_EQ(run("score far.nii.gz truth.nii.gz --grid-tolerance 0.1 --out far.json --quiet", dir_).code, 0);
+}
+
+// The truth a network learned from: a dataset made with the visible-vessel label policy (the
+// default of a dataset with a degraded image), its labels as the prediction. Against the training
+// label Dice 1; against the exact mask less, with both truths named in the results.
+TEST_F(ScoreRun, VisibleVesselLabelScoresOneAgainstItselfAndLessAgainstTheExactMask) {
+  std::ofstream(dir_ / "spec.toml") << "[dataset]\nname = \"Visible\"\nid = 904\nsamples = 1\nseed = 3\nprofile = \"cta\"\n"
+                                       "[domain]\ndemand_map = \"" +
+                                           (src_ / "demand_maps/uniform_100.txt").string() +
+                                           "\"\nvoxel_size = \"0.4 mm\"\n"
+                                           "[tree]\nterminals = 150\nroot_voxel = [0, 50, 50]\n"
+                                           "[physics]\nviscosity = \"3.6 mPa*s\"\nperfusion_pressure = \"13300 Pa\"\nterminal_pressure = \"8300 "
+                                           "Pa\"\nperfusion_flow = \"8330 mm3/s\"\n"
+                                           "[image]\nvoxel_size = \"0.625 mm\"\nsupersampling = 2\n";
+  ASSERT_EQ(run("dataset spec.toml --out raw --quiet", dir_).code, 0);
+  const fs::path ds = dir_ / "raw/Dataset904_Visible";
+  EXPECT_EQ(Json::parse(slurp(ds / "dataset.json"))["label_policy"], "visible");
+  fs::create_directories(dir_ / "pred");
+  fs::copy_file(ds / "labelsTr/Visible_0000.nii.gz", dir_ / "pred/Visible_0000.nii.gz");
+  ASSERT_EQ(run("score --dataset raw/Dataset904_Visible --predictions pred --out training.json --quiet", dir_).code, 0);
+  ASSERT_EQ(run("score --dataset raw/Dataset904_Visible --predictions pred --truth exact --out exact.json --quiet", dir_).code, 0);
+  const Json training = Json::parse(slurp(dir_ / "training.json")), exact = Json::parse(slurp(dir_ / "exact.json"));
+  EXPECT_EQ(training["summary"]["dice"]["mean"], 1.0);
+  EXPECT_NE(training["truth_is"].get<std::string>().find("label policy visible"), std::string::npos) << training["truth_is"];
+  EXPECT_LT(exact["summary"]["dice"]["mean"].get<double>(), 0.95);
+  EXPECT_LT(exact["summary"]["recall"]["mean"].get<double>(), 0.9);
+  EXPECT_EQ(exact["summary"]["precision"]["mean"], 1.0);  // the visible label lies within the mask
+  EXPECT_NE(exact["truth_is"].get<std::string>().find("exact mask"), std::string::npos) << exact["truth_is"];
 }
 
 }  // namespace

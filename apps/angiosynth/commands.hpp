@@ -65,10 +65,13 @@ CLI::App* addDataset(CLI::App& app, DatasetArgs& a);
 int runDatasetCommand(const DatasetArgs& a, const std::string& command_line);
 
 struct ScoreArgs {
-  std::string prediction, sample, out, csv;
-  std::string dataset, predictions;  // --dataset mode
+  std::string prediction, truth, out, csv, class_csv;
+  std::string centreline, radius, graph, legend, label_scheme;                 // with a plain annotation as TRUTH
+  std::string dataset, predictions, case_id, splits, truth_kind = "training";  // --dataset mode
+  std::vector<std::string> cases;
+  int fold = -1;
   std::string plot;
-  ScoreOptions options;  // tolerance and band width from their flags
+  ScoreOptions options;  // tolerance, band width and grid tolerance from their flags
   bool topcow = false, force = false;
   std::vector<double> bins_voxels, bins_mm;
   CommonOptions common;

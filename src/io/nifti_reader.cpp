@@ -82,6 +82,12 @@ NiftiVolume readNiftiVolume(const std::filesystem::path& file, std::uint64_t lim
   NiftiVolume out;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 4; ++c) out.affine[std::size_t(r * 4 + c)] = double(m.m[r][c]) * to_mm;
+  if (img->sform_code > 0 && img->qform_code > 0) {
+    std::array<double, 12> q{};
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) q[std::size_t(r * 4 + c)] = double(img->qto_xyz.m[r][c]) * to_mm;
+    out.other_affine = q;
+  }
   g.origin_mm = Vec3(out.affine[3], out.affine[7], out.affine[11]);
   out.values = Volume<float>(g);
   const auto n = static_cast<std::size_t>(g.voxelCount());

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 
 #include "raster/volume.hpp"
 
@@ -12,6 +13,9 @@ namespace angiosynth {
 struct NiftiVolume {
   Volume<float> values;             // scaled by scl_slope/scl_inter when the header sets them
   std::array<double, 12> affine{};  // rows of the voxel-to-world (mm) matrix: sform, else qform
+  // The qform as well, when the header sets both: writers round the two differently, and a
+  // prediction written by another tool may keep either.
+  std::optional<std::array<double, 12>> other_affine;
 };
 
 // `bytes_per_voxel`: what the caller will hold per voxel, for the memory check against `limit`.

@@ -19,8 +19,10 @@ constexpr std::uint64_t kBytesPerVoxel = 4 * 4 + 2 * 8 + 4;
 
 const char* conventionsText(ScoreConventions c) {
   return c == ScoreConventions::TopCoW
-             ? "TopCoW: 26-neighbour borders, 90 mm for a surface distance when one mask is empty, Dice and Jaccard 0 when both are"
-             : "default: 6-neighbour borders, null for a surface distance when one mask is empty, Dice and Jaccard 1 when both are";
+             ? "TopCoW: 26-neighbour borders; a surface distance 90 mm (the label scheme's bound) when one mask is empty; Dice, "
+               "Jaccard and clDice 0 when both masks (or skeletons) are empty; a class present on one side only scores Dice 0"
+             : "default: 6-neighbour borders; null for a surface distance when one mask is empty; Dice and Jaccard 1 when both are; "
+               "clDice null when a skeleton is empty";
 }
 
 }  // namespace
@@ -34,17 +36,39 @@ std::string ScoreOptions::invalid() const {
   if (tolerance_mm && !(std::isfinite(*tolerance_mm) && *tolerance_mm > 0)) return "the NSD tolerance must be a positive length in mm";
   if (boundary_width_mm && !(std::isfinite(*boundary_width_mm) && *boundary_width_mm > 0))
     return "the Boundary IoU band width must be a positive length in mm";
+  if (!(std::isfinite(grid_tolerance_voxels) && grid_tolerance_voxels >= 0)) return "the grid tolerance must be a non-negative number of voxels";
   return "";
 }
 
-ScoringCase::ScoringCase(const ScoreOptions& o, const TruthFiles& f, const NiftiVolume& pred, const NiftiVolume& t, const Volume<float>& centre,
-                         const Volume<float>& rad)
+namespace {
+
+Volume<std::uint8_t> valueVoxels(const Volume<float>& v, std::optional<int> value) {
+  Volume<std::uint8_t> out(v.grid);
+  if (value)
+    for (std::size_t i = 0; i < v.data.size(); ++i) out.data[i] = std::lround(v.data[i]) == *value;
+  return out;
+}
+
+Volume<std::uint8_t> vesselVoxels(const Volume<float>& v, const Volume<std::uint8_t>& ignore) {
+  Volume<std::uint8_t> out(v.grid);
+  for (std::size_t i = 0; i < v.data.size(); ++i) out.data[i] = v.data[i] > 0 && !ignore.data[i];
+  return out;
+}
+
+// A voxel value as a class (0 … 255).
+std::uint8_t classOf(float v) { return std::uint8_t(std::clamp<long>(std::lround(v), 0, 255)); }
+
+}  // namespace
+
+ScoringCase::ScoringCase(const ScoreOptions& o, const TruthFiles& f, const NiftiVolume& pred, const NiftiVolume& t, const Volume<float>* centre,
+                         const Volume<float>* rad)
     : options(o),
       files(f),
       prediction_file(pred),
       truth_file(t),
-      prediction(binaryMask(pred.values)),
-      truth(binaryMask(t.values)),
+      ignore(valueVoxels(t.values, f.ignore_value)),
+      prediction(vesselVoxels(pred.values, ignore)),
+      truth(vesselVoxels(t.values, ignore)),
       centreline(centre),
       radius(rad),
       voxel_mm(smallestEdge(t.values.grid)),
@@ -60,9 +84,54 @@ const Volume<std::uint8_t>& ScoringCase::truthSkeleton() const {
   return *truth_skeleton_;
 }
 
+const Volume<std::uint8_t>* ScoringCase::truthClasses() const {
+  if (!classes_read_) {
+    classes_read_ = true;
+    const bool labelled_mask = std::any_of(truth_file.values.data.begin(), truth_file.values.data.end(),
+                                           [&](float v) { return v > 1.5f && !(files.ignore_value && std::lround(v) == *files.ignore_value); });
+    std::optional<NiftiVolume> own;
+    const Volume<float>* values = nullptr;
+    if (!files.classes.empty() && !labelled_mask) {
+      own = readTruthVolume(files.classes, "the truth classes");
+      values = &own->values;
+    } else if (labelled_mask || !files.legend.empty() || options.scheme) {
+      values = &truth_file.values;
+    }
+    if (values) {
+      Volume<std::uint8_t> c(truth.grid);
+      for (std::size_t i = 0; i < c.data.size(); ++i) c.data[i] = truth.data[i] ? classOf(values->data[i]) : 0;
+      truth_classes_ = std::move(c);
+    }
+  }
+  return truth_classes_ ? &*truth_classes_ : nullptr;
+}
+
+const Volume<std::uint8_t>& ScoringCase::predictionClasses() const {
+  if (!prediction_classes_) {
+    Volume<std::uint8_t> c(prediction.grid);
+    for (std::size_t i = 0; i < c.data.size(); ++i) c.data[i] = prediction.data[i] ? classOf(prediction_file.values.data[i]) : 0;
+    prediction_classes_ = std::move(c);
+  }
+  return *prediction_classes_;
+}
+
+bool ScoringCase::predictionLabelled() const {
+  const auto& p = prediction_file.values.data;
+  if (std::any_of(p.begin(), p.end(), [](float v) { return v > 1.5f; })) return true;
+  const auto* t = truthClasses();
+  return t && std::none_of(t->data.begin(), t->data.end(), [](std::uint8_t v) { return v > 1; });
+}
+
+std::string ScoringCase::className(int value) const {
+  if (const auto it = files.legend.find(value); it != files.legend.end()) return it->second;
+  if (options.scheme)
+    if (const auto it = options.scheme->labels.find(value); it != options.scheme->labels.end()) return it->second;
+  return "label " + std::to_string(value);
+}
+
 NiftiVolume ScoringCase::readTruthVolume(const std::filesystem::path& file, const char* what) const {
   NiftiVolume v = readNiftiVolume(file, options.memory_limit, kBytesPerVoxel, what);
-  checkSameGrid(v, truth_file, file.string(), files.mask.string());
+  checkSameGrid(v, truth_file, file.string(), files.mask.string(), options.grid_tolerance_voxels);
   return v;
 }
 
@@ -77,9 +146,11 @@ Json CaseScores::toJson() const {
   Json j;
   j["prediction"] = prediction;
   j["truth"] = truth;
+  j["truth_is"] = truth_what;
   j["conventions"] = conventionsText(conventions);
   for (const auto& b : blocks) j[b.metric->key] = b.detail;
-  Json d{{"prediction", "voxels > 0 are vessel"}, {"truth", "the sample's mask.nii.gz (partial volume >= 0.5 or crossed by a centreline)"}};
+  Json d{{"prediction", "voxels > 0 are vessel; their values are classes when the prediction is labelled"},
+         {"truth", "voxels > 0 are vessel, except the ignore label's, which count neither way (truth_is says what the truth is)"}};
   for (const auto* m : scoreMetrics()) d[m->key] = m->definition;
   j["definitions"] = d;
   return j;
@@ -124,6 +195,7 @@ TruthFiles sampleTruth(const std::filesystem::path& dir) {
   TruthFiles t;
   t.mask = need("mask.nii.gz"), t.centerline = need("centerline.nii.gz"), t.radius = need("radius.nii.gz");
   t.name = dir.string();
+  t.what = "the sample's exact mask (mask.nii.gz: partial volume >= 0.5 or crossed by a centreline)";
   if (std::filesystem::is_regular_file(dir / "edges.csv") && std::filesystem::is_regular_file(dir / "nodes.csv")) t.edges = dir / "edges.csv";
   if (std::filesystem::is_regular_file(dir / "keypoints.csv")) t.keypoints = dir / "keypoints.csv";
   if (std::filesystem::is_regular_file(dir / "classes.nii.gz") && std::filesystem::is_regular_file(dir / "sample.json")) {
@@ -133,19 +205,36 @@ TruthFiles sampleTruth(const std::filesystem::path& dir) {
   return t;
 }
 
+TruthFiles annotationTruth(const std::filesystem::path& mask) {
+  if (!std::filesystem::is_regular_file(mask))
+    throw InputError(mask.string(), 0, "no such file; allowed: a NIfTI annotation (.nii, .nii.gz) or a sample directory angiosynth generate wrote");
+  TruthFiles t;
+  t.mask = mask;
+  t.name = mask.string();
+  t.what = "the annotation " + mask.filename().string() + " (voxels > 0 are vessel; values above 1 are classes)";
+  return t;
+}
+
 CaseScores scoreCase(const std::filesystem::path& pred_file, const TruthFiles& files, const ScoreOptions& opt) {
   if (const auto why = opt.invalid(); !why.empty()) throw InputError("", 0, why);
   const NiftiVolume truth = readNiftiVolume(files.mask, opt.memory_limit, kBytesPerVoxel, "the truth mask");
   const NiftiVolume pred = readNiftiVolume(pred_file, opt.memory_limit, kBytesPerVoxel, "the prediction");
-  checkSameGrid(pred, truth, pred_file.string(), files.mask.string());
-  const NiftiVolume centre = readNiftiVolume(files.centerline, opt.memory_limit, kBytesPerVoxel, "the truth centreline");
-  const NiftiVolume radius = readNiftiVolume(files.radius, opt.memory_limit, kBytesPerVoxel, "the truth radius");
-  checkSameGrid(centre, truth, files.centerline.string(), files.mask.string());
-  checkSameGrid(radius, truth, files.radius.string(), files.mask.string());
-  const ScoringCase c(opt, files, pred, truth, centre.values, radius.values);
+  checkSameGrid(pred, truth, pred_file.string(), files.mask.string(), opt.grid_tolerance_voxels);
+  std::optional<NiftiVolume> centre, radius;
+  if (!files.centerline.empty()) {
+    centre = readNiftiVolume(files.centerline, opt.memory_limit, kBytesPerVoxel, "the truth centreline");
+    checkSameGrid(*centre, truth, files.centerline.string(), files.mask.string(), opt.grid_tolerance_voxels);
+  }
+  if (!files.radius.empty()) {
+    radius = readNiftiVolume(files.radius, opt.memory_limit, kBytesPerVoxel, "the truth radius");
+    checkSameGrid(*radius, truth, files.radius.string(), files.mask.string(), opt.grid_tolerance_voxels);
+  }
+  if (radius && !centre) throw InputError(files.radius.string(), 0, "a radius volume is read along the centreline; give the centreline too");
+  const ScoringCase c(opt, files, pred, truth, centre ? &centre->values : nullptr, radius ? &radius->values : nullptr);
   CaseScores s;
   s.prediction = pred_file.string();
   s.truth = files.name;
+  s.truth_what = files.what;
   s.conventions = opt.conventions;
   for (const auto* m : scoreMetrics()) {
     Json block = m->compute(c);

@@ -84,7 +84,7 @@ double percentile95(std::vector<double> v) {
   return v[lo] + (x - double(lo)) * (v[hi] - v[lo]);
 }
 
-Json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, double tolerance_mm, bool topcow) {
+Json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, double tolerance_mm, bool topcow, double missing_mm) {
   const Volume<std::uint8_t> bp = borderVoxels(pred, topcow), bt = borderVoxels(truth, topcow);
   const std::int64_t np = std::count(bp.data.begin(), bp.data.end(), 1), nt = std::count(bt.data.begin(), bt.data.end(), 1);
   Json j{{"border", topcow ? "foreground voxels with a background voxel among their 26 neighbours"
@@ -93,7 +93,7 @@ Json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>&
          {"border_voxels_truth", nt},
          {"tolerance_mm", tolerance_mm}};
   if (np == 0 || nt == 0) {
-    const Json none = np == nt ? Json(0.0) : (topcow ? Json(90.0) : Json(nullptr));
+    const Json none = np == nt ? Json(0.0) : (topcow ? Json(missing_mm) : Json(nullptr));
     for (const char* k : {"hd_mm", "hd95_mm", "assd_mm", "masd_mm"}) j[k] = none;
     j["nsd"] = np == nt ? Json(1.0) : Json(0.0);
     return j;
@@ -117,13 +117,15 @@ Json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>&
 }
 
 Json clDice(const Volume<std::uint8_t>& pred_skeleton, const Volume<std::uint8_t>& truth, const Volume<std::uint8_t>& truth_skeleton,
-            const Volume<std::uint8_t>& pred) {
+            const Volume<std::uint8_t>& pred, bool topcow) {
   std::int64_t sp = 0, sp_in = 0, st = 0, st_in = 0;
   for (std::size_t i = 0; i < pred.data.size(); ++i) {
     if (pred_skeleton.data[i]) ++sp, sp_in += truth.data[i] != 0;
     if (truth_skeleton.data[i]) ++st, st_in += pred.data[i] != 0;
   }
-  const Json tprec = ratio(double(sp_in), double(sp)), tsens = ratio(double(st_in), double(st));
+  // TopCoW scores an empty skeleton's share as 0, so that a case without vessels counts as a miss.
+  const Json none = topcow ? Json(0.0) : Json(nullptr);
+  const Json tprec = sp > 0 ? Json(double(sp_in) / double(sp)) : none, tsens = st > 0 ? Json(double(st_in) / double(st)) : none;
   Json j{{"topology_precision", tprec}, {"topology_sensitivity", tsens}};
   if (tprec.is_null() || tsens.is_null())
     j["cldice"] = nullptr;
@@ -134,7 +136,8 @@ Json clDice(const Volume<std::uint8_t>& pred_skeleton, const Volume<std::uint8_t
   return j;
 }
 
-void checkSameGrid(const NiftiVolume& pred, const NiftiVolume& truth, const std::string& pred_file, const std::string& truth_file) {
+void checkSameGrid(const NiftiVolume& pred, const NiftiVolume& truth, const std::string& pred_file, const std::string& truth_file,
+                   double tolerance_voxels) {
   const auto& a = pred.values.grid;
   const auto& b = truth.values.grid;
   const auto size = [](const VolumeGrid& g) {
@@ -144,19 +147,42 @@ void checkSameGrid(const NiftiVolume& pred, const NiftiVolume& truth, const std:
     throw InputError(pred_file, 0,
                      "the prediction has " + size(a) + " voxels, the truth (" + truth_file + ") " + size(b) +
                          "; allowed: the truth's grid (resample the prediction onto it)");
-  const double tol = 1e-3 * smallestEdge(b);
-  for (std::size_t k = 0; k < 12; ++k)
-    if (!(std::abs(pred.affine[k] - truth.affine[k]) <= tol)) {
-      std::string pa, ta;
-      for (std::size_t q = 0; q < 12; ++q) {  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on " " + string
-        if (q) pa += ' ', ta += ' ';
-        pa += show(pred.affine[q]);
-        ta += show(truth.affine[q]);
+  // The largest distance between a corner voxel's centres under the two affines, for the pair of
+  // forms (sform, qform) of the two headers that agree best.
+  const auto forms = [](const NiftiVolume& v) {
+    std::vector<const std::array<double, 12>*> f{&v.affine};
+    if (v.other_affine) f.push_back(&*v.other_affine);
+    return f;
+  };
+  double best = INFINITY;
+  const std::array<double, 12>*best_p = &pred.affine, *best_t = &truth.affine;
+  for (const auto* p : forms(pred))
+    for (const auto* t : forms(truth)) {
+      double worst = 0;
+      for (int corner = 0; corner < 8; ++corner) {
+        const double idx[3] = {corner & 1 ? b.dims[0] - 1.0 : 0.0, corner & 2 ? b.dims[1] - 1.0 : 0.0, corner & 4 ? b.dims[2] - 1.0 : 0.0};
+        double d2 = 0;
+        for (int r = 0; r < 3; ++r) {
+          double x = (*p)[std::size_t(r * 4 + 3)] - (*t)[std::size_t(r * 4 + 3)];
+          for (int c = 0; c < 3; ++c) x += ((*p)[std::size_t(r * 4 + c)] - (*t)[std::size_t(r * 4 + c)]) * idx[c];
+          d2 += x * x;
+        }
+        worst = std::max(worst, std::sqrt(d2));
       }
-      throw InputError(pred_file, 0,
-                       "the prediction's voxel-to-world affine [" + pa + "] is not the truth's [" + ta + "] (" + truth_file +
-                           "); allowed: the same to 1e-3 voxel (mm)");
+      if (worst < best) best = worst, best_p = p, best_t = t;
     }
+  const double voxel = smallestEdge(b);
+  if (best <= tolerance_voxels * voxel) return;
+  std::string pa, ta;
+  for (std::size_t q = 0; q < 12; ++q) {  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on " " + string
+    if (q) pa += ' ', ta += ' ';
+    pa += show((*best_p)[q]);
+    ta += show((*best_t)[q]);
+  }
+  throw InputError(pred_file, 0,
+                   "the prediction's voxel-to-world affine [" + pa + "] is not the truth's [" + ta + "] (" + truth_file + "): a corner voxel lies " +
+                       show(best, 4) + " mm (" + show(best / voxel, 4) + " voxels) away; allowed: within " + show(tolerance_voxels) +
+                       " voxels (--grid-tolerance), sform or qform of either file");
 }
 
 namespace {

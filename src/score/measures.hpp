@@ -35,13 +35,15 @@ std::vector<double> directedBorderDistances(const Volume<std::uint8_t>& from_bor
 
 // HD, HD95 (the larger of the two directed 95th percentiles, linear interpolation between order
 // statistics as NumPy's default), ASSD, MASD and NSD at tolerance τ between the borders of two
-// volumes. Empty masks: both empty give 0 mm and NSD 1; one empty gives null (TopCoW: 90 mm).
-nlohmann::ordered_json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, double tolerance_mm, bool topcow);
+// volumes. Empty masks: both empty give 0 mm and NSD 1; one empty gives null (TopCoW:
+// `missing_mm`, 90 mm in TopCoW and 290 mm in TopBrain).
+nlohmann::ordered_json surfaceScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, double tolerance_mm, bool topcow,
+                                     double missing_mm = 90);
 
 // clDice (Shit et al. 2021) from the two skeletons and masks: topology precision, sensitivity,
-// their harmonic mean (null when a skeleton is empty).
+// their harmonic mean (null when a skeleton is empty; TopCoW: that share 0).
 nlohmann::ordered_json clDice(const Volume<std::uint8_t>& pred_skeleton, const Volume<std::uint8_t>& truth,
-                              const Volume<std::uint8_t>& truth_skeleton, const Volume<std::uint8_t>& pred);
+                              const Volume<std::uint8_t>& truth_skeleton, const Volume<std::uint8_t>& pred, bool topcow);
 
 // 95th percentile, linear interpolation between order statistics (NumPy's default).
 double percentile95(std::vector<double> values);
@@ -62,8 +64,10 @@ Volume<std::uint8_t> innerBoundaryBand(const Volume<std::uint8_t>& v, double d_m
 // axis (ratio 0.5: the whole box, the boxes' IoU). Unset when a mask is empty.
 std::optional<double> boxBoundaryIoU(const Volume<std::uint8_t>& a, const Volume<std::uint8_t>& b, double ratio);
 
-// Refuses `volume` (read from volume_file) unless it lies on the truth's grid: the same voxels
-// and the same voxel-to-world affine to 1e-3 voxel.
-void checkSameGrid(const NiftiVolume& volume, const NiftiVolume& truth, const std::string& volume_file, const std::string& truth_file);
+// Refuses `volume` (read from volume_file) unless it lies on the truth's grid: the same voxels,
+// and the centres of the grid's corner voxels within `tolerance_voxels` (of the smallest edge)
+// under the two voxel-to-world affines, either file's sform or qform.
+void checkSameGrid(const NiftiVolume& volume, const NiftiVolume& truth, const std::string& volume_file, const std::string& truth_file,
+                   double tolerance_voxels);
 
 }  // namespace angiosynth

@@ -6,14 +6,15 @@
 namespace angiosynth {
 
 extern const ScoreMetric kOverlapMetric, kSurfaceMetric, kCentrelineMetric, kVesselsMetric, kClDiceMetric, kTopologyMetric, kKeyPointsMetric,
-    kCalibreMetric, kCalibreMmMetric, kPerClassMetric, kBoundaryIoUMetric;
+    kCalibreMetric, kCalibreMmMetric, kPerClassMetric, kBoundaryIoUMetric, kLabelSchemeMetric;
 
 // clang-format off
 const std::vector<const ScoreMetric*>& scoreMetrics() {
-  // New metrics go last, so that the CSV's existing columns keep their places.
+  // New metrics go last, so that the CSV's existing columns keep their places (per_class moved
+  // behind boundary_iou when it gained its class-average columns).
   static const std::vector<const ScoreMetric*> all{&kOverlapMetric,   &kSurfaceMetric, &kCentrelineMetric, &kVesselsMetric,
                                                    &kClDiceMetric,    &kTopologyMetric, &kKeyPointsMetric, &kCalibreMetric,
-                                                   &kCalibreMmMetric, &kPerClassMetric, &kBoundaryIoUMetric};
+                                                   &kCalibreMmMetric, &kBoundaryIoUMetric, &kPerClassMetric, &kLabelSchemeMetric};
   return all;
 }
 // clang-format on

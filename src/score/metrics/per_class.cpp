@@ -1,55 +1,157 @@
-// Scores by kind of vessel (artery, vein) where the truth has several.
+// Scores class by class (artery and vein; the vessels of a challenge's label scheme), with class
+// averages computed as the TopCoW 2024 evaluation computes them (Yang et al. 2023): over the
+// classes present in the truth or the prediction, a class missing on one side scoring Dice 0.
 #include <algorithm>
 #include <cmath>
+
+#include "score/betti.hpp"
+#include "score/label_volumes.hpp"
 #include "score/measures.hpp"
 #include "score/metric.hpp"
+#include "score/skeleton.hpp"
 
 namespace angiosynth {
 namespace {
 
 using Json = nlohmann::ordered_json;
 
+// The numbers averaged over classes, by their place in a class's entry.
+const std::vector<std::pair<const char*, const char*>> kAveraged{{"dice", "/overlap/dice"},
+                                                                 {"cldice", "/cldice/cldice"},
+                                                                 {"b0_error", "/b0/error"},
+                                                                 {"hd95_mm", "/surface/hd95_mm"},
+                                                                 {"hd_mm", "/surface/hd_mm"},
+                                                                 {"recall", "/overlap/recall"},
+                                                                 {"centreline_recall", "/centreline/recall"}};
+
 Json perClass(const ScoringCase& c) {
-  const TruthFiles& files = c.files;
-  const VolumeGrid& g = c.truth.grid;
-  if (files.classes.empty() || files.legend.size() < 2) return Json();
-  const NiftiVolume cls = c.readTruthVolume(files.classes, "the truth classes");
-  const auto& pred = c.prediction_file;
-  // A prediction labelled by kind (values above 1) is scored class by class; a binary one only
-  // by what each class of the truth keeps (recall, centreline, calibre).
-  const bool labelled = std::any_of(pred.values.data.begin(), pred.values.data.end(), [](float v) { return v > 1.5f; });
+  const Volume<std::uint8_t>* truth = c.truthClasses();
+  if (!truth) return Json();
+  const bool labelled = c.predictionLabelled();
+  const Volume<std::uint8_t>& pred = labelled ? c.predictionClasses() : c.prediction;
+  const auto nt = labelCounts(*truth), np = labelCounts(c.predictionClasses());
+  std::set<int> values;
+  for (const auto& [v, name] : c.files.legend) values.insert(v);
+  for (int v = 1; v < 256; ++v)
+    if (nt[std::size_t(v)] || (labelled && np[std::size_t(v)])) values.insert(v);
+  Json warnings = Json::array();
   Json per = Json::object();
-  for (const auto& [value, name] : files.legend) {
-    Volume<std::uint8_t> pk(g), tk(g);
-    Volume<float> ck(g);
-    for (std::size_t i = 0; i < pk.data.size(); ++i) {
-      tk.data[i] = std::lround(cls.values.data[i]) == value;
-      pk.data[i] = labelled ? std::lround(pred.values.data[i]) == value : c.prediction.data[i];
-      ck.data[i] = tk.data[i] ? c.centreline.data[i] : 0.0f;
+  std::vector<std::vector<double>> averaged(kAveraged.size());
+  std::size_t present = 0;
+  for (int v : values) {
+    const std::string name = c.className(v);
+    const std::int64_t in_truth = nt[std::size_t(v)], in_pred = labelled ? np[std::size_t(v)] : 0;
+    const bool named = c.files.legend.count(v) || (c.options.scheme && c.options.scheme->labels.count(v));
+    if (!named && (!c.files.legend.empty() || c.options.scheme))
+      warnings.push_back(name + " occurs in the " + (in_truth ? "truth" : "prediction") + " but not in the legend; scored under that name");
+    Json k{{"label", v}, {"truth_voxels", in_truth}};
+    if (labelled) k["prediction_voxels"] = in_pred;
+    if (!in_truth && !in_pred) {
+      k["absent"] = true;  // in neither: not scored, not averaged
+      per[name] = k;
+      continue;
     }
-    Json k{{"label", value}};
+    ++present;
+    // Everything of this class in the box where it lies on either side, a voxel of background around.
+    const std::uint8_t value = std::uint8_t(v);
+    const VoxelBox box = labelled ? valueBox({truth, &pred}, value, 1) : valueBox({truth}, value, 1);
+    const Volume<std::uint8_t> tk = valueMask(*truth, value, box);
+    const Volume<std::uint8_t> pk = labelled ? valueMask(pred, value, box) : cropped(c.prediction, box);
     Json ov = overlapScores(pk, tk, c.topcow());
-    if (!labelled) ov = Json{{"recall", ov["recall"]}};
-    k["overlap"] = ov;
-    if (labelled) k["surface"] = surfaceScores(pk, tk, c.tolerance_mm, c.topcow());
-    std::int64_t n = 0, hit = 0;
-    for (std::size_t i = 0; i < ck.data.size(); ++i)
-      if (ck.data[i] > 0) ++n, hit += pk.data[i] != 0;
-    k["centreline"] = Json{{"voxels", n}, {"recall", ratio(double(hit), double(n))}};
-    k["calibre"] = calibreRecall(pk, tk, ck, c.radius, c.options.bins_voxels, c.voxel_mm, "voxels");
+    if (labelled) {
+      k["overlap"] = ov;
+      k["cldice"] = clDice(skeletonize(pk), tk, skeletonize(tk), pk, c.topcow());
+      const std::int64_t bt = countComponents(tk, 1, 26, false), bp = countComponents(pk, 1, 26, false);
+      k["b0"] = Json{{"truth", bt}, {"prediction", bp}, {"error", std::abs(bp - bt)}};
+      k["surface"] = surfaceScores(pk, tk, c.tolerance_mm, c.topcow(), c.options.missingDistanceMm());
+    } else {
+      k["overlap"] = Json{{"recall", ov["recall"]}};
+    }
+    if (c.centreline && c.radius) {
+      Volume<float> ck = cropped(*c.centreline, box);
+      for (std::size_t i = 0; i < ck.data.size(); ++i)
+        if (!tk.data[i]) ck.data[i] = 0;
+      std::int64_t n = 0, hit = 0;
+      for (std::size_t i = 0; i < ck.data.size(); ++i)
+        if (ck.data[i] > 0) ++n, hit += pk.data[i] != 0;
+      k["centreline"] = Json{{"voxels", n}, {"recall", ratio(double(hit), double(n))}};
+      k["calibre"] = calibreRecall(pk, tk, ck, cropped(*c.radius, box), c.options.bins_voxels, c.voxel_mm, "voxels");
+    }
+    for (std::size_t a = 0; a < kAveraged.size(); ++a) {
+      const Json::json_pointer p(kAveraged[a].second);
+      if (k.contains(p) && k.at(p).is_number()) averaged[a].push_back(k.at(p).get<double>());
+    }
     per[name] = k;
   }
-  return Json{{"prediction", labelled ? "labelled by kind (the truth's class values)" : "binary: recall-type scores only"}, {"classes", per}};
+  Json avg{{"classes", present}};
+  for (std::size_t a = 0; a < kAveraged.size(); ++a) {
+    double sum = 0;
+    for (double x : averaged[a]) sum += x;
+    avg[kAveraged[a].first] =
+        averaged[a].empty() ? Json(present == 0 && c.topcow() ? Json(0.0) : Json(nullptr)) : Json(sum / double(averaged[a].size()));
+    if (averaged[a].size() != present && !averaged[a].empty()) avg[std::string(kAveraged[a].first) + "_classes"] = averaged[a].size();
+  }
+  Json out{{"prediction",
+            labelled ? "labelled: each class against the truth's voxels of that value" : "binary: what of each class it covers (recall-type scores)"},
+           {"classes", per},
+           {"class_average", avg}};
+  if (!warnings.empty()) out["warnings"] = warnings;
+  return out;
+}
+
+// Over cases: each class's numbers summarised over the cases where it is present on either side,
+// and the class averages over every case.
+Json perClassAcrossCases(const std::vector<const Json*>& blocks) {
+  std::map<std::string, std::map<std::string, std::vector<double>>> by_class;
+  std::map<std::string, std::vector<double>> averages;
+  std::vector<std::string> order;
+  for (const Json* b : blocks) {
+    if (!b || !b->is_object()) continue;
+    for (const auto& [name, k] : (*b)["classes"].items()) {
+      if (std::find(order.begin(), order.end(), name) == order.end()) order.push_back(name);
+      if (k.contains("absent")) continue;
+      auto& m = by_class[name];
+      m["present"].push_back(1);
+      for (const auto& [key, pointer] : kAveraged) {
+        const Json::json_pointer p(pointer);
+        if (k.contains(p) && k.at(p).is_number()) m[key].push_back(k.at(p).get<double>());
+      }
+    }
+    for (const auto& [key, pointer] : kAveraged)
+      if ((*b)["class_average"].contains(key) && (*b)["class_average"][key].is_number())
+        averages[key].push_back((*b)["class_average"][key].get<double>());
+  }
+  if (order.empty()) return Json();
+  Json classes = Json::object();
+  for (const auto& name : order) {
+    Json k{{"cases_present", by_class[name]["present"].size()}};
+    for (const auto& [key, pointer] : kAveraged)
+      if (by_class[name].count(key)) k[key] = summaryOf(by_class[name][key]);
+    classes[name] = k;
+  }
+  Json avg = Json::object();
+  for (const auto& [key, pointer] : kAveraged)
+    if (averages.count(key)) avg[key] = summaryOf(averages[key]);
+  return Json{{"classes", classes}, {"class_average", avg}};
 }
 
 }  // namespace
 
 extern const ScoreMetric kPerClassMetric{
     "per_class",
-    "with a truth of several kinds (classes.nii.gz, its legend in sample.json): each class's voxels against the "
-    "prediction's voxels of that value (a prediction labelled by kind), or, for a binary prediction, the share of each "
-    "class the prediction covers (recall, centreline recall, calibre)",
-    {},
-    perClass};
+    "with a truth of several kinds (classes.nii.gz and its legend, a labelled mask, a label scheme): every class value in the "
+    "legend, the truth or the prediction, named by the legend (\"label N\" and a warning when it lacks one). A labelled "
+    "prediction is scored class by class against the truth's voxels of that value: overlap, clDice, b0 (26-connected pieces) "
+    "and its error, surface distances, centreline recall and calibre; a binary one by what of each class it covers (recall, "
+    "centreline recall, calibre). class_average: the mean over the classes present in the truth or the prediction (TopCoW "
+    "2024), a class present on one side only scoring Dice 0 and, with --topcow, clDice 0 and HD95 and HD at the scheme's "
+    "bound (90 mm; TopBrain 290 mm), else null and left out of the mean (its `<name>_classes` count then says over how many); "
+    "classes in neither are listed as absent and not averaged",
+    {{"class_avg_dice", "/class_average/dice"},
+     {"class_avg_cldice", "/class_average/cldice"},
+     {"class_avg_b0_error", "/class_average/b0_error"},
+     {"class_avg_hd95_mm", "/class_average/hd95_mm"}},
+    perClass,
+    perClassAcrossCases};
 
 }  // namespace angiosynth
