@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """A stand-in segmenter for trying `angiosynth score --dataset`: each image of a dataset's
-imagesTr thresholded at its mean intensity (scikit-image's threshold_mean: vessels are few and
-bright, so the mean lies just above the background), written as PRED_DIR/<case>.nii.gz, the names
-nnU-Net's predictions have. Replace it with your model's predictions.
+imagesTr thresholded three noise sigmas above its background (vessels fill a few percent of the
+voxels, so the median is the background's level and 1.4826 times the median absolute deviation
+its noise sigma), written as PRED_DIR/<case>.nii.gz, the names nnU-Net's predictions have.
+Replace it with your model's predictions.
 
     /usr/bin/python3 examples/threshold_dataset.py DATASET_DIR PRED_DIR
 """
@@ -11,7 +12,6 @@ import sys
 
 import nibabel as nib
 import numpy as np
-from skimage.filters import threshold_mean
 
 
 def main() -> int:
@@ -27,7 +27,9 @@ def main() -> int:
     for image in images:
         volume = nib.load(image)
         data = np.asanyarray(volume.dataobj).astype(np.float32)
-        mask = (data > threshold_mean(data)).astype(np.uint8)
+        background = np.median(data)
+        sigma = 1.4826 * np.median(np.abs(data - background))
+        mask = (data > background + 3 * sigma).astype(np.uint8)
         case = image.name[: -len("_0000.nii.gz")]
         nib.save(nib.Nifti1Image(mask, volume.affine), predictions / f"{case}.nii.gz")
     print(f"wrote {len(images)} predictions to {predictions}")

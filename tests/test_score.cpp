@@ -855,23 +855,28 @@ TEST_F(ScoreRun, GridToleranceAcceptsHeaderRoundingAndRefusesAShift) {
 
 // The truth a network learned from: a dataset made with the visible-vessel label policy (the
 // default of a dataset with a degraded image), its labels as the prediction. Against the training
-// label Dice 1; against the exact mask less, with both truths named in the results.
+// label Dice 1; against the exact mask less, with both truths named in the results. Under the
+// ignore policy the ignore label's voxels count neither way: labelsTr's every voxel > 0 as the
+// prediction still scores Dice 1.
 TEST_F(ScoreRun, VisibleVesselLabelScoresOneAgainstItselfAndLessAgainstTheExactMask) {
-  std::ofstream(dir_ / "spec.toml") << "[dataset]\nname = \"Visible\"\nid = 904\nsamples = 1\nseed = 3\nprofile = \"cta\"\n"
-                                       "[domain]\ndemand_map = \"" +
-                                           (src_ / "demand_maps/uniform_100.txt").string() +
-                                           "\"\nvoxel_size = \"0.4 mm\"\n"
-                                           "[tree]\nterminals = 150\nroot_voxel = [0, 50, 50]\n"
-                                           "[physics]\nviscosity = \"3.6 mPa*s\"\nperfusion_pressure = \"13300 Pa\"\nterminal_pressure = \"8300 "
-                                           "Pa\"\nperfusion_flow = \"8330 mm3/s\"\n"
-                                           "[image]\nvoxel_size = \"0.625 mm\"\nsupersampling = 2\n";
-  ASSERT_EQ(run("dataset spec.toml --out raw --quiet", dir_).code, 0);
-  const fs::path ds = dir_ / "raw/Dataset904_Visible";
+  const auto spec = [&](const std::string& name, int id, const std::string& image) {
+    std::ofstream(dir_ / (name + ".toml"))
+        << "[dataset]\nname = \"" << name << "\"\nid = " << id << "\nsamples = 1\nseed = 3\nprofile = \"cta\"\n"
+        << "[domain]\ndemand_map = \"" << (src_ / "demand_maps/uniform_100.txt").string()
+        << "\"\nvoxel_size = \"0.4 mm\"\n[tree]\nterminals = 150\nroot_voxel = [0, 50, 50]\n"
+           "[physics]\nviscosity = \"3.6 mPa*s\"\nperfusion_pressure = \"13300 Pa\"\nterminal_pressure = \"8300 Pa\"\n"
+           "perfusion_flow = \"8330 mm3/s\"\n[image]\nvoxel_size = \"0.625 mm\"\nsupersampling = 2\n"
+        << image;
+    EXPECT_EQ(run("dataset " + name + ".toml --out raw --quiet", dir_).code, 0) << name;
+    const fs::path ds = dir_ / "raw" / ("Dataset" + std::to_string(id) + "_" + name);
+    fs::create_directories(dir_ / ("pred_" + name));
+    fs::copy_file(ds / "labelsTr" / (name + "_0000.nii.gz"), dir_ / ("pred_" + name) / (name + "_0000.nii.gz"));
+    return ds;
+  };
+  const fs::path ds = spec("Visible", 904, "");
   EXPECT_EQ(Json::parse(slurp(ds / "dataset.json"))["label_policy"], "visible");
-  fs::create_directories(dir_ / "pred");
-  fs::copy_file(ds / "labelsTr/Visible_0000.nii.gz", dir_ / "pred/Visible_0000.nii.gz");
-  ASSERT_EQ(run("score --dataset raw/Dataset904_Visible --predictions pred --out training.json --quiet", dir_).code, 0);
-  ASSERT_EQ(run("score --dataset raw/Dataset904_Visible --predictions pred --truth exact --out exact.json --quiet", dir_).code, 0);
+  ASSERT_EQ(run("score --dataset raw/Dataset904_Visible --predictions pred_Visible --out training.json --quiet", dir_).code, 0);
+  ASSERT_EQ(run("score --dataset raw/Dataset904_Visible --predictions pred_Visible --truth exact --out exact.json --quiet", dir_).code, 0);
   const Json training = Json::parse(slurp(dir_ / "training.json")), exact = Json::parse(slurp(dir_ / "exact.json"));
   EXPECT_EQ(training["summary"]["dice"]["mean"], 1.0);
   EXPECT_NE(training["truth_is"].get<std::string>().find("label policy visible"), std::string::npos) << training["truth_is"];
@@ -879,6 +884,14 @@ TEST_F(ScoreRun, VisibleVesselLabelScoresOneAgainstItselfAndLessAgainstTheExactM
   EXPECT_LT(exact["summary"]["recall"]["mean"].get<double>(), 0.9);
   EXPECT_EQ(exact["summary"]["precision"]["mean"], 1.0);  // the visible label lies within the mask
   EXPECT_NE(exact["truth_is"].get<std::string>().find("exact mask"), std::string::npos) << exact["truth_is"];
+
+  spec("Ignore", 905, "label_policy = \"ignore\"\n");
+  ASSERT_EQ(run("score --dataset raw/Dataset905_Ignore --predictions pred_Ignore --out ignore.json --quiet", dir_).code, 0);
+  const Json ignore = Json::parse(slurp(dir_ / "ignore.json"));
+  EXPECT_NE(ignore["truth_is"].get<std::string>().find("ignore label (2) counts neither way"), std::string::npos) << ignore["truth_is"];
+  EXPECT_EQ(ignore["summary"]["dice"]["mean"], 1.0);  // the predicted ignore voxels are not false positives
+  const NiftiVolume label = readNiftiVolume(dir_ / "pred_Ignore/Ignore_0000.nii.gz", 1ULL << 32, 4, "label");
+  EXPECT_GT(std::count(label.values.data.begin(), label.values.data.end(), 2.0f), 100);  // there were ignore voxels to count
 }
 
 }  // namespace

@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
-#include "score/label_volumes.hpp"
+#include "score/measures.hpp"
 #include "score/metric.hpp"
 
 namespace angiosynth {

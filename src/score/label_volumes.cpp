@@ -62,22 +62,4 @@ std::map<int, std::set<int>> labelNeighbours(const Volume<std::uint8_t>& classes
   return out;
 }
 
-nlohmann::ordered_json summaryOf(std::vector<double> v) {
-  nlohmann::ordered_json s{{"cases", v.size()}};
-  if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  double sum = 0;
-  for (double x : v) sum += x;
-  const double mean = sum / double(v.size());
-  double ss = 0;
-  for (double x : v) ss += (x - mean) * (x - mean);
-  const std::size_t n = v.size();
-  s["mean"] = mean;
-  s["median"] = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-  s["sd"] = n > 1 ? nlohmann::ordered_json(std::sqrt(ss / double(n - 1))) : nlohmann::ordered_json(nullptr);
-  s["min"] = v.front();
-  s["max"] = v.back();
-  return s;
-}
-
 }  // namespace angiosynth

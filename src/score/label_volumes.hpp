@@ -7,8 +7,6 @@
 #include <set>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "raster/volume.hpp"
 
 namespace angiosynth {
@@ -46,8 +44,5 @@ Volume<T> cropped(const Volume<T>& v, const VoxelBox& box) {
 // Which classes touch (26-neighbours, background left out): for each class present, the other
 // classes among its voxels' neighbours. Symmetric.
 std::map<int, std::set<int>> labelNeighbours(const Volume<std::uint8_t>& classes);
-
-// n, mean, median, standard deviation (n − 1), min and max of the values (the cases' numbers).
-nlohmann::ordered_json summaryOf(std::vector<double> values);
 
 }  // namespace angiosynth

@@ -24,6 +24,24 @@ double smallestEdge(const VolumeGrid& g) { return std::min({g.spacing_mm.x, g.sp
 
 Json ratio(double num, double den) { return den > 0 ? Json(num / den) : Json(nullptr); }
 
+nlohmann::ordered_json summaryOf(std::vector<double> v) {
+  nlohmann::ordered_json s{{"cases", v.size()}};
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  double sum = 0;
+  for (double x : v) sum += x;
+  const double mean = sum / double(v.size());
+  double ss = 0;
+  for (double x : v) ss += (x - mean) * (x - mean);
+  const std::size_t n = v.size();
+  s["mean"] = mean;
+  s["median"] = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  s["sd"] = n > 1 ? nlohmann::ordered_json(std::sqrt(ss / double(n - 1))) : nlohmann::ordered_json(nullptr);
+  s["min"] = v.front();
+  s["max"] = v.back();
+  return s;
+}
+
 Json overlapScores(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, bool topcow) {
   std::int64_t tp = 0, fp = 0, fn = 0;
   for (std::size_t i = 0; i < pred.data.size(); ++i) {

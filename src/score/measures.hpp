@@ -16,6 +16,9 @@ namespace angiosynth {
 // A ratio, or null when its denominator is 0 (undefined): how every score states an empty case.
 nlohmann::ordered_json ratio(double num, double den);
 
+// n, mean, median, standard deviation (n − 1), min and max of the values (the cases' numbers).
+nlohmann::ordered_json summaryOf(std::vector<double> values);
+
 // Voxels > 0 of a volume as a binary mask.
 Volume<std::uint8_t> binaryMask(const Volume<float>& v);
 

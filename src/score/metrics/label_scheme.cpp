@@ -3,6 +3,8 @@
 // topology matching, each case's verdicts here and their rates over cases in the aggregate.
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <set>
 
 #include "score/betti.hpp"
 #include "score/label_volumes.hpp"

@@ -3,6 +3,8 @@
 // classes present in the truth or the prediction, a class missing on one side scoring Dice 0.
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <set>
 
 #include "score/betti.hpp"
 #include "score/label_volumes.hpp"
