@@ -12,26 +12,38 @@ std::array<std::int64_t, 256> labelCounts(const Volume<std::uint8_t>& classes) {
   return n;
 }
 
-VoxelBox valueBox(const std::vector<const Volume<std::uint8_t>*>& volumes, std::uint8_t value, int pad) {
-  VoxelBox b;
-  b.lo = {INT64_MAX, INT64_MAX, INT64_MAX};
-  b.hi = {INT64_MIN, INT64_MIN, INT64_MIN};
-  bool any = false;
+std::array<VoxelBox, 256> valueBoxes(const std::vector<const Volume<std::uint8_t>*>& volumes, int pad) {
+  std::array<VoxelBox, 256> boxes;
+  for (auto& b : boxes) b.lo = {INT64_MAX, INT64_MAX, INT64_MAX}, b.hi = {INT64_MIN, INT64_MIN, INT64_MIN};
+  std::array<bool, 256> seen{};
   for (const auto* v : volumes) {
     const VolumeGrid& g = v->grid;
     for (std::int64_t k = 0; k < g.dims[2]; ++k)
       for (std::int64_t j = 0; j < g.dims[1]; ++j)
         for (std::int64_t i = 0; i < g.dims[0]; ++i) {
-          if (v->at(i, j, k) != value) continue;
-          any = true;
+          const std::uint8_t value = v->at(i, j, k);
+          if (!value) continue;
+          seen[value] = true;
+          VoxelBox& b = boxes[value];
           const std::array<std::int64_t, 3> p{i, j, k};
           for (int a = 0; a < 3; ++a) b.lo[a] = std::min(b.lo[a], p[a]), b.hi[a] = std::max(b.hi[a], p[a]);
         }
   }
-  if (!any) return VoxelBox{};
   const VolumeGrid& g = volumes.front()->grid;
-  for (int a = 0; a < 3; ++a) b.lo[a] = std::max<std::int64_t>(0, b.lo[a] - pad), b.hi[a] = std::min<std::int64_t>(g.dims[a] - 1, b.hi[a] + pad);
-  return b;
+  for (std::size_t value = 0; value < boxes.size(); ++value) {
+    VoxelBox& b = boxes[value];
+    if (!seen[value]) {
+      b = VoxelBox{};
+      continue;
+    }
+    for (int a = 0; a < 3; ++a) b.lo[a] = std::max<std::int64_t>(0, b.lo[a] - pad), b.hi[a] = std::min<std::int64_t>(g.dims[a] - 1, b.hi[a] + pad);
+  }
+  return boxes;
+}
+
+VoxelBox valueBox(const std::vector<const Volume<std::uint8_t>*>& volumes, std::uint8_t value, int pad) {
+  if (!value) return VoxelBox{};
+  return valueBoxes(volumes, pad)[value];
 }
 
 Volume<std::uint8_t> valueMask(const Volume<std::uint8_t>& classes, std::uint8_t value, const VoxelBox& box) {

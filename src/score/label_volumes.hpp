@@ -23,6 +23,8 @@ struct VoxelBox {
 // The box of the voxels equal to `value` in any of the volumes, grown by `pad` voxels and kept
 // within the grid.
 VoxelBox valueBox(const std::vector<const Volume<std::uint8_t>*>& volumes, std::uint8_t value, int pad);
+// The same for every value at once (index = value), in one pass over the volumes.
+std::array<VoxelBox, 256> valueBoxes(const std::vector<const Volume<std::uint8_t>*>& volumes, int pad);
 
 // The voxels equal to `value` within the box, as a binary volume of the box's size (the spacing
 // kept): distances, thinning and components inside it are those of the whole grid when the box

@@ -40,6 +40,7 @@ Json perClass(const ScoringCase& c) {
   Json per = Json::object();
   std::vector<std::vector<double>> averaged(kAveraged.size());
   std::size_t present = 0;
+  const auto boxes = labelled ? valueBoxes({truth, &pred}, 1) : valueBoxes({truth}, 1);
   for (int v : values) {
     const std::string name = c.className(v);
     const std::int64_t in_truth = nt[std::size_t(v)], in_pred = labelled ? np[std::size_t(v)] : 0;
@@ -56,7 +57,7 @@ Json perClass(const ScoringCase& c) {
     ++present;
     // Everything of this class in the box where it lies on either side, a voxel of background around.
     const std::uint8_t value = std::uint8_t(v);
-    const VoxelBox box = labelled ? valueBox({truth, &pred}, value, 1) : valueBox({truth}, value, 1);
+    const VoxelBox& box = boxes[value];
     const Volume<std::uint8_t> tk = valueMask(*truth, value, box);
     const Volume<std::uint8_t> pk = labelled ? valueMask(pred, value, box) : cropped(c.prediction, box);
     Json ov = overlapScores(pk, tk, c.topcow());
