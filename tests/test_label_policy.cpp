@@ -179,9 +179,9 @@ TEST_F(LabelPolicyRun, SameSeedSameLabelsOnOneAndTwoThreads) {
 // the nnU-Net check. Soft labels cannot number kinds.
 TEST_F(LabelPolicyRun, DatasetLabelsFollowThePolicyAndDeclareTheIgnoreLabel) {
   std::string spec = slurp(src_ / "tests/data/dataset_av.toml");
-  const std::string image = "[image]\n";
-  ASSERT_NE(spec.find(image), std::string::npos);
-  spec.replace(spec.find(image), image.size(), image + "label_policy = \"ignore\"\n");
+  const std::string pinned = "label_policy = \"binary\"";
+  ASSERT_NE(spec.find(pinned), std::string::npos);
+  spec.replace(spec.find(pinned), pinned.size(), "label_policy = \"ignore\"");
   fs::copy_file(src_ / "tests/data/profile_warp.toml", dir_ / "profile_warp.toml");
   std::ofstream(dir_ / "spec.toml") << spec;
   const auto r = run("dataset spec.toml --out raw --quiet", dir_);

@@ -36,7 +36,6 @@ LabelScheme topbrain2025ct() {
   s.detection_labels = {8, 9, 10, 15, 16, 25, 26, 27, 28, 29, 30, 31, 32, 33, 34, 37, 38, 39};
   s.detection_name = "side road";
   s.missing_distance_mm = 290;  // about the largest distance in a human head
-  s.class_cldice = true;
   s.valid_neighbours = {{1, {2, 3, 23, 24, 25, 26, 27, 28, 29, 30}},
                         {2, {1, 4, 8, 11, 21, 25, 31, 38}},
                         {3, {1, 6, 9, 12, 22, 26, 32, 39}},
@@ -105,7 +104,6 @@ LabelScheme readScheme(const std::filesystem::path& file) {
     s.detection_iou = j.value("detection_iou", 0.25);
     s.missing_distance_mm = j.value("missing_distance_mm", 90.0);
     s.circle_of_willis = j.value("circle_of_willis", false);
-    s.class_cldice = j.value("class_cldice", false);
     if (j.contains("valid_neighbours"))
       for (const auto& [k, v] : j["valid_neighbours"].items()) s.valid_neighbours[labelValue(k, f)] = v.get<std::vector<int>>();
   } catch (const nlohmann::json::exception& e) {

@@ -23,7 +23,6 @@ struct LabelScheme {
   bool circle_of_willis = false;    // TopCoW's variant classification and topology matching
   // Each label's neighbours its anatomy allows (26-neighbour touching); empty: no such error.
   std::map<int, std::vector<int>> valid_neighbours;
-  bool class_cldice = false;  // clDice per class in the class average (TopBrain)
 };
 
 // The schemes built in, by name: topcow2024, topbrain2025-ct.
