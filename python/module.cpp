@@ -14,6 +14,7 @@
 #include <condition_variable>
 #include <mutex>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <random>
 #include <sstream>
@@ -34,6 +35,7 @@
 #include "pipeline/generate_sample.hpp"
 #include "pipeline/mesh_outputs.hpp"
 #include "score/case_scores.hpp"
+#include "score/label_schemes.hpp"
 
 namespace py = pybind11;
 using namespace angiosynth;
@@ -402,16 +404,22 @@ PYBIND11_MODULE(_core, m) {
   m.def("write_mesh", &writeMesh, py::arg("native"), py::arg("settings"), py::arg("out"), py::arg("force") = false, py::arg("threads") = 0);
   m.def(
       "score",
-      [](const std::filesystem::path& prediction, const std::filesystem::path& sample_dir, bool topcow, std::optional<double> tolerance_mm,
-         std::optional<std::vector<double>> bins_voxels, std::optional<std::vector<double>> bins_mm, int threads) {
+      [](const std::filesystem::path& prediction, const std::filesystem::path& truth, bool topcow, std::optional<double> tolerance_mm,
+         std::optional<std::vector<double>> bins_voxels, std::optional<std::vector<double>> bins_mm, std::optional<std::string> label_scheme,
+         std::optional<std::map<int, std::string>> legend, int threads) {
         ScoreOptions opt;
         if (topcow) opt.conventions = ScoreConventions::TopCoW;
         opt.tolerance_mm = tolerance_mm;
         if (bins_voxels) opt.bins_voxels = *bins_voxels;
         if (bins_mm) opt.bins_mm = *bins_mm;
+        if (label_scheme) opt.scheme = labelScheme(*label_scheme);
         opt.memory_limit = defaultMemoryLimitBytes();
-        return runReleased<std::string>([&](const Cancel&) { return scoreCase(prediction, sampleTruth(sample_dir), opt).toJson().dump(); }, threads);
+        // A sample directory, or a plain annotation (a NIfTI file, binary or labelled).
+        TruthFiles files = std::filesystem::is_directory(truth) ? sampleTruth(truth) : annotationTruth(truth);
+        if (legend) files.legend = *legend;
+        return runReleased<std::string>([&](const Cancel&) { return scoreCase(prediction, files, opt).toJson().dump(); }, threads);
       },
-      py::arg("prediction"), py::arg("sample_dir"), py::arg("topcow") = false, py::arg("tolerance_mm") = std::nullopt,
-      py::arg("bins_voxels") = std::nullopt, py::arg("bins_mm") = std::nullopt, py::arg("threads") = 0);
+      py::arg("prediction"), py::arg("truth"), py::arg("topcow") = false, py::arg("tolerance_mm") = std::nullopt,
+      py::arg("bins_voxels") = std::nullopt, py::arg("bins_mm") = std::nullopt, py::arg("label_scheme") = std::nullopt,
+      py::arg("legend") = std::nullopt, py::arg("threads") = 0);
 }

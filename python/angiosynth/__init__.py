@@ -327,25 +327,32 @@ def score(
     tolerance_mm: float | None = None,
     bins_voxels: list[float] | None = None,
     bins_mm: list[float] | None = None,
+    label_scheme: str | None = None,
+    legend: dict[int, str] | None = None,
     threads: int = 0,
 ) -> dict:
     """Scores a segmentation as `angiosynth score` does, and returns its results (the JSON it writes) as a dict.
 
-    prediction  a NIfTI file, or an array indexed (x, y, z) on the truth's grid (values > 0 are vessel)
-    truth       a sample directory the program wrote, or a Sample in memory
-    topcow      the TopCoW challenge's conventions (26-neighbour borders, 90 mm for an empty mask)
+    prediction    a NIfTI file, or an array indexed (x, y, z) on the truth's grid (values > 0 are vessel, above 1 classes)
+    truth         a sample directory the program wrote, a Sample in memory, or any NIfTI annotation (binary or labelled)
+    topcow        the TopCoW challenge's conventions (26-neighbour borders, 90 mm for an empty mask, 0 for empty ratios)
+    label_scheme  class names and challenge metrics: "topcow2024", "topbrain2025-ct" or a JSON file of one
+    legend        names of an annotation's class values, {1: "artery", 2: "vein"}
     """
     with tempfile.TemporaryDirectory(prefix="angiosynth-score-") as tmp:
         if isinstance(truth, Sample):
-            truth_dir = os.path.join(tmp, "truth")
-            os.mkdir(truth_dir)
-            _core.write_truth(truth._native, truth.volumes, truth_dir)
+            truth_path = os.path.join(tmp, "truth")
+            os.mkdir(truth_path)
+            _core.write_truth(truth._native, truth.volumes, truth_path)
         else:
-            truth_dir = os.fspath(truth)
+            truth_path = os.fspath(truth)
+        # The grid a prediction array is written on: the annotation's, or the sample's mask's.
+        reference = truth_path if os.path.isfile(truth_path) else os.path.join(truth_path, "mask.nii.gz")
         if isinstance(prediction, (str, os.PathLike)):
             pred_file = os.fspath(prediction)
         else:
             pred_file = os.path.join(tmp, "prediction.nii.gz")
-            _core.write_prediction(np.asarray(prediction), os.path.join(truth_dir, "mask.nii.gz"), pred_file)
-        result = _core.score(pred_file, truth_dir, topcow=topcow, tolerance_mm=tolerance_mm, bins_voxels=bins_voxels, bins_mm=bins_mm, threads=threads)
+            _core.write_prediction(np.asarray(prediction), reference, pred_file)
+        result = _core.score(pred_file, truth_path, topcow=topcow, tolerance_mm=tolerance_mm, bins_voxels=bins_voxels, bins_mm=bins_mm,
+                             label_scheme=label_scheme, legend=legend, threads=threads)
     return json.loads(result)

@@ -144,6 +144,9 @@ def test_score_agrees_with_the_program(program, tmp_path):
     for block in ("overlap", "centreline", "cldice", "calibre", "topology"):
         assert mine[block] == cli[block], block
     assert angiosynth.score(pred_file, tmp_path / "sample")["overlap"] == cli["overlap"]
+    # A plain annotation: the sample's mask as a NIfTI file scores the overlap alike, with no centreline metrics.
+    plain = angiosynth.score(pred, tmp_path / "sample/mask.nii.gz")
+    assert plain["overlap"] == cli["overlap"] and "centreline" not in plain
 
 
 def test_bad_input_raises_the_programs_message(tmp_path):
