@@ -1,12 +1,15 @@
 // Predictions as `score` reads them: the bytes as a NIfTI file (a gzip stream as .nii.gz, so
 // truncated and corrupt streams are tried) scored against a small sample's truth (16^3 voxels,
-// 24 terminals); odd sizes with TopCoW's conventions.
+// 24 terminals); odd sizes with TopCoW's conventions; sizes divisible by 3 against the sample's
+// mask as a plain annotation under the TopCoW 2024 label scheme (the prediction's values as
+// classes: per-class scores, detection, variants, topology matching).
 #include <zlib.h>
 
 #include "fuzz_support.hpp"
 #include "config/scenario.hpp"
 #include "pipeline/generate_sample.hpp"
 #include "score/case_scores.hpp"
+#include "score/label_schemes.hpp"
 
 namespace {
 
@@ -58,10 +61,12 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace angiosynth;
-  const auto truth = sampleTruth(sampleDir());
   ScoreOptions opt;
   opt.memory_limit = fuzz::kMemoryLimit;
   if (size % 2 == 1) opt.conventions = ScoreConventions::TopCoW;
+  const bool plain = size % 3 == 0;
+  if (plain) opt.scheme = labelScheme("topcow2024");
+  const auto truth = plain ? annotationTruth(sampleDir() / "mask.nii.gz") : sampleTruth(sampleDir());
   // A gzip stream (its magic bytes first) is read as .nii.gz, truncated or corrupt as it comes.
   const bool gz = size >= 2 && data[0] == 0x1f && data[1] == 0x8b;
   const auto file = fuzz::writeInput(data, size, gz ? "pred.nii.gz" : "pred.nii");

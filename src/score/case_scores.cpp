@@ -116,7 +116,10 @@ const Volume<std::uint8_t>& ScoringCase::predictionClasses() const {
 }
 
 bool ScoringCase::predictionLabelled() const {
+  // Labels are whole numbers from 0 to 255: a probability map or an image of intensities (HU,
+  // signal) as the prediction is binary.
   const auto& p = prediction_file.values.data;
+  if (std::any_of(p.begin(), p.end(), [](float v) { return v != std::nearbyint(v) || v < 0 || v > 255; })) return false;
   if (std::any_of(p.begin(), p.end(), [](float v) { return v > 1.5f; })) return true;
   const auto* t = truthClasses();
   return t && std::none_of(t->data.begin(), t->data.end(), [](std::uint8_t v) { return v > 1; });

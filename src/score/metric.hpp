@@ -41,7 +41,8 @@ class ScoringCase {
   const Volume<std::uint8_t>* truthClasses() const;
   // The prediction's values as classes (0 elsewhere, the ignore voxels left out).
   const Volume<std::uint8_t>& predictionClasses() const;
-  // The prediction holds classes: values above 1, or the truth's only class is 1.
+  // The prediction holds classes: whole numbers from 0 to 255, some above 1 (or the truth's only
+  // class is 1).
   bool predictionLabelled() const;
   // The legend's name of a class value ("label N" when the legend lacks it).
   std::string className(int value) const;

@@ -6,6 +6,8 @@
 #include <map>
 #include <set>
 
+#include <tbb/parallel_for.h>
+
 #include "score/betti.hpp"
 #include "score/label_volumes.hpp"
 #include "score/measures.hpp"
@@ -26,65 +28,84 @@ const std::vector<std::pair<const char*, const char*>> kAveraged{{"dice", "/over
                                                                  {"recall", "/overlap/recall"},
                                                                  {"centreline_recall", "/centreline/recall"}};
 
+// One class present in the truth or the prediction: its entry's scores. A class that is the whole
+// of both masks (a single kind) reuses the case's skeletons.
+void scoreClass(const ScoringCase& c, const Volume<std::uint8_t>& truth, const Volume<std::uint8_t>& pred, bool labelled, std::uint8_t value,
+                const VoxelBox& box, bool whole, Json& k) {
+  // Everything of this class in the box where it lies on either side, a voxel of background around.
+  const Volume<std::uint8_t> tk = valueMask(truth, value, box);
+  const Volume<std::uint8_t> pk = labelled ? valueMask(pred, value, box) : cropped(c.prediction, box);
+  Json ov = overlapScores(pk, tk, c.topcow());
+  if (labelled) {
+    k["overlap"] = ov;
+    k["cldice"] = whole ? clDice(c.predictionSkeleton(), c.truth, c.truthSkeleton(), c.prediction, c.topcow())
+                        : clDice(skeletonize(pk), tk, skeletonize(tk), pk, c.topcow());
+    const std::int64_t bt = countComponents(tk, 1, 26, false), bp = countComponents(pk, 1, 26, false);
+    k["b0"] = Json{{"truth", bt}, {"prediction", bp}, {"error", std::abs(bp - bt)}};
+    k["surface"] = surfaceScores(pk, tk, c.tolerance_mm, c.topcow(), c.options.missingDistanceMm());
+  } else {
+    k["overlap"] = Json{{"recall", ov["recall"]}};
+  }
+  if (c.centreline && c.radius) {
+    Volume<float> ck = cropped(*c.centreline, box);
+    for (std::size_t i = 0; i < ck.data.size(); ++i)
+      if (!tk.data[i]) ck.data[i] = 0;
+    std::int64_t n = 0, hit = 0;
+    for (std::size_t i = 0; i < ck.data.size(); ++i)
+      if (ck.data[i] > 0) ++n, hit += pk.data[i] != 0;
+    k["centreline"] = Json{{"voxels", n}, {"recall", ratio(double(hit), double(n))}};
+    k["calibre"] = calibreRecall(pk, tk, ck, cropped(*c.radius, box), c.options.bins_voxels, c.voxel_mm, "voxels");
+  }
+}
+
 Json perClass(const ScoringCase& c) {
   const Volume<std::uint8_t>* truth = c.truthClasses();
   if (!truth) return Json();
   const bool labelled = c.predictionLabelled();
   const Volume<std::uint8_t>& pred = labelled ? c.predictionClasses() : c.prediction;
   const auto nt = labelCounts(*truth), np = labelCounts(c.predictionClasses());
+  const std::int64_t truth_total = std::count(c.truth.data.begin(), c.truth.data.end(), 1),
+                     pred_total = std::count(c.prediction.data.begin(), c.prediction.data.end(), 1);
   std::set<int> values;
   for (const auto& [v, name] : c.files.legend) values.insert(v);
   for (int v = 1; v < 256; ++v)
     if (nt[std::size_t(v)] || (labelled && np[std::size_t(v)])) values.insert(v);
   Json warnings = Json::array();
-  Json per = Json::object();
-  std::vector<std::vector<double>> averaged(kAveraged.size());
-  std::size_t present = 0;
-  const auto boxes = labelled ? valueBoxes({truth, &pred}, 1) : valueBoxes({truth}, 1);
-  for (int v : values) {
+  std::vector<int> order(values.begin(), values.end());
+  std::vector<Json> entries(order.size());
+  std::vector<std::size_t> scored;
+  for (std::size_t e = 0; e < order.size(); ++e) {
+    const int v = order[e];
     const std::string name = c.className(v);
     const std::int64_t in_truth = nt[std::size_t(v)], in_pred = labelled ? np[std::size_t(v)] : 0;
     const bool named = c.files.legend.count(v) || (c.options.scheme && c.options.scheme->labels.count(v));
     if (!named && (!c.files.legend.empty() || c.options.scheme))
       warnings.push_back(name + " occurs in the " + (in_truth ? "truth" : "prediction") + " but not in the legend; scored under that name");
-    Json k{{"label", v}, {"truth_voxels", in_truth}};
-    if (labelled) k["prediction_voxels"] = in_pred;
-    if (!in_truth && !in_pred) {
-      k["absent"] = true;  // in neither: not scored, not averaged
-      per[name] = k;
-      continue;
-    }
-    ++present;
-    // Everything of this class in the box where it lies on either side, a voxel of background around.
-    const std::uint8_t value = std::uint8_t(v);
-    const VoxelBox& box = boxes[value];
-    const Volume<std::uint8_t> tk = valueMask(*truth, value, box);
-    const Volume<std::uint8_t> pk = labelled ? valueMask(pred, value, box) : cropped(c.prediction, box);
-    Json ov = overlapScores(pk, tk, c.topcow());
-    if (labelled) {
-      k["overlap"] = ov;
-      k["cldice"] = clDice(skeletonize(pk), tk, skeletonize(tk), pk, c.topcow());
-      const std::int64_t bt = countComponents(tk, 1, 26, false), bp = countComponents(pk, 1, 26, false);
-      k["b0"] = Json{{"truth", bt}, {"prediction", bp}, {"error", std::abs(bp - bt)}};
-      k["surface"] = surfaceScores(pk, tk, c.tolerance_mm, c.topcow(), c.options.missingDistanceMm());
-    } else {
-      k["overlap"] = Json{{"recall", ov["recall"]}};
-    }
-    if (c.centreline && c.radius) {
-      Volume<float> ck = cropped(*c.centreline, box);
-      for (std::size_t i = 0; i < ck.data.size(); ++i)
-        if (!tk.data[i]) ck.data[i] = 0;
-      std::int64_t n = 0, hit = 0;
-      for (std::size_t i = 0; i < ck.data.size(); ++i)
-        if (ck.data[i] > 0) ++n, hit += pk.data[i] != 0;
-      k["centreline"] = Json{{"voxels", n}, {"recall", ratio(double(hit), double(n))}};
-      k["calibre"] = calibreRecall(pk, tk, ck, cropped(*c.radius, box), c.options.bins_voxels, c.voxel_mm, "voxels");
-    }
+    entries[e] = Json{{"label", v}, {"truth_voxels", in_truth}};
+    if (labelled) entries[e]["prediction_voxels"] = in_pred;
+    if (!in_truth && !in_pred)
+      entries[e]["absent"] = true;  // in neither: not scored, not averaged
+    else
+      scored.push_back(e);
+  }
+  // Classes are independent: scored in parallel, each into its own entry, kept in label order.
+  const auto boxes = labelled ? valueBoxes({truth, &pred}, 1) : valueBoxes({truth}, 1);
+  tbb::parallel_for(std::size_t(0), scored.size(), [&](std::size_t q) {
+    const std::size_t e = scored[q];
+    const auto value = std::uint8_t(order[e]);
+    const bool whole = labelled && nt[value] == truth_total && np[value] == pred_total;
+    scoreClass(c, *truth, pred, labelled, value, boxes[value], whole, entries[e]);
+  });
+  Json per = Json::object();
+  std::vector<std::vector<double>> averaged(kAveraged.size());
+  const std::size_t present = scored.size();
+  for (std::size_t e = 0; e < order.size(); ++e) {
+    const Json& k = entries[e];
     for (std::size_t a = 0; a < kAveraged.size(); ++a) {
       const Json::json_pointer p(kAveraged[a].second);
       if (k.contains(p) && k.at(p).is_number()) averaged[a].push_back(k.at(p).get<double>());
     }
-    per[name] = k;
+    per[c.className(order[e])] = k;
   }
   Json avg{{"classes", present}};
   for (std::size_t a = 0; a < kAveraged.size(); ++a) {
