@@ -7,6 +7,7 @@ pkgs=(build-essential cmake pkg-config ccache
       libtbb-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libtinyxml2-dev
       zlib1g-dev libzip-dev libnifti2-dev libtiff-dev libpng-dev libjpeg-dev
       libopenvdb-dev libboost-iostreams-dev libssl-dev libceres-dev libcgal-dev libjemalloc-dev
+      libfftw3-dev  # k-space artefacts
       python3-dev pybind11-dev python3-numpy)  # the Python module
 if [ "${1:-all}" != program ]; then
   pkgs+=(libgtest-dev libbenchmark-dev

@@ -47,8 +47,9 @@ struct EffectType {
   const char* summary;  // one line for the docs and `--help`
   std::vector<ParamDecl> params;
   void (*apply)(const Drawn& p, EffectContext& ctx);
-  bool moves_geometry = false;  // a warp: at most one per profile
-  bool noise = false;           // random noise (left out of the visible label's noise-free runs)
+  bool moves_geometry = false;                // a warp: at most one per profile
+  bool noise = false;                         // random noise (left out of the visible label's noise-free runs)
+  std::uint64_t working_bytes_per_voxel = 0;  // what it holds beside the image while it runs (a k-space)
 };
 
 // Every effect, in the order the docs list them.

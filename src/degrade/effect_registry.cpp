@@ -3,11 +3,12 @@
 namespace angiosynth {
 
 extern const EffectType kGaussianNoise, kUniformNoise, kImpulseNoise, kRicianNoise, kPoissonNoise, kBlur, kDropout, kShadow, kBiasField, kContrast,
-    kTexture, kAttenuation, kWarp;
+    kTexture, kAttenuation, kWarp, kGibbs, kKSpaceSpike, kMotionGhost;
 
 const std::vector<const EffectType*>& effectTypes() {
-  static const std::vector<const EffectType*> all{&kGaussianNoise, &kUniformNoise, &kImpulseNoise, &kRicianNoise, &kPoissonNoise, &kBlur, &kDropout,
-                                                  &kShadow,        &kBiasField,    &kContrast,     &kTexture,     &kAttenuation,  &kWarp};
+  static const std::vector<const EffectType*> all{&kGaussianNoise, &kUniformNoise, &kImpulseNoise, &kRicianNoise, &kPoissonNoise, &kBlur,
+                                                  &kDropout,       &kShadow,       &kBiasField,    &kContrast,    &kTexture,      &kAttenuation,
+                                                  &kWarp,          &kGibbs,        &kKSpaceSpike,  &kMotionGhost};
   return all;
 }
 

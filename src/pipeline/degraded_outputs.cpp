@@ -1,5 +1,6 @@
 #include "pipeline/degraded_outputs.hpp"
 
+#include <algorithm>
 #include <optional>
 
 #include "degrade/degrade.hpp"
@@ -14,14 +15,16 @@ using Json = nlohmann::ordered_json;
 
 std::uint64_t degradedImageBytes(const Profile& p, const VolumeGrid& g) {
   bool warps = false, fields = false;
+  std::uint64_t working = 0;  // effects run one after another: the largest working set counts
   for (const auto& e : p.effects) {
     warps |= e.type->moves_geometry;
+    working = std::max(working, e.type->working_bytes_per_voxel);
     fields |= std::string(e.type->name) == "bias" || std::string(e.type->name) == "texture";
   }
   // Float image + a working copy (blur, warp) + the typed image; a warp adds its fraction and
   // labels. B-spline lattices are at least a voxel apart, so a field holds at most about one
   // coefficient per voxel plus its plane buffer (8 bytes); a warp keeps three.
-  const std::uint64_t per_voxel = 4 + 4 + 4 + (warps ? 4 + 1 + 1 + 4 + 4 + 24 : 0) + (fields ? 16 : 0);
+  const std::uint64_t per_voxel = 4 + 4 + 4 + (warps ? 4 + 1 + 1 + 4 + 4 + 24 : 0) + (fields ? 16 : 0) + working;
   return per_voxel * static_cast<std::uint64_t>(g.voxelCount());
 }
 
