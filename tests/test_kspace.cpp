@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "cli_run.hpp"
+#include "core/error.hpp"
 #include "degrade/degrade.hpp"
 #include "pipeline/volume_outputs.hpp"
 #include "test_support.hpp"
@@ -108,6 +109,15 @@ print('share', at / e.sum(), 'peak', abs(F[5, -3, 2]))
   for (float x : clean.image.data) sum += x;
   EXPECT_NEAR(peak, 0.05 * sum, 1e-6 * sum) << out;
   fs::remove_all(dir);
+  // A frequency the grid cannot hold is the profile's error, naming what it can.
+  try {
+    degrade(profileText("far", "[[effect]]\ntype = \"kspace_spike\"\nkx = 17\namplitude = 0.05\n"), gt);
+    ADD_FAILURE() << "kx = 17 on 32 voxels was taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("far.toml:1: k-space spike: kx = 17 lies beyond the grid's highest frequency; allowed: -16 to 16"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // One bright voxel on an empty image, lines along y modulated with a period of 8 of its 64

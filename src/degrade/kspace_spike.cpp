@@ -2,6 +2,7 @@
 // loose coil connection), which the inverse transform spreads over the whole image as stripes of
 // one frequency and orientation (the "herringbone" artefact).
 #include <cmath>
+#include <string>
 #include <utility>
 
 #include "degrade/effect.hpp"
@@ -12,17 +13,20 @@ namespace {
 
 void applySpike(const Drawn& p, EffectContext& ctx) {
   Volume<float>& image = ctx.state.image;
-  KSpace k(image);
-  const auto& d = k.dims();
+  const auto& d = image.grid.dims;
   const std::int64_t f[3] = {std::llround(p("kx")), std::llround(p("ky")), std::llround(p("kz"))};
   std::int64_t at[3], mirror[3];
   for (int a = 0; a < 3; ++a) {
-    if (std::abs(f[a]) > d[a] / 2)
-      throw std::invalid_argument("k-space spike: frequency " + std::to_string(f[a]) + " along axis " + std::to_string(a) + " exceeds the grid's " +
-                                  std::to_string(d[a] / 2));
+    if (std::abs(f[a]) > d[a] / 2) {
+      const char* name[] = {"kx", "ky", "kz"};
+      throw std::invalid_argument(std::string("k-space spike: ") + name[a] + " = " + std::to_string(f[a]) +
+                                  " lies beyond the grid's highest frequency; allowed: " + std::to_string(-(d[a] / 2)) + " to " +
+                                  std::to_string(d[a] / 2) + " (cycles per field of view)");
+    }
     at[a] = (f[a] % d[a] + d[a]) % d[a];
     mirror[a] = ((-f[a]) % d[a] + d[a]) % d[a];
   }
+  KSpace k(image);
   // Its height relative to the image's mean (k-space's centre); added with its mirror so that the
   // image stays real: stripes of 2 × amplitude × mean from crest to trough.
   const std::complex<float> spike = float(p("amplitude")) * std::abs(k.at(0, 0, 0));
