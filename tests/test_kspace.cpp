@@ -142,6 +142,24 @@ TEST(KSpace, MotionGhostsSitAtTheFieldOfViewOverThePeriodAlongThePhaseAxis) {
   EXPECT_LT(elsewhere, 1e-2);
 }
 
+// One bright voxel, one line in 4 along y kept: 4 copies of a quarter of its brightness, 64 ÷ 4
+// = 16 voxels apart (the fold of an accelerated acquisition); with 16 centre lines kept in full
+// the voxel keeps more than a quarter and its copies less.
+TEST(KSpace, UndersamplingFoldsTheImageIntoFactorCopies) {
+  auto gt = truthOn({16, 64, 8});
+  gt.fraction.at(5, 9, 3) = 1;
+  const auto d = degrade(profileText("fold", "background = 0\nvessel = 1000\n[[effect]]\ntype = \"undersample\"\nfactor = 4\n"), gt);
+  for (int m = 0; m < 4; ++m) EXPECT_NEAR(d.image.at(5, (9 + 16 * m) % 64, 3), 250, 1e-2) << m;
+  double total = 0;
+  for (float x : d.image.data) total += x;
+  EXPECT_NEAR(total, 1000, 1e-1);  // nothing but the four copies
+  EXPECT_NEAR(d.record["effects"][0]["lines_acquired_share"].get<double>(), 0.25, 1e-12) << d.record.dump();
+  const auto acs =
+      degrade(profileText("acs", "background = 0\nvessel = 1000\n[[effect]]\ntype = \"undersample\"\nfactor = 4\ncentre_lines = 16\n"), gt);
+  EXPECT_GT(acs.image.at(5, 9, 3), 300);
+  EXPECT_LT(acs.image.at(5, 25, 3), 250);
+}
+
 // The three effects in one profile through `generate`: the sample's mask, centreline and classes
 // are the bytes of the same sample without the profile (intensity-only effects move no label),
 // and the degraded image the same on one thread as on two.

@@ -3,12 +3,12 @@
 namespace angiosynth {
 
 extern const EffectType kGaussianNoise, kUniformNoise, kImpulseNoise, kRicianNoise, kPoissonNoise, kBlur, kDropout, kShadow, kBiasField, kContrast,
-    kTexture, kAttenuation, kWarp, kGibbs, kKSpaceSpike, kMotionGhost;
+    kTexture, kAttenuation, kWarp, kGibbs, kKSpaceSpike, kMotionGhost, kUndersample;
 
 const std::vector<const EffectType*>& effectTypes() {
   static const std::vector<const EffectType*> all{&kGaussianNoise, &kUniformNoise, &kImpulseNoise, &kRicianNoise, &kPoissonNoise, &kBlur,
                                                   &kDropout,       &kShadow,       &kBiasField,    &kContrast,    &kTexture,      &kAttenuation,
-                                                  &kWarp,          &kGibbs,        &kKSpaceSpike,  &kMotionGhost};
+                                                  &kWarp,          &kGibbs,        &kKSpaceSpike,  &kMotionGhost, &kUndersample};
   return all;
 }
 
