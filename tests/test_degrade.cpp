@@ -9,13 +9,13 @@
 #include <cstring>
 #include <fstream>
 #include <numeric>
-#include <unistd.h>
 
 #include "core/distributions.hpp"
 #include "core/error.hpp"
 #include "degrade/degrade.hpp"
 #include "degrade/warp.hpp"
 #include "pipeline/volume_outputs.hpp"
+#include "degrade_support.hpp"
 #include "test_support.hpp"
 
 namespace angiosynth {
@@ -23,18 +23,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path writeTemp(const std::string& name, const std::string& text) {
-  // A directory per process keeps tests that ctest runs in parallel off each other's files; the
-  // file keeps its name, which names the profile and so keys its random draws (a pid in the name
-  // made every process draw another warp).
-  const fs::path dir = fs::temp_directory_path() / ("angiosynth_degrade_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const fs::path p = dir / name;
-  std::ofstream(p, std::ios::binary) << text;
-  return p;
-}
-
-Profile profileFrom(const std::string& name, const std::string& text) { return readProfileToml(writeTemp(name + ".toml", text)); }
+using test::flatTruth;
+using test::kNoTree;
+using test::profileFrom;
+using test::writeTemp;
 
 // n³ voxels over the example's 40 mm map, voxel centres at (i + ½)·40/n.
 VolumeGrid mapGrid(int n) {
@@ -43,28 +35,6 @@ VolumeGrid mapGrid(int n) {
   g.spacing_mm = Vec3(40.0 / n, 40.0 / n, 40.0 / n);
   g.origin_mm = g.spacing_mm * 0.5;
   return g;
-}
-
-GroundTruthVolumes flatTruth(int n, const Vec3& spacing = Vec3(1, 1, 1)) {
-  VolumeGrid g;
-  g.dims = {n, n, n};
-  g.spacing_mm = spacing;
-  GroundTruthVolumes gt;
-  gt.fraction = Volume<float>(g);
-  gt.mask = Volume<std::uint8_t>(g);
-  gt.centerline = Volume<std::uint8_t>(g);
-  gt.radius = Volume<float>(g);
-  gt.instances = Volume<std::uint32_t>(g);
-  return gt;
-}
-
-DegradedImage run(const Profile& p, const GroundTruthVolumes& gt, const VascularTree& tree, std::uint64_t seed = 7) {
-  DegradeInput in;
-  in.tree = &tree;
-  in.truth = &gt;
-  in.seed = seed;
-  in.dtype = "float32";
-  return degradeImage(p, in);
 }
 
 struct Moments {
@@ -78,15 +48,9 @@ Moments moments(const VoxelBuffer<float>& v) {
   return {m, std::sqrt(s2 / (v.size() - 1))};
 }
 
-const VascularTree kNoTree = [] {
-  VascularTree t;
-  t.addNode(Vec3(0, 0, 0), -1);
-  return t;
-}();
-
 TEST(Degrade, GaussianNoiseHasItsMeanAndSigma) {
   const auto gt = flatTruth(64);
-  const auto d = run(profileFrom("g", "background = 100\n[[effect]]\ntype = \"gaussian\"\nmean = 5\nsigma = 20\n"), gt, kNoTree);
+  const auto d = test::degradeWith(profileFrom("g", "background = 100\n[[effect]]\ntype = \"gaussian\"\nmean = 5\nsigma = 20\n"), gt, kNoTree);
   const auto m = moments(d.image.data);
   const double n = double(d.image.data.size());
   EXPECT_NEAR(m.mean, 105, 5 * 20 / std::sqrt(n));
@@ -98,7 +62,7 @@ TEST(Degrade, GaussianNoiseHasItsMeanAndSigma) {
 
 TEST(Degrade, UniformNoiseHasItsBoundsMeanAndVariance) {
   const auto gt = flatTruth(64);
-  const auto d = run(profileFrom("u", "[[effect]]\ntype = \"uniform\"\nlow = -10\nhigh = 30\n"), gt, kNoTree);
+  const auto d = test::degradeWith(profileFrom("u", "[[effect]]\ntype = \"uniform\"\nlow = -10\nhigh = 30\n"), gt, kNoTree);
   const auto m = moments(d.image.data);
   const double n = double(d.image.data.size()), sd = 40 / std::sqrt(12.0);
   EXPECT_NEAR(m.mean, 10, 5 * sd / std::sqrt(n));
@@ -109,10 +73,10 @@ TEST(Degrade, UniformNoiseHasItsBoundsMeanAndVariance) {
 
 TEST(Degrade, ImpulseRatesMatchTheirProbabilities) {
   const auto gt = flatTruth(64);
-  const auto d = run(profileFrom("i",
-                                 "background = 100\nvessel = 200\n[[effect]]\ntype = \"impulse\"\nsalt_probability = 0.03\n"
-                                 "pepper_value = 0\npepper_probability = 0.05\n"),
-                     gt, kNoTree);
+  const auto d = test::degradeWith(profileFrom("i",
+                                               "background = 100\nvessel = 200\n[[effect]]\ntype = \"impulse\"\nsalt_probability = 0.03\n"
+                                               "pepper_value = 0\npepper_probability = 0.05\n"),
+                                   gt, kNoTree);
   const double n = double(d.image.data.size());
   const double salt = std::count(d.image.data.begin(), d.image.data.end(), 200.0f) / n;
   const double pepper = std::count(d.image.data.begin(), d.image.data.end(), 0.0f) / n;
@@ -124,7 +88,7 @@ TEST(Degrade, ImpulseRatesMatchTheirProbabilities) {
 TEST(Degrade, RicianNoiseOnZeroSignalFollowsTheRayleighLaw) {
   const auto gt = flatTruth(64);
   const double sigma = 10;
-  const auto d = run(profileFrom("r", "[[effect]]\ntype = \"rician\"\nsigma = 10\n"), gt, kNoTree);
+  const auto d = test::degradeWith(profileFrom("r", "[[effect]]\ntype = \"rician\"\nsigma = 10\n"), gt, kNoTree);
   std::vector<float> x(d.image.data.begin(), d.image.data.end());
   std::sort(x.begin(), x.end());
   const double n = double(x.size());
@@ -144,7 +108,7 @@ TEST(Degrade, PoissonNoiseHasMeanAndVarianceLambdaOnBothSamplers) {
   const auto gt = flatTruth(48);
   for (double lambda : {3.0, 40.0}) {  // Knuth's product below 10, PTRS above
     const auto p = profileFrom("p", "background = " + std::to_string(lambda) + "\n[[effect]]\ntype = \"poisson\"\n");
-    const auto d = run(p, gt, kNoTree);
+    const auto d = test::degradeWith(p, gt, kNoTree);
     const auto m = moments(d.image.data);
     const double n = double(d.image.data.size());
     EXPECT_NEAR(m.mean, lambda, 5 * std::sqrt(lambda / n)) << lambda;
@@ -160,7 +124,8 @@ TEST(Degrade, BlurredVoxelHasThePsfSigmaOnEachAxis) {
   // Anisotropic voxels; σ given in mm must come out in mm.
   auto gt = flatTruth(41, Vec3(0.5, 0.8, 1.0));
   gt.fraction.at(20, 20, 20) = 1;
-  const auto d = run(profileFrom("b", "vessel = 1\n[[effect]]\ntype = \"blur\"\nsigma = [\"1 mm\", \"1.6 mm\", \"3 mm\"]\n"), gt, kNoTree);
+  const auto d =
+      test::degradeWith(profileFrom("b", "vessel = 1\n[[effect]]\ntype = \"blur\"\nsigma = [\"1 mm\", \"1.6 mm\", \"3 mm\"]\n"), gt, kNoTree);
   double sum = 0, m2[3] = {0, 0, 0};
   const auto& g = d.image.grid;
   for (int k = 0; k < 41; ++k)
@@ -188,11 +153,11 @@ TEST(Degrade, SameSeedSameImageWhateverTheThreadsAndStreamsDiffer) {
   DegradedImage one, two;
   {
     tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
-    one = run(all, gt, tree, 11);
+    one = test::degradeWith(all, gt, tree, 11);
   }
   {
     tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
-    two = run(all, gt, tree, 11);
+    two = test::degradeWith(all, gt, tree, 11);
   }
   ASSERT_EQ(one.image.data.size(), two.image.data.size());
   EXPECT_EQ(std::memcmp(one.image.data.data(), two.image.data.data(), one.image.data.size() * 4), 0);
@@ -200,11 +165,11 @@ TEST(Degrade, SameSeedSameImageWhateverTheThreadsAndStreamsDiffer) {
   EXPECT_EQ(one.labels->mask.data, two.labels->mask.data);
   EXPECT_EQ(one.labels->instances.data, two.labels->instances.data);
   EXPECT_EQ(one.record.dump(), two.record.dump());
-  const auto other_seed = run(all, gt, tree, 12);
+  const auto other_seed = test::degradeWith(all, gt, tree, 12);
   EXPECT_NE(other_seed.record["effects"][0].dump(), one.record["effects"][0].dump());
   Profile renamed = all;
   renamed.name = "another";
-  EXPECT_NE(run(renamed, gt, tree, 11).record["effects"][0].dump(), one.record["effects"][0].dump());
+  EXPECT_NE(test::degradeWith(renamed, gt, tree, 11).record["effects"][0].dump(), one.record["effects"][0].dump());
 }
 
 // The warp moves image, labels and graph together.
@@ -217,7 +182,7 @@ class Warp : public ::testing::Test {
     clean_ = new GroundTruthVolumes(rasterizeGroundTruth(*tree_, grid_, RasterOptions{4}));
     // Control spacing 10 mm, displacements up to 3 mm (7.5 voxels): strongly curved vessels.
     const Profile p = profileFrom("w", "[[effect]]\ntype = \"warp\"\nspacing = \"10 mm\"\nmax_displacement = \"3 mm\"\n");
-    warped_ = new DegradedImage(run(p, *clean_, *tree_, 5));
+    warped_ = new DegradedImage(test::degradeWith(p, *clean_, *tree_, 5));
   }
   static void TearDownTestSuite() { delete warped_, delete clean_, delete tree_; }
   static inline VascularTree* tree_ = nullptr;
@@ -322,7 +287,7 @@ TEST(Degrade, DropoutsRemoveVesselContrastAtTheirGapsOnly) {
   const VascularTree tree = test::grow(ex);
   const VolumeGrid g = mapGrid(100);
   const auto gt = rasterizeGroundTruth(tree, g, RasterOptions{4});
-  const auto d = run(profileFrom("d", "[[effect]]\ntype = \"dropout\"\ncount = 60\nlength = \"2 mm\"\n"), gt, tree);
+  const auto d = test::degradeWith(profileFrom("d", "[[effect]]\ntype = \"dropout\"\ncount = 60\nlength = \"2 mm\"\n"), gt, tree);
   const auto& gaps = d.record["effects"][0]["gaps"];
   ASSERT_EQ(gaps.size(), 60u);
   // Depth 1: within the flat middle of every gap (±0.5 mm) all vessel signal is gone.
@@ -377,7 +342,7 @@ TEST(Degrade, ProfileErrorsNameFileAndLine) {
     const auto f = writeTemp("bad.toml", text);
     try {
       Profile p = readProfileToml(f);
-      run(p, flatTruth(8), kNoTree);
+      test::degradeWith(p, flatTruth(8), kNoTree);
       return ::testing::AssertionFailure() << "no error for " << text;
     } catch (const InputError& e) {
       if (std::string(e.what()).find(f.string() + want) == 0) return ::testing::AssertionSuccess();
@@ -402,7 +367,7 @@ TEST(Degrade, ShippedProfilesDrawWithinTheirRangesAndFitTheirDtype) {
   int profiles = 0;
   for (const auto& e : fs::directory_iterator(test::sourceDir() / "noise_profiles")) {
     const Profile p = readProfileToml(e.path());
-    const auto d = run(p, gt, tree, 3);
+    const auto d = test::degradeWith(p, gt, tree, 3);
     ++profiles;
     ASSERT_EQ(d.record["effects"].size(), p.effects.size()) << p.name;
     // Every drawn number lies within the profile's own range (plain amounts).
@@ -436,7 +401,7 @@ TEST(Degrade, VascuSynthProfileAddsSigma20WhereTheImageIsNotClamped) {
   // Mid-grey everywhere: fraction ½ → 127.5, far from both clamps.
   auto gt = flatTruth(64);
   std::fill(gt.fraction.data.begin(), gt.fraction.data.end(), 0.5f);
-  const auto d = run(readProfileToml(test::sourceDir() / "noise_profiles/vascusynth.toml"), gt, kNoTree);
+  const auto d = test::degradeWith(readProfileToml(test::sourceDir() / "noise_profiles/vascusynth.toml"), gt, kNoTree);
   const auto m = moments(d.image.data);
   EXPECT_NEAR(m.mean, 127.5, 0.2);
   EXPECT_NEAR(m.sd, 20, 0.2);  // clamping at 0 and 255 (6σ away) changes nothing measurable

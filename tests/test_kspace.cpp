@@ -7,12 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <unistd.h>
 
 #include "cli_run.hpp"
 #include "core/error.hpp"
-#include "degrade/degrade.hpp"
-#include "pipeline/volume_outputs.hpp"
+#include "degrade_support.hpp"
 #include "test_support.hpp"
 
 namespace angiosynth {
@@ -20,47 +18,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-Profile profileText(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::temp_directory_path() / ("angiosynth_kspace_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  std::ofstream(dir / (name + ".toml")) << text;
-  return readProfileToml(dir / (name + ".toml"));
-}
+using test::flatTruth;
+using test::profileFrom;
 
-GroundTruthVolumes truthOn(const std::array<std::int32_t, 3>& dims) {
-  VolumeGrid g;
-  g.dims = dims;
-  GroundTruthVolumes gt;
-  gt.fraction = Volume<float>(g);
-  gt.mask = Volume<std::uint8_t>(g);
-  gt.centerline = Volume<std::uint8_t>(g);
-  gt.radius = Volume<float>(g);
-  gt.instances = Volume<std::uint32_t>(g);
-  return gt;
-}
-
-DegradedImage degrade(const Profile& p, const GroundTruthVolumes& gt) {
-  static const VascularTree none = [] {
-    VascularTree t;
-    t.addNode(Vec3(0, 0, 0), -1);
-    return t;
-  }();
-  DegradeInput in;
-  in.tree = &none;
-  in.truth = &gt;
-  in.seed = 3;
-  in.dtype = "float32";
-  return degradeImage(p, in);
-}
+using test::degradeWith;
 
 // A step from 0 to 100 along x (a square wave, k-space being periodic), k-space kept to its
 // central eighth (|f| <= 64 of 1024): the overshoot beside each edge is 8.8227 % of the step, the
 // value NumPy's FFT gives for the same truncation (Gibbs's limit for a continuous step is
 // 8.95 %), and the plateaus far from the edges keep their level.
 TEST(KSpace, GibbsRingingOvershootsAStepByNinePercent) {
-  auto gt = truthOn({1024, 1, 1});
+  auto gt = flatTruth({1024, 1, 1});
   for (int x = 256; x < 768; ++x) gt.fraction.at(x, 0, 0) = 1;
-  const auto d = degrade(profileText("gibbs", "background = 0\nvessel = 100\n[[effect]]\ntype = \"gibbs\"\nkeep_x = 0.125\n"), gt);
+  const auto d = degradeWith(profileFrom("gibbs", "background = 0\nvessel = 100\n[[effect]]\ntype = \"gibbs\"\nkeep_x = 0.125\n"), gt);
   const auto& v = d.image.data;
   const float peak = *std::max_element(v.begin(), v.end()), trough = *std::min_element(v.begin(), v.end());
   EXPECT_NEAR(peak - 100, 8.95, 0.25);  // the overshoot, % of the step
@@ -68,22 +38,22 @@ TEST(KSpace, GibbsRingingOvershootsAStepByNinePercent) {
   EXPECT_NEAR(v[512], 100, 1.0);        // mid-plateau
   EXPECT_NEAR(v[0], 0, 1.0);
   // Untruncated (keep 1), the step comes back exactly.
-  const auto same = degrade(profileText("gibbs1", "background = 0\nvessel = 100\n[[effect]]\ntype = \"gibbs\"\n"), gt);
+  const auto same = degradeWith(profileFrom("gibbs1", "background = 0\nvessel = 100\n[[effect]]\ntype = \"gibbs\"\n"), gt);
   for (int x = 0; x < 1024; ++x) ASSERT_NEAR(same.image.data[x], x >= 256 && x < 768 ? 100 : 0, 1e-3) << x;
 }
 
 // A spike at (5, -3, 2) cycles per field of view: the image's change is one plane wave, all of
 // its energy at ±(5, -3, 2) in NumPy's FFT, of the height asked for.
 TEST(KSpace, SpikePutsItsEnergyAtItsFrequency) {
-  auto gt = truthOn({32, 24, 16});
+  auto gt = flatTruth({32, 24, 16});
   for (int z = 4; z < 12; ++z)
     for (int y = 6; y < 18; ++y)
       for (int x = 10; x < 20; ++x) gt.fraction.at(x, y, z) = 1;
-  const auto clean = degrade(profileText("none", "background = 20\nvessel = 120\n"), gt);
-  const auto d = degrade(profileText("spike",
-                                     "background = 20\nvessel = 120\n[[effect]]\ntype = \"kspace_spike\"\nkx = 5\nky = -3\nkz = 2\n"
-                                     "amplitude = 0.05\n"),
-                         gt);
+  const auto clean = degradeWith(profileFrom("none", "background = 20\nvessel = 120\n"), gt);
+  const auto d = degradeWith(profileFrom("spike",
+                                         "background = 20\nvessel = 120\n[[effect]]\ntype = \"kspace_spike\"\nkx = 5\nky = -3\nkz = 2\n"
+                                         "amplitude = 0.05\n"),
+                             gt);
   const fs::path dir = freshTestDir("angiosynth_kspace_spike_");
   {
     std::ofstream f(dir / "diff.f32", std::ios::binary);
@@ -111,7 +81,7 @@ print('share', at / e.sum(), 'peak', abs(F[5, -3, 2]))
   fs::remove_all(dir);
   // A frequency the grid cannot hold is the profile's error, naming what it can.
   try {
-    degrade(profileText("far", "[[effect]]\ntype = \"kspace_spike\"\nkx = 17\namplitude = 0.05\n"), gt);
+    degradeWith(profileFrom("far", "[[effect]]\ntype = \"kspace_spike\"\nkx = 17\namplitude = 0.05\n"), gt);
     ADD_FAILURE() << "kx = 17 on 32 voxels was taken";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("far.toml:1: k-space spike: kx = 17 lies beyond the grid's highest frequency; allowed: -16 to 16"),
@@ -124,12 +94,12 @@ print('share', at / e.sum(), 'peak', abs(F[5, -3, 2]))
 // lines: copies of a quarter of its brightness (amplitude 0.5 ÷ 2) 64 ÷ 8 = 8 voxels away along
 // y on both sides, nothing along x or z.
 TEST(KSpace, MotionGhostsSitAtTheFieldOfViewOverThePeriodAlongThePhaseAxis) {
-  auto gt = truthOn({32, 64, 16});
+  auto gt = flatTruth({32, 64, 16});
   gt.fraction.at(10, 20, 5) = 1;
-  const auto d = degrade(profileText("ghost",
-                                     "background = 0\nvessel = 1000\n[[effect]]\ntype = \"motion_ghost\"\naxis = 1\nperiod = 8\n"
-                                     "amplitude = 0.5\n"),
-                         gt);
+  const auto d = degradeWith(profileFrom("ghost",
+                                         "background = 0\nvessel = 1000\n[[effect]]\ntype = \"motion_ghost\"\naxis = 1\nperiod = 8\n"
+                                         "amplitude = 0.5\n"),
+                             gt);
   const auto& img = d.image;
   EXPECT_NEAR(img.at(10, 20, 5), 1000, 1e-2);
   EXPECT_NEAR(img.at(10, 28, 5), 250, 1e-2);
@@ -146,16 +116,16 @@ TEST(KSpace, MotionGhostsSitAtTheFieldOfViewOverThePeriodAlongThePhaseAxis) {
 // = 16 voxels apart (the fold of an accelerated acquisition); with 16 centre lines kept in full
 // the voxel keeps more than a quarter and its copies less.
 TEST(KSpace, UndersamplingFoldsTheImageIntoFactorCopies) {
-  auto gt = truthOn({16, 64, 8});
+  auto gt = flatTruth({16, 64, 8});
   gt.fraction.at(5, 9, 3) = 1;
-  const auto d = degrade(profileText("fold", "background = 0\nvessel = 1000\n[[effect]]\ntype = \"undersample\"\nfactor = 4\n"), gt);
+  const auto d = degradeWith(profileFrom("fold", "background = 0\nvessel = 1000\n[[effect]]\ntype = \"undersample\"\nfactor = 4\n"), gt);
   for (int m = 0; m < 4; ++m) EXPECT_NEAR(d.image.at(5, (9 + 16 * m) % 64, 3), 250, 1e-2) << m;
   double total = 0;
   for (float x : d.image.data) total += x;
   EXPECT_NEAR(total, 1000, 1e-1);  // nothing but the four copies
   EXPECT_NEAR(d.record["effects"][0]["lines_acquired_share"].get<double>(), 0.25, 1e-12) << d.record.dump();
   const auto acs =
-      degrade(profileText("acs", "background = 0\nvessel = 1000\n[[effect]]\ntype = \"undersample\"\nfactor = 4\ncentre_lines = 16\n"), gt);
+      degradeWith(profileFrom("acs", "background = 0\nvessel = 1000\n[[effect]]\ntype = \"undersample\"\nfactor = 4\ncentre_lines = 16\n"), gt);
   EXPECT_GT(acs.image.at(5, 9, 3), 300);
   EXPECT_LT(acs.image.at(5, 25, 3), 250);
 }

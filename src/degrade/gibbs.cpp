@@ -18,12 +18,9 @@ void applyGibbs(const Drawn& p, EffectContext& ctx) {
   // The highest frequency kept per axis (cycles per field of view); a one-voxel axis keeps its one.
   std::int64_t limit[3];
   for (int a = 0; a < 3; ++a) limit[a] = d[a] == 1 ? 0 : std::int64_t(std::floor(keep[a] * d[a] / 2.0));
-  for (std::int64_t z = 0; z < d[2]; ++z)
-    for (std::int64_t y = 0; y < d[1]; ++y)
-      for (std::int64_t x = 0; x < d[0]; ++x)
-        if (std::abs(KSpace::frequency(x, d[0])) > limit[0] || std::abs(KSpace::frequency(y, d[1])) > limit[1] ||
-            std::abs(KSpace::frequency(z, d[2])) > limit[2])
-          k.at(x, y, z) = 0;
+  k.forEachSample([&](const std::array<std::int64_t, 3>& f, std::complex<float>& v) {
+    if (std::abs(f[0]) > limit[0] || std::abs(f[1]) > limit[1] || std::abs(f[2]) > limit[2]) v = 0;
+  });
   std::move(k).toImage(image, /*magnitude=*/false);
 }
 

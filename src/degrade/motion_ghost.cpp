@@ -19,13 +19,10 @@ void applyMotionGhost(const Drawn& p, EffectContext& ctx) {
   const auto& d = k.dims();
   // Lines acquired from the lowest frequency to the highest, one per time step: line t's signal
   // scaled by 1 + depth × cos(2π t / period).
-  for (std::int64_t z = 0; z < d[2]; ++z)
-    for (std::int64_t y = 0; y < d[1]; ++y)
-      for (std::int64_t x = 0; x < d[0]; ++x) {
-        const std::int64_t n = axis == 0 ? x : axis == 1 ? y : z;
-        const std::int64_t t = KSpace::frequency(n, d[axis]) + d[axis] / 2;
-        k.at(x, y, z) *= float(1 + depth * std::cos(2 * std::numbers::pi * double(t) / period));
-      }
+  k.forEachSample([&](const std::array<std::int64_t, 3>& f, std::complex<float>& v) {
+    const std::int64_t t = f[axis] + d[axis] / 2;
+    v *= float(1 + depth * std::cos(2 * std::numbers::pi * double(t) / period));
+  });
   ctx.record["ghost_shift_voxels"] = double(d[axis]) / period;
   std::move(k).toImage(image, /*magnitude=*/true);
 }

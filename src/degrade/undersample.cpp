@@ -19,17 +19,13 @@ void applyUndersample(const Drawn& p, EffectContext& ctx) {
   KSpace k(image);
   const auto& d = k.dims();
   std::int64_t dropped = 0;
-  for (std::int64_t z = 0; z < d[2]; ++z)
-    for (std::int64_t y = 0; y < d[1]; ++y)
-      for (std::int64_t x = 0; x < d[0]; ++x) {
-        const std::int64_t n = axis == 0 ? x : axis == 1 ? y : z;
-        const std::int64_t f = KSpace::frequency(n, d[axis]);
-        // Line f acquired when it is a multiple of the factor, or within the centre's band.
-        if (f % factor != 0 && 2 * std::abs(f) >= centre) {
-          k.at(x, y, z) = 0;
-          ++dropped;
-        }
-      }
+  k.forEachSample([&](const std::array<std::int64_t, 3>& f, std::complex<float>& v) {
+    // Line f acquired when it is a multiple of the factor, or within the centre's band.
+    if (f[axis] % factor != 0 && 2 * std::abs(f[axis]) >= centre) {
+      v = 0;
+      ++dropped;
+    }
+  });
   ctx.record["lines_acquired_share"] = 1 - double(dropped) / double(d[0]) / double(d[1]) / double(d[2]);
   std::move(k).toImage(image, /*magnitude=*/true);
 }

@@ -41,11 +41,6 @@ std::array<VoxelBox, 256> valueBoxes(const std::vector<const Volume<std::uint8_t
   return boxes;
 }
 
-VoxelBox valueBox(const std::vector<const Volume<std::uint8_t>*>& volumes, std::uint8_t value, int pad) {
-  if (!value) return VoxelBox{};
-  return valueBoxes(volumes, pad)[value];
-}
-
 Volume<std::uint8_t> valueMask(const Volume<std::uint8_t>& classes, std::uint8_t value, const VoxelBox& box) {
   Volume<std::uint8_t> c = cropped(classes, box);
   for (auto& v : c.data) v = v == value;

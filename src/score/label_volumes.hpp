@@ -20,10 +20,8 @@ struct VoxelBox {
   bool empty() const { return lo[0] > hi[0] || lo[1] > hi[1] || lo[2] > hi[2]; }
 };
 
-// The box of the voxels equal to `value` in any of the volumes, grown by `pad` voxels and kept
-// within the grid.
-VoxelBox valueBox(const std::vector<const Volume<std::uint8_t>*>& volumes, std::uint8_t value, int pad);
-// The same for every value at once (index = value), in one pass over the volumes.
+// The box of the voxels of each value (index = value) in any of the volumes, grown by `pad`
+// voxels and kept within the grid; found in one pass over the volumes.
 std::array<VoxelBox, 256> valueBoxes(const std::vector<const Volume<std::uint8_t>*>& volumes, int pad);
 
 // The voxels equal to `value` within the box, as a binary volume of the box's size (the spacing

@@ -17,9 +17,13 @@ namespace {
 using Json = nlohmann::ordered_json;
 using Neighbours = std::map<int, std::set<int>>;
 
-std::int64_t commonVoxels(const Volume<std::uint8_t>& a, const Volume<std::uint8_t>& b, std::uint8_t v) {
-  std::int64_t n = 0;
-  for (std::size_t i = 0; i < a.data.size(); ++i) n += a.data[i] == v && b.data[i] == v;
+using Counts = std::array<std::int64_t, 256>;
+
+// Voxels of each value in both volumes at once (index = value).
+Counts commonCounts(const Volume<std::uint8_t>& a, const Volume<std::uint8_t>& b) {
+  Counts n{};
+  for (std::size_t i = 0; i < a.data.size(); ++i)
+    if (a.data[i] == b.data[i]) ++n[a.data[i]];
   return n;
 }
 
@@ -29,12 +33,11 @@ struct Detection {
   std::string result;
   double iou = 0;
 };
-Detection detect(const Volume<std::uint8_t>& t, const Volume<std::uint8_t>& p, const std::array<std::int64_t, 256>& nt,
-                 const std::array<std::int64_t, 256>& np, int v, double threshold) {
+Detection detect(const Counts& nt, const Counts& np, const Counts& common, int v, double threshold) {
   const std::int64_t a = nt[std::size_t(v)], b = np[std::size_t(v)];
   Detection d;
   if (a && b) {
-    const std::int64_t both = commonVoxels(t, p, std::uint8_t(v));
+    const std::int64_t both = common[std::size_t(v)];
     d.iou = double(both) / double(a + b - both);
   }
   d.result = a ? (d.iou >= threshold ? "TP" : "FN") : (b ? "FP" : "TN");
@@ -91,8 +94,9 @@ bool leftRightFlipped(const ScoringCase& c, const Volume<std::uint8_t>& p, const
   return median_left(lr.first) < median_left(lr.second);
 }
 
-std::int64_t pieces(const Volume<std::uint8_t>& classes, int v) {
-  const VoxelBox box = valueBox({&classes}, std::uint8_t(v), 1);
+// 26-connected pieces of class v, counted within its box.
+std::int64_t pieces(const Volume<std::uint8_t>& classes, const std::array<VoxelBox, 256>& boxes, int v) {
+  const VoxelBox& box = boxes[std::size_t(v)];
   return box.empty() ? 0 : countComponents(valueMask(classes, std::uint8_t(v), box), 1, 26, false);
 }
 
@@ -102,12 +106,12 @@ Json labelSchemeScores(const ScoringCase& c) {
   const Volume<std::uint8_t>* truth = c.truthClasses();
   if (!truth) return Json();
   const Volume<std::uint8_t>& pred = c.predictionClasses();
-  const auto nt = labelCounts(*truth), np = labelCounts(pred);
+  const Counts nt = labelCounts(*truth), np = labelCounts(pred), common = commonCounts(*truth, pred);
   Json out{{"scheme", s.name}, {"source", s.source}};
   if (!s.detection_labels.empty()) {
     Json labels = Json::object();
     for (int v : s.detection_labels) {
-      const Detection d = detect(*truth, pred, nt, np, v, s.detection_iou);
+      const Detection d = detect(nt, np, common, v, s.detection_iou);
       labels[c.className(v)] = Json{{"label", v}, {"iou", d.iou}, {"detection", d.result}};
     }
     out["detection"] = Json{{"vessels", s.detection_name}, {"iou_threshold", s.detection_iou}, {"labels", labels}};
@@ -137,14 +141,15 @@ Json labelSchemeScores(const ScoringCase& c) {
     Json cow{{"truth", Json{{"anterior", variantName("Ant", ta)}, {"posterior", variantName("Pos", tp)}}},
              {"prediction", Json{{"anterior", variantName("Ant", pa)}, {"posterior", variantName("Pos", pp)}}},
              {"variant_match", Json{{"anterior", ta == pa}, {"posterior", tp == pp}}}};
+    const auto truth_boxes = valueBoxes({truth}, 1), pred_boxes = valueBoxes({&pred}, 1);
     Json topo = Json::object();
     for (const bool anterior : {true, false}) {
       const std::vector<int> region = anterior ? std::vector<int>{10, 11, 12, 15} : std::vector<int>{2, 3, 8, 9};
       Json labels = Json::object();
       std::string why;
       for (int v : region) {
-        const Detection d = detect(*truth, pred, nt, np, v, s.detection_iou);
-        const std::int64_t bt = pieces(*truth, v), bp = pieces(pred, v);
+        const Detection d = detect(nt, np, common, v, s.detection_iou);
+        const std::int64_t bt = pieces(*truth, truth_boxes, v), bp = pieces(pred, pred_boxes, v);
         const auto ntv = sorted(nb_truth, v), npv = sorted(nb_pred, v);
         labels[c.className(v)] =
             Json{{"detection", d.result}, {"b0_truth", bt}, {"b0_prediction", bp}, {"neighbours_truth", ntv}, {"neighbours_prediction", npv}};

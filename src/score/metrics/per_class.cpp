@@ -2,6 +2,7 @@
 // averages computed as the TopCoW 2024 evaluation computes them (Yang et al. 2023): over the
 // classes present in the truth or the prediction, a class missing on one side scoring Dice 0.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <set>
@@ -63,7 +64,8 @@ Json perClass(const ScoringCase& c) {
   if (!truth) return Json();
   const bool labelled = c.predictionLabelled();
   const Volume<std::uint8_t>& pred = labelled ? c.predictionClasses() : c.prediction;
-  const auto nt = labelCounts(*truth), np = labelCounts(c.predictionClasses());
+  // The prediction's classes are counted only when it has them.
+  const auto nt = labelCounts(*truth), np = labelled ? labelCounts(pred) : std::array<std::int64_t, 256>{};
   const std::int64_t truth_total = std::count(c.truth.data.begin(), c.truth.data.end(), 1),
                      pred_total = std::count(c.prediction.data.begin(), c.prediction.data.end(), 1);
   std::set<int> values;
