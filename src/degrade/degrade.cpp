@@ -34,6 +34,11 @@ void dtypeRange(const std::string& dtype, double& lo, double& hi) {
     lo = -32768, hi = 32767;
 }
 
+const char* distractorName(std::uint8_t kind) {
+  static const char* const names[] = {"none", "blob", "tube", "plate", "bone", "calcification"};
+  return kind < 6 ? names[kind] : "unknown";
+}
+
 DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
   DegradedImage out;
   out.profile = profile.name;
@@ -102,6 +107,20 @@ DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
     out.segment_origin = s.segment_origin;
     out.warp = s.warp;
     out.seconds["warped_labels"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  if (!s.distractors.data.empty()) {
+    // A vessel the image shows stays a vessel: a distractor voxel is one the vessel label leaves out.
+    const Volume<std::uint8_t>& mask = out.labels ? out.labels->mask : in.truth->mask;
+    std::int64_t count[6] = {0, 0, 0, 0, 0, 0};
+    for (std::int64_t v = 0; v < s.grid.voxelCount(); ++v) {
+      if (mask.data[v]) s.distractors.data[v] = 0;
+      ++count[std::min<int>(s.distractors.data[v], 5)];
+    }
+    Json voxels;
+    for (int k = 1; k <= 5; ++k)
+      if (count[k]) voxels[distractorName(std::uint8_t(k))] = count[k];
+    rec["distractor_voxels"] = voxels;
+    out.distractors = std::move(s.distractors);
   }
   out.image = std::move(s.image);
   return out;

@@ -39,6 +39,9 @@ struct DegradedImage {
   std::vector<std::int32_t> segment_origin;  // clean segment of each warped-tree segment
   std::shared_ptr<const BSplineWarp> warp;
   nlohmann::ordered_json seconds;  // time per effect (kept out of `record`)
+  // Set when a distractor effect placed something: its kind per voxel (DistractorKind, 0 elsewhere),
+  // aligned with the image; never a vessel voxel.
+  std::optional<Volume<std::uint8_t>> distractors;
 };
 
 DegradedImage degradeImage(const Profile& profile, const DegradeInput& in);

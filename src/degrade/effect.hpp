@@ -32,7 +32,19 @@ struct DegradeState {
   std::shared_ptr<Volume<float>> warped_fraction;
   std::shared_ptr<VascularTree> warped_tree;
   std::int32_t originalSegment(std::int32_t s) const { return segment_origin.empty() ? s : segment_origin[s]; }
+  // What the distractor effects placed (DistractorKind per voxel), allocated by the first of them;
+  // aligned with `image` (a warp moves it too). Background in every vessel label.
+  Volume<std::uint8_t> distractors;
+  void markDistractor(std::int64_t v, std::uint8_t kind) {
+    if (distractors.data.empty()) distractors = Volume<std::uint8_t>(grid);
+    distractors.data[v] = kind;
+  }
 };
+
+// The values of the distractor label: structures an image shows that are not vessels.
+enum class DistractorKind : std::uint8_t { Blob = 1, Tube = 2, Plate = 3, Bone = 4, Calcification = 5 };
+// Names by value, for the sample record and the docs.
+const char* distractorName(std::uint8_t kind);
 
 struct EffectContext {
   DegradeState& state;
@@ -50,6 +62,7 @@ struct EffectType {
   bool moves_geometry = false;                // a warp: at most one per profile
   bool noise = false;                         // random noise (left out of the visible label's noise-free runs)
   std::uint64_t working_bytes_per_voxel = 0;  // what it holds beside the image while it runs (a k-space)
+  bool places_distractors = false;            // writes the distractor label (one byte per voxel, kept)
 };
 
 // Every effect, in the order the docs list them.

@@ -2,6 +2,7 @@
 // hardening) and an additive background texture (tissue that is not vessel).
 #include <cmath>
 
+#include "degrade/blur.hpp"
 #include "degrade/bspline_field.hpp"
 #include "degrade/effect.hpp"
 
@@ -57,6 +58,36 @@ void applyTexture(const Drawn& p, EffectContext& ctx) {
   });
 }
 
+void applyCompartments(const Drawn& p, EffectContext& ctx) {
+  auto& s = ctx.state;
+  const int count = static_cast<int>(p("count"));
+  // Each compartment owns the voxels where its random field is the largest: smooth, organ-like
+  // regions of about `scale` across. Their levels are drawn once, recorded, and blurred across
+  // the borders by `edge` (tissue boundaries are not sharper than the PSF).
+  std::vector<BSplineField> fields;
+  std::vector<double> level;
+  nlohmann::ordered_json levels = nlohmann::ordered_json::array();
+  for (int c = 0; c < count; ++c) {
+    fields.push_back(randomField(s.grid, p.vec("scale"), ctx.rng));
+    level.push_back(p("contrast") * ctx.rng.normal());
+    levels.push_back(level.back());
+  }
+  ctx.record["levels"] = levels;
+  Volume<float> offset(s.grid);
+  forEachVoxelIjk(s.grid, [&](std::int64_t v, std::int64_t i, std::int64_t j, std::int64_t k) {
+    int best = 0;
+    float top = -INFINITY;
+    for (int c = 0; c < count; ++c) {
+      const float f = fields[c].atVoxel(i, j, k);
+      if (f > top) top = f, best = c;
+    }
+    offset.data[v] = static_cast<float>(level[best]);
+  });
+  const double edge = p("edge");
+  if (edge > 0) gaussianBlur(offset, Vec3(edge, edge, edge));
+  forEachVoxel(s.grid.voxelCount(), [&](std::int64_t v) { s.image.data[v] += (1.0f - s.fraction->data[v]) * offset.data[v]; });
+}
+
 void applyContrast(const Drawn& p, EffectContext& ctx) {
   auto& s = ctx.state;
   const double bg = s.background, c = s.vessel - s.background;
@@ -98,6 +129,19 @@ extern const EffectType kTexture{
      {"octaves", ParamKind::Count, 1, 8, "3", "octaves, each at half the spacing of the previous one"},
      {"persistence", ParamKind::Number, 0, 1, "0.5", "amplitude ratio of successive octaves"}},
     applyTexture};
+
+extern const EffectType kCompartments{
+    "compartments",
+    "organ and tissue compartments: the field of view split into count smooth regions of about scale across (where each one's "
+    "random field is the largest), each adding its own level contrast × N(0, 1) where the vessels leave room",
+    {{"count", ParamKind::Count, 1, 16, "3", "number of compartments"},
+     {"scale", ParamKind::Length3, 1e-9, 1e9, "0.3 fov", "control-point spacing of the fields (the size of a compartment); at least 2 voxels", 2},
+     {"contrast", ParamKind::Intensity, 0, 1e9, nullptr, "standard deviation of the compartments' levels"},
+     {"edge", ParamKind::Length, 0, 1e9, "1 voxel", "Gaussian σ of the borders between compartments", 0, 0.25}},
+    applyCompartments,
+    /*moves_geometry=*/false,
+    /*noise=*/false,
+    /*working_bytes_per_voxel=*/4 + 8};
 
 extern const EffectType kContrast{
     "contrast",

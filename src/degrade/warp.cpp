@@ -186,6 +186,19 @@ Volume<float> warpVolume(const Volume<float>& v, const BSplineWarp& warp) {
   return out;
 }
 
+Volume<std::uint8_t> warpLabelNearest(const Volume<std::uint8_t>& v, const BSplineWarp& warp) {
+  const VolumeGrid& g = v.grid;
+  Volume<std::uint8_t> out(g);
+  forEachVoxelIjk(g, [&](std::int64_t q, std::int64_t i, std::int64_t j, std::int64_t k) {
+    const Vec3 u = warp.displacementAtVoxel(i, j, k);
+    const std::int64_t p[3] = {std::llround(i + u.x / g.spacing_mm.x), std::llround(j + u.y / g.spacing_mm.y),
+                               std::llround(k + u.z / g.spacing_mm.z)};
+    if (p[0] < 0 || p[1] < 0 || p[2] < 0 || p[0] >= g.dims[0] || p[1] >= g.dims[1] || p[2] >= g.dims[2]) return;
+    out.data[q] = v.at(p[0], p[1], p[2]);
+  });
+  return out;
+}
+
 GroundTruthVolumes warpedLabels(const Volume<float>& wf, const VascularTree& wt, const std::vector<std::int32_t>& origin,
                                 const Volume<std::uint32_t>& clean, const BSplineWarp& warp, int centerline_connectivity) {
   const VolumeGrid& g = wf.grid;
@@ -238,6 +251,7 @@ void applyWarp(const Drawn& p, EffectContext& ctx) {
   auto warp = std::make_shared<BSplineWarp>(s.grid, h, m, ctx.rng);
   s.image = warpVolume(s.image, *warp);
   s.warped_fraction = std::make_shared<Volume<float>>(warpVolume(*s.fraction, *warp));
+  if (!s.distractors.data.empty()) s.distractors = warpLabelNearest(s.distractors, *warp);
   const double min_spacing = std::min({s.grid.spacing_mm.x, s.grid.spacing_mm.y, s.grid.spacing_mm.z});
   // Pieces shorter than 1/16 voxel add points, not accuracy: that is the floor.
   const double piece = std::max(min_spacing / 16, std::min({p("piece_length") > 0 ? p("piece_length") : min_spacing, h.x / 8, h.y / 8, h.z / 8}));

@@ -55,6 +55,9 @@ float sampleTrilinear(const Volume<float>& v, const Vec3& index);
 // Resamples a volume through the warp's pull-back (trilinear).
 Volume<float> warpVolume(const Volume<float>& v, const BSplineWarp& warp);
 
+// Resamples a label volume through the warp's pull-back (nearest voxel; 0 outside the grid).
+Volume<std::uint8_t> warpLabelNearest(const Volume<std::uint8_t>& v, const BSplineWarp& warp);
+
 // Labels of the warped image. The mask is the warped partial volume ≥ ½ plus every voxel the
 // warped centrelines cross; centreline and radius are re-derived from the warped tree;
 // instances are taken from the clean instances (the corner of the trilinear stencil with the

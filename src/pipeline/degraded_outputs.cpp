@@ -14,17 +14,19 @@ namespace angiosynth {
 using Json = nlohmann::ordered_json;
 
 std::uint64_t degradedImageBytes(const Profile& p, const VolumeGrid& g) {
-  bool warps = false, fields = false;
+  bool warps = false, fields = false, distractors = false;
   std::uint64_t working = 0;  // effects run one after another: the largest working set counts
   for (const auto& e : p.effects) {
     warps |= e.type->moves_geometry;
     working = std::max(working, e.type->working_bytes_per_voxel);
+    distractors |= e.type->places_distractors;
     fields |= std::string(e.type->name) == "bias" || std::string(e.type->name) == "texture";
   }
   // Float image + a working copy (blur, warp) + the typed image; a warp adds its fraction and
   // labels. B-spline lattices are at least a voxel apart, so a field holds at most about one
-  // coefficient per voxel plus its plane buffer (8 bytes); a warp keeps three.
-  const std::uint64_t per_voxel = 4 + 4 + 4 + (warps ? 4 + 1 + 1 + 4 + 4 + 24 : 0) + (fields ? 16 : 0) + working;
+  // coefficient per voxel plus its plane buffer (8 bytes); a warp keeps three. The distractor
+  // label is a byte per voxel (two while a warp resamples it).
+  const std::uint64_t per_voxel = 4 + 4 + 4 + (warps ? 4 + 1 + 1 + 4 + 4 + 24 : 0) + (fields ? 16 : 0) + working + (distractors ? 2 : 0);
   return per_voxel * static_cast<std::uint64_t>(g.voxelCount());
 }
 
@@ -81,6 +83,10 @@ void writeDegradedImages(const Forest& forest, const std::vector<std::uint8_t>& 
       fillClasses(*d.labels, *d.tree, segment_classes, &d.segment_origin);  // labels: clean segment ids
       for (auto& c : labelChannels(*d.labels, suffix)) channels.push_back(c);
     }
+    // Structures that are not vessels, so that false positives on them can be counted.
+    if (d.distractors && !req.vascusynth)
+      channels.push_back(
+          {"distractors" + suffix, viewOf(*d.distractors, true, "angiosynth distractors: 1 blob, 2 tube, 3 plate, 4 bone, 5 calcification")});
     // The policy's label of this image, where it is not the clean one.
     Label label;
     if (!req.vascusynth && (ip.labels.perProfile() || (ip.labels.writesLabel() && d.labels))) {
