@@ -388,7 +388,7 @@ TEST(Degrade, ShippedProfilesDrawWithinTheirRangesAndFitTheirDtype) {
       for (float v : d.image.data) ASSERT_TRUE(v >= lo && v <= hi) << p.name;
     }
   }
-  EXPECT_EQ(profiles, 6);
+  EXPECT_EQ(profiles, 7);
 }
 
 TEST(Degrade, TheDocsListEveryEffectAsTheCodeDeclaresIt) {

@@ -13,7 +13,7 @@ namespace {
 void applyProjection(const Drawn& p, EffectContext& ctx) {
   auto& s = ctx.state;
   const int axis = static_cast<int>(std::llround(p("axis")));
-  const double tail = p("tail"), length = p("tail_length"), absorption = p("shadow");
+  const double tail = p("tail"), length = p("tail_length"), absorption = p("shadow_length") > 0 ? 1 / p("shadow_length") : 0;
   const auto& d = s.grid.dims;
   const double step = s.grid.spacing_mm[axis];
   const float decay = static_cast<float>(std::exp(-step / length));
@@ -42,11 +42,11 @@ void applyProjection(const Drawn& p, EffectContext& ctx) {
 extern const EffectType kProjection{
     "projection",
     "OCTA projection artefacts along the beam (axis, surface at index 0): each vessel's signal repeats below it as a tail "
-    "tail × contrast × exp(−distance/tail_length) and the tissue below it is darkened by exp(−shadow × vessel path above)",
+    "tail × contrast × exp(−distance/tail_length) and everything below it is darkened by exp(−vessel path above / shadow_length)",
     {{"axis", ParamKind::Count, 0, 2, "2", "the beam's axis: 0 x, 1 y, 2 z (depth grows with the index)"},
      {"tail", ParamKind::Number, 0, 10, "0.3", "the tail's strength just below a vessel, as a share of the vessel's contrast"},
      {"tail_length", ParamKind::Length, 1e-9, 1e12, "5 voxel", "distance over which a tail falls by e"},
-     {"shadow", ParamKind::Number, 0, 1e6, "0", "absorption per mm of vessel crossed above, 1/mm"}},
+     {"shadow_length", ParamKind::Length, 0, 1e12, "0", "vessel path over which the light below falls by e (0: no shadow)"}},
     applyProjection};
 
 }  // namespace angiosynth
