@@ -1,7 +1,12 @@
 // Degradation speed: one Gaussian noise pass on VascuSynth's 101³ grid, and the whole `cta`
 // profile (texture, anisotropic blur, Gaussian noise) on 256³, both on the N = 1000 example tree.
-// Also the domain-randomisation profile with every effect applied (warp included) on 256³.
+// Also the domain-randomisation profile with every effect applied (warp included) on 256³, and
+// each effect alone (its defaults, a value of its kind for what it requires) on 128³ and 256³.
 #include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 
 #include "bench_common.hpp"
 #include "core/memory.hpp"
@@ -86,6 +91,25 @@ void BM_DomainRandomisationAllEffects256(benchmark::State& state) {
   for (auto& e : p.effects) e.probability.reset();
   runProfile(state, p, 256);
 }
+
+// One effect alone: a profile of it and nothing else, read from a file as users write them.
+Profile oneEffect(const EffectType& t) {
+  const auto path = std::filesystem::temp_directory_path() / ("angiosynth_bench_" + std::to_string(::getpid()) + "_" + t.name + ".toml");
+  std::ofstream(path) << "background = 40\nvessel = 300\ndtype = \"float32\"\n" << exampleEffectToml(t);
+  Profile p = readProfileToml(path);
+  std::filesystem::remove(path);
+  return p;
+}
+
+const bool kEachEffect = [] {
+  for (const EffectType* t : effectTypes())
+    for (int size : {128, 256})
+      benchmark::RegisterBenchmark(("BM_Effect/" + std::string(t->name) + "/" + std::to_string(size)).c_str(),
+                                   [t, size](benchmark::State& state) { runProfile(state, oneEffect(*t), size); })
+          ->Unit(benchmark::kMillisecond)
+          ->MinTime(0.5);
+  return true;
+}();
 
 }  // namespace
 

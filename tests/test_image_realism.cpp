@@ -35,11 +35,12 @@ const char* const kLevels = "background = 100\nvessel = 300\ndtype = \"float32\"
 // labelled or changed, and the record names it.
 TEST(Realism, DecoyBlobHasItsVolumeLevelAndOwnLabel) {
   const auto gt = flatTruth(64);
-  const auto d =
-      degradeWith(profileFrom("decoy_blob", std::string(kLevels) +
-                                                "[[effect]]\ntype = \"decoys\"\nblobs = 1\nblob_radius_min = \"6 mm\"\nblob_radius_max = \"6 mm\"\n"
-                                                "intensity_min = 50\nintensity_max = 50\n"),
-                  gt);
+  const auto d = degradeWith(
+      profileFrom("decoy_blob",
+                  std::string(kLevels) +
+                      "[[effect]]\ntype = \"decoys\"\nblobs = 1\ntubes = 0\nplates = 0\nblob_radius_min = \"6 mm\"\nblob_radius_max = \"6 mm\"\n"
+                      "intensity_min = 50\nintensity_max = 50\n"),
+      gt);
   ASSERT_TRUE(d.distractors);
   std::int64_t labelled = 0, other = 0;
   double inside = 0;
@@ -326,43 +327,11 @@ TEST(Realism, PartialFourierBlursAlongItsAxisOnly) {
 // distractor label the same on one thread as on two.
 TEST(Realism, EveryIntensityEffectKeepsTheCleanLabelsOnAnyThreadCount) {
   const fs::path dir = freshTestDir("angiosynth_realism_labels_");
-  // Values for the parameters that have no default.
-  const std::map<std::string, std::string> required{{"gaussian.sigma", "10"},
-                                                    {"rician.sigma", "10"},
-                                                    {"shadow.count", "2"},
-                                                    {"bias.amplitude", "0.2"},
-                                                    {"texture.amplitude", "10"},
-                                                    {"attenuation.length", "40 mm"},
-                                                    {"undersample.factor", "2"},
-                                                    {"compartments.contrast", "20"},
-                                                    {"voronoi.amplitude", "5"},
-                                                    {"inflow.length", "10 mm"},
-                                                    {"slab.thickness", "2 mm"},
-                                                    {"speckle.looks", "8"},
-                                                    {"kspace_spike.kx", "3"},
-                                                    {"kspace_spike.amplitude", "0.01"},
-                                                    {"motion_ghost.amplitude", "0.1"},
-                                                    {"motion_ghost.period", "6"},
-                                                    {"uniform.low", "-5"},
-                                                    {"uniform.high", "5"},
-                                                    {"poisson.photons_per_unit", "1"},
-                                                    {"impulse.salt_probability", "0.001"},
-                                                    {"impulse.pepper_probability", "0.001"},
-                                                    {"blur.sigma", "0.3 mm"}};
   std::string profile = "description = \"every effect\"\nbackground = 100\nvessel = 400\n";
   int effects = 0;
   for (const EffectType* t : effectTypes()) {
     if (t->moves_geometry) continue;
-    profile += "[[effect]]\ntype = \"" + std::string(t->name) + "\"\n";
-    for (const auto& p : t->params) {
-      const auto it = required.find(std::string(t->name) + "." + p.name);
-      if (it != required.end()) {
-        const bool number = it->second.find(' ') == std::string::npos;
-        profile += std::string(p.name) + " = " + (number ? it->second : "\"" + it->second + "\"") + "\n";
-      } else {
-        ASSERT_NE(p.fallback, nullptr) << t->name << "." << p.name << " needs a value in this test";
-      }
-    }
+    profile += exampleEffectToml(*t);
     ++effects;
   }
   EXPECT_GE(effects, 25);

@@ -20,7 +20,7 @@ CLI::App* addGenerate(CLI::App& app, GenerateArgs& a) {
   a.output.add(*c, outputSettings());
   c->add_option("--profile", a.profiles,
                 "degradation profiles, overriding [degrade] profiles: shipped names (clean, vascusynth, cta, tof_mra, "
-                "two_photon, domain_randomisation), .toml profiles, or VascuSynth noise files; one image_<name> each")
+                "two_photon, octa, domain_randomisation), .toml profiles, or VascuSynth noise files; one image_<name> each")
       ->delimiter(',');
   c->add_flag("--no-profiles", a.no_profiles, "write the clean image only, ignoring [degrade] profiles");
   c->add_flag("--force", a.force, "replace an earlier angiosynth output in --out (only the files it wrote there)");

@@ -103,12 +103,27 @@ void applyDecoys(const Drawn& p, EffectContext& ctx) {
     }
     Vec3 lo = curve[0], hi = curve[0];
     for (const Vec3& c : curve) lo = componentMin(lo, c), hi = componentMax(hi, c);
+    // Distances to the curve, piece by piece over each piece's own box: the work grows with the
+    // tube's length, not with its bounding box times its pieces.
+    const double reach = radius + 2 * step;
+    const VoxelBox box = boxAround(g, lo, hi, reach);
+    if (box.hi[0] < box.lo[0] || box.hi[1] < box.lo[1] || box.hi[2] < box.lo[2]) continue;
+    const std::int64_t nx = box.hi[0] - box.lo[0] + 1, ny = box.hi[1] - box.lo[1] + 1;
+    std::vector<float> nearest(std::size_t(nx * ny * (box.hi[2] - box.lo[2] + 1)), INFINITY);
+    const auto slot = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+      return std::size_t((i - box.lo[0]) + nx * ((j - box.lo[1]) + ny * (k - box.lo[2])));
+    };
+    for (int q = 0; q < pieces; ++q)
+      forEachInBox(boxAround(g, curve[q], curve[q + 1], reach), [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+        float& d = nearest[slot(i, j, k)];
+        d = std::min(d, static_cast<float>(pointSegmentDistance(g.centre(i, j, k), curve[q], curve[q + 1])));
+      });
     paintShape(
-        s, boxAround(g, lo, hi, radius + 2 * step),
+        s, box,
         [&](const Vec3& q) {
-          double d = INFINITY;
-          for (int i = 0; i < pieces; ++i) d = std::min(d, pointSegmentDistance(q, curve[i], curve[i + 1]));
-          return d - radius;
+          const std::int64_t i = std::llround((q.x - g.origin_mm.x) / g.spacing_mm.x), j = std::llround((q.y - g.origin_mm.y) / g.spacing_mm.y),
+                             k = std::llround((q.z - g.origin_mm.z) / g.spacing_mm.z);
+          return double(nearest[slot(i, j, k)]) - radius;
         },
         [&](const Vec3&, double) { return value; }, DistractorKind::Tube);
     list.push_back({{"kind", "tube"}, {"start_mm", point(a)}, {"end_mm", point(b)}, {"radius_mm", radius}, {"intensity", value}});
@@ -217,15 +232,15 @@ extern const EffectType kDecoys{
     "decoys",
     "structures that are not vessels, placed uniformly in the field of view: ellipsoidal blobs, gently bent tubes (nerves, lymphatics), "
     "thin plates (membranes, bone edges); each adds its intensity where the vessels leave room; written to the distractor label",
-    {{"blobs", ParamKind::Count, 0, 100000, "0", "number of blobs"},
+    {{"blobs", ParamKind::Count, 0, 100000, "10", "number of blobs"},
      {"blob_radius_min", ParamKind::Length, 0, 1e9, "2 voxel", "least semi-axis of a blob"},
      {"blob_radius_max", ParamKind::Length, 0, 1e9, "6 voxel", "greatest semi-axis of a blob"},
-     {"tubes", ParamKind::Count, 0, 100000, "0", "number of tubes"},
+     {"tubes", ParamKind::Count, 0, 100000, "5", "number of tubes"},
      {"tube_radius_min", ParamKind::Length, 0, 1e9, "0.7 voxel", "least tube radius"},
      {"tube_radius_max", ParamKind::Length, 0, 1e9, "2 voxel", "greatest tube radius"},
      {"tube_length_min", ParamKind::Length, 0, 1e9, "0.2 fov", "least tube length"},
      {"tube_length_max", ParamKind::Length, 0, 1e9, "0.6 fov", "greatest tube length"},
-     {"plates", ParamKind::Count, 0, 100000, "0", "number of plates"},
+     {"plates", ParamKind::Count, 0, 100000, "2", "number of plates"},
      {"plate_thickness_min", ParamKind::Length, 0, 1e9, "1 voxel", "least plate thickness"},
      {"plate_thickness_max", ParamKind::Length, 0, 1e9, "3 voxel", "greatest plate thickness"},
      {"plate_extent_min", ParamKind::Length, 0, 1e9, "0.1 fov", "least side of a plate"},

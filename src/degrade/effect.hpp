@@ -70,6 +70,9 @@ const std::vector<const EffectType*>& effectTypes();
 const EffectType* findEffectType(const std::string& name);
 // Markdown list of every effect with its parameters (`angiosynth effects`, docs/degradation.md).
 std::string effectReference();
+// A profile's [[effect]] block that applies `t` with its defaults and a value of the right kind
+// for each parameter it requires (tests and benchmarks run every effect through it).
+std::string exampleEffectToml(const EffectType& t);
 
 // Applies f(v) to every voxel index in parallel; f must depend on v only (not on scheduling).
 template <class F>

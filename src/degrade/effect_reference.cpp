@@ -1,5 +1,6 @@
 // The reference of every effect and its parameters, generated from the declarations so that
 // `angiosynth effects` and the docs cannot drift from the code.
+#include <algorithm>
 #include <sstream>
 
 #include "degrade/effect.hpp"
@@ -19,7 +20,32 @@ const char* kindName(ParamKind k) {
   return "";
 }
 
+// A value of the parameter's kind within its bounds, for a parameter the effect needs given.
+std::string exampleValue(const ParamDecl& p) {
+  const auto number = [&](double v) {
+    std::ostringstream o;
+    o << std::clamp(v, p.lo, p.hi);
+    return o.str();
+  };
+  switch (p.kind) {
+    case ParamKind::Intensity: return "\"0.1 contrast\"";
+    case ParamKind::Length:
+    case ParamKind::Length3: return "\"2 voxel\"";
+    case ParamKind::Probability: return number(0.01);
+    case ParamKind::Count: return number(2);
+    case ParamKind::Number: return number(1);
+  }
+  return "";
+}
+
 }  // namespace
+
+std::string exampleEffectToml(const EffectType& t) {
+  std::string o = "[[effect]]\ntype = \"" + std::string(t.name) + "\"\n";
+  for (const auto& p : t.params)
+    if (!p.fallback) o += std::string(p.name) + " = " + exampleValue(p) + "\n";
+  return o;
+}
 
 std::string effectReference() {
   std::ostringstream o;

@@ -1,60 +1,79 @@
 // Cell-like tissue texture: a Voronoi tessellation of jittered seed points (Worley 1996), each cell
 // its own intensity and the walls between cells brighter or darker, as parenchyma, fat lobules
 // or cells in microscopy look. Anisotropic cell sizes give fibre-like cells.
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "degrade/effect.hpp"
 
 namespace angiosynth {
 namespace {
 
-// One seed per lattice cell at a random position in it: a pure function of the cell, so any
-// thread computes the same tessellation.
+// One seed per lattice cell at a random position in it, and the cell's level: pure functions of
+// the cell, so any thread computes the same tessellation. Tabulated over the lattice cells the grid
+// can reach (its own and one ring around them).
 struct SeedLattice {
-  CounterStream stream;
-  std::uint64_t index(std::int64_t a, std::int64_t b, std::int64_t c) const {
-    return mix64(std::uint64_t(a) * 0x9E3779B97F4A7C15ULL ^ std::uint64_t(b) * 0xC2B2AE3D27D4EB4FULL ^ std::uint64_t(c) * 0x165667B19E3779F9ULL);
+  std::int64_t lo[3], n[3];
+  std::vector<Vec3> seed;  // lattice units
+  std::vector<float> level;
+  SeedLattice(const VolumeGrid& g, const Vec3& cell, std::uint64_t key) {
+    const CounterStream stream{key};
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = -2;
+      n[a] = std::int64_t(std::ceil(g.dims[a] * g.spacing_mm[a] / cell[a])) + 4;
+    }
+    seed.resize(std::size_t(n[0] * n[1] * n[2]));
+    level.resize(seed.size());
+    for (std::int64_t c = 0; c < n[2]; ++c)
+      for (std::int64_t b = 0; b < n[1]; ++b)
+        for (std::int64_t a = 0; a < n[0]; ++a) {
+          const std::size_t i = std::size_t(a + n[0] * (b + n[1] * c));
+          const std::uint64_t draw = 4 * i;
+          seed[i] = Vec3(double(a + lo[0]) + stream.uniform(draw), double(b + lo[1]) + stream.uniform(draw + 1),
+                         double(c + lo[2]) + stream.uniform(draw + 2));
+          double x, y;
+          stream.normalPair(2 * i + 1 + 2 * seed.size(), x, y);
+          level[i] = static_cast<float>(x);
+        }
   }
-  Vec3 seed(std::int64_t a, std::int64_t b, std::int64_t c) const {
-    const std::uint64_t n = index(a, b, c) * 4;
-    return Vec3(a + stream.uniform(n), b + stream.uniform(n + 1), c + stream.uniform(n + 2));
-  }
-  double value(std::int64_t a, std::int64_t b, std::int64_t c) const {
-    double x, y;
-    stream.normalPair(index(a, b, c) * 2 + 1, x, y);
-    return x;
+  std::size_t index(std::int64_t a, std::int64_t b, std::int64_t c) const {
+    return std::size_t((a - lo[0]) + n[0] * ((b - lo[1]) + n[1] * (c - lo[2])));
   }
 };
 
 void applyVoronoi(const Drawn& p, EffectContext& ctx) {
   auto& s = ctx.state;
-  const SeedLattice lattice{CounterStream{ctx.rng.nextU64()}};
   const Vec3 cell = p.vec("cell_size");
+  const SeedLattice lattice(s.grid, cell, ctx.rng.nextU64());
   const double amplitude = p("amplitude"), wall = p("wall"), half_wall = p("wall_thickness") / 2, mean = p("mean");
   const double h = (s.grid.spacing_mm.x + s.grid.spacing_mm.y + s.grid.spacing_mm.z) / 3;
+  // Voxel centres relative to the grid's corner (voxel 0's outer face), in lattice units.
+  const Vec3 corner = s.grid.origin_mm - s.grid.spacing_mm * 0.5;
   forEachVoxelIjk(s.grid, [&](std::int64_t v, std::int64_t i, std::int64_t j, std::int64_t k) {
-    const Vec3 x = s.grid.centre(i, j, k) - s.grid.origin_mm;
-    const Vec3 u(x.x / cell.x, x.y / cell.y, x.z / cell.z);  // in lattice units
+    const Vec3 x = s.grid.centre(i, j, k) - corner;
+    const Vec3 u(x.x / cell.x, x.y / cell.y, x.z / cell.z);
     const std::int64_t a0 = std::int64_t(std::floor(u.x)), b0 = std::int64_t(std::floor(u.y)), c0 = std::int64_t(std::floor(u.z));
     double d1 = INFINITY, d2 = INFINITY;
-    Vec3 s1, s2;
-    std::int64_t n1[3] = {0, 0, 0};
+    std::size_t n1 = 0, n2 = 0;
     for (std::int64_t c = c0 - 1; c <= c0 + 1; ++c)
       for (std::int64_t b = b0 - 1; b <= b0 + 1; ++b)
         for (std::int64_t a = a0 - 1; a <= a0 + 1; ++a) {
-          const Vec3 q = lattice.seed(a, b, c);
-          const Vec3 r((q.x - u.x) * cell.x, (q.y - u.y) * cell.y, (q.z - u.z) * cell.z);  // mm
-          const double d = dot(r, r);
+          const std::size_t q = lattice.index(a, b, c);
+          const Vec3& sq = lattice.seed[q];
+          const double rx = (sq.x - u.x) * cell.x, ry = (sq.y - u.y) * cell.y, rz = (sq.z - u.z) * cell.z;  // mm
+          const double d = rx * rx + ry * ry + rz * rz;
           if (d < d1) {
-            d2 = d1, s2 = s1;
-            d1 = d, s1 = q, n1[0] = a, n1[1] = b, n1[2] = c;
+            d2 = d1, n2 = n1;
+            d1 = d, n1 = q;
           } else if (d < d2) {
-            d2 = d, s2 = q;
+            d2 = d, n2 = q;
           }
         }
-    double t = mean + amplitude * lattice.value(n1[0], n1[1], n1[2]);
-    if (wall != 0 && std::isfinite(d2)) {
+    double t = mean + amplitude * lattice.level[n1];
+    if (wall != 0) {
       // Distance to the wall between the two nearest cells: the bisector plane of their seeds.
+      const Vec3 &s1 = lattice.seed[n1], &s2 = lattice.seed[n2];
       const Vec3 gap((s2.x - s1.x) * cell.x, (s2.y - s1.y) * cell.y, (s2.z - s1.z) * cell.z);
       const double to_wall = (d2 - d1) / (2 * std::max(norm(gap), 1e-12));
       t += wall * std::clamp(0.5 - (to_wall - half_wall) / h, 0.0, 1.0);
