@@ -216,8 +216,10 @@ TEST_F(Cli, ProfilesGiveOneDegradedImageEachWithWarpedLabelsAndTheSameBytesForAn
   const Json j = Json::parse(slurp(dir_ / "one/sample.json"));
   EXPECT_EQ(j["files"]["image_cta"], "image_cta.nii.gz");
   EXPECT_EQ(j["degradation"]["cta"]["dtype"], "int16");
-  EXPECT_EQ(j["degradation"]["cta"]["effects"].size(), 3u);
-  const double sigma = j["degradation"]["cta"]["effects"][2]["parameters"]["sigma"];
+  const auto& cta_effects = j["degradation"]["cta"]["effects"];
+  ASSERT_EQ(cta_effects.size(), 6u);
+  ASSERT_EQ(cta_effects[5]["type"], "gaussian");
+  const double sigma = cta_effects[5]["parameters"]["sigma"];
   EXPECT_TRUE(sigma >= 10 && sigma <= 25) << sigma;
   EXPECT_GT(j["degradation"]["warpy"]["effects"][0]["min_jacobian_determinant"].get<double>(), 0);
   // The clean outputs are untouched by the profiles.

@@ -322,6 +322,26 @@ TEST(Realism, PartialFourierBlursAlongItsAxisOnly) {
   EXPECT_GT(std::fabs(d.image.at(5, 15, 5) - 100) + std::fabs(d.image.at(5, 17, 5) - 100), 0.1 * 200);
 }
 
+// Texture on the vessels too (vesselFM's foreground texture): with vessel_share 1 a grid full of
+// vessel takes exactly the field an empty grid takes; with 0 (the default), none of it.
+TEST(Realism, TextureReachesTheVesselsByItsVesselShare) {
+  const auto empty = flatTruth(32);
+  auto full = flatTruth(32);
+  std::fill(full.fraction.data.begin(), full.fraction.data.end(), 1.0f);
+  const auto textured = [](const char* share) {
+    return profileFrom(std::string("texture_share_") + share,
+                       std::string(kLevels) + "[[effect]]\ntype = \"texture\"\namplitude = 20\nvessel_share = " + share + "\n");
+  };
+  const auto tissue = degradeWith(textured("1"), empty), vessel = degradeWith(textured("1"), full), plain = degradeWith(textured("0"), full);
+  double spread = 0;
+  for (std::size_t v = 0; v < tissue.image.data.size(); ++v) {
+    ASSERT_NEAR(vessel.image.data[v] - 300, tissue.image.data[v] - 100, 1e-3);
+    ASSERT_EQ(plain.image.data[v], 300.0f);
+    spread = std::max(spread, std::fabs(double(tissue.image.data[v]) - 100));
+  }
+  EXPECT_GT(spread, 20);
+}
+
 // Every effect that leaves geometry alone, all in one profile through `generate`: mask,
 // centreline, radius, instances and classes are the clean run's bytes, and the image and the
 // distractor label the same on one thread as on two.

@@ -20,7 +20,11 @@ using Json = nlohmann::ordered_json;
 
 // A random orthonormal frame: e[2] uniform on the sphere.
 std::array<Vec3, 3> randomFrame(Rng& rng) {
-  Vec3 n(rng.normal(), rng.normal(), rng.normal());
+  // One draw per statement: the order of a call's arguments is unspecified.
+  const double x = rng.normal();
+  const double y = rng.normal();
+  const double z = rng.normal();
+  Vec3 n(x, y, z);
   n = n / std::max(norm(n), 1e-12);
   const Vec3 helper = std::fabs(n.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
   Vec3 u = cross(helper, n);
@@ -72,8 +76,9 @@ void applyDecoys(const Drawn& p, EffectContext& ctx) {
   for (int n = 0; n < int(p("blobs")); ++n) {
     const Vec3 c = uniformInGrid(g, ctx.rng);
     const auto e = randomFrame(ctx.rng);
-    const Vec3 a(drawBetween(ctx.rng, p("blob_radius_min"), p("blob_radius_max")), drawBetween(ctx.rng, p("blob_radius_min"), p("blob_radius_max")),
-                 drawBetween(ctx.rng, p("blob_radius_min"), p("blob_radius_max")));
+    double semi[3];
+    for (double& r : semi) r = drawBetween(ctx.rng, p("blob_radius_min"), p("blob_radius_max"));
+    const Vec3 a(semi[0], semi[1], semi[2]);
     const double value = intensity(), amin = std::min({a.x, a.y, a.z}), amax = std::max({a.x, a.y, a.z});
     // Scaled-sphere distance: exact on the surface, within the axis ratio elsewhere.
     paintShape(
@@ -250,7 +255,7 @@ extern const EffectType kDecoys{
     applyDecoys,
     /*moves_geometry=*/false,
     /*noise=*/false,
-    /*working_bytes_per_voxel=*/0,
+    /*working_bytes_per_voxel=*/4,  // a tube's distances over its box, at most the grid
     /*places_distractors=*/true};
 
 extern const EffectType kBone{

@@ -49,12 +49,13 @@ void applyTexture(const Drawn& p, EffectContext& ctx) {
   ctx.record["octaves_used"] = fields.size();
   if (fields.empty()) return;
   for (auto& w : weight) w = static_cast<float>(w * p("amplitude") / std::sqrt(norm));
-  const float mean = static_cast<float>(p("mean"));
-  // Tissue fills what the vessels leave of each voxel.
+  const float mean = static_cast<float>(p("mean")), inside = static_cast<float>(p("vessel_share"));
+  // Tissue fills what the vessels leave of each voxel; vessel_share of it textures the vessels too.
   forEachVoxelIjk(s.grid, [&](std::int64_t v, std::int64_t i, std::int64_t j, std::int64_t k) {
     float t = mean;
     for (std::size_t o = 0; o < fields.size(); ++o) t += weight[o] * fields[o].atVoxel(i, j, k);
-    s.image.data[v] += (1.0f - s.fraction->data[v]) * t;
+    const float f = s.fraction->data[v];
+    s.image.data[v] += (1.0f - f + inside * f) * t;
   });
 }
 
@@ -127,7 +128,9 @@ extern const EffectType kTexture{
      {"mean", ParamKind::Intensity, -1e9, 1e9, "0", "added to the background before the texture"},
      {"scale", ParamKind::Length3, 1e-9, 1e9, "0.125 fov", "control-point spacing of the coarsest octave; at least 1 voxel", 1},
      {"octaves", ParamKind::Count, 1, 8, "3", "octaves, each at half the spacing of the previous one"},
-     {"persistence", ParamKind::Number, 0, 1, "0.5", "amplitude ratio of successive octaves"}},
+     {"persistence", ParamKind::Number, 0, 1, "0.5", "amplitude ratio of successive octaves"},
+     {"vessel_share", ParamKind::Probability, 0, 1, "0",
+      "share of the texture the vessels take too (vesselFM's foreground texture; 0: tissue only)"}},
     applyTexture};
 
 extern const EffectType kCompartments{

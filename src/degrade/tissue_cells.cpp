@@ -30,8 +30,10 @@ struct SeedLattice {
         for (std::int64_t a = 0; a < n[0]; ++a) {
           const std::size_t i = std::size_t(a + n[0] * (b + n[1] * c));
           const std::uint64_t draw = 4 * i;
-          seed[i] = Vec3(double(a + lo[0]) + stream.uniform(draw), double(b + lo[1]) + stream.uniform(draw + 1),
-                         double(c + lo[2]) + stream.uniform(draw + 2));
+          const double u = stream.uniform(draw);
+          const double v = stream.uniform(draw + 1);
+          const double w = stream.uniform(draw + 2);
+          seed[i] = Vec3(double(a + lo[0]) + u, double(b + lo[1]) + v, double(c + lo[2]) + w);
           double x, y;
           stream.normalPair(2 * i + 1 + 2 * seed.size(), x, y);
           level[i] = static_cast<float>(x);
@@ -94,6 +96,10 @@ extern const EffectType kVoronoi{
      {"mean", ParamKind::Intensity, -1e9, 1e9, "0", "added to the background before the cells"},
      {"wall", ParamKind::Intensity, -1e9, 1e9, "0", "intensity the walls between cells add (negative: darker walls)"},
      {"wall_thickness", ParamKind::Length, 0, 1e9, "1 voxel", "thickness of the walls"}},
-    applyVoronoi};
+    applyVoronoi,
+    /*moves_geometry=*/false,
+    /*noise=*/false,
+    // The seed table: 28 bytes per lattice cell, a cell at least 2 voxels on each axis.
+    /*working_bytes_per_voxel=*/4};
 
 }  // namespace angiosynth
