@@ -11,6 +11,7 @@
 #include "config/scenario.hpp"
 #include "setting_flags.hpp"
 #include "score/case_scores.hpp"
+#include "segment/segment.hpp"
 
 namespace angiosynth::cli {
 
@@ -63,6 +64,16 @@ struct DatasetArgs {
 };
 CLI::App* addDataset(CLI::App& app, DatasetArgs& a);
 int runDatasetCommand(const DatasetArgs& a, const std::string& command_line);
+
+struct SegmentArgs {
+  std::string image, out, response;
+  SegmentOptions options;
+  bool dark = false, force = false;
+  std::optional<double> threshold;
+  CommonOptions common;
+};
+CLI::App* addSegment(CLI::App& app, SegmentArgs& a);
+int runSegment(SegmentArgs a);
 
 struct ScoreArgs {
   std::string prediction, truth, out, csv, class_csv;

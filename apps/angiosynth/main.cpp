@@ -31,6 +31,8 @@ int main(int argc, char** argv) {
   auto* in = cli::addInit(app, ia);
   cli::ScoreArgs sa;
   auto* sc = cli::addScore(app, sa);
+  cli::SegmentArgs sg;
+  auto* se = cli::addSegment(app, sg);
   cli::MeshArgs ma;
   auto* me = cli::addMesh(app, ma);
   cli::PlotCalibreArgs pc;
@@ -50,6 +52,7 @@ int main(int argc, char** argv) {
     if (in->parsed()) return cli::runInit(ia);
     if (sc->parsed()) return cli::runScore(sa);
     if (pl->parsed()) return cli::runPlotCalibre(pc);
+    if (se->parsed()) return cli::runSegment(sg);
     if (me->parsed()) return cli::runMesh(ma, cmdline);
     if (fx->parsed()) {
       std::cout << effectReference();

@@ -5,6 +5,7 @@
 // - NRRD is written in LPS (its usual space), so x and y axes and origin are negated there:
 //   the same physical geometry in every viewer.
 // Every writer throws InputError(path, 0, …) when the file cannot be written.
+#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -58,6 +59,9 @@ std::size_t voxelBytes(VoxelType t);
 
 // NIfTI-1, gzip-compressed (.nii.gz): sform = qform, code 1 (scanner), mm units.
 void writeNifti(const std::filesystem::path& file, const VolumeView& v);
+// The same whole or not at all (files/atomic_file), with the voxel-to-world `affine` (rows; from
+// another file, e.g. the image a mask was made from) instead of the grid's when given.
+void writeNiftiAtomically(const std::filesystem::path& file, const VolumeView& v, const std::array<double, 12>* affine, bool replace);
 // NRRD with gzip encoding, space left-posterior-superior.
 void writeNrrd(const std::filesystem::path& file, const VolumeView& v);
 // MetaImage (.mha), zlib-compressed, in ITK's LPS space.
