@@ -97,7 +97,8 @@ TEST(Segment, OtsuSplitsTwoGroups) {
 // (float image, bright ridges, the border voxel repeated: mode "nearest"): Pearson correlation
 // ≥ 0.9999 (the same arithmetic in single precision; with scikit-image's default "reflect"
 // borders 0.980 and 0.989, the interior alike); Otsu's mask as scikit-image's threshold_otsu
-// gives it; and the mask on the image's grid, as score's grid check and nibabel see it.
+// gives it; the mask on the image's grid, as score's grid check and nibabel see it; and score's
+// false positives on the distractor label as NumPy counts them.
 TEST(Segment, ResponsesAgreeWithScikitImageOnAShippedExample) {
   const fs::path dir = freshTestDir("angiosynth_segment_");
   const fs::path src = test::sourceDir();
@@ -133,9 +134,23 @@ print('same grid', np.allclose(mask.affine, img.affine, atol=1e-5))
   ASSERT_NE(agree, std::string::npos) << out;
   EXPECT_GT(std::stod(out.substr(agree + 11)), 0.999) << out;
   EXPECT_NE(out.find("same grid True"), std::string::npos) << out;
-  // score reads it on the sample's grid.
-  const auto scored = run("score frangi.nii.gz s --out scores.json", dir);
-  EXPECT_EQ(scored.code, 0) << scored.err;
+  // score reads it on the sample's grid, and counts its false positives on the CTA image's bone
+  // and plaque (the distractor label) as NumPy does.
+  const auto scored = run("score otsu.nii.gz s --out scores.json", dir);
+  ASSERT_EQ(scored.code, 0) << scored.err;
+  const std::string counted = debianPython(R"(
+import json, nibabel as nib, numpy as np
+p = np.asanyarray(nib.load('otsu.nii.gz').dataobj) > 0
+t = np.asanyarray(nib.load('s/mask.nii.gz').dataobj) > 0
+d = np.asanyarray(nib.load('s/distractors_cta.nii.gz').dataobj)
+block = json.load(open('scores.json'))['distractors']
+on = (d > 0) & ~t
+print('share', abs(block['share_called_vessel'] - (p & on).sum() / on.sum()) < 1e-12)
+print('of false positives', abs(block['share_of_false_positives'] - (p & on).sum() / (p & ~t).sum()) < 1e-12)
+)",
+                                           dir);
+  EXPECT_NE(counted.find("share True"), std::string::npos) << counted;
+  EXPECT_NE(counted.find("of false positives True"), std::string::npos) << counted;
   // A bad method is refused before anything is written.
   const auto bad = run("segment s/image_cta.nii.gz --method watershed --out bad.nii.gz", dir);
   EXPECT_EQ(bad.code, 2);

@@ -34,11 +34,6 @@ void dtypeRange(const std::string& dtype, double& lo, double& hi) {
     lo = -32768, hi = 32767;
 }
 
-const char* distractorName(std::uint8_t kind) {
-  static const char* const names[] = {"none", "blob", "tube", "plate", "bone", "calcification"};
-  return kind < 6 ? names[kind] : "unknown";
-}
-
 DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
   DegradedImage out;
   out.profile = profile.name;
@@ -111,13 +106,13 @@ DegradedImage degradeImage(const Profile& profile, const DegradeInput& in) {
   if (!s.distractors.data.empty()) {
     // A vessel the image shows stays a vessel: a distractor voxel is one the vessel label leaves out.
     const Volume<std::uint8_t>& mask = out.labels ? out.labels->mask : in.truth->mask;
-    std::int64_t count[6] = {0, 0, 0, 0, 0, 0};
+    std::int64_t count[kDistractorKinds + 1] = {};
     for (std::int64_t v = 0; v < s.grid.voxelCount(); ++v) {
       if (mask.data[v]) s.distractors.data[v] = 0;
-      ++count[std::min<int>(s.distractors.data[v], 5)];
+      ++count[std::min<int>(s.distractors.data[v], kDistractorKinds)];
     }
     Json voxels;
-    for (int k = 1; k <= 5; ++k)
+    for (int k = 1; k <= kDistractorKinds; ++k)
       if (count[k]) voxels[distractorName(std::uint8_t(k))] = count[k];
     rec["distractor_voxels"] = voxels;
     out.distractors = std::move(s.distractors);

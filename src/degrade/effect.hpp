@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/distractor_kind.hpp"
 #include "core/rng.hpp"
 #include "core/vascular_tree.hpp"
 #include "degrade/effect_params.hpp"
@@ -40,11 +41,6 @@ struct DegradeState {
     distractors.data[v] = kind;
   }
 };
-
-// The values of the distractor label: structures an image shows that are not vessels.
-enum class DistractorKind : std::uint8_t { Blob = 1, Tube = 2, Plate = 3, Bone = 4, Calcification = 5 };
-// Names by value, for the sample record and the docs.
-const char* distractorName(std::uint8_t kind);
 
 struct EffectContext {
   DegradeState& state;

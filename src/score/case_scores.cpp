@@ -205,6 +205,14 @@ TruthFiles sampleTruth(const std::filesystem::path& dir) {
     t.classes = dir / "classes.nii.gz";
     t.legend = classLegend(dir / "sample.json");
   }
+  // The distractor label of the sample's one degraded image that has one (with several, which
+  // image was segmented is not known: none).
+  std::vector<std::filesystem::path> distractors;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("distractors_", 0) == 0 && name.size() > 7 && name.substr(name.size() - 7) == ".nii.gz") distractors.push_back(e.path());
+  }
+  if (distractors.size() == 1) t.distractors = distractors.front();
   return t;
 }
 

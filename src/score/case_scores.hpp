@@ -52,6 +52,7 @@ struct TruthFiles {
   std::filesystem::path centerline, radius;  // the exact centreline and the radius along it
   std::filesystem::path edges, keypoints;    // the generating graph (nodes.csv beside edges) and its key points
   std::filesystem::path classes;             // the kind of each vessel voxel, when not the mask's own values
+  std::filesystem::path distractors;         // what the scored image shows that is not vessel (a degraded image's distractor label)
   std::map<int, std::string> legend;         // names of the class values (1 artery, 2 vein, …)
   std::optional<int> ignore_value;           // voxels of this value in `mask` count neither way (nnU-Net's ignore label)
   std::string name;                          // how the output names the truth (a file or directory)

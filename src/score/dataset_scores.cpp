@@ -101,6 +101,10 @@ TruthFiles datasetCaseTruth(const fs::path& ds, const std::string& id, DatasetTr
     if (!fs::is_regular_file(*f)) throw InputError(f->string(), 0, "missing: the dataset is incomplete (run `angiosynth dataset verify`)");
   if (fs::is_regular_file(file("edges", ".csv")) && fs::is_regular_file(file("nodes", ".csv"))) t.edges = file("edges", ".csv");
   if (fs::is_regular_file(file("keypoints", ".csv"))) t.keypoints = file("keypoints", ".csv");
+  // The distractor label of the case's image (its profile's).
+  if (sample.contains("degradation") && sample["degradation"].is_object())
+    for (const auto& [name, rec] : sample["degradation"].items())
+      if (fs::is_regular_file(g / ("distractors_" + name + ".nii.gz"))) t.distractors = g / ("distractors_" + name + ".nii.gz");
   // Kinds: the classes volume where the case keeps it, else labelsTr when it holds the classes.
   if (fs::is_regular_file(file("classes", ".nii.gz")))
     t.classes = file("classes", ".nii.gz");

@@ -6,7 +6,7 @@
 namespace angiosynth {
 
 extern const ScoreMetric kOverlapMetric, kSurfaceMetric, kCentrelineMetric, kVesselsMetric, kClDiceMetric, kTopologyMetric, kKeyPointsMetric,
-    kCalibreMetric, kCalibreMmMetric, kPerClassMetric, kBoundaryIoUMetric, kLabelSchemeMetric;
+    kCalibreMetric, kCalibreMmMetric, kPerClassMetric, kBoundaryIoUMetric, kLabelSchemeMetric, kDistractorsMetric;
 
 // clang-format off
 const std::vector<const ScoreMetric*>& scoreMetrics() {
@@ -14,7 +14,8 @@ const std::vector<const ScoreMetric*>& scoreMetrics() {
   // behind boundary_iou when it gained its class-average columns).
   static const std::vector<const ScoreMetric*> all{&kOverlapMetric,   &kSurfaceMetric, &kCentrelineMetric, &kVesselsMetric,
                                                    &kClDiceMetric,    &kTopologyMetric, &kKeyPointsMetric, &kCalibreMetric,
-                                                   &kCalibreMmMetric, &kBoundaryIoUMetric, &kPerClassMetric, &kLabelSchemeMetric};
+                                                   &kCalibreMmMetric, &kBoundaryIoUMetric, &kPerClassMetric, &kLabelSchemeMetric,
+                                                   &kDistractorsMetric};
   return all;
 }
 // clang-format on
