@@ -28,16 +28,40 @@ std::array<double, 3> eigenvaluesByMagnitude(double a, double b, double c, doubl
     // B = (A − qI) / p; r = det(B) / 2
     const double ba = (a - q) / p, bb = (b - q) / p, bc = (c - q) / p, bd = d / p, be = e / p, bf = f / p;
     const double r = (ba * (bb * bc - bf * bf) - bd * (bd * bc - bf * be) + be * (bd * bf - bb * be)) / 2;
-    const double phi = r <= -1 ? M_PI / 3 : r >= 1 ? 0 : std::acos(r) / 3;
-    l[0] = q + 2 * p * std::cos(phi);
-    l[2] = q + 2 * p * std::cos(phi + 2 * M_PI / 3);
+    // The angle in single precision (relative error ~1e-7 of p, far below the responses' use);
+    // cos(φ + 2π/3) from cos φ and sin φ: one cosine instead of two.
+    const float phi = r <= -1 ? float(M_PI / 3) : r >= 1 ? 0.0f : std::acos(float(r)) / 3;
+    const double c = std::cos(phi), s = std::sqrt(std::max(0.0, 1 - c * c));
+    l[0] = q + 2 * p * c;
+    l[2] = q + 2 * p * (-0.5 * c - 0.8660254037844386 * s);
     l[1] = 3 * q - l[0] - l[2];
   }
-  std::sort(l.begin(), l.end(), [](double x, double y) { return std::fabs(x) < std::fabs(y); });
+  // Three compare-exchanges by magnitude.
+  const auto order = [&](int x, int y) {
+    if (std::fabs(l[y]) < std::fabs(l[x])) std::swap(l[x], l[y]);
+  };
+  order(0, 1), order(1, 2), order(0, 1);
   return l;
 }
 
 double divideNonzero(double x, double y) { return x / (y == 0 ? 1e-10 : y); }
+
+// How many eigenvalues of the symmetric matrix are positive: the sign changes of its
+// characteristic polynomial's coefficients (Descartes' rule, exact when every root is real).
+int positiveEigenvalues(double a, double b, double c, double d, double e, double f) {
+  const double trace = a + b + c;
+  const double minors = a * b - d * d + a * c - e * e + b * c - f * f;
+  const double det = a * (b * c - f * f) - d * (d * c - f * e) + e * (d * f - b * e);
+  const double coef[4] = {1, -trace, minors, -det};
+  int changes = 0;
+  double last = 1;
+  for (double x : coef) {
+    if (x == 0) continue;
+    changes += (x > 0) != (last > 0);
+    last = x;
+  }
+  return changes;
+}
 
 // The response of one scale from the scale-normalised Hessian's eigenvalues of the image in
 // which vessels are bright, sorted by magnitude. `largest` is Jerman's max of −λ3 over the volume.
@@ -71,13 +95,18 @@ double jerman(const std::array<double, 3>& l, const SegmentOptions& o, double, d
 struct MethodEntry {
   SegmentMethod describe;
   Measure measure;  // null: a threshold on the image
+  // The measure is 0 wherever the Hessian has at least this many positive eigenvalues (4: never
+  // known in advance).
+  int zero_with_positives = 4;
 };
 
 const std::vector<MethodEntry>& registry() {
   static const std::vector<MethodEntry> all{
       {{"otsu", "the image at or above Otsu's threshold (256-bin histogram; Otsu 1979)"}, nullptr},
-      {{"frangi", "Frangi et al. (1998) vesselness, scale-normalised Hessian, max over scales, as scikit-image's frangi"}, frangi},
-      {{"sato", "Sato et al. (1998) tubeness sqrt(|λ1 λ2|) of the two most negative eigenvalues, max over scales, as scikit-image's sato"}, sato},
+      // Frangi: the two largest eigenvalues negative, impossible with two positive ones.
+      {{"frangi", "Frangi et al. (1998) vesselness, scale-normalised Hessian, max over scales, as scikit-image's frangi"}, frangi, 2},
+      // Sato: the smallest eigenvalue negative, impossible with three positive ones.
+      {{"sato", "Sato et al. (1998) tubeness sqrt(|λ1 λ2|) of the two most negative eigenvalues, max over scales, as scikit-image's sato"}, sato, 3},
       {{"jerman", "Jerman et al. (2016) vesselness with the largest eigenvalue regularised by τ, max over scales"}, jerman}};
   return all;
 }
@@ -90,24 +119,31 @@ const MethodEntry& find(const std::string& name) {
   throw std::invalid_argument("unknown segmentation method \"" + name + "\"; allowed: " + allowed);
 }
 
-// Central differences along an axis in mm, one-sided at the two ends (NumPy's gradient).
+// Central differences along an axis in mm, one-sided at the two ends (NumPy's gradient), a row
+// of x at a time.
 void gradient(const Volume<float>& in, int axis, Volume<float>& out) {
   const VolumeGrid& g = in.grid;
-  const std::int64_t n = g.dims[axis];
-  const std::int64_t stride = axis == 0 ? 1 : axis == 1 ? g.dims[0] : std::int64_t(g.dims[0]) * g.dims[1];
-  const double h = g.spacing_mm[axis];
-  forEachVoxelIjk(g, [&](std::int64_t v, std::int64_t i, std::int64_t j, std::int64_t k) {
-    const std::int64_t idx[3] = {i, j, k};
-    const std::int64_t x = idx[axis];
+  const std::int64_t nx = g.dims[0], ny = g.dims[1], n = g.dims[axis];
+  const std::int64_t stride = axis == 0 ? 1 : axis == 1 ? nx : nx * ny;
+  const float inv = float(1 / g.spacing_mm[axis]), half = 0.5f * inv;
+  tbb::parallel_for(std::int64_t(0), ny * g.dims[2], [&](std::int64_t row) {
+    const float* a = in.data.data() + row * nx;
+    float* o = out.data.data() + row * nx;
     if (n == 1) {
-      out.data[v] = 0;
-    } else if (x == 0) {
-      out.data[v] = static_cast<float>((in.data[v + stride] - in.data[v]) / h);
-    } else if (x == n - 1) {
-      out.data[v] = static_cast<float>((in.data[v] - in.data[v - stride]) / h);
-    } else {
-      out.data[v] = static_cast<float>((in.data[v + stride] - in.data[v - stride]) / (2 * h));
+      std::fill(o, o + nx, 0.0f);
+      return;
     }
+    if (axis == 0) {
+      o[0] = (a[1] - a[0]) * inv;
+      for (std::int64_t i = 1; i + 1 < nx; ++i) o[i] = (a[i + 1] - a[i - 1]) * half;
+      o[nx - 1] = (a[nx - 1] - a[nx - 2]) * inv;
+      return;
+    }
+    const std::int64_t pos = axis == 1 ? row % ny : row / ny;
+    const float* lo = pos == 0 ? a : a - stride;
+    const float* hi = pos == n - 1 ? a : a + stride;
+    const float scale = (pos == 0 || pos == n - 1) ? inv : half;
+    for (std::int64_t i = 0; i < nx; ++i) o[i] = (hi[i] - lo[i]) * scale;
   });
 }
 
@@ -186,22 +222,36 @@ Volume<std::uint8_t> segment(const Volume<float>& image, const SegmentOptions& o
       blurred = image;
       if (!o.bright)
         for (float& v : blurred.data) v = -v;
-      gaussianBlur(blurred, Vec3(sigma, sigma, sigma));
+      gaussianBlur(blurred, Vec3(sigma, sigma, sigma), 4, &gx);  // gx is free until the gradients
       gradient(blurred, 0, gx), gradient(blurred, 1, gy), gradient(blurred, 2, gz);
       // The Hessian of each voxel from the gradients' gradients, normalised by σ² (Lindeberg).
-      const auto hessian = [&](std::int64_t v, std::int64_t i, std::int64_t j, std::int64_t k) {
+      // The σ²-normalised Hessian of each voxel from the gradients' gradients (xx, yy, zz, xy, xz,
+      // yz): central differences inside, one-sided on the faces, as NumPy's gradient.
+      const std::int64_t sx = 1, sy = g.dims[0], sz = std::int64_t(g.dims[0]) * g.dims[1];
+      const double s2 = sigma * sigma, ih[3] = {1 / g.spacing_mm.x, 1 / g.spacing_mm.y, 1 / g.spacing_mm.z};
+      const auto entries = [&](std::int64_t v, std::int64_t i, std::int64_t j, std::int64_t k) {
+        const bool inside = i > 0 && j > 0 && k > 0 && i + 1 < g.dims[0] && j + 1 < g.dims[1] && k + 1 < g.dims[2];
+        if (inside) {
+          const auto c = [&](const Volume<float>& f, std::int64_t stride, int axis) {
+            return (double(f.data[v + stride]) - f.data[v - stride]) * 0.5 * ih[axis];
+          };
+          return std::array<double, 6>{s2 * c(gx, sx, 0), s2 * c(gy, sy, 1), s2 * c(gz, sz, 2),
+                                       s2 * c(gx, sy, 1), s2 * c(gx, sz, 2), s2 * c(gy, sz, 2)};
+        }
         const auto d = [&](const Volume<float>& f, int axis) {
           const std::int64_t idx[3] = {i, j, k};
           const std::int64_t n = g.dims[axis], x = idx[axis];
-          const std::int64_t stride = axis == 0 ? 1 : axis == 1 ? g.dims[0] : std::int64_t(g.dims[0]) * g.dims[1];
-          const double h = g.spacing_mm[axis];
+          const std::int64_t stride = axis == 0 ? sx : axis == 1 ? sy : sz;
           if (n == 1) return 0.0;
-          if (x == 0) return (double(f.data[v + stride]) - f.data[v]) / h;
-          if (x == n - 1) return (double(f.data[v]) - f.data[v - stride]) / h;
-          return (double(f.data[v + stride]) - f.data[v - stride]) / (2 * h);
+          if (x == 0) return (double(f.data[v + stride]) - f.data[v]) * ih[axis];
+          if (x == n - 1) return (double(f.data[v]) - f.data[v - stride]) * ih[axis];
+          return (double(f.data[v + stride]) - f.data[v - stride]) * 0.5 * ih[axis];
         };
-        const double s2 = sigma * sigma;
-        return eigenvaluesByMagnitude(s2 * d(gx, 0), s2 * d(gy, 1), s2 * d(gz, 2), s2 * d(gx, 1), s2 * d(gx, 2), s2 * d(gy, 2));
+        return std::array<double, 6>{s2 * d(gx, 0), s2 * d(gy, 1), s2 * d(gz, 2), s2 * d(gx, 1), s2 * d(gx, 2), s2 * d(gy, 2)};
+      };
+      const auto hessian = [&](std::int64_t v, std::int64_t i, std::int64_t j, std::int64_t k) {
+        const auto e = entries(v, i, j, k);
+        return eigenvaluesByMagnitude(e[0], e[1], e[2], e[3], e[4], e[5]);
       };
       double gamma = o.gamma, largest = 0;
       if (o.method == "jerman" || gamma == 0) {
@@ -236,10 +286,14 @@ Volume<std::uint8_t> segment(const Volume<float>& image, const SegmentOptions& o
       }
       forEachVoxelIjk(g, [&](std::int64_t v, std::int64_t i, std::int64_t j, std::int64_t k) {
         std::array<double, 3> l;
-        if (o.method == "jerman")
+        if (o.method == "jerman") {
           l = {0.0, -double(large2.data[v]), -double(large3.data[v])};
-        else
-          l = hessian(v, i, j, k);
+        } else {
+          const auto e = entries(v, i, j, k);
+          // Voxels the measure gives nothing, told by the signs alone (no eigenvalues needed).
+          if (method.zero_with_positives <= 3 && positiveEigenvalues(e[0], e[1], e[2], e[3], e[4], e[5]) >= method.zero_with_positives) return;
+          l = eigenvaluesByMagnitude(e[0], e[1], e[2], e[3], e[4], e[5]);
+        }
         best.data[v] = std::max(best.data[v], static_cast<float>(method.measure(l, o, gamma, largest)));
       });
     }
