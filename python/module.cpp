@@ -20,6 +20,7 @@
 #include <sstream>
 #include <thread>
 
+#include "segment/segment.hpp"
 #include "angiosynth/version.hpp"
 #include "config/scenario.hpp"
 #include "core/error.hpp"
@@ -398,6 +399,59 @@ PYBIND11_MODULE(_core, m) {
             return out;
           },
           py::arg("index"), py::arg("threads") = 0, py::arg("memory_limit") = 0);
+
+  m.def(
+      "segment",
+      [](const py::array& image, const std::array<double, 3>& spacing, const SegmentOptions& options, int threads) {
+        if (image.ndim() != 3) throw InputError("image", 0, "has " + std::to_string(image.ndim()) + " dimensions; allowed: 3, indexed (x, y, z)");
+        VolumeGrid g;
+        for (int a = 0; a < 3; ++a) g.dims[a] = static_cast<std::int32_t>(image.shape(a));
+        g.spacing_mm = Vec3(spacing[0], spacing[1], spacing[2]);
+        if (!(spacing[0] > 0 && spacing[1] > 0 && spacing[2] > 0)) throw InputError("spacing", 0, "must be > 0 mm on every axis");
+        const auto values = py::array_t<float, py::array::f_style | py::array::forcecast>::ensure(image);
+        Volume<float> v(g);
+        std::copy(values.data(), values.data() + g.voxelCount(), v.data.begin());
+        struct Made {
+          Volume<std::uint8_t> mask;
+          Volume<float> response;
+          SegmentSummary summary;
+        };
+        Made made = runReleased<Made>(
+            [&](const Cancel&) {
+              Made m;
+              try {
+                m.mask = segment(v, options, m.summary, &m.response);
+              } catch (const std::invalid_argument& e) { throw InputError("segment", 0, e.what()); }
+              return m;
+            },
+            threads);
+        const std::vector<py::ssize_t> shape{g.dims[0], g.dims[1], g.dims[2]};
+        py::array_t<std::uint8_t, py::array::f_style> mask(shape);
+        py::array_t<float, py::array::f_style> response(shape);
+        std::copy(made.mask.data.begin(), made.mask.data.end(), mask.mutable_data());
+        std::copy(made.response.data.begin(), made.response.data.end(), response.mutable_data());
+        py::dict summary;
+        summary["method"] = made.summary.method;
+        summary["sigmas_voxels"] = made.summary.sigmas_voxels;
+        summary["threshold"] = made.summary.threshold;
+        summary["max_response"] = made.summary.max_response;
+        summary["voxels"] = made.summary.voxels;
+        summary["seconds"] = made.summary.seconds;
+        return py::make_tuple(mask, response, summary);
+      },
+      py::arg("image"), py::arg("spacing"), py::arg("options"), py::arg("threads") = 0);
+  py::class_<SegmentOptions>(m, "SegmentOptions")
+      .def(py::init<>())
+      .def_readwrite("method", &SegmentOptions::method)
+      .def_readwrite("sigmas_mm", &SegmentOptions::sigmas_mm)
+      .def_readwrite("bright", &SegmentOptions::bright)
+      .def_readwrite("alpha", &SegmentOptions::alpha)
+      .def_readwrite("beta", &SegmentOptions::beta)
+      .def_readwrite("gamma", &SegmentOptions::gamma)
+      .def_readwrite("tau", &SegmentOptions::tau)
+      .def_readwrite("threshold_fraction", &SegmentOptions::threshold_fraction)
+      .def_readwrite("has_threshold", &SegmentOptions::has_threshold)
+      .def_readwrite("threshold", &SegmentOptions::threshold);
 
   m.def("write_truth", [](const NativeSample& s, const py::dict& volumes, const std::filesystem::path& dir) { writeTruth(s, volumes, dir); });
   m.def("write_prediction", &writePrediction);

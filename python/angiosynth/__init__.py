@@ -31,7 +31,7 @@ import numpy as np
 from . import _core
 from ._core import InputError
 
-__all__ = ["generate", "Sample", "Graph", "Spec", "score", "InputError", "__version__"]
+__all__ = ["generate", "Sample", "Graph", "Spec", "score", "segment", "InputError", "__version__"]
 __version__ = _core.version
 
 
@@ -317,6 +317,44 @@ class DatasetSample(Sample):
     image = property(lambda self: self.volumes[self.image_role], doc="the image of imagesTr")
     label = property(lambda self: self.volumes[self.label_role], doc="the label of labelsTr")
     clean_image = property(lambda self: self.volumes["image"])
+
+
+def segment(
+    image: Any,
+    spacing: tuple[float, float, float] = (1.0, 1.0, 1.0),
+    *,
+    method: str = "frangi",
+    sigmas_mm: list[float] | None = None,
+    dark: bool = False,
+    alpha: float = 0.5,
+    beta: float = 0.5,
+    gamma: float = 15.0,
+    tau: float = 0.75,
+    threshold_fraction: float = 0.02,
+    threshold: float | None = None,
+    threads: int = 0,
+) -> tuple[np.ndarray, np.ndarray, dict]:
+    """Segments an image with a reference method, as `angiosynth segment` does (docs/scoring.md).
+
+    image       an array indexed (x, y, z), e.g. a Sample's image or nibabel's dataobj
+    spacing     voxel size in mm per axis (scales and Hessians are in mm)
+    method      "otsu", "frangi", "sato" or "jerman"
+    sigmas_mm   vesselness scales, Gaussian σ in mm (default 1, 2, 3 voxels)
+    dark        vessels darker than their surroundings
+    threshold_fraction, threshold   the mask: response >= fraction × its maximum, or >= threshold
+
+    Returns (mask uint8, response float32, summary dict), each array indexed (x, y, z).
+    """
+    options = _core.SegmentOptions()
+    options.method = method
+    options.sigmas_mm = list(sigmas_mm or [])
+    options.bright = not dark
+    options.alpha, options.beta, options.gamma, options.tau = alpha, beta, gamma, tau
+    options.threshold_fraction = threshold_fraction
+    if threshold is not None:
+        options.has_threshold, options.threshold = True, float(threshold)
+    mask, response, summary = _core.segment(np.asarray(image), tuple(float(s) for s in spacing), options, threads)
+    return mask, response, dict(summary)
 
 
 def score(

@@ -231,3 +231,22 @@ def test_mesh_of_a_sample_in_memory_is_the_surface_generate_writes(program, tmp_
     assert st["tree_euler_characteristic"] == [2, 2]  # each tree's surface a sphere: closed, no handle
     with pytest.raises(angiosynth.InputError, match="formats"):
         angiosynth.generate(SMALL).mesh(tmp_path / "bad", formats=["xyz"])
+
+
+def test_segment_gives_the_programs_mask_and_response(program, tmp_path):
+    sample = angiosynth.generate(SMALL)
+    image = sample.images["cta"]
+    path = tmp_path / "image.nii.gz"
+    nib.save(nib.Nifti1Image(np.asarray(image, dtype=np.float32), sample.affine), str(path))
+    run(program, "segment", str(path), "--method", "frangi", "--sigmas", "0.25,0.5", "--out", str(tmp_path / "m.nii.gz"),
+        "--response", str(tmp_path / "r.nii.gz"), "--quiet")
+    mask, response, summary = angiosynth.segment(image, sample.spacing, method="frangi", sigmas_mm=[0.25, 0.5])
+    assert mask.shape == image.shape and mask.dtype == np.uint8
+    assert np.array_equal(mask, nifti(tmp_path / "m.nii.gz")[0])
+    assert np.array_equal(response, nifti(tmp_path / "r.nii.gz")[0])
+    assert summary["voxels"] == int(mask.sum()) > 0
+    # Dark vessels: the negated image gives the same mask.
+    dark, _, _ = angiosynth.segment(-np.asarray(image, dtype=np.float32), sample.spacing, method="frangi", sigmas_mm=[0.25, 0.5], dark=True)
+    assert np.array_equal(mask, dark)
+    with pytest.raises(ValueError, match="allowed: otsu, frangi, sato, jerman"):
+        angiosynth.segment(image, sample.spacing, method="watershed")
