@@ -254,35 +254,31 @@ Volume<std::uint8_t> segment(const Volume<float>& image, const SegmentOptions& o
         return eigenvaluesByMagnitude(e[0], e[1], e[2], e[3], e[4], e[5]);
       };
       double gamma = o.gamma, largest = 0;
-      if (o.method == "jerman" || gamma == 0) {
-        // A first pass for what the measure needs of the whole volume.
-        double max_norm = 0;
+      const auto volumeMax = [&](auto&& value) {
+        return tbb::parallel_reduce(
+            tbb::blocked_range<std::int64_t>(0, g.voxelCount()), 0.0,
+            [&](const tbb::blocked_range<std::int64_t>& r, double m) {
+              for (std::int64_t q = r.begin(); q < r.end(); ++q) m = std::max(m, value(q));
+              return m;
+            },
+            [](double x, double y) { return std::max(x, y); });
+      };
+      if (o.method == "jerman") {
+        // Jerman's τ is a share of the scale's largest −λ3: the eigenvalues first, then the measure.
         forEachVoxelIjk(g, [&](std::int64_t v, std::int64_t i, std::int64_t j, std::int64_t k) {
           const auto l = hessian(v, i, j, k);
-          if (o.method == "jerman") large2.data[v] = float(-l[1]), large3.data[v] = float(-l[2]);
+          large2.data[v] = float(-l[1]), large3.data[v] = float(-l[2]);
         });
-        if (o.method == "jerman")
-          largest = tbb::parallel_reduce(
-              tbb::blocked_range<std::size_t>(0, large3.data.size()), 0.0,
-              [&](const tbb::blocked_range<std::size_t>& r, double m) {
-                for (std::size_t q = r.begin(); q < r.end(); ++q) m = std::max(m, double(large3.data[q]));
-                return m;
-              },
-              [](double a, double b) { return std::max(a, b); });
-        if (gamma == 0) {
-          max_norm = tbb::parallel_reduce(
-              tbb::blocked_range<std::int64_t>(0, g.voxelCount()), 0.0,
-              [&](const tbb::blocked_range<std::int64_t>& r, double m) {
-                for (std::int64_t q = r.begin(); q < r.end(); ++q) {
-                  const std::int64_t i = q % g.dims[0], j = (q / g.dims[0]) % g.dims[1], k = q / (std::int64_t(g.dims[0]) * g.dims[1]);
-                  const auto l = hessian(q, i, j, k);
-                  m = std::max(m, std::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]));
-                }
-                return m;
-              },
-              [](double a, double b) { return std::max(a, b); });
-          gamma = std::max(max_norm / 2, 1e-12);
-        }
+        largest = volumeMax([&](std::int64_t q) { return double(large3.data[q]); });
+      }
+      if (gamma == 0) {
+        // Half the largest Hessian norm (its Frobenius norm: no eigenvalues needed).
+        const double max_norm = volumeMax([&](std::int64_t q) {
+          const std::int64_t i = q % g.dims[0], j = (q / g.dims[0]) % g.dims[1], k = q / (std::int64_t(g.dims[0]) * g.dims[1]);
+          const auto e = entries(q, i, j, k);
+          return std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + 2 * (e[3] * e[3] + e[4] * e[4] + e[5] * e[5]));
+        });
+        gamma = std::max(max_norm / 2, 1e-12);
       }
       forEachVoxelIjk(g, [&](std::int64_t v, std::int64_t i, std::int64_t j, std::int64_t k) {
         std::array<double, 3> l;
