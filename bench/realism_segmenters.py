@@ -119,7 +119,7 @@ def main():
             ("recall_thin", "recall r < 1 voxel"), ("recall_proximal", "recall, first quartile of levels"),
             ("recall_distal", "recall, last quartile of levels"), ("distractor_fp", "distractor voxels called vessel")]
     for method in ["threshold", "Frangi"]:
-        print(f"\n**{method}** (mean of seeds {', '.join(map(str, seeds))})\n")
+        print(f"\n**{method}** (mean over `--seed` {', '.join(map(str, seeds))})\n")
         print("| image | " + " | ".join(c[1] for c in cols) + " |")
         print("|---" * (len(cols) + 1) + "|")
         for name, r in rows:

@@ -7,8 +7,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 work=${1:-$(mktemp -d)}
 mkdir -p "$work"
-sed -e 's|^voxel_size = "0.3 mm".*|voxel_size = "0.2250 mm"|' -e 's|^formats = .*|formats = ["nifti"]|' \
-    examples/cco_sphere_3d.toml > "$work/sphere_256.toml"
+source bench/sphere_256.sh
+sphere256 "$work"
 build/angiosynth generate "$work/sphere_256.toml" --out "$work/sample" --no-profiles --force --quiet
 python3 -c "import json; print('image', json.load(open('$work/sample/sample.json'))['statistics']['image_size'])"
 /usr/bin/python3 -c "

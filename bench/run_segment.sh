@@ -8,8 +8,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 work=${1:-$(mktemp -d)}
 mkdir -p "$work"
-sed -e 's|^voxel_size = "0.3 mm".*|voxel_size = "0.2250 mm"|' -e 's|^formats = .*|formats = ["nifti"]|' \
-    examples/cco_sphere_3d.toml > "$work/sphere_256.toml"
+source bench/sphere_256.sh
+sphere256 "$work"
 build/angiosynth generate "$work/sphere_256.toml" --out "$work/sample" --profile cta --force --quiet
 sigmas=0.225,0.45,0.675
 for method in frangi sato; do

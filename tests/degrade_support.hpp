@@ -41,6 +41,23 @@ inline GroundTruthVolumes flatTruth(const std::array<std::int32_t, 3>& dims, con
 }
 inline GroundTruthVolumes flatTruth(int n, const Vec3& spacing = Vec3(1, 1, 1)) { return flatTruth({n, n, n}, spacing); }
 
+// n³ voxels of h mm from the origin: voxel centres at (i + ½)·h.
+inline VolumeGrid cubeGrid(int n, double h) {
+  VolumeGrid g;
+  g.dims = {n, n, n};
+  g.spacing_mm = Vec3(h, h, h);
+  g.origin_mm = g.spacing_mm * 0.5;
+  return g;
+}
+
+// A parameter file for `generate`: a 40-terminal CCO sphere imaged at 0.3 mm, NIfTI only, for
+// runs of profiles through the command line.
+inline const char* const kSmallCcoSample =
+    "seed = 4\n[domain]\nshape = \"sphere\"\nradius = \"6 mm\"\nvoxel_size = \"0.25 mm\"\n"
+    "[tree]\nmethod = \"cco\"\nterminals = 40\n"
+    "[physics]\nperfusion_pressure = \"100 mmHg\"\nterminal_pressure = \"60 mmHg\"\nperfusion_flow = \"20 mL/min\"\n"
+    "[image]\nformats = [\"nifti\"]\nvoxel_size = \"0.3 mm\"\n";
+
 inline const VascularTree kNoTree = [] {
   VascularTree t;
   t.addNode(Vec3(0, 0, 0), -1);

@@ -29,13 +29,7 @@ using test::profileFrom;
 using test::writeTemp;
 
 // n³ voxels over the example's 40 mm map, voxel centres at (i + ½)·40/n.
-VolumeGrid mapGrid(int n) {
-  VolumeGrid g;
-  g.dims = {n, n, n};
-  g.spacing_mm = Vec3(40.0 / n, 40.0 / n, 40.0 / n);
-  g.origin_mm = g.spacing_mm * 0.5;
-  return g;
-}
+VolumeGrid mapGrid(int n) { return test::cubeGrid(n, 40.0 / n); }
 
 struct Moments {
   double mean = 0, sd = 0;

@@ -71,10 +71,7 @@ TEST(Realism, DecoyBlobHasItsVolumeLevelAndOwnLabel) {
 TEST(Realism, DistractorsAreNeverVesselVoxels) {
   const auto ex = test::vascusynthExample(300, 3);
   const VascularTree tree = test::grow(ex);
-  VolumeGrid g;
-  g.dims = {64, 64, 64};
-  g.spacing_mm = Vec3(40.0 / 64, 40.0 / 64, 40.0 / 64);
-  g.origin_mm = g.spacing_mm * 0.5;
+  const VolumeGrid g = test::cubeGrid(64, 40.0 / 64);
   const auto gt = rasterizeGroundTruth(tree, g, RasterOptions{2});
   const auto d = degradeWith(profileFrom("decoys_tree", std::string(kLevels) + "[[effect]]\ntype = \"decoys\"\nblobs = 20\ntubes = 20\nplates = 10\n"
                                                                                "[[effect]]\ntype = \"bone\"\ncount = 2\n"
@@ -121,10 +118,7 @@ TEST(Realism, BoneHasCortexOnBothFacesAndMarrowBetween) {
 TEST(Realism, CalcificationBloomsByItsGaussian) {
   const auto ex = test::vascusynthExample(300, 3);
   const VascularTree tree = test::grow(ex);
-  VolumeGrid g;
-  g.dims = {80, 80, 80};
-  g.spacing_mm = Vec3(0.5, 0.5, 0.5);
-  g.origin_mm = g.spacing_mm * 0.5;
+  const VolumeGrid g = test::cubeGrid(80, 0.5);
   const auto gt = rasterizeGroundTruth(tree, g, RasterOptions{2});
   const auto make = [&](const char* bloom) {
     return degradeWith(profileFrom(std::string("calc_") + (bloom[0] == '0' ? "sharp" : "bloom"),
@@ -215,10 +209,7 @@ TEST(Realism, CompartmentsHoldTheirRecordedLevels) {
 TEST(Realism, InflowDecayConstantIsRecoveredAlongTheGraph) {
   const auto ex = test::vascusynthExample(300, 3);
   const VascularTree tree = test::grow(ex);
-  VolumeGrid g;
-  g.dims = {100, 100, 100};
-  g.spacing_mm = Vec3(0.4, 0.4, 0.4);
-  g.origin_mm = g.spacing_mm * 0.5;
+  const VolumeGrid g = test::cubeGrid(100, 0.4);
   const auto gt = rasterizeGroundTruth(tree, g, RasterOptions{2});
   for (const bool slow : {false, true}) {
     // D of each node, by walking up to the root.
@@ -356,10 +347,7 @@ TEST(Realism, EveryIntensityEffectKeepsTheCleanLabelsOnAnyThreadCount) {
   }
   EXPECT_GE(effects, 25);
   std::ofstream(dir / "all.toml") << profile;
-  std::ofstream(dir / "p.toml") << "seed = 4\n[domain]\nshape = \"sphere\"\nradius = \"6 mm\"\nvoxel_size = \"0.25 mm\"\n"
-                                   "[tree]\nmethod = \"cco\"\nterminals = 40\n"
-                                   "[physics]\nperfusion_pressure = \"100 mmHg\"\nterminal_pressure = \"60 mmHg\"\nperfusion_flow = \"20 mL/min\"\n"
-                                   "[image]\nformats = [\"nifti\"]\nvoxel_size = \"0.3 mm\"\n";
+  std::ofstream(dir / "p.toml") << test::kSmallCcoSample;
   ASSERT_EQ(run("generate p.toml --out plain --no-profiles --quiet", dir).code, 0);
   const auto r = run("generate p.toml --out all --profile all.toml --quiet", dir);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -450,10 +438,7 @@ BackgroundStats measure(const DegradedImage& d, const GroundTruthVolumes& gt) {
 TEST(RealismProfiles, ModalityProfilesHaveTheirContrastToNoiseAndAStructuredBackground) {
   const auto ex = test::vascusynthExample(1000, 2);
   const VascularTree tree = test::grow(ex);
-  VolumeGrid g;
-  g.dims = {100, 100, 100};
-  g.spacing_mm = Vec3(0.4, 0.4, 0.4);
-  g.origin_mm = g.spacing_mm * 0.5;
+  const VolumeGrid g = test::cubeGrid(100, 0.4);
   const auto gt = rasterizeGroundTruth(tree, g, RasterOptions{2});
   const std::map<std::string, std::pair<double, double>> band{
       {"cta", {5, 45}}, {"tof_mra", {4, 45}}, {"two_photon", {5, 60}}, {"octa", {3, 40}}, {"vascusynth", {18, 23}}};

@@ -139,10 +139,7 @@ TEST(KSpace, LabelsAreTheCleanRunsBytes) {
                                     "[[effect]]\ntype = \"gibbs\"\nkeep_x = 0.6\nkeep_y = 0.5\n"
                                     "[[effect]]\ntype = \"kspace_spike\"\nkx = {min = -10, max = 10}\nky = 4\namplitude = 0.02\n"
                                     "[[effect]]\ntype = \"motion_ghost\"\nperiod = {min = 4, max = 12}\namplitude = 0.2\n";
-  std::ofstream(dir / "p.toml") << "seed = 4\n[domain]\nshape = \"sphere\"\nradius = \"6 mm\"\nvoxel_size = \"0.25 mm\"\n"
-                                   "[tree]\nmethod = \"cco\"\nterminals = 40\n"
-                                   "[physics]\nperfusion_pressure = \"100 mmHg\"\nterminal_pressure = \"60 mmHg\"\nperfusion_flow = \"20 mL/min\"\n"
-                                   "[image]\nformats = [\"nifti\"]\nvoxel_size = \"0.3 mm\"\n";
+  std::ofstream(dir / "p.toml") << test::kSmallCcoSample;
   ASSERT_EQ(run("generate p.toml --out plain --no-profiles --quiet", dir).code, 0);
   const auto r = run("generate p.toml --out mr --profile mr.toml --quiet", dir);
   ASSERT_EQ(r.code, 0) << r.err;

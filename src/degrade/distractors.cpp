@@ -18,18 +18,22 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
+// An orthonormal frame {u, v, n} around the unit vector n.
+std::array<Vec3, 3> frameAround(const Vec3& n) {
+  const Vec3 helper = std::fabs(n.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
+  Vec3 u = cross(helper, n);
+  u = u / norm(u);
+  return {u, cross(n, u), n};
+}
+
 // A random orthonormal frame: e[2] uniform on the sphere.
 std::array<Vec3, 3> randomFrame(Rng& rng) {
   // One draw per statement: the order of a call's arguments is unspecified.
   const double x = rng.normal();
   const double y = rng.normal();
   const double z = rng.normal();
-  Vec3 n(x, y, z);
-  n = n / std::max(norm(n), 1e-12);
-  const Vec3 helper = std::fabs(n.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
-  Vec3 u = cross(helper, n);
-  u = u / norm(u);
-  return {u, cross(n, u), n};
+  const Vec3 n(x, y, z);
+  return frameAround(n / std::max(norm(n), 1e-12));
 }
 
 Vec3 uniformInGrid(const VolumeGrid& g, Rng& rng) {
@@ -192,28 +196,19 @@ void applyCalcification(const Drawn& p, EffectContext& ctx) {
   const VascularTree& tree = *s.tree;
   // Plaque forms in the walls of larger arteries: segments at least min_vessel_radius thick,
   // drawn in proportion to their length.
-  std::vector<std::int32_t> segments;
-  std::vector<double> cumulative;
-  double total = 0;
-  for (std::int32_t i = 0; i < tree.nodeCount(); ++i)
-    if (!tree.isRoot(i) && tree.radius[i] >= p("min_vessel_radius") && tree.length[i] > 0) {
-      segments.push_back(i);
-      cumulative.push_back(total += tree.length[i]);
-    }
+  const double thinnest = p("min_vessel_radius");
+  const PlaceOnTree place(tree, [&](std::int32_t i) { return !tree.isRoot(i) && tree.radius[i] >= thinnest; });
   Json list = Json::array();
-  if (segments.empty() || int(p("count")) == 0) {
+  if (!(place.total() > 0) || int(p("count")) == 0) {
     ctx.record["calcifications"] = list;
     return;
   }
   Volume<float> calcium(g);
   for (int n = 0; n < int(p("count")); ++n) {
-    const double x = ctx.rng.uniform() * total;
-    const std::size_t at = std::min<std::size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), x) - cumulative.begin(), segments.size() - 1);
-    const std::int32_t seg = segments[at];
+    const std::int32_t seg = place.draw(ctx.rng.uniform());
     const Vec3 a = tree.position[tree.parent[seg]], b = tree.position[seg];
     const Vec3 axis = (b - a) / tree.length[seg];
-    const Vec3 helper = std::fabs(axis.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
-    const Vec3 u = cross(helper, axis) / norm(cross(helper, axis)), v = cross(axis, u);
+    const auto [u, v, unused] = frameAround(axis);
     const double phi = ctx.rng.uniform(0, 2 * M_PI);
     const Vec3 on_axis = a + (b - a) * ctx.rng.uniform();
     const Vec3 c = on_axis + (u * std::cos(phi) + v * std::sin(phi)) * tree.radius[seg];  // on the wall

@@ -10,22 +10,6 @@
 namespace angiosynth {
 namespace {
 
-// A segment drawn with probability ∝ its length, and a uniform position along it.
-struct PlaceOnTree {
-  std::vector<double> cumulative;
-  explicit PlaceOnTree(const VascularTree& t) {
-    cumulative.assign(t.nodeCount(), 0.0);
-    for (std::int32_t s = 1; s < t.nodeCount(); ++s) cumulative[s] = cumulative[s - 1] + t.length[s];
-  }
-  std::int32_t draw(double u, double& along) const {
-    const double x = u * cumulative.back();
-    auto it = std::upper_bound(cumulative.begin() + 1, cumulative.end(), x);
-    const auto s = static_cast<std::int32_t>(std::min<std::ptrdiff_t>(it - cumulative.begin(), cumulative.size() - 1));
-    along = std::clamp(x - cumulative[s - 1], 0.0, cumulative[s] - cumulative[s - 1]);
-    return s;
-  }
-};
-
 // 1 in the middle half of the gap, a raised cosine to 0 over each outer quarter.
 double gapProfile(double offset, double length) {
   const double x = std::fabs(offset) / (length / 2);  // 0 at the centre, 1 at the ends

@@ -5,6 +5,9 @@
 #include <cmath>
 #include <cstdint>
 
+#include <vector>
+
+#include "core/vascular_tree.hpp"
 #include "raster/volume.hpp"
 
 namespace angiosynth {
@@ -24,6 +27,32 @@ inline VoxelBox boxAround(const VolumeGrid& g, const Vec3& a, const Vec3& b, dou
   }
   return box;
 }
+
+// A segment drawn with probability ∝ its length among those `eligible` takes (all by default),
+// and a uniform position along it.
+struct PlaceOnTree {
+  std::vector<double> cumulative;  // by node id: the eligible length up to and including segment s
+  template <class Eligible>
+  PlaceOnTree(const VascularTree& t, Eligible&& eligible) {
+    cumulative.assign(std::max(t.nodeCount(), 1), 0.0);
+    for (std::int32_t s = 1; s < t.nodeCount(); ++s) cumulative[s] = cumulative[s - 1] + (eligible(s) ? t.length[s] : 0.0);
+  }
+  explicit PlaceOnTree(const VascularTree& t) : PlaceOnTree(t, [](std::int32_t) { return true; }) {}
+  double total() const { return cumulative.back(); }
+  // u uniform in [0, 1); `along` the distance from the segment's proximal node.
+  std::int32_t draw(double u, double& along) const {
+    const double x = u * cumulative.back();
+    auto it = std::upper_bound(cumulative.begin() + 1, cumulative.end(), x);
+    auto s = static_cast<std::int32_t>(std::min<std::ptrdiff_t>(it - cumulative.begin(), cumulative.size() - 1));
+    while (s > 1 && cumulative[s] == cumulative[s - 1]) --s;  // x at the very end: the last segment with length
+    along = std::clamp(x - cumulative[s - 1], 0.0, cumulative[s] - cumulative[s - 1]);
+    return s;
+  }
+  std::int32_t draw(double u) const {
+    double along;
+    return draw(u, along);
+  }
+};
 
 template <class F>
 void forEachInBox(const VoxelBox& b, F&& f) {
