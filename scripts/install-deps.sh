@@ -14,7 +14,8 @@ if [ "${1:-all}" != program ]; then
          libopenimageio-dev python3-nibabel python3-networkx python3-scipy python3-skimage python3-vtk9 tetgen  # independent readers and references
          clang libclang-rt-14-dev  # the sanitizer build and libFuzzer (scripts/sanitize.sh)
          clang-format-14  # the style check (scripts/check_format.sh)
-         python3-pytest python3-torch)  # the Python module's tests and its PyTorch dataset
+         python3-pytest python3-torch  # the Python module's tests and its PyTorch dataset
+         chromium fonts-liberation)  # renders the benchmark report headless (its test)
 fi
 missing=()
 for p in "${pkgs[@]}"; do

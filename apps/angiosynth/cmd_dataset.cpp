@@ -77,6 +77,12 @@ std::string duration(double s) {
   return buf;
 }
 
+std::vector<SpecOverride> overrides(const DatasetArgs& a) {
+  std::vector<SpecOverride> out;
+  for (const auto& s : a.set) out.push_back(parseSpecOverride(s, "--set", 0));
+  return out;
+}
+
 int report(const DatasetCheck& c, const char* verb) {
   for (const auto& w : c.warnings) std::cerr << "warning: " << w << "\n";
   for (const auto& p : c.problems) std::cerr << p << "\n";
@@ -94,6 +100,11 @@ CLI::App* addDataset(CLI::App& app, DatasetArgs& a) {
   c->add_option("--index", a.index, "generate sample I only; auto: $SLURM_ARRAY_TASK_ID or $JOB_COMPLETION_INDEX");
   c->add_option("--range", a.range, "generate samples A to B-1");
   c->add_option("--shard", a.shard, "generate every M-th sample from K (K from 0); auto/M takes K from the environment");
+  const char* set_help =
+      "replace a value of the spec without editing it: KEY=VALUE, KEY dotted as in the spec (tree.terminals=200, "
+      "dataset.profile='\"tof_mra\"') or profile.<effect>.<parameter> for the image profile's effects (profile.gaussian.sigma=40); "
+      "recorded in spec.json";
+  c->add_option("--set", a.set, set_help);
   c->add_flag("--resume", a.resume, "skip samples whose files verify against the manifest");
   c->add_flag("--regenerate-changed", a.regenerate_changed,
               "with --resume: accept an edited spec and regenerate exactly the samples whose resolved parameters changed");
@@ -103,6 +114,7 @@ CLI::App* addDataset(CLI::App& app, DatasetArgs& a) {
   auto* d = c->add_subcommand("describe", "print sample I's resolved parameter file without generating it");
   d->add_option("SPEC", a.spec, "dataset spec (.toml)")->required();
   d->add_option("--index", a.index, "sample index")->required();
+  d->add_option("--set", a.set, set_help);
   auto* f = c->add_subcommand("finalize", "merge the shards' manifests; write manifest.jsonl, dataset.json, provenance.json");
   f->add_option("DIR", a.dir, "the DatasetNNN_Name directory")->required();
   auto* v = c->add_subcommand("verify", "re-hash every file; report missing, failed and corrupt samples (exit 1 if any)");
@@ -116,18 +128,21 @@ CLI::App* addDataset(CLI::App& app, DatasetArgs& a) {
 
 int runDatasetCommand(const DatasetArgs& a, const std::string& command_line) {
   if (a.describe->parsed()) {
-    const DatasetSpec spec = readDatasetSpec(a.spec);
+    const DatasetSpec spec = readDatasetSpec(a.spec, overrides(a));
     const auto i = parseIndex(a.index, "--index");
     if (i >= spec.samples) throw InputError(a.spec, 0, "--index " + a.index + " is beyond the " + std::to_string(spec.samples) + " samples");
     const ResolvedSample r = resolveSample(spec, i);
-    std::cout << "# sample " << r.index << " (" << r.id << "), seed " << r.seed << ", image profile " << r.profile << "\n" << readableParameters(r);
+    std::cout << "# sample " << r.index << " (" << r.id << "), seed " << r.seed << ", image profile " << r.profile << "\n";
+    for (const auto& o : spec.overrides)
+      if (o.key.rfind("profile.", 0) == 0) std::cout << "# image profile with " << o.key.substr(8) << " = " << o.value << "\n";
+    std::cout << readableParameters(r);
     return 0;
   }
   if (a.finalize->parsed()) return report(finalizeDataset(a.dir), "finalize");
   if (a.verify->parsed()) return report(verifyDataset(a.dir), "verify");
   if (a.spec.empty() || a.out.empty()) throw InputError("", 0, "dataset: give SPEC and --out DIR (or describe, finalize, verify)");
   const auto threads = limitThreads(a.common.threads);
-  const DatasetSpec spec = readDatasetSpec(a.spec);
+  const DatasetSpec spec = readDatasetSpec(a.spec, overrides(a));
   const DatasetSelection sel = selection(a, spec.samples);
   DatasetRunOptions opt;
   opt.resume = a.resume;

@@ -54,6 +54,7 @@ int runInit(const InitArgs& a);
 struct DatasetArgs {
   std::string spec, out, dir;
   std::string index, range, shard;
+  std::vector<std::string> set;  // key=value overrides of the spec
   bool resume = false;
   bool regenerate_changed = false;
   int in_flight = 0;
@@ -64,6 +65,17 @@ struct DatasetArgs {
 };
 CLI::App* addDataset(CLI::App& app, DatasetArgs& a);
 int runDatasetCommand(const DatasetArgs& a, const std::string& command_line);
+
+struct BenchmarkArgs {
+  std::string spec, out, shard;
+  std::vector<std::string> predictions;  // NAME=DIR
+  std::vector<std::string> set;          // key=value for every rung
+  std::vector<std::string> ladders;      // run these only
+  bool resume = false, regenerate_changed = false;
+  CommonOptions common;
+};
+CLI::App* addBenchmark(CLI::App& app, BenchmarkArgs& a);
+int runBenchmarkCommand(const BenchmarkArgs& a, const std::string& command_line);
 
 struct SegmentArgs {
   std::string image, out, response;

@@ -33,6 +33,8 @@ int main(int argc, char** argv) {
   auto* sc = cli::addScore(app, sa);
   cli::SegmentArgs sg;
   auto* se = cli::addSegment(app, sg);
+  cli::BenchmarkArgs ba;
+  auto* bm = cli::addBenchmark(app, ba);
   cli::MeshArgs ma;
   auto* me = cli::addMesh(app, ma);
   cli::PlotCalibreArgs pc;
@@ -54,6 +56,7 @@ int main(int argc, char** argv) {
     if (pl->parsed()) return cli::runPlotCalibre(pc);
     if (se->parsed()) return cli::runSegment(sg);
     if (me->parsed()) return cli::runMesh(ma, cmdline);
+    if (bm->parsed()) return cli::runBenchmarkCommand(ba, cmdline);
     if (fx->parsed()) {
       std::cout << effectReference();
       return 0;

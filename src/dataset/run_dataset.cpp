@@ -70,7 +70,7 @@ std::uint64_t sampleBytes(const DatasetSpec& spec, std::uint64_t limit) {
   const auto growth = sc.growth->prepare(limit);
   const DemandMap& map = growth->frame();
   const VolumeGrid g = imageGrid(map, sc.image, spec.file, 0);
-  loadProfile(r.profile, spec.file, 0);
+  sampleProfile(spec, r.profile);
   return denseRasterBytes(g) + 4ULL * g.voxelCount() + 24ULL * g.voxelCount() + map.demand.size() * 16;
 }
 
@@ -83,6 +83,7 @@ SampleRequest sampleRequest(const DatasetSpec& spec, const ResolvedSample& r, co
   req.memory_limit = memory_limit;
   req.record_timing = false;  // sample files depend on (spec, index) only
   if (spec.labels == "kind") req.class_kinds = spec.kinds;
+  req.profiles = std::vector<Profile>{sampleProfile(spec, r.profile)};
   return req;
 }
 
@@ -94,7 +95,7 @@ struct SampleRoles {
 };
 SampleRoles sampleRoles(const DatasetSpec& spec, const ResolvedSample& r, const std::function<bool(const std::string&)>& made) {
   std::string suffix(1, '_');  // (appended: GCC 12 warns falsely, -Wrestrict, on "_" + string)
-  suffix += loadProfile(r.profile, spec.file, 0).name;
+  suffix += sampleProfile(spec, r.profile).name;
   const auto own = [&](const std::string& role) { return made(role + suffix) ? role + suffix : role; };
   return {own("image"), own(spec.label_policy != "binary" ? "label" : spec.labels == "kind" ? "classes" : "mask")};
 }
@@ -232,12 +233,14 @@ void checkExistingDataset(const DatasetSpec& spec, const fs::path& dir, const st
   const Json old = readSpecRecord(dir);
   const std::string old_text = old["spec"].get<std::string>();
   std::string old_hash;
+  std::vector<SpecOverride> old_overrides;
   try {
-    old_hash = canonicalSpecSha256(old_text, (dir / "spec.json").string());
+    old_overrides = overridesFromJson(old.value("overrides", Json()), (dir / "spec.json").string());
+    old_hash = canonicalSpecSha256(old_text, (dir / "spec.json").string(), old_overrides);
   } catch (const InputError&) {}
   spec_changed = old_hash != spec.sha256;
   if (spec_changed) {
-    const auto keys = changedSpecKeys(old_text, spec.text);
+    const auto keys = changedSpecKeys(old_text, spec.text, old_overrides, spec.overrides);
     std::string list;
     for (std::size_t i = 0; i < keys.size() && i < 12; ++i) list += (i ? ", " : "") + keys[i];
     if (keys.size() > 12) list += ", … (" + std::to_string(keys.size()) + " in all)";
@@ -299,6 +302,7 @@ DatasetRunReport runDataset(const DatasetSpec& spec, const fs::path& out_parent,
   spec_record["spec_file"] = spec.file;
   spec_record["spec_sha256"] = spec.sha256;
   spec_record["spec"] = spec.text;
+  if (!spec.overrides.empty()) spec_record["overrides"] = overridesJson(spec.overrides);  // datasets without any as before
   writeJsonAtomically(dir / "spec.json", spec_record);
   writeJsonAtomically(dir / "manifest" / (sel.part + ".run.json"), Json{{"tool", {{"name", "angiosynth"}, {"version", kVersion}}},
                                                                         {"command_line", opt.command_line},
@@ -443,6 +447,7 @@ DatasetCheck finalizeDataset(const fs::path& dir) {
   writeJsonAtomically(dir / "provenance.json", Json{{"tool", {{"name", "angiosynth"}, {"version", kVersion}}},
                                                     {"spec_file", info["spec_file"]},
                                                     {"spec", info["spec"]},
+                                                    {"overrides", info.value("overrides", Json::array())},
                                                     {"seed", info["seed"]},
                                                     {"samples", c.samples},
                                                     {"licence", info.value("licence", std::string("not recorded (made by an earlier version)"))},

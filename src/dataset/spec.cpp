@@ -185,6 +185,39 @@ void resolveTable(toml::table& t, Rng& rng, const std::string& file) {
   }
 }
 
+// An override's value as a node on the line it was written on (for errors that cite it).
+toml::table overrideValue(const SpecOverride& o) {
+  try {
+    return toml::parse(std::string(std::max(0, o.line - 1), '\n') + "v = " + o.value, std::string_view(o.file));
+  } catch (const toml::parse_error& e) {
+    throw InputError(o.file, o.line,
+                     o.key + " = " + o.value + ": not a TOML value (" + std::string(e.description()) + "); quote text and quantities: \"0.3 mm\"");
+  }
+}
+
+bool profileOverride(const SpecOverride& o) { return o.key.rfind("profile.", 0) == 0; }
+
+// Sets t[a][b]…[key] = value, making the tables on the way. `profile_too` also places the
+// profile's overrides (under a table "profile": for hashes and comparisons, not for samples).
+void applyOverrides(toml::table& root, const std::vector<SpecOverride>& overrides, bool profile_too) {
+  for (const auto& o : overrides) {
+    if (profileOverride(o) && !profile_too) continue;
+    toml::table* t = &root;
+    std::string rest = o.key;
+    for (auto dot = rest.find('.'); dot != std::string::npos; dot = rest.find('.')) {
+      const std::string part = rest.substr(0, dot);
+      rest = rest.substr(dot + 1);
+      if (!t->contains(part)) t->insert(part, toml::table{});
+      t = t->get(part)->as_table();
+      if (!t || t->is_inline())
+        throw InputError(o.file, o.line, o.key + ": " + part + " is a value in the spec, not a table; allowed: the dotted key of a value");
+    }
+    if (rest.empty()) throw InputError(o.file, o.line, "the key '" + o.key + "' is empty after a dot; allowed: a dotted key such as tree.terminals");
+    toml::table v = overrideValue(o);
+    v.get("v")->visit([&](auto& x) { t->insert_or_assign(rest, std::move(x)); });
+  }
+}
+
 bool validName(const std::string& s) {
   if (s.empty()) return false;
   for (char c : s)
@@ -257,8 +290,9 @@ nlohmann::ordered_json labelValues(const DatasetSpec& spec) {
   return j;
 }
 
-DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
+DatasetSpec readDatasetSpec(const std::filesystem::path& path, const std::vector<SpecOverride>& overrides) {
   DatasetSpec s;
+  s.overrides = overrides;
   s.file = path.string();
   if (!std::filesystem::exists(path)) throw InputError(s.file, 0, "no such dataset spec");
   if (!std::filesystem::is_regular_file(path)) throw InputError(s.file, 0, "the dataset spec is not a regular file (a directory or device)");
@@ -274,6 +308,7 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
   } catch (const toml::parse_error& e) {
     throw InputError(s.file, static_cast<int>(e.source().begin.line), std::string("not valid TOML: ") + std::string(e.description()));
   }
+  applyOverrides(*root, s.overrides, false);
   const auto* ds = root->get("dataset");
   if (!ds || !ds->is_table()) throw InputError(s.file, 0, "a dataset spec needs a [dataset] table (name, id, samples, seed)");
   const auto& d = *ds->as_table();
@@ -321,12 +356,59 @@ DatasetSpec readDatasetSpec(const std::filesystem::path& path) {
     if (!h->is_boolean()) throw InputError(s.file, lineOf(*h), "record_host must be true or false (host names in provenance.json)");
     s.record_host = *h->value<bool>();
   }
-  s.sha256 = canonicalSpecSha256(s.text, s.file);
+  s.sha256 = canonicalSpecSha256(s.text, s.file, s.overrides);
   if (root->contains("seed")) throw InputError(s.file, lineOf(*root->get("seed")), "the seed of a dataset goes in [dataset]");
   // Resolve and read one sample now, so a bad spec fails before any work starts.
   const ResolvedSample first = resolveSample(s, 0);
   readTomlParameters(*first.table, s.file);
+  sampleProfile(s, first.profile);
   return s;
+}
+
+SpecOverride parseSpecOverride(const std::string& assignment, const std::string& file, int line) {
+  const auto eq = assignment.find('=');
+  const auto trim = [](std::string x) {
+    x.erase(0, x.find_first_not_of(" \t"));
+    x.erase(x.find_last_not_of(" \t") + 1);
+    return x;
+  };
+  SpecOverride o{eq == std::string::npos ? "" : trim(assignment.substr(0, eq)), eq == std::string::npos ? "" : trim(assignment.substr(eq + 1)), file,
+                 line};
+  bool key_ok = !o.key.empty() && o.key.front() != '.' && o.key.back() != '.' && o.key.find("..") == std::string::npos;
+  for (char c : o.key) key_ok &= std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
+  if (!key_ok || o.value.empty())
+    throw InputError(file, line,
+                     "'" + assignment + "' is not key=value; allowed: a dotted key of the spec and a TOML value, e.g. tree.terminals=200");
+  overrideValue(o);
+  return o;
+}
+
+nlohmann::json overridesJson(const std::vector<SpecOverride>& overrides) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& o : overrides) j.push_back({{"key", o.key}, {"value", o.value}});
+  return j;
+}
+
+std::vector<SpecOverride> overridesFromJson(const nlohmann::json& j, const std::string& file) {
+  std::vector<SpecOverride> out;
+  if (j.is_null()) return out;
+  if (!j.is_array()) throw InputError(file, 0, "overrides must be a list of {key, value}");
+  for (const auto& e : j) {
+    if (!e.is_object() || !e.contains("key") || !e["key"].is_string() || !e.contains("value") || !e["value"].is_string())
+      throw InputError(file, 0, "overrides must be a list of {key, value} strings");
+    out.push_back({e["key"].get<std::string>(), e["value"].get<std::string>(), file, 0});
+  }
+  return out;
+}
+
+Profile sampleProfile(const DatasetSpec& spec, const std::string& profile_ref) {
+  Profile p = loadProfile(profile_ref, spec.file, 0);
+  for (const auto& o : spec.overrides)
+    if (profileOverride(o)) {
+      const toml::table v = overrideValue(o);
+      overrideProfileValue(p, o.key.substr(8), *v.get("v"), o.file);
+    }
+  return p;
 }
 
 std::string sampleId(const DatasetSpec& spec, std::int64_t index) {
@@ -391,6 +473,7 @@ ResolvedSample resolveSample(const DatasetSpec& spec, std::int64_t index) {
   // Parsed afresh, not copied: toml++ drops source lines on copy, and errors about a sample's
   // values must point into the spec.
   auto t = std::make_shared<toml::table>(toml::parse(spec.text, std::string_view(spec.file)));
+  applyOverrides(*t, spec.overrides, false);
   r.profile = "clean";
   auto& dataset = *t->get("dataset")->as_table();
   if (dataset.contains("profile")) {
@@ -414,7 +497,11 @@ ResolvedSample resolveSample(const DatasetSpec& spec, std::int64_t index) {
   std::string labels;
   if (spec.labels == "kind")
     for (const auto& k : spec.kinds) labels += (labels.empty() ? "labels by kind: " : ", ") + k;
-  r.sha256 = sha256Text(r.toml + "\nimage profile: " + r.profile + "\n" + (labels.empty() ? "" : labels + "\n"));
+  // The profile's overrides change the image; samples without any hash as they always did.
+  std::string profile_overrides;
+  for (const auto& o : spec.overrides)
+    if (profileOverride(o)) profile_overrides += "image profile override: " + o.key + " = " + o.value + "\n";
+  r.sha256 = sha256Text(r.toml + "\nimage profile: " + r.profile + "\n" + (labels.empty() ? "" : labels + "\n") + profile_overrides);
   r.table = t;
   return r;
 }
@@ -442,22 +529,30 @@ void flatten(const toml::table& t, const std::string& prefix, std::map<std::stri
   }
 }
 
+std::map<std::string, std::string> flatSpec(const std::string& text, const std::string& file, const std::vector<SpecOverride>& overrides) {
+  toml::table t = parseSpecText(text, file);
+  applyOverrides(t, overrides, true);
+  std::map<std::string, std::string> flat;
+  flatten(t, "", flat);
+  return flat;
+}
+
 }  // namespace
 
-std::string canonicalSpecSha256(const std::string& text, const std::string& file) {
-  std::map<std::string, std::string> flat;
-  flatten(parseSpecText(text, file), "", flat);
+std::string canonicalSpecSha256(const std::string& text, const std::string& file, const std::vector<SpecOverride>& overrides) {
+  const auto flat = flatSpec(text, file, overrides);
   std::string canonical;
   for (const auto& [k, v] : flat) canonical += k + " = " + v + "\n";
   return sha256Text(canonical);
 }
 
-std::vector<std::string> changedSpecKeys(const std::string& old_text, const std::string& new_text) {
+std::vector<std::string> changedSpecKeys(const std::string& old_text, const std::string& new_text, const std::vector<SpecOverride>& old_overrides,
+                                         const std::vector<SpecOverride>& new_overrides) {
   std::map<std::string, std::string> a, b;
   try {
-    flatten(parseSpecText(old_text, "old spec"), "", a);
+    a = flatSpec(old_text, "old spec", old_overrides);
   } catch (const InputError&) { return {"(the recorded spec is not valid TOML)"}; }
-  flatten(parseSpecText(new_text, "new spec"), "", b);
+  b = flatSpec(new_text, "new spec", new_overrides);
   std::vector<std::string> out;
   for (const auto& [k, v] : a)
     if (!b.count(k))
@@ -482,7 +577,7 @@ void checkSampleDraws(const DatasetSpec& spec, const std::vector<std::int64_t>& 
           throw InputError(spec.file, spec.labels_line,
                            "the sample grows a tree of kind '" + kind + "', which has no label: kinds = [" + list + "]; add it to [dataset] kinds");
         }
-      if (profiles.insert(r.profile).second) loadProfile(r.profile, spec.file, 0);
+      if (profiles.insert(r.profile).second) sampleProfile(spec, r.profile);
     } catch (const InputError& e) {
       throw InputError("", 0,
                        std::string(e.what()) + " (sample " + std::to_string(i) + ", " + r.id + "; see `angiosynth dataset describe " + spec.file +

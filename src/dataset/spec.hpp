@@ -22,6 +22,19 @@ class table;
 
 namespace angiosynth {
 
+struct Profile;
+
+// One value of a spec replaced, without editing the spec (a benchmark's rung, `dataset --set`):
+// `key` dotted as in the spec ("tree.terminals", "dataset.profile"), or
+// "profile.<effect type>.<parameter>" for that parameter of every such effect of the image
+// profile ("profile.background" and "profile.vessel" for its intensities); `value` is TOML
+// ("40", "\"0.3 mm\"", "{uniform = [1, 2]}").
+struct SpecOverride {
+  std::string key, value;
+  std::string file;  // where the override was written, for errors
+  int line = 0;
+};
+
 struct DatasetSpec {
   std::string file;    // the spec, for errors and provenance
   std::string text;    // its content, recorded in provenance.json
@@ -45,18 +58,30 @@ struct DatasetSpec {
   // The licence the dataset's author gives the generated data (an SPDX identifier or any text):
   // dataset.json and provenance.json name it.
   std::string licence = "CC0-1.0";
-  bool record_host = false;  // provenance.json names the machines' host names (off: cores and memory only)
+  bool record_host = false;             // provenance.json names the machines' host names (off: cores and memory only)
+  std::vector<SpecOverride> overrides;  // applied to the text; part of sha256 and of every sample's hash
 };
 
 // The label values of labelsTr, as dataset.json and each sample's meta list them.
 nlohmann::ordered_json labelValues(const DatasetSpec& spec);
 
-DatasetSpec readDatasetSpec(const std::filesystem::path& file);
+DatasetSpec readDatasetSpec(const std::filesystem::path& file, const std::vector<SpecOverride>& overrides = {});
 
-// The canonical form of a spec's text (TOML re-serialised with sorted keys) and its SHA-256.
-std::string canonicalSpecSha256(const std::string& spec_text, const std::string& file);
-// Dotted keys whose values differ between two spec texts ("tree.terminals", "dataset.samples").
-std::vector<std::string> changedSpecKeys(const std::string& old_text, const std::string& new_text);
+// "key=value" as `--set` takes it; throws InputError naming `file` and `line` when malformed.
+SpecOverride parseSpecOverride(const std::string& assignment, const std::string& file, int line);
+
+// The canonical form of a spec's text with its overrides (TOML re-serialised with sorted keys)
+// and its SHA-256.
+std::string canonicalSpecSha256(const std::string& spec_text, const std::string& file, const std::vector<SpecOverride>& overrides = {});
+// Dotted keys whose values differ between two specs ("tree.terminals", "dataset.samples").
+std::vector<std::string> changedSpecKeys(const std::string& old_text, const std::string& new_text,
+                                         const std::vector<SpecOverride>& old_overrides = {}, const std::vector<SpecOverride>& new_overrides = {});
+// The overrides as spec.json records them, and back.
+nlohmann::json overridesJson(const std::vector<SpecOverride>& overrides);
+std::vector<SpecOverride> overridesFromJson(const nlohmann::json& j, const std::string& file);
+
+// The image profile of a sample: its profile with the spec's "profile." overrides applied.
+Profile sampleProfile(const DatasetSpec& spec, const std::string& profile_ref);
 
 // Reads every sample's draws and parameter file and every file they name (maps, masks,
 // profiles), so a bad draw or a missing file fails before the first sample is written.

@@ -210,4 +210,37 @@ Profile loadProfile(const std::string& ref, const std::filesystem::path& named_i
   return readVascuSynthNoiseFile(path);
 }
 
+void overrideProfileValue(Profile& p, const std::string& key, const toml::node& value, const std::string& file) {
+  const int line = lineOf(value);
+  if (key == "background" || key == "vessel") {
+    (key == "background" ? p.background : p.vessel) = plainSpec(value, ParamKind::Intensity, key, file);
+    return;
+  }
+  const auto dot = key.find('.');
+  const std::string type = key.substr(0, dot), param = dot == std::string::npos ? "" : key.substr(dot + 1);
+  std::string present;
+  int changed = 0;
+  for (auto& e : p.effects) {
+    present += (present.empty() ? "" : ", ") + std::string(e.type->name);
+    if (e.type->name != type) continue;
+    const ParamDecl* decl = nullptr;
+    for (const auto& d : e.type->params)
+      if (param == d.name) decl = &d;
+    if (param == "probability") {
+      e.probability = plainSpec(value, ParamKind::Probability, "probability", file);
+    } else if (decl) {
+      e.params[param] = readParamSpec(value, decl->kind, param, file);
+    } else {
+      std::string list = "probability";
+      for (const auto& d : e.type->params) list += std::string(", ") + d.name;
+      throw InputError(file, line, "profile." + key + ": effect " + type + " has no parameter '" + param + "'; allowed: " + list);
+    }
+    ++changed;
+  }
+  if (!changed)
+    throw InputError(file, line,
+                     "profile." + key + ": the profile " + p.name + " has no effect '" + type + "'; allowed: profile.background, profile.vessel, " +
+                         "profile.<effect>.<parameter> with an effect of the profile (" + (present.empty() ? "none" : present) + ")");
+}
+
 }  // namespace angiosynth

@@ -43,4 +43,9 @@ std::vector<std::filesystem::path> profileSearchPath();
 // Paths are resolved beside the naming file, then in the working directory.
 Profile loadProfile(const std::string& ref, const std::filesystem::path& named_in, int line);
 
+// Replaces one value of a loaded profile: "<effect type>.<parameter>" in every effect of that
+// type, or "background" / "vessel". `value` is read as the profile file's would be; errors name
+// `file` and the value's line.
+void overrideProfileValue(Profile& profile, const std::string& key, const toml::node& value, const std::string& file);
+
 }  // namespace angiosynth
