@@ -44,6 +44,9 @@ struct BenchmarkSpec {
   std::vector<std::string> methods;       // reference segmenters (angiosynth segment's methods)
   SegmentOptions segment;                 // their options (method aside)
   DatasetTruth truth = DatasetTruth::Exact;
+  // Also each baseline with the threshold that maximises the rung's mean Dice against the truth
+  // ("<method>-tuned"): an upper bound for any global threshold rule, not a method to deploy.
+  bool tuned = false;
   std::vector<BenchmarkLadder> ladders;
 };
 
@@ -84,6 +87,7 @@ struct BenchmarkRow {
   double thin_recall = 0;                                    // of vessels thinner than a voxel in radius
   std::vector<std::pair<std::string, double>> class_recall;  // mean recall of each kind (with two kinds or more)
   double seconds_per_case = 0;                               // the segmenter's time (baselines)
+  double tuned_fraction = 0;                                 // a tuned baseline's threshold, as a share of each case's response range (else NaN)
 };
 
 struct BenchmarkSummary {

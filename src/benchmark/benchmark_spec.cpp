@@ -187,7 +187,7 @@ BenchmarkSpec readBenchmarkSpec(const std::filesystem::path& path, const std::ve
   const auto* b = root.get("benchmark");
   if (!b || !b->is_table()) throw InputError(s.file, 0, "a benchmark file needs a [benchmark] table (title, dataset, methods, truth)");
   const auto& bt = *b->as_table();
-  checkKeys(bt, {"title", "description", "dataset", "samples", "methods", "truth", "set"}, "[benchmark]", s.file);
+  checkKeys(bt, {"title", "description", "dataset", "samples", "methods", "truth", "tuned", "set"}, "[benchmark]", s.file);
   s.title = text(bt, "title", s.file, path.stem().string());
   s.description = text(bt, "description", s.file);
   const std::string dataset = text(bt, "dataset", s.file);
@@ -220,6 +220,10 @@ BenchmarkSpec readBenchmarkSpec(const std::filesystem::path& path, const std::ve
     if (!v || (*v != "exact" && *v != "training"))
       throw InputError(s.file, lineOf(*n), "truth must be \"exact\" (the exact mask) or \"training\" (labelsTr, under the dataset's label policy)");
     s.truth = *v == "exact" ? DatasetTruth::Exact : DatasetTruth::Training;
+  }
+  if (const auto* n = bt.get("tuned")) {
+    if (!n->is_boolean()) throw InputError(s.file, lineOf(*n), "tuned must be true (also each baseline at its best threshold for the rung) or false");
+    s.tuned = *n->value<bool>();
   }
   if (const auto* n = root.get("segment")) {
     if (!n->is_table()) throw InputError(s.file, lineOf(*n), "[segment] is a table of the baselines' options");

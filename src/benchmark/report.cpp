@@ -65,7 +65,7 @@ const char* colour(std::size_t k) {
 struct Series {
   std::string name;
   const char* colour;
-  bool baseline;
+  bool baseline, dashed;
   std::vector<double> mean, sd;  // per rung (NaN: none)
 };
 
@@ -103,7 +103,7 @@ std::string chart(const std::string& title, const std::string& x_title, const st
         << escaped(rungs[k]) << ": " << fixed(se.mean[k]) << "</title></circle>";
     }
     s << "<polyline points=\"" << points << "\" fill=\"none\" stroke=\"" << se.colour << "\" stroke-width=\"" << (se.baseline ? 1.6 : 2.8) << "\""
-      << (se.baseline ? "" : "") << "/>";
+      << (se.dashed ? " stroke-dasharray=\"5 3\"" : "") << "/>";
   }
   s << "</svg>";
   return s.str();
@@ -143,7 +143,7 @@ double kindRecall(const BenchmarkRow& r, const std::string& kind) {
 std::string benchmarkCsv(const std::vector<BenchmarkRow>& rows) {
   std::ostringstream s;
   s << "ladder,rung,label,method,baseline,cases,dice,dice_sd,cldice,cldice_sd,thin_vessel_recall,hd95_mm,precision,recall,centreline_recall,"
-       "b0_error,seconds_per_case";
+       "b0_error,seconds_per_case,tuned_fraction";
   std::size_t bins = 0;
   for (const auto& r : rows) bins = std::max(bins, r.calibre_lower.size());
   const BenchmarkRow* widest = nullptr;
@@ -162,7 +162,7 @@ std::string benchmarkCsv(const std::vector<BenchmarkRow>& rows) {
   for (const auto& r : rows) {
     s << field(r.ladder) << ',' << r.rung << ',' << field(r.label) << ',' << field(r.method) << ',' << (r.baseline ? 1 : 0) << ',' << r.cases;
     for (double v : {r.dice, r.dice_sd, r.cldice, r.cldice_sd, r.thin_recall, r.hd95_mm, r.precision, r.recall, r.centreline_recall, r.b0_error,
-                     r.seconds_per_case})
+                     r.seconds_per_case, r.tuned_fraction})
       s << ',' << csvNumber(v);
     for (std::size_t b = 0; b < bins; ++b) s << ',' << (b < r.calibre_recall.size() ? csvNumber(r.calibre_recall[b]) : "");
     for (const auto& k : kinds) s << ',' << csvNumber(kindRecall(r, k));
@@ -173,12 +173,20 @@ std::string benchmarkCsv(const std::vector<BenchmarkRow>& rows) {
 
 std::string benchmarkReportHtml(const BenchmarkSpec& spec, const BenchmarkSummary& summary, const std::vector<BenchmarkThumbnail>& thumbnails,
                                 const std::string& command_line) {
-  std::vector<std::string> methods;
-  std::map<std::string, bool> baseline;
+  std::vector<std::string> methods, bases;  // a tuned baseline takes its method's colour, dashed
+  std::map<std::string, bool> baseline, tuned;
+  const std::string suffix = "-tuned";
   for (const auto& r : summary.rows) {
     if (std::find(methods.begin(), methods.end(), r.method) == methods.end()) methods.push_back(r.method);
     baseline[r.method] = r.baseline;
+    tuned[r.method] = r.baseline && std::isfinite(r.tuned_fraction);
+    const std::string base = tuned[r.method] ? r.method.substr(0, r.method.size() - suffix.size()) : r.method;
+    if (std::find(bases.begin(), bases.end(), base) == bases.end()) bases.push_back(base);
   }
+  const auto colourOf = [&](const std::string& method) {
+    const std::string base = tuned[method] ? method.substr(0, method.size() - suffix.size()) : method;
+    return colour(std::find(bases.begin(), bases.end(), base) - bases.begin());
+  };
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" << escaped(spec.title) << "</title><style>" << kStyle
     << "</style></head><body>\n";
@@ -195,9 +203,16 @@ std::string benchmarkReportHtml(const BenchmarkSpec& spec, const BenchmarkSummar
        "(26-connected). Baselines: Otsu (1979) thresholding, and Frangi et al. (1998), Sato et al. (1998), Jerman et al. (2016) vesselness "
        "thresholded as <code>angiosynth segment</code> does.</p>\n";
   h << "<p class=\"legend\">";
-  for (std::size_t m = 0; m < methods.size(); ++m)
-    h << "<span><i style=\"background:" << colour(m) << "\"></i>" << escaped(methods[m]) << (baseline[methods[m]] ? "" : " (yours)") << "</span>";
+  bool any_tuned = false;
+  for (const auto& m : bases)
+    h << "<span><i style=\"background:" << colourOf(m) << "\"></i>" << escaped(m) << (baseline[m] ? "" : " (yours)") << "</span>";
+  for (const auto& m : methods) any_tuned |= tuned[m];
+  if (any_tuned) h << "<span>dashed: the same method at its tuned threshold</span>";
   h << "</p>\n";
+  if (any_tuned)
+    h << "<p class=\"meta\">A tuned baseline (<code>&lt;method&gt;-tuned</code>, dashed) thresholds its response at the share of each case's "
+         "response range (one share for the rung, shown in the table) that gives the best mean Dice against the truth: the most any global "
+         "threshold rule could get from that filter, not a method one could deploy.</p>\n";
   for (const auto& l : spec.ladders) {
     h << "<h2 id=\"" << escaped(l.name) << "\">" << escaped(l.title) << "</h2>\n<p class=\"meta\">ladder <b>" << escaped(l.name) << "</b>: <code>"
       << escaped(l.key) << "</code> = ";
@@ -213,7 +228,12 @@ std::string benchmarkReportHtml(const BenchmarkSpec& spec, const BenchmarkSummar
                           Plot{"thin-vessel recall (radius < 1 voxel)", &BenchmarkRow::thin_recall, nullptr}}) {
       std::vector<Series> series;
       for (std::size_t m = 0; m < methods.size(); ++m) {
-        Series se{methods[m], colour(m), baseline[methods[m]], std::vector<double>(l.values.size(), NAN), std::vector<double>(l.values.size(), NAN)};
+        Series se{methods[m],
+                  colourOf(methods[m]),
+                  baseline[methods[m]],
+                  tuned[methods[m]],
+                  std::vector<double>(l.values.size(), NAN),
+                  std::vector<double>(l.values.size(), NAN)};
         for (const auto& r : summary.rows)
           if (r.ladder == l.name && r.method == methods[m]) {
             const std::size_t k = std::stoul(r.rung);
@@ -241,7 +261,8 @@ std::string benchmarkReportHtml(const BenchmarkSpec& spec, const BenchmarkSummar
     };
     for (const auto& r : summary.rows)
       if (r.ladder == l.name)
-        h << "<tr><td class=\"l\">" << escaped(r.label) << "</td><td class=\"l\">" << escaped(r.method) << "</td><td>" << r.cases << "</td><td>"
+        h << "<tr><td class=\"l\">" << escaped(r.label) << "</td><td class=\"l\">" << escaped(r.method)
+          << (std::isfinite(r.tuned_fraction) ? " (" + fixed(r.tuned_fraction, 4) + ")" : "") << "</td><td>" << r.cases << "</td><td>"
           << fixed(r.dice) << " ± " << fixed(r.dice_sd) << "</td><td>" << fixed(r.cldice) << " ± " << fixed(r.cldice_sd) << "</td><td>"
           << fixed(r.thin_recall) << "</td><td>" << fixed(r.hd95_mm, 2) << "</td><td>" << fixed(r.precision) << "</td><td>" << fixed(r.recall)
           << "</td><td>" << kindCells(r) << fixed(r.b0_error, 1) << "</td><td>" << (r.baseline ? fixed(r.seconds_per_case, 2) : "–")

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <optional>
 
 #include "angiosynth/version.hpp"
 #include "benchmark/benchmark.hpp"
@@ -133,6 +134,52 @@ std::string thumbnail(const fs::path& image, bool bright, std::uint64_t memory_l
   return pngBytes(maximumProjection(v.values, 2, lo, hi > lo ? hi : lo + 1));
 }
 
+// Candidate thresholds of the tuned baselines, as shares of a response's range: log-spaced
+// where vesselness thresholds live (1e-4 … 1), linear across the range for the image (Otsu).
+const std::vector<double> kTunedFractions = [] {
+  std::vector<double> f;
+  for (int k = 0; k <= 48; ++k) f.push_back(std::pow(10.0, -4.0 + 4.0 * k / 48.0));
+  for (int k = 1; k < 50; ++k) f.push_back(k / 50.0);
+  std::sort(f.begin(), f.end());
+  f.erase(std::unique(f.begin(), f.end()), f.end());
+  return f;
+}();
+
+// Dice of `response >= lo + f (hi - lo)` against `truth > 0` for every candidate f, the ignore
+// label's voxels left out; lo = 0 for vesselness (never negative), the minimum for an image.
+struct DiceCurve {
+  double lo = 0, hi = 0;
+  std::vector<double> dice;
+};
+DiceCurve diceCurve(const Volume<float>& response, const Volume<float>& truth, std::optional<int> ignore, bool image) {
+  DiceCurve c;
+  const auto& r = response.data;
+  c.hi = *std::max_element(r.begin(), r.end());
+  c.lo = image ? *std::min_element(r.begin(), r.end()) : 0.0;
+  std::vector<double> thresholds;
+  for (double f : kTunedFractions) thresholds.push_back(c.lo + f * (c.hi - c.lo));
+  // Voxels at or above each threshold: counted in the bin of the highest threshold they reach.
+  std::vector<std::int64_t> above(thresholds.size() + 1, 0), hits(thresholds.size() + 1, 0);
+  std::int64_t positives = 0;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    if (ignore && truth.data[i] == float(*ignore)) continue;
+    const bool vessel = truth.data[i] > 0;
+    positives += vessel;
+    const std::size_t bin = std::upper_bound(thresholds.begin(), thresholds.end(), double(r[i])) - thresholds.begin();
+    ++above[bin];
+    hits[bin] += vessel;
+  }
+  // Bin b holds voxels reaching thresholds[0 … b-1]: threshold f counts the bins above it.
+  std::int64_t p = 0, tp = 0;
+  c.dice.assign(thresholds.size(), 0.0);
+  for (std::size_t f = thresholds.size(); f-- > 0;) {
+    p += above[f + 1];
+    tp += hits[f + 1];
+    c.dice[f] = p + positives > 0 ? 2.0 * double(tp) / double(p + positives) : 1.0;
+  }
+  return c;
+}
+
 std::vector<std::string> caseIds(const fs::path& dataset_dir, std::int64_t samples) {
   std::vector<std::string> ids;
   for (const auto& [i, e] : readManifests(dataset_dir, samples))
@@ -195,8 +242,17 @@ BenchmarkSummary runBenchmark(const BenchmarkSpec& spec, const fs::path& out, co
       const std::string inputs_key = sha256File(rep.dir / "manifest.jsonl");
       thumbnails.push_back({l.name, l.rungDir(k),
                             thumbnail(rep.dir / "imagesTr" / (ids.front() + "_0000.nii.gz"), spec.segment.bright, opt.memory_limit), l.labels[k]});
-      const auto addRow = [&](const Json& results, const std::string& method, bool baseline, double seconds) {
+      const auto readCase = [&](const std::string& id, const SegmentOptions& o) {
+        return readNiftiVolume(rep.dir / "imagesTr" / (id + "_0000.nii.gz"), opt.memory_limit, 9 + segmentBytesPerVoxel(o), "image");
+      };
+      const auto runSegment = [&](const Volume<float>& image, const SegmentOptions& o, SegmentSummary& ss, Volume<float>* response) {
+        try {
+          return segment(image, o, ss, response);
+        } catch (const std::invalid_argument& e) { throw InputError(spec.file, 0, std::string("[segment]: ") + e.what()); }
+      };
+      const auto addRow = [&](const Json& results, const std::string& method, bool baseline, double seconds, double tuned_fraction = kNaN) {
         BenchmarkRow row = rowOf(results);
+        row.tuned_fraction = tuned_fraction;
         row.ladder = l.name;
         row.rung = l.rungDir(k);
         row.label = l.labels[k];
@@ -210,44 +266,71 @@ BenchmarkSummary runBenchmark(const BenchmarkSpec& spec, const fs::path& out, co
       so.memory_limit = opt.memory_limit;
       DatasetScoreOptions select;
       select.truth = spec.truth;
-      for (const auto& method : spec.methods) {
-        SegmentOptions o = spec.segment;
-        o.method = method;
-        const std::string key = sha256Text(std::string(kVersion) + "\n" + inputs_key + "\n" + method + "\n" + segmentOptionsJson(o).dump() + "\n" +
-                                           datasetTruthName(spec.truth));
-        const fs::path scores_file = rung_dir / "scores" / (method + ".json");
-        Json kept = fs::exists(scores_file) ? readJsonFile(scores_file) : Json();
+      // One baseline's masks for every case (the rule's, or per case `threshold_of` on the
+      // response), scored; kept while `key` is unchanged.
+      const auto baseline = [&](const std::string& name, const SegmentOptions& o, const std::string& key, double tuned_fraction,
+                                const std::function<double(std::size_t)>& threshold_of) {
+        const fs::path scores_file = rung_dir / "scores" / (name + ".json");
+        const Json kept = fs::exists(scores_file) ? readJsonFile(scores_file) : Json();
         if (kept.is_object() && kept.value("inputs_sha256", std::string()) == key && kept.contains("results")) {
-          addRow(kept["results"], method, true, kept.value("seconds_per_case", 0.0));
-          continue;
+          addRow(kept["results"], name, true, kept.value("seconds_per_case", 0.0), kept.value("tuned_fraction", kNaN));
+          return;
         }
-        const fs::path pred_dir = rung_dir / "predictions" / method;
+        const fs::path pred_dir = rung_dir / "predictions" / name;
         fs::create_directories(pred_dir);
         double seconds = 0;
-        for (const auto& id : ids) {
-          const NiftiVolume in =
-              readNiftiVolume(rep.dir / "imagesTr" / (id + "_0000.nii.gz"), opt.memory_limit, 5 + segmentBytesPerVoxel(o), "image");
+        for (std::size_t c = 0; c < ids.size(); ++c) {
+          const NiftiVolume in = readCase(ids[c], o);
+          SegmentOptions oc = o;
+          if (threshold_of) oc.has_threshold = true, oc.threshold = threshold_of(c);
           SegmentSummary ss;
-          Volume<std::uint8_t> mask;
-          try {
-            mask = segment(in.values, o, ss);
-          } catch (const std::invalid_argument& e) { throw InputError(spec.file, 0, std::string("[segment]: ") + e.what()); }
+          const Volume<std::uint8_t> mask = runSegment(in.values, oc, ss, nullptr);
           seconds += ss.seconds;
-          writeNiftiAtomically(pred_dir / (id + ".nii.gz"), viewOf(mask, true, "angiosynth segment " + method), &in.affine, true);
+          writeNiftiAtomically(pred_dir / (ids[c] + ".nii.gz"), viewOf(mask, true, "angiosynth segment " + o.method), &in.affine, true);
           ++sum.cases_segmented;
         }
         const DatasetScores scores = scoreDataset(rep.dir, pred_dir, so, select, {});
         fs::create_directories(scores_file.parent_path());
         const double per_case = seconds / double(ids.size());
-        writeFileAtomically(scores_file, Json{{"inputs_sha256", key},
-                                              {"method", method},
-                                              {"segment", segmentOptionsJson(o)},
-                                              {"seconds_per_case", per_case},
-                                              {"results", scores.results}}
-                                                 .dump(1) +
-                                             "\n");
-        addRow(scores.results, method, true, per_case);
-        say(where + ": " + method + " mean Dice " + std::to_string(sum.rows.back().dice));
+        Json record{{"inputs_sha256", key}, {"method", name}, {"segment", segmentOptionsJson(o)}, {"seconds_per_case", per_case}};
+        if (std::isfinite(tuned_fraction)) record["tuned_fraction"] = tuned_fraction;
+        record["results"] = scores.results;
+        writeFileAtomically(scores_file, record.dump(1) + "\n");
+        addRow(scores.results, name, true, per_case, tuned_fraction);
+        say(where + ": " + name + " mean Dice " + std::to_string(sum.rows.back().dice));
+      };
+      for (const auto& method : spec.methods) {
+        SegmentOptions o = spec.segment;
+        o.method = method;
+        const std::string key = sha256Text(std::string(kVersion) + "\n" + inputs_key + "\n" + method + "\n" + segmentOptionsJson(o).dump() + "\n" +
+                                           datasetTruthName(spec.truth));
+        baseline(method, o, key, kNaN, {});
+        if (!spec.tuned) continue;
+        // The oracle: the share of each case's response range (one for the rung) whose
+        // threshold gives the best mean Dice against the truth.
+        const std::string tuned_key = sha256Text(key + "\ntuned threshold");
+        const std::string tuned_name = method + "-tuned";
+        const Json kept = readJsonFile(rung_dir / "scores" / (tuned_name + ".json"));
+        if (kept.is_object() && kept.value("inputs_sha256", std::string()) == tuned_key) {
+          baseline(tuned_name, o, tuned_key, kNaN, {});
+          continue;
+        }
+        std::vector<double> mean_dice(kTunedFractions.size(), 0.0);
+        std::vector<std::pair<double, double>> range(ids.size());
+        for (std::size_t c = 0; c < ids.size(); ++c) {
+          const NiftiVolume in = readCase(ids[c], o);
+          SegmentSummary ss;
+          Volume<float> response;
+          runSegment(in.values, o, ss, &response);
+          const TruthFiles truth = datasetCaseTruth(rep.dir, ids[c], spec.truth);
+          const NiftiVolume t = readNiftiVolume(truth.mask, opt.memory_limit, 4 + 4, "truth");
+          const DiceCurve curve = diceCurve(response, t.values, truth.ignore_value, o.method == "otsu");
+          range[c] = {curve.lo, curve.hi};
+          for (std::size_t f = 0; f < kTunedFractions.size(); ++f) mean_dice[f] += curve.dice[f] / double(ids.size());
+        }
+        const std::size_t best = std::max_element(mean_dice.begin(), mean_dice.end()) - mean_dice.begin();
+        const double fraction = kTunedFractions[best];
+        baseline(tuned_name, o, tuned_key, fraction, [&](std::size_t c) { return range[c].first + fraction * (range[c].second - range[c].first); });
       }
       for (const auto& p : opt.predictions) {
         const fs::path dir = p.dir / l.name / l.rungDir(k);
@@ -296,6 +379,7 @@ BenchmarkSummary runBenchmark(const BenchmarkSpec& spec, const fs::path& out, co
                         {"recall", r.recall},
                         {"centreline_recall", r.centreline_recall},
                         {"b0_error", r.b0_error},
+                        {"tuned_fraction", r.tuned_fraction},
                         {"seconds_per_case", r.seconds_per_case}});
   }
   writeFileAtomically(sum.json, Json{{"tool", {{"name", "angiosynth"}, {"version", kVersion}}},
