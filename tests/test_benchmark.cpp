@@ -1,13 +1,17 @@
 // Benchmarks: the shipped noise ladder's Dice falls rung by rung for every baseline (and a
-// baseline's mean Dice is what NumPy computes from its masks), a run resumes without redoing
-// anything and scores a user's predictions beside the baselines, bad benchmark files name file
+// baseline's mean Dice is what NumPy computes from its masks), a run gives the same bytes on one
+// thread or two, resumes without redoing anything and scores a user's predictions beside the
+// baselines, bad benchmark files name file
 // and line, overrides reach the samples, and the report renders in headless Chromium with
 // nothing fetched.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <map>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "benchmark/benchmark.hpp"
 #include "cli_run.hpp"
@@ -84,6 +88,16 @@ TEST(Benchmark, ShippedNoiseLadderDiceFallsForEveryBaseline) {
   // only gain.
   for (const char* method : {"frangi", "sato", "jerman"})
     for (std::size_t k = 0; k < 6; ++k) EXPECT_GE(dice[std::string(method) + "-tuned"][k], dice[method][k] - 1e-9) << method << " rung " << k;
+  // The tuning's own Dice at the share it chose is the scored Dice of the masks it made.
+  for (const char* method : {"otsu", "frangi", "sato", "jerman"})
+    for (const char* rung : {"00", "03", "05"}) {
+      const auto j = nlohmann::json::parse(slurp(dir / "out" / "noise" / rung / "scores" / (std::string(method) + "-tuned.json")));
+      const auto& fractions = j["tuning"]["fractions"];
+      const std::size_t best = std::find(fractions.begin(), fractions.end(), j["tuned_fraction"]) - fractions.begin();
+      ASSERT_LT(best, fractions.size());
+      EXPECT_NEAR(j["tuning"]["mean_dice"][best].get<double>(), j["results"]["summary"]["dice"]["mean"].get<double>(), 1e-12)
+          << method << " " << rung;
+    }
   // The mean Dice of a rung, recomputed by NumPy from the baseline's masks and the exact truth.
   const std::string out = debianPython(R"(
 import glob, os, nibabel as nib, numpy as np
@@ -110,8 +124,13 @@ print('dice', len(d), np.mean(d))
 TEST(Benchmark, ResumesWithoutRedoingAndScoresYourPredictionsBesideTheBaselines) {
   const fs::path dir = freshTestDir("angiosynth_bench_");
   const fs::path spec = writeSmallBenchmark(dir);
-  ASSERT_EQ(run("benchmark bench.toml --out out", dir).code, 0);
+  ASSERT_EQ(run("benchmark bench.toml --out out --threads 2", dir).code, 0);
   const std::string csv = slurp(dir / "out" / "results.csv");
+  // One thread: the same scores and masks, byte for byte.
+  ASSERT_EQ(run("benchmark bench.toml --out one_thread --threads 1", dir).code, 0);
+  EXPECT_EQ(slurp(dir / "one_thread" / "results.csv"), csv);
+  for (const auto& f : fs::directory_iterator(dir / "out" / "noise" / "01" / "predictions" / "frangi"))
+    EXPECT_EQ(slurp(f.path()), slurp(dir / "one_thread" / "noise" / "01" / "predictions" / "frangi" / f.path().filename())) << f.path();
   // Into the same directory: refused without --resume; with it, nothing is made again.
   const ::Run again = run("benchmark bench.toml --out out", dir);
   EXPECT_EQ(again.code, 2);

@@ -109,6 +109,7 @@ struct BenchmarkThumbnail {
 };
 std::string benchmarkReportHtml(const BenchmarkSpec& spec, const BenchmarkSummary& summary, const std::vector<BenchmarkThumbnail>& thumbnails,
                                 const std::string& command_line);
+// results.csv: the scores only (no timing), so the same spec gives the same bytes.
 std::string benchmarkCsv(const std::vector<BenchmarkRow>& rows);
 
 }  // namespace angiosynth

@@ -143,7 +143,7 @@ double kindRecall(const BenchmarkRow& r, const std::string& kind) {
 std::string benchmarkCsv(const std::vector<BenchmarkRow>& rows) {
   std::ostringstream s;
   s << "ladder,rung,label,method,baseline,cases,dice,dice_sd,cldice,cldice_sd,thin_vessel_recall,hd95_mm,precision,recall,centreline_recall,"
-       "b0_error,seconds_per_case,tuned_fraction";
+       "b0_error,tuned_fraction";
   std::size_t bins = 0;
   for (const auto& r : rows) bins = std::max(bins, r.calibre_lower.size());
   const BenchmarkRow* widest = nullptr;
@@ -162,7 +162,7 @@ std::string benchmarkCsv(const std::vector<BenchmarkRow>& rows) {
   for (const auto& r : rows) {
     s << field(r.ladder) << ',' << r.rung << ',' << field(r.label) << ',' << field(r.method) << ',' << (r.baseline ? 1 : 0) << ',' << r.cases;
     for (double v : {r.dice, r.dice_sd, r.cldice, r.cldice_sd, r.thin_recall, r.hd95_mm, r.precision, r.recall, r.centreline_recall, r.b0_error,
-                     r.seconds_per_case, r.tuned_fraction})
+                     r.tuned_fraction})
       s << ',' << csvNumber(v);
     for (std::size_t b = 0; b < bins; ++b) s << ',' << (b < r.calibre_recall.size() ? csvNumber(r.calibre_recall[b]) : "");
     for (const auto& k : kinds) s << ',' << csvNumber(kindRecall(r, k));

@@ -145,35 +145,46 @@ const std::vector<double> kTunedFractions = [] {
   return f;
 }();
 
-// Dice of `response >= lo + f (hi - lo)` against `truth > 0` for every candidate f, the ignore
-// label's voxels left out; lo = 0 for vesselness (never negative), the minimum for an image.
+// Dice against `truth > 0` (the ignore label's voxels left out) of the mask segment() makes at
+// the threshold lo + f (hi - lo), for every candidate f: for the image (Otsu) voxels above it,
+// lo its minimum; for vesselness voxels of positive response at or above it (in single
+// precision, as segment() compares), lo = 0.
 struct DiceCurve {
   double lo = 0, hi = 0;
   std::vector<double> dice;
 };
+double tunedThreshold(const DiceCurve& c, double fraction, bool image) {
+  const double t = c.lo + fraction * (c.hi - c.lo);
+  return image ? t : double(float(t));
+}
 DiceCurve diceCurve(const Volume<float>& response, const Volume<float>& truth, std::optional<int> ignore, bool image) {
   DiceCurve c;
   const auto& r = response.data;
   c.hi = *std::max_element(r.begin(), r.end());
   c.lo = image ? *std::min_element(r.begin(), r.end()) : 0.0;
   std::vector<double> thresholds;
-  for (double f : kTunedFractions) thresholds.push_back(c.lo + f * (c.hi - c.lo));
-  // Voxels at or above each threshold: counted in the bin of the highest threshold they reach.
-  std::vector<std::int64_t> above(thresholds.size() + 1, 0), hits(thresholds.size() + 1, 0);
+  for (double f : kTunedFractions) thresholds.push_back(tunedThreshold(c, f, image));
+  // Each voxel counts in the bin of how many thresholds it passes; threshold f is passed by the
+  // voxels of bins f + 1 and above.
+  std::vector<std::int64_t> passing(thresholds.size() + 1, 0), hits(thresholds.size() + 1, 0);
   std::int64_t positives = 0;
   for (std::size_t i = 0; i < r.size(); ++i) {
     if (ignore && truth.data[i] == float(*ignore)) continue;
     const bool vessel = truth.data[i] > 0;
     positives += vessel;
-    const std::size_t bin = std::upper_bound(thresholds.begin(), thresholds.end(), double(r[i])) - thresholds.begin();
-    ++above[bin];
+    const double v = r[i];
+    std::size_t bin = 0;
+    if (image)
+      bin = std::lower_bound(thresholds.begin(), thresholds.end(), v) - thresholds.begin();  // thresholds below v
+    else if (v > 0)
+      bin = std::upper_bound(thresholds.begin(), thresholds.end(), v) - thresholds.begin();  // thresholds at or below v
+    ++passing[bin];
     hits[bin] += vessel;
   }
-  // Bin b holds voxels reaching thresholds[0 … b-1]: threshold f counts the bins above it.
   std::int64_t p = 0, tp = 0;
   c.dice.assign(thresholds.size(), 0.0);
   for (std::size_t f = thresholds.size(); f-- > 0;) {
-    p += above[f + 1];
+    p += passing[f + 1];
     tp += hits[f + 1];
     c.dice[f] = p + positives > 0 ? 2.0 * double(tp) / double(p + positives) : 1.0;
   }
@@ -269,7 +280,7 @@ BenchmarkSummary runBenchmark(const BenchmarkSpec& spec, const fs::path& out, co
       // One baseline's masks for every case (the rule's, or per case `threshold_of` on the
       // response), scored; kept while `key` is unchanged.
       const auto baseline = [&](const std::string& name, const SegmentOptions& o, const std::string& key, double tuned_fraction,
-                                const std::function<double(std::size_t)>& threshold_of) {
+                                const std::function<double(std::size_t)>& threshold_of, const Json& tuning = Json()) {
         const fs::path scores_file = rung_dir / "scores" / (name + ".json");
         const Json kept = fs::exists(scores_file) ? readJsonFile(scores_file) : Json();
         if (kept.is_object() && kept.value("inputs_sha256", std::string()) == key && kept.contains("results")) {
@@ -294,6 +305,7 @@ BenchmarkSummary runBenchmark(const BenchmarkSpec& spec, const fs::path& out, co
         const double per_case = seconds / double(ids.size());
         Json record{{"inputs_sha256", key}, {"method", name}, {"segment", segmentOptionsJson(o)}, {"seconds_per_case", per_case}};
         if (std::isfinite(tuned_fraction)) record["tuned_fraction"] = tuned_fraction;
+        if (!tuning.is_null()) record["tuning"] = tuning;
         record["results"] = scores.results;
         writeFileAtomically(scores_file, record.dump(1) + "\n");
         addRow(scores.results, name, true, per_case, tuned_fraction);
@@ -316,7 +328,7 @@ BenchmarkSummary runBenchmark(const BenchmarkSpec& spec, const fs::path& out, co
           continue;
         }
         std::vector<double> mean_dice(kTunedFractions.size(), 0.0);
-        std::vector<std::pair<double, double>> range(ids.size());
+        std::vector<DiceCurve> curves(ids.size());
         for (std::size_t c = 0; c < ids.size(); ++c) {
           const NiftiVolume in = readCase(ids[c], o);
           SegmentSummary ss;
@@ -324,13 +336,15 @@ BenchmarkSummary runBenchmark(const BenchmarkSpec& spec, const fs::path& out, co
           runSegment(in.values, o, ss, &response);
           const TruthFiles truth = datasetCaseTruth(rep.dir, ids[c], spec.truth);
           const NiftiVolume t = readNiftiVolume(truth.mask, opt.memory_limit, 4 + 4, "truth");
-          const DiceCurve curve = diceCurve(response, t.values, truth.ignore_value, o.method == "otsu");
-          range[c] = {curve.lo, curve.hi};
-          for (std::size_t f = 0; f < kTunedFractions.size(); ++f) mean_dice[f] += curve.dice[f] / double(ids.size());
+          curves[c] = diceCurve(response, t.values, truth.ignore_value, o.method == "otsu");
+          for (std::size_t f = 0; f < kTunedFractions.size(); ++f) mean_dice[f] += curves[c].dice[f] / double(ids.size());
+          curves[c].dice.clear();
         }
         const std::size_t best = std::max_element(mean_dice.begin(), mean_dice.end()) - mean_dice.begin();
         const double fraction = kTunedFractions[best];
-        baseline(tuned_name, o, tuned_key, fraction, [&](std::size_t c) { return range[c].first + fraction * (range[c].second - range[c].first); });
+        const Json tuning{{"fractions", kTunedFractions}, {"mean_dice", mean_dice}};
+        baseline(
+            tuned_name, o, tuned_key, fraction, [&](std::size_t c) { return tunedThreshold(curves[c], fraction, o.method == "otsu"); }, tuning);
       }
       for (const auto& p : opt.predictions) {
         const fs::path dir = p.dir / l.name / l.rungDir(k);

@@ -102,7 +102,7 @@ struct MethodEntry {
 
 const std::vector<MethodEntry>& registry() {
   static const std::vector<MethodEntry> all{
-      {{"otsu", "the image at or above Otsu's threshold (256-bin histogram; Otsu 1979)"}, nullptr},
+      {{"otsu", "the image above Otsu's threshold (256-bin histogram; Otsu 1979)"}, nullptr},
       // Frangi: the two largest eigenvalues negative, impossible with two positive ones.
       {{"frangi", "Frangi et al. (1998) vesselness, scale-normalised Hessian, max over scales, as scikit-image's frangi"}, frangi, 2},
       // Sato: the smallest eigenvalue negative, impossible with three positive ones.
