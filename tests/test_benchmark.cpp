@@ -131,6 +131,17 @@ TEST(Benchmark, ResumesWithoutRedoingAndScoresYourPredictionsBesideTheBaselines)
   EXPECT_EQ(slurp(dir / "one_thread" / "results.csv"), csv);
   for (const auto& f : fs::directory_iterator(dir / "out" / "noise" / "01" / "predictions" / "frangi"))
     EXPECT_EQ(slurp(f.path()), slurp(dir / "one_thread" / "noise" / "01" / "predictions" / "frangi" / f.path().filename())) << f.path();
+  // In two shards (each rung's samples split), then scored once: the same bytes again.
+  for (const char* shard : {"0/2", "1/2"}) {
+    const ::Run part = runPrinted(std::string("benchmark bench.toml --out sharded --shard ") + shard, dir);
+    ASSERT_EQ(part.code, 0) << part.err;
+    EXPECT_NE(part.err.find("when every shard is done"), std::string::npos) << part.err;
+    EXPECT_FALSE(fs::exists(dir / "sharded" / "results.csv"));
+  }
+  const ::Run joined = runPrinted("benchmark bench.toml --out sharded --resume", dir);
+  ASSERT_EQ(joined.code, 0) << joined.err;
+  EXPECT_NE(joined.err.find("0 samples generated, 4 kept"), std::string::npos) << joined.err;
+  EXPECT_EQ(slurp(dir / "sharded" / "results.csv"), csv);
   // Into the same directory: refused without --resume; with it, nothing is made again.
   const ::Run again = run("benchmark bench.toml --out out", dir);
   EXPECT_EQ(again.code, 2);
