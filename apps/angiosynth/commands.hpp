@@ -77,6 +77,15 @@ struct BenchmarkArgs {
 CLI::App* addBenchmark(CLI::App& app, BenchmarkArgs& a);
 int runBenchmarkCommand(const BenchmarkArgs& a, const std::string& command_line);
 
+struct StatsArgs {
+  std::string input, out;
+  std::vector<double> bands;
+  bool force = false;
+  CommonOptions common;
+};
+CLI::App* addStats(CLI::App& app, StatsArgs& a);
+int runStats(const StatsArgs& a);
+
 struct SegmentArgs {
   std::string image, out, response;
   SegmentOptions options;

@@ -35,6 +35,8 @@ int main(int argc, char** argv) {
   auto* se = cli::addSegment(app, sg);
   cli::BenchmarkArgs ba;
   auto* bm = cli::addBenchmark(app, ba);
+  cli::StatsArgs st;
+  auto* stt = cli::addStats(app, st);
   cli::MeshArgs ma;
   auto* me = cli::addMesh(app, ma);
   cli::PlotCalibreArgs pc;
@@ -57,6 +59,7 @@ int main(int argc, char** argv) {
     if (se->parsed()) return cli::runSegment(sg);
     if (me->parsed()) return cli::runMesh(ma, cmdline);
     if (bm->parsed()) return cli::runBenchmarkCommand(ba, cmdline);
+    if (stt->parsed()) return cli::runStats(st);
     if (fx->parsed()) {
       std::cout << effectReference();
       return 0;

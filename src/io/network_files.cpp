@@ -104,6 +104,8 @@ ExistingNetwork assemble(const std::string& file, const std::vector<Row>& rows, 
   std::size_t placed = 0;
   for (std::size_t tr = 0; tr < roots.size(); ++tr) {
     const auto& r = rows[roots[tr]];
+    net.tree_names.push_back(r.tree_name);
+    net.tree_kinds.push_back(r.kind);
     const auto root = t.addNode(swc ? r.dist * unit_mm : r.prox * unit_mm, -1, std::int32_t(tr));
     if (swc) {
       note(root, r);

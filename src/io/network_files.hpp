@@ -16,6 +16,8 @@ struct ExistingNetwork {
   VascularTree tree;             // positions in mm; radii as in the file (mm), not solved
   std::vector<std::string> ids;  // per node: its id in the file (a .cco vessel's, an SWC sample's)
   std::vector<int> lines;        // per node: the line of the file that defines it
+  // Per tree (root order): its name and kind where the file gives them (angiosynth's CSV), else empty.
+  std::vector<std::string> tree_names, tree_kinds;
   // .cco header: the tree's inflow (file units^3/s), reference pressure and root radius.
   double flow = 0, reference_pressure = 0, root_radius = 0;
 };

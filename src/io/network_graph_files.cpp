@@ -157,7 +157,8 @@ ExistingNetwork readCsv(const std::string& file, double unit_mm) {
   const int eid = edges.column("id", false), from = edges.column("node1id", true), to = edges.column("node2id", true),
             radius = edges.column("radius", true), stage = edges.column("stage", false), role = edges.column("role", false),
             branching = edges.column("branching", false), radius_start = edges.column("radius_start", false),
-            wall_start = edges.column("wall_start", false), wall = edges.column("wall", false);
+            wall_start = edges.column("wall_start", false), wall = edges.column("wall", false), tree_column = edges.column("tree", false),
+            kind_column = edges.column("kind", false);
   std::vector<PointSegment> segments;
   for (const auto& [line, c] : edges.rows) {
     const auto& f = edges.file;
@@ -181,6 +182,8 @@ ExistingNetwork readCsv(const std::string& file, double unit_mm) {
     }
     if (role >= 0) s.row.role = roleNamed(f, line, c[role]);
     if (branching >= 0) s.row.branching = branchingNamed(f, line, c[branching]);
+    if (tree_column >= 0) s.row.tree_name = c[tree_column];
+    if (kind_column >= 0) s.row.kind = c[kind_column];
     segments.push_back(std::move(s));
   }
   if (segments.empty()) throw InputError(edges.file, 1, "no edges");

@@ -18,6 +18,7 @@ struct Row {
   double wall_start = 0, wall = 0;  // its wall thickness at the proximal and distal end (0: none given)
   std::int16_t stage = -1;
   std::uint8_t role = 0, branching = 0;
+  std::string tree_name, kind;  // CSV columns tree and kind (empty: not given)
   int line = 0;
 };
 

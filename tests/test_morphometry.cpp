@@ -1,0 +1,246 @@
+// Morphometry: hand-built trees with known angles, radii, exponents, orders and tortuosity give
+// exactly those numbers, and `angiosynth stats` on a grown forest of curved vessels agrees vessel
+// by vessel and bifurcation by bifurcation with NetworkX, NumPy and SciPy on its edges.csv.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "cli_run.hpp"
+#include "morphometry/morphometry.hpp"
+#include "test_support.hpp"
+
+namespace angiosynth {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kPi = 3.14159265358979323846;
+
+Vec3 direction(double degrees_from_z, double azimuth_degrees) {
+  const double t = degrees_from_z * kPi / 180, a = azimuth_degrees * kPi / 180;
+  return {std::sin(t) * std::cos(a), std::sin(t) * std::sin(a), std::cos(t)};
+}
+
+std::int32_t add(VascularTree& t, std::int32_t parent, const Vec3& p, double radius) {
+  const std::int32_t id = t.addNode(p, parent);
+  t.radius[std::size_t(id)] = radius;
+  return id;
+}
+
+// A parent along z splitting into daughters at 30° and 45° on either side in the x-z plane, the
+// small daughter's radius chosen for Murray's exponent 2.7; then a second split whose daughters'
+// plane (x-y) is square to the parent.
+TEST(Morphometry, HandBuiltBifurcationsHaveTheirAnglesRadiiAndExponent) {
+  VascularTree t;
+  const auto root = t.addNode({0, 0, 0}, -1);
+  const auto a = add(t, root, {0, 0, 10}, 1.0);
+  const double r_small = std::pow(1 - std::pow(0.8, 2.7), 1 / 2.7);
+  const auto b = add(t, a, Vec3(0, 0, 10) + direction(30, 0) * 5.0, 0.8);
+  add(t, a, Vec3(0, 0, 10) + direction(45, 180) * 5.0, r_small);
+  const Vec3 end_b = t.position[std::size_t(b)], along = direction(30, 0);
+  add(t, b, end_b + Vec3(0, 1, 0) * 3.0, 0.5);
+  add(t, b, end_b + cross(along, Vec3(0, 1, 0)) * 3.0, 0.5);
+  const Morphometry m = measureTrees(t, {}, {});
+  ASSERT_EQ(m.bifurcations.size(), 2u);
+  const auto& first = m.bifurcations[0];
+  EXPECT_NEAR(first.angle_large_deg, 30, 1e-9);
+  EXPECT_NEAR(first.angle_small_deg, 45, 1e-9);
+  EXPECT_NEAR(first.angle_between_deg, 75, 1e-9);
+  EXPECT_NEAR(first.out_of_plane_deg, 0, 1e-9);
+  EXPECT_NEAR(first.murray_exponent, 2.7, 1e-9);
+  EXPECT_NEAR(first.asymmetry, r_small / 0.8, 1e-12);
+  EXPECT_NEAR(first.area_ratio, 0.64 + r_small * r_small, 1e-12);
+  const auto& second = m.bifurcations[1];
+  EXPECT_NEAR(second.angle_between_deg, 90, 1e-9);
+  EXPECT_NEAR(second.out_of_plane_deg, 90, 1e-9);
+  EXPECT_NEAR(second.murray_exponent, std::log(2.0) / std::log(1.6), 1e-9);  // 2 (0.5 / 0.8)^γ = 1
+  EXPECT_NEAR(murrayExponent(1, std::pow(0.5, 1 / 3.0), std::pow(0.5, 1 / 3.0)), 3, 1e-9);
+  EXPECT_TRUE(std::isnan(murrayExponent(1, 1, 0.5)));
+}
+
+// A symmetric binary tree of depth 5: Strahler orders 1 … 6, each vessel its own element, element
+// counts halving (Horton's branching ratio 2), lengths doubling and diameters growing by 2^(1/3)
+// per order, Murray's exponent 3 at every bifurcation.
+TEST(Morphometry, SymmetricTreeHasHortonsRatiosAndMurraysExponent) {
+  VascularTree t;
+  const int depth = 5;
+  const auto root = t.addNode({0, 0, 0}, -1);
+  std::vector<std::int32_t> level{add(t, root, {0, 0, 32}, 1.0)};
+  for (int g = 1; g <= depth; ++g) {
+    std::vector<std::int32_t> next;
+    const double length = std::pow(2.0, 5 - g), radius = std::pow(2.0, -g / 3.0);
+    for (const auto p : level)
+      for (const double side : {-1.0, 1.0}) {
+        const Vec3 d = direction(30, side > 0 ? 90.0 * (g % 2) : 180 + 90.0 * (g % 2));
+        next.push_back(add(t, p, t.position[std::size_t(p)] + d * length, radius));
+      }
+    level = next;
+  }
+  const Morphometry m = measureTrees(t, {}, {});
+  const auto& g = m.groups.at(0);
+  EXPECT_EQ(g.vessels, 63);
+  EXPECT_EQ(g.terminals, 32);
+  ASSERT_EQ(g.strahler.size(), 6u);
+  for (const auto& o : g.strahler) EXPECT_EQ(o.elements, o.vessels) << o.order;
+  EXPECT_NEAR(g.horton_branching, 2, 1e-12);
+  EXPECT_NEAR(g.horton_length, 2, 1e-12);
+  EXPECT_NEAR(g.horton_diameter, std::cbrt(2.0), 1e-12);
+  EXPECT_NEAR(g.murray_fitted, 3, 1e-9);
+  for (const auto& b : m.bifurcations) EXPECT_NEAR(b.murray_exponent, 3, 1e-9);
+  EXPECT_NEAR(g.summaries.at("terminal_path_length_mm").min, 32 + 16 + 8 + 4 + 2 + 1, 1e-12);
+  EXPECT_NEAR(g.summaries.at("terminal_generation").max, 5, 0);
+}
+
+// A zigzag vessel of four pieces at right angles in a plane: distance metric √2, two inflections,
+// and the sum of angles 3 × 90° over its length; a helix turns one way only: no inflection.
+TEST(Morphometry, TortuosityOfPolylinesFollowsBullittsMetrics) {
+  VascularTree t;
+  std::int32_t at = t.addNode({0, 0, 0}, -1);
+  for (const Vec3 p : {Vec3(1, 1, 0), Vec3(2, 0, 0), Vec3(3, 1, 0), Vec3(4, 0, 0)}) at = add(t, at, p, 0.1);
+  const Morphometry zigzag = measureTrees(t, {}, {});
+  ASSERT_EQ(zigzag.vessels.size(), 1u);
+  const auto& v = zigzag.vessels[0];
+  EXPECT_EQ(v.pieces, 4);
+  EXPECT_NEAR(v.distance_metric, std::sqrt(2.0), 1e-12);
+  EXPECT_EQ(v.inflections, 2);
+  EXPECT_NEAR(v.sum_of_angles_per_mm, 3 * kPi / 2 / (4 * std::sqrt(2.0)), 1e-12);
+  VascularTree h;
+  at = h.addNode({1, 0, 0}, -1);
+  for (int k = 1; k <= 40; ++k) at = add(h, at, {std::cos(k * 0.3), std::sin(k * 0.3), 0.1 * k}, 0.1);
+  const Morphometry helix = measureTrees(h, {}, {});
+  EXPECT_EQ(helix.vessels[0].inflections, 0);
+  EXPECT_GT(helix.vessels[0].distance_metric, 1.5);
+}
+
+// A forest of curved arteries and veins grown by `generate`, measured by `stats`, and measured
+// again from its edges.csv and nodes.csv with NetworkX (vessels, generations, path lengths,
+// Strahler orders), NumPy (angles) and SciPy (Murray's exponent by brentq).
+TEST(Morphometry, StatsAgreeWithNetworkXOnAGrownForestOfCurvedVessels) {
+  const fs::path dir = freshTestDir("angiosynth_stats_");
+  std::ofstream(dir / "forest.toml") << R"(seed = 3
+[domain]
+shape = "sphere"
+radius = "10 mm"
+voxel_size = "0.3 mm"
+[tree]
+method = "cco"
+terminals = 150
+[[tree.inlet]]
+kind = "artery"
+root_offset = [-2, 9.7, 0]
+[[tree.inlet]]
+kind = "vein"
+root_offset = [2, 9.7, 0]
+root_pressure = "5 mmHg"
+terminal_pressure = "20 mmHg"
+[physics]
+murray_exponent = 2.7
+perfusion_pressure = "100 mmHg"
+terminal_pressure = "60 mmHg"
+perfusion_flow = "50 mL/min"
+[curves]
+tortuosity = 1.2
+tortuosity_sd = 0.05
+wavelength_radii = 40
+[image]
+enabled = false
+)";
+  ASSERT_EQ(run("generate forest.toml --out sample --quiet", dir).code, 0);
+  const ::Run r = run("stats sample --out stats --quiet", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string out = debianPython(R"(
+import csv, json, math
+import networkx as nx, numpy as np
+from scipy.optimize import brentq
+nodes = {r['id']: r for r in csv.DictReader(open('sample/nodes.csv'))}
+edges = list(csv.DictReader(open('sample/edges.csv')))
+pos = {k: np.array([float(v['pos_x']), float(v['pos_y']), float(v['pos_z'])]) for k, v in nodes.items()}
+G = nx.DiGraph()
+for e in edges:
+    G.add_edge(e['node1id'], e['node2id'], id=e['id'], radius=float(e['radius']),
+               length=float(np.linalg.norm(pos[e['node2id']] - pos[e['node1id']])), kind=e['kind'])
+# Vessels: from a root or branching node through nodes of one child, named by their last edge.
+vessels, bif = {}, []
+def walk(start, first, parent, gen, path):
+    chain = [first]
+    while G.out_degree(chain[-1][1]) == 1:
+        u = chain[-1][1]
+        chain.append((u, next(iter(G.successors(u)))))
+    name = G.edges[chain[-1]]['id']
+    length = sum(G.edges[e]['length'] for e in chain)
+    vessels[name] = dict(parent=parent, pieces=len(chain), length=length, generation=gen, path=path,
+                         end=chain[-1][1], chain=chain, children=[])
+    if parent: vessels[parent]['children'].append(name)
+    for v in G.successors(chain[-1][1]):
+        walk(chain[-1][1], (chain[-1][1], v), name, gen + 1, path + length)
+roots = [n for n in G if G.in_degree(n) == 0]
+for r0 in roots:
+    for v in G.successors(r0): walk(r0, (r0, v), '', 0, 0.0)
+# Path lengths again, by NetworkX's Dijkstra from each root.
+for r0 in roots:
+    d = nx.single_source_dijkstra_path_length(G, r0, weight='length')
+    for name, v in vessels.items():
+        if v['chain'][0][0] in d: v['dijkstra'] = d[v['chain'][0][0]]
+def strahler(name):
+    kids = [strahler(c) for c in vessels[name]['children']]
+    if not kids: o = 1
+    else:
+        top = max(kids); o = top + 1 if kids.count(top) >= 2 else top
+    vessels[name]['strahler'] = o
+    return o
+for name, v in vessels.items():
+    if not v['parent']: strahler(name)
+worst = dict(length=0, path=0, dijkstra=0, pieces=0, generation=0, strahler=0, angle=0, murray=0, count=0)
+for row in csv.DictReader(open('stats/vessels.csv')):
+    v = vessels[row['vessel']]
+    worst['length'] = max(worst['length'], abs(float(row['length_mm']) - v['length']))
+    worst['path'] = max(worst['path'], abs(float(row['path_length_to_root_mm']) - v['path']))
+    worst['dijkstra'] = max(worst['dijkstra'], abs(float(row['path_length_to_root_mm']) - v['dijkstra']))
+    worst['pieces'] += int(row['pieces']) != v['pieces']
+    worst['generation'] += int(row['generation']) != v['generation']
+    worst['strahler'] += int(row['strahler']) != v['strahler']
+    worst['count'] += 1
+def angle(a, b): return math.degrees(math.acos(max(-1.0, min(1.0, a @ b / np.linalg.norm(a) / np.linalg.norm(b)))))
+bifs = 0
+for row in csv.DictReader(open('stats/bifurcations.csv')):
+    p = vessels[row['parent']]
+    last = p['chain'][-1]
+    u0 = pos[last[1]] - pos[last[0]]
+    for key, d in (('angle_large_deg', row['daughter_large']), ('angle_small_deg', row['daughter_small'])):
+        e = vessels[d]['chain'][0]
+        worst['angle'] = max(worst['angle'], abs(float(row[key]) - angle(u0, pos[e[1]] - pos[e[0]])))
+    r0 = G.edges[last]['radius']
+    r1 = G.edges[vessels[row['daughter_large']]['chain'][0]]['radius']
+    r2 = G.edges[vessels[row['daughter_small']]['chain'][0]]['radius']
+    g = brentq(lambda g: (r1 / r0) ** g + (r2 / r0) ** g - 1, 0.01, 100, xtol=1e-14)
+    worst['murray'] = max(worst['murray'], abs(float(row['murray_exponent']) - g))
+    bifs += 1
+stats = json.load(open('stats/stats.json'))
+groups = [g['group'] for g in stats['groups']]
+print('vessels', worst['count'], len(vessels), 'bifurcations', bifs, 'length', worst['length'], 'path', worst['path'],
+      'dijkstra', worst['dijkstra'], 'pieces', worst['pieces'], 'generation', worst['generation'], 'strahler', worst['strahler'],
+      'angle', worst['angle'], 'murray', worst['murray'], 'groups', ','.join(groups).replace(' ', '_'))
+)",
+                                       dir);
+  std::istringstream in(out.substr(out.find("vessels")));
+  std::string w, groups;
+  long counted = 0, expected = 0, bifurcations = 0, pieces = -1, generation = -1, strahler = -1;
+  double length = 1, path = 1, dijkstra = 1, angle = 1, murray = 1;
+  in >> w >> counted >> expected >> w >> bifurcations >> w >> length >> w >> path >> w >> dijkstra >> w >> pieces >> w >> generation >> w >>
+      strahler >> w >> angle >> w >> murray >> w >> groups;
+  EXPECT_EQ(counted, expected) << out;
+  EXPECT_EQ(expected, 598) << out;  // 2 × (2 × 150 − 1) vessels
+  EXPECT_EQ(bifurcations, 298) << out;
+  EXPECT_LT(length, 1e-9) << out;
+  EXPECT_LT(path, 1e-9) << out;
+  EXPECT_LT(dijkstra, 1e-9) << out;
+  EXPECT_EQ(pieces, 0) << out;
+  EXPECT_EQ(generation, 0) << out;
+  EXPECT_EQ(strahler, 0) << out;
+  EXPECT_LT(angle, 1e-9) << out;
+  EXPECT_LT(murray, 1e-9) << out;
+  EXPECT_EQ(groups, "all,kind_artery,kind_vein") << out;
+}
+
+}  // namespace
+}  // namespace angiosynth
