@@ -11,7 +11,7 @@ CLI::App* addBenchmark(CLI::App& app, BenchmarkArgs& a) {
   auto* c = app.add_subcommand("benchmark",
                                "difficulty ladders over a dataset spec: every rung generated, segmented by the reference segmenters and scored; "
                                "report.html (curves, thumbnails, tables), results.csv, benchmark.json");
-  c->add_option("SPEC", a.spec, "benchmark file (.toml): [benchmark], [segment], [[ladder]] (docs/benchmarks-for-segmentation.md)")->required();
+  c->add_option("SPEC", a.spec, "benchmark file (.toml): [benchmark], [segment], [[ladder]] (docs/benchmark-ladders.md)")->required();
   c->add_option("--out", a.out, "the benchmark's directory")->required();
   c->add_option("--predictions", a.predictions,
                 "NAME=DIR: your method's masks, DIR/<ladder>/<rung>/<case>.nii.gz, scored beside the baselines (repeatable)");
