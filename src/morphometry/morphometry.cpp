@@ -181,14 +181,15 @@ Morphometry measureTrees(const VascularTree& t, const std::vector<std::string>& 
   for (const auto root : t.roots())
     for (const auto s : kids[std::size_t(root)]) queue.emplace_back(s, -1);
   for (std::size_t q = 0; q < queue.size(); ++q) {
-    const auto [first, parent] = queue[q];
+    const std::int32_t first = queue[q].first, parent = queue[q].second;
     VesselMeasures v;
     v.parent = parent;
-    v.proximal_node = parent >= 0 ? m.vessels[std::size_t(parent)].id : [&] {
-      std::int32_t r = t.parent[first];
-      while (!t.isRoot(r) && t.isLink(r)) r = t.parent[r];
-      return r;
-    }();
+    if (parent >= 0) {
+      v.proximal_node = m.vessels[std::size_t(parent)].id;
+    } else {
+      v.proximal_node = t.parent[std::size_t(first)];
+      while (!t.isRoot(v.proximal_node) && t.isLink(v.proximal_node)) v.proximal_node = t.parent[std::size_t(v.proximal_node)];
+    }
     v.tree = t.tree.empty() ? 0 : t.tree[std::size_t(first)];
     std::vector<Vec3> points{t.position[std::size_t(v.proximal_node)]};
     double weighted_radius = 0;
