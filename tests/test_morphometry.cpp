@@ -240,6 +240,15 @@ print('vessels', worst['count'], len(vessels), 'bifurcations', bifs, 'length', w
   EXPECT_LT(angle, 1e-9) << out;
   EXPECT_LT(murray, 1e-9) << out;
   EXPECT_EQ(groups, "all,kind_artery,kind_vein") << out;
+  // The figure: twelve histograms, arteries in red and veins in blue (the class colours).
+  const std::string png = debianPython(R"(
+from PIL import Image
+im = Image.open('stats/stats.png').convert('RGB')
+px = list(im.getdata())
+print('png', im.size[0], im.size[1], sum(1 for p in px if p == (0xB3, 0x26, 0x2E)) > 500, sum(1 for p in px if p == (0x2B, 0x4C, 0x9A)) > 500)
+)",
+                                       dir);
+  EXPECT_NE(png.find("png 990 950 True True"), std::string::npos) << png;
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "files/atomic_file.hpp"
 #include "files/output_guard.hpp"
 #include "io/network_files.hpp"
+#include "io/volume_writers.hpp"
 #include "morphometry/morphometry.hpp"
 
 namespace angiosynth::cli {
@@ -20,7 +21,8 @@ CLI::App* addStats(CLI::App& app, StatsArgs& a) {
                          "radius band, Strahler orders and Horton's ratios, path lengths; per tree and per kind");
   c->add_option("INPUT", a.input, "a sample directory (its nodes.csv and edges.csv are read) or a graph file: .csv, .gxl, .vtp, .swc, .cco")
       ->required();
-  c->add_option("--out", a.out, "write stats.json, vessels.csv and bifurcations.csv into this directory (default: print the summary)");
+  c->add_option("--out", a.out,
+                "write stats.json, vessels.csv, bifurcations.csv and stats.png (histograms) into this directory (default: print the summary)");
   c->add_option("--murray-bands", a.bands, "lower edges (mm) of the parent-radius bands of Murray's exponent (default 0.1 1)");
   c->add_flag("--force", a.force, "replace the files of an earlier --out");
   addCommonOptions(*c, a.common);
@@ -41,7 +43,7 @@ int runStats(const StatsArgs& a) {
   }
   std::vector<OutputFile> outputs;
   if (!a.out.empty())
-    for (const char* f : {"stats.json", "vessels.csv", "bifurcations.csv"}) outputs.push_back({fs::path(a.out) / f, "--out"});
+    for (const char* f : {"stats.json", "vessels.csv", "bifurcations.csv", "stats.png"}) outputs.push_back({fs::path(a.out) / f, "--out"});
   checkOutputFiles(outputs, {graph}, a.force);
   const ExistingNetwork net = readNetwork(graph, 1, memoryLimit(a.common));
   Morphometry m = measureTrees(net.tree, net.tree_names, net.tree_kinds, options);
@@ -53,6 +55,7 @@ int runStats(const StatsArgs& a) {
     writeFileAtomically(fs::path(a.out) / "stats.json", j.dump(1) + "\n", a.force);
     writeFileAtomically(fs::path(a.out) / "vessels.csv", m.vesselsCsv(), a.force);
     writeFileAtomically(fs::path(a.out) / "bifurcations.csv", m.bifurcationsCsv(), a.force);
+    writeFileAtomically(fs::path(a.out) / "stats.png", encodePng(morphometryFigure(m)), a.force);
   }
   if (a.common.quiet) return 0;
   for (const auto& g : m.groups) {

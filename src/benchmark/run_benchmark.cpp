@@ -94,25 +94,6 @@ BenchmarkRow rowOf(const Json& results) {
   return r;
 }
 
-// The PNG of an image as bytes.
-std::string pngBytes(const Image8& image) {
-  char* buf = nullptr;
-  std::size_t size = 0;
-  std::FILE* f = open_memstream(&buf, &size);
-  if (!f) throw std::runtime_error("cannot open a memory stream for a PNG");
-  try {
-    writePng(f, "thumbnail", image);
-  } catch (...) {
-    std::fclose(f);
-    std::free(buf);
-    throw;
-  }
-  std::fclose(f);
-  std::string out(buf, size);
-  std::free(buf);
-  return out;
-}
-
 // The maximum projection of a case's image along z, its grey range from the 0.5th to the 99.95th
 // percentile (a few bright voxels of noise or bone do not grey out the vessels); dark vessels
 // are projected as the minimum.
@@ -131,7 +112,7 @@ std::string thumbnail(const fs::path& image, bool bright, std::uint64_t memory_l
   std::vector<float> sorted = mip;
   std::sort(sorted.begin(), sorted.end());
   const double lo = sorted[std::size_t(0.005 * (sorted.size() - 1))], hi = sorted[std::size_t(0.9995 * (sorted.size() - 1))];
-  return pngBytes(maximumProjection(v.values, 2, lo, hi > lo ? hi : lo + 1));
+  return encodePng(maximumProjection(v.values, 2, lo, hi > lo ? hi : lo + 1));
 }
 
 // Candidate thresholds of the tuned baselines, as shares of a response's range: log-spaced

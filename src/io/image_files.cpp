@@ -4,6 +4,8 @@
 #include <cstdarg>
 #include <cstddef>
 #include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
 
 #include <jpeglib.h>  // needs size_t and FILE declared first
 #include <png.h>
@@ -106,6 +108,24 @@ void writePng(std::FILE* out, const std::filesystem::path& file, const Image8& i
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
   if (std::fflush(out) != 0 || std::ferror(out)) fail(file, "write error (disk full?)");
+}
+
+std::string encodePng(const Image8& image) {
+  char* buf = nullptr;
+  std::size_t size = 0;
+  std::FILE* f = open_memstream(&buf, &size);
+  if (!f) throw std::runtime_error("cannot open a memory stream for a PNG");
+  try {
+    writePng(f, "image", image);
+  } catch (...) {
+    std::fclose(f);
+    std::free(buf);
+    throw;
+  }
+  std::fclose(f);
+  std::string out(buf, size);
+  std::free(buf);
+  return out;
 }
 
 namespace {

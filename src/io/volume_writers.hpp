@@ -94,6 +94,8 @@ Image8 sliceZ(const Volume<float>& v, std::int32_t z, double lo, double hi);
 void writePng(const std::filesystem::path& file, const Image8& image);
 // The same into an open stream (an AtomicFile's); `file` names it in errors.
 void writePng(std::FILE* out, const std::filesystem::path& file, const Image8& image);
+// The PNG's bytes (for a data URI, or a file written whole or not at all).
+std::string encodePng(const Image8& image);
 // Baseline JPEG through libjpeg (lossy: VascuSynth's slice format, kept for its users' scripts).
 void writeJpeg(const std::filesystem::path& file, const Image8& image, int quality = 95);
 

@@ -276,6 +276,11 @@ Morphometry measureTrees(const VascularTree& t, const std::vector<std::string>& 
   const auto kindOf = [&](std::int32_t tree) {
     return std::size_t(tree) < tree_kinds.size() && !tree_kinds[std::size_t(tree)].empty() ? tree_kinds[std::size_t(tree)] : std::string("tree");
   };
+  for (const auto root : t.roots()) {
+    const std::int32_t tree = t.tree.empty() ? 0 : t.tree[std::size_t(root)];
+    if (std::size_t(tree) >= m.tree_kinds.size()) m.tree_kinds.resize(std::size_t(tree) + 1, "tree");
+    m.tree_kinds[std::size_t(tree)] = kindOf(tree);
+  }
   const auto nameOf = [&](std::int32_t tree) {
     return std::size_t(tree) < tree_names.size() && !tree_names[std::size_t(tree)].empty() ? tree_names[std::size_t(tree)]
                                                                                            : "tree " + std::to_string(tree);

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/vascular_tree.hpp"
+#include "io/volume_writers.hpp"
 
 namespace angiosynth {
 
@@ -95,6 +96,7 @@ struct Morphometry {
   // How the CSVs name a vessel: the file's id of its distal segment (node id → name; empty: the
   // node id itself).
   std::vector<std::string> segment_names;
+  std::vector<std::string> tree_kinds;  // per tree, as measured ("tree" where none was given)
   nlohmann::ordered_json toJson() const;
   std::string vesselName(std::int32_t vessel) const;
   std::string vesselsCsv() const;
@@ -104,6 +106,12 @@ struct Morphometry {
 // `tree_kinds[t]`: the kind of tree t (empty: "tree"); `tree_names[t]` its name.
 Morphometry measureTrees(const VascularTree& tree, const std::vector<std::string>& tree_names, const std::vector<std::string>& tree_kinds,
                          const MorphometryOptions& options = {});
+
+// A figure of the distributions: one histogram per statistic (vessel radius, length, length /
+// radius, distance metric, generation; the bifurcations' angles, asymmetry and Murray exponent),
+// each kind a curve in its colour when there are two or more, and element counts by Strahler
+// order on a log scale.
+Image8 morphometryFigure(const Morphometry& m);
 
 // γ with x1^γ + x2^γ = 1 (0 < x1, x2 < 1), by bisection to 1e-12; NaN when none.
 double murrayExponent(double r_parent, double r1, double r2);
