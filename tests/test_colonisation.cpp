@@ -14,7 +14,7 @@
 #include "core/rng.hpp"
 #include "grow/colonisation/grower.hpp"
 #include "grow/common/neighbourhood_count.hpp"
-#include "grow/common/point_hash.hpp"
+#include "core/point_hash.hpp"
 #include "grow_file.hpp"
 #include "test_support.hpp"
 

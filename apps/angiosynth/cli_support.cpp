@@ -4,11 +4,14 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <climits>
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <random>
 
+#include "core/error.hpp"
 #include "core/memory.hpp"
 
 namespace angiosynth::cli {
@@ -75,6 +78,42 @@ CLI::Validator finiteIn(double lo, double hi) {
         return {};
       },
       "FINITE in [" + CLI::detail::to_string(lo) + ", " + CLI::detail::to_string(hi) + "]");
+}
+
+std::filesystem::path graphOfInput(const std::string& input) {
+  const std::filesystem::path in(input);
+  if (!std::filesystem::exists(in)) throw InputError(input, 0, "no such sample directory or graph file");
+  const std::filesystem::path graph = std::filesystem::is_directory(in) ? in / "edges.csv" : in;
+  if (!std::filesystem::exists(graph))
+    throw InputError(graph.string(), 0, "no such file: a sample directory holds the nodes.csv and edges.csv angiosynth generate writes");
+  return graph;
+}
+
+std::int64_t parseIndex(const std::string& text, const std::string& what) {
+  std::size_t used = 0;
+  long long v = -1;
+  try {
+    v = std::stoll(text, &used);
+  } catch (const std::exception&) {}
+  if (text.empty() || used != text.size() || v < 0)
+    throw InputError("", 0, what + ": '" + text + "' is not a whole number in 0…" + std::to_string(LLONG_MAX));
+  return v;
+}
+
+std::int64_t indexFromEnvironment(const std::string& what) {
+  for (const char* var : {"SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX"})
+    if (const char* v = std::getenv(var)) return parseIndex(v, var);
+  throw InputError("", 0, what + " auto: neither SLURM_ARRAY_TASK_ID nor JOB_COMPLETION_INDEX is set");
+}
+
+std::pair<std::int64_t, std::int64_t> parseShard(const std::string& text) {
+  const auto slash = text.find('/');
+  if (slash == std::string::npos) throw InputError("", 0, "--shard takes K/M (K from 0) or auto/M");
+  const std::int64_t shards = parseIndex(text.substr(slash + 1), "--shard M");
+  const std::string k = text.substr(0, slash);
+  const std::int64_t shard = k == "auto" ? indexFromEnvironment("--shard") : parseIndex(k, "--shard K");
+  if (shards < 1 || shard >= shards) throw InputError("", 0, "--shard K/M needs 0 <= K < M");
+  return {shard, shards};
 }
 
 std::string commandLine(int argc, char** argv) {

@@ -1,5 +1,6 @@
 // `angiosynth benchmark SPEC --out DIR`: difficulty ladders, baselines, scores and a report.
 #include <iostream>
+#include <tuple>
 
 #include "benchmark/benchmark.hpp"
 #include "commands.hpp"
@@ -20,7 +21,9 @@ CLI::App* addBenchmark(CLI::App& app, BenchmarkArgs& a) {
   c->add_option("--ladders", a.ladders, "run these ladders only (their names in SPEC)");
   c->add_flag("--resume", a.resume, "continue in DIR: keep verified samples and the scores of unchanged baselines");
   c->add_flag("--regenerate-changed", a.regenerate_changed, "with --resume: accept an edited spec, regenerate the samples it changes");
-  c->add_option("--shard", a.shard, "K/M: generate every M-th sample of every rung from K only (then run once without --shard to score)");
+  c->add_option("--shard", a.shard,
+                "K/M: generate every M-th sample of every rung from K only (K from 0; auto/M takes K from $SLURM_ARRAY_TASK_ID or "
+                "$JOB_COMPLETION_INDEX); then run once without --shard to score");
   addCommonOptions(*c, a.common);
   return c;
 }
@@ -35,15 +38,7 @@ int runBenchmarkCommand(const BenchmarkArgs& a, const std::string& command_line)
   opt.resume = a.resume;
   opt.regenerate_changed = a.regenerate_changed;
   if (a.regenerate_changed && !a.resume) throw InputError("", 0, "--regenerate-changed goes with --resume");
-  if (!a.shard.empty()) {
-    const auto slash = a.shard.find('/');
-    try {
-      opt.shard = std::stoll(a.shard.substr(0, slash));
-      opt.shards = std::stoll(a.shard.substr(slash + 1));
-    } catch (const std::exception&) { opt.shards = 0; }
-    if (slash == std::string::npos || opt.shards < 1 || opt.shard < 0 || opt.shard >= opt.shards)
-      throw InputError("", 0, "--shard takes K/M with 0 <= K < M");
-  }
+  if (!a.shard.empty()) std::tie(opt.shard, opt.shards) = parseShard(a.shard);
   for (const auto& p : a.predictions) {
     const auto eq = p.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == p.size())

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <tuple>
 
 #include "commands.hpp"
 #include "core/error.hpp"
@@ -13,24 +14,6 @@
 
 namespace angiosynth::cli {
 namespace {
-
-std::int64_t parseIndex(const std::string& text, const std::string& what) {
-  std::size_t used = 0;
-  long long v = -1;
-  try {
-    v = std::stoll(text, &used);
-  } catch (const std::exception&) {}
-  if (text.empty() || used != text.size() || v < 0)
-    throw InputError("", 0, what + ": '" + text + "' is not a whole number in 0…" + std::to_string(LLONG_MAX));
-  return v;
-}
-
-// SLURM_ARRAY_TASK_ID (Slurm job arrays) or JOB_COMPLETION_INDEX (Kubernetes Indexed Jobs).
-std::int64_t indexFromEnvironment(const std::string& what) {
-  for (const char* var : {"SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX"})
-    if (const char* v = std::getenv(var)) return parseIndex(v, var);
-  throw InputError("", 0, what + " auto: neither SLURM_ARRAY_TASK_ID nor JOB_COMPLETION_INDEX is set");
-}
 
 DatasetSelection selection(const DatasetArgs& a, std::int64_t samples) {
   DatasetSelection s;
@@ -53,12 +36,7 @@ DatasetSelection selection(const DatasetArgs& a, std::int64_t samples) {
     if (s.begin >= s.end) throw InputError("", 0, "--range " + a.range + " holds no sample of 0…" + std::to_string(samples - 1));
     s.part = "range-" + std::to_string(s.begin) + "-" + std::to_string(s.end);
   } else if (!a.shard.empty()) {
-    const auto slash = a.shard.find('/');
-    if (slash == std::string::npos) throw InputError("", 0, "--shard takes K/M (K from 0) or auto/M");
-    s.shards = parseIndex(a.shard.substr(slash + 1), "--shard M");
-    const std::string k = a.shard.substr(0, slash);
-    s.shard = k == "auto" ? indexFromEnvironment("--shard") : parseIndex(k, "--shard K");
-    if (s.shards < 1 || s.shard >= s.shards) throw InputError("", 0, "--shard K/M needs 0 <= K < M");
+    std::tie(s.shard, s.shards) = parseShard(a.shard);
     s.part = "shard-" + std::to_string(s.shard) + "-of-" + std::to_string(s.shards);
   }
   if (s.begin >= samples)

@@ -39,10 +39,7 @@ int runMesh(const MeshArgs& a, const std::string& command_line) {
   const auto threads = limitThreads(a.common.threads);
   const auto t0 = std::chrono::steady_clock::now();
   const fs::path in(a.input);
-  if (!fs::exists(in)) throw InputError(a.input, 0, "no such sample directory or graph file");
-  const fs::path graph = fs::is_directory(in) ? in / "edges.csv" : in;
-  if (!fs::exists(graph))
-    throw InputError(graph.string(), 0, "no such file: a sample directory holds the nodes.csv and edges.csv angiosynth generate writes");
+  const fs::path graph = graphOfInput(a.input);
   const auto net = readNetwork(graph, 1, memoryLimit(a.common));
   refuseLargeJunctions(net, graph.string(), "mesh takes");
   // By default beside the input, named after it: never inside it, whatever the path ends with

@@ -30,10 +30,7 @@ CLI::App* addStats(CLI::App& app, StatsArgs& a) {
 }
 
 int runStats(const StatsArgs& a) {
-  const fs::path in(a.input);
-  const fs::path graph = fs::is_directory(in) ? in / "edges.csv" : in;
-  if (!fs::exists(graph))
-    throw InputError(graph.string(), 0, "no such file: a sample directory holds the nodes.csv and edges.csv angiosynth generate writes");
+  const fs::path graph = graphOfInput(a.input);
   MorphometryOptions options;
   if (!a.bands.empty()) {
     for (std::size_t k = 0; k < a.bands.size(); ++k)

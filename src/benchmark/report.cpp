@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "angiosynth/version.hpp"
+#include "core/format.hpp"
 #include "benchmark/benchmark.hpp"
 
 namespace angiosynth {
@@ -31,12 +32,7 @@ std::string fixed(double v, int digits = 3) {
   return buf;
 }
 
-std::string csvNumber(double v) {
-  if (!std::isfinite(v)) return "";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
+std::string csvNumber(double v) { return std::isfinite(v) ? show(v, 6) : std::string(); }
 
 std::string base64(const std::string& in) {
   static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -111,15 +107,15 @@ std::string chart(const std::string& title, const std::string& x_title, const st
 
 const char* kStyle = R"(
 body{font:14px/1.45 system-ui,-apple-system,"Segoe UI",sans-serif;margin:24px auto;max-width:1220px;color:#1b1b1b;padding:0 16px}
-h1{font-size:24px;margin:0 0 4px}h2{font-size:19px;margin:28px 0 6px;border-bottom:1px solid #ccc}
-.meta{color:#555;font-size:13px}.meta code{font-size:12px}
+h1{font-size:24px;margin:0 0 4px}h2{font-size:19px;margin:28px 0 6px;border-bottom:1px solid #cccccc}
+.meta{color:#555555;font-size:13px}.meta code{font-size:12px}
 table{border-collapse:collapse;margin:8px 0 16px;font-size:13px}th,td{padding:3px 8px;text-align:right;border-bottom:1px solid #e4e4e4}
 th{background:#f4f4f4}td.l,th.l{text-align:left}
-.charts{display:flex;flex-wrap:wrap;gap:8px}.ct{font-size:13px;font-weight:600}.yl{font-size:10px;text-anchor:end;fill:#444}
-.xl{font-size:10px;text-anchor:middle;fill:#444}.xt{font-size:11px;text-anchor:middle;fill:#222}.grid{stroke:#e2e2e2}
+.charts{display:flex;flex-wrap:wrap;gap:8px}.ct{font-size:13px;font-weight:600}.yl{font-size:10px;text-anchor:end;fill:#444444}
+.xl{font-size:10px;text-anchor:middle;fill:#444444}.xt{font-size:11px;text-anchor:middle;fill:#222222}.grid{stroke:#e2e2e2}
 .legend span{display:inline-block;margin-right:14px}.legend i{display:inline-block;width:18px;height:4px;margin-right:5px;vertical-align:middle}
 .thumbs{display:flex;flex-wrap:wrap;gap:10px}figure{margin:0;text-align:center;font-size:12px}
-figure img{width:150px;height:150px;image-rendering:pixelated;border:1px solid #bbb;background:#000}
+figure img{width:150px;height:150px;image-rendering:pixelated;border:1px solid #bbbbbb;background:#000000}
 )";
 
 // The kinds of the rows' per-kind recall, in order of appearance.
@@ -153,14 +149,9 @@ std::string benchmarkCsv(const std::vector<BenchmarkRow>& rows) {
   const auto kinds = kindsOf(rows);
   for (const auto& k : kinds) s << ",recall_" << k;
   s << "\n";
-  const auto field = [](const std::string& t) {
-    if (t.find_first_of(",\"\n") == std::string::npos) return t;
-    std::string q = "\"";
-    for (char c : t) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return q + "\"";
-  };
   for (const auto& r : rows) {
-    s << field(r.ladder) << ',' << r.rung << ',' << field(r.label) << ',' << field(r.method) << ',' << (r.baseline ? 1 : 0) << ',' << r.cases;
+    s << csvField(r.ladder) << ',' << r.rung << ',' << csvField(r.label) << ',' << csvField(r.method) << ',' << (r.baseline ? 1 : 0) << ','
+      << r.cases;
     for (double v : {r.dice, r.dice_sd, r.cldice, r.cldice_sd, r.thin_recall, r.hd95_mm, r.precision, r.recall, r.centreline_recall, r.b0_error,
                      r.tuned_fraction})
       s << ',' << csvNumber(v);

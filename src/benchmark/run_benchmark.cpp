@@ -260,14 +260,18 @@ BenchmarkSummary runBenchmark(const BenchmarkSpec& spec, const fs::path& out, co
       select.truth = spec.truth;
       // One baseline's masks for every case (the rule's, or per case `threshold_of` on the
       // response), scored; kept while `key` is unchanged.
-      const auto baseline = [&](const std::string& name, const SegmentOptions& o, const std::string& key, double tuned_fraction,
-                                const std::function<double(std::size_t)>& threshold_of, const Json& tuning = Json()) {
+      // A baseline's scores from an earlier run, when made from the same inputs: its row added.
+      const auto keptScores = [&](const std::string& name, const std::string& key) {
         const fs::path scores_file = rung_dir / "scores" / (name + ".json");
         const Json kept = fs::exists(scores_file) ? readJsonFile(scores_file) : Json();
-        if (kept.is_object() && kept.value("inputs_sha256", std::string()) == key && kept.contains("results")) {
-          addRow(kept["results"], name, true, kept.value("seconds_per_case", 0.0), kept.value("tuned_fraction", kNaN));
-          return;
-        }
+        if (!kept.is_object() || kept.value("inputs_sha256", std::string()) != key || !kept.contains("results")) return false;
+        addRow(kept["results"], name, true, kept.value("seconds_per_case", 0.0), kept.value("tuned_fraction", kNaN));
+        return true;
+      };
+      const auto baseline = [&](const std::string& name, const SegmentOptions& o, const std::string& key, double tuned_fraction,
+                                const std::function<double(std::size_t)>& threshold_of, const Json& tuning = Json()) {
+        if (keptScores(name, key)) return;
+        const fs::path scores_file = rung_dir / "scores" / (name + ".json");
         const fs::path pred_dir = rung_dir / "predictions" / name;
         fs::create_directories(pred_dir);
         double seconds = 0;
@@ -303,11 +307,7 @@ BenchmarkSummary runBenchmark(const BenchmarkSpec& spec, const fs::path& out, co
         // threshold gives the best mean Dice against the truth.
         const std::string tuned_key = sha256Text(key + "\ntuned threshold");
         const std::string tuned_name = method + "-tuned";
-        const Json kept = readJsonFile(rung_dir / "scores" / (tuned_name + ".json"));
-        if (kept.is_object() && kept.value("inputs_sha256", std::string()) == tuned_key) {
-          baseline(tuned_name, o, tuned_key, kNaN, {});
-          continue;
-        }
+        if (keptScores(tuned_name, tuned_key)) continue;
         std::vector<double> mean_dice(kTunedFractions.size(), 0.0);
         std::vector<DiceCurve> curves(ids.size());
         for (std::size_t c = 0; c < ids.size(); ++c) {

@@ -19,6 +19,14 @@ inline std::string show(double v, int digits = 6) {
   return buf;
 }
 
+// A CSV field (RFC 4180): quoted only when it holds a comma, a quote or a line break.
+inline std::string csvField(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + '"';
+}
+
 // "1 tree", "3 trees".
 inline std::string counted(long long n, const std::string& noun) { return std::to_string(n) + " " + noun + (n == 1 ? "" : "s"); }
 

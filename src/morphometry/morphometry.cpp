@@ -1,6 +1,7 @@
 #include "morphometry/morphometry.hpp"
 
 #include "core/format.hpp"
+#include "core/point_hash.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +10,6 @@
 #include <limits>
 #include <numeric>
 #include <sstream>
-#include <unordered_map>
 
 namespace angiosynth {
 namespace {
@@ -91,37 +91,22 @@ double fittedMurray(const std::vector<std::pair<double, double>>& x) {
   return (lo + hi) / 2;
 }
 
-// Mean distance from each point to its nearest other point, on a uniform grid.
+// Mean distance from each point to its nearest other point.
 double meanNearestNeighbour(const std::vector<Vec3>& p) {
   if (p.size() < 2) return kNaN;
   Vec3 lo = p[0], hi = p[0];
   for (const auto& q : p) lo = componentMin(lo, q), hi = componentMax(hi, q);
   // Cells from the largest extent, so that points on a plane or a line still spread over them.
-  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-9});
-  const double cell = extent / std::max(1.0, std::cbrt(double(p.size())));
-  const std::int64_t last_ring = std::int64_t(std::ceil(extent / cell)) + 1;
-  const auto key = [&](std::int64_t i, std::int64_t j, std::int64_t k) { return (i * 73856093) ^ (j * 19349663) ^ (k * 83492791); };
-  const auto index = [&](const Vec3& q, int a) { return std::int64_t(std::floor((q[a] - lo[a]) / cell)); };
-  std::unordered_map<std::int64_t, std::vector<std::size_t>> grid;
-  for (std::size_t n = 0; n < p.size(); ++n) grid[key(index(p[n], 0), index(p[n], 1), index(p[n], 2))].push_back(n);
+  const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, 1e-9});
+  PointHash grid(lo, hi, extent / std::max(1.0, std::cbrt(double(p.size()))), false);
+  for (std::size_t n = 0; n < p.size(); ++n) grid.insert(p[n], std::int32_t(n));
+  const double reach = 2 * extent;  // beyond the box's diagonal: every point is a candidate
   double total = 0;
   for (std::size_t n = 0; n < p.size(); ++n) {
-    double best = std::numeric_limits<double>::infinity();
-    const std::int64_t ci = index(p[n], 0), cj = index(p[n], 1), ck = index(p[n], 2);
-    // Rings of cells until the nearest found lies within the searched radius.
-    for (std::int64_t ring = 0;; ++ring) {
-      for (std::int64_t i = ci - ring; i <= ci + ring; ++i)
-        for (std::int64_t j = cj - ring; j <= cj + ring; ++j)
-          for (std::int64_t k = ck - ring; k <= ck + ring; ++k) {
-            if (std::max({std::abs(i - ci), std::abs(j - cj), std::abs(k - ck)}) != ring) continue;
-            const auto it = grid.find(key(i, j, k));
-            if (it == grid.end()) continue;
-            for (const auto m : it->second)
-              if (m != n) best = std::min(best, distance(p[n], p[m]));
-          }
-      if (best <= double(ring) * cell || ring >= last_ring) break;
-    }
-    total += best;
+    const auto nearest = grid.nearest(p[n], reach, [&](std::int32_t id) {
+      return std::size_t(id) == n ? std::numeric_limits<double>::infinity() : dot(p[std::size_t(id)] - p[n], p[std::size_t(id)] - p[n]);
+    });
+    total += distance(p[n], p[std::size_t(nearest)]);
   }
   return total / double(p.size());
 }
@@ -345,17 +330,14 @@ Morphometry measureTrees(const VascularTree& t, const std::vector<std::string>& 
     for (const auto& b : m.bifurcations) {
       if (!in(b.tree)) continue;
       ++g.bifurcations;
-      for (const char* key :
-           {"angle_large_deg", "angle_small_deg", "angle_between_deg", "out_of_plane_deg", "asymmetry", "area_ratio", "murray_exponent"}) {
-        const std::string k(key);
-        values[k].push_back(k == "angle_large_deg"     ? b.angle_large_deg
-                            : k == "angle_small_deg"   ? b.angle_small_deg
-                            : k == "angle_between_deg" ? b.angle_between_deg
-                            : k == "out_of_plane_deg"  ? b.out_of_plane_deg
-                            : k == "asymmetry"         ? b.asymmetry
-                            : k == "area_ratio"        ? b.area_ratio
-                                                       : b.murray_exponent);
-      }
+      const std::pair<const char*, double> measured[] = {{"angle_large_deg", b.angle_large_deg},
+                                                         {"angle_small_deg", b.angle_small_deg},
+                                                         {"angle_between_deg", b.angle_between_deg},
+                                                         {"out_of_plane_deg", b.out_of_plane_deg},
+                                                         {"asymmetry", b.asymmetry},
+                                                         {"area_ratio", b.area_ratio},
+                                                         {"murray_exponent", b.murray_exponent}};
+      for (const auto& [key, value] : measured) values[key].push_back(value);
       std::size_t band = 0;
       while (band < options.murray_band_edges_mm.size() && b.r_parent_mm >= options.murray_band_edges_mm[band]) ++band;
       if (std::isfinite(b.murray_exponent)) {

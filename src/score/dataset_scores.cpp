@@ -21,14 +21,6 @@ using Json = nlohmann::ordered_json;
 // people and spreadsheets.
 std::string number(double v) { return show(v, 6); }
 
-// RFC 4180: a field is quoted only when it holds a comma, a quote or a line break.
-std::string csvField(const std::string& s) {
-  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + '"';
-}
-
 Json readJson(const fs::path& f) {
   std::ifstream in(f);
   const Json j = Json::parse(in, nullptr, /*allow_exceptions=*/false);

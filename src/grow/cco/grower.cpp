@@ -12,7 +12,7 @@
 #include "grow/common/connection_commit.hpp"
 #include "grow/common/intersections.hpp"
 #include "grow/common/kamiya.hpp"
-#include "grow/common/point_hash.hpp"
+#include "core/point_hash.hpp"
 #include "core/segment_index.hpp"
 
 namespace angiosynth {

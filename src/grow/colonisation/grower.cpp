@@ -10,7 +10,7 @@
 
 #include "core/rng.hpp"
 #include "grow/common/neighbourhood_count.hpp"
-#include "grow/common/point_hash.hpp"
+#include "core/point_hash.hpp"
 
 namespace angiosynth {
 

@@ -6,7 +6,7 @@
 
 #include "core/error.hpp"
 #include "core/quantity_json.hpp"
-#include "grow/common/point_hash.hpp"
+#include "core/point_hash.hpp"
 #include "grow/colonisation/setup.hpp"
 #include "grow/common/chain_trees.hpp"
 #include "grow/common/intersections.hpp"
