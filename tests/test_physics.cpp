@@ -4,6 +4,10 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/units.hpp"
+#include "domain/growth_domain.hpp"
+#include "grow/cco/grower.hpp"
+#include "morphometry/morphometry.hpp"
 #include "physics/hemodynamics.hpp"
 #include "test_support.hpp"
 
@@ -46,3 +50,81 @@ TEST(Physics, RootRadiusFromPressureDrop) {
 }
 
 }  // namespace
+
+namespace {
+
+// Each bifurcation's exponent measured from its radii is its band's (parent radius outside the
+// ramps at the edges), and every band holds `at_least` of them.
+void expectBandsMeasuredBack(const Morphometry& m, const PhysicsParameters& p, int at_least) {
+  const auto& edges = p.murray_band_edges;
+  std::vector<int> count(edges.size() + 1, 0);
+  for (const auto& b : m.bifurcations) {
+    std::size_t band = 0;
+    bool ramp = false;
+    for (double e : edges) {
+      ramp = ramp || (b.r_parent_mm > e / 1.05 && b.r_parent_mm < e * 1.05);
+      band += b.r_parent_mm >= e;
+    }
+    if (ramp) continue;
+    ++count[band];
+    EXPECT_NEAR(b.murray_exponent, p.murray_band_exponents[band], 1e-9) << "bifurcation at node " << b.node << ", parent radius " << b.r_parent_mm;
+  }
+  for (std::size_t k = 0; k < count.size(); ++k) EXPECT_GE(count[k], at_least) << "band " << k;
+}
+
+}  // namespace
+
+// Murray's exponent by parent-radius band (3, 2.7, 2.3 split at 0.1 and 1 mm, as measured from
+// arterioles to large arteries): the radii solved under it satisfy Murray's law with the band's γ
+// at every bifurcation, flow and Poiseuille to 1e-9, and the exponents measured back from the
+// radii (the morphometry's band medians) are the bands'.
+TEST(Physics, BandedMurrayExponentsHoldAtEveryBifurcationAndAreMeasuredBack) {
+  const double radius = std::cbrt(3 * 1e5 / (4 * std::numbers::pi));  // 100 cm³
+  const auto d = GrowthDomain::analytic(DomainShape::Sphere, radius, radius / 50);
+  CcoOptions o;
+  o.terminals = 2000;
+  o.root_mm = d.defaultRoot();
+  o.physics.perfusion_flow = 500 * 1e3 / 60;
+  o.physics.perfusion_pressure = 100 * kPaPerMmHg;
+  o.physics.terminal_pressure = 60 * kPaPerMmHg;
+  o.physics.total_terminals = o.terminals;
+  o.physics.murray_band_edges = {0.1, 1.0};
+  o.physics.murray_band_exponents = {3.0, 2.7, 2.3};
+  GrowthReport rep;
+  const auto t = growCco(d, o, rep);
+  test::expectHemodynamicInvariants(t, o.physics, o.terminals);
+  EXPECT_EQ(rep.intersecting_pairs, 0);
+  expectBandsMeasuredBack(measureTrees(t, {}, {}), o.physics, 5);
+
+  // VascuSynth's oxygen-demand growth under bands set inside its own range of radii.
+  auto ex = test::vascusynthExample(400, 1);
+  const auto plain = test::grow(ex);
+  const double r_root = plain.radius[plain.rootSegment()];
+  ex.options.physics.murray_band_edges = {r_root / 8, r_root / 2.5};
+  ex.options.physics.murray_band_exponents = {3.0, 2.6, 2.2};
+  const auto v = test::grow(ex);
+  test::expectHemodynamicInvariants(v, ex.options.physics, 400);
+  expectBandsMeasuredBack(measureTrees(v, {}, {}), ex.options.physics, 3);
+}
+
+// The law between bands: the band's γ away from an edge, a linear ramp in log r across ±5 % of it.
+TEST(Physics, MurrayLawRampsAcrossBandEdges) {
+  PhysicsParameters p;
+  p.murray_band_edges = {0.1, 1.0};
+  p.murray_band_exponents = {3.0, 2.7, 2.3};
+  const MurrayLaw law(p);
+  EXPECT_EQ(law.exponentAt(0.0), 3.0);
+  EXPECT_EQ(law.exponentAt(0.09), 3.0);
+  EXPECT_NEAR(law.exponentAt(0.1), 2.85, 1e-12);
+  EXPECT_EQ(law.exponentAt(0.2), 2.7);
+  EXPECT_NEAR(law.exponentAt(1.0), 2.5, 1e-12);
+  EXPECT_NEAR(law.exponentAt(1.05), 2.3, 1e-12);
+  EXPECT_EQ(law.exponentAt(50), 2.3);
+  const double lo = 0.1 / 1.05, hi = 0.1 * 1.05;
+  EXPECT_NEAR(law.exponentAt(std::sqrt(lo * 0.1)), 3.0 - 0.3 * 0.25, 1e-12);  // a quarter of the way in log r
+  EXPECT_NEAR(law.exponentAt(hi), 2.7, 1e-12);
+  PhysicsParameters one;
+  one.murray_exponent = 2.55;
+  EXPECT_EQ(MurrayLaw(one).exponentAt(7), 2.55);
+  EXPECT_FALSE(MurrayLaw(one).banded());
+}

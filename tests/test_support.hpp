@@ -63,7 +63,7 @@ inline void expectHemodynamicInvariants(const VascularTree& t, const PhysicsPara
     ++bifurcations;
     const auto a = t.child0[i], b = t.child1[i];
     EXPECT_NEAR(t.flow[i], t.flow[a] + t.flow[b], 1e-9 * t.flow[i]);
-    const double g = p.murray_exponent;
+    const double g = MurrayLaw(p).exponentAt(t.radius[i]);  // γ, or the band's of the parent radius
     const double lhs = std::pow(t.radius[i], g), rhs = std::pow(t.radius[a], g) + std::pow(t.radius[b], g);
     EXPECT_NEAR(lhs, rhs, 1e-9 * lhs) << "segment " << i;
     for (auto c : {a, b}) {

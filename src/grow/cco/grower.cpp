@@ -613,7 +613,14 @@ class CcoGrower {
           g.index.insert(g.tree, c.segment);
           g.index.refresh(g.tree);
           if (g.rel[n - 2] >= kThick) g.thick.push_back(n - 2);
-          if (g.terminalCount() % kRefreshEvery == 0) refreshRelativeRadii(g);
+          if (g.terminalCount() % kRefreshEvery == 0) {
+            refreshRelativeRadii(g);
+            // Banded γ reads each bifurcation's parent radius: the radii in final units as they stand now.
+            if (g.kernel.law().banded()) {
+              const double r_root = currentRootRadius(g);
+              for (std::int32_t x = 1; x < g.tree.nodeCount(); ++x) g.tree.radius[x] = g.rel[x] * r_root;
+            }
+          }
           g.terminal_radius = g.rel[n - 1] * rr;
           return true;
         }

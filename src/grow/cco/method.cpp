@@ -68,7 +68,8 @@ const std::vector<SettingRule<CcoOptions>>& ccoRules() {
 // clang-format off
 const std::vector<Setting<PhysicsParameters>>& ccoPhysics() {
   static const std::vector<Setting<PhysicsParameters>> settings{
-      physicsSetting("murray_exponent", "3"), physicsSetting("viscosity", "0.0036 Pa*s"), physicsSetting("perfusion_pressure", "100 mmHg"),
+      physicsSetting("murray_exponent", "3"), physicsSetting("murray_band_edges", "none"), physicsSetting("murray_band_exponents", "none"),
+      physicsSetting("viscosity", "0.0036 Pa*s"), physicsSetting("perfusion_pressure", "100 mmHg"),
       physicsSetting("terminal_pressure", "60 mmHg"), physicsSetting("perfusion_flow", "500 mL/min")};
   return settings;
 }

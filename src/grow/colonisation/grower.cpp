@@ -16,6 +16,14 @@ namespace angiosynth {
 
 double symmetricMurrayAngle(double kappa) { return std::acos(std::clamp(std::pow(2.0, 2.0 / kappa - 1.0), -1.0, 1.0)); }
 
+MurrayLaw colonisationLaw(const ColonisationOptions& o) {
+  PhysicsParameters p;
+  p.murray_exponent = o.murray_exponent;
+  p.murray_band_edges = o.murray_band_edges;
+  p.murray_band_exponents = o.murray_band_exponents;
+  return MurrayLaw(p);
+}
+
 double lateralMurrayAngle(double rp, double rb, double kappa) {
   // A parent is at least as thick as a symmetric split of two such branches (a chain of leaves'
   // radius would otherwise leave no continuation and an angle of 0).
@@ -73,6 +81,7 @@ struct System {
   std::vector<double> radius;       // exact Murray radii, set by finishRadii()
   std::vector<std::int32_t> roots;  // the root nodes
   double kappa = 2.55;
+  MurrayLaw law;           // κ, or κ by band of parent radius
   PointHash nodes;         // cells of the perception distance
   PointHash close;         // cells of the satisfaction distance: "is a node this close?"
   PointHash drains;        // cells of the drain spacing
@@ -193,7 +202,7 @@ struct System {
       else if (b < 0)
         radius[k] = radius[a];
       else
-        radius[k] = std::pow(std::pow(radius[a], kappa) + std::pow(radius[b], kappa), 1.0 / kappa);
+        radius[k] = law.parentRadius(radius[a], radius[b]);
     }
   }
   // Keeps the drains listed (ascending), renumbered from 0: ids stay small and storage warm.
@@ -235,6 +244,7 @@ class Grower {
     art_.vein = false;
     ven_.vein = true;
     art_.kappa = ven_.kappa = o.murray_exponent;
+    art_.law = ven_.law = colonisationLaw(o);
     symmetric_angle_ = symmetricMurrayAngle(o.murray_exponent);
     for (const auto& st : o.stages) reach_ = std::max({reach_, st.perception_distance, st.co2_distance, st.satisfaction_distance});
     for (std::size_t k = 0; k < o.roots.size(); ++k) {
@@ -431,7 +441,7 @@ class Grower {
           s.cos_lo[j] = cos_half;
           s.cos_hi[j] = 1.0;
         } else if (st.lateral && s.child1[j] < 0 && s.parent[j] >= 0) {
-          const double alpha = s.lateral_angle[j] = lateralMurrayAngle(s.radiusOf(j), t.terminal_radius, o_.murray_exponent);
+          const double alpha = s.lateral_angle[j] = lateralMurrayAngle(s.radiusOf(j), t.terminal_radius, s.law.exponentAt(s.radiusOf(j)));
           s.cos_lo[j] = std::cos(std::min(std::numbers::pi, alpha + half));
           s.cos_hi[j] = std::cos(std::max(0.0, alpha - half));
         }
@@ -518,7 +528,7 @@ class Grower {
         if (!(norm(w) > 1e-9)) w = m - e * dot(m, e);
         if (!(norm(w) > 1e-9)) w = perpendicular(e);
         w = unit(w);
-        const double alpha_s = symmetric_angle_;
+        const double alpha_s = s.law.banded() ? symmetricMurrayAngle(s.law.exponentAt(s.radiusOf(j))) : symmetric_angle_;
         const Vec3 d1 = e * std::cos(alpha_s) + w * std::sin(alpha_s), d2 = e * std::cos(alpha_s) - w * std::sin(alpha_s);
         if (tryAdd(s, t, j, d1, d) && tryAdd(s, t, j, d2, d)) {
           d.move = Move::Bifurcation;

@@ -18,6 +18,7 @@
 #include "core/vascular_tree.hpp"
 #include "domain/growth_domain.hpp"
 #include "grow/common/growth_report.hpp"
+#include "physics/hemodynamics.hpp"
 
 namespace angiosynth {
 
@@ -65,9 +66,12 @@ struct ColonisationOptions {
   std::vector<ColonisationStage> stages;
   std::vector<ColonisationRoot> roots;
   double murray_exponent = 2.55;  // κ in (2, 4)
-  double sigma0 = 1;              // σ_0, the tissue's initial size
-  bool veins = true;              // grow the venous system (needs a vein root)
-  bool avoid_crossing = false;    // no new vessel closer to another than their radii
+  // κ by parent-radius band instead (as [physics] murray_band_edges, mm, and _exponents): the
+  // final radii exactly, the angles and growing radii from the radii as they stand.
+  std::vector<double> murray_band_edges, murray_band_exponents;
+  double sigma0 = 1;            // σ_0, the tissue's initial size
+  bool veins = true;            // grow the venous system (needs a vein root)
+  bool avoid_crossing = false;  // no new vessel closer to another than their radii
   std::uint64_t seed = 1, sample = 0;
 };
 
@@ -90,6 +94,8 @@ std::vector<double> colonisationScales(const ColonisationOptions& o);
 
 // Symmetric daughters' angle to the parent direction, radians: arccos(2^(2/κ−1)).
 double symmetricMurrayAngle(double kappa);
+// κ, or κ by band of parent radius, of the options.
+MurrayLaw colonisationLaw(const ColonisationOptions& o);
 // Angle of a lateral branch of radius rb off a parent of radius rp (continuation by Murray's law
 // with κ), radians, eq. (1).
 double lateralMurrayAngle(double rp, double rb, double kappa);

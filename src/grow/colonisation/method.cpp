@@ -115,6 +115,10 @@ const std::vector<Setting<PhysicsParameters>>& colonisationPhysics() {
     auto murray = physicsSetting("murray_exponent", "2.55");
     murray.meaning = "κ in (2, 4): r_p^κ = r_a^κ + r_b^κ";
     murray.range = {2, 4, true, true};
+    auto band_edges = physicsSetting("murray_band_edges", "none");
+    auto band_exponents = physicsSetting("murray_band_exponents", "none");
+    band_exponents.meaning = "κ of each band of parent radius, in (2, 4), the smallest radii first: one more than murray_band_edges, at most 8";
+    band_exponents.range = murray.range;
     auto viscosity = physicsSetting("viscosity", "0.0036 Pa*s");
     viscosity.meaning = "blood viscosity η (flows and pressures of the outputs)";
     auto pressure = physicsSetting("perfusion_pressure", "100 mmHg");
@@ -124,7 +128,7 @@ const std::vector<Setting<PhysicsParameters>>& colonisationPhysics() {
     venous.meaning = "pressure at the venous roots";
     auto flow = physicsSetting("perfusion_flow", "1 mL/min");
     flow.meaning = "Q, split equally among the leaves of each system";
-    return std::vector<Setting<PhysicsParameters>>{murray, viscosity, pressure, venous, flow};
+    return std::vector<Setting<PhysicsParameters>>{murray, band_edges, band_exponents, viscosity, pressure, venous, flow};
   }();
   return settings;
 }
@@ -255,7 +259,7 @@ class PreparedColonisation final : public PreparedGrowth {
     o.sample = sample;
     cr_ = ColonisationReport{};
     auto trees = growColonisation(o, report, cr_, progress);
-    if (o.avoid_crossing) cr_.pruned = pruneCrossings(trees, o.murray_exponent);
+    if (o.avoid_crossing) cr_.pruned = pruneCrossings(trees, colonisationLaw(o));
     Forest f;
     for (std::size_t k = 0; k < trees.size(); ++k) {
       // Each system's leaves share Q equally: an artery supplies what a vein drains.
@@ -311,7 +315,7 @@ class PreparedColonisation final : public PreparedGrowth {
 
   // avoid_crossing: vessels that overlap once Murray's law has thickened them lose the branch
   // with fewer leaves below it (and the chain left dangling), until none overlaps.
-  static std::int64_t pruneCrossings(std::vector<VascularTree>& trees, double kappa) {
+  static std::int64_t pruneCrossings(std::vector<VascularTree>& trees, const MurrayLaw& law) {
     std::int64_t pruned = 0;
     for (int round = 0; round < 200; ++round) {
       Forest tmp;
@@ -356,7 +360,7 @@ class PreparedColonisation final : public PreparedGrowth {
         for (auto it = fo.rbegin(); it != fo.rend(); ++it) {  // Murray from the leaves, which keep their radius
           const auto i = *it, a = fresh.child0[i], b = fresh.child1[i];
           if (a < 0) continue;
-          fresh.radius[i] = b < 0 ? fresh.radius[a] : std::pow(std::pow(fresh.radius[a], kappa) + std::pow(fresh.radius[b], kappa), 1.0 / kappa);
+          fresh.radius[i] = b < 0 ? fresh.radius[a] : law.parentRadius(fresh.radius[a], fresh.radius[b]);
         }
         trees[k] = std::move(fresh);
       }
@@ -478,6 +482,8 @@ std::shared_ptr<const GrowthSetup> readColonisationToml(const TomlReader& r, con
   readRoots(r, m, tree, *s, flat);
   s->physics_summary = readPhysics(r, colonisationPhysics(), ph);
   o.murray_exponent = s->physics_summary.murray_exponent;
+  o.murray_band_edges = s->physics_summary.murray_band_edges;
+  o.murray_band_exponents = s->physics_summary.murray_band_exponents;
   s->regions = readRegions(r, m, flat);
   std::set<std::string> names;
   for (const auto& g : s->regions) names.insert(g.name);

@@ -26,7 +26,8 @@ double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, do
   const auto [R_s, V_s] = shortened(s, l_down);
   const double R_t = l_term, V_t = k.lengthCost(l_term);
   // The new segment from s's proximal node to b, with children s and the terminal.
-  auto sp = k.split(t.terminals[s], R_s, 1.0, R_t);
+  // With banded γ the new bifurcation's parent takes s's radius, and each ancestor its own (as last solved).
+  auto sp = k.split(t.terminals[s], R_s, 1.0, R_t, t.radius[s]);
   double R = combinedResistance(l_up, sp, R_s, R_t);
   double V = k.lengthCost(l_up) + k.radiusCost(sp.beta_a) * V_s + k.radiusCost(sp.beta_b) * V_t;
   std::int32_t n = t.terminals[s] + 1;
@@ -34,7 +35,7 @@ double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, do
   std::int32_t below = s;
   for (std::int32_t node = t.parent[s]; node != 0; below = node, node = t.parent[node]) {
     const auto other = t.child0[node] == below ? t.child1[node] : t.child0[node];
-    sp = k.split(n, R, t.terminals[other], t.reduced_resistance[other]);
+    sp = k.split(n, R, t.terminals[other], t.reduced_resistance[other], t.radius[node]);
     R = combinedResistance(t.length[node], sp, R, t.reduced_resistance[other]);
     V = k.lengthCost(t.length[node]) + k.radiusCost(sp.beta_a) * V + k.radiusCost(sp.beta_b) * t.cost_ratio[other];
     n = t.terminals[node] + 1;
@@ -99,7 +100,7 @@ BifurcationOptimizer::Level0 BifurcationOptimizer::level0(std::int32_t s, double
   const auto& k = kernel_;
   const auto [R_s, V_s] = shortened(s, l_down);
   const double R_t = l_term, V_t = k.lengthCost(l_term);
-  const auto sp = k.split(tree_.terminals[s], R_s, 1.0, R_t);
+  const auto sp = k.split(tree_.terminals[s], R_s, 1.0, R_t, tree_.radius[s]);
   return {combinedResistance(l_up, sp, R_s, R_t), k.lengthCost(l_up) + k.radiusCost(sp.beta_a) * V_s + k.radiusCost(sp.beta_b) * V_t};
 }
 
@@ -116,9 +117,9 @@ BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, 
   for (std::int32_t node = t.parent[s]; node != 0; below = node, node = t.parent[node]) {
     const auto o = t.child0[node] == below ? t.child1[node] : t.child0[node];
     const double R_o = t.reduced_resistance[o], V_o = t.cost_ratio[o];
-    const auto sp = k.split(n, R, t.terminals[o], R_o);
+    const auto sp = k.split(n, R, t.terminals[o], R_o, t.radius[node]);
     const double q = sp.beta_b / sp.beta_a;  // r_o / r_c
-    const double u = k.murray(q);
+    const double u = k.murray(q, t.radius[node]);
     const double D = pow4(sp.beta_a) / R + pow4(sp.beta_b) / R_o;
     const double bc = k.radiusCost(sp.beta_a), bo = k.radiusCost(sp.beta_b);
     // Closed forms: ∂β_c/∂R = β_c·u/(4R(1+u)), ∂β_o/∂R = −β_o/(4R(1+u)), ∂R'/∂R = 1/(R·D·(1+u)).

@@ -26,6 +26,8 @@ ConnectionUndo commitConnection(VascularTree& t, const Connection& c, const Bifu
   t.length[b] = distance(t.position[P], c.bifurcation);
   t.length[s] = distance(c.bifurcation, t.position[s]);
   const auto term = t.addNode(c.terminal, b);
+  // Banded γ reads each parent's radius (the last solved): the new bifurcation's takes s's.
+  if (k.law().banded()) t.radius[b] = t.radius[term] = t.radius[s];
   const auto sv = opt.shortened(s, t.length[s]);
   t.reduced_resistance[s] = sv.reduced_resistance;
   t.cost_ratio[s] = sv.cost_ratio;

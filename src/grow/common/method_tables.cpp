@@ -85,6 +85,13 @@ Setting<PhysicsParameters> physicsSetting(const char* key, const char* fallback)
   static const std::vector<Setting<P>> shared{
       {.table = "physics", .key = "murray_exponent", .unit = "", .fallback = nullptr, .meaning = "γ in r_parent^γ = r_a^γ + r_b^γ",
        .field = &P::murray_exponent, .range = {Limits::kMinMurray, Limits::kMaxMurray, true, false}},
+      {.table = "physics", .key = "murray_band_edges", .unit = "[\"<length>\" …]", .fallback = nullptr,
+       .meaning = "parent radii splitting the bifurcations into bands with a Murray exponent each (murray_band_exponents, which then replace "
+                  "murray_exponent): ascending, each at least 1.25 times the one before; γ ramps across an edge over ±5 % of its radius",
+       .field = &P::murray_band_edges, .range = {0, 1e6, true, false}, .quantity = Dimension::Length, .range_unit = "mm"},
+      {.table = "physics", .key = "murray_band_exponents", .unit = "[γ …]", .fallback = nullptr,
+       .meaning = "γ of each band of parent radius, the smallest radii first: one more than murray_band_edges, at most 8",
+       .field = &P::murray_band_exponents, .range = {Limits::kMinMurray, Limits::kMaxMurray, true, false}},
       {.table = "physics", .key = "cost_radius_exponent", .unit = "", .fallback = nullptr, .meaning = "λ of the cost Σ l^μ r^λ",
        .field = &P::cost_radius_exponent, .range = {0, Limits::kMaxCostExponent}},
       {.table = "physics", .key = "cost_length_exponent", .unit = "", .fallback = nullptr, .meaning = "μ of the cost Σ l^μ r^λ",
@@ -102,7 +109,7 @@ Setting<PhysicsParameters> physicsSetting(const char* key, const char* fallback)
   for (auto s : shared)
     if (std::string(s.key) == key) {
       s.fallback = fallback;
-      s.fallback_is_value = fallback != nullptr;
+      s.fallback_is_value = fallback != nullptr && std::string(fallback) != "none";
       return s;
     }
   throw std::logic_error(std::string("no shared [physics] setting ") + key);
@@ -121,12 +128,34 @@ const std::vector<SettingRule<PhysicsParameters>>& physicsRules() {
 }
 // clang-format on
 
+// clang-format off
+const std::vector<SettingRule<PhysicsParameters>>& murrayBandRules() {
+  static const std::vector<SettingRule<PhysicsParameters>> rules{
+      {{"murray_band_exponents", "murray_band_edges"}, [](const PhysicsParameters& p) {
+         const auto& e = p.murray_band_edges;
+         const auto& g = p.murray_band_exponents;
+         if (e.empty() && g.empty()) return std::string();
+         if (g.size() != e.size() + 1)
+           return "murray_band_exponents holds " + std::to_string(g.size()) + " exponents for " + std::to_string(e.size()) +
+                  " murray_band_edges; allowed: one exponent more than edges";
+         if (g.size() > std::size_t(MurrayLaw::kMaxBands)) return std::string("murray_band_exponents holds more than 8 bands; allowed: 2 … 8");
+         for (std::size_t k = 1; k < e.size(); ++k)
+           if (!(e[k] >= 1.25 * e[k - 1]))
+             return "murray_band_edges " + show(e[k - 1]) + " mm and " + show(e[k]) +
+                    " mm: allowed: ascending, each edge at least 1.25 times the one before (an edge ramps γ over ±5 % of its radius)";
+         return std::string();
+       }}};
+  return rules;
+}
+// clang-format on
+
 PhysicsParameters readPhysics(const TomlReader& r, const std::vector<Setting<PhysicsParameters>>& settings, const toml::table& ph) {
   PhysicsParameters p;
   readSettingsFrom(r, ph, "physics", settings, p, 0);
   const auto keys = settingKeys(settings);
   if (keys.count("perfusion_pressure") && keys.count("terminal_pressure"))
     checkRules(physicsRules(), p, keysIn(r, ph), Where{r.file(), r.lineOf(&ph)});
+  if (keys.count("murray_band_edges")) checkRules(murrayBandRules(), p, keysIn(r, ph), Where{r.file(), r.lineOf(&ph)});
   return p;
 }
 

@@ -62,11 +62,13 @@ std::vector<MethodParam> settingRows(const std::vector<Setting<Options>>& settin
 std::vector<MethodParam> joinRows(std::initializer_list<std::vector<MethodParam>> lists);
 
 // One [physics] setting of the flow-driven methods as they share it (murray_exponent,
-// cost_radius_exponent, cost_length_exponent, viscosity, perfusion_pressure, terminal_pressure,
+// murray_band_edges, murray_band_exponents (default "none"), cost_radius_exponent, cost_length_exponent, viscosity, perfusion_pressure, terminal_pressure,
 // perfusion_flow), with the method's default (nullptr: required), which is its value.
 Setting<PhysicsParameters> physicsSetting(const char* key, const char* fallback);
 // perfusion_pressure above terminal_pressure by at least 0.001 Pa.
 const std::vector<SettingRule<PhysicsParameters>>& physicsRules();
+// Murray bands: one exponent more than edges, edges rising by 1.25 times at least.
+const std::vector<SettingRule<PhysicsParameters>>& murrayBandRules();
 
 // [physics] of a file read through the method's declarations; the rules checked when both
 // pressures are declared.

@@ -10,6 +10,7 @@
 #include "core/rng.hpp"
 #include "grow/common/intersections.hpp"
 #include "core/segment_grid.hpp"
+#include "physics/hemodynamics.hpp"
 
 namespace angiosynth {
 
@@ -38,7 +39,11 @@ struct Branch {
 class GrammarGrower {
  public:
   GrammarGrower(const GrammarOptions& o, GrammarReport& r)
-      : o_(o), r_(r), rng_(o.seed, o.sample, Stage::Growth), grid_(o.domain->lo(), o.domain->hi(), cellSize(o), o.domain->dimension() == 2) {}
+      : o_(o),
+        law_(lawOf(o)),
+        r_(r),
+        rng_(o.seed, o.sample, Stage::Growth),
+        grid_(o.domain->lo(), o.domain->hi(), cellSize(o), o.domain->dimension() == 2) {}
 
   VascularTree run(const ProgressFn& progress) {
     t_.addNode(o_.root, -1);
@@ -160,7 +165,7 @@ class GrammarGrower {
   // The two daughters of the stem just drawn (diameter d, ending at node `end`).
   void bifurcate(std::int32_t end, double d0, std::vector<Branch>& next) {
     const Branch b{end, last_dir_, last_up_, last_dir_, d0};
-    const double k = o_.murray_exponent;
+    const double k = law_.exponentAt(d0 / 2);
     double d1, d2, th1, th2;
     if (o_.murray) {
       const double opt = b.d / std::pow(2.0, 1.0 / k);
@@ -187,7 +192,16 @@ class GrammarGrower {
     }
   }
 
+  static MurrayLaw lawOf(const GrammarOptions& o) {
+    PhysicsParameters p;
+    p.murray_exponent = o.murray_exponent;
+    p.murray_band_edges = o.murray_band_edges;
+    p.murray_band_exponents = o.murray_band_exponents;
+    return MurrayLaw(p);
+  }
+
   const GrammarOptions& o_;
+  MurrayLaw law_;
   GrammarReport& r_;
   Rng rng_;
   VascularTree t_;

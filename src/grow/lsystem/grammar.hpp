@@ -25,7 +25,9 @@ struct GrammarOptions {
   double length_margin = 0.2;           // m: relative half-width of the stem length
   double diameter_sd = 0.2;             // d1's standard deviation relative to d/2^(1/k) (0: exact)
   double murray_exponent = 3;           // k
-  bool murray = true;                   // false: both daughters d·radius_ratio
+  // k by band of the parent's radius instead (as [physics] murray_band_edges, mm, and _exponents).
+  std::vector<double> murray_band_edges, murray_band_exponents;
+  bool murray = true;  // false: both daughters d·radius_ratio
   double radius_ratio = 0.7937;
   bool zamir_angles = true;  // false: ±branch_angle
   double branch_angle = 35;  // deg

@@ -173,6 +173,10 @@ const std::vector<Setting<PhysicsParameters>>& lsystemPhysics() {
   static const std::vector<Setting<PhysicsParameters>> settings = [] {
     auto murray = physicsSetting("murray_exponent", "3");
     murray.meaning = "grammar: k of Murray's law d^k = d1^k + d2^k";
+    auto band_edges = physicsSetting("murray_band_edges", "none");
+    band_edges.meaning = "grammar: parent radii splitting the bifurcations into bands with a k each (murray_band_exponents, which then "
+                         "replace murray_exponent): ascending, each at least 1.25 times the one before";
+    auto band_exponents = physicsSetting("murray_band_exponents", "none");
     auto viscosity = physicsSetting("viscosity", "0.0036 Pa*s");
     viscosity.meaning = "blood viscosity η (flows and pressures of the outputs)";
     auto pressure = physicsSetting("perfusion_pressure", "100 mmHg");
@@ -180,7 +184,7 @@ const std::vector<Setting<PhysicsParameters>>& lsystemPhysics() {
     auto flow = physicsSetting("perfusion_flow", "1 mL/min");
     flow.meaning = "Q into the inlet: lzh, the same through every capillary, the outlet's pressure follows (Poiseuille, tapered vessels); "
                    "grammar, split equally among the tips";
-    return std::vector<Setting<PhysicsParameters>>{murray, viscosity, pressure, flow};
+    return std::vector<Setting<PhysicsParameters>>{murray, band_edges, band_exponents, viscosity, pressure, flow};
   }();
   return settings;
 }
@@ -191,7 +195,7 @@ const std::vector<Setting<PhysicsParameters>>& lsystemPhysics() {
 bool grammarOnly(const std::string& table, const std::string& key) {
   static const std::set<std::string> domain{"shape", "radius", "side", "mask"}, tree{"root_offset", "root", "root_voxel", "direction"};
   if (table == "domain") return domain.count(key) > 0;
-  if (table == "physics") return key == "murray_exponent";
+  if (table == "physics") return key == "murray_exponent" || key == "murray_band_edges" || key == "murray_band_exponents";
   return tree.count(key) > 0 || settingKeys(grammarSettings()).count(key) > 0;
 }
 
@@ -223,6 +227,8 @@ void readGrammar(const TomlReader& r, const toml::table& dom, const toml::table&
   auto& g = s.grammar_options;
   readSettingsFrom(r, tree, "tree", grammarSettings(), g, s.voxel_mm);
   g.murray_exponent = s.physics_summary.murray_exponent;
+  g.murray_band_edges = s.physics_summary.murray_band_edges;
+  g.murray_band_exponents = s.physics_summary.murray_band_exponents;
   s.physics_summary.total_terminals = std::int64_t(1) << g.iterations;
 }
 
@@ -334,7 +340,7 @@ Json LsystemSetup::describe() const {
   j["voxel_size"] = quantityJson(voxel_mm, "mm");
   j.update(settingsJson(lzhSettings(), p));
   auto inflow = settingsJson(lsystemPhysics(), physics_summary);
-  inflow.erase("murray_exponent");  // grammar only
+  for (const char* key : {"murray_exponent", "murray_band_edges", "murray_band_exponents"}) inflow.erase(key);  // grammar only
   j.update(inflow);
   j["outlet_pressure"] = quantityJson(physics_summary.terminal_pressure, "Pa");
   return j;

@@ -47,7 +47,8 @@ const std::vector<Setting<GrowthOptions>>& vascuSynthSettings() {
 // clang-format off
 const std::vector<Setting<PhysicsParameters>>& vascuSynthPhysics() {
   static const std::vector<Setting<PhysicsParameters>> settings{
-      physicsSetting("murray_exponent", "3"),        physicsSetting("cost_radius_exponent", "2"), physicsSetting("cost_length_exponent", "1"),
+      physicsSetting("murray_exponent", "3"),        physicsSetting("murray_band_edges", "none"), physicsSetting("murray_band_exponents", "none"),
+      physicsSetting("cost_radius_exponent", "2"), physicsSetting("cost_length_exponent", "1"),
       physicsSetting("viscosity", nullptr),          physicsSetting("perfusion_pressure", nullptr), physicsSetting("terminal_pressure", nullptr),
       physicsSetting("perfusion_flow", nullptr)};
   return settings;
