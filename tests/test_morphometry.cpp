@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 
 #include "cli_run.hpp"
 #include "morphometry/morphometry.hpp"
@@ -253,31 +254,44 @@ print('png', im.size[0], im.size[1], sum(1 for p in px if p == (0xB3, 0x26, 0x2E
   EXPECT_NE(png.find("png 990 950 True True"), std::string::npos) << png;
 }
 
-// The methods that size vessels from the leaves up (space colonisation) or from the root down (the
-// L-system grammar) under Murray exponents by band of parent radius: every bifurcation outside
-// the ramps at the edges measures its band's exponent, and every band holds bifurcations.
-TEST(Morphometry, ColonisationAndGrammarTreesHaveTheirBandsMurrayExponents) {
+// The methods that size vessels from the leaves up (space colonisation), from the root down (the
+// L-system grammar) or with a fixed root radius and a viscosity fixed point (DCCO) under Murray
+// exponents by band of parent radius: every bifurcation outside the ramps at the edges measures
+// its band's exponent, and every band holds bifurcations.
+TEST(Morphometry, ColonisationGrammarAndDccoTreesHaveTheirBandsMurrayExponents) {
   const fs::path dir = freshTestDir("angiosynth_bands_");
   const auto src = test::sourceDir() / "examples";
-  std::string colonisation = slurp(src / "colonisation_fig5_2d.toml");
-  const auto at = colonisation.find("murray_exponent = 2.55");
-  ASSERT_NE(at, std::string::npos);
-  colonisation.insert(at, "murray_band_edges = [\"0.02 mm\", \"0.05 mm\"]\nmurray_band_exponents = [3.0, 2.7, 2.3]\n");
-  std::ofstream(dir / "colonisation.toml") << colonisation;
-  std::ofstream(dir / "grammar.toml") << slurp(src / "lsystem_grammar_3d.toml")
-                                      << "\n[physics]\nmurray_band_edges = [\"0.01 mm\", \"0.03 mm\"]\nmurray_band_exponents = [3.0, 2.7, 2.3]\n";
-  for (const auto& [name, edges] : {std::pair{"colonisation", "0.02 0.05"}, std::pair{"grammar", "0.01 0.03"}}) {
-    const std::string n = name;
-    ASSERT_EQ(run("generate " + n + ".toml --out " + n + " --no-image --quiet", dir).code, 0) << n;
-    const ::Run r = run("stats " + n + " --out " + n + "_stats --murray-bands " + edges + " --quiet", dir);
+  const std::string bands = "murray_band_exponents = [3.0, 2.7, 2.3]\n";
+  struct Case {
+    std::string name, example, after, edges;
+  };
+  for (const Case& c :
+       {Case{"colonisation", "colonisation_fig5_2d.toml", "[physics]\n", "0.02 0.05"}, Case{"grammar", "lsystem_grammar_3d.toml", "", "0.01 0.03"},
+        Case{"dcco", "dcco_pdf_uniform_2d.toml", "[physics]\n", "0.02 0.05"}}) {
+    std::string text = slurp(src / c.example);
+    std::istringstream edges_in(c.edges);
+    std::string e0, e1;
+    edges_in >> e0 >> e1;
+    const std::string keys = "murray_band_edges = [\"" + e0 + " mm\", \"" + e1 + " mm\"]\n" + bands;
+    if (c.after.empty()) {
+      text += "\n[physics]\n" + keys;
+    } else {
+      const auto at = text.find(c.after);
+      ASSERT_NE(at, std::string::npos) << c.name;
+      text.insert(at + c.after.size(), keys);
+    }
+    std::ofstream(dir / (c.name + ".toml")) << text;
+    for (const auto& f : fs::directory_iterator(src))  // the initial networks the examples name
+      if (f.path().extension() == ".swc") fs::copy_file(f.path(), dir / f.path().filename(), fs::copy_options::skip_existing);
+    ASSERT_EQ(run("generate " + c.name + ".toml --out " + c.name + " --no-image --quiet", dir).code, 0) << c.name;
+    const ::Run r = run("stats " + c.name + " --out " + c.name + "_stats --murray-bands " + c.edges + " --quiet", dir);
     ASSERT_EQ(r.code, 0) << r.err;
     const std::string out = debianPython(R"(
-import csv, sys
-edges = [float(x) for x in ')" + std::string(edges) +
-                                             R"('.split()]
+import csv
+edges = [float(x) for x in ')" + c.edges + R"('.split()]
 gammas = [3.0, 2.7, 2.3]
 count, worst = [0, 0, 0], 0.0
-for row in csv.DictReader(open(')" + n + R"(_stats/bifurcations.csv')):
+for row in csv.DictReader(open(')" + c.name + R"(_stats/bifurcations.csv')):
     r = float(row['r_parent_mm'])
     if any(e / 1.05 < r < e * 1.05 for e in edges): continue
     band = sum(r >= e for e in edges)
@@ -289,8 +303,8 @@ print('counts', *count, 'worst', worst)
     double worst = 1;
     int c0 = 0, c1 = 0, c2 = 0;
     ASSERT_EQ(std::sscanf(out.c_str(), "counts %d %d %d worst %lf", &c0, &c1, &c2, &worst), 4) << out;
-    EXPECT_LE(worst, 1e-9) << n << ": " << out;
-    EXPECT_GE(std::min({c0, c1, c2}), 50) << n << ": " << out;
+    EXPECT_LE(worst, 1e-9) << c.name << ": " << out;
+    EXPECT_GE(std::min({c0, c1, c2}), 50) << c.name << ": " << out;
   }
 }
 

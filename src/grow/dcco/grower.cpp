@@ -39,12 +39,14 @@ double characteristicLength(const GrowthDomain& d) {
   return d.dimension() == 2 ? std::sqrt(d.measure() / std::numbers::pi) : std::cbrt(3 * d.measure() / (4 * std::numbers::pi));
 }
 
-// Murray kernels per stage (γ may differ between stages).
-std::vector<PowerKernel> kernelsOf(const std::vector<double>& gamma_of_stage) {
+// Murray kernels per stage (γ may differ between stages), or the bands' for every stage.
+std::vector<PowerKernel> kernelsOf(const std::vector<double>& gamma_of_stage, const DccoOptions& o) {
   std::vector<PowerKernel> k;
   for (double g : gamma_of_stage) {
     PhysicsParameters p;
     p.murray_exponent = g;
+    p.murray_band_edges = o.murray_band_edges;
+    p.murray_band_exponents = o.murray_band_exponents;
     k.emplace_back(p);
   }
   return k;
@@ -79,7 +81,7 @@ class DccoGrower {
   DccoGrower(const DccoOptions& o, GrowthReport& r, DccoReport& d)
       : o_(o), report_(r), dr_(d), rng_(o.seed, o.sample, Stage::Growth), index_(o.world->lo(), o.world->hi(), o.world->dimension() == 2) {
     for (const auto& st : o.stages) gamma_.push_back(st.gamma);
-    kernels_ = kernelsOf(gamma_);
+    kernels_ = kernelsOf(gamma_, o_);
     std::int64_t total = 0;
     for (const auto& st : o.stages) total += st.terminal_count;
     t_.reserve(2 * total + 2 + (o.initial ? std::size_t(o.initial->nodeCount()) : 0));
@@ -304,14 +306,14 @@ class DccoGrower {
       const double l_up = distance(T.position[q], b), l_down = distance(b, T.position[s]);
       const double R_sd = es * l_down + (T.reduced_resistance[s] - es * T.length[s]);
       const double V_sd = l_down + (T.cost_ratio[s] - T.length[s]);
-      const auto sp = kernels_[stage_].split(load_[s], R_sd, 1, R_t);
+      const auto sp = kernels_[stage_].split(load_[s], R_sd, 1, R_t, T.radius[s]);
       path.push_back(Level{-1, s, -1, sp.beta_a, sp.beta_b, es * l_up + 1.0 / (pow4(sp.beta_a) / R_sd + pow4(sp.beta_b) / R_t),
                            l_up + sp.beta_a * sp.beta_a * V_sd + sp.beta_b * sp.beta_b * V_t, T.terminals[s] + 1, load_[s] + 1});
     } else if (T.child0[s] < 0) {  // s ends free: the new vessel continues it, s stops being a terminal
       path.push_back(Level{s, -1, -1, 1, 1, es * T.length[s] + R_t, T.length[s] + V_t, T.terminals[s], load_[s]});
     } else {  // s's end becomes a bifurcation of its child and the new vessel
       const auto c = T.child0[s];
-      const auto sp = kernels_[stage_].split(load_[c], T.reduced_resistance[c], 1, R_t);
+      const auto sp = kernels_[stage_].split(load_[c], T.reduced_resistance[c], 1, R_t, T.radius[s]);
       path.push_back(Level{s, c, -1, sp.beta_a, sp.beta_b,
                            es * T.length[s] + 1.0 / (pow4(sp.beta_a) / T.reduced_resistance[c] + pow4(sp.beta_b) / R_t),
                            T.length[s] + sp.beta_a * sp.beta_a * T.cost_ratio[c] + sp.beta_b * sp.beta_b * V_t, T.terminals[s] + 1, load_[s] + 1});
@@ -328,7 +330,7 @@ class DccoGrower {
         path.push_back(Level{y, child, -1, 1, 0, e(y) * T.length[y] + below.R, T.length[y] + below.V, T.terminals[y] + dn, load_[y] + dw});
         continue;
       }
-      const auto spl = kernelAt(T, y, kernels_).split(below.w, below.R, load_[other], T.reduced_resistance[other]);
+      const auto spl = kernelAt(T, y, kernels_).split(below.w, below.R, load_[other], T.reduced_resistance[other], T.radius[y]);
       path.push_back(Level{y, child, other, spl.beta_a, spl.beta_b,
                            e(y) * T.length[y] + 1.0 / (pow4(spl.beta_a) / below.R + pow4(spl.beta_b) / T.reduced_resistance[other]),
                            T.length[y] + spl.beta_a * spl.beta_a * below.V + spl.beta_b * spl.beta_b * T.cost_ratio[other], T.terminals[y] + dn,
@@ -1060,7 +1062,11 @@ int solveDccoTree(VascularTree& t, std::vector<double>& eta, const DccoOptions& 
   std::vector<double> own_load;
   auto& load = load_out ? *load_out : own_load;
   load.assign(t.nodeCount(), 0.0);
-  const auto kernels = kernelsOf(gamma_of_stage);
+  const auto kernels = kernelsOf(gamma_of_stage, o);
+  // Banded γ: each bifurcation's from its parent's radius of the pass before, to a fixed point
+  // with the viscosities.
+  const bool banded = kernels.front().law().banded();
+  std::vector<double> radius_used;
   // Outlets carry f_i·Q; the common terminals share (1 − Σf)·Q: in units of their flow q_f an
   // outlet weighs f_i·N_common / (1 − Σf).
   std::int64_t common = 0;
@@ -1077,6 +1083,7 @@ int solveDccoTree(VascularTree& t, std::vector<double>& eta, const DccoOptions& 
   int it = 0;
   for (;;) {
     ++it;
+    if (banded) radius_used = t.radius;
     for (auto k = order.rbegin(); k != order.rend(); ++k) {
       const auto i = *k;
       if (t.parent[i] < 0) continue;
@@ -1098,7 +1105,7 @@ int solveDccoTree(VascularTree& t, std::vector<double>& eta, const DccoOptions& 
         t.cost_ratio[i] = t.length[i] + t.cost_ratio[a];
         continue;
       }
-      const auto s = kernelAt(t, i, kernels).split(load[a], t.reduced_resistance[a], load[b], t.reduced_resistance[b]);
+      const auto s = kernelAt(t, i, kernels).split(load[a], t.reduced_resistance[a], load[b], t.reduced_resistance[b], t.radius[i]);
       t.beta[a] = s.beta_a;
       t.beta[b] = s.beta_b;
       t.terminals[i] = t.terminals[a] + t.terminals[b];
@@ -1107,7 +1114,7 @@ int solveDccoTree(VascularTree& t, std::vector<double>& eta, const DccoOptions& 
       t.cost_ratio[i] = t.length[i] + s.beta_a * s.beta_a * t.cost_ratio[a] + s.beta_b * s.beta_b * t.cost_ratio[b];
     }
     const double q_term = o.flow * (1 - reserved) / double(common);
-    double change = 0;
+    double change = 0, gamma_change = 0;
     next.resize(t.nodeCount());
     for (auto i : order) {
       const auto par = t.parent[i];
@@ -1122,10 +1129,14 @@ int solveDccoTree(VascularTree& t, std::vector<double>& eta, const DccoOptions& 
       t.pressure[i] = t.pressure[par] - t.flow[i] * 8.0 * eta[i] * t.length[i] / (std::numbers::pi * pow4(t.radius[i]));
       next[i] = o.viscosity.at(t.radius[i]);
       change = std::max(change, std::abs(next[i] - eta[i]) / next[i]);
+      if (banded && t.child1[i] >= 0) {
+        const auto& law = kernelAt(t, i, kernels).law();
+        gamma_change = std::max(gamma_change, std::abs(law.exponentAt(t.radius[i]) - law.exponentAt(radius_used[std::size_t(i)])));
+      }
     }
     // The tree keeps the viscosities its radii and pressures were computed with (consistent to
     // rounding); they differ from η(r) by less than the tolerance.
-    if (change < tolerance) return it;
+    if (change < tolerance && gamma_change <= 1e-13) return it;
     if (it >= 200) throw GrowthError("the radius–viscosity fixed point (Algorithm 1) did not converge in 200 iterations");
     for (auto i : order)
       if (t.parent[i] >= 0) eta[i] = next[i];

@@ -69,6 +69,9 @@ struct DccoOptions {
   double root_radius = 1;        // mm, fixed (r_1)
   double flow = 8330;            // mm^3/s, Q
   double root_pressure = 13300;  // Pa at the root (pressures downstream follow)
+  // γ by band of parent radius (mm) for every bifurcation, instead of each stage's γ ([physics]
+  // murray_band_edges and _exponents; empty: the stages').
+  std::vector<double> murray_band_edges, murray_band_exponents;
   Viscosity viscosity;
   const GrowthDomain* world = nullptr;  // every vessel stays inside (minus the avascular regions of its stage)
   // The network growth continues (Maso Talou et al.'s vascular completion; null: the first stage plants a

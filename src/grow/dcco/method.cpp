@@ -107,7 +107,11 @@ const std::vector<Setting<PhysicsParameters>>& dccoPhysics() {
     flow.meaning = "Q, the inflow, split equally among the terminals";
     auto pressure = physicsSetting("perfusion_pressure", "100 mmHg");
     pressure.meaning = "pressure at the root (the pressures downstream follow from the radii)";
-    return std::vector<Setting<PhysicsParameters>>{flow, pressure};
+    auto band_edges = physicsSetting("murray_band_edges", "none");
+    band_edges.meaning = "parent radii splitting the bifurcations into bands with a Murray exponent each (murray_band_exponents, which then "
+                         "replace every stage's murray_exponent): ascending, each at least 1.25 times the one before; γ ramps across an edge "
+                         "over ±5 % of its radius";
+    return std::vector<Setting<PhysicsParameters>>{flow, pressure, band_edges, physicsSetting("murray_band_exponents", "none")};
   }();
   return settings;
 }
@@ -462,6 +466,8 @@ std::shared_ptr<const GrowthSetup> readDccoToml(const TomlReader& r, const Growt
   s->physics_summary = readPhysics(r, dccoPhysics(), ph);
   o.flow = s->physics_summary.perfusion_flow;
   o.root_pressure = s->physics_summary.perfusion_pressure;
+  o.murray_band_edges = s->physics_summary.murray_band_edges;
+  o.murray_band_exponents = s->physics_summary.murray_band_exponents;
   s->regions = readRegions(r, m, flat);
   std::set<std::string> region_names;
   for (const auto& g : s->regions) region_names.insert(g.name);
