@@ -7,10 +7,12 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "cli_run.hpp"
 #include "morphometry/morphometry.hpp"
+#include "morphometry/reference.hpp"
 #include "test_support.hpp"
 
 namespace angiosynth {
@@ -88,6 +90,11 @@ TEST(Morphometry, SymmetricTreeHasHortonsRatiosAndMurraysExponent) {
   EXPECT_NEAR(g.horton_branching, 2, 1e-12);
   EXPECT_NEAR(g.horton_length, 2, 1e-12);
   EXPECT_NEAR(g.horton_diameter, std::cbrt(2.0), 1e-12);
+  // Each order one diameter: the diameter-defined orders are the topological ones.
+  ASSERT_EQ(g.diameter_orders.size(), 6u);
+  EXPECT_NEAR(g.horton_by_diameter.branching, 2, 1e-12);
+  EXPECT_NEAR(g.horton_by_diameter.length, 2, 1e-12);
+  EXPECT_NEAR(g.horton_by_diameter.diameter, std::cbrt(2.0), 1e-12);
   EXPECT_NEAR(g.murray_fitted, 3, 1e-9);
   for (const auto& b : m.bifurcations) EXPECT_NEAR(b.murray_exponent, 3, 1e-9);
   EXPECT_NEAR(g.summaries.at("terminal_path_length_mm").min, 32 + 16 + 8 + 4 + 2 + 1, 1e-12);
@@ -306,6 +313,180 @@ print('counts', *count, 'worst', worst)
     EXPECT_LE(worst, 1e-9) << c.name << ": " << out;
     EXPECT_GE(std::min({c0, c1, c2}), 50) << c.name << ": " << out;
   }
+}
+
+// Diameter-defined orders (Kassab et al. 1993): a vessel whose diameter belongs to the next order
+// moves there. A symmetric tree whose orders have two diameters each, one vessel per order made
+// as wide as the order above: it joins that order, and no other vessel moves.
+TEST(Morphometry, DiameterDefinedOrdersMoveVesselsToTheOrderOfTheirDiameter) {
+  VascularTree t;
+  const auto root = t.addNode({0, 0, 0}, -1);
+  std::vector<std::int32_t> level{add(t, root, {0, 0, 32}, 1.0)};
+  std::vector<std::int32_t> widened;
+  for (int g = 1; g <= 5; ++g) {
+    std::vector<std::int32_t> next;
+    for (const auto p : level)
+      for (const double side : {-1.0, 1.0}) {
+        const bool wide = g >= 2 && next.empty() && side < 0;  // the first vessel of levels 2–5
+        const double radius = std::pow(2.0, -(wide ? g - 1 : g) / 3.0) * (side < 0 ? 1.02 : 0.98);
+        next.push_back(add(t, p, t.position[std::size_t(p)] + direction(30, side > 0 ? 0 : 180) * std::pow(2.0, 5 - g), radius));
+        if (wide) widened.push_back(next.back());
+      }
+    level = next;
+  }
+  const Morphometry m = measureTrees(t, {}, {});
+  const auto& g = m.groups.at(0);
+  // Topologically every level is one order; by diameter each widened vessel joins the order above.
+  std::map<int, std::int64_t> topological, by_diameter;
+  for (const auto& o : g.strahler) topological[o.order] = o.vessels;
+  for (const auto& o : g.diameter_orders) by_diameter[o.order] = o.vessels;
+  for (int order = 1; order <= 5; ++order) {
+    const std::int64_t moved_out = order <= 4 ? 1 : 0, moved_in = order >= 2 && order <= 5 ? 1 : 0;
+    EXPECT_EQ(by_diameter[order], topological[order] - moved_out + moved_in) << "order " << order;
+  }
+  EXPECT_EQ(by_diameter[6], 1);
+  EXPECT_EQ(widened.size(), 4u);
+}
+
+// The distances `stats --compare` reports, against SciPy: the two-sample KS statistic D (and its
+// asymptotic p within 0.02 of SciPy's), and 2Φ(|d|/2) − 1 for a standardised difference d.
+TEST(Morphometry, KolmogorovSmirnovDistanceAgreesWithScipy) {
+  std::vector<double> a, b;
+  std::uint64_t x = 12345;
+  const auto next = [&] {
+    x = x * 6364136223846793005ULL + 1442695040888963407ULL;
+    return double(x >> 11) / double(1ULL << 53);
+  };
+  for (int k = 0; k < 300; ++k) a.push_back(next());
+  for (int k = 0; k < 200; ++k) b.push_back(std::pow(next(), 1.3));
+  b.push_back(a[7]);  // a tie across the samples
+  const KsResult ks = kolmogorovSmirnov(a, b);
+  const fs::path dir = freshTestDir("angiosynth_ks_");
+  {
+    std::ofstream f(dir / "samples.txt");
+    f.precision(17);
+    for (double v : a) f << v << ' ';
+    f << '\n';
+    for (double v : b) f << v << ' ';
+    f << '\n';
+  }
+  const std::string out = debianPython(R"(
+from scipy.stats import ks_2samp, norm
+lines = open('samples.txt').read().split('\n')
+a = [float(v) for v in lines[0].split()]
+b = [float(v) for v in lines[1].split()]
+r = ks_2samp(a, b, mode='asymp')
+print('%.17g %.17g %.17g' % (r.statistic, r.pvalue, 2 * norm.cdf(1.3 / 2) - 1))
+)",
+                                       dir);
+  double d = 0, p = 0, normal = 0;
+  ASSERT_EQ(std::sscanf(out.c_str(), "%lf %lf %lf", &d, &p, &normal), 3) << out;
+  EXPECT_NEAR(ks.d, d, 1e-12);
+  EXPECT_NEAR(ks.p, p, 0.02);
+  EXPECT_GT(ks.d, 0.05);
+  EXPECT_EQ(kolmogorovSmirnov(a, a).d, 0);
+  // A one-statistic reference 1.3 spreads away from the tree's mean.
+  VascularTree t;
+  const auto root = t.addNode({0, 0, 0}, -1);
+  const auto trunk = add(t, root, {0, 0, 10}, 1.0);
+  add(t, trunk, {3, 0, 20}, 0.8);
+  add(t, trunk, {-3, 0, 20}, 0.7);
+  const Morphometry m = measureTrees(t, {}, {});
+  MorphometryReference ref;
+  ReferenceStatistic s;
+  s.name = "asymmetry";
+  s.mean = 0.875 - 1.3 * 0.1;
+  s.spread = 0.1;
+  ref.statistics.push_back(s);
+  const auto c = compareMorphometry(m, ref);
+  ASSERT_EQ(c.rows.size(), 1u);
+  EXPECT_NEAR(c.rows[0].statistic_value, 1.3, 1e-12);
+  EXPECT_NEAR(c.rows[0].distance, normal, 1e-12);
+  EXPECT_NEAR(c.overall, normal, 1e-12);
+}
+
+// `stats --compare` on a grown tree: with a shipped reference (Kassab et al. 1993: Horton's
+// ratios by diameter-defined order, each against the spread of the reference's log ratios
+// between successive orders, recomputed here with NumPy from the file), with the tree's own stats
+// directory (every KS D 0) and with another tree's (the D of SciPy's ks_2samp on the CSVs); a bad
+// reference names file and line and writes nothing.
+TEST(Morphometry, CompareWithShippedReferencesAndOtherTrees) {
+  const fs::path dir = freshTestDir("angiosynth_compare_");
+  const auto src = test::sourceDir() / "examples";
+  for (const char* seed : {"1", "2"}) {
+    std::string text = slurp(src / "cco_sphere_3d.toml");
+    text.replace(text.find("terminals = 4000"), 16, "terminals = 800");
+    text.replace(text.find("seed = 1"), 8, std::string("seed = ") + seed);
+    std::ofstream(dir / (std::string("tree") + seed + ".toml")) << text;
+    ASSERT_EQ(run(std::string("generate tree") + seed + ".toml --out tree" + seed + " --no-image --quiet", dir).code, 0);
+    ASSERT_EQ(run(std::string("stats tree") + seed + " --out stats" + seed + " --quiet", dir).code, 0);
+  }
+  const ::Run r = run("stats tree1 --out cmp --compare kassab1993_pig_coronary_rca stats1 stats2 --quiet", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string out = debianPython(R"(
+import csv, json, tomllib
+import numpy as np
+from scipy.stats import ks_2samp
+c = json.load(open('cmp/comparison.json'))['comparisons']
+stats = json.load(open('cmp/stats.json'))['groups'][0]
+ref = tomllib.load(open(')" + (test::sourceDir() / "data/morphometry/kassab1993_pig_coronary_rca.toml").string() +
+                                           R"(', 'rb'))
+rows = [r for r in ref['strahler']['rows'] if 5 <= r[0] <= 11]
+worst = 0
+for col, name, sign in ((5, 'branching', -1), (1, 'diameter', 1), (3, 'length', 1)):
+    pts = [(r[0], np.log(r[col])) for r in rows if r[col] == r[col]]
+    x, y = np.array(pts).T
+    ratio = np.exp(sign * np.polyfit(x, y, 1)[0])
+    steps = [sign * (b[1] - a[1]) for a, b in zip(pts, pts[1:]) if b[0] == a[0] + 1]
+    sd = np.std(steps, ddof=1)
+    tree = stats['horton_ratios_by_diameter'][name]
+    row = [s for s in c[0]['statistics'] if s['statistic'] == 'horton_' + name][0]
+    worst = max(worst, abs(row['reference'] - ratio) / ratio, abs(row['reference_spread'] - sd) / sd, abs(row['tree'] - tree) / tree,
+                abs(row['standardised_difference'] - (np.log(tree) - np.log(ratio)) / sd))
+self_d = max(s['ks_d'] for s in c[1]['statistics'])
+other = 0
+for f in ('vessels', 'bifurcations'):
+    a = list(csv.DictReader(open('stats1/%s.csv' % f)))
+    b = list(csv.DictReader(open('stats2/%s.csv' % f)))
+    for s in c[2]['statistics']:
+        if s['statistic'] not in a[0]: continue
+        va = [float(r[s['statistic']]) for r in a if r[s['statistic']] not in ('', 'nan')]
+        vb = [float(r[s['statistic']]) for r in b if r[s['statistic']] not in ('', 'nan')]
+        other = max(other, abs(ks_2samp(va, vb).statistic - s['ks_d']))
+print(len(c[0]['statistics']), worst, self_d, c[1]['overall_distance'], other, c[2]['overall_distance'], len(c[2]['statistics']))
+)",
+                                       dir);
+  int rows = 0, ks_rows = 0;
+  double worst = 1, self_d = 1, self_overall = 1, other = 1, other_overall = 0;
+  ASSERT_EQ(std::sscanf(out.c_str(), "%d %lf %lf %lf %lf %lf %d", &rows, &worst, &self_d, &self_overall, &other, &other_overall, &ks_rows), 7) << out;
+  EXPECT_EQ(rows, 3);
+  EXPECT_LE(worst, 1e-9) << out;
+  EXPECT_EQ(self_d, 0);
+  EXPECT_EQ(self_overall, 0);
+  EXPECT_LE(other, 1e-12) << out;
+  EXPECT_GT(other_overall, 0);
+  EXPECT_GE(ks_rows, 14);
+  // Bad references: file:line, what is allowed, no output.
+  const std::pair<const char*, const char*> bad[] = {
+      {"[reference]\nname = \"x\"\ntitle = \"x\"\ncitation = \"x\"\n[[statistic]]\nname = \"girth\"\nmean = 1\nsd = 1\n",
+       "bad.toml:6: statistic 'girth' is not one stats measures; allowed: radius_mm"},
+      {"[reference]\nname = \"x\"\ntitle = \"x\"\ncitation = \"x\"\n[[statistic]]\nname = \"asymmetry\"\nmean = 1\n",
+       "bad.toml:5: statistic 'asymmetry' needs samples, or mean with sd (or with scale and scale_note)"},
+      {"[reference]\nname = \"x\"\ntitle = \"x\"\ncitation = \"x\"\n[[statistic]]\nname = \"murray_exponent\"\nmean = 3\nsd = 1\nband_mm = [1, "
+       "0.5]\n",
+       "bad.toml:9: band_mm [1, 0.5]: allowed: 0 <= lower < upper (mm)"},
+  };
+  for (const auto& [text, message] : bad) {
+    std::ofstream(dir / "bad.toml") << text;
+    const ::Run b = run("stats tree1 --out badout --compare bad.toml", dir);
+    EXPECT_NE(b.code, 0);
+    EXPECT_NE(b.err.find(message), std::string::npos) << b.err;
+    EXPECT_FALSE(fs::exists(dir / "badout"));
+  }
+  const ::Run unknown = run("stats tree1 --compare no_such_reference", dir);
+  EXPECT_NE(unknown.err.find("no such reference file, stats directory or shipped reference; shipped: cassot2010_human_cortex_arterioles"),
+            std::string::npos)
+      << unknown.err;
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "io/network_files.hpp"
 #include "io/volume_writers.hpp"
 #include "morphometry/morphometry.hpp"
+#include "morphometry/reference.hpp"
 
 namespace angiosynth::cli {
 namespace fs = std::filesystem;
@@ -24,6 +25,13 @@ CLI::App* addStats(CLI::App& app, StatsArgs& a) {
   c->add_option("--out", a.out,
                 "write stats.json, vessels.csv, bifurcations.csv and stats.png (histograms) into this directory (default: print the summary)");
   c->add_option("--murray-bands", a.bands, "lower edges (mm) of the parent-radius bands of Murray's exponent (default 0.1 1)");
+  std::string shipped;
+  for (const auto& n : shippedMorphometryReferences()) shipped += (shipped.empty() ? "" : ", ") + n;
+  c->add_option("--compare", a.compare,
+                "compare with published morphometry or another tree: a reference file (data/morphometry/*.toml), a shipped reference by name (" +
+                    shipped + "), or another `stats --out` directory (its vessels and bifurcations as samples); repeatable")
+      ->take_all();
+  c->add_option("--group", a.group, "the group compared: all, kind <kind> or tree <name> (default: the reference's, else all)");
   c->add_flag("--force", a.force, "replace the files of an earlier --out");
   addCommonOptions(*c, a.common);
   return c;
@@ -38,13 +46,23 @@ int runStats(const StatsArgs& a) {
         throw InputError("--murray-bands", 0, "band edges must be increasing radii in mm, each > 0");
     options.murray_band_edges_mm = a.bands;
   }
+  // References first: a bad one is refused before anything is written.
+  std::vector<MorphometryReference> references;
+  for (const auto& r : a.compare) {
+    references.push_back(readMorphometryReference(r));
+    if (!a.group.empty()) references.back().group = a.group;
+  }
   std::vector<OutputFile> outputs;
-  if (!a.out.empty())
+  if (!a.out.empty()) {
     for (const char* f : {"stats.json", "vessels.csv", "bifurcations.csv", "stats.png"}) outputs.push_back({fs::path(a.out) / f, "--out"});
+    if (!references.empty()) outputs.push_back({fs::path(a.out) / "comparison.json", "--out"});
+  }
   checkOutputFiles(outputs, {graph}, a.force);
   const ExistingNetwork net = readNetwork(graph, 1, memoryLimit(a.common));
   Morphometry m = measureTrees(net.tree, net.tree_names, net.tree_kinds, options);
   m.segment_names = net.ids;
+  std::vector<MorphometryComparison> comparisons;
+  for (const auto& r : references) comparisons.push_back(compareMorphometry(m, r));
   if (!a.out.empty()) {
     fs::create_directories(a.out);
     auto j = m.toJson();
@@ -53,8 +71,15 @@ int runStats(const StatsArgs& a) {
     writeFileAtomically(fs::path(a.out) / "vessels.csv", m.vesselsCsv(), a.force);
     writeFileAtomically(fs::path(a.out) / "bifurcations.csv", m.bifurcationsCsv(), a.force);
     writeFileAtomically(fs::path(a.out) / "stats.png", encodePng(morphometryFigure(m)), a.force);
+    if (!comparisons.empty()) {
+      nlohmann::ordered_json list = nlohmann::ordered_json::array();
+      for (const auto& c : comparisons) list.push_back(c.toJson());
+      writeFileAtomically(fs::path(a.out) / "comparison.json",
+                          nlohmann::ordered_json{{"input", graph.string()}, {"comparisons", list}}.dump(1) + "\n", a.force);
+    }
   }
   if (a.common.quiet) return 0;
+  for (const auto& c : comparisons) std::printf("%s\n", c.table().c_str());
   for (const auto& g : m.groups) {
     std::printf("%s: %lld vessels, %lld bifurcations, %lld terminals; Horton ratios branching %.3g, length %.3g, diameter %.3g; Murray exponent %.3g",
                 g.name.c_str(), (long long)g.vessels, (long long)g.bifurcations, (long long)g.terminals, g.horton_branching, g.horton_length,

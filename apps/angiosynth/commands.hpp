@@ -78,8 +78,9 @@ CLI::App* addBenchmark(CLI::App& app, BenchmarkArgs& a);
 int runBenchmarkCommand(const BenchmarkArgs& a, const std::string& command_line);
 
 struct StatsArgs {
-  std::string input, out;
+  std::string input, out, group;
   std::vector<double> bands;
+  std::vector<std::string> compare;
   bool force = false;
   CommonOptions common;
 };

@@ -55,8 +55,9 @@ double quantile(const std::vector<double>& sorted, double q) {
   return sorted[lo] + (at - double(lo)) * (sorted[hi] - sorted[lo]);
 }
 
-// Least-squares slope of y on x.
-double slope(const std::vector<double>& x, const std::vector<double>& y) {
+}  // namespace
+
+double leastSquaresSlope(const std::vector<double>& x, const std::vector<double>& y) {
   const double n = double(x.size());
   if (x.size() < 2) return kNaN;
   const double mx = std::accumulate(x.begin(), x.end(), 0.0) / n, my = std::accumulate(y.begin(), y.end(), 0.0) / n;
@@ -64,6 +65,8 @@ double slope(const std::vector<double>& x, const std::vector<double>& y) {
   for (std::size_t i = 0; i < x.size(); ++i) sxy += (x[i] - mx) * (y[i] - my), sxx += (x[i] - mx) * (x[i] - mx);
   return sxx > 0 ? sxy / sxx : kNaN;
 }
+
+namespace {
 
 // γ minimising Σ (x1^γ + x2^γ − 1)²: a scan on [0.5, 20], then golden-section refinement.
 double fittedMurray(const std::vector<std::pair<double, double>>& x) {
@@ -139,6 +142,34 @@ Summary summarise(std::vector<double> values) {
   return s;
 }
 
+const std::vector<std::pair<std::string, double (*)(const VesselMeasures&)>>& vesselStatistics() {
+  using V = VesselMeasures;
+  static const std::vector<std::pair<std::string, double (*)(const V&)>> list{
+      {"radius_mm", [](const V& v) { return v.radius_mm; }},
+      {"length_mm", [](const V& v) { return v.length_mm; }},
+      {"length_over_radius", [](const V& v) { return v.length_over_radius; }},
+      {"distance_metric", [](const V& v) { return v.distance_metric; }},
+      {"inflections", [](const V& v) { return double(v.inflections); }},
+      {"sum_of_angles_per_mm", [](const V& v) { return v.sum_of_angles_per_mm; }},
+      {"generation", [](const V& v) { return double(v.generation); }},
+      {"strahler", [](const V& v) { return double(v.strahler); }}};
+  return list;
+}
+
+const std::vector<std::pair<std::string, double (*)(const BifurcationMeasures&)>>& bifurcationStatistics() {
+  using B = BifurcationMeasures;
+  static const std::vector<std::pair<std::string, double (*)(const B&)>> list{
+      {"angle_large_deg", [](const B& b) { return b.angle_large_deg; }},
+      {"angle_small_deg", [](const B& b) { return b.angle_small_deg; }},
+      {"angle_between_deg", [](const B& b) { return b.angle_between_deg; }},
+      {"out_of_plane_deg", [](const B& b) { return b.out_of_plane_deg; }},
+      {"asymmetry", [](const B& b) { return b.asymmetry; }},
+      {"area_ratio", [](const B& b) { return b.area_ratio; }},
+      {"daughter_area_ratio", [](const B& b) { return b.daughter_area_ratio; }},
+      {"murray_exponent", [](const B& b) { return b.murray_exponent; }}};
+  return list;
+}
+
 double murrayExponent(double r0, double r1, double r2) {
   if (!(r0 > 0) || !(r1 > 0) || !(r2 > 0) || r1 >= r0 || r2 >= r0) return kNaN;
   const double x1 = r1 / r0, x2 = r2 / r0;
@@ -151,6 +182,100 @@ double murrayExponent(double r0, double r1, double r2) {
   }
   return (lo + hi) / 2;
 }
+
+namespace {
+
+// Elements (runs of vessels of one order, joined end to end: from where the order begins, on
+// through the child of the same order, the wider when both are) and Horton's ratios from the
+// least-squares lines through their log count, mean length and length-weighted mean diameter.
+struct OrderTable {
+  std::vector<StrahlerOrder> orders;
+  HortonRatios horton;
+};
+
+OrderTable orderTable(const Morphometry& m, const std::vector<std::vector<std::int32_t>>& children, const std::function<bool(std::int32_t)>& in,
+                      const std::vector<int>& order) {
+  std::map<int, StrahlerOrder> orders;
+  for (std::size_t k = 0; k < m.vessels.size(); ++k) {
+    const auto& v = m.vessels[k];
+    if (!in(v.tree)) continue;
+    auto& o = orders[order[k]];
+    o.order = order[k];
+    ++o.vessels;
+    if (v.parent >= 0 && order[std::size_t(v.parent)] == order[k]) continue;
+    double length = 0, diameter_length = 0;
+    for (std::int32_t e = std::int32_t(k); e >= 0;) {
+      const auto& ve = m.vessels[std::size_t(e)];
+      length += ve.length_mm;
+      diameter_length += 2 * ve.radius_mm * ve.length_mm;
+      std::int32_t next = -1;
+      for (const auto c : children[std::size_t(e)])
+        if (order[std::size_t(c)] == order[k] && (next < 0 || m.vessels[std::size_t(c)].radius_mm > m.vessels[std::size_t(next)].radius_mm)) next = c;
+      e = next;
+    }
+    ++o.elements;
+    o.mean_element_length_mm += length;
+    o.mean_element_diameter_mm += length > 0 ? diameter_length / length : 0;
+  }
+  OrderTable table;
+  std::vector<double> order_x, log_n, log_l, log_d;
+  for (auto& [k, o] : orders) {
+    if (o.elements > 0) {
+      o.mean_element_length_mm /= double(o.elements);
+      o.mean_element_diameter_mm /= double(o.elements);
+      order_x.push_back(k);
+      log_n.push_back(std::log(double(o.elements)));
+      log_l.push_back(std::log(o.mean_element_length_mm));
+      log_d.push_back(std::log(o.mean_element_diameter_mm));
+    }
+    table.orders.push_back(o);
+  }
+  table.horton.branching = std::exp(-leastSquaresSlope(order_x, log_n));
+  table.horton.length = std::exp(leastSquaresSlope(order_x, log_l));
+  table.horton.diameter = std::exp(leastSquaresSlope(order_x, log_d));
+  return table;
+}
+
+// Diameter-defined Strahler orders (Kassab et al. 1993; Jiang et al. 1994): from the topological
+// orders, each vessel moves to the order whose diameter range holds its diameter, a range bounded
+// halfway between the neighbouring orders' mean + SD and mean − SD, until fewer than 1 % move.
+std::vector<int> diameterDefinedOrders(const Morphometry& m, const std::function<bool(std::int32_t)>& in, std::vector<int> order) {
+  // The orders stay those the topology gave; one left empty keeps its last mean and SD.
+  std::map<int, std::pair<double, double>> stats;
+  for (int round = 0; round < 50; ++round) {
+    std::map<int, std::vector<double>> diameters;
+    for (std::size_t k = 0; k < m.vessels.size(); ++k)
+      if (in(m.vessels[k].tree)) diameters[order[k]].push_back(2 * m.vessels[k].radius_mm);
+    for (auto& [k, d] : diameters) {
+      const Summary s = summarise(d);
+      stats[k] = {s.mean, s.sd};
+    }
+    if (stats.size() < 2) return order;
+    std::vector<int> ids;
+    std::vector<double> upper;  // of each order but the last: halfway between its mean + SD and the next's mean − SD
+    for (auto it = stats.begin(); it != stats.end(); ++it) {
+      ids.push_back(it->first);
+      const auto next = std::next(it);
+      if (next == stats.end()) break;
+      const double u = 0.5 * ((it->second.first + it->second.second) + (next->second.first - next->second.second));
+      upper.push_back(upper.empty() ? u : std::max(u, upper.back()));
+    }
+    std::int64_t moved = 0, counted = 0;
+    for (std::size_t k = 0; k < m.vessels.size(); ++k) {
+      if (!in(m.vessels[k].tree)) continue;
+      const double d = 2 * m.vessels[k].radius_mm;
+      std::size_t j = 0;
+      while (j < upper.size() && d >= upper[j]) ++j;
+      ++counted;
+      moved += order[k] != ids[j];
+      order[k] = ids[j];
+    }
+    if (double(moved) < 0.01 * double(counted)) break;
+  }
+  return order;
+}
+
+}  // namespace
 
 Morphometry measureTrees(const VascularTree& t, const std::vector<std::string>& tree_names, const std::vector<std::string>& tree_kinds,
                          const MorphometryOptions& options) {
@@ -254,6 +379,7 @@ Morphometry measureTrees(const VascularTree& t, const std::vector<std::string>& 
     b.out_of_plane_deg = norm(normal) > 1e-12 ? std::asin(std::clamp(std::abs(dot(unit(u0), unit(normal))), 0.0, 1.0)) * kDeg : kNaN;
     b.asymmetry = b.r_large_mm > 0 ? b.r_small_mm / b.r_large_mm : kNaN;
     b.area_ratio = b.r_parent_mm > 0 ? (b.r_large_mm * b.r_large_mm + b.r_small_mm * b.r_small_mm) / (b.r_parent_mm * b.r_parent_mm) : kNaN;
+    b.daughter_area_ratio = b.asymmetry * b.asymmetry;
     b.murray_exponent = murrayExponent(b.r_parent_mm, b.r_large_mm, b.r_small_mm);
     m.bifurcations.push_back(b);
   }
@@ -283,21 +409,17 @@ Morphometry measureTrees(const VascularTree& t, const std::vector<std::string>& 
   for (const auto& [name, in] : groups) {
     MorphometryGroup g;
     g.name = name;
+    for (const auto& v : m.vessels)
+      if (in(v.tree) && (g.trees.empty() || g.trees.back() != v.tree)) g.trees.push_back(v.tree);
+    std::sort(g.trees.begin(), g.trees.end());
+    g.trees.erase(std::unique(g.trees.begin(), g.trees.end()), g.trees.end());
     std::map<std::string, std::vector<double>> values;
     std::vector<Vec3> terminal_points;
-    std::map<int, StrahlerOrder> orders;
     for (std::size_t k = 0; k < m.vessels.size(); ++k) {
       const auto& v = m.vessels[k];
       if (!in(v.tree)) continue;
       ++g.vessels;
-      values["radius_mm"].push_back(v.radius_mm);
-      values["length_mm"].push_back(v.length_mm);
-      values["length_over_radius"].push_back(v.length_over_radius);
-      values["distance_metric"].push_back(v.distance_metric);
-      values["inflections"].push_back(v.inflections);
-      values["sum_of_angles_per_mm"].push_back(v.sum_of_angles_per_mm);
-      values["generation"].push_back(v.generation);
-      values["strahler"].push_back(v.strahler);
+      for (const auto& [key, value] : vesselStatistics()) values[key].push_back(value(v));
       if (v.terminal) {
         ++g.terminals;
         values["terminal_path_length_mm"].push_back(v.path_length_to_root_mm + v.length_mm);
@@ -305,24 +427,6 @@ Morphometry measureTrees(const VascularTree& t, const std::vector<std::string>& 
         terminal_points.push_back(t.position[std::size_t(v.id)]);
       }
       g.junctions += children[k].size() > 2;
-      auto& o = orders[v.strahler];
-      o.order = v.strahler;
-      ++o.vessels;
-      // An element: a run of vessels of one order, from where the order begins.
-      if (v.parent >= 0 && m.vessels[std::size_t(v.parent)].strahler == v.strahler) continue;
-      double length = 0, diameter_length = 0;
-      for (std::int32_t e = std::int32_t(k); e >= 0;) {
-        const auto& ve = m.vessels[std::size_t(e)];
-        length += ve.length_mm;
-        diameter_length += 2 * ve.radius_mm * ve.length_mm;
-        std::int32_t next = -1;
-        for (const auto c : children[std::size_t(e)])
-          if (m.vessels[std::size_t(c)].strahler == v.strahler) next = c;
-        e = next;
-      }
-      ++o.elements;
-      o.mean_element_length_mm += length;
-      o.mean_element_diameter_mm += length > 0 ? diameter_length / length : 0;
     }
     std::vector<std::pair<double, double>> ratios;
     std::vector<std::vector<std::pair<double, double>>> band_ratios(options.murray_band_edges_mm.size() + 1);
@@ -330,14 +434,7 @@ Morphometry measureTrees(const VascularTree& t, const std::vector<std::string>& 
     for (const auto& b : m.bifurcations) {
       if (!in(b.tree)) continue;
       ++g.bifurcations;
-      const std::pair<const char*, double> measured[] = {{"angle_large_deg", b.angle_large_deg},
-                                                         {"angle_small_deg", b.angle_small_deg},
-                                                         {"angle_between_deg", b.angle_between_deg},
-                                                         {"out_of_plane_deg", b.out_of_plane_deg},
-                                                         {"asymmetry", b.asymmetry},
-                                                         {"area_ratio", b.area_ratio},
-                                                         {"murray_exponent", b.murray_exponent}};
-      for (const auto& [key, value] : measured) values[key].push_back(value);
+      for (const auto& [key, value] : bifurcationStatistics()) values[key].push_back(value(b));
       std::size_t band = 0;
       while (band < options.murray_band_edges_mm.size() && b.r_parent_mm >= options.murray_band_edges_mm[band]) ++band;
       if (std::isfinite(b.murray_exponent)) {
@@ -348,21 +445,16 @@ Morphometry measureTrees(const VascularTree& t, const std::vector<std::string>& 
       }
     }
     for (auto& [key, vals] : values) g.summaries[key] = summarise(vals);
-    std::vector<double> order_x, log_n, log_l, log_d;
-    for (auto& [k, o] : orders) {
-      if (o.elements > 0) {
-        o.mean_element_length_mm /= double(o.elements);
-        o.mean_element_diameter_mm /= double(o.elements);
-        order_x.push_back(k);
-        log_n.push_back(std::log(double(o.elements)));
-        log_l.push_back(std::log(o.mean_element_length_mm));
-        log_d.push_back(std::log(o.mean_element_diameter_mm));
-      }
-      g.strahler.push_back(o);
-    }
-    g.horton_branching = std::exp(-slope(order_x, log_n));
-    g.horton_length = std::exp(slope(order_x, log_l));
-    g.horton_diameter = std::exp(slope(order_x, log_d));
+    std::vector<int> topological(m.vessels.size());
+    for (std::size_t k = 0; k < m.vessels.size(); ++k) topological[k] = m.vessels[k].strahler;
+    const auto by_topology = orderTable(m, children, in, topological);
+    g.strahler = by_topology.orders;
+    g.horton_branching = by_topology.horton.branching;
+    g.horton_length = by_topology.horton.length;
+    g.horton_diameter = by_topology.horton.diameter;
+    const auto by_diameter = orderTable(m, children, in, diameterDefinedOrders(m, in, topological));
+    g.diameter_orders = by_diameter.orders;
+    g.horton_by_diameter = by_diameter.horton;
     for (std::size_t band = 0; band < band_ratios.size(); ++band) {
       MurrayBand mb;
       mb.lower_mm = band == 0 ? 0 : options.murray_band_edges_mm[band - 1];
@@ -388,31 +480,38 @@ nlohmann::ordered_json Morphometry::toJson() const {
     for (const auto& [k, v] : g.summaries)
       s[k] = Json{{"count", v.count},  {"mean", num(v.mean)},     {"sd", num(v.sd)},   {"min", num(v.min)}, {"p05", num(v.p05)},
                   {"p25", num(v.p25)}, {"median", num(v.median)}, {"p75", num(v.p75)}, {"p95", num(v.p95)}, {"max", num(v.max)}};
-    Json orders = Json::array();
-    for (const auto& o : g.strahler)
-      orders.push_back(Json{{"order", o.order},
-                            {"vessels", o.vessels},
-                            {"elements", o.elements},
-                            {"mean_element_length_mm", num(o.mean_element_length_mm)},
-                            {"mean_element_diameter_mm", num(o.mean_element_diameter_mm)}});
+    const auto orderList = [&](const std::vector<StrahlerOrder>& table) {
+      Json orders = Json::array();
+      for (const auto& o : table)
+        orders.push_back(Json{{"order", o.order},
+                              {"vessels", o.vessels},
+                              {"elements", o.elements},
+                              {"mean_element_length_mm", num(o.mean_element_length_mm)},
+                              {"mean_element_diameter_mm", num(o.mean_element_diameter_mm)}});
+      return orders;
+    };
+    const auto horton = [&](const HortonRatios& h) {
+      return Json{{"branching", num(h.branching)}, {"length", num(h.length)}, {"diameter", num(h.diameter)}};
+    };
     Json bands = Json::array();
     for (const auto& b : g.murray_bands)
       bands.push_back(Json{{"parent_radius_mm", {b.lower_mm, std::isfinite(b.upper_mm) ? Json(b.upper_mm) : Json("inf")}},
                            {"bifurcations", b.bifurcations},
                            {"median_exponent", num(b.median_exponent)},
                            {"fitted_exponent", num(b.fitted_exponent)}});
-    groups_json.push_back(
-        Json{{"group", g.name},
-             {"vessels", g.vessels},
-             {"bifurcations", g.bifurcations},
-             {"junctions", g.junctions},
-             {"terminals", g.terminals},
-             {"terminal_nearest_neighbour_mm", num(g.terminal_nearest_neighbour_mm)},
-             {"murray_fitted_exponent", num(g.murray_fitted)},
-             {"murray_bands", bands},
-             {"strahler_orders", orders},
-             {"horton_ratios", {{"branching", num(g.horton_branching)}, {"length", num(g.horton_length)}, {"diameter", num(g.horton_diameter)}}},
-             {"summaries", s}});
+    groups_json.push_back(Json{{"group", g.name},
+                               {"vessels", g.vessels},
+                               {"bifurcations", g.bifurcations},
+                               {"junctions", g.junctions},
+                               {"terminals", g.terminals},
+                               {"terminal_nearest_neighbour_mm", num(g.terminal_nearest_neighbour_mm)},
+                               {"murray_fitted_exponent", num(g.murray_fitted)},
+                               {"murray_bands", bands},
+                               {"strahler_orders", orderList(g.strahler)},
+                               {"horton_ratios", horton({g.horton_branching, g.horton_length, g.horton_diameter})},
+                               {"diameter_defined_orders", orderList(g.diameter_orders)},
+                               {"horton_ratios_by_diameter", horton(g.horton_by_diameter)},
+                               {"summaries", s}});
   }
   return Json{{"groups", groups_json},
               {"definitions",
@@ -422,9 +521,15 @@ nlohmann::ordered_json Morphometry::toJson() const {
                 {"inflections", "changes of the turning direction (binormal reversals) along the vessel"},
                 {"sum_of_angles_per_mm", "Σ sqrt(in-plane² + torsion²) angles at its interior points / length, rad/mm (Bullitt et al. 2003)"},
                 {"angles", "between the directions of the vessels' pieces at the branching point; 0 = straight on"},
+                {"asymmetry", "r_small / r_large of the daughters"},
+                {"area_ratio", "(r_large² + r_small²) / r_parent²: the daughters' cross-sections over the parent's"},
+                {"daughter_area_ratio", "r_small² / r_large²: the smaller daughter's cross-section over the larger's"},
                 {"murray_exponent", "γ solving r_parent^γ = r_large^γ + r_small^γ; fitted: γ minimising Σ (x_large^γ + x_small^γ − 1)²"},
                 {"strahler", "terminal vessels 1; a parent takes its children's highest order, plus one when two or more children share it"},
-                {"horton_ratios", "from least-squares lines through log(element count, mean length, mean diameter) against order"}}}};
+                {"horton_ratios", "from least-squares lines through log(element count, mean length, mean diameter) against order"},
+                {"diameter_defined_orders",
+                 "Strahler orders redrawn by diameter until fewer than 1 % of vessels move: each order's range ends halfway between its mean + SD "
+                 "and the next order's mean − SD (Kassab et al. 1993; Jiang et al. 1994)"}}}};
 }
 
 std::string Morphometry::vesselName(std::int32_t vessel) const {
@@ -449,12 +554,12 @@ std::string Morphometry::vesselsCsv() const {
 std::string Morphometry::bifurcationsCsv() const {
   std::ostringstream o;
   o << "tree,parent,daughter_large,daughter_small,r_parent_mm,r_large_mm,r_small_mm,angle_large_deg,angle_small_deg,angle_between_deg,"
-       "out_of_plane_deg,asymmetry,area_ratio,murray_exponent\n";
+       "out_of_plane_deg,asymmetry,area_ratio,daughter_area_ratio,murray_exponent\n";
   for (const auto& b : bifurcations)
     o << b.tree << ',' << vesselName(b.parent) << ',' << vesselName(b.daughter_large) << ',' << vesselName(b.daughter_small) << ','
       << number(b.r_parent_mm) << ',' << number(b.r_large_mm) << ',' << number(b.r_small_mm) << ',' << number(b.angle_large_deg) << ','
       << number(b.angle_small_deg) << ',' << number(b.angle_between_deg) << ',' << number(b.out_of_plane_deg) << ',' << number(b.asymmetry) << ','
-      << number(b.area_ratio) << ',' << number(b.murray_exponent) << '\n';
+      << number(b.area_ratio) << ',' << number(b.daughter_area_ratio) << ',' << number(b.murray_exponent) << '\n';
   return o.str();
 }
 

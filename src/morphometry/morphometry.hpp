@@ -53,6 +53,7 @@ struct BifurcationMeasures {
   double out_of_plane_deg = 0;                                      // the parent's direction against the daughters' plane (0: coplanar)
   double asymmetry = 0;                                             // r_small / r_large
   double area_ratio = 0;                                            // (r_large² + r_small²) / r_parent²
+  double daughter_area_ratio = 0;                                   // r_small² / r_large²
   double murray_exponent = 0;  // γ with r_parent^γ = r_large^γ + r_small^γ (NaN: none, a daughter as wide as the parent)
 };
 
@@ -75,15 +76,26 @@ struct MurrayBand {
   double fitted_exponent = 0;  // minimising Σ (x_large^γ + x_small^γ − 1)², x = r / r_parent (NaN: none)
 };
 
+// Horton's ratios: branching N_k/N_{k+1}, length and diameter L_{k+1}/L_k, D_{k+1}/D_k of the
+// elements by order (NaN with fewer than two orders).
+struct HortonRatios {
+  double branching = 0, length = 0, diameter = 0;
+};
+
 // The statistics of one group of vessels (a tree, a kind, or all).
 struct MorphometryGroup {
   std::string name;
+  std::vector<std::int32_t> trees;  // the trees it holds (ids, ascending)
   std::int64_t vessels = 0, bifurcations = 0, junctions = 0, terminals = 0;
   std::map<std::string, Summary> summaries;  // by statistic (radius_mm, length_mm, …)
   std::vector<StrahlerOrder> strahler;
   // Horton's ratios from the elements' regression on order: branching N_k/N_{k+1}, length and
   // diameter L_{k+1}/L_k, D_{k+1}/D_k (NaN with fewer than two orders).
   double horton_branching = 0, horton_length = 0, horton_diameter = 0;
+  // The same by diameter-defined Strahler orders (Kassab et al. 1993; Jiang et al. 1994), as
+  // published morphometry of casts orders vessels.
+  std::vector<StrahlerOrder> diameter_orders;
+  HortonRatios horton_by_diameter;
   std::vector<MurrayBand> murray_bands;
   double murray_fitted = 0;                  // over all its bifurcations
   double terminal_nearest_neighbour_mm = 0;  // mean distance from a terminal to the nearest other terminal of the group
@@ -112,6 +124,14 @@ Morphometry measureTrees(const VascularTree& tree, const std::vector<std::string
 // each kind a curve in its colour when there are two or more, and element counts by Strahler
 // order on a log scale.
 Image8 morphometryFigure(const Morphometry& m);
+
+// Least-squares slope of y on x (NaN with fewer than two points or one x).
+double leastSquaresSlope(const std::vector<double>& x, const std::vector<double>& y);
+
+// The statistics per vessel and per bifurcation by the names of vessels.csv and bifurcations.csv
+// (radius_mm, length_over_radius, …, asymmetry, murray_exponent): one value each.
+const std::vector<std::pair<std::string, double (*)(const VesselMeasures&)>>& vesselStatistics();
+const std::vector<std::pair<std::string, double (*)(const BifurcationMeasures&)>>& bifurcationStatistics();
 
 // γ with x1^γ + x2^γ = 1 (0 < x1, x2 < 1), by bisection to 1e-12; NaN when none.
 double murrayExponent(double r_parent, double r1, double r2);
