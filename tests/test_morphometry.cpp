@@ -489,5 +489,41 @@ print(len(c[0]['statistics']), worst, self_d, c[1]['overall_distance'], other, c
       << unknown.err;
 }
 
+// Curves aimed at a sum of angles per mm reach it as `stats` measures it: every vessel curved at
+// full amplitude measures the target (the others were flattened to stay in the domain or clear
+// of other vessels, and measure less).
+TEST(Morphometry, CurvesAimedAtASumOfAnglesMeasureItInStats) {
+  const fs::path dir = freshTestDir("angiosynth_soam_");
+  std::ofstream(dir / "soam.toml") << R"(seed = 3
+[domain]
+shape = "sphere"
+radius = "10 mm"
+voxel_size = "0.3 mm"
+[tree]
+method = "cco"
+terminals = 150
+[curves]
+sum_of_angles = 0.6
+[image]
+enabled = false
+)";
+  ASSERT_EQ(run("generate soam.toml --out sample --quiet", dir).code, 0);
+  ASSERT_EQ(run("stats sample --out stats --quiet", dir).code, 0);
+  const std::string out = debianPython(R"(
+import csv, json
+v = [float(r['sum_of_angles_per_mm']) for r in csv.DictReader(open('stats/vessels.csv'))]
+c = json.load(open('sample/sample.json'))['statistics']['curves']
+print(len(v), sum(abs(x - 0.6) < 1e-6 for x in v), max(v), c['curved'], c['flattened_by_domain'] + c['flattened_by_overlap'], c['tortuosity_target_error_max'])
+)",
+                                       dir);
+  int vessels = 0, at_target = 0, curved = 0, flattened = 0;
+  double largest = 0, error = 1;
+  ASSERT_EQ(std::sscanf(out.c_str(), "%d %d %lf %d %d %lf", &vessels, &at_target, &largest, &curved, &flattened, &error), 6) << out;
+  EXPECT_GE(at_target, curved - flattened) << out;
+  EXPECT_GE(at_target, vessels / 2) << out;
+  EXPECT_LE(largest, 0.6 + 1e-6) << out;
+  EXPECT_LE(error, 1e-9) << out;
+}
+
 }  // namespace
 }  // namespace angiosynth

@@ -2,6 +2,7 @@
 
 #include "core/format.hpp"
 #include "core/point_hash.hpp"
+#include "core/polyline_turns.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -25,26 +26,9 @@ double angleBetween(const Vec3& a, const Vec3& b) {
 
 // Tortuosity of a polyline (Bullitt et al. 2003): inflections and the sum of angles.
 void tortuosity(const std::vector<Vec3>& p, VesselMeasures& v) {
-  std::vector<Vec3> d, b;
-  for (std::size_t k = 1; k < p.size(); ++k) d.push_back(unit(p[k] - p[k - 1]));
-  double total = 0;
-  for (std::size_t k = 0; k + 1 < d.size(); ++k) {
-    const Vec3 n = cross(d[k], d[k + 1]);
-    b.push_back(norm(n) > 1e-12 ? unit(n) : Vec3(0, 0, 0));
-  }
-  for (std::size_t k = 0; k < b.size(); ++k) {
-    const double in_plane = std::acos(std::clamp(dot(d[k], d[k + 1]), -1.0, 1.0));
-    double torsion = 0;
-    if (k + 1 < b.size() && norm(b[k]) > 0 && norm(b[k + 1]) > 0) {
-      const double c = dot(b[k], b[k + 1]);
-      torsion = std::acos(std::clamp(c, -1.0, 1.0));
-      v.inflections += c < 0;
-      // A flip of the turning direction is an inflection, not torsion.
-      if (c < 0) torsion = M_PI - torsion;
-    }
-    total += std::sqrt(in_plane * in_plane + torsion * torsion);
-  }
-  v.sum_of_angles_per_mm = v.length_mm > 0 ? total / v.length_mm : 0;
+  const PolylineTurns turns = polylineTurns(p);
+  v.inflections = turns.inflections;
+  v.sum_of_angles_per_mm = v.length_mm > 0 ? turns.total_angle / v.length_mm : 0;
 }
 
 double quantile(const std::vector<double>& sorted, double q) {

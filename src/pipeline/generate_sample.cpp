@@ -216,22 +216,25 @@ void addTreeStatistics(const VascularTree& tree, const PreparedSample& ps, const
 }
 
 Json curveStatistics(const CurveReport& curves) {
-  return Json{{"vessels", curves.vessels},
-              {"curved", curves.curved},
-              {"already_tortuous", curves.already_tortuous},
-              {"flattened_by_domain", curves.flattened_by_domain},
-              {"flattened_by_overlap", curves.flattened_by_overlap},
-              {"left_straight", curves.straightened},
-              {"overlap_rounds", curves.overlap_rounds},
-              {"overlapping_vessel_pairs", curves.overlapping_vessel_pairs},
-              {"nodes_before", curves.nodes_before},
-              {"nodes_after", curves.nodes_after},
-              {"tortuosity_mean", curves.tortuosity_mean},
-              {"tortuosity_min", curves.tortuosity_min},
-              {"tortuosity_max", curves.tortuosity_max},
-              {"tortuosity_target_error_max", curves.target_error_max},
-              {"tortuosity_definition", "distance metric of each vessel (root, bifurcation or terminal to the next): arc length over chord"},
-              {"pressures", "radii and flows as grown; pressures along the longer paths (Poiseuille)"}};
+  Json j{{"vessels", curves.vessels},
+         {"curved", curves.curved},
+         {"already_tortuous", curves.already_tortuous},
+         {"flattened_by_domain", curves.flattened_by_domain},
+         {"flattened_by_overlap", curves.flattened_by_overlap},
+         {"left_straight", curves.straightened},
+         {"overlap_rounds", curves.overlap_rounds},
+         {"overlapping_vessel_pairs", curves.overlapping_vessel_pairs},
+         {"nodes_before", curves.nodes_before},
+         {"nodes_after", curves.nodes_after},
+         {"tortuosity_mean", curves.tortuosity_mean},
+         {"tortuosity_min", curves.tortuosity_min},
+         {"tortuosity_max", curves.tortuosity_max},
+         {"tortuosity_target_error_max", curves.target_error_max},
+         {"tortuosity_definition", "distance metric of each vessel (root, bifurcation or terminal to the next): arc length over chord"},
+         {"pressures", "radii and flows as grown; pressures along the longer paths (Poiseuille)"}};
+  if (curves.target_sum_of_angles)
+    j["tortuosity_target"] = "sum of angles per mm (Bullitt et al. 2003), which tortuosity_target_error_max measures against";
+  return j;
 }
 
 // Mean radius per bifurcation level (the root segment is level 0), as Kerautret et al. (OpenCCO)

@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "core/memory.hpp"
+#include "core/polyline_turns.hpp"
 #include "core/rng.hpp"
 #include "domain/growth_domain.hpp"
 #include "grow/common/intersections.hpp"
@@ -94,6 +95,15 @@ struct VesselCurve {
     for (const auto& p : points) l += distance(prev, p), prev = p;
     return chord > 0 ? l / chord : 1.0;
   }
+  // Σ angles / length of the curve (rad/mm), as `stats` measures a vessel.
+  double sumOfAngles() const {
+    std::vector<Vec3> line{base[0]};
+    line.insert(line.end(), points.begin(), points.end());
+    double l = 0;
+    for (std::size_t k = 1; k < line.size(); ++k) l += distance(line[k - 1], line[k]);
+    return l > 0 ? polylineTurns(line).total_angle / l : 0.0;
+  }
+  double measure(bool by_angles) const { return by_angles ? sumOfAngles() : metric(); }
   double radiusOfPiece(std::size_t i, std::size_t& seg) const {
     while (seg + 1 < path.segments.size() && piece_u[i] > arc[seg + 1]) ++seg;
     const auto s = path.segments[seg];
@@ -223,6 +233,8 @@ VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const Gr
   const bool flat = frame.dims[2] == 1;
   const double piece = o.piece_mm.value_or(frame.voxel_mm);
   const Bounds bounds{domain, frame, o.wall_clearance_mm};
+  const bool by_angles = o.sum_of_angles.has_value();
+  rep.target_sum_of_angles = by_angles;
 
   // The pieces before anything is drawn (each knot interval gets at least 8, as below): a piece
   // length far below the vessels makes millions of nodes, drawn some ninety times each while the
@@ -270,7 +282,8 @@ VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const Gr
     }
     c.chord = distance(c.base.front(), c.base.back());
     Rng rng(seed, sample, Stage::Curves, std::uint64_t(c.path.segments.front()));
-    c.target = std::max(1.0, o.tortuosity + o.tortuosity_sd * rng.normal());
+    const double spread = rng.normal();
+    c.target = by_angles ? std::max(0.0, *o.sum_of_angles * (1 + o.tortuosity_sd * spread)) : std::max(1.0, o.tortuosity + o.tortuosity_sd * spread);
     const double wavelength = o.wavelength(r);
     const int m = std::clamp(int(std::lround(2 * c.length() / std::max(wavelength, 1e-12))), 2, 4096);
     const double step = pieceStep(piece, c.length(), m, r);
@@ -289,22 +302,22 @@ VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const Gr
       c.knot[std::size_t(k)] = (e1 * x1 + (flat ? Vec3(0, 0, 0) : e2 * x2)) * (c.length() / m);
     }
     c.draw(0);
-    const double own = c.metric();
+    const double own = c.measure(by_angles);
     if (c.chord <= 0 || own >= c.target) {
-      c.own_path_enough = own >= c.target && c.target > 1;
+      c.own_path_enough = own >= c.target && c.target > (by_angles ? 0 : 1);
       return;
     }
-    // The metric grows with the amplitude (convex in it, least at 0 for a straight path).
+    // The metric (or the sum of angles) grows with the amplitude, least at 0 for a straight path.
     double lo = 0, hi = 0.25;
     for (int i = 0; i < 40; ++i) {
       c.draw(hi);
-      if (c.metric() >= c.target) break;
+      if (c.measure(by_angles) >= c.target) break;
       lo = hi, hi *= 2;
     }
     for (int i = 0; i < 50 && hi - lo > 1e-12 * hi; ++i) {
       const double mid = (lo + hi) / 2;
       c.draw(mid);
-      (c.metric() < c.target ? lo : hi) = mid;
+      (c.measure(by_angles) < c.target ? lo : hi) = mid;
     }
     c.amplitude = (lo + hi) / 2;
     for (c.level = 0;; ++c.level) {
@@ -399,7 +412,7 @@ VascularTree curveVessels(const VascularTree& t, const CurveOptions& o, const Gr
     rep.flattened_by_domain += c.flattened_by_domain ? 1 : 0;
     rep.flattened_by_overlap += c.flattened_by_overlap ? 1 : 0;
     rep.straightened += (c.amplitude > 0 && !c.moved) ? 1 : 0;
-    if (c.moved && c.level == 0) rep.target_error_max = std::max(rep.target_error_max, std::fabs(dm - c.target));
+    if (c.moved && c.level == 0) rep.target_error_max = std::max(rep.target_error_max, std::fabs((by_angles ? c.sumOfAngles() : dm) - c.target));
   }
   if (curves.empty()) rep.tortuosity_min = rep.tortuosity_max = 1;
   rep.tortuosity_mean = curves.empty() ? 1 : sum / double(curves.size());

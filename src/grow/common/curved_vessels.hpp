@@ -4,7 +4,8 @@
 // drawn as a chain of short straight pieces that every later stage already treats exactly.
 // The curve is the vessel's own path plus a lateral Catmull-Rom displacement that vanishes at
 // both ends, scaled so that the vessel's distance metric (arc length over chord, Bullitt 2003)
-// reaches the requested tortuosity. Curves that would leave the domain, enter zero demand or
+// reaches the requested tortuosity (or its sum of angles per mm, Bullitt 2003, the requested
+// value). Curves that would leave the domain, enter zero demand or
 // overlap another vessel are flattened (amplitude halved) until they fit, down to the straight
 // vessel growth made. Radii and flows stay; pressures follow the longer paths (Poiseuille).
 #include <cstdint>
@@ -19,8 +20,10 @@ class GrowthDomain;
 
 struct CurveOptions {
   bool enabled = false;
-  double tortuosity = 1.2;                 // the target distance metric of each vessel (≥ 1)
-  double tortuosity_sd = 0;                // normal spread of the target between vessels
+  double tortuosity = 1.2;   // the target distance metric of each vessel (≥ 1)
+  double tortuosity_sd = 0;  // normal spread of the target between vessels (relative for sum_of_angles)
+  // The target as the sum of angles per mm instead (rad/mm, as `stats` measures it).
+  std::optional<double> sum_of_angles;
   std::optional<double> wavelength_mm;     // the curve's wavelength; unset: wavelength_radii × the vessel's radius
   std::optional<double> wavelength_radii;  // unset: 40
   std::optional<double> piece_mm;          // longest piece; unset: one voxel of the frame
@@ -41,6 +44,7 @@ struct CurveReport {
   std::int64_t nodes_before = 0, nodes_after = 0;
   double tortuosity_mean = 1, tortuosity_min = 1, tortuosity_max = 1;  // measured, over all vessels
   double target_error_max = 0;                                         // |measured − target| over vessels curved at full amplitude
+  bool target_sum_of_angles = false;                                   // the target was the sum of angles per mm
 };
 
 // The curved tree (roots, bifurcations and terminals where they were; a forest's tree ids kept).
