@@ -525,5 +525,20 @@ print(len(v), sum(abs(x - 0.6) < 1e-6 for x in v), max(v), c['curved'], c['flatt
   EXPECT_LE(error, 1e-9) << out;
 }
 
+// A grammar whose daughters' diameters spread widely draws first daughters near zero or near
+// their parent's width (leaving the second near zero): every vessel keeps the smallest radius a
+// graph file holds, so `stats` reads back what `generate` wrote.
+TEST(Morphometry, GrammarTreesOfWidelySpreadDiametersReadBack) {
+  const fs::path dir = freshTestDir("angiosynth_grammar_spread_");
+  std::string text = slurp(test::sourceDir() / "examples/lsystem_grammar_3d.toml");
+  text.replace(text.find("mode = \"grammar\""), 16, "mode = \"grammar\"\ndiameter_sd = 0.3");
+  std::ofstream(dir / "grammar.toml") << text;
+  ASSERT_EQ(run("generate grammar.toml --out sample --no-image --quiet", dir).code, 0);
+  const ::Run r = run("stats sample --out stats --quiet", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string out = debianPython("import csv\nprint(min(float(r['radius']) for r in csv.DictReader(open('sample/edges.csv'))))\n", dir);
+  EXPECT_GE(std::stod(out), 1e-4) << out;
+}
+
 }  // namespace
 }  // namespace angiosynth

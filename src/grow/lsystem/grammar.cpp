@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/physical_ranges.hpp"
 #include "core/rng.hpp"
 #include "grow/common/intersections.hpp"
 #include "core/segment_grid.hpp"
@@ -167,10 +168,15 @@ class GrammarGrower {
     const Branch b{end, last_dir_, last_up_, last_dir_, d0};
     const double k = law_.exponentAt(d0 / 2);
     double d1, d2, th1, th2;
+    // No vessel thinner than the smallest radius a graph file holds: a vessel too thin to split
+    // into two such daughters ends here, and the first daughter is held where both keep it.
+    const double d_min = 2 * physical::kMinRadiusMm;
+    if (o_.murray ? b.d < std::pow(2.0, 1.0 / k) * d_min : b.d * o_.radius_ratio < d_min) return;
     if (o_.murray) {
       const double opt = b.d / std::pow(2.0, 1.0 / k);
       d1 = o_.diameter_sd > 0 ? std::abs(opt + o_.diameter_sd * opt * normal()) : opt;
       if (!(d1 < b.d)) d1 = opt;
+      d1 = std::clamp(d1, d_min, std::pow(std::pow(b.d, k) - std::pow(d_min, k), 1.0 / k));
       d2 = std::pow(std::pow(b.d, k) - std::pow(d1, k), 1.0 / k);
     } else {
       d1 = d2 = b.d * o_.radius_ratio;
