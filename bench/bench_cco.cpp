@@ -1,8 +1,11 @@
 // CCO growth time and memory for N terminals in the Kerautret et al. (OpenCCO) §5 sphere (or the 2D disc):
-//   bench_cco [N ...] [--disc] [--threads T] [--max-nu M] [--seed S]
+//   bench_cco [N ...] [--disc] [--threads T] [--max-nu M] [--seed S] [--murray-bands]
 // One line per N: seconds, µs per terminal, µs per terminal / log2 N, peak RSS, checks.
+// --murray-bands: Murray's exponent 3, 2.73, 7/3 below 0.1 mm, to 1 mm, above; also the passes
+// the radius–exponent fixed point takes from radii of zero on the grown tree.
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -13,18 +16,21 @@
 
 #include "core/memory.hpp"
 #include "grow/cco/grower.hpp"
+#include "physics/hemodynamics.hpp"
 
 using namespace angiosynth;
 
 int main(int argc, char** argv) {
   std::vector<long> sizes;
-  bool disc = false;
+  bool disc = false, bands = false;
   int threads = 0;
   int max_nu = 0;  // ν doubles up to this (0: the default)
   long seed = 1;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--disc"))
       disc = true;
+    else if (!std::strcmp(argv[i], "--murray-bands"))
+      bands = true;
     else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc)
       seed = std::atol(argv[++i]);
     else if (!std::strcmp(argv[i], "--max-nu") && i + 1 < argc)
@@ -51,6 +57,10 @@ int main(int argc, char** argv) {
     o.physics.perfusion_flow = 500 * 1000.0 / 60.0;  // Karch 1999: 500 mL/min for the whole organ
     o.physics.perfusion_pressure = 100 * 133.322;
     o.physics.terminal_pressure = 60 * 133.322;
+    if (bands) {
+      o.physics.murray_band_edges = {0.1, 1.0};
+      o.physics.murray_band_exponents = {3.0, 2.73, 7.0 / 3.0};
+    }
     GrowthReport rep;
     const auto t0 = std::chrono::steady_clock::now();
     const auto tree = growCco(dom, o, rep);
@@ -58,6 +68,15 @@ int main(int argc, char** argv) {
     std::printf("%-7s %9ld %9.3f %12.1f %16.2f %10.1f %6lld %6lld %9.1f\n", disc ? "disc" : "sphere", n, s, s / n * 1e6,
                 s / n * 1e6 / std::log2(double(n)), peakRssBytes() / 1048576.0, (long long)rep.intersecting_pairs, (long long)rep.short_segments,
                 treeVolume(tree));
+    if (bands) {
+      auto cold = tree;
+      std::fill(cold.radius.begin(), cold.radius.end(), 0.0);
+      PhysicsParameters p = o.physics;
+      p.total_terminals = n;
+      const auto t1 = std::chrono::steady_clock::now();
+      const int passes = solveTree(cold, p);
+      std::printf("        banded γ: %d passes from radii of zero, %.3f s\n", passes, std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
+    }
     std::fprintf(stderr,
                  "  draws too close %lld, candidates %lld, unconnectable %lld, relaxations %lld, doublings %lld, kamiya failures %lld, collisions "
                  "%lld, repair rounds %d, repaired %lld\n",

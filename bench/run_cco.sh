@@ -6,3 +6,4 @@ cd "$(dirname "$0")/.."
 bash scripts/build.sh >/dev/null
 build/bench_cco 1000 2000 4000 8000 16000 32000 50000
 build/bench_cco 4000 --disc
+build/bench_cco 4000 20000 --murray-bands
