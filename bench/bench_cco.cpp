@@ -75,7 +75,8 @@ int main(int argc, char** argv) {
       p.total_terminals = n;
       const auto t1 = std::chrono::steady_clock::now();
       const int passes = solveTree(cold, p);
-      std::printf("        banded γ: %d passes from radii of zero, %.3f s\n", passes, std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
+      std::printf("        banded γ: %d passes from radii of zero, %.3f s\n", passes,
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
     }
     std::fprintf(stderr,
                  "  draws too close %lld, candidates %lld, unconnectable %lld, relaxations %lld, doublings %lld, kamiya failures %lld, collisions "

@@ -125,40 +125,11 @@ TEST(Morphometry, TortuosityOfPolylinesFollowsBullittsMetrics) {
 // A forest of curved arteries and veins grown by `generate`, measured by `stats`, and measured
 // again from its edges.csv and nodes.csv with NetworkX (vessels, generations, path lengths,
 // Strahler orders), NumPy (angles) and SciPy (Murray's exponent by brentq).
-TEST(Morphometry, StatsAgreeWithNetworkXOnAGrownForestOfCurvedVessels) {
-  const fs::path dir = freshTestDir("angiosynth_stats_");
-  std::ofstream(dir / "forest.toml") << R"(seed = 3
-[domain]
-shape = "sphere"
-radius = "10 mm"
-voxel_size = "0.3 mm"
-[tree]
-method = "cco"
-terminals = 150
-[[tree.inlet]]
-kind = "artery"
-root_offset = [-2, 9.7, 0]
-[[tree.inlet]]
-kind = "vein"
-root_offset = [2, 9.7, 0]
-root_pressure = "5 mmHg"
-terminal_pressure = "20 mmHg"
-[physics]
-murray_exponent = 2.7
-perfusion_pressure = "100 mmHg"
-terminal_pressure = "60 mmHg"
-perfusion_flow = "50 mL/min"
-[curves]
-tortuosity = 1.2
-tortuosity_sd = 0.05
-wavelength_radii = 40
-[image]
-enabled = false
-)";
-  ASSERT_EQ(run("generate forest.toml --out sample --quiet", dir).code, 0);
-  const ::Run r = run("stats sample --out stats --quiet", dir);
-  ASSERT_EQ(r.code, 0) << r.err;
-  const std::string out = debianPython(R"(
+// The vessels and bifurcations of a sample, walked with NetworkX on its edges.csv and
+// nodes.csv (lengths, path lengths also by Dijkstra, pieces, generations, Strahler orders, angles
+// by NumPy, Murray's exponent by SciPy's brentq), against `stats`' CSVs: the worst differences.
+std::string networkxCheck(const std::string& sample, const std::string& stats) {
+  std::string script = R"(
 import csv, json, math
 import networkx as nx, numpy as np
 from scipy.optimize import brentq
@@ -230,8 +201,46 @@ groups = [g['group'] for g in stats['groups']]
 print('vessels', worst['count'], len(vessels), 'bifurcations', bifs, 'length', worst['length'], 'path', worst['path'],
       'dijkstra', worst['dijkstra'], 'pieces', worst['pieces'], 'generation', worst['generation'], 'strahler', worst['strahler'],
       'angle', worst['angle'], 'murray', worst['murray'], 'groups', ','.join(groups).replace(' ', '_'))
-)",
-                                       dir);
+)";
+  for (const auto& [from, to] : {std::pair{std::string("'sample/"), "'" + sample + "/"}, std::pair{std::string("'stats/"), "'" + stats + "/"}})
+    for (auto at = script.find(from); at != std::string::npos; at = script.find(from, at + to.size())) script.replace(at, from.size(), to);
+  return script;
+}
+
+TEST(Morphometry, StatsAgreeWithNetworkXOnAGrownForestOfCurvedVessels) {
+  const fs::path dir = freshTestDir("angiosynth_stats_");
+  std::ofstream(dir / "forest.toml") << R"(seed = 3
+[domain]
+shape = "sphere"
+radius = "10 mm"
+voxel_size = "0.3 mm"
+[tree]
+method = "cco"
+terminals = 150
+[[tree.inlet]]
+kind = "artery"
+root_offset = [-2, 9.7, 0]
+[[tree.inlet]]
+kind = "vein"
+root_offset = [2, 9.7, 0]
+root_pressure = "5 mmHg"
+terminal_pressure = "20 mmHg"
+[physics]
+murray_exponent = 2.7
+perfusion_pressure = "100 mmHg"
+terminal_pressure = "60 mmHg"
+perfusion_flow = "50 mL/min"
+[curves]
+tortuosity = 1.2
+tortuosity_sd = 0.05
+wavelength_radii = 40
+[image]
+enabled = false
+)";
+  ASSERT_EQ(run("generate forest.toml --out sample --quiet", dir).code, 0);
+  const ::Run r = run("stats sample --out stats --quiet", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string out = debianPython(networkxCheck("sample", "stats"), dir);
   std::istringstream in(out.substr(out.find("vessels")));
   std::string w, groups;
   long counted = 0, expected = 0, bifurcations = 0, pieces = -1, generation = -1, strahler = -1;
@@ -259,6 +268,24 @@ print('png', im.size[0], im.size[1], sum(1 for p in px if p == (0xB3, 0x26, 0x2E
 )",
                                        dir);
   EXPECT_NE(png.find("png 990 950 True True"), std::string::npos) << png;
+  // Two shipped examples the same way: two trees of one kind in a disc, and VascuSynth's rods.
+  for (const char* example : {"cco_two_inlets_2d", "vascusynth_like"}) {
+    const std::string e = example;
+    ASSERT_EQ(
+        run("generate " + (test::sourceDir() / "examples" / (e + ".toml")).string() + " --out " + e + " --no-image --no-profiles --quiet", dir).code,
+        0);
+    ASSERT_EQ(run("stats " + e + " --out " + e + "_stats --quiet", dir).code, 0);
+    const std::string check = debianPython(networkxCheck(e, e + "_stats"), dir);
+    std::istringstream sin(check.substr(check.find("vessels")));
+    long n_counted = 0, n_expected = -1, n_bif = 0, n_pieces = -1, n_generation = -1, n_strahler = -1;
+    double n_length = 1, n_path = 1, n_dijkstra = 1, n_angle = 1, n_murray = 1;
+    sin >> w >> n_counted >> n_expected >> w >> n_bif >> w >> n_length >> w >> n_path >> w >> n_dijkstra >> w >> n_pieces >> w >> n_generation >> w >>
+        n_strahler >> w >> n_angle >> w >> n_murray;
+    EXPECT_EQ(n_counted, n_expected) << e << ": " << check;
+    EXPECT_GT(n_bif, 400) << e << ": " << check;
+    EXPECT_LT(std::max({n_length, n_path, n_dijkstra, n_angle, n_murray}), 1e-9) << e << ": " << check;
+    EXPECT_EQ(n_pieces + n_generation + n_strahler, 0) << e << ": " << check;
+  }
 }
 
 // The methods that size vessels from the leaves up (space colonisation), from the root down (the

@@ -65,9 +65,11 @@ Given valueOf(const Setting<Options>& s) {
           else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
             const std::string v = s.choices.empty() ? "clean" : s.choices.back();
             return {"[\"" + v + "\"]", v};
-          } else if constexpr (std::is_same_v<T, std::vector<double>>)
-            return entries(s.count, s.quantity.has_value());
-          else if constexpr (std::is_same_v<T, std::optional<Vec3>>)
+          } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+            // Murray's bands: two edges, and three exponents (one more) given with them.
+            const bool exponents = std::string(s.key) == "murray_band_exponents";
+            return entries(s.count ? s.count : exponents ? 3 : 2, s.quantity.has_value());
+          } else if constexpr (std::is_same_v<T, std::optional<Vec3>>)
             return entries(3, s.quantity.has_value());
           else {
             // A number inside the range that its extra check (a bound with a hole) takes too.
@@ -199,8 +201,14 @@ TEST_F(Settings, EveryCcoKeyFillsItsFieldAndTheSidecar) {
       const Given g = valueOf(s);
       const std::string line = std::string(s.key) + " = " + g.file + "\n";
       const bool tree = std::string(s.table) == "tree", terminals = std::string(s.key) == "terminals";
-      // A perfusion pressure this low needs a terminal pressure below it.
-      const std::string physics = tree ? "" : line + (std::string(s.key) == "perfusion_pressure" ? "terminal_pressure = \"1 Pa\"\n" : "");
+      // A perfusion pressure this low needs a terminal pressure below it; one of Murray's band
+      // settings, the other.
+      const std::string key = s.key;
+      const std::string partner = key == "perfusion_pressure"      ? "terminal_pressure = \"1 Pa\"\n"
+                                  : key == "murray_band_edges"     ? "murray_band_exponents = [3, 2.7, 2.3]\n"
+                                  : key == "murray_band_exponents" ? "murray_band_edges = [\"0.1 mm\", \"1 mm\"]\n"
+                                                                   : "";
+      const std::string physics = tree ? "" : line + partner;
       const Scenario sc = read((tree ? line : "") + (terminals ? "" : "terminals = 2\n"), physics);
       EXPECT_FALSE(sameField(s, of(sc), of(base))) << s.key << " = " << g.file << " left its field at the default";
       EXPECT_TRUE(sc.growth->describe().contains(s.key)) << s.key << " is missing from the sidecar";
@@ -209,7 +217,7 @@ TEST_F(Settings, EveryCcoKeyFillsItsFieldAndTheSidecar) {
   };
   check(ccoSettings(), cco);
   check(ccoPhysics(), [&](const Scenario& sc) { return cco(sc).physics; });
-  EXPECT_EQ(checked, 14);
+  EXPECT_EQ(checked, 16);
 }
 
 TEST_F(Settings, TheParameterReferencePrintsEachDeclaration) {
