@@ -24,8 +24,10 @@ export UBSAN_OPTIONS="log_path=$logs/ubsan:print_stacktrace=1:halt_on_error=1:ex
 # on large surfaces: 250 s of the release suite, several times that under the sanitizers): the
 # same meshing code runs under the sanitizers in the other mesh tests and in the mesh fuzz targets.
 # So is the shipped noise ladder (37 s of scoring 144 masks): the other Benchmark tests run the
-# same code on a smaller ladder.
-release_only='^(Mesh\.(TetgenFindsNoSelfIntersectionInAnyFormat|SliverRepairKeepsTopologyVolumeAndSurface|WrittenFilesReadBackClosedByVtkWithTheUnionsVolume|RemeshingMakesTheNetsTrianglesAcuteAndKeepsTheSurface)|Benchmark\.ShippedNoiseLadderDiceFallsForEveryBaseline)$'
+# same code on a smaller ladder. And the README's commands (the longest test under the
+# sanitizers, 137 s): the commands they run are each run under the sanitizers by the Cli,
+# Dataset, Score and Benchmark tests.
+release_only='^(Mesh\.(TetgenFindsNoSelfIntersectionInAnyFormat|SliverRepairKeepsTopologyVolumeAndSurface|WrittenFilesReadBackClosedByVtkWithTheUnionsVolume|RemeshingMakesTheNetsTrianglesAcuteAndKeepsTheSurface)|Benchmark\.ShippedNoiseLadderDiceFallsForEveryBaseline|Docs\.ReadmeCommandsRun)$'
 (cd build-san && ctest --output-on-failure -j "$(nproc)" --timeout 900 -E "$release_only")
 if compgen -G "$logs/*" >/dev/null; then
   echo "sanitizer reports:"; head -n 60 "$logs"/*; exit 1
