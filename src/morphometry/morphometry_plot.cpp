@@ -35,7 +35,9 @@ void histogram(PlotCanvas& c, int x0, int y0, const Panel& p, const std::vector<
     double n = 0;
     for (double x : p.values[k])
       if (std::isfinite(x)) {
-        const int b = std::clamp(int((x - lo) / (hi - lo) * kBins), 0, kBins - 1);
+        // Clamped before the conversion: values beyond the percentiles may lie far outside.
+        const double at = (x - lo) / (hi - lo) * kBins;
+        const int b = at > 0 ? int(std::min(at, double(kBins - 1))) : 0;
         share[k][std::size_t(b)] += 1, n += 1;
       }
     for (auto& s : share[k]) top_share = std::max(top_share, s /= std::max(n, 1.0));
