@@ -60,6 +60,13 @@ const BadCase kCases[] = {
      "generate p.toml --out out", "p.toml:10: missing key 'root_offset' (mm from the centre) in [[tree.inlet]]"},
     {"inlet_roots_touch", "p.toml", "", "", CCO_FOREST "[[tree.inlet]]\nroot_offset = [0, 10, 0]\n[[tree.inlet]]\nroot_offset = [0.1, 9.99, 0]\n",
      "generate p.toml --out out", "p.toml:11: the roots of inlets 'artery_1' and 'artery_2' lie 0.100499 mm apart"},
+    {"murray_bands_count", "p.toml", "", "", CCO_FOREST "[physics]\nmurray_band_edges = [\"0.1 mm\", \"1 mm\"]\nmurray_band_exponents = [3, 2.5]\n",
+     "generate p.toml --out out",
+     "p.toml:10: murray_band_exponents holds 2 exponents for 2 murray_band_edges; allowed: one exponent more than edges"},
+    {"murray_bands_close", "p.toml", "", "",
+     CCO_FOREST "[physics]\nmurray_band_edges = [\"0.1 mm\", \"0.11 mm\"]\nmurray_band_exponents = [3, 2.7, 2.3]\n", "generate p.toml --out out",
+     "p.toml:9: murray_band_edges 0.1 mm and 0.11 mm: allowed: ascending, each edge at least 1.25 times the one before (an edge ramps γ over ±5 % of "
+     "its radius)"},
 #undef CCO_FOREST
 // dcco growing from an existing network ([initial]).
 #define DCCO_INITIAL \

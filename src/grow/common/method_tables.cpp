@@ -139,6 +139,10 @@ const std::vector<SettingRule<PhysicsParameters>>& murrayBandRules() {
            return "murray_band_exponents holds " + std::to_string(g.size()) + " exponents for " + std::to_string(e.size()) +
                   " murray_band_edges; allowed: one exponent more than edges";
          if (g.size() > std::size_t(MurrayLaw::kMaxBands)) return std::string("murray_band_exponents holds more than 8 bands; allowed: 2 … 8");
+         return std::string();
+       }},
+      {{"murray_band_edges"}, [](const PhysicsParameters& p) {
+         const auto& e = p.murray_band_edges;
          for (std::size_t k = 1; k < e.size(); ++k)
            if (!(e[k] >= 1.25 * e[k - 1]))
              return "murray_band_edges " + show(e[k - 1]) + " mm and " + show(e[k]) +
