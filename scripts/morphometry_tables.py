@@ -134,6 +134,7 @@ def organ_table(run, title, default, tuned, references, statistics):
                     per.setdefault(key, []).append((x["tree"], x["distance"], x["reference"], x["band_mm"]))
         results[label] = (per, statistics_mean(overall))
     closer_all = True
+    bars = []
     for key in results["default"][0]:
         if statistics and key[1] not in statistics:
             continue
@@ -145,16 +146,40 @@ def organ_table(run, title, default, tuned, references, statistics):
         closer_all &= closer
         band = f" ({band_text(d[0][3])} mm)" if key[1] == "murray_exponent" else ""
         lines.append(f"| {key[1]}{band} | {fmt(d[0][2])} | {fmt(dv)} | {dd:.3f} | {fmt(tv)} | {td:.3f} | {'equal' if abs(td - dd) <= 5e-4 else 'yes' if td < dd else 'no'} |")
+        bars.append((f"{key[1]}{band}", dd, td))
     lines.append(
         f"| **overall** | | | {results['default'][1]:.3f} | | {results['tuned'][1]:.3f} | "
         f"{'yes' if results['tuned'][1] < results['default'][1] else 'no'} |"
     )
-    return "\n".join(lines), closer_all
+    return "\n".join(lines), closer_all, bars
 
 
 def band_text(band):
     lo, hi = band
     return f"> {lo:g}" if hi == "inf" else f"{lo:g}–{hi:g}" if lo > 0 else f"< {hi:g}"
+
+
+def figure(coronary, cortex, path):
+    """Bars of each statistic's distance to its reference, example against organ set."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), gridspec_kw={"width_ratios": [len(coronary), max(len(cortex), 3)]})
+    for ax, bars, title in ((axes[0], coronary, "pig coronary arteries (Kassab et al. 1993; Murray bands)"),
+                            (axes[1], cortex, "human cortical arterioles\n(Cassot et al. 2010)")):
+        x = range(len(bars))
+        ax.bar([i - 0.2 for i in x], [b[1] for b in bars], 0.4, label="shipped example", color="#999999")
+        ax.bar([i + 0.2 for i in x], [b[2] for b in bars], 0.4, label="organ set", color="#2b4c9a")
+        ax.set_xticks(list(x))
+        ax.set_xticklabels([b[0].replace("murray_exponent", "Murray γ").replace("horton_", "Horton ") for b in bars], rotation=25, ha="right", fontsize=8)
+        ax.set_ylim(0, 1)
+        ax.set_title(title, fontsize=10)
+        ax.set_ylabel("distance to the reference (0 = alike)")
+    axes[0].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
 
 
 def mean(v):
@@ -187,12 +212,14 @@ def main():
         out += ["## Parameter sets per organ", "",
                 "Each set starts from a shipped example and changes what the text of its file says; both are grown with five seeds and compared "
                 "statistic by statistic (`stats --compare`).", ""]
-        coronary, ok1 = organ_table(run, "Pig coronary arteries (examples/morphometry/coronary_vascusynth.toml against vascusynth_like.toml)",
+        coronary, ok1, bars1 = organ_table(run, "Pig coronary arteries (examples/morphometry/coronary_vascusynth.toml against vascusynth_like.toml)",
                                     "vascusynth_like.toml", "morphometry/coronary_vascusynth.toml",
                                     ["kassab1993_pig_coronary_rca", "murray_exponent_bands"], None)
-        cortex, ok2 = organ_table(run, "Human cortical arterioles (examples/morphometry/cortex_arterioles_grammar.toml against lsystem_grammar_3d.toml)",
+        cortex, ok2, bars2 = organ_table(run, "Human cortical arterioles (examples/morphometry/cortex_arterioles_grammar.toml against lsystem_grammar_3d.toml)",
                                   "lsystem_grammar_3d.toml", "morphometry/cortex_arterioles_grammar.toml", ["cassot2010_human_cortex_arterioles"], None)
-        out += [coronary, "", cortex, ""]
+        figure(bars1, bars2, ROOT / "docs/gallery/morphometry_organ_sets.png")
+        out += ["![Distance to the reference per statistic: each shipped example against its organ set](gallery/morphometry_organ_sets.png)", "",
+                coronary, "", cortex, ""]
         out += ["## What each control moves", "",
                 "One setting swept on a shipped example, the rest as shipped; medians over the tree's vessels or bifurcations "
                 "(`stats`). Asymmetry: r_small / r_large of the daughters.", ""]
