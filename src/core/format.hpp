@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace angiosynth {
 
@@ -25,6 +26,31 @@ inline std::string csvField(const std::string& s) {
   std::string q = "\"";
   for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
   return q + '"';
+}
+
+// The fields of one CSV line as csvField writes them (a quoted field may hold commas and doubled
+// quotes; a trailing carriage return is dropped).
+inline std::vector<std::string> csvFieldsOf(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (std::size_t k = 0; k < line.size(); ++k) {
+    const char c = line[k];
+    if (quoted) {
+      if (c == '"' && k + 1 < line.size() && line[k + 1] == '"')
+        out.back() += '"', ++k;
+      else if (c == '"')
+        quoted = false;
+      else
+        out.back() += c;
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      out.emplace_back();
+    } else if (c != '\r') {
+      out.back() += c;
+    }
+  }
+  return out;
 }
 
 // "1 tree", "3 trees".

@@ -3,6 +3,7 @@
 #include "core/format.hpp"
 #include "core/point_hash.hpp"
 #include "core/polyline_turns.hpp"
+#include "core/quantity_json.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -457,39 +458,39 @@ Morphometry measureTrees(const VascularTree& t, const std::vector<std::string>& 
 
 nlohmann::ordered_json Morphometry::toJson() const {
   using Json = nlohmann::ordered_json;
-  const auto num = [](double v) { return std::isfinite(v) ? Json(v) : Json(); };
   Json groups_json = Json::array();
   for (const auto& g : groups) {
     Json s = Json::object();
     for (const auto& [k, v] : g.summaries)
-      s[k] = Json{{"count", v.count},  {"mean", num(v.mean)},     {"sd", num(v.sd)},   {"min", num(v.min)}, {"p05", num(v.p05)},
-                  {"p25", num(v.p25)}, {"median", num(v.median)}, {"p75", num(v.p75)}, {"p95", num(v.p95)}, {"max", num(v.max)}};
+      s[k] = Json{{"count", v.count},           {"mean", numberOrNull(v.mean)}, {"sd", numberOrNull(v.sd)},         {"min", numberOrNull(v.min)},
+                  {"p05", numberOrNull(v.p05)}, {"p25", numberOrNull(v.p25)},   {"median", numberOrNull(v.median)}, {"p75", numberOrNull(v.p75)},
+                  {"p95", numberOrNull(v.p95)}, {"max", numberOrNull(v.max)}};
     const auto orderList = [&](const std::vector<StrahlerOrder>& table) {
       Json orders = Json::array();
       for (const auto& o : table)
         orders.push_back(Json{{"order", o.order},
                               {"vessels", o.vessels},
                               {"elements", o.elements},
-                              {"mean_element_length_mm", num(o.mean_element_length_mm)},
-                              {"mean_element_diameter_mm", num(o.mean_element_diameter_mm)}});
+                              {"mean_element_length_mm", numberOrNull(o.mean_element_length_mm)},
+                              {"mean_element_diameter_mm", numberOrNull(o.mean_element_diameter_mm)}});
       return orders;
     };
     const auto horton = [&](const HortonRatios& h) {
-      return Json{{"branching", num(h.branching)}, {"length", num(h.length)}, {"diameter", num(h.diameter)}};
+      return Json{{"branching", numberOrNull(h.branching)}, {"length", numberOrNull(h.length)}, {"diameter", numberOrNull(h.diameter)}};
     };
     Json bands = Json::array();
     for (const auto& b : g.murray_bands)
-      bands.push_back(Json{{"parent_radius_mm", {b.lower_mm, std::isfinite(b.upper_mm) ? Json(b.upper_mm) : Json("inf")}},
+      bands.push_back(Json{{"parent_radius_mm", rangeJson(b.lower_mm, b.upper_mm)},
                            {"bifurcations", b.bifurcations},
-                           {"median_exponent", num(b.median_exponent)},
-                           {"fitted_exponent", num(b.fitted_exponent)}});
+                           {"median_exponent", numberOrNull(b.median_exponent)},
+                           {"fitted_exponent", numberOrNull(b.fitted_exponent)}});
     groups_json.push_back(Json{{"group", g.name},
                                {"vessels", g.vessels},
                                {"bifurcations", g.bifurcations},
                                {"junctions", g.junctions},
                                {"terminals", g.terminals},
-                               {"terminal_nearest_neighbour_mm", num(g.terminal_nearest_neighbour_mm)},
-                               {"murray_fitted_exponent", num(g.murray_fitted)},
+                               {"terminal_nearest_neighbour_mm", numberOrNull(g.terminal_nearest_neighbour_mm)},
+                               {"murray_fitted_exponent", numberOrNull(g.murray_fitted)},
                                {"murray_bands", bands},
                                {"strahler_orders", orderList(g.strahler)},
                                {"horton_ratios", horton({g.horton_branching, g.horton_length, g.horton_diameter})},

@@ -11,6 +11,7 @@
 #include "angiosynth/morphometry_references.hpp"
 #include "core/error.hpp"
 #include "core/format.hpp"
+#include "core/quantity_json.hpp"
 #include "files/toml_file.hpp"
 #include "settings/toml_reader.hpp"
 
@@ -156,30 +157,6 @@ MorphometryReference parseReference(const toml::table& root, const std::string& 
   return ref;
 }
 
-// Fields of one CSV line (quoted fields may hold commas and doubled quotes).
-std::vector<std::string> csvFields(const std::string& line) {
-  std::vector<std::string> out(1);
-  bool quoted = false;
-  for (std::size_t k = 0; k < line.size(); ++k) {
-    const char c = line[k];
-    if (quoted) {
-      if (c == '"' && k + 1 < line.size() && line[k + 1] == '"')
-        out.back() += '"', ++k;
-      else if (c == '"')
-        quoted = false;
-      else
-        out.back() += c;
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      out.emplace_back();
-    } else if (c != '\r') {
-      out.back() += c;
-    }
-  }
-  return out;
-}
-
 // Samples of every statistic a stats CSV holds a column of.
 void readSampleColumns(const fs::path& csv, bool vessels, MorphometryReference& ref) {
   std::ifstream in(csv);
@@ -188,7 +165,7 @@ void readSampleColumns(const fs::path& csv, bool vessels, MorphometryReference& 
                      "no such file: a stats directory holds stats.json, vessels.csv and bifurcations.csv (angiosynth stats INPUT --out DIR)");
   std::string line;
   std::getline(in, line);
-  const auto header = csvFields(line);
+  const auto header = csvFieldsOf(line);
   std::vector<std::pair<std::size_t, ReferenceStatistic>> columns;
   for (std::size_t c = 0; c < header.size(); ++c)
     if (vessels ? isVesselStatistic(header[c]) : isBifurcationStatistic(header[c])) {
@@ -201,7 +178,7 @@ void readSampleColumns(const fs::path& csv, bool vessels, MorphometryReference& 
   while (std::getline(in, line)) {
     ++line_no;
     if (line.empty()) continue;
-    const auto f = csvFields(line);
+    const auto f = csvFieldsOf(line);
     if (f.size() != header.size())
       throw InputError(csv.string(), line_no, std::to_string(f.size()) + " fields; allowed: " + std::to_string(header.size()) + ", as the header");
     for (auto& [c, s] : columns) {
@@ -434,28 +411,26 @@ MorphometryComparison compareMorphometry(const Morphometry& m, const Morphometry
 
 nlohmann::ordered_json MorphometryComparison::toJson() const {
   using Json = nlohmann::ordered_json;
-  const auto num = [](double v) { return std::isfinite(v) ? Json(v) : Json(); };
   Json list = Json::array();
   for (const auto& r : rows) {
-    Json band = Json::array({r.lower_mm, std::isfinite(r.upper_mm) ? Json(r.upper_mm) : Json("inf")});
     list.push_back(Json{{"statistic", r.statistic},
-                        {"band_mm", band},
+                        {"band_mm", rangeJson(r.lower_mm, r.upper_mm)},
                         {"test", r.test},
-                        {"tree", num(r.tree)},
-                        {"reference", num(r.reference)},
-                        {"reference_spread", num(r.reference_spread)},
+                        {"tree", numberOrNull(r.tree)},
+                        {"reference", numberOrNull(r.reference)},
+                        {"reference_spread", numberOrNull(r.reference_spread)},
                         {"tree_count", r.tree_count},
                         {"reference_count", r.reference_count},
-                        {r.test == "ks" ? "ks_d" : "standardised_difference", num(r.statistic_value)},
-                        {"p_value", num(r.p_value)},
-                        {"distance", num(r.distance)},
+                        {r.test == "ks" ? "ks_d" : "standardised_difference", numberOrNull(r.statistic_value)},
+                        {"p_value", numberOrNull(r.p_value)},
+                        {"distance", numberOrNull(r.distance)},
                         {"source", r.source}});
   }
   return Json{{"reference", reference},
               {"title", title},
               {"citation", citation},
               {"group", group},
-              {"overall_distance", num(overall)},
+              {"overall_distance", numberOrNull(overall)},
               {"statistics_compared", compared},
               {"statistics", list},
               {"definitions",

@@ -6,14 +6,14 @@
 
 namespace angiosynth {
 
-MurrayLaw::MurrayLaw(const PhysicsParameters& p) {
-  exponent_[0] = p.murray_exponent;
-  if (p.murray_band_exponents.empty()) return;
-  if (p.murray_band_exponents.size() != p.murray_band_edges.size() + 1 || p.murray_band_exponents.size() > std::size_t(kMaxBands))
+MurrayLaw::MurrayLaw(double exponent, const std::vector<double>& band_edges, const std::vector<double>& band_exponents) {
+  exponent_[0] = exponent;
+  if (band_exponents.empty()) return;
+  if (band_exponents.size() != band_edges.size() + 1 || band_exponents.size() > std::size_t(kMaxBands))
     throw std::logic_error("Murray bands: one exponent more than edges, at most 8 bands");
-  bands_ = int(p.murray_band_exponents.size());
-  for (int k = 0; k < bands_; ++k) exponent_[k] = p.murray_band_exponents[k];
-  for (int k = 0; k + 1 < bands_; ++k) log_edge_[k] = std::log(p.murray_band_edges[k]);
+  bands_ = int(band_exponents.size());
+  for (int k = 0; k < bands_; ++k) exponent_[k] = band_exponents[k];
+  for (int k = 0; k + 1 < bands_; ++k) log_edge_[k] = std::log(band_edges[k]);
 }
 
 double rootRadius(const PhysicsParameters& p, double root_flow, double root_reduced_resistance) {

@@ -53,7 +53,9 @@ class MurrayLaw {
   static constexpr int kMaxBands = 8;
   static constexpr double kRampHalfWidth = 0.04879016416943205;  // ln 1.05
   MurrayLaw() { exponent_[0] = 3; }
-  explicit MurrayLaw(const PhysicsParameters& p);
+  // γ everywhere, or by band when band_exponents (one more than band_edges, mm) are given.
+  MurrayLaw(double exponent, const std::vector<double>& band_edges, const std::vector<double>& band_exponents);
+  explicit MurrayLaw(const PhysicsParameters& p) : MurrayLaw(p.murray_exponent, p.murray_band_edges, p.murray_band_exponents) {}
   bool banded() const { return bands_ > 1; }
   double exponentAt(double parent_radius_mm) const {
     if (bands_ == 1) return exponent_[0];

@@ -8,6 +8,7 @@
 
 #include "core/distance_transform.hpp"
 #include "core/error.hpp"
+#include "core/quantity_json.hpp"
 #include "settings/param_checks.hpp"
 
 namespace angiosynth {
@@ -211,8 +212,6 @@ std::vector<double> binEdges(const std::vector<double>& lower) {
   return e;
 }
 
-Json binRange(double lo, double hi) { return Json::array({lo, std::isfinite(hi) ? Json(hi) : Json("inf")}); }
-
 }  // namespace
 
 Json calibreRecall(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>& truth, const Volume<float>& centre, const Volume<float>& radius,
@@ -231,7 +230,7 @@ Json calibreRecall(const Volume<std::uint8_t>& pred, const Volume<std::uint8_t>&
   }
   Json bins = Json::array();
   for (std::size_t b = 0; b < lower.size(); ++b)
-    bins.push_back(Json{{std::string("radius_") + unit, binRange(edges[b], edges[b + 1])},
+    bins.push_back(Json{{std::string("radius_") + unit, rangeJson(edges[b], edges[b + 1])},
                         {"centreline_voxels", n[b]},
                         {"recall", ratio(double(hit[b]), double(n[b]))},
                         {"truth_coverage", ratio(double(covered[b]), double(n[b]))}});

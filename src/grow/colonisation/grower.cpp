@@ -16,13 +16,7 @@ namespace angiosynth {
 
 double symmetricMurrayAngle(double kappa) { return std::acos(std::clamp(std::pow(2.0, 2.0 / kappa - 1.0), -1.0, 1.0)); }
 
-MurrayLaw colonisationLaw(const ColonisationOptions& o) {
-  PhysicsParameters p;
-  p.murray_exponent = o.murray_exponent;
-  p.murray_band_edges = o.murray_band_edges;
-  p.murray_band_exponents = o.murray_band_exponents;
-  return MurrayLaw(p);
-}
+MurrayLaw colonisationLaw(const ColonisationOptions& o) { return {o.murray_exponent, o.murray_band_edges, o.murray_band_exponents}; }
 
 double lateralMurrayAngle(double rp, double rb, double kappa) {
   // A parent is at least as thick as a symmetric split of two such branches (a chain of leaves'

@@ -41,7 +41,7 @@ class GrammarGrower {
  public:
   GrammarGrower(const GrammarOptions& o, GrammarReport& r)
       : o_(o),
-        law_(lawOf(o)),
+        law_(o.murray_exponent, o.murray_band_edges, o.murray_band_exponents),
         r_(r),
         rng_(o.seed, o.sample, Stage::Growth),
         grid_(o.domain->lo(), o.domain->hi(), cellSize(o), o.domain->dimension() == 2) {}
@@ -196,14 +196,6 @@ class GrammarGrower {
       const Vec3 up = flat ? last_up_ : unit(rotate(last_up_ - dir * dot(last_up_, dir), dir, roll));
       next.push_back({end, dir, up, last_dir_, side == 0 ? d1 : d2});
     }
-  }
-
-  static MurrayLaw lawOf(const GrammarOptions& o) {
-    PhysicsParameters p;
-    p.murray_exponent = o.murray_exponent;
-    p.murray_band_edges = o.murray_band_edges;
-    p.murray_band_exponents = o.murray_band_exponents;
-    return MurrayLaw(p);
   }
 
   const GrammarOptions& o_;
