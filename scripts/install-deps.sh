@@ -8,10 +8,11 @@ pkgs=(build-essential cmake pkg-config ccache
       zlib1g-dev libzip-dev libnifti2-dev libtiff-dev libpng-dev libjpeg-dev
       libopenvdb-dev libboost-iostreams-dev libssl-dev libceres-dev libcgal-dev libjemalloc-dev
       libfftw3-dev  # k-space artefacts
+      libblosc-dev  # OME-Zarr chunks
       python3-dev pybind11-dev python3-numpy)  # the Python module
 if [ "${1:-all}" != program ]; then
   pkgs+=(libgtest-dev libbenchmark-dev
-         libopenimageio-dev python3-nibabel python3-networkx python3-scipy python3-skimage python3-vtk9 tetgen  # independent readers and references
+         libopenimageio-dev python3-nibabel python3-networkx python3-scipy python3-skimage python3-vtk9 python3-zarr tetgen  # independent readers and references
          clang libclang-rt-14-dev  # the sanitizer build and libFuzzer (scripts/sanitize.sh)
          clang-format-14  # the style check (scripts/check_format.sh)
          python3-pytest python3-torch  # the Python module's tests and its PyTorch dataset

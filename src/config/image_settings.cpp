@@ -1,5 +1,7 @@
 #include "config/image_settings.hpp"
 
+#include <cmath>
+
 #include "io/graph_formats.hpp"
 #include "io/volume_formats.hpp"
 #include "settings/param_checks.hpp"
@@ -7,6 +9,10 @@
 namespace angiosynth {
 
 namespace {
+
+std::string chunkProblem(double n) {
+  return std::fmod(n, 8) == 0 ? "" : "zarr_chunk = " + show(n) + "; allowed: a multiple of 8 (the rasteriser's bricks) from 8 to 1024";
+}
 
 std::string connectivityProblem(double n) {
   return n == 6 || n == 26 ? "" : "centerline_connectivity = " + show(n) + "; allowed: 26 (a thin curve), 6 (face-connected)";
@@ -45,6 +51,15 @@ const std::vector<Setting<ImageParameters>>& imageSettings() {
        .field = &P::formats, .choices = volumeFormatNames(), .flag = "--format"},
       {.table = "image", .key = "graph_formats", .unit = "[text]", .fallback = "[\"csv\", \"vtp\", \"swc\", \"graphml\"]",
        .meaning = graph_formats.c_str(), .field = &P::graph_formats, .choices = graphFormatNames()},
+      {.table = "image", .key = "zarr_chunk", .unit = "count", .fallback = "128",
+       .meaning = "formats = zarr: voxels along each edge of a chunk, a multiple of 8 (8 … 1024); memory per process follows the chunk, not the volume",
+       .field = &P::zarr_chunk, .range = {8, 1024}, .problem = chunkProblem},
+      {.table = "image", .key = "zarr_compression", .unit = "text", .fallback = "blosc",
+       .meaning = "formats = zarr: blosc (LZ4, byte shuffle; zarr-python's default) or zlib",
+       .field = &P::zarr_compression, .choices = {"blosc", "zlib"}},
+      {.table = "image", .key = "zarr_levels", .unit = "count", .fallback = "0",
+       .meaning = "formats = zarr: levels of the multiscale pyramid with the full resolution (each halves the voxels per axis); 0: until one chunk holds the volume",
+       .field = &P::zarr_levels, .range = {0, 20}},
   };
   return settings;
 }

@@ -23,6 +23,9 @@ struct ImageParameters {
   std::string dtype = "uint8";                                             // uint8, uint16, int16, float32
   std::vector<std::string> formats{"nifti", "png"};                        // names of io/volume_formats.hpp
   std::vector<std::string> graph_formats{"csv", "vtp", "swc", "graphml"};  // names of io/graph_formats.hpp; GXL and DOT always
+  int zarr_chunk = 128;                                                    // voxels along a chunk's edge (formats = zarr)
+  std::string zarr_compression = "blosc";                                  // blosc (LZ4, shuffled) or zlib
+  int zarr_levels = 0;                                                     // pyramid levels; 0: until one chunk holds the volume
   LabelPolicy labels;                                                      // the training label (label.nii.gz) beside the mask
 };
 

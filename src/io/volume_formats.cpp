@@ -14,6 +14,8 @@ constexpr VolumeFormat kFormats[] = {
     {"mha", ".mha", "MetaImage, zlib, LPS (ITK, 3D Slicer)", VolumeFormatKind::PerChannel, &writeMetaImage},
     {"png", "", "maximum-intensity projections", VolumeFormatKind::Projections},
     {"vdb", ".vdb", "sparse OpenVDB grids", VolumeFormatKind::Sparse},
+    {"zarr", ".ome.zarr", "OME-Zarr: chunked, compressed, multiscale, every channel, made chunk by chunk in bounded memory",
+     VolumeFormatKind::Chunked},
 };
 
 }  // namespace

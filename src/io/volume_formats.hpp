@@ -16,6 +16,7 @@ enum class VolumeFormatKind {
   PerChannel,   // each channel (image, mask, centreline, …) a file of its own, written by `write`
   Projections,  // the image's maximum-intensity projections as PNG pictures
   Sparse,       // every channel in one sparse OpenVDB file
+  Chunked,      // every channel in one OME-Zarr store, rasterised chunk by chunk
 };
 
 struct VolumeFormat {

@@ -53,14 +53,28 @@ double brickPairBound(const VascularTree& tree, const VolumeGrid& g) {
   return total;
 }
 
-BrickBins binSegments(const VascularTree& tree, const VolumeGrid& g) {
+std::vector<std::int32_t> treeSegments(const VascularTree& tree) {
+  std::vector<std::int32_t> out;
+  out.reserve(std::size_t(std::max(0, tree.nodeCount() - 1)));
+  for (std::int32_t s = 1; s < tree.nodeCount(); ++s)
+    if (!tree.isRoot(s)) out.push_back(s);
+  return out;
+}
+
+BrickBins binSegments(const VascularTree& tree, const VolumeGrid& g) { return binSegments(tree, g, VoxelWindow::whole(g), treeSegments(tree)); }
+
+BrickBins binSegments(const VascularTree& tree, const VolumeGrid& g, const VoxelWindow& window, std::span<const std::int32_t> segments) {
   BrickBins bins;
   for (int ax = 0; ax < 3; ++ax) bins.bricks[ax] = (g.dims[ax] + kBrick - 1) / kBrick;
   const Vec3 sp = g.spacing_mm;
   const double brick_half_diag = 0.5 * kBrick * std::sqrt(dot(sp, sp));
+  int window_lo[3], window_hi[3];  // bricks
+  for (int ax = 0; ax < 3; ++ax) {
+    window_lo[ax] = static_cast<int>(std::max<std::int64_t>(0, window.lo[ax]) / kBrick);
+    window_hi[ax] = static_cast<int>((std::min<std::int64_t>(g.dims[ax], window.hi[ax]) + kBrick - 1) / kBrick) - 1;
+  }
   std::vector<std::pair<std::int64_t, std::int32_t>> pairs;
-  for (std::int32_t s = 1; s < tree.nodeCount(); ++s) {
-    if (tree.isRoot(s)) continue;
+  for (const std::int32_t s : segments) {
     const Vec3 a = tree.position[tree.parent[s]], b = tree.position[s];
     const double r = tree.maxRadius(s);
     // Voxel x (cube [x−½, x+½] in index units) can touch the capsule's box if
@@ -77,7 +91,15 @@ BrickBins binSegments(const VascularTree& tree, const VolumeGrid& g) {
       hi[ax] = static_cast<int>(std::max(x_lo, x_hi)) / kBrick;
     }
     if (outside) continue;
+    // Whether a segment is tested against each brick's centre depends on its whole box, not on
+    // the window, so a window keeps exactly the whole grid's pairs.
     const bool big = (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1) > 8;
+    for (int ax = 0; ax < 3; ++ax) {
+      lo[ax] = std::max(lo[ax], window_lo[ax]);
+      hi[ax] = std::min(hi[ax], window_hi[ax]);
+      outside |= hi[ax] < lo[ax];
+    }
+    if (outside) continue;
     for (int k = lo[2]; k <= hi[2]; ++k)
       for (int j = lo[1]; j <= hi[1]; ++j)
         for (int i = lo[0]; i <= hi[0]; ++i) {

@@ -7,6 +7,7 @@
 // not depend on the thread count.
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <vector>
 
 #include "core/vascular_tree.hpp"
@@ -33,6 +34,12 @@ struct BrickBins {
 // bounding box. Cheap (no allocation), so the sparse path can be refused before binning.
 double brickPairBound(const VascularTree& tree, const VolumeGrid& g);
 BrickBins binSegments(const VascularTree& tree, const VolumeGrid& grid);
+// The bins of the bricks inside `window` (its lo a multiple of kBrick), from `segments` (ascending;
+// any superset of those that reach the window): the same bins the whole grid's binning holds for
+// those bricks, so the window's voxels rasterise to the same values.
+BrickBins binSegments(const VascularTree& tree, const VolumeGrid& grid, const VoxelWindow& window, std::span<const std::int32_t> segments);
+// The segments (not roots), ascending.
+std::vector<std::int32_t> treeSegments(const VascularTree& tree);
 
 // Calls visit(brick_id, fraction[512], instance[512]) for every non-empty brick, in parallel.
 // fraction is in [0,1]; instance is the segment id whose capsule surface is deepest around the

@@ -3,6 +3,7 @@
 // and instance labels, all derived from the tree (the single source of truth).
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/vascular_tree.hpp"
@@ -39,6 +40,14 @@ void fillClasses(GroundTruthVolumes& gt, const VascularTree& t, const std::vecto
                  const std::vector<std::int32_t>* label_of_segment = nullptr);
 
 GroundTruthVolumes rasterizeGroundTruth(const VascularTree& tree, const VolumeGrid& grid, const RasterOptions& opt);
+// The ground truth of the voxels of `window` alone (its lo a multiple of kBrick), on
+// subGrid(grid, window), from `segments` (ascending; any superset of those that reach the window):
+// voxel for voxel the whole grid's values, so a volume can be made chunk by chunk.
+GroundTruthVolumes rasterizeGroundTruth(const VascularTree& tree, const VolumeGrid& grid, const VoxelWindow& window,
+                                        std::span<const std::int32_t> segments, const RasterOptions& opt);
+// fillClasses for such a window: each centreline's course is counted on the whole grid.
+void fillClasses(GroundTruthVolumes& gt, const VascularTree& t, const std::vector<std::uint8_t>& class_of_segment, const VolumeGrid& grid,
+                 const VoxelWindow& window, std::span<const std::int32_t> segments);
 
 // The centreline pass: marks centreline (as gt.centerline_connectivity says) and radius, and adds
 // to the mask (and, where the partial volume left no label, to the instances) every voxel a

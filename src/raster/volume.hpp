@@ -35,6 +35,31 @@ struct VolumeGrid {
   bool operator==(const VolumeGrid&) const = default;
 };
 
+// The voxels lo <= (i, j, k) < hi of a grid: a chunk of a volume rasterised piece by piece.
+struct VoxelWindow {
+  std::array<std::int64_t, 3> lo{0, 0, 0}, hi{0, 0, 0};
+  static VoxelWindow whole(const VolumeGrid& g) { return VoxelWindow{{0, 0, 0}, {g.dims[0], g.dims[1], g.dims[2]}}; }
+  std::int64_t size(int axis) const { return hi[axis] - lo[axis]; }
+  std::int64_t voxelCount() const { return size(0) * size(1) * size(2); }
+  bool contains(std::int64_t i, std::int64_t j, std::int64_t k) const {
+    return i >= lo[0] && j >= lo[1] && k >= lo[2] && i < hi[0] && j < hi[1] && k < hi[2];
+  }
+  // Index of voxel (i, j, k) of the grid in the window's own volume (x fastest).
+  std::int64_t flat(std::int64_t i, std::int64_t j, std::int64_t k) const { return (i - lo[0]) + size(0) * ((j - lo[1]) + size(1) * (k - lo[2])); }
+  bool operator==(const VoxelWindow&) const = default;
+};
+
+// The grid of a window's voxels: the same spacing, the origin at the centre of voxel lo. Values
+// rasterised for the window are computed on the whole grid's voxel centres, so they equal the whole
+// grid's voxel for voxel.
+inline VolumeGrid subGrid(const VolumeGrid& g, const VoxelWindow& b) {
+  VolumeGrid s;
+  for (int ax = 0; ax < 3; ++ax) s.dims[ax] = static_cast<std::int32_t>(b.size(ax));
+  s.origin_mm = g.centre(b.lo[0], b.lo[1], b.lo[2]);
+  s.spacing_mm = g.spacing_mm;
+  return s;
+}
+
 // Large volumes in transparent huge pages where the system allows it: a voxel read before it is
 // written maps the shared zero page, and the write that follows then costs a page fault and a TLB
 // flush on every core, per 4 KiB page; per 2 MiB page this is 512 times rarer (the rasteriser's
