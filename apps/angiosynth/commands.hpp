@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli_support.hpp"
+#include "config/image_settings.hpp"
 #include "config/mesh_settings.hpp"
 #include "config/scenario.hpp"
 #include "setting_flags.hpp"
@@ -120,6 +121,17 @@ struct MeshArgs {
 };
 CLI::App* addMesh(CLI::App& app, MeshArgs& a);
 int runMesh(const MeshArgs& a, const std::string& command_line);
+
+struct RasterizeArgs {
+  std::string input, out;
+  ImageParameters image;  // the [image] settings with a flag here (cmd_rasterize.cpp); the rest: the sample's
+  int task = -1, tasks = 0;
+  bool pyramid = false;
+  SettingFlagList<ImageParameters> flags;  // which were given
+  CommonOptions common;
+};
+CLI::App* addRasterize(CLI::App& app, RasterizeArgs& a);
+int runRasterize(const RasterizeArgs& a, const std::string& command_line);
 
 struct PlotCalibreArgs {
   std::string out;

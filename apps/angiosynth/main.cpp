@@ -39,6 +39,8 @@ int main(int argc, char** argv) {
   auto* stt = cli::addStats(app, st);
   cli::MeshArgs ma;
   auto* me = cli::addMesh(app, ma);
+  cli::RasterizeArgs ra;
+  auto* ras = cli::addRasterize(app, ra);
   cli::PlotCalibreArgs pc;
   auto* pl = cli::addPlotCalibre(app, pc);
   try {
@@ -58,6 +60,7 @@ int main(int argc, char** argv) {
     if (pl->parsed()) return cli::runPlotCalibre(pc);
     if (se->parsed()) return cli::runSegment(sg);
     if (me->parsed()) return cli::runMesh(ma, cmdline);
+    if (ras->parsed()) return cli::runRasterize(ra, cmdline);
     if (bm->parsed()) return cli::runBenchmarkCommand(ba, cmdline);
     if (stt->parsed()) return cli::runStats(st);
     if (fx->parsed()) {

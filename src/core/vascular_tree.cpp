@@ -227,6 +227,41 @@ std::vector<std::int32_t> VascularTree::topDownOrder() const {
   return order;
 }
 
+VascularTree VascularTree::renumbered(const std::vector<std::int32_t>& new_id) const {
+  VascularTree t = *this;
+  const auto n = std::size_t(nodeCount());
+  const auto move = [&](auto& field, const auto& from) {
+    if (from.size() != n) return;
+    for (std::size_t i = 0; i < n; ++i) field[std::size_t(new_id[i])] = from[i];
+  };
+  const auto index = [&](std::int32_t i) { return i < 0 ? i : new_id[std::size_t(i)]; };
+  move(t.position, position);
+  move(t.terminals, terminals);
+  move(t.length, length);
+  move(t.reduced_resistance, reduced_resistance);
+  move(t.beta, beta);
+  move(t.cost_ratio, cost_ratio);
+  move(t.radius, radius);
+  move(t.flow, flow);
+  move(t.pressure, pressure);
+  move(t.depth, depth);
+  move(t.tree, tree);
+  move(t.stage, stage);
+  move(t.role, role);
+  move(t.branching, branching);
+  move(t.outflow, outflow);
+  move(t.radius_start, radius_start);
+  move(t.wall_start, wall_start);
+  move(t.wall, wall);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto j = std::size_t(new_id[i]);
+    t.parent[j] = index(parent[i]);
+    t.child0[j] = index(child0[i]);
+    t.child1[j] = index(child1[i]);
+  }
+  return t;
+}
+
 void VascularTree::removeSubtrees(const std::vector<std::int32_t>& segments, const std::vector<std::int32_t>& prune) {
   std::vector<char> removed(position.size(), 0);
   const auto drop = [&](std::int32_t root) {

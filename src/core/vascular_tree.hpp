@@ -109,6 +109,9 @@ struct VascularTree {
   // Nodes in `prune` lose both child subtrees and become terminals (no splice). Pruning comes
   // first; segments inside pruned subtrees are skipped.
   void removeSubtrees(const std::vector<std::int32_t>& segments, const std::vector<std::int32_t>& prune = {});
+  // The same tree with node i renamed new_id[i] (a permutation of 0 … n − 1): a tree read from a
+  // file gets the file's ids back, and with them its instance labels.
+  VascularTree renumbered(const std::vector<std::int32_t>& new_id) const;
 };
 
 const char* nodeTypeName(NodeType t);

@@ -1,6 +1,7 @@
 #include "pipeline/chunked_volume.hpp"
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -291,12 +292,12 @@ std::int32_t pyramidLevels(const ChunkedVolumeOptions& opt) {
 
 std::uint64_t chunkedVolumeBytes(const ChunkedVolumeOptions& opt) {
   const std::uint64_t c3 = std::uint64_t(opt.chunk) * opt.chunk * opt.chunk;
-  // Level 0: every channel (19 bytes a voxel with a float image), the image's conversion, a padded
-  // copy and a compressed copy of each channel.
-  const std::uint64_t level0 = c3 * (19 + 4 + 19 + 19);
+  // Level 0, per thread (a chunk each): every channel (19 bytes a voxel with a float image), the
+  // image's conversion, a padded copy and a compressed copy of each channel.
+  const std::uint64_t threads = std::max<std::uint64_t>(1, std::uint64_t(tbb::this_task_arena::max_concurrency()));
+  const std::uint64_t level0 = threads * c3 * (19 + 4 + 19 + 19);
   // Pyramid: per thread, eight children and the reduced chunk of a float channel, twice (fraction
   // and image together).
-  const std::uint64_t threads = std::max<std::uint64_t>(1, std::thread::hardware_concurrency());
   const std::uint64_t pyramid = threads * 2 * c3 * 4 * 10;
   return std::max(level0, pyramid) + (64u << 20);
 }
@@ -397,55 +398,73 @@ ChunkedVolumeSummary rasterizeChunks(const Forest& forest, const fs::path& store
   std::array<ZarrArray, kChannelCount> arrays;
   for (int c = 0; c < kChannelCount; ++c) arrays[std::size_t(c)] = arrayOf(store, opt, c, 0, image_fill);
   if (opt.progress) opt.progress(done, sum.task_chunks);
-  for (std::int64_t id = first + done; id < last; ++id) {
+  // The fill of the image's padding, as its voxel type stores it.
+  std::uint8_t image_pad[4] = {0, 0, 0, 0};
+  {
+    const ZarrArray& a = arrays[0];
+    const float f = float(a.fill);
+    const auto s16 = std::int16_t(a.fill);
+    const auto u16 = std::uint16_t(std::max(0.0, a.fill));
+    if (a.type == VoxelType::Float32) std::memcpy(image_pad, &f, 4);
+    if (a.type == VoxelType::Int16) std::memcpy(image_pad, &s16, 2);
+    if (a.type == VoxelType::UInt16) std::memcpy(image_pad, &u16, 2);
+    if (a.type == VoxelType::UInt8) image_pad[0] = std::uint8_t(u16);
+  }
+  struct ChunkResult {
+    std::int64_t mask_voxels = 0, voxels = 0, stored_chunks = 0;
+    std::uint64_t stored_bytes = 0;
+    bool occupied = false;
+  };
+  const auto rasterizeOne = [&](std::int64_t id) {
+    ChunkResult r;
     const auto segments = near.of(id - first - done);
-    if (!segments.empty()) {
-      const VoxelWindow w = layout.window(id, g);
-      GroundTruthVolumes gt = rasterizeGroundTruth(tree, g, w, segments, opt.raster);
-      fillClasses(gt, tree, classes, g, w, segments);
-      TypedImage image;
-      makeTypedImage(image, gt.fraction, opt.background, opt.vessel - opt.background, opt.dtype, "");
-      const std::array<const void*, kChannelCount> data{image.view.data,       gt.fraction.data.data(),   gt.radius.data.data(),
-                                                        gt.mask.data.data(),   gt.centerline.data.data(), gt.instances.data.data(),
-                                                        gt.classes.data.data()};
-      for (auto m : gt.mask.data) sum.mask_voxels += m;
-      sum.voxels += w.voxelCount();
-      ++sum.occupied_chunks;
-      const auto c = layout.coords(id);
-      std::array<std::uint64_t, kChannelCount> stored{};
-      tbb::parallel_for(0, kChannelCount, [&](int ch) {
-        const ZarrArray& a = arrays[std::size_t(ch)];
-        const std::size_t vb = voxelBytes(a.type);
-        const std::array<std::int64_t, 3> key{c[2], c[1], c[0]};
-        if (w.voxelCount() == std::int64_t(opt.chunk) * opt.chunk * opt.chunk) {
-          stored[std::size_t(ch)] = a.writeChunk(key, data[std::size_t(ch)]);
-        } else {
-          std::uint8_t fill[4] = {0, 0, 0, 0};
-          if (ch == 0) {
-            const float f = float(a.fill);
-            const std::uint32_t u = std::uint32_t(std::max(0.0, a.fill));
-            const auto s16 = std::int16_t(a.fill);
-            if (a.type == VoxelType::Float32)
-              std::memcpy(fill, &f, 4);
-            else if (a.type == VoxelType::Int16)
-              std::memcpy(fill, &s16, 2);
-            else if (a.type == VoxelType::UInt16) {
-              const auto u16 = std::uint16_t(u);
-              std::memcpy(fill, &u16, 2);
-            } else
-              fill[0] = std::uint8_t(u);
-          }
-          const auto padded = padToChunk(data[std::size_t(ch)], vb, w, opt.chunk, fill);
-          stored[std::size_t(ch)] = a.writeChunk(key, padded.data());
-        }
-      });
-      for (auto b : stored) {
-        sum.stored_bytes += b;
-        sum.stored_chunks += b > 0;
+    if (segments.empty()) return r;
+    const VoxelWindow w = layout.window(id, g);
+    GroundTruthVolumes gt = rasterizeGroundTruth(tree, g, w, segments, opt.raster);
+    fillClasses(gt, tree, classes, g, w, segments);
+    TypedImage image;
+    makeTypedImage(image, gt.fraction, opt.background, opt.vessel - opt.background, opt.dtype, "");
+    const std::array<const void*, kChannelCount> data{image.view.data,           gt.fraction.data.data(),  gt.radius.data.data(), gt.mask.data.data(),
+                                                      gt.centerline.data.data(), gt.instances.data.data(), gt.classes.data.data()};
+    for (auto m : gt.mask.data) r.mask_voxels += m;
+    r.voxels = w.voxelCount();
+    r.occupied = true;
+    const auto c = layout.coords(id);
+    std::array<std::uint64_t, kChannelCount> stored{};
+    tbb::parallel_for(0, kChannelCount, [&](int ch) {
+      const ZarrArray& a = arrays[std::size_t(ch)];
+      const std::array<std::int64_t, 3> key{c[2], c[1], c[0]};
+      if (w.voxelCount() == std::int64_t(opt.chunk) * opt.chunk * opt.chunk) {
+        stored[std::size_t(ch)] = a.writeChunk(key, data[std::size_t(ch)]);
+      } else {
+        const std::uint8_t zero[4] = {0, 0, 0, 0};
+        const auto padded = padToChunk(data[std::size_t(ch)], voxelBytes(a.type), w, opt.chunk, ch == 0 ? image_pad : zero);
+        stored[std::size_t(ch)] = a.writeChunk(key, padded.data());
       }
+    });
+    for (auto b : stored) {
+      r.stored_bytes += b;
+      r.stored_chunks += b > 0;
     }
-    writeFileAtomically(progress, std::to_string(id - first + 1) + "\n");
-    if (opt.progress) opt.progress(id - first + 1, sum.task_chunks);
+    return r;
+  };
+  // Chunks in batches, one per thread at a time (memory: a batch of chunks); progress is recorded
+  // after each batch, so a rerun redoes at most one batch.
+  const std::int64_t batch = std::max<std::int64_t>(1, tbb::this_task_arena::max_concurrency());
+  std::vector<ChunkResult> results;
+  for (std::int64_t id = first + done; id < last; id += batch) {
+    const std::int64_t end = std::min(last, id + batch);
+    results.assign(std::size_t(end - id), ChunkResult{});
+    tbb::parallel_for(id, end, [&](std::int64_t c) { results[std::size_t(c - id)] = rasterizeOne(c); });
+    for (const auto& r : results) {
+      sum.mask_voxels += r.mask_voxels;
+      sum.voxels += r.voxels;
+      sum.stored_bytes += r.stored_bytes;
+      sum.stored_chunks += r.stored_chunks;
+      sum.occupied_chunks += r.occupied;
+    }
+    writeFileAtomically(progress, std::to_string(end - first) + "\n");
+    if (opt.progress) opt.progress(end - first, sum.task_chunks);
   }
   if (sum.task_chunks == 0) writeFileAtomically(progress, "0\n");
   sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -467,57 +486,51 @@ T modeOf(const T* v, int n) {
   return best;
 }
 
-// One reduced chunk of a channel at `level` from the eight chunks below it (level − 1).
+// One reduced chunk of a channel at `level` from the eight chunks below it (level − 1). Each
+// child chunk makes one octant of the result (chunks have an even edge), so only the stored
+// children cost anything.
 template <class T>
 std::vector<T> reduceChunk(const ZarrArray& below, const std::array<std::int64_t, 3>& key, Reduce how, std::int64_t C, bool& any) {
-  // The 2C × 2C × 2C voxels below, z, y, x.
-  const std::int64_t B = 2 * C;
-  std::vector<T> src(std::size_t(B * B * B));
-  std::vector<T> chunk(std::size_t(C * C * C));
+  std::vector<T> out, child(std::size_t(C * C * C));
   any = false;
   const auto grid = below.chunkGrid();
+  const std::int64_t H = C / 2;
   for (int dz = 0; dz < 2; ++dz)
     for (int dy = 0; dy < 2; ++dy)
       for (int dx = 0; dx < 2; ++dx) {
         const std::array<std::int64_t, 3> k{2 * key[0] + dz, 2 * key[1] + dy, 2 * key[2] + dx};
         if (k[0] >= grid[0] || k[1] >= grid[1] || k[2] >= grid[2]) continue;
-        if (!below.readChunk(k, chunk.data())) continue;
+        if (!below.readChunk(k, child.data())) continue;
+        if (!any) out.assign(std::size_t(C * C * C), T(0));
         any = true;
-        for (std::int64_t z = 0; z < C; ++z)
-          for (std::int64_t y = 0; y < C; ++y)
-            std::copy_n(&chunk[std::size_t((z * C + y) * C)], C, &src[std::size_t(((dz * C + z) * B + dy * C + y) * B + dx * C)]);
-      }
-  std::vector<T> out(std::size_t(C * C * C), T(0));
-  if (!any) return out;
-  // Voxels of the level below that lie inside its array (the rest of its chunks is padding).
-  std::array<std::int64_t, 3> valid{};
-  for (int a = 0; a < 3; ++a) valid[a] = std::clamp<std::int64_t>(below.shape[a] - 2 * key[a] * C, 0, B);
-  tbb::parallel_for(std::int64_t(0), C, [&](std::int64_t z) {
-    for (std::int64_t y = 0; y < C; ++y)
-      for (std::int64_t x = 0; x < C; ++x) {
-        T v[8];
-        int n = 0;
-        for (int dz = 0; dz < 2; ++dz)
-          for (int dy = 0; dy < 2; ++dy)
-            for (int dx = 0; dx < 2; ++dx) {
-              const std::int64_t sz = 2 * z + dz, sy = 2 * y + dy, sx = 2 * x + dx;
-              if (sz < valid[0] && sy < valid[1] && sx < valid[2]) v[n++] = src[std::size_t((sz * B + sy) * B + sx)];
+        // The child's voxels inside the array below (the rest of a chunk at its edge is padding).
+        std::array<std::int64_t, 3> valid{};
+        for (int a = 0; a < 3; ++a) valid[a] = std::clamp<std::int64_t>(below.shape[a] - k[a] * C, 0, C);
+        tbb::parallel_for(std::int64_t(0), std::min(H, (valid[0] + 1) / 2), [&](std::int64_t z) {
+          for (std::int64_t y = 0; y < std::min(H, (valid[1] + 1) / 2); ++y)
+            for (std::int64_t x = 0; x < std::min(H, (valid[2] + 1) / 2); ++x) {
+              T v[8];
+              int n = 0;
+              for (int ez = 0; ez < 2; ++ez)
+                for (int ey = 0; ey < 2; ++ey)
+                  for (int ex = 0; ex < 2; ++ex) {
+                    const std::int64_t sz = 2 * z + ez, sy = 2 * y + ey, sx = 2 * x + ex;
+                    if (sz < valid[0] && sy < valid[1] && sx < valid[2]) v[n++] = child[std::size_t((sz * C + sy) * C + sx)];
+                  }
+              T r = 0;
+              if (how == Reduce::Mean) {
+                double sum = 0;
+                for (int i = 0; i < n; ++i) sum += double(v[i]);
+                r = T(sum / n);
+              } else if (how == Reduce::Max) {
+                r = *std::max_element(v, v + n);
+              } else {
+                r = modeOf(v, n);
+              }
+              out[std::size_t(((dz * H + z) * C + dy * H + y) * C + dx * H + x)] = r;
             }
-        T r = 0;
-        if (n > 0) {
-          if (how == Reduce::Mean) {
-            double s = 0;
-            for (int i = 0; i < n; ++i) s += double(v[i]);
-            r = T(s / n);
-          } else if (how == Reduce::Max) {
-            r = *std::max_element(v, v + n);
-          } else {
-            r = modeOf(v, n);
-          }
-        }
-        out[std::size_t((z * C + y) * C + x)] = r;
+        });
       }
-  });
   return out;
 }
 

@@ -23,9 +23,11 @@ void convert(Volume<T>& out, const Volume<float>& src, double offset, double sca
   constexpr bool integral = std::is_integral_v<T>;
   // Saturating: a value beyond the type (or NaN, as 0) never reaches an undefined conversion.
   const double lo = double(std::numeric_limits<T>::lowest()), hi = double(std::numeric_limits<T>::max());
+  const auto typed = [&](double x) { return std::isnan(x) ? T(0) : static_cast<T>(std::clamp(integral ? std::round(x) : x, lo, hi)); };
+  // Most voxels of a vessel image are background: their value once (the same arithmetic).
+  const T background = typed(offset + scale * 0.0f);
   forEachVoxel(static_cast<std::int64_t>(src.data.size()), [&](std::int64_t v) {
-    const double x = offset + scale * src.data[v];
-    out.data[v] = std::isnan(x) ? T(0) : static_cast<T>(std::clamp(integral ? std::round(x) : x, lo, hi));
+    out.data[v] = src.data[v] == 0 && !std::signbit(src.data[v]) ? background : typed(offset + scale * src.data[v]);
   });
 }
 
