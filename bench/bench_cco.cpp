@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
   if (sizes.empty()) sizes = {1000, 4000};
   std::unique_ptr<tbb::global_control> gc;
   if (threads > 0) gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
-  // Seed 000 §5 / Karch 1999: 100 cm³ perfused with 500 mL/min (4000 terminals of 0.125 mL/min).
+  // Kerautret et al. (OpenCCO) §5 and Karch et al. 1999: 100 cm³ perfused with 500 mL/min (4000 terminals of 0.125 mL/min).
   const double radius = disc ? 50.0 : std::cbrt(3 * 1e5 / (4 * M_PI));
   const auto dom = GrowthDomain::analytic(disc ? DomainShape::Disc : DomainShape::Sphere, radius, radius / 50);
   std::printf("%-7s %9s %9s %12s %16s %10s %6s %6s %9s\n", "domain", "terminals", "time (s)", "us/terminal", "us/term/log2(N)", "peak MiB", "pairs",
