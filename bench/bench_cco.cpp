@@ -1,5 +1,5 @@
 // CCO growth time and memory for N terminals in the Kerautret et al. (OpenCCO) §5 sphere (or the 2D disc):
-//   bench_cco [N ...] [--disc] [--threads T] [--max-nu M] [--seed S] [--murray-bands]
+//   bench_cco [N ...] [--disc] [--threads T] [--max-nu M] [--seed S] [--murray-bands] [--organ-scale]
 // One line per N: seconds, µs per terminal, µs per terminal / log2 N, peak RSS, checks.
 // --murray-bands: Murray's exponent 3, 2.73, 7/3 below 0.1 mm, to 1 mm, above; also the passes
 // the radius–exponent fixed point takes from radii of zero on the grown tree.
@@ -22,7 +22,7 @@ using namespace angiosynth;
 
 int main(int argc, char** argv) {
   std::vector<long> sizes;
-  bool disc = false, bands = false;
+  bool disc = false, bands = false, organ = false;
   int threads = 0;
   int max_nu = 0;  // ν doubles up to this (0: the default)
   long seed = 1;
@@ -31,6 +31,8 @@ int main(int argc, char** argv) {
       disc = true;
     else if (!std::strcmp(argv[i], "--murray-bands"))
       bands = true;
+    else if (!std::strcmp(argv[i], "--organ-scale"))
+      organ = true;
     else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc)
       seed = std::atol(argv[++i]);
     else if (!std::strcmp(argv[i], "--max-nu") && i + 1 < argc)
@@ -53,6 +55,7 @@ int main(int argc, char** argv) {
     o.terminals = n;
     if (max_nu > 0) o.max_neighbours = max_nu;
     o.seed = std::uint64_t(seed);
+    o.organ_scale = organ;
     o.root_mm = dom.defaultRoot();
     o.physics.perfusion_flow = 500 * 1000.0 / 60.0;  // Karch 1999: 500 mL/min for the whole organ
     o.physics.perfusion_pressure = 100 * 133.322;
@@ -68,6 +71,28 @@ int main(int argc, char** argv) {
     std::printf("%-7s %9ld %9.3f %12.1f %16.2f %10.1f %6lld %6lld %9.1f\n", disc ? "disc" : "sphere", n, s, s / n * 1e6,
                 s / n * 1e6 / std::log2(double(n)), peakRssBytes() / 1048576.0, (long long)rep.intersecting_pairs, (long long)rep.short_segments,
                 treeVolume(tree));
+    {
+      // The physics of the final tree: the worst relative residual of Murray's law, flow
+      // conservation and Poiseuille's drop at any bifurcation.
+      PhysicsParameters p = o.physics;
+      p.total_terminals = n;
+      const MurrayLaw law(p);
+      const double k = 8 * p.viscosity / M_PI, drop = std::abs(p.perfusion_pressure - p.terminal_pressure);
+      double murray = 0, flow = 0, poiseuille = 0, ratio = 1e300;
+      for (std::int32_t i = 1; i < tree.nodeCount(); ++i) {
+        ratio = std::min(ratio, tree.length[i] / tree.radius[i]);
+        if (tree.isTerminal(i)) continue;
+        const auto a = tree.child0[i], b = tree.child1[i];
+        const double g = law.exponentAt(tree.radius[i]);
+        const double lhs = std::pow(tree.radius[i], g);
+        murray = std::max(murray, std::abs(lhs - std::pow(tree.radius[a], g) - std::pow(tree.radius[b], g)) / lhs);
+        flow = std::max(flow, std::abs(tree.flow[i] - tree.flow[a] - tree.flow[b]) / tree.flow[i]);
+        for (auto c : {a, b})
+          poiseuille = std::max(
+              poiseuille, std::abs(tree.pressure[i] - tree.pressure[c] - tree.flow[c] * k * tree.length[c] / std::pow(tree.radius[c], 4)) / drop);
+      }
+      std::printf("        residuals: Murray %.1e, flow %.1e, Poiseuille %.1e; shortest l/r %.3f\n", murray, flow, poiseuille, ratio);
+    }
     if (bands) {
       auto cold = tree;
       std::fill(cold.radius.begin(), cold.radius.end(), 0.0);

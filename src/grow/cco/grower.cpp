@@ -21,6 +21,8 @@ namespace {
 // ρ is recomputed exactly for the whole tree this often (O(N), so O(1) per terminal); between
 // refreshes only the path of each new terminal is exact.
 constexpr std::int64_t kRefreshEvery = 64;
+// At organ scale the relative radii are refreshed once the tree has grown by 1/kOrganRefreshShare.
+constexpr std::int64_t kOrganRefreshShare = 256;
 // The final repair never removes more than this share of the terminals for one violation.
 constexpr double kMaxRepairShare = 0.05;
 // For a trunk shorter than 2r that no move can lengthen, the side branch it merges with its
@@ -121,8 +123,9 @@ struct TreeGrowth {
   // Terminal points for the spacing test of draws, in cells of δ when built; rebuilt when the
   // terminals double (δ shrinks) and after a repair (nodes renumbered and moved).
   std::unique_ptr<PointHash> terminal_grid;
-  std::int32_t grid_nodes = 0;  // nodes [0, grid_nodes) are in the grid
-  std::int64_t grid_built = 0;  // terminals when it was built
+  std::int32_t grid_nodes = 0;    // nodes [0, grid_nodes) are in the grid
+  std::int64_t grid_built = 0;    // terminals when it was built
+  std::int64_t next_refresh = 0;  // terminals at the next refresh of the relative radii
   std::int32_t terminalCount() const { return tree.terminalCount(); }
 };
 
@@ -143,6 +146,9 @@ constexpr int kRefineIterations = 4;
 constexpr double kInteriorMargin = 1.05;
 constexpr double kRootMargin = 1.25;
 constexpr std::size_t kRefineNearest = 8;
+// At organ scale: how many of Kamiya's valid points (the lightest) and of the nearest segments
+// without one are refined.
+constexpr std::size_t kOrganRefined = 4;
 
 // A trial connection of a drawn point to one tree, ranked by the volume it adds to the forest.
 struct Candidate {
@@ -159,6 +165,7 @@ class CcoGrower {
     int systems = 0;
     for (const auto& in : inlets) systems = std::max(systems, in.system + 1);
     systems_.resize(systems);
+    relaxed_.assign(std::size_t(systems), 0.0);
     for (std::size_t k = 0; k < inlets.size(); ++k) {
       const auto& in = inlets[k];
       trees_.emplace_back(d, inletPhysics(volumePhysics(o), in.root_pressure, in.terminal_pressure), in.root_mm, in.system, o.terminals);
@@ -478,6 +485,16 @@ class CcoGrower {
     return overlapsOtherVessel(T, x, a0, a1, rx, candidates, radius_of);
   }
 
+  // Every kRefreshEvery terminals; at organ scale once the tree has grown by 1/kOrganRefreshShare
+  // of itself (and at most every kRefreshEvery terminals): O(N) node visits in all, not O(N²).
+  bool refreshDue(TreeGrowth& g) const {
+    const std::int64_t n = g.terminalCount();
+    if (!opt_.organ_scale) return n % kRefreshEvery == 0;
+    if (n < g.next_refresh) return false;
+    g.next_refresh = n + std::max(kRefreshEvery, n / kOrganRefreshShare);
+    return true;
+  }
+
   // ρ of the whole tree, and the list of thick segments.
   static void refreshRelativeRadii(TreeGrowth& g) {
     refreshRelative(g.tree, g.rel);
@@ -549,6 +566,15 @@ class CcoGrower {
         // One task per segment: the other thread is often asleep when a candidate arrives and
         // wakes too late to take half of the list.
         const bool planar = dom_.dimension() == 2;
+        // Whether trial j's exact refinement runs (all that qualify, or at organ scale only those
+        // refine_set marks).
+        const auto refineTrial = [&](std::size_t j) {
+          const auto& k = trials[j].c[0];
+          if (opt_.bifurcation == BifurcationPoint::Exact && (k.valid || (j < kRefineNearest && !trials[j].at_node)))
+            trials[j].c[1] = refine(g, k, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
+          if (planar)
+            for (int w : {0, 1}) trials[j].crosses[w] = trials[j].c[w].valid && terminalCrossesInPlane(g.tree, trials[j].c[w], g.near);
+        };
         tbb::parallel_for(
             tbb::blocked_range<std::size_t>(g.done, g.near.size(), 1),
             [&](const auto& r) {
@@ -570,16 +596,33 @@ class CcoGrower {
                 // only slide towards the node, where the parent part is short, and skipping them saves
                 // time at no cost in volume. In space such steps, stopped short of the node, are often
                 // valid, and without them the trees come out heavier (docs/benchmarks.md, as above).
-                const auto& k = trials[j].c[0];
                 trials[j].at_node = planar && opt_.bifurcation == BifurcationPoint::Exact && j < kRefineNearest && trials[j].merged_at_parent &&
                                     opts[i].optimumAtProximalNode(g.near[j].second, p);
-                if (opt_.bifurcation == BifurcationPoint::Exact && (k.valid || (j < kRefineNearest && !trials[j].at_node)))
-                  trials[j].c[1] = refine(g, k, g.near[j].second, p, n_new[i], shrink_new, opts[i]);
-                if (planar)
-                  for (int w : {0, 1}) trials[j].crosses[w] = trials[j].c[w].valid && terminalCrossesInPlane(g.tree, trials[j].c[w], g.near);
+                if (!opt_.organ_scale) refineTrial(j);
               }
             },
             tbb::simple_partitioner());
+        if (opt_.organ_scale) {
+          // At organ scale only the kOrganRefined lightest of Kamiya's valid points, and the
+          // kOrganRefined nearest segments where he found none, are refined: each refinement walks
+          // to the root several times, and the walk grows with the tree (docs/benchmarks.md).
+          refine_set_.clear();
+          for (std::size_t j = g.done; j < g.near.size(); ++j)
+            if (trials[j].c[0].valid) refine_set_.push_back(j);
+          std::sort(refine_set_.begin(), refine_set_.end(),
+                    [&](std::size_t a, std::size_t b) { return std::tie(trials[a].c[0].cost, a) < std::tie(trials[b].c[0].cost, b); });
+          if (refine_set_.size() > kOrganRefined) refine_set_.resize(kOrganRefined);
+          std::size_t nearest_invalid = 0;
+          for (std::size_t j = g.done; j < g.near.size() && nearest_invalid < kOrganRefined; ++j)
+            if (!trials[j].c[0].valid && !trials[j].hidden && !trials[j].crowded && j < kRefineNearest && !trials[j].at_node)
+              refine_set_.push_back(j), ++nearest_invalid;
+          tbb::parallel_for(
+              tbb::blocked_range<std::size_t>(0, refine_set_.size(), 1),
+              [&](const auto& r) {
+                for (auto q = r.begin(); q != r.end(); ++q) refineTrial(refine_set_[q]);
+              },
+              tbb::simple_partitioner());
+        }
         for (std::size_t j = g.done; j < g.near.size(); ++j) {
           if (trials[j].kamiya_failed) ++report_.kamiya_failures;
           if (trials[j].hidden) ++report_.hidden_segments;
@@ -613,7 +656,7 @@ class CcoGrower {
           g.index.insert(g.tree, c.segment);
           g.index.refresh(g.tree);
           if (g.rel[n - 2] >= kThick) g.thick.push_back(n - 2);
-          if (g.terminalCount() % kRefreshEvery == 0) {
+          if (refreshDue(g)) {
             refreshRelativeRadii(g);
             // Banded γ reads each bifurcation's parent radius: the radii in final units as they stand now.
             if (g.kernel.law().banded()) {
@@ -685,6 +728,9 @@ class CcoGrower {
       const std::int64_t n = systemTerminals(sys);
       // δ_max (Kerautret et al. (OpenCCO) eq. 15) for the system's current number of terminals, relaxed by runs of failures.
       double delta = std::pow(dom_.measure() / double(n), 1.0 / dom_.dimension());
+      // At organ scale the threshold the last connection was made at carries over: starting from
+      // δ_max again, every terminal of a large tree spends a run of rejected draws relaxing it.
+      if (opt_.organ_scale && relaxed_[std::size_t(si)] > 0) delta = std::min(delta, relaxed_[std::size_t(si)]);
       for (std::int64_t failures = 1;; ++failures) {
         if (failures > opt_.max_draws)
           throw GrowthError("could place only " + std::to_string(n) + " of " + std::to_string(sys.target) + " terminals" +
@@ -706,6 +752,7 @@ class CcoGrower {
           ++report_.candidates;
           if (connect(p, sys)) {
             report_.lenient_connections += skipped_;
+            relaxed_[std::size_t(si)] = delta;
             break;
           }
           ++report_.rejected_unreachable;
@@ -1029,6 +1076,8 @@ class CcoGrower {
   Rng rng_;
   std::vector<TreeGrowth> trees_;
   std::vector<System> systems_;
+  std::vector<std::size_t> refine_set_;     // trials refined at organ scale
+  std::vector<double> relaxed_;             // per system: the last connection's distance threshold
   std::vector<std::vector<Trial>> trials_;  // per open tree of the connection being made
   std::vector<Candidate> ranked_;
   std::vector<std::int32_t> check_;

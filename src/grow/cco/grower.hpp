@@ -55,6 +55,11 @@ struct CcoOptions {
   std::uint64_t sample = 0;
   int max_repair_rounds = 30;
   std::int64_t max_draws = 2000000;  // consecutive failed draws before giving up
+  // Organ scale: each terminal's distance threshold starts where the last connection's stood
+  // rather than at δ_max, the relative radii of the whole tree are refreshed once it has grown by
+  // 1/256 of itself rather than every 64 terminals, and only the lightest of Kamiya's points are
+  // refined; each keeps the cost per terminal from growing with the tree (docs/benchmarks.md).
+  bool organ_scale = false;
 };
 
 // One tree of a forest.

@@ -46,6 +46,12 @@ const std::vector<Setting<CcoOptions>>& ccoSettings() {
        .meaning = "each connection's bifurcation: the lighter of Kamiya's fixed point and the exact minimum of the tree's volume (which "
                   "slides along l = 2r), or Kamiya's point alone (as in OpenCCO, Kerautret et al.)",
        .field = enumChoice<O, &O::bifurcation, kBifurcationWords>(), .choices = wordList(kBifurcationWords), .fallback_is_value = true},
+      {.table = "tree", .key = "organ_scale", .unit = "true/false", .fallback = "false",
+       .meaning = "for 10^5 to 10^6 terminals: each terminal's distance threshold starts where the last connection's stood (not at "
+                  "delta_max), the vessels' relative radii are refreshed as the tree grows by 1/256 of itself (not every 64 terminals), and "
+                  "only the 4 lightest of Kamiya's bifurcations and the 4 nearest segments without one are refined; time per terminal grows "
+                  "slowly, volume within 1 % (docs/benchmarks.md); false: as Karch et al. 1999",
+       .field = &O::organ_scale, .fallback_is_value = true},
   };
   return settings;
 }
