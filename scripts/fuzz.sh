@@ -16,7 +16,7 @@ corpus=build-san/fuzz-corpus
 findings=build-san/fuzz-findings
 mkdir -p "$findings"
 for t in toml_params vascusynth_params box_map noise_file profile dataset_spec manifest nifti_mask network_file \
-         graph_mesh initial_network method_params mesh_options score plot_calibre morphometry_reference; do mkdir -p "$corpus/fuzz_$t"; done
+         graph_mesh initial_network method_params mesh_options score plot_calibre morphometry_reference zarr_chunk; do mkdir -p "$corpus/fuzz_$t"; done
 cp examples/*.toml "$corpus/fuzz_toml_params/" 2>/dev/null || true
 for f in examples/vascusynth/param*.txt; do cp "$f" "$corpus/fuzz_vascusynth_params/"; done
 for f in demand_maps/vascusynth_rods_100.txt demand_maps/supply_100.txt tests/data/*.txt; do [ -f "$f" ] && cp "$f" "$corpus/fuzz_box_map/" || true; done
@@ -49,6 +49,13 @@ printf '%s' '{"per_case":[{"calibre":[{"radius_voxels":[0,1],"recall":0.5}]},{"c
 for f in data/morphometry/*.toml; do { printf '0'; cat "$f"; } > "$corpus/fuzz_morphometry_reference/$(basename "$f")"; done
 printf '1tree,parent,r_parent_mm,asymmetry,area_ratio,murray_exponent,radius_mm\n0,1,0.5,0.8,1.2,2.9,0.4\n0,2,0.2,0.5,1.1,3.1,0.1\n' \
   > "$corpus/fuzz_morphometry_reference/stats.csv"
+# Zarr chunks: a float chunk of 8^3 by numcodecs, Blosc (first byte 8) and zlib (9).
+/usr/bin/python3 - "$corpus/fuzz_zarr_chunk" <<'PY'
+import sys, numpy as np, numcodecs
+v = np.linspace(0, 1, 512, dtype='<f4').tobytes()
+open(sys.argv[1] + '/blosc_f32', 'wb').write(b'\x08' + numcodecs.Blosc(cname='lz4', clevel=5, shuffle=1).encode(v))
+open(sys.argv[1] + '/zlib_f32', 'wb').write(b'\x09' + numcodecs.Zlib(level=5).encode(v))
+PY
 # Predictions (fuzz_score): the target writes its sample's own mask into its corpus on start.
 for f in examples/dataset_*.toml tests/data/dataset_*.toml; do cp "$f" "$corpus/fuzz_dataset_spec/"; done
 printf '%s\n' '{"index":0,"status":"ok","files":[{"path":"imagesTr/F_0000_0000.nii.gz","size":5,"sha256":"6105d6cc76af400325e94d588ce511be5bfdbb73b437dc51eca43917d7a43e3d"}]}' \
@@ -66,7 +73,7 @@ for d in fuzz/regressions/*/; do cp "$d"* "$corpus/$(basename "$d")/" 2>/dev/nul
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(fuzz_toml_params fuzz_vascusynth_params fuzz_box_map fuzz_noise_file fuzz_profile fuzz_dataset_spec fuzz_manifest fuzz_nifti_mask fuzz_network_file
                                      fuzz_graph_mesh fuzz_initial_network fuzz_method_params fuzz_mesh_options fuzz_score fuzz_plot_calibre
-                                     fuzz_morphometry_reference)
+                                     fuzz_morphometry_reference fuzz_zarr_chunk)
 export ASAN_OPTIONS="detect_leaks=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/sanitizer/ubsan.supp"
 status=0

@@ -146,9 +146,11 @@ bool ZarrArray::readChunk(const std::array<std::int64_t, 3>& chunk, void* out) c
   const std::string packed((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   bool ok = false;
   if (codec == ZarrCodec::Blosc) {
-    std::size_t stored = 0, compressed = 0, block = 0;
-    if (packed.size() >= BLOSC_MIN_HEADER_LENGTH) blosc_cbuffer_sizes(packed.data(), &stored, &compressed, &block);
-    ok = stored == bytes && compressed == packed.size() && blosc_decompress_ctx(packed.data(), out, bytes, 1) == int(bytes);
+    // The header is validated first (sizes consistent with the buffer): a damaged chunk is refused,
+    // not decoded.
+    std::size_t stored = 0;
+    ok = packed.size() >= BLOSC_MIN_HEADER_LENGTH && blosc_cbuffer_validate(packed.data(), packed.size(), &stored) == 0 && stored == bytes &&
+         blosc_decompress_ctx(packed.data(), out, bytes, 1) == int(bytes);
   } else {
     uLongf n = uLongf(bytes);
     ok = uncompress(static_cast<Bytef*>(out), &n, reinterpret_cast<const Bytef*>(packed.data()), uLong(packed.size())) == Z_OK && n == bytes;
