@@ -217,7 +217,7 @@ TEST_F(Settings, EveryCcoKeyFillsItsFieldAndTheSidecar) {
   };
   check(ccoSettings(), cco);
   check(ccoPhysics(), [&](const Scenario& sc) { return cco(sc).physics; });
-  EXPECT_EQ(checked, 16);
+  EXPECT_EQ(checked, 17);
 }
 
 TEST_F(Settings, TheParameterReferencePrintsEachDeclaration) {
