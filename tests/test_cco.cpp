@@ -516,12 +516,12 @@ TEST(Cco, OrganScaleTreesKeepEveryInvariantAtNearlyTheSameVolume) {
   // within 2 % of the faithful tree's (docs/benchmarks.md has it for 10,000 to 1,000,000 terminals).
   const double radius = std::cbrt(3 * 1e5 / (4 * std::numbers::pi));
   const auto d = GrowthDomain::analytic(DomainShape::Sphere, radius, radius / 50);
-  auto o = karch(4000, d);
+  auto o = karch(2000, d);
   GrowthReport faithful_report, organ_report;
   const auto faithful = growCco(d, o, faithful_report);
   o.organ_scale = true;
   const auto organ = growCco(d, o, organ_report);
-  test::expectHemodynamicInvariants(organ, o.physics, 4000);
+  test::expectHemodynamicInvariants(organ, o.physics, 2000);
   test::expectGeometry(organ, d);
   EXPECT_EQ(organ_report.intersecting_pairs, 0);
   EXPECT_EQ(test::bruteForceIntersections(organ), 0);
@@ -530,7 +530,7 @@ TEST(Cco, OrganScaleTreesKeepEveryInvariantAtNearlyTheSameVolume) {
   // The same tree on one thread or two.
   const auto run = [&](int threads) {
     tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
-    auto small = karch(1000, d, 5);
+    auto small = karch(500, d, 5);
     small.organ_scale = true;
     GrowthReport rep;
     return growCco(d, small, rep);
