@@ -225,21 +225,10 @@ int runRasterize(const RasterizeArgs& a, const std::string& command_line) {
   }
   assignClassLabels(forest.trees);
 
-  ChunkedVolumeOptions o;
-  if (sample.is_null()) {
-    if (!p.voxel_mm) throw InputError("--voxel-size", 0, "is needed for a graph file (a sample directory has its grid); allowed: a voxel edge in mm");
-    o.grid = graphGrid(forest.vessels, *p.voxel_mm);
-  } else {
-    o.grid = sampleGrid(sample, sample_file, p.voxel_mm);
-  }
-  o.raster = RasterOptions{p.supersampling, p.centerline_connectivity};
-  o.chunk = p.zarr_chunk;
-  o.levels = p.zarr_levels;
-  o.codec = *findZarrCodec(p.zarr_compression);
-  o.background = p.background;
-  o.vessel = p.vessel;
-  o.dtype = p.dtype;
-  o.memory_limit = memoryLimit(a.common);
+  if (sample.is_null() && !p.voxel_mm)
+    throw InputError("--voxel-size", 0, "is needed for a graph file (a sample directory has its grid); allowed: a voxel edge in mm");
+  const VolumeGrid grid = sample.is_null() ? graphGrid(forest.vessels, *p.voxel_mm) : sampleGrid(sample, sample_file, p.voxel_mm);
+  ChunkedVolumeOptions o = chunkedVolumeOptions(p, grid, memoryLimit(a.common));
   Json input = {{"graph", fs::absolute(graph).lexically_normal().string()}, {"sha256", sha256File(graph)}};
   if (graph.filename() == "edges.csv" && fs::exists(graph.parent_path() / "nodes.csv"))
     input["nodes_sha256"] = sha256File(graph.parent_path() / "nodes.csv");

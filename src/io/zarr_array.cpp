@@ -3,6 +3,7 @@
 #include <blosc.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -18,41 +19,34 @@ namespace {
 
 constexpr ZarrCodec kCodecs[] = {ZarrCodec::Blosc, ZarrCodec::Zlib};
 
-template <class T>
-bool allEqual(const void* data, std::size_t bytes, double fill) {
-  const T* v = static_cast<const T*>(data);
-  const T f = static_cast<T>(fill);
-  const std::size_t n = bytes / sizeof(T);
-  for (std::size_t i = 0; i < n; ++i)
-    if (std::memcmp(&v[i], &f, sizeof(T)) != 0) return false;
-  return true;
+// f(T{}) with T the voxel type's C++ type.
+template <class F>
+decltype(auto) withVoxelType(VoxelType t, F&& f) {
+  switch (t) {
+    case VoxelType::UInt8: return f(std::uint8_t{});
+    case VoxelType::Int16: return f(std::int16_t{});
+    case VoxelType::UInt16: return f(std::uint16_t{});
+    case VoxelType::UInt32: return f(std::uint32_t{});
+    case VoxelType::Float32: break;
+  }
+  return f(float{});
 }
 
 bool isFill(const void* data, std::size_t bytes, VoxelType t, double fill) {
-  switch (t) {
-    case VoxelType::UInt8: return allEqual<std::uint8_t>(data, bytes, fill);
-    case VoxelType::Int16: return allEqual<std::int16_t>(data, bytes, fill);
-    case VoxelType::UInt16: return allEqual<std::uint16_t>(data, bytes, fill);
-    case VoxelType::UInt32: return allEqual<std::uint32_t>(data, bytes, fill);
-    case VoxelType::Float32: return allEqual<float>(data, bytes, fill);
-  }
-  return false;
-}
-
-template <class T>
-void fillWith(void* out, std::size_t bytes, double fill) {
-  T* v = static_cast<T*>(out);
-  std::fill(v, v + bytes / sizeof(T), static_cast<T>(fill));
+  return withVoxelType(t, [&](auto zero) {
+    using T = decltype(zero);
+    const T* v = static_cast<const T*>(data);
+    const T f = static_cast<T>(fill);
+    return std::all_of(v, v + bytes / sizeof(T), [&](const T& x) { return std::memcmp(&x, &f, sizeof(T)) == 0; });
+  });
 }
 
 void fillChunk(void* out, std::size_t bytes, VoxelType t, double fill) {
-  switch (t) {
-    case VoxelType::UInt8: return fillWith<std::uint8_t>(out, bytes, fill);
-    case VoxelType::Int16: return fillWith<std::int16_t>(out, bytes, fill);
-    case VoxelType::UInt16: return fillWith<std::uint16_t>(out, bytes, fill);
-    case VoxelType::UInt32: return fillWith<std::uint32_t>(out, bytes, fill);
-    case VoxelType::Float32: return fillWith<float>(out, bytes, fill);
-  }
+  withVoxelType(t, [&](auto zero) {
+    using T = decltype(zero);
+    T* v = static_cast<T*>(out);
+    std::fill(v, v + bytes / sizeof(T), static_cast<T>(fill));
+  });
 }
 
 }  // namespace

@@ -8,10 +8,6 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <limits>
-#include <map>
-#include <sstream>
-#include <thread>
 
 #include "core/error.hpp"
 #include "core/memory.hpp"
@@ -246,6 +242,20 @@ void writeJsonFile(const fs::path& file, const Json& j) {
 Json sortedJson(const Json& j) { return nlohmann::json::parse(j.dump()); }
 
 }  // namespace
+
+ChunkedVolumeOptions chunkedVolumeOptions(const ImageParameters& ip, const VolumeGrid& grid, std::uint64_t memory_limit) {
+  ChunkedVolumeOptions o;
+  o.grid = grid;
+  o.raster = RasterOptions{ip.supersampling, ip.centerline_connectivity};
+  o.chunk = ip.zarr_chunk;
+  o.levels = ip.zarr_levels;
+  o.codec = *findZarrCodec(ip.zarr_compression);
+  o.background = ip.background;
+  o.vessel = ip.vessel;
+  o.dtype = ip.dtype;
+  o.memory_limit = memory_limit;
+  return o;
+}
 
 Json ChunkedVolumeSummary::toJson() const {
   return {{"chunks", chunks},

@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "config/image_settings.hpp"
 #include "core/forest.hpp"
 #include "grow/common/growth_report.hpp"
 #include "io/zarr_array.hpp"
@@ -37,6 +38,9 @@ struct ChunkedVolumeOptions {
   std::uint64_t memory_limit = 0;     // bytes; 0: 75 % of physical memory
   ProgressFn progress;                // chunks done, chunks of the task (or of the level)
 };
+
+// The options [image] gives (chunk, levels, compression, intensities, supersampling) on `grid`.
+ChunkedVolumeOptions chunkedVolumeOptions(const ImageParameters& image, const VolumeGrid& grid, std::uint64_t memory_limit);
 
 // Task `index` of `count` takes the `index`-th of `count` contiguous ranges of level-0 chunks.
 struct ChunkTask {

@@ -61,21 +61,6 @@ bool needsDense(const VolumeRequest& req) {
 
 bool asks(const ImageParameters& ip, const char* format) { return std::find(ip.formats.begin(), ip.formats.end(), format) != ip.formats.end(); }
 
-ChunkedVolumeOptions chunkedOptions(const VolumeRequest& req) {
-  const ImageParameters& ip = req.image;
-  ChunkedVolumeOptions o;
-  o.grid = req.grid;
-  o.raster = RasterOptions{ip.supersampling, ip.centerline_connectivity};
-  o.chunk = ip.zarr_chunk;
-  o.levels = ip.zarr_levels;
-  o.codec = *findZarrCodec(ip.zarr_compression);
-  o.background = ip.background;
-  o.vessel = ip.vessel;
-  o.dtype = ip.dtype;
-  o.memory_limit = req.memory_limit;
-  return o;
-}
-
 void checkVolumeMemory(const VolumeRequest& req) {
   if (!needsDense(req)) return;  // the sparse path is checked once the tree is known
   const VolumeGrid& g = req.grid;
@@ -119,7 +104,7 @@ void writeVolumes(const Forest& forest, const VolumeRequest& req, const std::fil
   }
   if (req.write_files && asks(ip, "zarr")) {
     // One process, every chunk: the same store a cluster's tasks write (`angiosynth rasterize`).
-    const ChunkedVolumeOptions o = chunkedOptions(req);
+    const ChunkedVolumeOptions o = chunkedVolumeOptions(ip, g, req.memory_limit);
     const auto store = dir / "volume.ome.zarr";
     openChunkedVolume(store, o, chunkedJob(o, "the tree of this sample"));
     const ChunkedVolumeSummary level0 = rasterizeChunks(forest, store, o, ChunkTask{});
