@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Runs every libFuzzer target of build-san/ for SECONDS each (default 20), seeded from the shipped
+# Runs every libFuzzer target of build-san/ for SECONDS each (default 20), as many at a time as there
+# are cores (each target is one process on one core), seeded from the shipped
 # examples, profiles, maps and test data. A crash, sanitizer report, internal error (an exception
 # other than a file:line input error), time-out (10 s per case) or allocation over 2 GiB stops it
 # with the case saved in build-san/fuzz-findings/.
@@ -76,18 +77,34 @@ targets=("$@")
                                      fuzz_morphometry_reference fuzz_zarr_chunk)
 export ASAN_OPTIONS="detect_leaks=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/sanitizer/ubsan.supp"
-status=0
-for t in "${targets[@]}"; do
+# Targets run $(nproc) at a time: each is one process on one core.
+fuzz_one() {
+  local t=$1 work runs run_limit=()
   work=$(mktemp -d)
-  run_limit=()
   [ -n "${FUZZ_RUNS:-}" ] && run_limit=(-runs="$FUZZ_RUNS")
-  (cd "$work" && "$root/build-san/$t" -max_total_time="$seconds" "${run_limit[@]}" -seed="${FUZZ_SEED:-1}" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
-      -artifact_prefix="$root/$findings/$t-" -print_final_stats=1 "$root/$corpus/$t" >"$work/log" 2>&1) || status=1
-  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$work/log" | grep -o '[0-9]*$' || echo 0)
-  if [ $status -ne 0 ]; then
-    echo "$t: FAILED after $runs cases"; tail -n 40 "$work/log"; rm -rf "$work"; exit 1
+  if ! (cd "$work" && "$root/build-san/$t" -max_total_time="$seconds" "${run_limit[@]}" -seed="${FUZZ_SEED:-1}" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
+        -artifact_prefix="$root/$findings/$t-" -print_final_stats=1 "$root/$corpus/$t" >"$work/log" 2>&1); then
+    runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$work/log" | grep -o '[0-9]*$' || echo 0)
+    { echo "$t: FAILED after $runs cases"; tail -n 40 "$work/log"; } >&2
+    rm -rf "$work"
+    touch "$marks/$t"
+    return 1
   fi
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$work/log" | grep -o '[0-9]*$' || echo 0)
   echo "$t: $runs cases in $(grep -o 'Done [0-9]* runs in [0-9]* second' "$work/log" | grep -o 'in [0-9]* second' | grep -o '[0-9]*' || echo "$seconds") s, 0 crashes, 0 sanitizer reports, 0 internal errors, 0 time-outs"
   rm -rf "$work"
+}
+lanes=$(nproc)
+marks=$(mktemp -d)  # one file per failed target
+for t in "${targets[@]}"; do
+  while [ "$(jobs -rp | wc -l)" -ge "$lanes" ]; do wait -n || true; done
+  fuzz_one "$t" &
 done
+wait
+failed=$(find "$marks" -type f | wc -l)
+rm -rf "$marks"
+if [ "$failed" -gt 0 ]; then
+  echo "fuzz: $failed of ${#targets[@]} failed (cases in $findings/)"
+  exit 1
+fi
 echo "fuzz: ${#targets[@]} passed, 0 failed"
