@@ -232,8 +232,7 @@ Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int 
     const MinLengths at = minimumsAt(s, c.bifurcation, term, path);
     if (admissible(s, c.bifurcation, term, at)) return c;
     for (int j = 0; j < 3; ++j) m[j] = std::max(m[j], at[j] * (1 + 1e-6));
-    const Vec3 from = c.bifurcation;  // the last optimum, pushed out to the larger minimums
-    c = search(s, term, m, max_iterations, &from, path);
+    c = search(s, term, m, max_iterations, start, path);
   }
   if (c.valid && length_ratio_ > 0 && !admissible(s, c.bifurcation, term, minimumsAt(s, c.bifurcation, term, path))) c.valid = false;
   return c;
