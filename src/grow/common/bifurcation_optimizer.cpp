@@ -35,10 +35,9 @@ void BifurcationOptimizer::ancestors(std::int32_t s, Ancestors& path) const {
   forEachAncestor(s, [&](const Ancestor& a) { path.push_back(a); });
 }
 
-double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, double l_term, std::vector<PathLevel>* record,
-                                  WalkSummary* summary) const {
+double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, double l_term, std::vector<PathLevel>* record) const {
   return costOver(
-      s, l_up, l_down, l_term, [&](auto&& f) { forEachAncestor(s, f); }, record, summary);
+      s, l_up, l_down, l_term, [&](auto&& f) { forEachAncestor(s, f); }, record);
 }
 
 double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, double l_term, const Ancestors& path,
@@ -48,12 +47,11 @@ double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, do
       [&](auto&& f) {
         for (const auto& a : path) f(a);
       },
-      record, nullptr);
+      record);
 }
 
 template <class Walk>
-double BifurcationOptimizer::costOver(std::int32_t s, double l_up, double l_down, double l_term, Walk&& walk, std::vector<PathLevel>* record,
-                                      WalkSummary* summary) const {
+double BifurcationOptimizer::costOver(std::int32_t s, double l_up, double l_down, double l_term, Walk&& walk, std::vector<PathLevel>* record) const {
   const auto& t = tree_;
   const auto& k = kernel_;
   // The old segment s keeps its subtree but now starts at b.
@@ -66,19 +64,13 @@ double BifurcationOptimizer::costOver(std::int32_t s, double l_up, double l_down
   double V = k.lengthCost(l_up) + k.radiusCost(sp.beta_a) * V_s + k.radiusCost(sp.beta_b) * V_t;
   double n = t.terminals[s] + 1;
   if (record) record->push_back({-1, s, -1, sp.beta_a, sp.beta_b, R, V, std::int32_t(n)});
-  if (summary) *summary = {1.0, sp.beta_a, sp.beta_b, 0.0, 0};
   walk([&](const Ancestor& a) {
     sp = k.split(n, R, a.other_terminals, a.other_resistance, a.radius);
     R = combinedResistance(a.length, sp, R, a.other_resistance);
     V = a.length_cost + k.radiusCost(sp.beta_a) * V + k.radiusCost(sp.beta_b) * a.other_cost;
     n = a.terminals_after;
     if (record) record->push_back({a.node, a.below, a.other, sp.beta_a, sp.beta_b, R, V, std::int32_t(n)});
-    if (summary) summary->rho *= sp.beta_a;
   });
-  if (summary) {
-    summary->root_reduced_resistance = R;
-    summary->root_terminals = std::int32_t(n);
-  }
   const double r_root = rootRadius(params_, n * params_.terminalFlow(), R);
   return k.radiusCost(r_root) * V;
 }

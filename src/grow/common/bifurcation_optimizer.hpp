@@ -72,16 +72,8 @@ class BifurcationOptimizer {
   // Off: trial points are not tested against zero-demand voxels (a caller that checks the
   // domain exactly on the result, as CCO's capsule test does).
   void checkObstacles(bool on) { check_obstacles_ = on; }
-  // What a connection's checks read of its walk to the root, without recording the path: the new
-  // bifurcation segment's radius relative to the root's (the product of the ancestors' β), the
-  // split's two β, and the root's reduced resistance and terminals.
-  struct WalkSummary {
-    double rho = 1, beta_split = 0, beta_terminal = 0, root_reduced_resistance = 0;
-    std::int32_t root_terminals = 0;
-  };
   // Exact whole-tree cost with the three new lengths (parent part, distal part, terminal).
-  double cost(std::int32_t s, double l_up, double l_down, double l_term, std::vector<PathLevel>* record = nullptr,
-              WalkSummary* summary = nullptr) const;
+  double cost(std::int32_t s, double l_up, double l_down, double l_term, std::vector<PathLevel>* record = nullptr) const;
   // Exact cost and its derivatives with respect to the three new lengths, from one walk to the
   // root that carries forward-mode derivatives of (R̃, V) of the new bifurcation segment.
   struct Evaluation {
@@ -143,7 +135,7 @@ class BifurcationOptimizer {
   template <class F>
   void forEachAncestor(std::int32_t s, F&& f) const;
   template <class Walk>
-  double costOver(std::int32_t s, double l_up, double l_down, double l_term, Walk&& walk, std::vector<PathLevel>* record, WalkSummary* summary) const;
+  double costOver(std::int32_t s, double l_up, double l_down, double l_term, Walk&& walk, std::vector<PathLevel>* record) const;
   template <class Walk>
   Evaluation evaluateOver(std::int32_t s, const double (&l)[3], Walk&& walk) const;
 
