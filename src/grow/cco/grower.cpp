@@ -982,7 +982,12 @@ class CcoGrower {
       const bool x_goes = std::tie(nx, fy) < std::tie(ny, fx);
       // Two trunks, both too large to regrow: push the thinner one aside, else the thicker.
       const auto [kt, t, kw, w] = x_goes ? std::tuple(kx, x, ky, y) : std::tuple(ky, y, kx, x);
-      if (tooLargeToRegrow(kx, x) && tooLargeToRegrow(ky, y) && (separate(kt, t, kw, w) || separate(kw, w, kt, t))) {
+      // At organ scale also where the lighter side is a subtree of more than a few terminals:
+      // trunks that grew into their neighbours would otherwise send hundreds of thousands of
+      // terminals to be regrown at a million (docs/benchmarks.md).
+      const bool both_large = tooLargeToRegrow(kx, x) && tooLargeToRegrow(ky, y);
+      const bool worth_moving = opt_.organ_scale && std::min(nx, ny) > kMaxClearedTerminals;
+      if ((both_large || worth_moving) && (separate(kt, t, kw, w) || separate(kw, w, kt, t))) {
         ++report_.moved_nodes;
         continue;
       }
