@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Runs every libFuzzer target of build-san/ for SECONDS each (default 20), as many at a time as there
-# are cores (each target is one process on one core), seeded from the shipped
-# examples, profiles, maps and test data. A crash, sanitizer report, internal error (an exception
-# other than a file:line input error), time-out (10 s per case) or allocation over 2 GiB stops it
-# with the case saved in build-san/fuzz-findings/.
+# are cores (each target is one process on one core), seeded from the shipped examples, profiles,
+# maps and test data. A crash, sanitizer report, internal error (an exception other than a
+# file:line input error), time-out (10 s per case) or allocation over 2 GiB stops that target with
+# the case saved in build-san/fuzz-findings/, and the run fails once every target has finished.
 #   bash scripts/fuzz.sh [SECONDS] [TARGET...]      e.g. bash scripts/fuzz.sh 3600 fuzz_profile
 #   FUZZ_RUNS=100000 bash scripts/fuzz.sh 7200       stop each target after 100000 cases (SECONDS caps it)
 #   FUZZ_SEED=0 …                                    a random seed (default 1: CI explores the same cases every run)
