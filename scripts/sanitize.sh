@@ -26,10 +26,10 @@ export UBSAN_OPTIONS="log_path=$logs/ubsan:print_stacktrace=1:halt_on_error=1:ex
 # So is the shipped noise ladder (37 s of scoring 144 masks): the other Benchmark tests run the
 # same code on a smaller ladder. And the README's commands (the longest test under the
 # sanitizers, 137 s): the commands they run are each run under the sanitizers by the Cli,
-# Dataset, Score and Benchmark tests. And the example outputs' hashes (313 s under the sanitizers,
-# the longest of all): byte identity is the release run's to check, and the growth methods,
-# writers, profiles and meshes the examples use run under the sanitizers in the Shipped, Cli,
-# Dataset, Degrade and Mesh tests.
+# Dataset, Score and Benchmark tests. And the example outputs' hashes: their record is of the
+# release compiler, so under clang the test grew every example (313 s, the longest test here) only
+# to skip the comparison; the growth methods, writers, profiles and meshes the examples use run
+# under the sanitizers in the Shipped, Cli, Dataset, Degrade and Mesh tests.
 release_only='^(Mesh\.(TetgenFindsNoSelfIntersectionInAnyFormat|SliverRepairKeepsTopologyVolumeAndSurface|WrittenFilesReadBackClosedByVtkWithTheUnionsVolume|RemeshingMakesTheNetsTrianglesAcuteAndKeepsTheSurface)|Benchmark\.ShippedNoiseLadderDiceFallsForEveryBaseline|Docs\.ReadmeCommandsRun|ExampleOutputs\.EveryFileTheShippedExamplesWriteIsByteIdenticalToTheRecord)$'
 (cd build-san && ctest --output-on-failure -j "$(nproc)" --timeout 900 -E "$release_only")
 if compgen -G "$logs/*" >/dev/null; then
