@@ -82,15 +82,16 @@ fuzz_one() {
   local t=$1 work runs run_limit=()
   work=$(mktemp -d)
   [ -n "${FUZZ_RUNS:-}" ] && run_limit=(-runs="$FUZZ_RUNS")
-  if ! (cd "$work" && "$root/build-san/$t" -max_total_time="$seconds" "${run_limit[@]}" -seed="${FUZZ_SEED:-1}" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
-        -artifact_prefix="$root/$findings/$t-" -print_final_stats=1 "$root/$corpus/$t" >"$work/log" 2>&1); then
-    runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$work/log" | grep -o '[0-9]*$' || echo 0)
+  local ok=1
+  (cd "$work" && "$root/build-san/$t" -max_total_time="$seconds" "${run_limit[@]}" -seed="${FUZZ_SEED:-1}" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
+      -artifact_prefix="$root/$findings/$t-" -print_final_stats=1 "$root/$corpus/$t" >"$work/log" 2>&1) || ok=0
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$work/log" | grep -o '[0-9]*$' || echo 0)
+  if [ "$ok" = 0 ]; then
     { echo "$t: FAILED after $runs cases"; tail -n 40 "$work/log"; } >&2
     rm -rf "$work"
     touch "$marks/$t"
     return 1
   fi
-  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$work/log" | grep -o '[0-9]*$' || echo 0)
   echo "$t: $runs cases in $(grep -o 'Done [0-9]* runs in [0-9]* second' "$work/log" | grep -o 'in [0-9]* second' | grep -o '[0-9]*' || echo "$seconds") s, 0 crashes, 0 sanitizer reports, 0 internal errors, 0 time-outs"
   rm -rf "$work"
 }

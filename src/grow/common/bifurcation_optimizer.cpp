@@ -19,39 +19,7 @@ BifurcationOptimizer::Subtree BifurcationOptimizer::shortened(std::int32_t s, do
   return v;
 }
 
-template <class F>
-void BifurcationOptimizer::forEachAncestor(std::int32_t s, F&& f) const {
-  const auto& t = tree_;
-  std::int32_t below = s;
-  for (std::int32_t node = t.parent[s]; node != 0; below = node, node = t.parent[node]) {
-    const auto other = t.child0[node] == below ? t.child1[node] : t.child0[node];
-    f(Ancestor{node, below, other, t.length[node], kernel_.lengthCost(t.length[node]), t.radius[node], double(t.terminals[other]),
-               t.reduced_resistance[other], t.cost_ratio[other], double(t.terminals[node] + 1)});
-  }
-}
-
-void BifurcationOptimizer::ancestors(std::int32_t s, Ancestors& path) const {
-  path.clear();
-  forEachAncestor(s, [&](const Ancestor& a) { path.push_back(a); });
-}
-
 double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, double l_term, std::vector<PathLevel>* record) const {
-  return costOver(
-      s, l_up, l_down, l_term, [&](auto&& f) { forEachAncestor(s, f); }, record);
-}
-
-double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, double l_term, const Ancestors& path,
-                                  std::vector<PathLevel>* record) const {
-  return costOver(
-      s, l_up, l_down, l_term,
-      [&](auto&& f) {
-        for (const auto& a : path) f(a);
-      },
-      record);
-}
-
-template <class Walk>
-double BifurcationOptimizer::costOver(std::int32_t s, double l_up, double l_down, double l_term, Walk&& walk, std::vector<PathLevel>* record) const {
   const auto& t = tree_;
   const auto& k = kernel_;
   // The old segment s keeps its subtree but now starts at b.
@@ -62,15 +30,17 @@ double BifurcationOptimizer::costOver(std::int32_t s, double l_up, double l_down
   auto sp = k.split(t.terminals[s], R_s, 1.0, R_t, t.radius[s]);
   double R = combinedResistance(l_up, sp, R_s, R_t);
   double V = k.lengthCost(l_up) + k.radiusCost(sp.beta_a) * V_s + k.radiusCost(sp.beta_b) * V_t;
-  double n = t.terminals[s] + 1;
-  if (record) record->push_back({-1, s, -1, sp.beta_a, sp.beta_b, R, V, std::int32_t(n)});
-  walk([&](const Ancestor& a) {
-    sp = k.split(n, R, a.other_terminals, a.other_resistance, a.radius);
-    R = combinedResistance(a.length, sp, R, a.other_resistance);
-    V = a.length_cost + k.radiusCost(sp.beta_a) * V + k.radiusCost(sp.beta_b) * a.other_cost;
-    n = a.terminals_after;
-    if (record) record->push_back({a.node, a.below, a.other, sp.beta_a, sp.beta_b, R, V, std::int32_t(n)});
-  });
+  std::int32_t n = t.terminals[s] + 1;
+  if (record) record->push_back({-1, s, -1, sp.beta_a, sp.beta_b, R, V, n});
+  std::int32_t below = s;
+  for (std::int32_t node = t.parent[s]; node != 0; below = node, node = t.parent[node]) {
+    const auto other = t.child0[node] == below ? t.child1[node] : t.child0[node];
+    sp = k.split(n, R, t.terminals[other], t.reduced_resistance[other], t.radius[node]);
+    R = combinedResistance(t.length[node], sp, R, t.reduced_resistance[other]);
+    V = k.lengthCost(t.length[node]) + k.radiusCost(sp.beta_a) * V + k.radiusCost(sp.beta_b) * t.cost_ratio[other];
+    n = t.terminals[node] + 1;
+    if (record) record->push_back({node, below, other, sp.beta_a, sp.beta_b, R, V, n});
+  }
   const double r_root = rootRadius(params_, n * params_.terminalFlow(), R);
   return k.radiusCost(r_root) * V;
 }
@@ -91,16 +61,9 @@ bool BifurcationOptimizer::admissible(std::int32_t s, const Vec3& b, const Vec3&
 }
 
 std::array<double, 3> BifurcationOptimizer::radiiAt(std::int32_t s, const Vec3& b, const Vec3& term) const {
-  thread_local Ancestors path;
-  ancestors(s, path);
-  return radiiAt(s, b, term, path);
-}
-
-std::array<double, 3> BifurcationOptimizer::radiiAt(std::int32_t s, const Vec3& b, const Vec3& term, const Ancestors& ancestors) const {
-  thread_local std::vector<PathLevel> path;
-  path.clear();
+  std::vector<PathLevel> path;
   const double l_up = std::max(distance(tree_.position[tree_.parent[s]], b), min_length_);
-  cost(s, l_up, std::max(distance(b, tree_.position[s]), min_length_), std::max(distance(b, term), min_length_), ancestors, &path);
+  cost(s, l_up, std::max(distance(b, tree_.position[s]), min_length_), std::max(distance(b, term), min_length_), &path);
   const auto& top = path.back();
   double r = rootRadius(params_, top.terminals * params_.terminalFlow(), top.reduced_resistance);
   for (std::size_t k = path.size() - 1; k >= 1; --k) r *= path[k].beta_child;  // down to the new segment
@@ -108,16 +71,13 @@ std::array<double, 3> BifurcationOptimizer::radiiAt(std::int32_t s, const Vec3& 
 }
 
 bool BifurcationOptimizer::keepsLengthRatio(const Connection& c) const {
-  if (!(length_ratio_ > 0)) return true;
-  thread_local Ancestors path;
-  ancestors(c.segment, path);
-  return admissible(c.segment, c.bifurcation, c.terminal, minimumsAt(c.segment, c.bifurcation, c.terminal, path));
+  return !(length_ratio_ > 0) || admissible(c.segment, c.bifurcation, c.terminal, minimumsAt(c.segment, c.bifurcation, c.terminal));
 }
 
-BifurcationOptimizer::MinLengths BifurcationOptimizer::minimumsAt(std::int32_t s, const Vec3& b, const Vec3& term, const Ancestors& path) const {
+BifurcationOptimizer::MinLengths BifurcationOptimizer::minimumsAt(std::int32_t s, const Vec3& b, const Vec3& term) const {
   MinLengths m{min_length_, min_length_, min_length_};
   if (!(length_ratio_ > 0)) return m;
-  const auto r = radiiAt(s, b, term, path);
+  const auto r = radiiAt(s, b, term);
   for (int j = 0; j < 3; ++j) m[j] = std::max(m[j], length_ratio_ * radius_scale_ * r[j]);
   if (tree_.parent[s] == 0) m[0] = std::max(m[0], length_ratio_ * root_radius_scale_ * r[0]);
   return m;
@@ -145,17 +105,6 @@ BifurcationOptimizer::Level0 BifurcationOptimizer::level0(std::int32_t s, double
 }
 
 BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, const double (&l)[3]) const {
-  return evaluateOver(s, l, [&](auto&& f) { forEachAncestor(s, f); });
-}
-
-BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, const double (&l)[3], const Ancestors& path) const {
-  return evaluateOver(s, l, [&](auto&& f) {
-    for (const auto& a : path) f(a);
-  });
-}
-
-template <class Walk>
-BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluateOver(std::int32_t s, const double (&l)[3], Walk&& walk) const {
   const auto& t = tree_;
   const auto& k = kernel_;
   const double lambda = params_.cost_radius_exponent;
@@ -164,11 +113,13 @@ BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluateOver(std::int32_t
   double n = t.terminals[s] + 1;
   // Tangents: a = ∂R/∂R0, bR = ∂V/∂R0, cV = ∂V/∂V0 (R does not depend on V0).
   double a = 1, bR = 0, cV = 1;
-  walk([&](const Ancestor& anc) {
-    const double R_o = anc.other_resistance, V_o = anc.other_cost;
-    const auto sp = k.split(n, R, anc.other_terminals, R_o, anc.radius);
+  std::int32_t below = s;
+  for (std::int32_t node = t.parent[s]; node != 0; below = node, node = t.parent[node]) {
+    const auto o = t.child0[node] == below ? t.child1[node] : t.child0[node];
+    const double R_o = t.reduced_resistance[o], V_o = t.cost_ratio[o];
+    const auto sp = k.split(n, R, t.terminals[o], R_o, t.radius[node]);
     const double q = sp.beta_b / sp.beta_a;  // r_o / r_c
-    const double u = k.murray(q, anc.radius);
+    const double u = k.murray(q, t.radius[node]);
     const double D = pow4(sp.beta_a) / R + pow4(sp.beta_b) / R_o;
     const double bc = k.radiusCost(sp.beta_a), bo = k.radiusCost(sp.beta_b);
     // Closed forms: ∂β_c/∂R = β_c·u/(4R(1+u)), ∂β_o/∂R = −β_o/(4R(1+u)), ∂R'/∂R = 1/(R·D·(1+u)).
@@ -178,10 +129,10 @@ BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluateOver(std::int32_t
     bR = dV_dR * a + bc * bR;
     cV = bc * cV;
     a = dR_dR * a;
-    R = anc.length + 1.0 / D;
-    V = anc.length_cost + bc * V + bo * V_o;
-    n = anc.terminals_after;
-  });
+    R = t.length[node] + 1.0 / D;
+    V = k.lengthCost(t.length[node]) + bc * V + bo * V_o;
+    n = t.terminals[node] + 1;
+  }
   const double r_root = rootRadius(params_, n * params_.terminalFlow(), R);
   const double rl = k.radiusCost(r_root);
   Evaluation e;
@@ -214,24 +165,21 @@ bool BifurcationOptimizer::optimumAtProximalNode(std::int32_t s, const Vec3& ter
 
 Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int max_iterations, const Vec3* start) const {
   const std::array<Vec3, 3> ends{tree_.position[tree_.parent[s]], tree_.position[s], term};
-  thread_local Ancestors path;
-  ancestors(s, path);
-  MinLengths m = minimumsAt(s, start ? *start : (ends[0] + ends[1]) * 0.5, term, path);
-  Connection c = search(s, term, m, max_iterations, start, path);
+  MinLengths m = minimumsAt(s, start ? *start : (ends[0] + ends[1]) * 0.5, term);
+  Connection c = search(s, term, m, max_iterations, start);
   // The radii, and so the minimums, move a little with the bifurcation: search again with the
   // larger of the two until the result keeps its own minimums (once or twice at most).
   for (int pass = 0; pass < 3 && c.valid && length_ratio_ > 0; ++pass) {
-    const MinLengths at = minimumsAt(s, c.bifurcation, term, path);
+    const MinLengths at = minimumsAt(s, c.bifurcation, term);
     if (admissible(s, c.bifurcation, term, at)) return c;
     for (int j = 0; j < 3; ++j) m[j] = std::max(m[j], at[j] * (1 + 1e-6));
-    c = search(s, term, m, max_iterations, start, path);
+    c = search(s, term, m, max_iterations, start);
   }
-  if (c.valid && length_ratio_ > 0 && !admissible(s, c.bifurcation, term, minimumsAt(s, c.bifurcation, term, path))) c.valid = false;
+  if (c.valid && !keepsLengthRatio(c)) c.valid = false;
   return c;
 }
 
-Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const MinLengths& m, int max_iterations, const Vec3* given,
-                                        const Ancestors& path) const {
+Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const MinLengths& m, int max_iterations, const Vec3* given) const {
   const std::array<Vec3, 3> ends{tree_.position[tree_.parent[s]], tree_.position[s], term};
   Connection best;
   best.segment = s;
@@ -253,7 +201,7 @@ Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const 
     if (!admissible(s, start, term, m)) continue;
     double ls[3];
     lengths(start, ls);
-    const Evaluation es = evaluate(s, ls, path);
+    const Evaluation es = evaluate(s, ls);
     if (have && es.cost >= e.cost) continue;
     have = true;
     b = start;
@@ -300,7 +248,7 @@ Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const 
       next = keepLengths(b + dir * t, ends, m);
       if (!admissible(s, next, term, m)) continue;
       lengths(next, ln);
-      en = evaluate(s, ln, path);
+      en = evaluate(s, ln);
       moved = en.cost < e.cost + 1e-4 * t * slope || (t < 0.2 && en.cost < e.cost);
     }
     if (!moved) break;
@@ -345,8 +293,6 @@ void BifurcationOptimizer::polish(Connection& c) const {
   for (int j = 0; j < 3; ++j) l[j] = std::max(distance(b, ends[j]), min_length_);
   double best_cost = c.cost;
   double step = 0.25 * std::min({l[0], l[1], l[2]});
-  thread_local Ancestors path;
-  ancestors(s, path);
   const double tol = 1e-6 * (distance(ends[0], ends[1]) + distance(ends[1], ends[2]) + 1e-12);
   const double min_step = 1e-3 * min_length_ + tol;
   for (int evals = 0; evals < kPolishEvaluations && step > min_step;) {
@@ -359,7 +305,7 @@ void BifurcationOptimizer::polish(Connection& c) const {
       ++evals;
       double ln[3];
       for (int j = 0; j < 3; ++j) ln[j] = std::max(distance(next, ends[j]), min_length_);
-      const double cn = cost(s, ln[0], ln[1], ln[2], path);
+      const double cn = cost(s, ln[0], ln[1], ln[2]);
       if (cn < best_cost) {
         b = next;
         best_cost = cn;

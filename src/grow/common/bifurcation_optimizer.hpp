@@ -81,20 +81,6 @@ class BifurcationOptimizer {
     double d_length[3];  // ∂C/∂l for parent part, distal part, terminal
   };
   Evaluation evaluate(std::int32_t s, const double (&l)[3]) const;
-  // What the walk to the root reads of each ancestor of s, gathered once: a search evaluates the
-  // same path tens of times, and reading it from one array rather than from the tree's scattered
-  // nodes is most of the cost of a walk.
-  struct Ancestor {
-    std::int32_t node, below, other;
-    double length, length_cost;  // of the ancestor
-    double radius;               // as last solved (banded γ)
-    double other_terminals, other_resistance, other_cost;
-    double terminals_after;  // the ancestor's terminals with the new one
-  };
-  using Ancestors = std::vector<Ancestor>;
-  void ancestors(std::int32_t s, Ancestors& path) const;
-  Evaluation evaluate(std::int32_t s, const double (&l)[3], const Ancestors& path) const;
-  double cost(std::int32_t s, double l_up, double l_down, double l_term, const Ancestors& path, std::vector<PathLevel>* record = nullptr) const;
   // True if the exact optimum on s lies at s's proximal node: there the pull of the other two
   // segments, weighted by ∂C/∂l, is weaker than the parent part's by 1 % (the weighted Fermat
   // condition), one walk to the root.
@@ -126,18 +112,10 @@ class BifurcationOptimizer {
   struct Level0 {
     double R, V;
   };
-  MinLengths minimumsAt(std::int32_t s, const Vec3& b, const Vec3& t, const Ancestors& path) const;
-  std::array<double, 3> radiiAt(std::int32_t s, const Vec3& b, const Vec3& t, const Ancestors& path) const;
-  Connection search(std::int32_t s, const Vec3& t, const MinLengths& m, int max_iterations, const Vec3* start, const Ancestors& path) const;
+  MinLengths minimumsAt(std::int32_t s, const Vec3& b, const Vec3& t) const;
+  Connection search(std::int32_t s, const Vec3& t, const MinLengths& m, int max_iterations, const Vec3* start) const;
   Vec3 keepLengths(Vec3 b, const std::array<Vec3, 3>& ends, const MinLengths& m) const;
   Level0 level0(std::int32_t s, double l_up, double l_down, double l_term) const;
-  // The ancestors of s read from the tree, bottom-up; and the walks over either source.
-  template <class F>
-  void forEachAncestor(std::int32_t s, F&& f) const;
-  template <class Walk>
-  double costOver(std::int32_t s, double l_up, double l_down, double l_term, Walk&& walk, std::vector<PathLevel>* record) const;
-  template <class Walk>
-  Evaluation evaluateOver(std::int32_t s, const double (&l)[3], Walk&& walk) const;
 
   const VascularTree& tree_;
   const PhysicsParameters& params_;
