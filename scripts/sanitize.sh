@@ -12,7 +12,7 @@ export CCACHE_BASEDIR="$root" CCACHE_NOHASHDIR=1
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
-      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
+      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only" \
       -DANGIOSYNTH_SANITIZE=ON -DANGIOSYNTH_FUZZ=ON -DANGIOSYNTH_BENCH=OFF -DANGIOSYNTH_PYTHON=OFF "${launcher[@]}" >/dev/null
 cmake --build build-san -j "$(nproc)"
 logs="$root/build-san/sanitizer-logs"
