@@ -108,7 +108,8 @@ void ZarrArray::writeMetadata() const {
 std::uint64_t ZarrArray::writeChunk(const std::array<std::int64_t, 3>& chunk, const void* data) const {
   const std::size_t bytes = chunkBytes();
   if (isFill(data, bytes, type, fill)) return 0;
-  std::string packed;
+  // Kept per thread: a buffer the size of a chunk, made afresh, takes a page fault per page.
+  thread_local std::string packed;
   if (codec == ZarrCodec::Blosc) {
     packed.resize(bytes + BLOSC_MAX_OVERHEAD);
     // One internal thread: chunks and channels already run in parallel, and the stream does not

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <memory>
+#include <mutex>
 
 #include "core/error.hpp"
 #include "core/memory.hpp"
@@ -425,14 +427,34 @@ ChunkedVolumeSummary rasterizeChunks(const Forest& forest, const fs::path& store
     std::uint64_t stored_bytes = 0;
     bool occupied = false;
   };
+  // The volumes of a chunk, reused by the next chunk: made afresh, each of their pages would take a
+  // page fault per chunk. A pool, not one per thread: a thread waiting in a chunk's inner
+  // parallel loop may start another chunk.
+  struct ChunkBuffers {
+    GroundTruthVolumes gt;
+    TypedImage image;
+  };
+  std::mutex pool_mutex;
+  std::vector<std::unique_ptr<ChunkBuffers>> pool;
   const auto rasterizeOne = [&](std::int64_t id) {
     ChunkResult r;
     const auto segments = near.of(id - first - done);
     if (segments.empty()) return r;
+    std::unique_ptr<ChunkBuffers> buffers;
+    {
+      const std::lock_guard lock(pool_mutex);
+      if (pool.empty()) {
+        buffers = std::make_unique<ChunkBuffers>();
+      } else {
+        buffers = std::move(pool.back());
+        pool.pop_back();
+      }
+    }
     const VoxelWindow w = layout.window(id, g);
-    GroundTruthVolumes gt = rasterizeGroundTruth(tree, g, w, segments, opt.raster);
+    GroundTruthVolumes& gt = buffers->gt;
+    rasterizeGroundTruth(tree, g, w, segments, opt.raster, gt);
     fillClasses(gt, tree, classes, g, w, segments);
-    TypedImage image;
+    TypedImage& image = buffers->image;
     makeTypedImage(image, gt.fraction, opt.background, opt.vessel - opt.background, opt.dtype, "");
     const std::array<const void*, kChannelCount> data{image.view.data,           gt.fraction.data.data(),  gt.radius.data.data(), gt.mask.data.data(),
                                                       gt.centerline.data.data(), gt.instances.data.data(), gt.classes.data.data()};
@@ -456,6 +478,8 @@ ChunkedVolumeSummary rasterizeChunks(const Forest& forest, const fs::path& store
       r.stored_bytes += b;
       r.stored_chunks += b > 0;
     }
+    const std::lock_guard lock(pool_mutex);
+    pool.push_back(std::move(buffers));
     return r;
   };
   // Chunks in batches, one per thread at a time (memory: a batch of chunks); progress is recorded

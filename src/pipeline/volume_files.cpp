@@ -19,7 +19,9 @@ using Json = nlohmann::ordered_json;
 
 template <class T>
 void convert(Volume<T>& out, const Volume<float>& src, double offset, double scale) {
-  out = Volume<T>(src.grid);
+  // Every voxel is written below: storage of the same size is reused as it is.
+  if (out.data.size() != src.data.size()) out.data = VoxelBuffer<T>(src.data.size());
+  out.grid = src.grid;
   constexpr bool integral = std::is_integral_v<T>;
   // Saturating: a value beyond the type (or NaN, as 0) never reaches an undefined conversion.
   const double lo = double(std::numeric_limits<T>::lowest()), hi = double(std::numeric_limits<T>::max());

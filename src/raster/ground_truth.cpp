@@ -57,7 +57,7 @@ struct Crossing {
 void fillClassesIn(GroundTruthVolumes& gt, const VascularTree& t, const std::vector<std::uint8_t>& class_of_segment,
                    const std::vector<std::int32_t>* label_of_segment, const VolumeGrid& g, const VoxelWindow& window,
                    std::span<const std::int32_t> segments) {
-  gt.classes = Volume<std::uint8_t>(gt.instances.grid);
+  gt.classes.reset(gt.instances.grid);
   const std::int64_t n = static_cast<std::int64_t>(gt.instances.data.size());
   tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, n, 1 << 16), [&](const tbb::blocked_range<std::int64_t>& r) {
     for (std::int64_t v = r.begin(); v < r.end(); ++v) {
@@ -202,12 +202,19 @@ GroundTruthVolumes rasterizeGroundTruth(const VascularTree& t, const VolumeGrid&
 GroundTruthVolumes rasterizeGroundTruth(const VascularTree& t, const VolumeGrid& g, const VoxelWindow& window, std::span<const std::int32_t> segments,
                                         const RasterOptions& opt) {
   GroundTruthVolumes gt;
+  rasterizeGroundTruth(t, g, window, segments, opt, gt);
+  return gt;
+}
+
+void rasterizeGroundTruth(const VascularTree& t, const VolumeGrid& g, const VoxelWindow& window, std::span<const std::int32_t> segments,
+                          const RasterOptions& opt, GroundTruthVolumes& gt) {
   const VolumeGrid local = subGrid(g, window);
-  gt.fraction = Volume<float>(local);
-  gt.instances = Volume<std::uint32_t>(local);
-  gt.mask = Volume<std::uint8_t>(local);
-  gt.centerline = Volume<std::uint8_t>(local);
-  gt.radius = Volume<float>(local);
+  gt.fraction.reset(local);
+  gt.instances.reset(local);
+  gt.mask.reset(local);
+  gt.centerline.reset(local);
+  gt.radius.reset(local);
+  if (!gt.classes.data.empty()) gt.classes.reset(local);  // fillClasses fills them
   gt.centerline_connectivity = opt.centerline_connectivity;
   // Bricks are disjoint, so the visitor writes from several threads without conflict; only
   // non-zero voxels are written.
@@ -230,7 +237,6 @@ GroundTruthVolumes rasterizeGroundTruth(const VascularTree& t, const VolumeGrid&
         }
   });
   addCenterlinesIn(t, gt, nullptr, g, window, segments);
-  return gt;
 }
 
 }  // namespace angiosynth

@@ -45,6 +45,10 @@ GroundTruthVolumes rasterizeGroundTruth(const VascularTree& tree, const VolumeGr
 // voxel for voxel the whole grid's values, so a volume can be made chunk by chunk.
 GroundTruthVolumes rasterizeGroundTruth(const VascularTree& tree, const VolumeGrid& grid, const VoxelWindow& window,
                                         std::span<const std::int32_t> segments, const RasterOptions& opt);
+// The same into `gt`, whose volumes are reused when they have the window's size (chunk after
+// chunk); classes, if gt has them, are zeroed for fillClasses.
+void rasterizeGroundTruth(const VascularTree& tree, const VolumeGrid& grid, const VoxelWindow& window, std::span<const std::int32_t> segments,
+                          const RasterOptions& opt, GroundTruthVolumes& gt);
 // fillClasses for such a window: each centreline's course is counted on the whole grid.
 void fillClasses(GroundTruthVolumes& gt, const VascularTree& t, const std::vector<std::uint8_t>& class_of_segment, const VolumeGrid& grid,
                  const VoxelWindow& window, std::span<const std::int32_t> segments);

@@ -113,6 +113,16 @@ struct Volume {
   explicit Volume(const VolumeGrid& g, T fill = T{}) : grid(g), data(static_cast<std::size_t>(g.voxelCount())) {
     if (fill != T{}) std::fill(data.begin(), data.end(), fill);
   }
+  // Zero on grid g, keeping the storage when the voxel count is the same: a volume made afresh for
+  // every chunk of a larger one would take a page fault on each of its pages, every time.
+  void reset(const VolumeGrid& g) {
+    const auto n = static_cast<std::size_t>(g.voxelCount());
+    if (data.size() == n)
+      std::fill(data.begin(), data.end(), T{});
+    else
+      data = VoxelBuffer<T>(n);
+    grid = g;
+  }
   T& at(std::int64_t i, std::int64_t j, std::int64_t k) { return data[grid.flat(i, j, k)]; }
   const T& at(std::int64_t i, std::int64_t j, std::int64_t k) const { return data[grid.flat(i, j, k)]; }
 };
