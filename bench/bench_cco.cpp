@@ -1,6 +1,8 @@
 // CCO growth time and memory for N terminals in the Kerautret et al. (OpenCCO) §5 sphere (or the 2D disc):
-//   bench_cco [N ...] [--disc] [--threads T] [--max-nu M] [--seed S] [--murray-bands] [--organ-scale]
+//   bench_cco [N ...] [--disc] [--threads T] [--max-nu M] [--seed S] [--murray-bands] [--organ-scale] [--parts K]
 // One line per N: seconds, µs per terminal, µs per terminal / log2 N, peak RSS, checks.
+// --parts K: grown by domain decomposition (a trunk of K terminals, K parts in parallel, the
+// join), with the time of each stage and the join's checks.
 // --murray-bands: Murray's exponent 3, 2.73, 7/3 below 0.1 mm, to 1 mm, above; also the passes
 // the radius–exponent fixed point takes from radii of zero on the grown tree.
 #include <tbb/global_control.h>
@@ -15,6 +17,7 @@
 #include <vector>
 
 #include "core/memory.hpp"
+#include "grow/cco/decomposition.hpp"
 #include "grow/cco/grower.hpp"
 #include "physics/hemodynamics.hpp"
 
@@ -24,6 +27,7 @@ int main(int argc, char** argv) {
   std::vector<long> sizes;
   bool disc = false, bands = false, organ = false;
   int threads = 0;
+  int parts = 0;
   int max_nu = 0;  // ν doubles up to this (0: the default)
   long seed = 1;
   for (int i = 1; i < argc; ++i) {
@@ -37,6 +41,8 @@ int main(int argc, char** argv) {
       seed = std::atol(argv[++i]);
     else if (!std::strcmp(argv[i], "--max-nu") && i + 1 < argc)
       max_nu = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--parts") && i + 1 < argc)
+      parts = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc)
       threads = std::atoi(argv[++i]);
     else
@@ -68,9 +74,22 @@ int main(int argc, char** argv) {
     const auto t0 = std::chrono::steady_clock::now();
     const auto since = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
     double growth_s = -1;  // until the tree first holds every terminal; the rest is the final check's repair
-    const auto tree = growCco(dom, o, rep, [&](std::int64_t done, std::int64_t total) {
+    const ProgressFn progress = [&](std::int64_t done, std::int64_t total) {
       if (growth_s < 0 && done >= total) growth_s = since();
-    });
+    };
+    CcoDecompositionSummary parts_sum;
+    VascularTree tree;
+    if (parts > 0) {
+      CcoDecompositionOptions d;
+      d.cco = o;
+      d.parts = parts;
+      tree = growCcoDecomposed(dom, d, parts_sum, progress);
+      rep.intersecting_pairs = parts_sum.intersecting_pairs;
+      rep.short_segments = parts_sum.short_segments;
+      rep.repaired_terminals = parts_sum.repaired_terminals;
+    } else {
+      tree = growCco(dom, o, rep, progress);
+    }
     const double s = since();
     std::printf("%-7s %9ld %9.3f %12.1f %16.2f %10.1f %6lld %6lld %9.1f\n", disc ? "disc" : "sphere", n, s, s / n * 1e6,
                 s / n * 1e6 / std::log2(double(n)), peakRssBytes() / 1048576.0, (long long)rep.intersecting_pairs, (long long)rep.short_segments,
@@ -87,6 +106,11 @@ int main(int argc, char** argv) {
         ratio = std::min(ratio, tree.length[i] / tree.radius[i]);
         if (tree.isTerminal(i)) continue;
         const auto a = tree.child0[i], b = tree.child1[i];
+        if (b < 0) {  // inside a vessel (a part's root on the trunk): one radius and flow
+          murray = std::max(murray, std::abs(tree.radius[a] - tree.radius[i]) / tree.radius[i]);
+          flow = std::max(flow, std::abs(tree.flow[a] - tree.flow[i]) / tree.flow[i]);
+          continue;
+        }
         const double g = law.exponentAt(tree.radius[i]);
         const double lhs = std::pow(tree.radius[i], g);
         murray = std::max(murray, std::abs(lhs - std::pow(tree.radius[a], g) - std::pow(tree.radius[b], g)) / lhs);
@@ -97,6 +121,13 @@ int main(int argc, char** argv) {
       }
       std::printf("        residuals: Murray %.1e, flow %.1e, Poiseuille %.1e; shortest l/r %.3f\n", murray, flow, poiseuille, ratio);
     }
+    if (parts > 0)
+      std::printf(
+          "        %d parts: trunk %.2f s, parts %.1f s (slowest %.1f s), join %.2f s; terminals %lld, outside %lld; part radii x%.3f-%.3f "
+          "of grown, trunk radius <= %.2f of clearance, part pressure share >= %.3f; demand in no part %.4f\n",
+          parts, parts_sum.trunk_seconds, parts_sum.parts_seconds, parts_sum.slowest_part_seconds, parts_sum.join_seconds,
+          (long long)parts_sum.terminals, (long long)parts_sum.outside_segments, parts_sum.smallest_part_scale, parts_sum.largest_part_scale,
+          parts_sum.largest_trunk_radius_share, parts_sum.smallest_part_pressure_share, parts_sum.unreached_share);
     if (bands) {
       auto cold = tree;
       std::fill(cold.radius.begin(), cold.radius.end(), 0.0);

@@ -52,6 +52,13 @@ void solvePasses(VascularTree& t, const PhysicsParameters& p, const PowerKernel&
       t.cost_ratio[i] = k.lengthCost(t.length[i]);
       continue;
     }
+    if (b < 0) {  // a node inside a vessel (trees joined at a terminal): one radius, resistances in series
+      t.beta[a] = 1;
+      t.terminals[i] = t.terminals[a];
+      t.reduced_resistance[i] = t.length[i] + t.reduced_resistance[a];
+      t.cost_ratio[i] = k.lengthCost(t.length[i]) + t.cost_ratio[a];
+      continue;
+    }
     const auto s =
         k.split(t.terminals[a], t.reduced_resistance[a], t.terminals[b], t.reduced_resistance[b], parent_radius ? (*parent_radius)[i] : 0.0);
     t.beta[a] = s.beta_a;

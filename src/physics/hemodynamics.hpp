@@ -129,7 +129,8 @@ inline double combinedResistance(double l, const PowerKernel::Split& s, double R
 double rootRadius(const PhysicsParameters& p, double root_flow, double root_reduced_resistance);
 
 // Recomputes terminal counts, lengths, reduced resistances, β, cost ratios (bottom-up) and then
-// radii, flows and pressures (top-down) of the whole tree from its geometry alone: O(N). With
+// radii, flows and pressures (top-down) of the whole tree from its geometry alone: O(N). A node
+// with one child lies inside a vessel: both segments keep one radius, their resistances in series. With
 // banded γ the two passes repeat, each bifurcation's γ taken from its parent's radius of the pass
 // before, until every γ is the law's at the final radii (to 1e-13): returns the passes made.
 int solveTree(VascularTree& tree, const PhysicsParameters& p);

@@ -289,6 +289,14 @@ class CcoGrower {
     return false;
   }
 
+  // A point drawn in the domain, at least terminal_depth deep.
+  Vec3 drawPoint() {
+    for (;;) {
+      const Vec3 p = dom_.sample(rng_);
+      if (!(opt_.terminal_depth > 0) || dom_.depth(p) >= opt_.terminal_depth) return p;
+    }
+  }
+
   void plantFirst(int k) {
     auto& g = trees_[k];
     const auto& sys = systems_[g.system];
@@ -296,7 +304,7 @@ class CcoGrower {
     const double shrink_new = shrink(sys, systemTerminals(sys) + 1);
     for (std::int64_t draws = 0; draws < opt_.max_draws; ++draws) {
       ++report_.candidates;
-      const Vec3 p = dom_.sample(rng_);
+      const Vec3 p = drawPoint();
       const double l = distance(root, p);
       const double r = rootRadiusFinal(g, 1, l, shrink_new);
       if (!(l > 2 * r) || !dom_.capsuleInside(root, p, r, true) || hitsOtherTree(k, root, p, kRecheckGrowth * r)) {
@@ -744,7 +752,7 @@ class CcoGrower {
         // are no longer checked against other trees; the exact final check and repair see them.
         if (failures == 1) ancestor_blocks_ = 0;
         lenient_ = ancestor_blocks_ > kLenientAfter;
-        const Vec3 p = dom_.sample(rng_);
+        const Vec3 p = drawPoint();
         const double spacing = delta * dom_.spacingScale(p);
         if (std::any_of(sys.trees.begin(), sys.trees.end(), [&](int k) { return tooClose(k, p, spacing); })) {
           ++report_.rejected_too_close;

@@ -60,6 +60,9 @@ struct CcoOptions {
   // 1/256 of itself rather than every 64 terminals, and only the lightest of Kamiya's points are
   // refined; each keeps the cost per terminal from growing with the tree (docs/benchmarks.md).
   bool organ_scale = false;
+  // Terminals are drawn at least this deep in the domain (mm): a decomposition's trunk, whose
+  // terminals continue into the parts.
+  double terminal_depth = 0;
 };
 
 // One tree of a forest.
