@@ -333,6 +333,7 @@ VascularTree joinCcoParts(const GrowthDomain& domain, const CcoTrunk& trunk, con
   sum.largest_part_scale = 0;
   sum.smallest_part_scale = std::numeric_limits<double>::infinity();
   sum.smallest_part_pressure_share = std::numeric_limits<double>::infinity();
+  sum.repaired_terminals = 0;
   const double drop = opt.cco.physics.perfusion_pressure - opt.cco.physics.terminal_pressure;
   for (std::size_t k = 0; k < parts.size(); ++k) {
     const double scale = J.radius[part_root_segment[k]] / parts[k].tree.radius[parts[k].tree.rootSegment()];

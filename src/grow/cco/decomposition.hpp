@@ -88,7 +88,8 @@ CcoPart growCcoPart(const GrowthDomain& domain, const CcoTrunk& trunk, int part,
 // vessels meet others' are listed (summary.offending_parts), to be grown again.
 VascularTree joinCcoParts(const GrowthDomain& domain, const CcoTrunk& trunk, const std::vector<CcoPart>& parts, const CcoDecompositionOptions& opt,
                           CcoDecompositionSummary& summary);
-// All three in one process, the parts in parallel, regrowing offending parts until none is left.
+// All three in one process, the parts in parallel; offending parts are grown again, for up to
+// 4 rounds (what is left then stays in the summary's counts).
 VascularTree growCcoDecomposed(const GrowthDomain& domain, const CcoDecompositionOptions& opt, CcoDecompositionSummary& summary,
                                const ProgressFn& progress = {});
 
