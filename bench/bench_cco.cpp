@@ -83,10 +83,8 @@ int main(int argc, char** argv) {
       CcoDecompositionOptions d;
       d.cco = o;
       d.parts = parts;
-      tree = growCcoDecomposed(dom, d, parts_sum, progress);
-      rep.intersecting_pairs = parts_sum.intersecting_pairs;
-      rep.short_segments = parts_sum.short_segments;
-      rep.repaired_terminals = parts_sum.repaired_terminals;
+      tree = growCcoDecomposed(dom, d, rep, progress);
+      parts_sum = *rep.decomposition;
     } else {
       tree = growCco(dom, o, rep, progress);
     }

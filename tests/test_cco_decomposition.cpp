@@ -58,8 +58,9 @@ TEST(CcoDecomposition, JoinedTreeKeepsEveryInvariantAcrossPartBorders) {
   const double radius = std::cbrt(3 * 1e5 / (4 * std::numbers::pi));
   const auto d = GrowthDomain::analytic(DomainShape::Sphere, radius, radius / 50);
   const auto o = sphereParts(3000, 4, d);
-  CcoDecompositionSummary sum;
-  const auto t = growCcoDecomposed(d, o, sum);
+  GrowthReport report;
+  const auto t = growCcoDecomposed(d, o, report);
+  const CcoDecompositionSummary& sum = *report.decomposition;
   PhysicsParameters p = o.cco.physics;
   p.total_terminals = 3000;
   expectJoinedPhysics(t, p, 3000);
@@ -94,8 +95,8 @@ TEST(CcoDecomposition, SameTreeWhateverTheThreadsAndWhereverThePartsGrow) {
   const auto o = sphereParts(600, 3, d, 4);
   const auto run = [&](int threads) {
     tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
-    CcoDecompositionSummary sum;
-    return growCcoDecomposed(d, o, sum);
+    GrowthReport report;
+    return growCcoDecomposed(d, o, report);
   };
   const auto a = run(1), b = run(2);
   ASSERT_EQ(a.nodeCount(), b.nodeCount());

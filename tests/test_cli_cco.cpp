@@ -118,4 +118,81 @@ TEST_F(CliCco, BadCcoInputNamesTheLineAndWritesNothing) {
               "cco minimises the total volume");
 }
 
+// A tree grown in parts ([tree] parts): array tasks (--part I) and a join (--join) write the very
+// sample one process writes; a rerun task keeps its part; the join refuses missing, foreign and
+// damaged parts and writes nothing then.
+TEST_F(CliCco, PartsGrownAsTasksAndJoinedAreTheTreeGrownInOneProcess) {
+  std::string text = slurp(src_ / "examples/cco_organ_parts_3d.toml");
+  text.replace(text.find("terminals = 1000000"), 19, "terminals = 3000");
+  text.replace(text.find("parts = 8"), 9, "parts = 4");
+  text.replace(text.find("voxel_size = \"0.5 mm\""), 21, "voxel_size = \"1 mm\"");
+  std::ofstream(dir_ / "organ.toml") << text;
+  const auto whole = run("generate organ.toml --out whole --quiet", dir_);
+  ASSERT_EQ(whole.code, 0) << whole.err;
+  for (int k = 0; k < 3; ++k) ASSERT_EQ(run("generate organ.toml --out joined --part " + std::to_string(k), dir_).code, 0);
+  // The join before every task has finished: names the missing part, writes no sample.
+  auto r = run("generate organ.toml --out joined --join", dir_);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("part(s) 3 of 4"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "joined"));
+  ASSERT_EQ(run("generate organ.toml --out joined --part 3", dir_).code, 0);
+  r = run("generate organ.toml --out joined --part 1", dir_);
+  ASSERT_EQ(r.code, 0);
+  EXPECT_NE(r.err.find("kept"), std::string::npos) << r.err;
+  r = run("generate organ.toml --out joined --join --quiet", dir_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  // Every file byte for byte; sample.json but for the command line and the times.
+  int compared = 0;
+  for (const auto& e : fs::directory_iterator(dir_ / "whole")) {
+    const auto name = e.path().filename();
+    if (name == "sample.json") continue;
+    EXPECT_EQ(slurp(e.path()), slurp(dir_ / "joined" / name)) << name;
+    ++compared;
+  }
+  EXPECT_GE(compared, 4);
+  Json a = sample(dir_ / "whole"), b = sample(dir_ / "joined");
+  for (Json* j : {&a, &b}) {
+    j->erase("command_line");
+    j->erase("timing_seconds");
+  }
+  EXPECT_TRUE(a == b) << "sample.json differs beyond its command line and times";
+  const auto& s = b["statistics"];
+  EXPECT_EQ(s["terminals"], 3000);
+  EXPECT_EQ(s["intersecting_pairs"], 0);
+  EXPECT_EQ(s["short_segments"], 0);
+  EXPECT_EQ(s["outside_segments"], 0);
+  EXPECT_EQ(s["decomposition"]["parts"], 4);
+  EXPECT_LE(s["decomposition"]["part_radius_scale"][1].get<double>(), 1.0);
+  EXPECT_LT(s["decomposition"]["trunk_radius_share"].get<double>(), 1.0);
+  // A part of another seed, and a damaged part: refused, nothing written.
+  ASSERT_EQ(run("generate organ.toml --out other --part 0 --seed 2", dir_).code, 0);
+  fs::copy_file(dir_ / "other.parts/part_00000.ccopart", dir_ / "joined.parts/part_00000.ccopart", fs::copy_options::overwrite_existing);
+  r = run("generate organ.toml --out again --join --parts-dir joined.parts", dir_);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("part_00000.ccopart: is part 0 of 4 grown from other parameters, seed or sample"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "again"));
+  std::string bytes = slurp(dir_ / "joined.parts/part_00001.ccopart");
+  bytes[bytes.size() / 2] ^= 1;
+  std::ofstream(dir_ / "joined.parts/part_00001.ccopart", std::ios::binary) << bytes;
+  r = run("generate organ.toml --out again --part 1 --parts-dir joined.parts", dir_);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("part_00001.ccopart: is damaged"), std::string::npos) << r.err;
+  // Bad requests, each refused before any growth.
+  r = run("generate organ.toml --out x --part 4", dir_);
+  EXPECT_NE(r.err.find("--part: 4 is not a part of the 4"), std::string::npos) << r.err;
+  r = run("generate organ.toml --out x --part 0 --join", dir_);
+  EXPECT_NE(r.err.find("--part I (one task) or --join"), std::string::npos) << r.err;
+  std::ofstream(dir_ / "unseeded.toml") << text.substr(text.find("[domain]"));
+  r = run("generate unseeded.toml --out x --part 0", dir_);
+  EXPECT_NE(r.err.find("needs a fixed seed"), std::string::npos) << r.err;
+  std::string one = text;
+  one.replace(one.find("parts = 4"), 9, "parts = 1");
+  std::ofstream(dir_ / "one.toml") << one;
+  r = run("generate one.toml --out x", dir_);
+  EXPECT_NE(r.err.find("parts = 1 is one tree grown the long way"), std::string::npos) << r.err;
+  r = run("generate " + (src_ / "examples/cco_disc_2d.toml").string() + " --out x --part 0 --seed 1", dir_);
+  EXPECT_NE(r.err.find("grows one tree whole"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "x"));
+}
+
 }  // namespace

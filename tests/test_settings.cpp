@@ -217,7 +217,8 @@ TEST_F(Settings, EveryCcoKeyFillsItsFieldAndTheSidecar) {
   };
   check(ccoSettings(), cco);
   check(ccoPhysics(), [&](const Scenario& sc) { return cco(sc).physics; });
-  EXPECT_EQ(checked, 17);
+  check(ccoDecompositionSettings(), [&](const Scenario& sc) { return dynamic_cast<const CcoSetup&>(*sc.growth).decomposition; });
+  EXPECT_EQ(checked, 18);
 }
 
 TEST_F(Settings, TheParameterReferencePrintsEachDeclaration) {

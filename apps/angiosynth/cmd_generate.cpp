@@ -23,6 +23,12 @@ CLI::App* addGenerate(CLI::App& app, GenerateArgs& a) {
                 "two_photon, octa, domain_randomisation), .toml profiles, or VascuSynth noise files; one image_<name> each")
       ->delimiter(',');
   c->add_flag("--no-profiles", a.no_profiles, "write the clean image only, ignoring [degrade] profiles");
+  c->add_option("--part", a.part,
+                "grow only part I of a tree grown in parts ([tree] parts = K) into --parts-dir, as one task of a cluster array (0-based; a "
+                "Slurm array passes $SLURM_ARRAY_TASK_ID); a rerun keeps a finished part")
+      ->check(CLI::Range(0, 4095));
+  c->add_flag("--join", a.join, "join the parts that --part tasks grew in --parts-dir into the sample, instead of growing the tree");
+  c->add_option("--parts-dir", a.parts_dir, "where --part writes its part and --join reads them (default: --out's path with .parts appended)");
   c->add_flag("--force", a.force, "replace an earlier angiosynth output in --out (only the files it wrote there)");
   addCommonOptions(*c, a.common, CommonInputs::WithVascuSynthFiles);
   return c;
@@ -40,9 +46,15 @@ int runGenerate(const GenerateArgs& a, const std::string& command_line) {
   a.output.applyTo(sc);
   const std::filesystem::path out =
       a.out.empty() ? std::filesystem::path("out") / std::filesystem::path(a.params).stem() : std::filesystem::path(a.out);
+  if (a.part >= 0 && a.join) throw InputError("--part", 0, "with --join; allowed: --part I (one task) or --join (after every task)");
+  if (!a.parts_dir.empty() && a.part < 0 && !a.join) throw InputError("--parts-dir", 0, "without --part or --join; allowed: with either");
+  if ((a.part >= 0 || a.join) && !a.seed && !sc.seed)
+    throw InputError(a.params, 0,
+                     std::string(a.join ? "--join" : "--part") +
+                         " needs a fixed seed, so that every task grows the same trunk; allowed: [sample] seed in the file, or --seed");
+  const std::filesystem::path parts_dir = a.parts_dir.empty() ? std::filesystem::path(out.string() + ".parts") : std::filesystem::path(a.parts_dir);
   std::vector<std::filesystem::path> inputs = scenarioInputs(sc);
   for (const auto& p : a.profiles) inputs.push_back(p);
-  StagedDirectory dir(out, a.force ? ExistingOutput::ReplaceOwn : ExistingOutput::Refuse, inputs);
   SampleRequest req;
   req.scenario = &sc;
   req.seed = a.seed ? *a.seed : (sc.seed ? *sc.seed : freshSeed());
@@ -56,6 +68,16 @@ int runGenerate(const GenerateArgs& a, const std::string& command_line) {
     req.profiles.emplace();
     for (const auto& p : a.profiles) req.profiles->push_back(loadProfile(p, "--profile", 0));
   }
+  if (a.part >= 0) {
+    req.progress = {};
+    const PartTaskSummary done = growSamplePart(req, a.part, parts_dir);
+    if (!a.common.quiet)
+      std::cerr << (done.resumed ? "kept " : "wrote ") << done.file.string() << ": part " << a.part << ", " << done.terminals << " terminals, "
+                << show(done.seconds) << " s growth" << (done.resumed ? " (grown earlier from the same parameters and seed)" : "") << "\n";
+    return 0;
+  }
+  if (a.join) req.parts_dir = parts_dir;
+  StagedDirectory dir(out, a.force ? ExistingOutput::ReplaceOwn : ExistingOutput::Refuse, inputs);
   const SampleSummary made = generateSample(req, dir.path());
   dir.commit();
   if (!a.common.quiet)

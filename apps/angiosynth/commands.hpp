@@ -25,6 +25,10 @@ struct GenerateArgs {
   bool force = false;
   std::vector<std::string> profiles;
   bool no_profiles = false;
+  // A tree grown in parts ([tree] parts): one part as a task, or the join of all of them.
+  int part = -1;
+  bool join = false;
+  std::string parts_dir;
   CommonOptions common;
 };
 CLI::App* addGenerate(CLI::App& app, GenerateArgs& a);

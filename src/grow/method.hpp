@@ -30,6 +30,14 @@ struct MethodParam {
   const char* meaning;
 };
 
+// What one task of a growth in parts did (PreparedGrowth::growPart).
+struct PartTaskSummary {
+  std::filesystem::path file;  // the part's file
+  bool resumed = false;        // it was there already, from the same parameters and seed: kept
+  std::int64_t terminals = 0;
+  double seconds = 0;  // its growth (when resumed: as recorded)
+};
+
 // A method's domain read and checked, ready to grow (possibly several samples from it).
 class PreparedGrowth {
  public:
@@ -42,6 +50,16 @@ class PreparedGrowth {
   virtual const GrowthDomain* domain() const { return nullptr; }
   // Grows the forest for (seed, sample); throws GrowthError when the domain cannot be filled.
   virtual Forest grow(std::uint64_t seed, std::uint64_t sample, GrowthReport& report, const ProgressFn& progress) const = 0;
+  // Growth in parts that separate processes grow (a cluster array's tasks) and one joins: how
+  // many parts the parameters ask for, 0 when the method grows whole.
+  virtual int parts() const { return 0; }
+  // Grows part `index` of (seed, sample) into its file in `dir`, whole or not at all, unless the
+  // file of the same parameters, seed and sample is there (a rerun task resumes).
+  virtual PartTaskSummary growPart(std::uint64_t seed, std::uint64_t sample, int index, const std::filesystem::path& dir) const;
+  // The forest joined from every part's file in `dir`: the one grow() makes for (seed, sample).
+  // InputError naming the parts whose files are missing.
+  virtual Forest joinParts(std::uint64_t seed, std::uint64_t sample, const std::filesystem::path& dir, GrowthReport& report,
+                           const ProgressFn& progress) const;
   // Figures only this method reports, added to sample.json's statistics.
   virtual void addStatistics(const GrowthReport&, nlohmann::ordered_json&) const {}
 };

@@ -1,6 +1,7 @@
 // The growth methods by name, and their reference generated from their declarations so that
 // `angiosynth methods` and the docs cannot drift from the readers.
 #include <sstream>
+#include <stdexcept>
 
 #include "grow/cco/setup.hpp"
 #include "grow/colonisation/setup.hpp"
@@ -10,6 +11,14 @@
 #include "grow/vascusynth/setup.hpp"
 
 namespace angiosynth {
+
+// Methods that grow whole: callers ask parts() first.
+PartTaskSummary PreparedGrowth::growPart(std::uint64_t, std::uint64_t, int, const std::filesystem::path&) const {
+  throw std::logic_error("growPart on a method that grows whole");
+}
+Forest PreparedGrowth::joinParts(std::uint64_t, std::uint64_t, const std::filesystem::path&, GrowthReport&, const ProgressFn&) const {
+  throw std::logic_error("joinParts on a method that grows whole");
+}
 
 const std::vector<const GrowthMethod*>& growthMethods() {
   static const std::vector<const GrowthMethod*> all{&kVascuSynthMethod, &kCcoMethod, &kDccoMethod, &kColonisationMethod, &kLsystemMethod};

@@ -107,6 +107,10 @@ void checkSampleInputs(const Scenario& sc, std::uint64_t memory_limit) {
 
 namespace {
 
+std::string partsNeeded(const std::string& what) {
+  return "grows one tree whole; allowed: " + what + " of a tree grown in parts ([tree] parts = K with method \"cco\")";
+}
+
 // Growth, class labels and curves: the forest every later stage writes.
 Forest growForest(const PreparedSample& ps, const SampleRequest& req, GrowthReport& report, CurveReport& curves, Json& timing) {
   const Scenario& sc = *req.scenario;
@@ -119,7 +123,12 @@ Forest growForest(const PreparedSample& ps, const SampleRequest& req, GrowthRepo
         if (req.cancelled()) throw Cancelled();
         if (req.progress) req.progress(done, total);
       };
-    forest = ps.growth->grow(req.seed, req.sample, report, progress);
+    if (req.parts_dir) {
+      if (ps.growth->parts() == 0) throw InputError(sc.parameter_file, 0, partsNeeded("a join"));
+      forest = ps.growth->joinParts(req.seed, req.sample, *req.parts_dir, report, progress);
+    } else {
+      forest = ps.growth->grow(req.seed, req.sample, report, progress);
+    }
     if (!req.class_kinds.empty()) assignClassLabels(forest.trees, req.class_kinds);
     // A sample without a vessel has no truth to label: a method whose parameters leave nothing to
     // grow (a step that leaves the domain, drains that all die) says so instead of writing one.
@@ -299,6 +308,20 @@ Json classLegend(const Forest& forest) {
 std::filesystem::path SampleSummary::file(const std::string& role) const { return sidecar.at("files").at(role).get<std::string>(); }
 
 bool SampleSummary::wrote(const std::string& role) const { return sidecar.at("files").contains(role); }
+
+PartTaskSummary growSamplePart(const SampleRequest& req, int index, const std::filesystem::path& dir) {
+  const Scenario& sc = *req.scenario;
+  const PreparedSample ps = prepareSample(req);
+  const int parts = ps.growth->parts();
+  if (parts == 0) throw InputError(sc.parameter_file, 0, partsNeeded("a task"));
+  if (index < 0 || index >= parts)
+    throw InputError("--part", 0,
+                     std::to_string(index) + " is not a part of the " + std::to_string(parts) + "; allowed: 0 <= I < " + std::to_string(parts));
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError(dir.string(), 0, "cannot be created (" + ec.message() + "); allowed: a directory this user may write");
+  return ps.growth->growPart(req.seed, req.sample, index, dir);
+}
 
 SampleSummary generateSample(const SampleRequest& req, const std::filesystem::path& dir) {
   const Scenario& sc = *req.scenario;

@@ -13,6 +13,7 @@
 
 #include "degrade/profile.hpp"
 #include "grow/common/growth_report.hpp"
+#include "grow/method.hpp"
 #include "config/scenario.hpp"
 #include "pipeline/vascusynth_layout.hpp"
 #include "pipeline/volume_outputs.hpp"
@@ -39,6 +40,8 @@ struct SampleRequest {
   // with write_files false nothing written (the sidecar is made all the same).
   SampleCapture* capture = nullptr;
   bool write_files = true;
+  // Join the parts grown into this directory (growSamplePart) instead of growing the tree.
+  std::optional<std::filesystem::path> parts_dir;
   // Polled at growth's progress points and between stages: true stops the sample with Cancelled.
   std::function<bool()> cancelled;
 };
@@ -65,6 +68,11 @@ struct SampleSummary {
 
 // Writes the sample's files and its sample.json into `dir`.
 SampleSummary generateSample(const SampleRequest& request, const std::filesystem::path& dir);
+
+// One task of a tree grown in parts ([tree] parts): grows part `index` of the request's sample
+// into its file in `dir` (created if missing), or keeps the file a finished earlier run left.
+// A later generateSample with parts_dir = dir joins them into the sample.
+PartTaskSummary growSamplePart(const SampleRequest& request, int index, const std::filesystem::path& dir);
 
 // Reads and checks everything a sample needs before growth (maps, masks, profiles, volume sizes,
 // feasibility of the growth), writing nothing: so a batch can refuse a bad input before its first

@@ -107,7 +107,7 @@ bool growTrunk(const GrowthDomain& domain, const CcoDecompositionOptions& opt, c
 }  // namespace
 
 CcoTrunk planCcoTrunk(const GrowthDomain& domain, const CcoDecompositionOptions& opt) {
-  if (opt.parts < 1) throw GrowthError("a decomposition needs at least 1 part");
+  if (opt.parts < 2) throw GrowthError("a decomposition needs at least 2 parts");
   if (opt.cco.terminals < opt.parts) throw GrowthError("fewer terminals than parts: each part grows at least one");
   CcoTrunk trunk;
   CcoOptions o = opt.cco;
@@ -327,6 +327,7 @@ VascularTree joinCcoParts(const GrowthDomain& domain, const CcoTrunk& trunk, con
   PhysicsParameters physics = opt.cco.physics;
   physics.total_terminals = opt.cco.terminals;
   solveTree(J, physics);
+  sum.parts = int(parts.size());
   sum.terminals = J.totalTerminals();
   sum.unreached_share = trunk.unreached_share;
   // What the parts' own checks assumed, against the whole tree.
@@ -365,8 +366,53 @@ VascularTree joinCcoParts(const GrowthDomain& domain, const CcoTrunk& trunk, con
   return J;
 }
 
-VascularTree growCcoDecomposed(const GrowthDomain& domain, const CcoDecompositionOptions& opt, CcoDecompositionSummary& sum,
-                               const ProgressFn& progress) {
+VascularTree joinCcoPartsRegrowing(const GrowthDomain& domain, const CcoTrunk& trunk, std::vector<CcoPart>& parts, const CcoDecompositionOptions& opt,
+                                   CcoDecompositionSummary& sum) {
+  // A part whose vessels meet another part's or the trunk's (near where it joins the trunk: rare)
+  // is grown again from its next seed.
+  for (int round = 1;; ++round) {
+    VascularTree joined = joinCcoParts(domain, trunk, parts, opt, sum);
+    if (sum.offending_parts.empty() || round > kMaxRegrowRounds) return joined;
+    const auto t1 = std::chrono::steady_clock::now();
+    const auto again = sum.offending_parts;
+    tbb::parallel_for(std::size_t(0), again.size(), [&](std::size_t i) {
+      const int k = again[i];
+      parts[std::size_t(k)] = growCcoPart(domain, trunk, k, opt, parts[std::size_t(k)].attempt + 1);
+    });
+    sum.regrown_parts += std::int64_t(again.size());
+    sum.parts_seconds += secondsSince(t1);
+  }
+}
+
+GrowthReport decomposedReport(const std::vector<CcoPart>& parts, const CcoDecompositionSummary& sum, const VascularTree& joined) {
+  GrowthReport r;
+  for (const auto& p : parts) {
+    const GrowthReport& q = p.report;
+    r.candidates += q.candidates;
+    r.rejected_too_close += q.rejected_too_close;
+    r.rejected_unreachable += q.rejected_unreachable;
+    r.rejected_intersection += q.rejected_intersection;
+    r.retracted_terminals += q.retracted_terminals;
+    r.moved_nodes += q.moved_nodes;
+    r.repaired_terminals += q.repaired_terminals;
+    r.repair_rounds = std::max(r.repair_rounds, q.repair_rounds);
+    r.threshold_relaxations += q.threshold_relaxations;
+    r.neighbour_doublings += q.neighbour_doublings;
+    r.kamiya_failures += q.kamiya_failures;
+    r.hidden_segments += q.hidden_segments;
+    r.crowded_segments += q.crowded_segments;
+    r.node_optima += q.node_optima;
+  }
+  r.intersecting_pairs = sum.intersecting_pairs;
+  r.short_segments = sum.short_segments;
+  r.outside_segments = sum.outside_segments;
+  r.root_radius_mm = joined.nodeCount() > 1 ? joined.radius[joined.rootSegment()] : 0;
+  r.decomposition = sum;
+  return r;
+}
+
+VascularTree growCcoDecomposed(const GrowthDomain& domain, const CcoDecompositionOptions& opt, GrowthReport& report, const ProgressFn& progress) {
+  CcoDecompositionSummary sum;
   auto t0 = std::chrono::steady_clock::now();
   const CcoTrunk trunk = planCcoTrunk(domain, opt);
   sum.trunk_seconds = secondsSince(t0);
@@ -384,20 +430,9 @@ VascularTree growCcoDecomposed(const GrowthDomain& domain, const CcoDecompositio
   sum.parts_seconds = secondsSince(t0);
   sum.slowest_part_seconds = 0;
   for (const auto& p : parts) sum.slowest_part_seconds = std::max(sum.slowest_part_seconds, p.seconds);
-  // A part whose vessels meet another part's or the trunk's (near where it joins the trunk: rare)
-  // is grown again from its next seed.
-  for (int round = 1;; ++round) {
-    VascularTree joined = joinCcoParts(domain, trunk, parts, opt, sum);
-    if (sum.offending_parts.empty() || round > kMaxRegrowRounds) return joined;
-    const auto t1 = std::chrono::steady_clock::now();
-    const auto again = sum.offending_parts;
-    tbb::parallel_for(std::size_t(0), again.size(), [&](std::size_t i) {
-      const int k = again[i];
-      parts[std::size_t(k)] = growCcoPart(domain, trunk, k, opt, parts[std::size_t(k)].attempt + 1);
-    });
-    sum.regrown_parts += std::int64_t(again.size());
-    sum.parts_seconds += secondsSince(t1);
-  }
+  VascularTree joined = joinCcoPartsRegrowing(domain, trunk, parts, opt, sum);
+  report = decomposedReport(parts, sum, joined);
+  return joined;
 }
 
 }  // namespace angiosynth

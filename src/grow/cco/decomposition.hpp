@@ -24,7 +24,7 @@ namespace angiosynth {
 
 struct CcoDecompositionOptions {
   CcoOptions cco;  // the whole tree: N terminals, its root, physics and seed
-  int parts = 8;   // K, the trunk's terminals
+  int parts = 0;   // K, the trunk's terminals (at least 2)
   // The trunk is grown with radii this many times those it would have alone (a pressure drop
   // factor⁴ times smaller): a bound on its radii in the whole tree, larger as the whole tree's
   // resistance is (checked by the join: largest_trunk_radius_share). Parts keep out of those
@@ -58,24 +58,7 @@ struct CcoPart {
   int attempt = 0;  // of its seed
 };
 
-struct CcoDecompositionSummary {
-  double trunk_seconds = 0, parts_seconds = 0, join_seconds = 0;
-  double slowest_part_seconds = 0;
-  std::int64_t terminals = 0;
-  std::int64_t intersecting_pairs = 0;  // every vessel against every other, exact (target 0)
-  std::int64_t short_segments = 0;      // l <= 2r (target 0)
-  std::int64_t outside_segments = 0;    // capsules leaving the domain (target 0)
-  // Each part's radii in the whole tree over those it was grown with (<= 1: its checks hold).
-  double largest_part_scale = 0, smallest_part_scale = 0;
-  // The trunk's final radii over the clearance the parts kept (< 1: the parts kept clear).
-  double largest_trunk_radius_share = 0;
-  // Pressure drop across each part in the whole tree, as a share of the root-to-terminal drop.
-  double smallest_part_pressure_share = 0;
-  std::int64_t repaired_terminals = 0;  // summed over the parts' own final checks
-  double unreached_share = 0;           // of the demand, in no part (CcoTrunk)
-  std::vector<int> offending_parts;     // parts with a vessel in an intersecting pair (to grow again)
-  std::int64_t regrown_parts = 0;
-};
+using CcoDecompositionSummary = DecompositionReport;
 
 // Stage 1: grows the trunk and splits the N terminals among the parts; throws GrowthError.
 CcoTrunk planCcoTrunk(const GrowthDomain& domain, const CcoDecompositionOptions& opt);
@@ -88,9 +71,15 @@ CcoPart growCcoPart(const GrowthDomain& domain, const CcoTrunk& trunk, int part,
 // vessels meet others' are listed (summary.offending_parts), to be grown again.
 VascularTree joinCcoParts(const GrowthDomain& domain, const CcoTrunk& trunk, const std::vector<CcoPart>& parts, const CcoDecompositionOptions& opt,
                           CcoDecompositionSummary& summary);
+// Stage 3 with the repair: the parts whose vessels meet others' are grown again from their next
+// seeds (in `parts`), for up to 4 rounds (what is left then stays in the summary's counts).
+VascularTree joinCcoPartsRegrowing(const GrowthDomain& domain, const CcoTrunk& trunk, std::vector<CcoPart>& parts, const CcoDecompositionOptions& opt,
+                                   CcoDecompositionSummary& summary);
+// The growth report of the joined tree: the parts' counts summed, the whole tree's checks and the summary.
+GrowthReport decomposedReport(const std::vector<CcoPart>& parts, const CcoDecompositionSummary& summary, const VascularTree& joined);
 // All three in one process, the parts in parallel; offending parts are grown again, for up to
 // 4 rounds (what is left then stays in the summary's counts).
-VascularTree growCcoDecomposed(const GrowthDomain& domain, const CcoDecompositionOptions& opt, CcoDecompositionSummary& summary,
-                               const ProgressFn& progress = {});
+// The report is decomposedReport's.
+VascularTree growCcoDecomposed(const GrowthDomain& domain, const CcoDecompositionOptions& opt, GrowthReport& report, const ProgressFn& progress = {});
 
 }  // namespace angiosynth

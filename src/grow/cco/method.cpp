@@ -1,10 +1,12 @@
 // Method "cco": its parameters, TOML reader, description, domain and grow function.
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <set>
 
 #include "core/error.hpp"
 #include "core/quantity_json.hpp"
+#include "grow/cco/part_file.hpp"
 #include "grow/cco/setup.hpp"
 #include "grow/common/feasibility.hpp"
 #include "grow/common/method_tables.hpp"
@@ -57,6 +59,24 @@ const std::vector<Setting<CcoOptions>>& ccoSettings() {
 }
 // clang-format on
 
+// [tree]'s settings of a tree grown in parts.
+// clang-format off
+const std::vector<Setting<CcoDecompositionOptions>>& ccoDecompositionSettings() {
+  using O = CcoDecompositionOptions;
+  static const std::vector<Setting<O>> settings{
+      {.table = "tree", .key = "parts", .unit = "count", .fallback = "0",
+       .meaning = "K >= 2: the tree is grown in K parts by domain decomposition (after Cury et al. 2021): a trunk of K terminals, then each "
+                  "part in its terminal's territory with its share of the terminals and flow (in parallel, or as separate tasks with "
+                  "`generate --part`), then joined, solved and checked whole; for 10^6 terminals and more (about 25 % more volume than one "
+                  "tree, docs/benchmarks.md). 0: one tree. A single inlet only",
+       .field = &O::parts, .range = {0, 4096},
+       .problem = [](double v) { return v == 1 ? std::string("parts = 1 is one tree grown the long way; allowed: 0 (one tree) or 2 to 4096") : std::string(); },
+       .fallback_is_value = true},
+  };
+  return settings;
+}
+// clang-format on
+
 // clang-format off
 const std::vector<SettingRule<CcoOptions>>& ccoRules() {
   static const std::vector<SettingRule<CcoOptions>> rules{
@@ -99,6 +119,30 @@ std::vector<std::string> kindsOf(const std::vector<CcoInletSpec>& inlets) {
 
 class PreparedCco final : public PreparedGrowth {
  public:
+  // The trees in inlet order as the forest, named and labelled by their inlets.
+  Forest forestOf(std::vector<VascularTree> trees) const {
+    Forest f;
+    for (std::size_t k = 0; k < trees.size(); ++k) {
+      f.vessels.appendTree(trees[k], int(k));
+      f.trees.push_back(TreeInfo{setup_.inlets[k].id, setup_.inlets[k].kind, 0});
+    }
+    assignClassLabels(f.trees);
+    return f;
+  }
+  // The decomposition of the (single) tree of (seed, sample).
+  CcoDecompositionOptions decomposition(std::uint64_t seed, std::uint64_t sample) const {
+    CcoDecompositionOptions d = setup_.decomposition;
+    d.cco = setup_.cco;
+    d.cco.seed = seed;
+    d.cco.sample = sample;
+    d.cco.root_mm = inlets_.front().root_mm;
+    return d;
+  }
+  // Of what a part depends on: the resolved parameters, seed and sample.
+  std::uint64_t fingerprint(std::uint64_t seed, std::uint64_t sample) const {
+    const std::string text = setup_.describe().dump() + "|" + std::to_string(seed) + "|" + std::to_string(sample);
+    return hashName(text.data(), text.size());
+  }
   // The inlets' roots are placed (and checked inside the domain) once, for every sample.
   PreparedCco(const CcoSetup& s, GrowthDomain d) : setup_(s), domain_(std::move(d)) {
     const auto kinds = kindsOf(s.inlets);
@@ -118,6 +162,10 @@ class PreparedCco final : public PreparedGrowth {
     std::int64_t inside = 0;  // voxels of the domain
     for (float v : domain_.frame().demand) inside += v > 0;
     const auto& c = setup_.cco;
+    if (setup_.decomposition.parts > c.terminals)
+      throw InputError(setup_.parameter_file, setup_.terminals_line,
+                       std::to_string(c.terminals) + " terminals in " + std::to_string(setup_.decomposition.parts) +
+                           " parts; allowed: at least one terminal per part (more terminals or fewer parts)");
     const std::int64_t total = c.terminals * std::int64_t(systems_);
     // A terminal per voxel of the domain at most: finer than its resolution the mask says nothing.
     if (total > inside)
@@ -150,16 +198,77 @@ class PreparedCco final : public PreparedGrowth {
     CcoOptions co = setup_.cco;
     co.seed = seed;
     co.sample = sample;
-    auto trees = growCcoForest(domain_, co, inlets_, report, progress);
-    Forest f;
-    for (std::size_t k = 0; k < trees.size(); ++k) {
-      f.vessels.appendTree(trees[k], int(k));
-      f.trees.push_back(TreeInfo{setup_.inlets[k].id, setup_.inlets[k].kind, 0});
+    if (parts() > 0) {
+      const auto d = decomposition(seed, sample);
+      VascularTree t = growCcoDecomposed(domain_, d, report, progress);
+      return forestOf({std::move(t)});
     }
-    assignClassLabels(f.trees);
-    return f;
+    return forestOf(growCcoForest(domain_, co, inlets_, report, progress));
+  }
+  int parts() const override { return setup_.decomposition.parts; }
+  PartTaskSummary growPart(std::uint64_t seed, std::uint64_t sample, int index, const std::filesystem::path& dir) const override {
+    const auto d = decomposition(seed, sample);
+    const CcoPartKey key{fingerprint(seed, sample), index, d.parts};
+    PartTaskSummary out;
+    out.file = ccoPartFile(dir, index);
+    if (const auto kept = readCcoPartFile(out.file, key)) {
+      out.resumed = true;
+      for (std::int32_t i = 1; i < kept->tree.nodeCount(); ++i) out.terminals += kept->tree.isTerminal(i);
+      out.seconds = kept->seconds;
+      return out;
+    }
+    const CcoTrunk trunk = planCcoTrunk(domain_, d);
+    const CcoPart part = growCcoPart(domain_, trunk, index, d);
+    writeCcoPartFile(out.file, part, key);
+    out.terminals = part.tree.terminalCount();
+    out.seconds = part.seconds;
+    return out;
+  }
+  Forest joinParts(std::uint64_t seed, std::uint64_t sample, const std::filesystem::path& dir, GrowthReport& report,
+                   const ProgressFn& progress) const override {
+    const auto d = decomposition(seed, sample);
+    const auto t0 = std::chrono::steady_clock::now();
+    const CcoTrunk trunk = planCcoTrunk(domain_, d);
+    CcoDecompositionSummary sum;
+    sum.trunk_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::vector<CcoPart> parts;
+    std::vector<int> missing;
+    for (int k = 0; k < d.parts; ++k) {
+      auto p = readCcoPartFile(ccoPartFile(dir, k), CcoPartKey{fingerprint(seed, sample), k, d.parts});
+      if (!p) {
+        missing.push_back(k);
+        continue;
+      }
+      sum.slowest_part_seconds = std::max(sum.slowest_part_seconds, p->seconds);
+      sum.parts_seconds += p->seconds;
+      parts.push_back(std::move(*p));
+      if (progress) progress(k + 1, d.parts);
+    }
+    if (!missing.empty()) {
+      std::string list;
+      for (std::size_t i = 0; i < missing.size() && i < 20; ++i) list += (i ? ", " : "") + std::to_string(missing[i]);
+      if (missing.size() > 20) list += ", …";
+      throw InputError(dir.string(), 0,
+                       "holds no file of part(s) " + list + " of " + std::to_string(d.parts) +
+                           "; allowed: the join once every `generate --part I` task has finished (rerun those tasks)");
+    }
+    VascularTree t = joinCcoPartsRegrowing(domain_, trunk, parts, d, sum);
+    report = decomposedReport(parts, sum, t);
+    return forestOf({std::move(t)});
   }
   void addStatistics(const GrowthReport& report, Json& stats) const override {
+    if (const auto& d = report.decomposition) {
+      stats["decomposition"] =
+          Json{{"parts", d->parts},
+               {"regrown_parts", d->regrown_parts},
+               {"part_radius_scale", {d->smallest_part_scale, d->largest_part_scale}},
+               {"part_radius_scale_definition", "each part's radii in the whole tree over those it was grown with (at most 1: its own checks hold)"},
+               {"trunk_radius_share", d->largest_trunk_radius_share},
+               {"trunk_radius_share_definition", "largest trunk radius over the clearance the parts kept from it (below 1)"},
+               {"part_pressure_share", d->smallest_part_pressure_share},
+               {"part_pressure_share_definition", "smallest pressure drop across a part, as a share of the root-to-terminal drop"},
+               {"unreached_demand_share", d->unreached_share}};
+    }
     stats["threshold_relaxations"] = report.threshold_relaxations;
     stats["neighbour_doublings"] = report.neighbour_doublings;
     stats["kamiya_failures"] = report.kamiya_failures;
@@ -333,6 +442,9 @@ std::shared_ptr<const GrowthSetup> readCcoToml(const TomlReader& r, const Growth
   c.physics = readPhysics(r, ccoPhysics(), methodTable(r, m, "physics"));
   c.physics.total_terminals = c.terminals;
   readInlets(r, m, tree, *s);
+  readSettingsFrom(r, tree, "tree", ccoDecompositionSettings(), s->decomposition, s->domain.voxel_mm);
+  if (s->decomposition.parts > 0 && s->inlet_tables)
+    throw InputError(file, r.lineOf(tree.get("parts")), "parts with [[tree.inlet]] tables; allowed: parts for a single tree ([tree] holds its root)");
   return s;
 }
 
@@ -367,6 +479,7 @@ Json CcoSetup::describe() const {
   if (!inlet_tables) describeRoot(inlets.front().root, j);
   if (d.voxel_mm > 0) j["voxel_size"] = quantityJson(d.voxel_mm, "mm");
   j.update(settingsJson(ccoSettings(), c));
+  j.update(settingsJson(ccoDecompositionSettings(), decomposition));
   describePhysics(ccoPhysics(), c.physics, c.terminals, j);
   if (inlet_tables) {
     j["terminals_per"] = "kind: each kind of inlet perfuses (or drains) the whole domain with this many terminals";
@@ -399,7 +512,7 @@ const GrowthMethod kCcoMethod{
     "domain grows with the tree, each terminal joins the one of its nearest segments whose Kamiya bifurcation gives the "
     "least total volume, no vessel leaves the domain or overlaps another",
     withDomainParams("sphere, cube, disc or square (2D), or mask",
-                     "masks: terminals drawn uniformly, or ∝ the mask value (demand)", joinRows({settingRows(ccoSettings()), {
+                     "masks: terminals drawn uniformly, or ∝ the mask value (demand)", joinRows({settingRows(ccoSettings()), settingRows(ccoDecompositionSettings()), {
         {"tree.inlet", "id", "text", "its kind (kind_1, kind_2, ... when several)", "the tree's name in graphs and sample.json"},
         {"tree.inlet", "kind", "text", "artery", "artery, vein or a free name; inlets of one kind compete for its `terminals`, each kind fills the domain"},
         {"tree.inlet", "root_offset", "[x, y(, z)] mm", nullptr, "analytic shapes: the root relative to the centre"},

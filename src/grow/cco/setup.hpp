@@ -6,6 +6,7 @@
 
 #include "domain/growth_domain.hpp"
 #include "grow/common/domain_spec.hpp"
+#include "grow/cco/decomposition.hpp"
 #include "grow/cco/grower.hpp"
 #include "grow/method.hpp"
 #include "settings/schema.hpp"
@@ -26,9 +27,10 @@ struct CcoInletSpec {
 struct CcoSetup final : GrowthSetup {
   std::string parameter_file;
   DomainSpec domain;
-  CcoOptions cco;                    // everything but the roots, seed and sample
-  std::vector<CcoInletSpec> inlets;  // one per tree
-  bool inlet_tables = false;         // the trees come from [[tree.inlet]] (else [tree] holds the one root)
+  CcoOptions cco;                         // everything but the roots, seed and sample
+  CcoDecompositionOptions decomposition;  // [tree] parts (its `cco` is filled at growth)
+  std::vector<CcoInletSpec> inlets;       // one per tree
+  bool inlet_tables = false;              // the trees come from [[tree.inlet]] (else [tree] holds the one root)
   int terminals_line = 0;
 
   const char* method() const override { return "cco"; }
@@ -45,5 +47,6 @@ extern const GrowthMethod kCcoMethod;
 // Its [tree] and [physics] settings (the inlets' tables are read beside them).
 const std::vector<Setting<CcoOptions>>& ccoSettings();
 const std::vector<Setting<PhysicsParameters>>& ccoPhysics();
+const std::vector<Setting<CcoDecompositionOptions>>& ccoDecompositionSettings();
 
 }  // namespace angiosynth

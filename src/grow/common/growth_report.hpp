@@ -3,11 +3,34 @@
 // final checks (targets 0), progress callbacks and the error for a domain that cannot be filled.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace angiosynth {
+
+// A tree grown in parts by domain decomposition (grow/cco/decomposition.hpp): how the stages went
+// and the margins the construction relies on, as measured on the joined tree.
+struct DecompositionReport {
+  int parts = 0;
+  double trunk_seconds = 0, parts_seconds = 0, join_seconds = 0;
+  double slowest_part_seconds = 0;
+  std::int64_t terminals = 0;
+  std::int64_t intersecting_pairs = 0;  // every vessel against every other, exact (target 0)
+  std::int64_t short_segments = 0;      // l <= 2r (target 0)
+  std::int64_t outside_segments = 0;    // capsules leaving the domain (target 0)
+  // Each part's radii in the whole tree over those it was grown with (<= 1: its checks hold).
+  double largest_part_scale = 0, smallest_part_scale = 0;
+  // The trunk's final radii over the clearance the parts kept (< 1: the parts kept clear).
+  double largest_trunk_radius_share = 0;
+  // Pressure drop across each part in the whole tree, as a share of the root-to-terminal drop.
+  double smallest_part_pressure_share = 0;
+  std::int64_t repaired_terminals = 0;  // summed over the parts' own final checks
+  double unreached_share = 0;           // of the demand, in no part (enclosed by the trunk's clearance)
+  std::vector<int> offending_parts;     // parts with a vessel in an intersecting pair (to grow again)
+  std::int64_t regrown_parts = 0;
+};
 
 struct GrowthReport {
   std::int64_t candidates = 0;             // candidate terminals drawn
@@ -38,6 +61,7 @@ struct GrowthReport {
   std::int64_t outside_segments = 0;     // final segments leaving the domain (target 0)
   std::int64_t lenient_connections = 0;  // forests: connections whose thickened ancestors were checked only in part
   double root_radius_mm = 0;
+  std::optional<DecompositionReport> decomposition;  // CCO grown in parts
 };
 
 using ProgressFn = std::function<void(std::int64_t done, std::int64_t total)>;
