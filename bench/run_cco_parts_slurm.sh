@@ -13,8 +13,9 @@ sed -e "s/^terminals = .*/terminals = $n/" -e "s/^parts = [0-9]*/parts = $parts/
 t0=$(date +%s.%N)
 job=$(sbatch --parsable --array=0-$((parts - 1)) --cpus-per-task="$cpus" --mem=3G -o "$work/task_%a.log" \
   --export=ALL,PATH="$build:$PATH",PARAMS="$work/organ.toml",OUT="$work/slurm" examples/cluster/slurm_cco_parts.sh)
-sbatch --wait --parsable --dependency=afterok:"$job" --cpus-per-task="$cpus" --mem=6G -o "$work/join.log" \
-  --wrap "/usr/bin/time -f 'join: peak RSS %M kB, wall %e s' $build/angiosynth generate $work/organ.toml --out $work/slurm --join --threads $cpus --quiet" >/dev/null
+sbatch --wait --parsable --dependency=afterok:"$job" --kill-on-invalid-dep=yes --cpus-per-task="$cpus" --mem=6G -o "$work/join.log" \
+  --wrap "/usr/bin/time -f 'join: peak RSS %M kB, wall %e s' $build/angiosynth generate $work/organ.toml --out $work/slurm --join --threads $cpus --quiet" >/dev/null ||
+  { echo "run_cco_parts_slurm.sh: a task or the join failed; logs in $work" >&2; tail -n 3 "$work"/*.log >&2; exit 1; }
 t1=$(date +%s.%N)
 /usr/bin/time -f "one process: peak RSS %M kB, wall %e s" "$build/angiosynth" generate "$work/organ.toml" --out "$work/one" --quiet
 cat "$work/join.log"

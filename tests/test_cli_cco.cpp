@@ -125,7 +125,8 @@ TEST_F(CliCco, PartsGrownAsTasksAndJoinedAreTheTreeGrownInOneProcess) {
   std::string text = slurp(src_ / "examples/cco_organ_parts_3d.toml");
   text.replace(text.find("terminals = 1000000"), 19, "terminals = 3000");
   text.replace(text.find("parts = 8"), 9, "parts = 4");
-  text.replace(text.find("voxel_size = \"0.5 mm\""), 21, "voxel_size = \"1 mm\"");
+  const auto voxel = text.find("voxel_size = \"");
+  text.replace(voxel, text.find('"', voxel + 14) + 1 - voxel, "voxel_size = \"1 mm\"");
   std::ofstream(dir_ / "organ.toml") << text;
   const auto whole = run("generate organ.toml --out whole --quiet", dir_);
   ASSERT_EQ(whole.code, 0) << whole.err;
@@ -190,6 +191,13 @@ TEST_F(CliCco, PartsGrownAsTasksAndJoinedAreTheTreeGrownInOneProcess) {
   std::ofstream(dir_ / "one.toml") << one;
   r = run("generate one.toml --out x", dir_);
   EXPECT_NE(r.err.find("parts = 1 is one tree grown the long way"), std::string::npos) << r.err;
+  std::string big = text;
+  big.replace(big.find("parts = 4"), 9, "parts = 0");
+  big.replace(big.find("terminals = 3000"), 16, "terminals = 6000000");
+  std::ofstream(dir_ / "big.toml") << big;
+  r = run("generate big.toml --out x", dir_);
+  EXPECT_NE(r.err.find("big.toml:19: terminals = 6000000 in one tree; allowed: up to 5e+06, or up to 1e+08 grown in parts"), std::string::npos)
+      << r.err;
   r = run("generate " + (src_ / "examples/cco_disc_2d.toml").string() + " --out x --part 0 --seed 1", dir_);
   EXPECT_NE(r.err.find("grows one tree whole"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "x"));

@@ -38,6 +38,8 @@ inline std::string nameProblem(const std::string& name, const std::string& what)
 // The growth and physics limits, in one place for both formats.
 struct Limits {
   static constexpr double kMaxTerminals = 5e6;
+  // A CCO tree grown in parts ([tree] parts): each part stays within one process's reach.
+  static constexpr double kMaxTerminalsInParts = 1e8;
   static constexpr double kMaxNeighbours = 100;
   static constexpr double kMinMurray = 1, kMaxMurray = 10;  // γ in (1, 10]
   static constexpr double kMaxCostExponent = 10;            // λ, μ in [0, 10]

@@ -25,7 +25,7 @@ const std::vector<Setting<CcoOptions>>& ccoSettings() {
   using O = CcoOptions;
   static const std::vector<Setting<O>> settings{
       {.table = "tree", .key = "terminals", .unit = "count", .fallback = nullptr, .meaning = "N, the number of terminal segments",
-       .field = &O::terminals, .range = {1, Limits::kMaxTerminals}},
+       .field = &O::terminals, .range = {1, Limits::kMaxTerminalsInParts}},
       {.table = "tree", .key = "closest_neighbours", .unit = "count", .fallback = "20", .meaning = "ν, the nearest segments tried per terminal",
        .field = &O::closest_neighbours, .range = {1, Limits::kMaxNeighbours}, .fallback_is_value = true},
       {.table = "tree", .key = "max_closest_neighbours", .unit = "count", .fallback = "closest_neighbours",
@@ -162,6 +162,10 @@ class PreparedCco final : public PreparedGrowth {
     std::int64_t inside = 0;  // voxels of the domain
     for (float v : domain_.frame().demand) inside += v > 0;
     const auto& c = setup_.cco;
+    if (setup_.decomposition.parts == 0 && double(c.terminals) > Limits::kMaxTerminals)
+      throw InputError(setup_.parameter_file, setup_.terminals_line,
+                       "terminals = " + std::to_string(c.terminals) + " in one tree; allowed: up to " + show(Limits::kMaxTerminals) + ", or up to " +
+                           show(Limits::kMaxTerminalsInParts) + " grown in parts ([tree] parts = K)");
     if (setup_.decomposition.parts > c.terminals)
       throw InputError(setup_.parameter_file, setup_.terminals_line,
                        std::to_string(c.terminals) + " terminals in " + std::to_string(setup_.decomposition.parts) +

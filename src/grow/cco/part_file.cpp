@@ -37,7 +37,8 @@ struct Cursor {
   const std::string& file;
   template <class T>
   T get() {
-    if (bytes.size() - at < sizeof(T)) throw InputError(file, 0, "ends early; allowed: a part file angiosynth wrote whole (rerun the part's task)");
+    if (bytes.size() - at < sizeof(T))
+      throw InputError(file, 0, "ends early; allowed: a part file angiosynth wrote whole (remove it, then rerun the part's task)");
     T v;
     std::memcpy(&v, bytes.data() + at, sizeof(T));
     at += sizeof(T);
@@ -84,10 +85,13 @@ std::optional<CcoPart> readCcoPartFile(const std::filesystem::path& file, const 
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string name = file.string();
   if (bytes.size() < sizeof kMagic + 8 || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
-    throw InputError(name, 0, "is not a part file; allowed: the part files `angiosynth generate --part` writes");
+    throw InputError(name, 0,
+                     "is not a part file; allowed: the part files `angiosynth generate --part` writes (move it away, or use another --parts-dir)");
   std::uint64_t sum;
   std::memcpy(&sum, bytes.data() + bytes.size() - 8, 8);
-  if (sum != hashName(bytes.data(), bytes.size() - 8)) throw InputError(name, 0, "is damaged (its checksum differs); allowed: rerun the part's task");
+  if (sum != hashName(bytes.data(), bytes.size() - 8))
+    throw InputError(name, 0,
+                     "is damaged (its checksum differs); allowed: a part file as angiosynth wrote it (remove it, then rerun the part's task)");
   Cursor c{bytes, sizeof kMagic, name};
   const auto fingerprint = c.get<std::uint64_t>();
   const int part = c.get<std::int32_t>(), parts = c.get<std::int32_t>();
@@ -107,7 +111,8 @@ std::optional<CcoPart> readCcoPartFile(const std::filesystem::path& file, const 
   constexpr std::size_t kNodeBytes = 3 * 8 + 4 + 8;
   if (nodes < 2 || std::uint64_t(nodes) > (bytes.size() - c.at) / kNodeBytes)
     throw InputError(name, 0,
-                     "holds " + std::to_string(nodes) + " nodes, more than its size allows or fewer than a vessel; allowed: rerun the part's task");
+                     "holds " + std::to_string(nodes) +
+                         " nodes, more than its size allows or fewer than a vessel; allowed: remove it, then rerun the part's task");
   VascularTree& t = p.tree;
   t.reserve(std::size_t(nodes));
   for (std::int64_t i = 0; i < nodes; ++i) {
@@ -115,8 +120,9 @@ std::optional<CcoPart> readCcoPartFile(const std::filesystem::path& file, const 
     const Vec3 x(px, py, pz);
     const auto parent = c.get<std::int32_t>();
     if ((i == 0) != (parent < 0) || parent >= i)
-      throw InputError(
-          name, 0, "node " + std::to_string(i) + " has parent " + std::to_string(parent) + ", not an earlier node; allowed: rerun the part's task");
+      throw InputError(name, 0,
+                       "node " + std::to_string(i) + " has parent " + std::to_string(parent) +
+                           ", not an earlier node; allowed: remove it, then rerun the part's task");
     t.addNode(x, parent);
     t.radius[std::size_t(i)] = c.get<double>();
   }
