@@ -10,7 +10,6 @@
 #include <limits>
 #include <string>
 #include <mutex>
-#include <queue>
 #include <tuple>
 
 #include "core/rng.hpp"
@@ -40,6 +39,61 @@ int trunkZone(const CcoTrunk& trunk, const Vec3& p) {
 }
 
 Vec3 voxelCentre(const DemandMap& m, std::int64_t i, std::int64_t j, std::int64_t k) { return Vec3(i + 0.5, j + 0.5, k + 0.5) * m.voxel_mm; }
+
+// trunkZone for the many points of a grid: the trunk's segments and part roots are listed per
+// block of 8³ voxels of the domain's frame (each where it can reach), so that a point tests only
+// its block's, in the same order: the same answers, at a cost that does not grow with the trunk.
+class TrunkZones {
+ public:
+  TrunkZones(const CcoTrunk& trunk, const DemandMap& m) : trunk_(trunk), edge_(kBlock * m.voxel_mm) {
+    for (int a = 0; a < 3; ++a) blocks_[a] = std::max<std::int64_t>(1, (m.dims[a] + kBlock - 1) / kBlock);
+    lists_.resize(std::size_t(blocks_[0] * blocks_[1] * blocks_[2]));
+    const double half_diagonal = 0.5 * edge_ * std::sqrt(3.0) * (1 + 1e-9);
+    const auto& T = trunk.tree;
+    // Item i < 0: segment -i; i >= 0: root i (roots after segments, as trunkZone tests them).
+    const auto stamp = [&](std::int32_t item, const Vec3& a, const Vec3& b, double reach) {
+      std::array<std::int64_t, 3> lo{}, hi{};
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::clamp<std::int64_t>(std::int64_t(std::floor((std::min(a[k], b[k]) - reach) / edge_)) - 1, 0, blocks_[k] - 1);
+        hi[k] = std::clamp<std::int64_t>(std::int64_t(std::floor((std::max(a[k], b[k]) + reach) / edge_)) + 1, 0, blocks_[k] - 1);
+      }
+      for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+        for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+          for (std::int64_t x = lo[0]; x <= hi[0]; ++x) {
+            const Vec3 centre = Vec3(x + 0.5, y + 0.5, z + 0.5) * edge_;
+            if (pointSegmentDistance(centre, a, b) < reach + half_diagonal)
+              lists_[std::size_t(x + blocks_[0] * (y + blocks_[1] * z))].push_back(item);
+          }
+    };
+    for (std::int32_t seg = 1; seg < T.nodeCount(); ++seg)
+      if (trunk.clearance_mm[seg] > 0) stamp(-seg, T.position[T.parent[seg]], trunk.clearance_end[seg], trunk.clearance_mm[seg]);
+    for (std::size_t i = 0; i < trunk.terminal_node.size(); ++i) {
+      const Vec3 root = T.position[trunk.terminal_node[i]];
+      stamp(std::int32_t(i), root, root, 1.5 * trunk.domain_voxel_mm);
+    }
+  }
+  // trunkZone(trunk, p) for p inside the frame.
+  int at(const Vec3& p) const {
+    std::int64_t b[3];
+    for (int k = 0; k < 3; ++k) b[k] = std::clamp<std::int64_t>(std::int64_t(std::floor(p[k] / edge_)), 0, blocks_[k] - 1);
+    const auto& T = trunk_.tree;
+    for (const std::int32_t item : lists_[std::size_t(b[0] + blocks_[0] * (b[1] + blocks_[1] * b[2]))]) {
+      if (item < 0) {
+        if (pointSegmentDistance(p, T.position[T.parent[-item]], trunk_.clearance_end[-item]) < trunk_.clearance_mm[-item]) return -2;
+      } else if (distance(p, T.position[trunk_.terminal_node[std::size_t(item)]]) < 1.5 * trunk_.domain_voxel_mm) {
+        return item;
+      }
+    }
+    return -1;
+  }
+
+ private:
+  static constexpr std::int64_t kBlock = 8;
+  const CcoTrunk& trunk_;
+  double edge_;
+  std::array<std::int64_t, 3> blocks_{};
+  std::vector<std::vector<std::int32_t>> lists_;  // per block: segments (as -s) in order, then roots
+};
 
 // Physics of a part: its share of the flow, and part_pressure_share of the drop at its root.
 PhysicsParameters partPhysics(const CcoDecompositionOptions& opt, std::int64_t part_terminals) {
@@ -137,12 +191,13 @@ CcoTrunk planCcoTrunk(const GrowthDomain& domain, const CcoDecompositionOptions&
   const auto n_vox = std::size_t(m.voxelCount());
   trunk.cell.assign(n_vox, -1);
   std::vector<std::int16_t> zone(n_vox, -2);  // -2 closed (outside or clearance), -1 open, else a ball's part
+  const TrunkZones zones(trunk, m);
   tbb::parallel_for(tbb::blocked_range<std::int32_t>(0, m.dims[2]), [&](const tbb::blocked_range<std::int32_t>& r) {
     for (std::int32_t z = r.begin(); z < r.end(); ++z)
       for (std::int32_t y = 0; y < m.dims[1]; ++y)
         for (std::int32_t x = 0; x < m.dims[0]; ++x) {
           const auto v = std::size_t(m.flat(x, y, z));
-          if (m.demand[v] > 0) zone[v] = std::int16_t(trunkZone(trunk, voxelCentre(m, x, y, z)));
+          if (m.demand[v] > 0) zone[v] = std::int16_t(zones.at(voxelCentre(m, x, y, z)));
         }
   });
   {
@@ -152,27 +207,33 @@ CcoTrunk planCcoTrunk(const GrowthDomain& domain, const CcoDecompositionOptions&
       std::int64_t v;
       bool operator>(const Item& o) const { return std::tie(d, part, v) > std::tie(o.d, o.part, o.v); }
     };
-    std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+    // Dijkstra's order without a heap: a step is at least 1 voxel, so everything at distance
+    // [b, b + 1) is known once the distances below b are settled, and it reaches no further than
+    // b + 1 + √3. Buckets of width 1, three alive, each sorted as the heap would pop it.
+    std::array<std::vector<Item>, 3> ring;
     std::vector<float> dist(n_vox, std::numeric_limits<float>::infinity());
     for (std::size_t v = 0; v < n_vox; ++v)
-      if (zone[v] >= 0) dist[v] = 0, queue.push({0.0f, std::int16_t(zone[v]), std::int64_t(v)});
+      if (zone[v] >= 0) dist[v] = 0, ring[0].push_back({0.0f, std::int16_t(zone[v]), std::int64_t(v)});
     const std::int64_t nx = m.dims[0], ny = m.dims[1], nz = m.dims[2];
-    while (!queue.empty()) {
-      const Item it = queue.top();
-      queue.pop();
-      if (trunk.cell[std::size_t(it.v)] >= 0) continue;
-      trunk.cell[std::size_t(it.v)] = it.part;
-      const std::int64_t x = it.v % nx, y = (it.v / nx) % ny, z = it.v / (nx * ny);
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const std::int64_t X = x + dx, Y = y + dy, Z = z + dz;
-            if ((dx | dy | dz) == 0 || X < 0 || Y < 0 || Z < 0 || X >= nx || Y >= ny || Z >= nz) continue;
-            const auto w = std::size_t(X + nx * (Y + ny * Z));
-            if (zone[w] == -2 || trunk.cell[w] >= 0) continue;
-            const float d = it.d + float(std::sqrt(double(dx * dx + dy * dy + dz * dz)));
-            if (d < dist[w]) dist[w] = d, queue.push({d, it.part, std::int64_t(w)});
-          }
+    for (std::int64_t b = 0; !(ring[0].empty() && ring[1].empty() && ring[2].empty()); ++b) {
+      auto& bucket = ring[std::size_t(b % 3)];
+      std::sort(bucket.begin(), bucket.end(), [](const Item& l, const Item& r) { return r > l; });
+      for (const Item& it : bucket) {
+        if (trunk.cell[std::size_t(it.v)] >= 0) continue;
+        trunk.cell[std::size_t(it.v)] = it.part;
+        const std::int64_t x = it.v % nx, y = (it.v / nx) % ny, z = it.v / (nx * ny);
+        for (int dz = -1; dz <= 1; ++dz)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              const std::int64_t X = x + dx, Y = y + dy, Z = z + dz;
+              if ((dx | dy | dz) == 0 || X < 0 || Y < 0 || Z < 0 || X >= nx || Y >= ny || Z >= nz) continue;
+              const auto w = std::size_t(X + nx * (Y + ny * Z));
+              if (zone[w] == -2 || trunk.cell[w] >= 0) continue;
+              const float d = it.d + float(std::sqrt(double(dx * dx + dy * dy + dz * dz)));
+              if (d < dist[w]) dist[w] = d, ring[std::size_t(std::int64_t(d) % 3)].push_back({d, it.part, std::int64_t(w)});
+            }
+      }
+      bucket.clear();
     }
   }
   const std::size_t k = trunk.terminal_node.size();
@@ -228,6 +289,7 @@ GrowthDomain ccoPartDomain(const GrowthDomain& domain, const CcoTrunk& trunk, in
   // trunk's clearance (but in its own ball), and its neighbours' centres lie in no other cell (a
   // gap of two voxels between parts, wider than the depth's half-voxel error).
   const double inset = 0.5 * h * (flat ? std::sqrt(2.0) : std::sqrt(3.0));
+  const TrunkZones zones(trunk, m);
   const auto cellAt = [&](const Vec3& c) {
     const auto v = m.voxelAt(c);
     return v >= 0 ? trunk.cell[std::size_t(v)] : std::int16_t(-1);
@@ -260,7 +322,7 @@ GrowthDomain ccoPartDomain(const GrowthDomain& domain, const CcoTrunk& trunk, in
           if (flat) c.z = domain.planeZ();
           const auto v = m.voxelAt(c);
           if (v < 0 || trunk.cell[std::size_t(v)] != part || !(domain.depth(c) >= inset)) continue;
-          const int zone = trunkZone(trunk, c);
+          const int zone = zones.at(c);
           if (zone == -2 || (zone >= 0 && zone != part)) continue;
           if (border[std::size_t(v)]) {
             bool alone = true;
