@@ -1,6 +1,7 @@
 // Each growth method's parameters, grown: the first byte picks a method, the rest is a TOML
 // fragment whose keys replace those of a small template of that method (a [[stage]] fragment
-// merges into the first stage). Sizes are capped (terminals, iterations, steps, drains) so a
+// merges into the first stage). Sizes are capped (terminals, iterations, steps, drains, a DCCO
+// stage's failed draws) so a
 // case stays small; every other value goes to the reader and the growth as a user wrote it.
 #include <toml++/toml.h>
 
@@ -20,7 +21,9 @@ std::string templateOf(int method, const std::string& map) {
              "perfusion_flow = \"100 mm3/s\"\n";
     case 1: return disc + "[tree]\nmethod = \"cco\"\nterminals = 30\n[physics]\nperfusion_flow = \"5 mL/min\"\n";
     case 2:
-      return disc + "[tree]\nmethod = \"dcco\"\nroot_radius = \"0.2 mm\"\n[physics]\nperfusion_flow = \"0.3 mL/min\"\n[[stage]]\nterminals = 20\n";
+      return disc +
+             "[tree]\nmethod = \"dcco\"\nroot_radius = \"0.2 mm\"\n[physics]\nperfusion_flow = \"0.3 mL/min\"\n[[stage]]\nterminals = "
+             "20\ndraws_before_relaxing = 20\n";
     case 3: return disc + "[tree]\nmethod = \"colonisation\"\n[[stage]]\nsteps = 10\ndrains_per_step = 200\n";
     default: return disc + "[tree]\nmethod = \"lsystem\"\nmode = \"grammar\"\niterations = 5\n";
   }
@@ -69,6 +72,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         cap(*st, "terminals", 30);
         cap(*st, "steps", 20);
         cap(*st, "drains_per_step", 300);
+        cap(*st, "draws_before_relaxing", 20);  // a stage gives up after 100 of these: 2,000 failed points, not 10,000
       }
   }
   base.insert_or_assign("image", toml::table{{"formats", toml::array{}}, {"graph_formats", toml::array{}}});

@@ -24,6 +24,9 @@ double secondsSince(std::chrono::steady_clock::time_point t0) { return std::chro
 // Rounds of regrowing the parts whose vessels meet others before the join gives up (and reports them).
 constexpr int kMaxRegrowRounds = 4;
 
+// Failed draws in a row before the trunk gives up (a whole tree's limit is 2·10⁶).
+constexpr std::int64_t kTrunkDraws = 20000;
+
 // Empty voxels around a part's grid, so that its border has outside voxels to measure depth from.
 constexpr int kPartMargin = 2;
 
@@ -107,7 +110,12 @@ PhysicsParameters partPhysics(const CcoDecompositionOptions& opt, std::int64_t p
 // CcoTrunk); false if a terminal has no room for that.
 bool growTrunk(const GrowthDomain& domain, const CcoDecompositionOptions& opt, const CcoOptions& o, CcoTrunk& trunk) {
   GrowthReport rep;
-  trunk.tree = growCco(domain, o, rep);
+  try {
+    trunk.tree = growCco(domain, o, rep);
+  } catch (const GrowthError& e) {
+    throw GrowthError("the trunk of " + std::to_string(opt.parts) + " parts (its vessels twice as thick as they will be) does not fit: " + e.what() +
+                      "; allowed: fewer parts, a smaller perfusion_flow or a larger domain");
+  }
   auto& T = trunk.tree;
   trunk.terminal_node.clear();
   for (std::int32_t i = 1; i < T.nodeCount(); ++i)
@@ -167,6 +175,8 @@ CcoTrunk planCcoTrunk(const GrowthDomain& domain, const CcoDecompositionOptions&
   CcoOptions o = opt.cco;
   o.terminals = opt.parts;
   o.organ_scale = false;
+  // A few terminals over the whole domain: when this many draws in a row fail, its vessels do not fit.
+  o.max_draws = std::min<std::int64_t>(o.max_draws, kTrunkDraws);
   // Grown with its radii at the bound on their final values (a drop trunk_radius_factor⁴ times
   // smaller), so that its own checks (length, overlap, inside) hold for the whole tree's radii.
   o.physics.perfusion_pressure =
@@ -250,6 +260,11 @@ CcoTrunk planCcoTrunk(const GrowthDomain& domain, const CcoDecompositionOptions&
   double total = 0;
   for (double w : weight) total += w;
   if (!(total > 0)) throw GrowthError("no voxel of the domain is left to the parts: lower the trunk clearance or use finer voxels");
+  // Before any part grows: a part without room would only fail once the others had grown.
+  for (std::size_t i = 0; i < k; ++i)
+    if (!(weight[i] > 0))
+      throw GrowthError("part " + std::to_string(i) +
+                        " has no voxel left beside the trunk's vessels; allowed: fewer parts, finer voxels or a smaller perfusion_flow");
   std::vector<double> shares(k);
   for (std::size_t i = 0; i < k; ++i) shares[i] = weight[i] / total;
   trunk.part_terminals = terminalQuotas(shares, opt.cco.terminals - std::int64_t(k));
@@ -269,7 +284,9 @@ GrowthDomain ccoPartDomain(const GrowthDomain& domain, const CcoTrunk& trunk, in
           const std::array<std::int32_t, 3> c{x, y, z};
           for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
         }
-  if (hi[0] < 0) throw GrowthError("part " + std::to_string(part) + " has no voxel left: lower the trunk clearance or use finer voxels");
+  if (hi[0] < 0)
+    throw GrowthError("part " + std::to_string(part) +
+                      " has no voxel left beside the trunk's vessels; allowed: fewer parts, finer voxels or a smaller perfusion_flow");
   const bool flat = domain.dimension() == 2;
   DemandMap pm;
   pm.voxel_mm = h;
