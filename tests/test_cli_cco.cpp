@@ -198,6 +198,13 @@ TEST_F(CliCco, PartsGrownAsTasksAndJoinedAreTheTreeGrownInOneProcess) {
   r = run("generate big.toml --out x", dir_);
   EXPECT_NE(r.err.find("big.toml:19: terminals = 6000000 in one tree; allowed: up to 5e+06, or up to 1e+08 grown in parts"), std::string::npos)
       << r.err;
+  // A trunk that cannot fit (vessels as thick as 500 mL/min makes them, in a 10 mm disc): an input error, fast.
+  std::ofstream(dir_ / "tight.toml") << "seed = 1\n[domain]\nshape = \"disc\"\nradius = \"10 mm\"\nvoxel_size = \"0.1 mm\"\n"
+                                        "[tree]\nmethod = \"cco\"\nterminals = 40\nparts = 8\n[physics]\nperfusion_pressure = \"99 mmHg\"\n"
+                                        "perfusion_flow = \"500 mL/min\"\n";
+  r = run("generate tight.toml --out x --part 0", dir_);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("tight.toml: the trunk of 8 parts"), std::string::npos) << r.err;
   r = run("generate " + (src_ / "examples/cco_disc_2d.toml").string() + " --out x --part 0 --seed 1", dir_);
   EXPECT_NE(r.err.find("grows one tree whole"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "x"));

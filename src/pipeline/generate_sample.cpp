@@ -320,7 +320,9 @@ PartTaskSummary growSamplePart(const SampleRequest& req, int index, const std::f
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw InputError(dir.string(), 0, "cannot be created (" + ec.message() + "); allowed: a directory this user may write");
-  return ps.growth->growPart(req.seed, req.sample, index, dir);
+  try {
+    return ps.growth->growPart(req.seed, req.sample, index, dir);
+  } catch (const GrowthError& e) { throw InputError(sc.parameter_file, 0, e.what()); }
 }
 
 SampleSummary generateSample(const SampleRequest& req, const std::filesystem::path& dir) {
