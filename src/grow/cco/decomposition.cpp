@@ -465,22 +465,13 @@ VascularTree joinCcoPartsRegrowing(const GrowthDomain& domain, const CcoTrunk& t
 
 GrowthReport decomposedReport(const std::vector<CcoPart>& parts, const CcoDecompositionSummary& sum, const VascularTree& joined) {
   GrowthReport r;
+  // The parts' counts add up; the whole tree's checks replace theirs.
   for (const auto& p : parts) {
-    const GrowthReport& q = p.report;
-    r.candidates += q.candidates;
-    r.rejected_too_close += q.rejected_too_close;
-    r.rejected_unreachable += q.rejected_unreachable;
-    r.rejected_intersection += q.rejected_intersection;
-    r.retracted_terminals += q.retracted_terminals;
-    r.moved_nodes += q.moved_nodes;
-    r.repaired_terminals += q.repaired_terminals;
+    GrowthReport q = p.report;
+    const auto from = q.counts();
+    const auto into = r.counts();
+    for (std::size_t i = 0; i < into.size(); ++i) *into[i] += *from[i];
     r.repair_rounds = std::max(r.repair_rounds, q.repair_rounds);
-    r.threshold_relaxations += q.threshold_relaxations;
-    r.neighbour_doublings += q.neighbour_doublings;
-    r.kamiya_failures += q.kamiya_failures;
-    r.hidden_segments += q.hidden_segments;
-    r.crowded_segments += q.crowded_segments;
-    r.node_optima += q.node_optima;
   }
   r.intersecting_pairs = sum.intersecting_pairs;
   r.short_segments = sum.short_segments;

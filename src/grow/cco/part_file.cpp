@@ -1,6 +1,5 @@
 #include "grow/cco/part_file.hpp"
 
-#include <array>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -16,14 +15,6 @@ namespace angiosynth {
 namespace {
 
 constexpr char kMagic[8] = {'A', 'S', 'C', 'C', 'O', 'P', 'T', '1'};
-
-// The report's counts in file order.
-std::array<std::int64_t*, 18> counts(GrowthReport& r) {
-  return {&r.candidates,          &r.rejected_too_close, &r.rejected_unreachable, &r.rejected_intersection, &r.retracted_terminals,
-          &r.moved_nodes,         &r.repaired_terminals, &r.relaxed_bifurcations, &r.intersecting_pairs,    &r.threshold_relaxations,
-          &r.neighbour_doublings, &r.kamiya_failures,    &r.hidden_segments,      &r.crowded_segments,      &r.node_optima,
-          &r.short_segments,      &r.outside_segments,   &r.lenient_connections};
-}
 
 template <class T>
 void put(std::string& out, const T& v) {
@@ -68,7 +59,7 @@ void writeCcoPartFile(const std::filesystem::path& file, const CcoPart& part, co
   put(out, part.seconds);
   put(out, part.report.root_radius_mm);
   GrowthReport report = part.report;
-  for (auto* c : counts(report)) put(out, *c);
+  for (auto* c : report.counts()) put(out, *c);
   put(out, std::int64_t(order.size()));
   for (auto i : order) {
     for (int a = 0; a < 3; ++a) put(out, t.position[i][a]);
@@ -106,7 +97,7 @@ std::optional<CcoPart> readCcoPartFile(const std::filesystem::path& file, const 
   p.report.repair_rounds = c.get<std::int32_t>();
   p.seconds = c.get<double>();
   p.report.root_radius_mm = c.get<double>();
-  for (auto* v : counts(p.report)) *v = c.get<std::int64_t>();
+  for (auto* v : p.report.counts()) *v = c.get<std::int64_t>();
   const auto nodes = c.get<std::int64_t>();
   constexpr std::size_t kNodeBytes = 3 * 8 + 4 + 8;
   if (nodes < 2 || std::uint64_t(nodes) > (bytes.size() - c.at) / kNodeBytes)

@@ -1,6 +1,7 @@
 #pragma once
 // What every growth method reports: counts of drawn, rejected and repaired candidates, the
 // final checks (targets 0), progress callbacks and the error for a domain that cannot be filled.
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -62,6 +63,13 @@ struct GrowthReport {
   std::int64_t lenient_connections = 0;  // forests: connections whose thickened ancestors were checked only in part
   double root_radius_mm = 0;
   std::optional<DecompositionReport> decomposition;  // CCO grown in parts
+
+  // Every count above, in one fixed order: what a part's file stores and parts add up.
+  std::array<std::int64_t*, 18> counts() {
+    return {&candidates,         &rejected_too_close,   &rejected_unreachable, &rejected_intersection, &retracted_terminals, &moved_nodes,
+            &repaired_terminals, &relaxed_bifurcations, &intersecting_pairs,   &threshold_relaxations, &neighbour_doublings, &kamiya_failures,
+            &hidden_segments,    &crowded_segments,     &node_optima,          &short_segments,        &outside_segments,    &lenient_connections};
+  }
 };
 
 using ProgressFn = std::function<void(std::int64_t done, std::int64_t total)>;
