@@ -1,5 +1,6 @@
 // Growth time and peak memory of the VascuSynth grower at 1k, 10k and 100k terminals, with and
-// without the no-stub rule.
+// without the no-stub rule; the depth map of a mask domain (an exact distance transform), which
+// every mask domain and every part of a tree grown in parts computes first.
 // 1k and 10k grow in VascuSynth's 100^3 example map (twelve zero-demand rods); 1k, 10k and 100k
 // in a uniform 200^3 map, the series that shows how time per terminal scales with N.
 // Parameters as in examples/vascusynth_like (CGS values converted).
@@ -8,6 +9,7 @@
 
 #include "bench_common.hpp"
 #include "core/memory.hpp"
+#include "domain/growth_domain.hpp"
 #include "grow/vascusynth/grower.hpp"
 
 using namespace angiosynth;
@@ -40,8 +42,25 @@ void BM_GrowVascuSynth(benchmark::State& state) {
   state.counters["repaired"] = double(report.repaired_terminals);
 }
 
+// range(0): edge of a cubic map holding a ball of half its width (the inside and the outside
+// both get distances).
+void BM_MaskDepth(benchmark::State& state) {
+  const int n = int(state.range(0));
+  DemandMap map;
+  map.dims = {n, n, n};
+  map.demand.assign(std::size_t(n) * n * n, 0.0f);
+  const double c = 0.5 * (n - 1), r = 0.25 * n;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        if ((i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c) <= r * r) map.demand[std::size_t(map.flat(i, j, k))] = 1.0f;
+  for (auto _ : state) benchmark::DoNotOptimize(maskDepthMap(map).data());
+  state.counters["Mvoxels_per_s"] = benchmark::Counter(double(map.voxelCount()) * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
+}
+
 }  // namespace
 
+BENCHMARK(BM_MaskDepth)->ArgName("edge")->Arg(128)->Arg(320)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_GrowVascuSynth)
     ->ArgNames({"terminals", "uniform200", "stubs"})
     ->ArgsProduct({{1000, 10000}, {0}, {0, 1}})

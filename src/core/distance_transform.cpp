@@ -3,19 +3,18 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 
 namespace angiosynth {
 namespace {
 
-// Squared distances along one line of spacing h to the nearest site (f: squared distance at the
-// line's own points so far; 0 at sites).
-void edt1d(const std::vector<double>& f, double h, std::vector<double>& d, std::vector<int>& v, std::vector<double>& z) {
-  const int n = int(f.size());
-  v.assign(n, 0);
-  z.assign(n + 1, 0);
+// Squared distances along one line of n points and spacing h to the nearest site (f: squared
+// distance at the line's own points so far; 0 at sites); v and z are scratch of n and n + 1.
+void edt1d(const double* f, int n, double h, double* d, int* v, double* z) {
   int k = 0;
+  v[0] = 0;
   // Infinite sentinels: with a spacing below ½ an intersection can lie beyond ±kFarSquared.
   z[0] = -INFINITY;
   z[1] = INFINITY;
@@ -31,7 +30,6 @@ void edt1d(const std::vector<double>& f, double h, std::vector<double>& d, std::
     z[k] = s;
     z[k + 1] = INFINITY;
   }
-  d.resize(n);
   k = 0;
   for (int q = 0; q < n; ++q) {
     while (z[k + 1] < at(q)) ++k;
@@ -39,28 +37,47 @@ void edt1d(const std::vector<double>& f, double h, std::vector<double>& d, std::
   }
 }
 
+// Lines along y and z are read as blocks of this many lines adjacent in x: one cache line of
+// doubles serves all of them, where a line alone would touch a cache line (and, along z, a
+// page) per point.
+constexpr int kLinesPerBlock = 8;
+
 }  // namespace
 
 void squaredDistances(std::vector<double>& g, const std::array<int, 3>& n, const std::array<double, 3>& h, int axes) {
   for (int axis = 0; axis < axes; ++axis) {
-    // The lines along `axis`, indexed by their two other coordinates.
+    // The lines along `axis`, indexed by their two other coordinates a (x unless the lines run
+    // along x) and b.
     const int a = axis == 0 ? 1 : 0, b = axis == 2 ? 1 : 2;
     const int len = n[axis], na = n[a];
-    const std::size_t lines = std::size_t(n[a]) * n[b];
     const std::size_t stride[3] = {1, std::size_t(n[0]), std::size_t(n[0]) * n[1]};
     const std::size_t step = stride[axis], sa = stride[a], sb = stride[b];
+    const int width = sa == 1 ? kLinesPerBlock : 1;
+    const std::size_t blocks_a = std::size_t((na + width - 1) / width);
+    const std::size_t blocks = blocks_a * std::size_t(n[b]);
     const double spacing = h[axis];
     double* data = g.data();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lines), [=](const tbb::blocked_range<std::size_t>& r) {
-      std::vector<double> f(static_cast<std::size_t>(len)), d, z;
-      std::vector<int> v;
-      for (std::size_t line = r.begin(); line != r.end(); ++line) {
-        double* p = data + (line % std::size_t(na)) * sa + (line / std::size_t(na)) * sb;
-        bool any = false;
-        for (int q = 0; q < len; ++q) any |= (f[std::size_t(q)] = p[std::size_t(q) * step]) < kFarSquared;
-        if (!any) continue;  // no site reaches this line yet: it stays far
-        edt1d(f, spacing, d, v, z);
-        for (int q = 0; q < len; ++q) p[std::size_t(q) * step] = d[std::size_t(q)];
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks), [=](const tbb::blocked_range<std::size_t>& r) {
+      // Line j of a block at f[j·len …], its distances at d[j·len …].
+      std::vector<double> f(std::size_t(len) * width), d(std::size_t(len) * width), z(std::size_t(len) + 1);
+      std::vector<int> v(static_cast<std::size_t>(len));
+      for (std::size_t block = r.begin(); block != r.end(); ++block) {
+        const int first = int(block % blocks_a) * width, lines = std::min(width, na - first);
+        double* p = data + std::size_t(first) * sa + (block / blocks_a) * sb;
+        for (int q = 0; q < len; ++q)
+          for (int j = 0; j < lines; ++j) f[std::size_t(j) * len + q] = p[std::size_t(q) * step + std::size_t(j) * sa];
+        for (int j = 0; j < lines; ++j) {
+          double* fj = f.data() + std::size_t(j) * len;
+          double* dj = d.data() + std::size_t(j) * len;
+          bool any = false;
+          for (int q = 0; q < len; ++q) any |= fj[q] < kFarSquared;
+          if (any)
+            edt1d(fj, len, spacing, dj, v.data(), z.data());
+          else  // no site reaches this line yet: it stays far
+            std::copy(fj, fj + len, dj);
+        }
+        for (int q = 0; q < len; ++q)
+          for (int j = 0; j < lines; ++j) p[std::size_t(q) * step + std::size_t(j) * sa] = d[std::size_t(j) * len + q];
       }
     });
   }
