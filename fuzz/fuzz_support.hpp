@@ -16,13 +16,28 @@
 
 namespace angiosynth::fuzz {
 
+// One directory per process, removed when the process exits normally, so fuzzing leaves no files
+// behind. A crashing case keeps it: the input that crashed is then still there to look at.
+class ScratchDir {
+ public:
+  ScratchDir() : path_(std::filesystem::temp_directory_path() / ("angiosynth-fuzz-" + std::to_string(::getpid()))) {
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
 inline std::filesystem::path scratchDir() {
-  static const std::filesystem::path d = [] {
-    auto p = std::filesystem::temp_directory_path() / ("angiosynth-fuzz-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(p);
-    return p;
-  }();
-  return d;
+  static const ScratchDir d;
+  return d.path();
 }
 
 inline std::filesystem::path writeInput(const std::uint8_t* data, std::size_t size, const std::string& name) {
