@@ -13,6 +13,8 @@ else
 fi
 # ccache hits across clones (CI builds a fresh clone): paths below the checkout count as relative.
 export CCACHE_BASEDIR="$(pwd)" CCACHE_NOHASHDIR=1
+# Units compiled with a precompiled header are cached only with these sloppiness flags.
+export CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 cmake -S . -B build -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" -DANGIOSYNTH_WERROR="${WERROR:-OFF}" -DANGIOSYNTH_TESTS="$tests" "${launcher[@]}" >/dev/null
