@@ -365,23 +365,28 @@ class CcoGrower {
     return o;
   }
 
-  // Records c's path and cost at its bifurcation and sets c.valid if its three segments are
-  // longer than twice their radii (in final-domain units) and inside the domain.
+  // The lengths of c's three segments (parent part, distal part, terminal) in the tree as it is.
+  static std::array<double, 3> lengthsOf(const VascularTree& T, const Connection& c) {
+    const Vec3& b = c.bifurcation;
+    return {distance(T.position[T.parent[c.segment]], b), distance(b, T.position[c.segment]), distance(b, c.terminal)};
+  }
+
+  // Sets c's cost at its bifurcation, and c.valid if its three segments are longer than twice
+  // their radii (in final-domain units) and inside the domain. Its path is recorded only if it is
+  // committed (in connect).
   bool fits(const TreeGrowth& g, Connection& c, std::int64_t n_new, double shrink_new, const BifurcationOptimizer& opt, double margin = 1) const {
     const auto& T = g.tree;
     if (dom_.dimension() == 2) c.bifurcation.z = dom_.planeZ();  // in the plane to the last bit
     const Vec3 x0 = T.position[T.parent[c.segment]], x1 = T.position[c.segment], b = c.bifurcation;
-    const double l[3] = {distance(x0, b), distance(b, x1), distance(b, c.terminal)};
-    c.path.clear();
-    c.cost = opt.cost(c.segment, l[0], l[1], l[2], &c.path);
-    const auto& top = c.path.back();
-    c.root_radius = rootRadius(g.params, top.terminals * g.params.terminalFlow(), top.reduced_resistance);
-    // ρ of the new bifurcation segment: the product of β from the root down the recorded path.
-    double rho_b = 1;
-    for (std::size_t lv = 1; lv < c.path.size(); ++lv) rho_b *= c.path[lv].beta_child;
-    const double rr = rootRadiusFinal(g, n_new, top.reduced_resistance, shrink_new);
+    const auto l = lengthsOf(T, c);
+    const auto sum = opt.summarise(c.segment, l[0], l[1], l[2]);
+    c.cost = sum.cost;
+    c.root_radius = rootRadius(g.params, sum.terminals * g.params.terminalFlow(), sum.reduced_resistance);
+    // ρ of the new bifurcation segment: the product of β from the root down the path.
+    const double rho_b = sum.beta_down;
+    const double rr = rootRadiusFinal(g, n_new, sum.reduced_resistance, shrink_new);
     // Radii in final-domain units: new bifurcation segment, split part, terminal.
-    const double r[3] = {rr * rho_b, rr * rho_b * c.path[0].beta_child, rr * rho_b * c.path[0].beta_other};
+    const double r[3] = {rr * rho_b, rr * rho_b * sum.beta_child, rr * rho_b * sum.beta_other};
     // The root segment gets kRootMargin more: its proximal end is fixed, so the final check
     // cannot lengthen it when the solved root comes out thicker than its mapped radius.
     const double root_margin = startsAtRoot(g, c.segment) ? kRootMargin : 1.0;
@@ -648,12 +653,17 @@ class CcoGrower {
       for (const auto& cand : ranked_) {
         const int k = open[cand.tree];
         auto& g = trees_[k];
-        const Trial& trial = trials_[cand.tree][cand.trial];
-        const Connection& c = trial.c[cand.which];
+        Trial& trial = trials_[cand.tree][cand.trial];
+        Connection& c = trial.c[cand.which];
         if (trial.crosses[cand.which]) {
           ++report_.rejected_intersection;
           continue;
         }
+        // The path fits() summed, now recorded: the tree is as it was then (a refused
+        // connection is rolled back), so the values are the same.
+        const auto l = lengthsOf(g.tree, c);
+        c.path.clear();
+        opts[cand.tree].cost(c.segment, l[0], l[1], l[2], &c.path);
         const auto undo = commitConnection(g.tree, c, opts[cand.tree], g.kernel, g.rel);
         const double rr = rootRadiusFinal(g, n_new[cand.tree], c.path.back().reduced_resistance, shrink_new);
         if (!collides(k, c, rr)) {

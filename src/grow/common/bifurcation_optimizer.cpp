@@ -19,7 +19,10 @@ BifurcationOptimizer::Subtree BifurcationOptimizer::shortened(std::int32_t s, do
   return v;
 }
 
-double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, double l_term, std::vector<PathLevel>* record) const {
+// The walk from the new bifurcation to the root behind cost() and summarise(): visit sees each
+// level's new values, the new bifurcation's first.
+template <class Visit>
+double BifurcationOptimizer::walkToRoot(std::int32_t s, double l_up, double l_down, double l_term, Visit&& visit) const {
   const auto& t = tree_;
   const auto& k = kernel_;
   // The old segment s keeps its subtree but now starts at b.
@@ -31,7 +34,7 @@ double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, do
   double R = combinedResistance(l_up, sp, R_s, R_t);
   double V = k.lengthCost(l_up) + k.radiusCost(sp.beta_a) * V_s + k.radiusCost(sp.beta_b) * V_t;
   std::int32_t n = t.terminals[s] + 1;
-  if (record) record->push_back({-1, s, -1, sp.beta_a, sp.beta_b, R, V, n});
+  visit(PathLevel{-1, s, -1, sp.beta_a, sp.beta_b, R, V, n});
   std::int32_t below = s;
   for (std::int32_t node = t.parent[s]; node != 0; below = node, node = t.parent[node]) {
     const auto other = t.child0[node] == below ? t.child1[node] : t.child0[node];
@@ -39,10 +42,31 @@ double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, do
     R = combinedResistance(t.length[node], sp, R, t.reduced_resistance[other]);
     V = k.lengthCost(t.length[node]) + k.radiusCost(sp.beta_a) * V + k.radiusCost(sp.beta_b) * t.cost_ratio[other];
     n = t.terminals[node] + 1;
-    if (record) record->push_back({node, below, other, sp.beta_a, sp.beta_b, R, V, n});
+    visit(PathLevel{node, below, other, sp.beta_a, sp.beta_b, R, V, n});
   }
   const double r_root = rootRadius(params_, n * params_.terminalFlow(), R);
   return k.radiusCost(r_root) * V;
+}
+
+double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, double l_term, std::vector<PathLevel>* record) const {
+  return walkToRoot(s, l_up, l_down, l_term, [&](const PathLevel& level) {
+    if (record) record->push_back(level);
+  });
+}
+
+BifurcationOptimizer::PathSummary BifurcationOptimizer::summarise(std::int32_t s, double l_up, double l_down, double l_term) const {
+  PathSummary sum{0, 0, 0, 1, 0, 0};
+  bool first = true;
+  sum.cost = walkToRoot(s, l_up, l_down, l_term, [&](const PathLevel& level) {
+    if (first) {
+      sum.beta_child = level.beta_child, sum.beta_other = level.beta_other, first = false;
+    } else {
+      sum.beta_down *= level.beta_child;  // in the order the recorded path multiplies them, from level 1 up
+    }
+    sum.terminals = level.terminals;
+    sum.reduced_resistance = level.reduced_resistance;
+  });
+  return sum;
 }
 
 double BifurcationOptimizer::costAt(std::int32_t s, const Vec3& b, const Vec3& term) const {

@@ -74,6 +74,16 @@ class BifurcationOptimizer {
   void checkObstacles(bool on) { check_obstacles_ = on; }
   // Exact whole-tree cost with the three new lengths (parent part, distal part, terminal).
   double cost(std::int32_t s, double l_up, double l_down, double l_term, std::vector<PathLevel>* record = nullptr) const;
+  // The same walk without recording the path (which allocates, once per trial in parallel): the
+  // cost, what sizes the root, and the β that give the three new segments their radii.
+  struct PathSummary {
+    double cost;
+    std::int32_t terminals;         // at the root
+    double reduced_resistance;      // of the root segment
+    double beta_down;               // product of β on the path from the root down to the new bifurcation segment
+    double beta_child, beta_other;  // of the split part and of the terminal, at the new bifurcation
+  };
+  PathSummary summarise(std::int32_t s, double l_up, double l_down, double l_term) const;
   // Exact cost and its derivatives with respect to the three new lengths, from one walk to the
   // root that carries forward-mode derivatives of (R̃, V) of the new bifurcation segment.
   struct Evaluation {
@@ -109,6 +119,8 @@ class BifurcationOptimizer {
   std::array<double, 3> radiiAt(std::int32_t s, const Vec3& b, const Vec3& t) const;
 
  private:
+  template <class Visit>
+  double walkToRoot(std::int32_t s, double l_up, double l_down, double l_term, Visit&& visit) const;
   struct Level0 {
     double R, V;
   };
