@@ -194,7 +194,8 @@ void LeafSplitter::square(int level, const HalfPoint& origin, int axis, std::arr
   corner[2][std::size_t(b)] += size;
   corner[2][std::size_t(c)] += size;
   corner[3][std::size_t(c)] += size;
-  std::vector<HalfPoint> ring;
+  auto& ring = ring_;
+  ring.clear();
   for (int k = 0; k < 4; ++k) {
     ring.push_back(corner[k]);
     edgePoints(level, corner[k], corner[(k + 1) % 4], ring);

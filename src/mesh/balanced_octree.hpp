@@ -98,6 +98,7 @@ class LeafSplitter {
   };
   int unit_level_ = -1;
   std::array<Window, 3> windows_;  // unit level, one below, two below
+  std::vector<HalfPoint> ring_;    // a face's corners and edge points, reused: faces are many and small
 };
 
 }  // namespace angiosynth
