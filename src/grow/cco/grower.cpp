@@ -365,12 +365,6 @@ class CcoGrower {
     return o;
   }
 
-  // The lengths of c's three segments (parent part, distal part, terminal) in the tree as it is.
-  static std::array<double, 3> lengthsOf(const VascularTree& T, const Connection& c) {
-    const Vec3& b = c.bifurcation;
-    return {distance(T.position[T.parent[c.segment]], b), distance(b, T.position[c.segment]), distance(b, c.terminal)};
-  }
-
   // Sets c's cost at its bifurcation, and c.valid if its three segments are longer than twice
   // their radii (in final-domain units) and inside the domain. Its path is recorded only if it is
   // committed (in connect).
@@ -378,10 +372,9 @@ class CcoGrower {
     const auto& T = g.tree;
     if (dom_.dimension() == 2) c.bifurcation.z = dom_.planeZ();  // in the plane to the last bit
     const Vec3 x0 = T.position[T.parent[c.segment]], x1 = T.position[c.segment], b = c.bifurcation;
-    const auto l = lengthsOf(T, c);
+    const double l[3] = {distance(x0, b), distance(b, x1), distance(b, c.terminal)};
     const auto sum = opt.summarise(c.segment, l[0], l[1], l[2]);
     c.cost = sum.cost;
-    c.root_radius = rootRadius(g.params, sum.terminals * g.params.terminalFlow(), sum.reduced_resistance);
     // ρ of the new bifurcation segment: the product of β from the root down the path.
     const double rho_b = sum.beta_down;
     const double rr = rootRadiusFinal(g, n_new, sum.reduced_resistance, shrink_new);
@@ -661,9 +654,7 @@ class CcoGrower {
         }
         // The path fits() summed, now recorded: the tree is as it was then (a refused
         // connection is rolled back), so the values are the same.
-        const auto l = lengthsOf(g.tree, c);
-        c.path.clear();
-        opts[cand.tree].cost(c.segment, l[0], l[1], l[2], &c.path);
+        opts[cand.tree].record(c);
         const auto undo = commitConnection(g.tree, c, opts[cand.tree], g.kernel, g.rel);
         const double rr = rootRadiusFinal(g, n_new[cand.tree], c.path.back().reduced_resistance, shrink_new);
         if (!collides(k, c, rr)) {

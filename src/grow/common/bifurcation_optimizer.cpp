@@ -56,10 +56,9 @@ double BifurcationOptimizer::cost(std::int32_t s, double l_up, double l_down, do
 
 BifurcationOptimizer::PathSummary BifurcationOptimizer::summarise(std::int32_t s, double l_up, double l_down, double l_term) const {
   PathSummary sum{0, 0, 0, 1, 0, 0};
-  bool first = true;
   sum.cost = walkToRoot(s, l_up, l_down, l_term, [&](const PathLevel& level) {
-    if (first) {
-      sum.beta_child = level.beta_child, sum.beta_other = level.beta_other, first = false;
+    if (level.segment < 0) {  // the new bifurcation
+      sum.beta_child = level.beta_child, sum.beta_other = level.beta_other;
     } else {
       sum.beta_down *= level.beta_child;  // in the order the recorded path multiplies them, from level 1 up
     }
