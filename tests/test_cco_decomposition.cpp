@@ -54,9 +54,10 @@ TEST(CcoDecomposition, JoinedTreeKeepsEveryInvariantAcrossPartBorders) {
   // physics holds everywhere, with no vessel touching another (brute force, across parts and
   // against the trunk), none shorter than twice its radius and none leaving the sphere; the parts
   // were grown thicker than the whole tree makes them, and the trunk's vessels stay inside the
-  // clearance the parts kept.
+  // clearance the parts kept. The domain's voxels are coarse against the terminals' spacing, as
+  // at organ scale: the parts grow on grids of half its voxel.
   const double radius = std::cbrt(3 * 1e5 / (4 * std::numbers::pi));
-  const auto d = GrowthDomain::analytic(DomainShape::Sphere, radius, radius / 50);
+  const auto d = GrowthDomain::analytic(DomainShape::Sphere, radius, radius / 30);
   const auto o = sphereParts(3000, 4, d);
   GrowthReport report;
   const auto t = growCcoDecomposed(d, o, report);
@@ -75,6 +76,7 @@ TEST(CcoDecomposition, JoinedTreeKeepsEveryInvariantAcrossPartBorders) {
   EXPECT_GT(sum.smallest_part_pressure_share, o.part_pressure_share);
   // Every part vessel lies in its own part's domain: parts cannot meet.
   const CcoTrunk trunk = planCcoTrunk(d, o);
+  EXPECT_EQ(trunk.part_voxel_mm, d.frame().voxel_mm / 2);
   std::int64_t sum_n = 0;
   for (auto n : trunk.part_terminals) sum_n += n;
   EXPECT_EQ(sum_n, 3000);
@@ -105,12 +107,31 @@ TEST(CcoDecomposition, SameTreeWhateverTheThreadsAndWhereverThePartsGrow) {
     EXPECT_EQ(a.radius[i], b.radius[i]);
   }
   const CcoTrunk trunk = planCcoTrunk(d, o);
+  // Voxels of a quarter of the terminals' spacing or less: the parts keep them.
+  EXPECT_EQ(trunk.part_voxel_mm, d.frame().voxel_mm);
   std::vector<CcoPart> parts;
   for (int k = 0; k < o.parts; ++k) parts.push_back(growCcoPart(d, trunk, k, o));
   CcoDecompositionSummary sum;
   const auto c = joinCcoParts(d, trunk, parts, o, sum);
   ASSERT_EQ(a.nodeCount(), c.nodeCount());
   for (std::int32_t i = 0; i < a.nodeCount(); ++i) EXPECT_EQ(a.position[i], c.position[i]);
+}
+
+TEST(CcoDecomposition, ATrunkTooThickForItsDomainIsRefusedOnItsCostlyDraws) {
+  // 500 mL/min into a sphere of 8.79 mm: the trunk's vessels, at the bound on their radii, leave
+  // no room for its last terminal. Draws too close to a vessel are cheap and relax the spacing;
+  // the refusal comes from the draws far enough from every vessel that found no connection, each
+  // of which costs an optimisation per neighbour, long before the trunk's limit on all draws.
+  const auto d = GrowthDomain::analytic(DomainShape::Sphere, 8.79, 0.4);
+  const auto o = sphereParts(40, 8, d);
+  try {
+    planCcoTrunk(d, o);
+    FAIL() << "the trunk fitted";
+  } catch (const GrowthError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("the trunk of 8 parts"), std::string::npos) << what;
+    EXPECT_NE(what.find("500 points in a row far enough from every vessel"), std::string::npos) << what;
+  }
 }
 
 }  // namespace

@@ -24,8 +24,15 @@ double secondsSince(std::chrono::steady_clock::time_point t0) { return std::chro
 // Rounds of regrowing the parts whose vessels meet others before the join gives up (and reports them).
 constexpr int kMaxRegrowRounds = 4;
 
-// Failed draws in a row before the trunk gives up (a whole tree's limit is 2·10⁶).
+// Failed draws in a row before the trunk gives up (a whole tree's limit is 2·10⁶), and of those
+// the draws far enough from every vessel that still found no connection: the costly ones. A trunk
+// that fits rarely has more than a few of these in a row (docs/benchmarks.md); one whose vessels
+// are too thick for the domain has nothing else.
 constexpr std::int64_t kTrunkDraws = 20000;
+constexpr std::int64_t kTrunkUnconnectable = 500;
+
+// Domain voxels per terminal spacing from which the parts' grids keep the domain's voxel.
+constexpr double kFineAgainstSpacing = 4;
 
 // Empty voxels around a part's grid, so that its border has outside voxels to measure depth from.
 constexpr int kPartMargin = 2;
@@ -121,7 +128,12 @@ bool growTrunk(const GrowthDomain& domain, const CcoDecompositionOptions& opt, c
   for (std::int32_t i = 1; i < T.nodeCount(); ++i)
     if (T.isTerminal(i)) trunk.terminal_node.push_back(i);
   const DemandMap& m = domain.frame();
-  trunk.part_voxel_mm = opt.part_voxel_mm > 0 ? opt.part_voxel_mm : m.voxel_mm / 2;
+  // The parts' grids halve the domain's voxel where it is coarse against the terminals' spacing
+  // (V/N)^(1/d), so that the band a part loses along its borders stays thin against that
+  // spacing; where the voxel is already a quarter of the spacing or less, halving it would only
+  // multiply each part's grid, and its depth map, by 2^d.
+  const double spacing = std::pow(domain.measure() / double(opt.cco.terminals), 1.0 / domain.dimension());
+  trunk.part_voxel_mm = opt.part_voxel_mm > 0 ? opt.part_voxel_mm : spacing >= kFineAgainstSpacing * m.voxel_mm ? m.voxel_mm : m.voxel_mm / 2;
   trunk.clearance_mm.assign(std::size_t(T.nodeCount()), 0.0);
   trunk.domain_voxel_mm = m.voxel_mm;
   trunk.clearance_end = T.position;
@@ -177,6 +189,7 @@ CcoTrunk planCcoTrunk(const GrowthDomain& domain, const CcoDecompositionOptions&
   o.organ_scale = false;
   // A few terminals over the whole domain: when this many draws in a row fail, its vessels do not fit.
   o.max_draws = std::min<std::int64_t>(o.max_draws, kTrunkDraws);
+  o.max_unconnectable = std::min<std::int64_t>(o.max_unconnectable, kTrunkUnconnectable);
   // Grown with its radii at the bound on their final values (a drop trunk_radius_factor⁴ times
   // smaller), so that its own checks (length, overlap, inside) hold for the whole tree's radii.
   o.physics.perfusion_pressure =

@@ -33,8 +33,9 @@ struct CcoDecompositionOptions {
   // A part is grown with this share of the root-to-terminal pressure drop across it; the whole
   // tree leaves it more (measured: docs/benchmarks.md), so the join only shrinks its radii.
   double part_pressure_share = 0.4;
-  // Voxel of the parts' grids (mm); 0: half the domain's. Parts lose a voxel at the domain's
-  // border and on each side of a border between two parts.
+  // Voxel of the parts' grids (mm); 0: half the domain's, or the domain's own where it is a
+  // quarter of the terminals' spacing or less. Parts lose a voxel at the domain's border and on
+  // each side of a border between two parts.
   double part_voxel_mm = 0;
 };
 

@@ -740,11 +740,14 @@ class CcoGrower {
       // At organ scale the threshold the last connection was made at carries over: starting from
       // δ_max again, every terminal of a large tree spends a run of rejected draws relaxing it.
       if (opt_.organ_scale && relaxed_[std::size_t(si)] > 0) delta = std::min(delta, relaxed_[std::size_t(si)]);
+      std::int64_t unconnectable = 0;  // of this run of failures
       for (std::int64_t failures = 1;; ++failures) {
-        if (failures > opt_.max_draws)
+        if (failures > opt_.max_draws || unconnectable >= opt_.max_unconnectable)
           throw GrowthError("could place only " + std::to_string(n) + " of " + std::to_string(sys.target) + " terminals" +
-                            (systems_.size() > 1 ? " of system " + std::to_string(si + 1) : std::string()) + ": " + std::to_string(opt_.max_draws) +
-                            " points in a row found no valid connection "
+                            (systems_.size() > 1 ? " of system " + std::to_string(si + 1) : std::string()) + ": " +
+                            (failures > opt_.max_draws ? std::to_string(opt_.max_draws) + " points in a row"
+                                                       : std::to_string(unconnectable) + " points in a row far enough from every vessel") +
+                            " found no valid connection "
                             "(too close " +
                             std::to_string(report_.rejected_too_close) + ", unconnectable " + std::to_string(report_.rejected_unreachable) +
                             "); lower the number of terminals or enlarge the domain");
@@ -765,6 +768,7 @@ class CcoGrower {
             break;
           }
           ++report_.rejected_unreachable;
+          ++unconnectable;
         }
         if (failures % opt_.draws_before_relaxing == 0) {
           delta *= opt_.relaxation;
