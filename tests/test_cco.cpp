@@ -542,3 +542,20 @@ TEST(Cco, OrganScaleTreesKeepEveryInvariantAtNearlyTheSameVolume) {
     EXPECT_EQ(a.radius[i], b.radius[i]);
   }
 }
+
+TEST(Cco, VesselsTooThickForTheirDomainAreRefusedOnTheirCostlyDraws) {
+  // Karch et al.'s 500 mL/min into a disc of 2 mm: no second vessel fits beside the first. Draws
+  // too close to a vessel are cheap and relax the spacing; the refusal comes from the draws far
+  // enough from every vessel that found no connection, each of which costs an optimisation per
+  // neighbour, long before the limit on all draws.
+  const auto d = GrowthDomain::analytic(DomainShape::Disc, 2, 0.05);
+  const auto o = karch(3, d);
+  GrowthReport rep;
+  try {
+    growCco(d, o, rep);
+    FAIL() << "the tree fitted";
+  } catch (const GrowthError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("20000 points in a row far enough from every vessel"), std::string::npos) << what;
+  }
+}

@@ -130,7 +130,7 @@ TEST(CcoDecomposition, ATrunkTooThickForItsDomainIsRefusedOnItsCostlyDraws) {
   } catch (const GrowthError& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("the trunk of 8 parts"), std::string::npos) << what;
-    EXPECT_NE(what.find("500 points in a row far enough from every vessel"), std::string::npos) << what;
+    EXPECT_NE(what.find("2000 points in a row far enough from every vessel"), std::string::npos) << what;
   }
 }
 

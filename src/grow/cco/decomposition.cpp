@@ -24,12 +24,12 @@ double secondsSince(std::chrono::steady_clock::time_point t0) { return std::chro
 // Rounds of regrowing the parts whose vessels meet others before the join gives up (and reports them).
 constexpr int kMaxRegrowRounds = 4;
 
-// Failed draws in a row before the trunk gives up (a whole tree's limit is 2·10⁶), and of those
-// the draws far enough from every vessel that still found no connection: the costly ones. A trunk
-// that fits rarely has more than a few of these in a row (docs/benchmarks.md); one whose vessels
-// are too thick for the domain has nothing else.
+// Failed draws in a row before the trunk gives up, and of those the draws far enough from every
+// vessel that still found no connection (a whole tree's limits are 2·10⁶ and 20,000): a trunk of
+// a few terminals over the whole domain that fits showed at most a few of the latter in a row
+// (docs/benchmarks.md).
 constexpr std::int64_t kTrunkDraws = 20000;
-constexpr std::int64_t kTrunkUnconnectable = 500;
+constexpr std::int64_t kTrunkUnconnectable = 2000;
 
 // Domain voxels per terminal spacing from which the parts' grids keep the domain's voxel.
 constexpr double kFineAgainstSpacing = 4;

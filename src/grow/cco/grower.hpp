@@ -55,10 +55,11 @@ struct CcoOptions {
   std::uint64_t sample = 0;
   int max_repair_rounds = 30;
   std::int64_t max_draws = 2000000;  // consecutive failed draws before giving up
-  // Consecutive draws, far enough from every vessel, that no vessel could connect to before
-  // giving up: each costs a bifurcation optimisation per neighbour, where a draw too close costs a
-  // lookup. The default is max_draws'; a decomposition's trunk sets less.
-  std::int64_t max_unconnectable = 2000000;
+  // Of those, the draws far enough from every vessel that no vessel could connect to: each costs
+  // a bifurcation optimisation per neighbour, where a draw too close costs a lookup. Trees that
+  // fit showed at most a few hundred in a row (a part's first vessels, beside the trunk), vessels
+  // too thick for their domain nothing else (docs/benchmarks.md).
+  std::int64_t max_unconnectable = 20000;
   // Organ scale: each terminal's distance threshold starts where the last connection's stood
   // rather than at δ_max, the relative radii of the whole tree are refreshed once it has grown by
   // 1/256 of itself rather than every 64 terminals, and only the lightest of Kamiya's points are
