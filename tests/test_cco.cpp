@@ -556,6 +556,6 @@ TEST(Cco, VesselsTooThickForTheirDomainAreRefusedOnTheirCostlyDraws) {
     FAIL() << "the tree fitted";
   } catch (const GrowthError& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("20000 points in a row far enough from every vessel"), std::string::npos) << what;
+    EXPECT_NE(what.find("5000 points in a row far enough from every vessel"), std::string::npos) << what;
   }
 }

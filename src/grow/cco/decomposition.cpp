@@ -25,7 +25,7 @@ double secondsSince(std::chrono::steady_clock::time_point t0) { return std::chro
 constexpr int kMaxRegrowRounds = 4;
 
 // Failed draws in a row before the trunk gives up, and of those the draws far enough from every
-// vessel that still found no connection (a whole tree's limits are 2·10⁶ and 20,000): a trunk of
+// vessel that still found no connection (a whole tree's limits are 2·10⁶ and 5,000): a trunk of
 // a few terminals over the whole domain that fits showed at most a few of the latter in a row
 // (docs/benchmarks.md).
 constexpr std::int64_t kTrunkDraws = 20000;

@@ -59,7 +59,7 @@ struct CcoOptions {
   // a bifurcation optimisation per neighbour, where a draw too close costs a lookup. Trees that
   // fit showed at most a few hundred in a row (a part's first vessels, beside the trunk), vessels
   // too thick for their domain nothing else (docs/benchmarks.md).
-  std::int64_t max_unconnectable = 20000;
+  std::int64_t max_unconnectable = 5000;
   // Organ scale: each terminal's distance threshold starts where the last connection's stood
   // rather than at δ_max, the relative radii of the whole tree are refreshed once it has grown by
   // 1/256 of itself rather than every 64 terminals, and only the lightest of Kamiya's points are
