@@ -14,6 +14,7 @@
 #include "grow/common/bifurcation_optimizer.hpp"
 #include "grow/common/intersections.hpp"
 #include "grow/common/kamiya.hpp"
+#include "grow/common/spread_bifurcation.hpp"
 #include "core/segment_index.hpp"
 #include "physics/hemodynamics.hpp"
 #include "test_support.hpp"
@@ -213,6 +214,51 @@ TEST(Cco, ATrunkBlockedOnlyBySmallVesselsIsLengthenedNotLeftShort) {
   EXPECT_EQ(rep.intersecting_pairs, 0);
   EXPECT_EQ(t.terminalCount(), 20000);
   for (std::int32_t s = 1; s < t.nodeCount(); ++s) ASSERT_GT(t.length[s], 2 * t.radius[s]) << "segment " << s;
+}
+
+TEST(Cco, ABifurcationBetweenShortSegmentsIsSpreadUntilEachIsLongEnough) {
+  // The repair's last free move for a short trunk whose sibling is as short (seen near the
+  // roots of organ-scale trees grown in parts, where each such trunk cost a side branch of
+  // thousands of terminals): every bifurcation of a real tree, its trunk and larger child made
+  // short (r = 0.55 l), is spread so that all three segments reach 2.05 r.
+  const double radius = std::cbrt(3 * 1e5 / (4 * std::numbers::pi));
+  const auto d = GrowthDomain::analytic(DomainShape::Sphere, radius, radius / 50);
+  GrowthReport rep;
+  const auto t = growCco(d, karch(2000, d), rep);
+  int spread = 0, tried = 0;
+  for (std::int32_t v = 1; v < t.nodeCount(); ++v) {
+    if (t.isTerminal(v)) continue;
+    auto s = t;
+    const auto larger = s.terminals[s.child0[v]] >= s.terminals[s.child1[v]] ? s.child0[v] : s.child1[v];
+    for (const auto x : {v, larger}) s.radius[x] = 0.55 * s.length[x];
+    const auto lengths = [&](const Vec3& q) {
+      return std::array<double, 3>{distance(q, s.position[s.parent[v]]) / s.radius[v], distance(q, s.position[s.child0[v]]) / s.radius[s.child0[v]],
+                                   distance(q, s.position[s.child1[v]]) / s.radius[s.child1[v]]};
+    };
+    ++tried;
+    const auto q = spreadBifurcation(s, v);
+    if (!q) continue;
+    ++spread;
+    for (const double l : lengths(*q)) ASSERT_GE(l, kSpreadSettled) << "bifurcation " << v;
+    const double thickest = std::max({s.radius[v], s.radius[s.child0[v]], s.radius[s.child1[v]]});
+    EXPECT_LE(distance(*q, s.position[v]), kSpreadLength * thickest) << "bifurcation " << v;
+  }
+  EXPECT_GE(spread, 0.99 * tried) << spread << " of " << tried;
+  // Nothing to do where every segment is long enough, and no answer where the ends leave no
+  // room within 2.1 r (the nearest room is 2 away, the pushes end 3.1 away).
+  const auto long_enough = [&](std::int32_t x) { return t.length[x] >= kSpreadSettled * t.radius[x]; };
+  for (std::int32_t v = 1; v < t.nodeCount(); ++v) {
+    if (!t.isTerminal(v) && long_enough(v) && long_enough(t.child0[v]) && long_enough(t.child1[v])) {
+      ASSERT_FALSE(spreadBifurcation(t, v)) << "bifurcation " << v;
+    }
+  }
+  VascularTree cramped;
+  cramped.addNode(Vec3(0, 0, 0), -1);
+  const auto mid = cramped.addNode(Vec3(1, 0, 0), 0);
+  cramped.addNode(Vec3(2, 0, 0), mid);
+  cramped.addNode(Vec3(1, 3, 0), mid);
+  cramped.radius.assign(4, 1.0);
+  EXPECT_FALSE(spreadBifurcation(cramped, mid));
 }
 
 TEST(Cco, AnAncestorKeptBackByATinyVesselGrowsOnAndTheRepairRegrowsTheVessel) {

@@ -12,6 +12,7 @@
 #include "grow/common/connection_commit.hpp"
 #include "grow/common/intersections.hpp"
 #include "grow/common/kamiya.hpp"
+#include "grow/common/spread_bifurcation.hpp"
 #include "core/point_hash.hpp"
 #include "core/segment_index.hpp"
 
@@ -856,7 +857,8 @@ class CcoGrower {
 
   // A trunk that thickened past half its length since it was made: slide its distal
   // bifurcation outwards (along the trunk, or towards its children), or its proximal one back,
-  // to 2.1–3 r, whichever first fits. Failing that, the same slides to 2.1 r where only small
+  // to 2.1–3 r, or move either end away from every segment end it is too close to, whichever
+  // first fits. Failing that, the same moves to 2.1 r where only small
   // vessels (at most kMaxClearedTerminals terminals or 1/kSmallBeside of the trunk's, fewer
   // than its own, so none of its ancestors) are in the way: they go to `regrow`. A trunk left
   // short is typically blocked by a single terminal segment.
@@ -870,7 +872,16 @@ class CcoGrower {
     const std::int32_t small = std::min(smallBeside(T, s), T.terminals[s] - 1);
     if (!T.isTerminal(s) && tryMove(k, s, a + u * L, &regrow, small)) return true;
     if (P > 0 && tryMove(k, P, e - u * L, &regrow, small)) return true;
-    return slideWithNeighbour(k, s, &regrow, small);
+    return slideWithNeighbour(k, s, &regrow, small) || spreadEnd(k, s, &regrow, small);
+  }
+
+  // Both ends of s moved, in turn, away from every node they are too close to (spreadBifurcation).
+  bool spreadEnd(int k, std::int32_t s, std::vector<std::int32_t>* regrow = nullptr, std::int32_t small = 0) {
+    const auto& T = trees_[k].tree;
+    for (const auto v : {s, T.parent[s]})
+      if (v > 0 && !T.isTerminal(v))
+        if (const auto q = spreadBifurcation(T, v); q && tryMove(k, v, *q, regrow, small)) return true;
+    return false;
   }
 
   // In a chain of trunks each near 2r, neither neighbour has the room alone: both ends of s
@@ -926,7 +937,7 @@ class CcoGrower {
           const Vec3 d = u * std::cos(t) + (p1 * std::cos(phi) + p2 * std::sin(phi)) * std::sin(t);
           if (tryMove(k, s, a + d * (f * T.radius[s]))) return true;
         }
-    return false;
+    return spreadEnd(k, s);
   }
 
   // A segment that the solved radii push out of the domain (its subtree too large to regrow):
