@@ -239,14 +239,14 @@ TEST(Cco, ABifurcationBetweenShortSegmentsIsSpreadUntilEachIsLongEnough) {
     const auto q = spreadBifurcation(s, v);
     if (!q) continue;
     ++spread;
-    for (const double l : lengths(*q)) ASSERT_GE(l, kSpreadSettled) << "bifurcation " << v;
+    for (const double l : lengths(*q)) ASSERT_GE(l, 2 * kSpreadSettled) << "bifurcation " << v;
     const double thickest = std::max({s.radius[v], s.radius[s.child0[v]], s.radius[s.child1[v]]});
-    EXPECT_LE(distance(*q, s.position[v]), kSpreadLength * thickest) << "bifurcation " << v;
+    EXPECT_LE(distance(*q, s.position[v]), 2 * kSpreadLength * thickest) << "bifurcation " << v;
   }
   EXPECT_GE(spread, 0.99 * tried) << spread << " of " << tried;
   // Nothing to do where every segment is long enough, and no answer where the ends leave no
   // room within 2.1 r (the nearest room is 2 away, the pushes end 3.1 away).
-  const auto long_enough = [&](std::int32_t x) { return t.length[x] >= kSpreadSettled * t.radius[x]; };
+  const auto long_enough = [&](std::int32_t x) { return t.length[x] >= 2 * kSpreadSettled * t.radius[x]; };
   for (std::int32_t v = 1; v < t.nodeCount(); ++v) {
     if (!t.isTerminal(v) && long_enough(v) && long_enough(t.child0[v]) && long_enough(t.child1[v])) {
       ASSERT_FALSE(spreadBifurcation(t, v)) << "bifurcation " << v;

@@ -5,7 +5,7 @@
 
 namespace angiosynth {
 
-std::optional<Vec3> spreadBifurcation(const VascularTree& tree, std::int32_t v) {
+std::optional<Vec3> spreadBifurcation(const VascularTree& tree, std::int32_t v, double min_ratio) {
   if (tree.parent[v] < 0) return std::nullopt;
   std::array<std::int32_t, 3> segs{v, tree.child0[v], tree.child1[v]};
   std::array<Vec3, 3> far_end{tree.position[tree.parent[v]]};
@@ -22,12 +22,12 @@ std::optional<Vec3> spreadBifurcation(const VascularTree& tree, std::int32_t v) 
       if (segs[i] < 0) continue;
       const Vec3 d = q - far_end[i];
       const double len = norm(d);
-      if (len >= kSpreadSettled * tree.radius[segs[i]]) continue;
+      if (len >= kSpreadSettled * min_ratio * tree.radius[segs[i]]) continue;
       if (!(len > 0)) return std::nullopt;
       settled = false;
-      q = q + d * ((kSpreadLength * tree.radius[segs[i]] - len) / len);
+      q = q + d * ((kSpreadLength * min_ratio * tree.radius[segs[i]] - len) / len);
     }
-    if (settled) return sweep > 0 && distance(q, tree.position[v]) <= kSpreadLength * thickest ? std::optional<Vec3>(q) : std::nullopt;
+    if (settled) return sweep > 0 && distance(q, tree.position[v]) <= kSpreadLength * min_ratio * thickest ? std::optional<Vec3>(q) : std::nullopt;
   }
   return std::nullopt;
 }
