@@ -7,6 +7,14 @@
 namespace angiosynth {
 
 void VascularTree::junctionChildren(std::int32_t i, std::vector<std::int32_t>& out) const {
+  // Grown trees have no links: their children directly, without the walk's allocation (this runs
+  // for every pair the collision checks meet).
+  const auto plain = [&](std::int32_t c) { return c < 0 || !isLink(c); };
+  if (plain(child0[i]) && plain(child1[i])) {
+    for (const auto c : {child0[i], child1[i]})
+      if (c >= 0) out.push_back(c);
+    return;
+  }
   // Depth first, child0 before child1, without recursion: a file's junction may have thousands
   // of children, hence a chain of as many links.
   std::vector<std::int32_t> stack;

@@ -84,7 +84,9 @@ bool BifurcationOptimizer::admissible(std::int32_t s, const Vec3& b, const Vec3&
 }
 
 std::array<double, 3> BifurcationOptimizer::radiiAt(std::int32_t s, const Vec3& b, const Vec3& term) const {
-  std::vector<PathLevel> path;
+  // Reused: this runs several times for every trial, and a fresh path grew by reallocation.
+  thread_local std::vector<PathLevel> path;
+  path.clear();
   const double l_up = std::max(distance(tree_.position[tree_.parent[s]], b), min_length_);
   cost(s, l_up, std::max(distance(b, tree_.position[s]), min_length_), std::max(distance(b, term), min_length_), &path);
   const auto& top = path.back();

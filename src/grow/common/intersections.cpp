@@ -11,6 +11,14 @@ namespace angiosynth {
 
 bool withinTwoSegments(const VascularTree& t, std::int32_t x, std::int32_t y) {
   // Segments are edges; they are ≤ 2 apart iff some end of y is an end of x or a neighbour of one.
+  const auto p = t.parent[x], pp = t.parent[p];
+  // Where no node involved is a link (every grown tree), directly: this runs for every pair the
+  // collision checks meet.
+  const auto plain = [&](std::int32_t v) { return v < 0 || !t.isLink(v); };
+  if (plain(x) && plain(p) && plain(pp) && plain(t.sibling(x)) && plain(t.child0[x]) && plain(t.child1[x]) && plain(y) && plain(t.parent[y])) {
+    const auto near = [&](std::int32_t v) { return v == p || v == x || v == pp || t.parent[v] == p || t.parent[v] == x; };
+    return near(y) || near(t.parent[y]);
+  }
   // The nodes of an N-ary junction (joined by links) count as one node.
   thread_local std::vector<std::int32_t> near;
   near.clear();
