@@ -14,6 +14,7 @@
 #include "grow/common/bifurcation_optimizer.hpp"
 #include "grow/common/connection_commit.hpp"
 #include "grow/common/intersections.hpp"
+#include "grow/common/spread_bifurcation.hpp"
 #include "core/segment_index.hpp"
 
 namespace angiosynth {
@@ -389,6 +390,10 @@ class Grower {
           const Vec3 d = u * std::cos(t) + (p1 * std::cos(phi) + p2 * std::sin(phi)) * std::sin(t);
           if (tryMove(s, a + d * (f * opt_.min_length_ratio * tree_.radius[s]) - e, index)) return true;
         }
+    // A sibling or child as short: either end away from every end it is too close to.
+    for (const auto v : {s, P})
+      if (v > 0 && !tree_.isTerminal(v))
+        if (const auto q = spreadBifurcation(tree_, v, opt_.min_length_ratio); q && tryMove(v, *q - tree_.position[v], index)) return true;
     return false;
   }
 
