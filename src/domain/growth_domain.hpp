@@ -5,6 +5,7 @@
 // VascuSynth growth share one domain model. Disc, square and one-slice masks are 2D: the tree
 // lies in the plane z = plane_z and CCO's scaling laws use d = 2.
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -34,6 +35,9 @@ class GrowthDomain {
   DomainShape shape() const { return shape_; }
   int dimension() const { return dimension_; }
   double measure() const { return measure_; }  // mm² (2D) or mm³ (3D)
+  // (V/n)^(1/d): the spacing of n terminals spread evenly over the domain (δ_max of Kerautret
+  // et al. (OpenCCO) eq. 15).
+  double terminalSpacing(std::int64_t n) const { return std::pow(measure_ / double(n), 1.0 / dimension_); }
   const DemandMap& frame() const { return map_; }
   Vec3 lo() const { return Vec3(0, 0, 0); }
   Vec3 hi() const { return map_.extentMm(); }

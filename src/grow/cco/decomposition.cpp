@@ -132,7 +132,7 @@ bool growTrunk(const GrowthDomain& domain, const CcoDecompositionOptions& opt, c
   // (V/N)^(1/d), so that the band a part loses along its borders stays thin against that
   // spacing; where the voxel is already a quarter of the spacing or less, halving it would only
   // multiply each part's grid, and its depth map, by 2^d.
-  const double spacing = std::pow(domain.measure() / double(opt.cco.terminals), 1.0 / domain.dimension());
+  const double spacing = domain.terminalSpacing(opt.cco.terminals);
   trunk.part_voxel_mm = opt.part_voxel_mm > 0 ? opt.part_voxel_mm : spacing >= kFineAgainstSpacing * m.voxel_mm ? m.voxel_mm : m.voxel_mm / 2;
   trunk.clearance_mm.assign(std::size_t(T.nodeCount()), 0.0);
   trunk.domain_voxel_mm = m.voxel_mm;

@@ -736,8 +736,8 @@ class CcoGrower {
         continue;
       }
       const std::int64_t n = systemTerminals(sys);
-      // δ_max (Kerautret et al. (OpenCCO) eq. 15) for the system's current number of terminals, relaxed by runs of failures.
-      double delta = std::pow(dom_.measure() / double(n), 1.0 / dom_.dimension());
+      // δ_max for the system's current number of terminals, relaxed by runs of failures.
+      double delta = dom_.terminalSpacing(n);
       // At organ scale the threshold the last connection was made at carries over: starting from
       // δ_max again, every terminal of a large tree spends a run of rejected draws relaxing it.
       if (opt_.organ_scale && relaxed_[std::size_t(si)] > 0) delta = std::min(delta, relaxed_[std::size_t(si)]);
@@ -787,7 +787,7 @@ class CcoGrower {
     if (opt_.spacing_from == TerminalSpacing::Segments) return g.index.anyWithin(g.tree, p, spacing);
     const auto& T = g.tree;
     if (!g.terminal_grid || T.nodeCount() < g.grid_nodes || g.terminalCount() >= 2 * g.grid_built) {
-      const double delta = std::pow(dom_.measure() / double(std::max<std::int64_t>(1, g.terminalCount())), 1.0 / dom_.dimension());
+      const double delta = dom_.terminalSpacing(std::max<std::int64_t>(1, g.terminalCount()));
       g.terminal_grid = std::make_unique<PointHash>(dom_.lo(), dom_.hi(), std::max(spacing, delta), dom_.dimension() == 2);
       g.grid_nodes = 0;
       g.grid_built = g.terminalCount();
