@@ -226,9 +226,10 @@ TEST(Cco, ABifurcationBetweenShortSegmentsIsSpreadUntilEachIsLongEnough) {
   GrowthReport rep;
   const auto t = growCco(d, karch(2000, d), rep);
   int spread = 0, tried = 0;
+  auto s = t;
   for (std::int32_t v = 1; v < t.nodeCount(); ++v) {
     if (t.isTerminal(v)) continue;
-    auto s = t;
+    s.radius = t.radius;
     const auto larger = s.terminals[s.child0[v]] >= s.terminals[s.child1[v]] ? s.child0[v] : s.child1[v];
     for (const auto x : {v, larger}) s.radius[x] = 0.55 * s.length[x];
     const auto lengths = [&](const Vec3& q) {
