@@ -1,5 +1,5 @@
 #pragma once
-// A bifurcation moved so that none of its segments is shorter than twice its radius.
+// A bifurcation moved so that none of its segments is shorter than a given number of radii.
 #include <cstdint>
 #include <optional>
 
@@ -12,9 +12,9 @@ namespace angiosynth {
 // each segment still shorter than kSpreadSettled × `min_ratio` radii, in a few sweeps. nullopt if
 // no segment is short, or if the pushes do not settle within kSpreadLength × `min_ratio` radii
 // of the thickest of them (the ends leave no room nearby: a farther move would reshape the
-// bifurcation, not lengthen it). Near the root of an organ-scale tree a
-// short trunk's sibling or child is often as short as the trunk: a slide along one segment
-// shortens the other, and only a move away from all of them lengthens both.
+// bifurcation, not lengthen it). Near the root of an organ-scale tree a short trunk's sibling or
+// child is often as short as the trunk: a slide along one segment shortens the other, and only a
+// move away from all of them lengthens both.
 std::optional<Vec3> spreadBifurcation(const VascularTree& tree, std::int32_t v, double min_ratio = 2);
 
 // The length, in minimum lengths, the pushes give a short segment...
