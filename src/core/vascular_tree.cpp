@@ -7,8 +7,8 @@
 namespace angiosynth {
 
 void VascularTree::junctionChildren(std::int32_t i, std::vector<std::int32_t>& out) const {
-  // Grown trees have no links: their children directly, without the walk's allocation (this runs
-  // for every pair the collision checks meet).
+  // Grown trees have no links: their children directly, without the walk's allocation (graph
+  // writers and morphometry ask this of every node).
   const auto plain = [&](std::int32_t c) { return c < 0 || !isLink(c); };
   if (plain(child0[i]) && plain(child1[i])) {
     for (const auto c : {child0[i], child1[i]})

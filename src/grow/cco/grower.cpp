@@ -875,13 +875,9 @@ class CcoGrower {
     return slideWithNeighbour(k, s, &regrow, small) || spreadEnd(k, s, &regrow, small);
   }
 
-  // Both ends of s moved, in turn, away from every node they are too close to (spreadBifurcation).
+  // Either end of s moved away from every node it is too close to (spreadEitherEnd).
   bool spreadEnd(int k, std::int32_t s, std::vector<std::int32_t>* regrow = nullptr, std::int32_t small = 0) {
-    const auto& T = trees_[k].tree;
-    for (const auto v : {s, T.parent[s]})
-      if (v > 0 && !T.isTerminal(v))
-        if (const auto q = spreadBifurcation(T, v); q && tryMove(k, v, *q, regrow, small)) return true;
-    return false;
+    return spreadEitherEnd(trees_[k].tree, s, 2, [&](std::int32_t v, const Vec3& q) { return tryMove(k, v, q, regrow, small); });
   }
 
   // In a chain of trunks each near 2r, neither neighbour has the room alone: both ends of s

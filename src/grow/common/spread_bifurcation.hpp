@@ -17,6 +17,17 @@ namespace angiosynth {
 // move away from all of them lengthens both.
 std::optional<Vec3> spreadBifurcation(const VascularTree& tree, std::int32_t v, double min_ratio = 2);
 
+// spreadBifurcation at each end of segment s in turn, its distal node then its proximal one
+// (bifurcations only), each point handed to the grower's own checked move(v, q); true once one
+// is taken.
+template <class Move>
+bool spreadEitherEnd(const VascularTree& tree, std::int32_t s, double min_ratio, Move&& move) {
+  for (const auto v : {s, tree.parent[s]})
+    if (v >= 0 && !tree.isRoot(v) && !tree.isTerminal(v))
+      if (const auto q = spreadBifurcation(tree, v, min_ratio); q && move(v, *q)) return true;
+  return false;
+}
+
 // The length, in minimum lengths, the pushes give a short segment...
 inline constexpr double kSpreadLength = 1.05;
 // ... and the length from which a segment counts as long enough (the growers' checks allow a

@@ -391,10 +391,7 @@ class Grower {
           if (tryMove(s, a + d * (f * opt_.min_length_ratio * tree_.radius[s]) - e, index)) return true;
         }
     // A sibling or child as short: either end away from every end it is too close to.
-    for (const auto v : {s, P})
-      if (v > 0 && !tree_.isTerminal(v))
-        if (const auto q = spreadBifurcation(tree_, v, opt_.min_length_ratio); q && tryMove(v, *q - tree_.position[v], index)) return true;
-    return false;
+    return spreadEitherEnd(tree_, s, opt_.min_length_ratio, [&](std::int32_t v, const Vec3& q) { return tryMove(v, q - tree_.position[v], index); });
   }
 
   Removal removalOf(std::int32_t s) const {
