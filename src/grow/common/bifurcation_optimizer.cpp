@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <optional>
 #include <span>
 
 #include "domain/demand_map.hpp"
@@ -96,13 +97,12 @@ std::array<double, 3> BifurcationOptimizer::radiiAt(std::int32_t s, const Vec3& 
 }
 
 bool BifurcationOptimizer::keepsLengthRatio(const Connection& c) const {
-  return !(length_ratio_ > 0) || admissible(c.segment, c.bifurcation, c.terminal, minimumsAt(c.segment, c.bifurcation, c.terminal));
+  return !(length_ratio_ > 0) || admissible(c.segment, c.bifurcation, c.terminal, minimumsFrom(c.segment, c.radii));
 }
 
-BifurcationOptimizer::MinLengths BifurcationOptimizer::minimumsAt(std::int32_t s, const Vec3& b, const Vec3& term) const {
+BifurcationOptimizer::MinLengths BifurcationOptimizer::minimumsFrom(std::int32_t s, const std::array<double, 3>& r) const {
   MinLengths m{min_length_, min_length_, min_length_};
   if (!(length_ratio_ > 0)) return m;
-  const auto r = radiiAt(s, b, term);
   for (int j = 0; j < 3; ++j) m[j] = std::max(m[j], length_ratio_ * radius_scale_ * r[j]);
   if (tree_.parent[s] == 0) m[0] = std::max(m[0], length_ratio_ * root_radius_scale_ * r[0]);
   return m;
@@ -126,10 +126,15 @@ BifurcationOptimizer::Level0 BifurcationOptimizer::level0(std::int32_t s, double
   const auto [R_s, V_s] = shortened(s, l_down);
   const double R_t = l_term, V_t = k.lengthCost(l_term);
   const auto sp = k.split(tree_.terminals[s], R_s, 1.0, R_t, tree_.radius[s]);
-  return {combinedResistance(l_up, sp, R_s, R_t), k.lengthCost(l_up) + k.radiusCost(sp.beta_a) * V_s + k.radiusCost(sp.beta_b) * V_t};
+  return {combinedResistance(l_up, sp, R_s, R_t), k.lengthCost(l_up) + k.radiusCost(sp.beta_a) * V_s + k.radiusCost(sp.beta_b) * V_t, sp.beta_a,
+          sp.beta_b};
 }
 
-BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, const double (&l)[3]) const {
+BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, const double (&l)[3], bool with_radii) const {
+  // β of the path's children, bottom-up: the radii multiply them top-down from the root, in the
+  // order radiiAt does, so that both give the same bits.
+  thread_local std::vector<double> betas;
+  betas.clear();
   const auto& t = tree_;
   const auto& k = kernel_;
   const double lambda = params_.cost_radius_exponent;
@@ -151,6 +156,7 @@ BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, 
     const double inv = 1.0 / (4.0 * R * (1.0 + u));
     const double dV_dR = lambda * inv * (bc * V * u - bo * V_o);
     const double dR_dR = 1.0 / (R * D * (1.0 + u));
+    if (with_radii) betas.push_back(sp.beta_a);
     bR = dV_dR * a + bc * bR;
     cV = bc * cV;
     a = dR_dR * a;
@@ -162,6 +168,11 @@ BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, 
   const double rl = k.radiusCost(r_root);
   Evaluation e;
   e.cost = rl * V;
+  if (with_radii) {
+    double r = r_root;
+    for (auto beta = betas.rbegin(); beta != betas.rend(); ++beta) r *= *beta;
+    e.radii = {r, r * base.beta_a, r * base.beta_b};
+  }
   const double gR = lambda / 4.0 * e.cost / R * a + rl * bR;  // ∂C/∂R0
   const double gV = rl * cV;                                  // ∂C/∂V0
   // Level 0 depends on the three lengths in O(1): differentiate it numerically.
@@ -190,21 +201,33 @@ bool BifurcationOptimizer::optimumAtProximalNode(std::int32_t s, const Vec3& ter
 
 Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int max_iterations, const Vec3* start) const {
   const std::array<Vec3, 3> ends{tree_.position[tree_.parent[s]], tree_.position[s], term};
-  MinLengths m = minimumsAt(s, start ? *start : (ends[0] + ends[1]) * 0.5, term);
-  Connection c = search(s, term, m, max_iterations, start);
+  MinLengths m = minimumsFrom(s, {});
+  std::optional<Probe> probe;
+  if (length_ratio_ > 0) {
+    // The minimums come from the radii at the start (the midpoint without one). The walk that
+    // gives them also costs that point, which the search reuses when it starts there unmoved.
+    const Vec3 at = start ? *start : (ends[0] + ends[1]) * 0.5;
+    double l[3];
+    for (int j = 0; j < 3; ++j) l[j] = std::max(distance(at, ends[j]), min_length_);
+    probe = Probe{at, evaluate(s, l, true)};
+    m = minimumsFrom(s, probe->evaluation.radii);
+  }
+  Connection c = search(s, term, m, max_iterations, start, probe ? &*probe : nullptr);
   // The radii, and so the minimums, move a little with the bifurcation: search again with the
   // larger of the two until the result keeps its own minimums (once or twice at most).
   for (int pass = 0; pass < 3 && c.valid && length_ratio_ > 0; ++pass) {
-    const MinLengths at = minimumsAt(s, c.bifurcation, term);
+    const MinLengths at = minimumsFrom(s, c.radii);
     if (admissible(s, c.bifurcation, term, at)) return c;
     for (int j = 0; j < 3; ++j) m[j] = std::max(m[j], at[j] * (1 + 1e-6));
-    c = search(s, term, m, max_iterations, start);
+    c = search(s, term, m, max_iterations, start, probe ? &*probe : nullptr);
   }
   if (c.valid && !keepsLengthRatio(c)) c.valid = false;
   return c;
 }
 
-Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const MinLengths& m, int max_iterations, const Vec3* given) const {
+Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const MinLengths& m, int max_iterations, const Vec3* given,
+                                        const Probe* probe) const {
+  const bool with_radii = length_ratio_ > 0;
   const std::array<Vec3, 3> ends{tree_.position[tree_.parent[s]], tree_.position[s], term};
   Connection best;
   best.segment = s;
@@ -226,7 +249,7 @@ Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const 
     if (!admissible(s, start, term, m)) continue;
     double ls[3];
     lengths(start, ls);
-    const Evaluation es = evaluate(s, ls);
+    const Evaluation es = probe && probe->point == start ? probe->evaluation : evaluate(s, ls, with_radii);
     if (have && es.cost >= e.cost) continue;
     have = true;
     b = start;
@@ -255,6 +278,7 @@ Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const 
   if (!(h0 > 0)) {
     best.cost = e.cost;
     best.bifurcation = b;
+    best.radii = e.radii;
     return best;
   }
   // BFGS from the Weiszfeld metric (whose plain step b − h0·∇C is the Weiszfeld point), with
@@ -273,7 +297,7 @@ Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const 
       next = keepLengths(b + dir * t, ends, m);
       if (!admissible(s, next, term, m)) continue;
       lengths(next, ln);
-      en = evaluate(s, ln);
+      en = evaluate(s, ln, with_radii);
       moved = en.cost < e.cost + 1e-4 * t * slope || (t < 0.2 && en.cost < e.cost);
     }
     if (!moved) break;
@@ -303,6 +327,7 @@ Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const 
   }
   best.cost = e.cost;
   best.bifurcation = b;
+  best.radii = e.radii;
   return best;
 }
 
@@ -339,6 +364,7 @@ void BifurcationOptimizer::polish(Connection& c) const {
     }
     if (!improved) step *= 0.5;
   }
+  if (length_ratio_ > 0 && !(b == c.bifurcation)) c.radii = radiiAt(s, b, term);
   c.bifurcation = b;
   c.cost = best_cost;
 }

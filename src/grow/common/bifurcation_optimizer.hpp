@@ -47,6 +47,9 @@ struct Connection {
   bool valid = false;
   bool converged = false;               // the quasi-Newton iteration reached a stationary point
   std::array<double, 3> min_lengths{};  // parent part, distal part, terminal (mm), set by optimise
+  // Radii of the three segments at `bifurcation` after the connection, set by optimise and polish
+  // when a length ratio is on: the walk that costed the point gave them.
+  std::array<double, 3> radii{};
 };
 
 class BifurcationOptimizer {
@@ -88,9 +91,10 @@ class BifurcationOptimizer {
   // root that carries forward-mode derivatives of (R̃, V) of the new bifurcation segment.
   struct Evaluation {
     double cost;
-    double d_length[3];  // ∂C/∂l for parent part, distal part, terminal
+    double d_length[3];             // ∂C/∂l for parent part, distal part, terminal
+    std::array<double, 3> radii{};  // of the three new segments (with_radii only), as radiiAt gives them
   };
-  Evaluation evaluate(std::int32_t s, const double (&l)[3]) const;
+  Evaluation evaluate(std::int32_t s, const double (&l)[3], bool with_radii = false) const;
   // True if the exact optimum on s lies at s's proximal node: there the pull of the other two
   // segments, weighted by ∂C/∂l, is weaker than the parent part's by 1 % (the weighted Fermat
   // condition), one walk to the root.
@@ -114,7 +118,7 @@ class BifurcationOptimizer {
   bool admissible(std::int32_t s, const Vec3& b, const Vec3& t, const MinLengths& m) const;
   // Radii of the three segments meeting at b (parent part, distal part, terminal) after the
   // connection, in the tree as it is now.
-  // True if c's three segments keep the length ratio at their radii at c's bifurcation.
+  // True if c's three segments keep the length ratio at the radii optimise or polish recorded.
   bool keepsLengthRatio(const Connection& c) const;
   std::array<double, 3> radiiAt(std::int32_t s, const Vec3& b, const Vec3& t) const;
 
@@ -123,9 +127,15 @@ class BifurcationOptimizer {
   double walkToRoot(std::int32_t s, double l_up, double l_down, double l_term, Visit&& visit) const;
   struct Level0 {
     double R, V;
+    double beta_a, beta_b;  // of the split part and of the terminal
   };
-  MinLengths minimumsAt(std::int32_t s, const Vec3& b, const Vec3& t) const;
-  Connection search(std::int32_t s, const Vec3& t, const MinLengths& m, int max_iterations, const Vec3* start) const;
+  // A point already costed with its radii, which the search reuses when it starts there.
+  struct Probe {
+    Vec3 point;
+    Evaluation evaluation;
+  };
+  MinLengths minimumsFrom(std::int32_t s, const std::array<double, 3>& radii) const;
+  Connection search(std::int32_t s, const Vec3& t, const MinLengths& m, int max_iterations, const Vec3* start, const Probe* probe) const;
   Vec3 keepLengths(Vec3 b, const std::array<Vec3, 3>& ends, const MinLengths& m) const;
   Level0 level0(std::int32_t s, double l_up, double l_down, double l_term) const;
 
