@@ -500,12 +500,15 @@ class Grower {
           ++moved;
           continue;
         }
-        // A terminal goes with its bifurcation; a trunk merges with its larger child when the
-        // smaller child's subtree goes.
-        const auto gone = tree_.isTerminal(s)                                                    ? s
-                          : tree_.terminals[tree_.child0[s]] <= tree_.terminals[tree_.child1[s]] ? tree_.child0[s]
-                                                                                                 : tree_.child1[s];
-        const Removal r = removalOf(gone);
+        // A terminal goes with its bifurcation. A trunk merges with its larger child when the
+        // smaller child's subtree goes, or with its parent when its sibling's does, whichever
+        // loses fewer terminals: along a trunk of short segments the side branch to lose is
+        // often the small one just above.
+        Removal r = removalOf(s);
+        if (!tree_.isTerminal(s)) {
+          r = std::min(removalOf(tree_.child0[s]), removalOf(tree_.child1[s]));
+          if (tree_.parent[s] > 0) r = std::min(r, removalOf(tree_.sibling(s)));
+        }
         if (r.lost > kMaxRepairShare * double(opt_.terminals)) continue;  // left and reported
         if (r.segment >= 0)
           remove.push_back(r.segment);
