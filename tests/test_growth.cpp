@@ -9,6 +9,7 @@
 #include "core/distributions.hpp"
 #include "core/rng.hpp"
 #include "domain/demand_sampler.hpp"
+#include "domain/supply.hpp"
 #include "grow/common/bifurcation_optimizer.hpp"
 #include "grow/common/intersections.hpp"
 #include "core/segment_index.hpp"
@@ -286,6 +287,32 @@ TEST(DemandSampler, DrawsProportionallyToDemandAndUpdatesExactly) {
   s.update({{1, 0.0}, {3, 2.0}});
   EXPECT_DOUBLE_EQ(s.total(), 11);
   EXPECT_DOUBLE_EQ(s.value(3), 2);
+}
+
+TEST(DemandSampler, PerfusingAllTerminalsAtOnceLeavesTheSameBitsAsOneAtATime) {
+  // The repair recomputes the demand of a grown tree in one parallel pass; it must leave exactly
+  // what perfusing its terminals one by one in the same order leaves, or regrowth would differ.
+  auto ex = test::vascusynthExample(300, 1);
+  const VascularTree t = test::grow(ex);
+  std::vector<Vec3> terminals;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i)
+    if (t.isTerminal(i)) terminals.push_back(t.position[i]);
+  ASSERT_EQ(terminals.size(), 300u);
+  DemandSampler one_by_one(ex.map.demand);
+  std::vector<std::pair<std::int64_t, double>> scratch;
+  for (const Vec3& p : terminals) perfuse(ex.map, one_by_one, p, scratch);
+  for (int threads : {1, 2}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    const DemandSampler at_once = perfusedDemand(ex.map, terminals);
+    std::int64_t lowered = 0, differing = 0;
+    for (std::int64_t v = 0; v < ex.map.voxelCount(); ++v) {
+      lowered += at_once.value(v) < (ex.map.demand[std::size_t(v)] > 0 ? double(ex.map.demand[std::size_t(v)]) : 0.0);
+      differing += at_once.value(v) != one_by_one.value(v);
+    }
+    EXPECT_GT(lowered, 1000) << "the terminals must have supplied many voxels";
+    EXPECT_EQ(differing, 0) << threads << " threads";
+    EXPECT_EQ(at_once.total(), one_by_one.total());
+  }
 }
 
 TEST(DemandMap, SegmentClearDetectsRodsAndBoundary) {

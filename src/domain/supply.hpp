@@ -18,4 +18,9 @@ double supplyFactor(const std::vector<double>& coefficients, double d);
 // only voxels within the cut-off.
 void perfuse(const DemandMap& map, DemandSampler& sampler, const Vec3& terminal_mm, std::vector<std::pair<std::int64_t, double>>& scratch);
 
+// The map's demand after perfusing `terminals_mm` in order: the same products in the same order
+// per voxel as perfuse() one terminal at a time, so the same bits, computed in one pass over
+// slabs of the map in parallel.
+DemandSampler perfusedDemand(const DemandMap& map, const std::vector<Vec3>& terminals_mm);
+
 }  // namespace angiosynth

@@ -402,9 +402,11 @@ class Grower {
 
   // Demand as if only the current terminals had been perfused, in the order they were added.
   void recomputeDemand() {
-    sampler_ = DemandSampler(map_.demand);
+    std::vector<Vec3> terminals;
+    terminals.reserve(std::size_t(tree_.terminalCount()));
     for (std::int32_t i = 1; i < tree_.nodeCount(); ++i)
-      if (tree_.isTerminal(i)) perfuse(map_, sampler_, tree_.position[i], scratch_);
+      if (tree_.isTerminal(i)) terminals.push_back(tree_.position[i]);
+    sampler_ = perfusedDemand(map_, terminals);
   }
 
   // Each bifurcation was placed for the radii of its day; the vessels around it have thickened
