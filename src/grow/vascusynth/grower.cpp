@@ -421,6 +421,8 @@ class Grower {
     index.refresh(tree_, true);
     r_max_ = tree_.radius[tree_.rootSegment()];
     for (int sweep = 0; sweep < opt_.relax_sweeps; ++sweep) {
+      // Every move appends its segments to the index: rebuilt, it holds each segment once again.
+      if (sweep > 0) index.refresh(tree_, true);
       std::int64_t moved = 0;
       for (std::int32_t v = 1; v < tree_.nodeCount(); ++v) {
         if (tree_.isTerminal(v)) continue;
