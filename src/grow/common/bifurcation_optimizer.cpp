@@ -285,8 +285,17 @@ Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const 
   // backtracking that also steps back from points that cross an obstacle.
   double H[3][3] = {{h0, 0, 0}, {0, h0, 0}, {0, 0, h0}};
   for (int it = 0; it < max_iterations; ++it) {
-    const Vec3 dir(-(H[0][0] * g.x + H[0][1] * g.y + H[0][2] * g.z), -(H[1][0] * g.x + H[1][1] * g.y + H[1][2] * g.z),
-                   -(H[2][0] * g.x + H[2][1] * g.y + H[2][2] * g.z));
+    Vec3 dir(-(H[0][0] * g.x + H[0][1] * g.y + H[0][2] * g.z), -(H[1][0] * g.x + H[1][1] * g.y + H[1][2] * g.z),
+             -(H[2][0] * g.x + H[2][1] * g.y + H[2][2] * g.z));
+    // On a minimum-length sphere a step into it is only pushed back out, and the line search
+    // failed there, leaving the point to the compass polish: slide along the sphere instead.
+    for (int j = 0; j < 3; ++j) {
+      const Vec3 out = b - ends[j];
+      const double len = norm(out);
+      if (!(len > 0) || len > m[j] * (1 + 1e-6)) continue;
+      const double inward = dot(dir, out / len);
+      if (inward < 0) dir = dir - out / len * inward;
+    }
     const double slope = dot(g, dir);
     if (!(slope < 0)) break;
     bool moved = false;
