@@ -8,22 +8,34 @@ namespace angiosynth {
 void SegmentIndex::refresh(const VascularTree& tree, bool force) {
   const auto n = tree.segmentCount();
   if (!force && cell_ > 0 && n < 2 * std::max<std::int32_t>(built_for_, 8)) return;
+  build(tree, cellSizeFor(n));
+}
+
+double SegmentIndex::cellSizeFor(std::int64_t n) const {
   const Vec3 ext = hi_ - lo_;
   // About two segments per cell on average; never more than ~2^22 cells.
-  double cell;
   // A box without thickness (a 2D tree's, given flat) is planar whatever the caller said: its
   // volume would give cells of no size.
   if (planar_ || !(ext.z > 1e-9 * std::max(ext.x, ext.y))) {
     const double area = std::max(ext.x * ext.y, 1e-30);
-    cell = std::max(std::sqrt(2.0 * area / std::max<std::int32_t>(n, 1)), std::sqrt(area / double(1 << 22)));
-  } else {
-    const double volume = std::max(ext.x * ext.y * ext.z, 1e-30);
-    cell = std::max(std::cbrt(2.0 * volume / std::max<std::int32_t>(n, 1)), std::cbrt(volume / double(1 << 22)));
+    return std::max(std::sqrt(2.0 * area / double(std::max<std::int64_t>(n, 1))), std::sqrt(area / double(1 << 22)));
   }
-  build(tree, cell);
+  const double volume = std::max(ext.x * ext.y * ext.z, 1e-30);
+  return std::max(std::cbrt(2.0 * volume / double(std::max<std::int64_t>(n, 1))), std::cbrt(volume / double(1 << 22)));
+}
+
+void SegmentIndex::rebuild(const VascularTree& tree, std::span<const std::int32_t> segments) {
+  clear(tree, cellSizeFor(std::int64_t(segments.size())));
+  for (const auto s : segments) insert(tree, s);
 }
 
 void SegmentIndex::build(const VascularTree& tree, double cell) {
+  clear(tree, cell);
+  for (std::int32_t s = 1; s < tree.nodeCount(); ++s)
+    if (!tree.isRoot(s)) insert(tree, s);
+}
+
+void SegmentIndex::clear(const VascularTree& tree, double cell) {
   cell_ = cell;
   journal_.clear();  // a rebuild keeps what it finds: nothing left to take back
   journaling_ = false;
@@ -31,8 +43,6 @@ void SegmentIndex::build(const VascularTree& tree, double cell) {
   for (int ax = 0; ax < 3; ++ax) n_[ax] = std::max(1, static_cast<int>(std::ceil(ext[ax] / cell_)));
   cells_.assign(std::size_t(n_[0]) * n_[1] * n_[2], {});
   built_for_ = tree.segmentCount();
-  for (std::int32_t s = 1; s < tree.nodeCount(); ++s)
-    if (!tree.isRoot(s)) insert(tree, s);
 }
 
 void SegmentIndex::cellRange(const Vec3& lo, const Vec3& hi, int* a, int* b) const {

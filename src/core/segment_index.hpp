@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <utility>
+#include <span>
 #include <vector>
 
 #include "core/vascular_tree.hpp"
@@ -21,6 +22,8 @@ class SegmentIndex {
 
   // Rebuilds when the tree has doubled since the last build (or on `force`).
   void refresh(const VascularTree& tree, bool force = false);
+  // Rebuilds holding only `segments`, with cells sized for their number.
+  void rebuild(const VascularTree& tree, std::span<const std::int32_t> segments);
   void insert(const VascularTree& tree, std::int32_t segment);
   // Insertions between beginTrial() and endTrial(false) are taken back: a grower that inserts a
   // trial's segments before checking them leaves nothing behind when it rolls the trial back
@@ -103,6 +106,8 @@ class SegmentIndex {
 
  private:
   void build(const VascularTree& tree, double cell);
+  double cellSizeFor(std::int64_t segments) const;
+  void clear(const VascularTree& tree, double cell);  // no entries, cells of the given size
   void cellRange(const Vec3& lo, const Vec3& hi, int* a, int* b) const;
   // The cell holding p, or the nearest one for a point outside the grid.
   void cellOf(const Vec3& p, int* c) const {

@@ -31,6 +31,41 @@ constexpr double kMaxPredictedScale = 4.0;
 // The final repair never removes more than this share of the terminals for one collision.
 constexpr double kMaxRepairShare = 0.05;
 
+// Segments by position for the final check, whose radii stay fixed between rebuilds. A query
+// must reach as far as the thickest vessel it could touch; reaching the root's radius from every
+// thin vessel would scan many cells, so the few vessels thicker than kThickShare × the root's
+// radius also sit in a sparse index of their own, searched that far, and the full index is
+// searched only as far as the thickest of the others.
+class VesselIndex {
+ public:
+  VesselIndex(const VascularTree& tree, const Vec3& lo, const Vec3& hi) : all_(lo, hi), thick_(lo, hi) { rebuild(tree); }
+  void rebuild(const VascularTree& tree) {
+    r_max_ = tree.segmentCount() > 0 ? tree.radius[tree.rootSegment()] : 0.0;
+    r_thin_ = kThickShare * r_max_;
+    all_.refresh(tree, true);
+    std::vector<std::int32_t> thick;
+    for (std::int32_t s = 1; s < tree.nodeCount(); ++s)
+      if (!tree.isRoot(s) && tree.radius[s] > r_thin_) thick.push_back(s);
+    thick_.rebuild(tree, thick);
+  }
+  void insert(const VascularTree& tree, std::int32_t s) {
+    all_.insert(tree, s);
+    if (tree.radius[s] > r_thin_) thick_.insert(tree, s);
+  }
+  // Calls f(id) for every segment that may lie closer to a–e than r + margin × its radius (some
+  // more than once).
+  template <class F>
+  void forEachNearVessel(const Vec3& a, const Vec3& e, double r, double margin, F&& f) {
+    all_.forEachNearSegment(a, e, r + margin * r_thin_, f);
+    thick_.forEachNearSegment(a, e, r + margin * r_max_, f);
+  }
+
+ private:
+  static constexpr double kThickShare = 0.1;
+  SegmentIndex all_, thick_;
+  double r_max_ = 0, r_thin_ = 0;
+};
+
 class Grower {
  public:
   Grower(const DemandMap& map, const GrowthOptions& o, GrowthReport& report)
@@ -263,16 +298,15 @@ class Grower {
   };
   // True if segment s, with ends a–e, clears every vessel more than two segments away from it
   // (radii with 1 % margin, as the physics re-solve after a repair shifts them slightly).
-  bool capsuleClear(std::int32_t s, const Vec3& a, const Vec3& e, SegmentIndex& index) const {
+  bool capsuleClear(std::int32_t s, const Vec3& a, const Vec3& e, VesselIndex& index) const {
     const double rs = 1.01 * tree_.radius[s];
     return !overlapsOtherVessel(
-        tree_, s, a, e, rs, [&](auto&& f) { index.forEachNearSegment(a, e, rs + 1.01 * r_max_, f); },
-        [&](std::int32_t y) { return 1.01 * tree_.radius[y]; });
+        tree_, s, a, e, rs, [&](auto&& f) { index.forEachNearVessel(a, e, rs, 1.01, f); }, [&](std::int32_t y) { return 1.01 * tree_.radius[y]; });
   }
 
   // Pulls terminal segment s back towards its bifurcation until it clears every vessel; false if
   // even the shortest length collides. Any part of a clear segment is clear of obstacles.
-  bool retract(std::int32_t s, SegmentIndex& index) {
+  bool retract(std::int32_t s, VesselIndex& index) {
     if (!tree_.isTerminal(s)) return false;
     const Vec3 a = tree_.position[tree_.parent[s]], end = tree_.position[s];
     const double len = distance(a, end);
@@ -292,7 +326,7 @@ class Grower {
 
   // Moves node v by d if every segment meeting at v stays long enough, clear of obstacles and
   // clear of other vessels; restores it otherwise.
-  bool tryMove(std::int32_t v, const Vec3& d, SegmentIndex& index) {
+  bool tryMove(std::int32_t v, const Vec3& d, VesselIndex& index) {
     const Vec3 old = tree_.position[v];
     tree_.position[v] = old + d;
     std::int32_t segs[3] = {v, tree_.child0[v], tree_.child1[v]};
@@ -318,7 +352,7 @@ class Grower {
   // Separates a colliding pair by moving one end node of either vessel away from the other by
   // the overlap (scaled by how much the closest point follows that node); the thinner vessel's
   // nodes are tried first. This keeps trunk collisions from costing whole branches.
-  bool separate(std::int32_t x, std::int32_t y, SegmentIndex& index) {
+  bool separate(std::int32_t x, std::int32_t y, VesselIndex& index) {
     if (tree_.radius[x] > tree_.radius[y]) std::swap(x, y);
     double sx, sy;
     const Vec3 x0 = tree_.position[tree_.parent[x]], x1 = tree_.position[x];
@@ -362,7 +396,7 @@ class Grower {
 
   // A segment that thickened past the ratio since it was made: slide its distal bifurcation out
   // along it (or towards its children), or its proximal one back, to 1.05–1.5 × the minimum.
-  bool lengthen(std::int32_t s, SegmentIndex& index) {
+  bool lengthen(std::int32_t s, VesselIndex& index) {
     const auto P = tree_.parent[s];
     const Vec3 a = tree_.position[P], e = tree_.position[s];
     const double len = distance(a, e);
@@ -417,12 +451,11 @@ class Grower {
   void relaxBifurcations() {
     if (tree_.segmentCount() < 3) return;
     const double lambda = params_.cost_radius_exponent, mu = params_.cost_length_exponent;
-    SegmentIndex index(Vec3(0, 0, 0), map_.extentMm());
-    index.refresh(tree_, true);
-    r_max_ = tree_.radius[tree_.rootSegment()];
+    VesselIndex index(tree_, Vec3(0, 0, 0), map_.extentMm());
     for (int sweep = 0; sweep < opt_.relax_sweeps; ++sweep) {
-      // Every move appends its segments to the index: rebuilt, it holds each segment once again.
-      if (sweep > 0) index.refresh(tree_, true);
+      // The last sweep's solve changed the radii, and each of its moves appended three segments:
+      // rebuilt, the index holds each segment once, filed by its present radius.
+      if (sweep > 0) index.rebuild(tree_);
       std::int64_t moved = 0;
       for (std::int32_t v = 1; v < tree_.nodeCount(); ++v) {
         if (tree_.isTerminal(v)) continue;
@@ -475,9 +508,7 @@ class Grower {
       if (pairs.empty() && too_short.empty()) return;
       ++report_.repair_rounds;
       std::vector<std::int32_t> remove, prune;
-      SegmentIndex index(Vec3(0, 0, 0), map_.extentMm());
-      index.refresh(tree_, true);
-      r_max_ = tree_.radius[tree_.rootSegment()];
+      VesselIndex index(tree_, Vec3(0, 0, 0), map_.extentMm());
       std::int64_t retracted = 0, moved = 0;
       for (const auto& [x, y] : pairs) {
         // Cheapest first: retract a terminal (the thinner side first), move a node, and only
@@ -567,7 +598,6 @@ class Grower {
   std::vector<double> root_history_;  // root radius when the tree had n terminals
   std::vector<std::pair<std::int64_t, double>> scratch_;
   double min_length_ = 0;
-  double r_max_ = 0;
 };
 
 }  // namespace
