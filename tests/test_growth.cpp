@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <iomanip>
+#include <numbers>
 
 #include <tbb/global_control.h>
 
@@ -200,6 +201,53 @@ TEST(Growth, OptimiserBeatsVascuSynthAxisHillClimb) {
   }
   EXPECT_GT(compared, 50);
   EXPECT_GT(better, compared / 2);
+}
+
+TEST(Growth, AConnectionOnAMinimumLengthSphereCannotGoLowerAlongIt) {
+  // With the length ratio, many optima lie on a sphere of minimum length around one of the three
+  // ends. The search, and the polish growth applies after it, must reach the lowest point along
+  // that sphere, not stop where a step first hit it (a search that did stopped there as if
+  // converged, unpolished, in a tenth of these cases): probed a few degrees around the sphere's
+  // centre either way, no admissible point may lower the connection's added cost by 0.1 %.
+  auto ex = test::vascusynthExample(300, 2);
+  const VascularTree t = test::grow(ex);
+  const BifurcationOptimizer opt(t, ex.options.physics, ex.map, ex.map.voxel_mm / 20, 2.0);
+  const double tree_cost = treeCost(t, ex.options.physics);
+  SegmentIndex index(Vec3(0, 0, 0), ex.map.extentMm());
+  index.refresh(t, true);
+  Rng rng(7, 0, Stage::Growth);
+  std::vector<std::pair<double, std::int32_t>> near;
+  int on_sphere = 0, lower_along = 0;
+  for (int trial = 0; trial < 1500; ++trial) {
+    const Vec3 cand = ex.map.toMm(uniformPoint(rng, 1, 99));
+    if (!ex.map.perfusable(cand)) continue;
+    index.nearest(t, cand, 5, near);
+    const std::int32_t s = near[std::size_t(trial) % near.size()].second;
+    Connection c = opt.optimise(s, cand);
+    if (!c.valid) continue;
+    opt.polish(c);
+    const std::array<Vec3, 3> ends{t.position[t.parent[s]], t.position[s], cand};
+    std::size_t j = 0;
+    while (j < 3 && distance(c.bifurcation, ends[j]) > c.min_lengths[j] * (1 + 1e-6)) ++j;
+    if (j == 3) continue;
+    ++on_sphere;
+    const Vec3 centre = ends[j];
+    const double radius = distance(c.bifurcation, centre);
+    const Vec3 u = (c.bifurcation - centre) / radius;
+    Vec3 p1 = cross(u, std::abs(u.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0));
+    p1 = p1 / norm(p1);
+    const Vec3 p2 = cross(u, p1);
+    double lowest = c.cost;
+    for (double degrees : {1.0, 5.0})
+      for (int k = 0; k < 8; ++k) {
+        const double theta = degrees * std::numbers::pi / 180, phi = 2 * std::numbers::pi * k / 8;
+        const Vec3 q = centre + (u * std::cos(theta) + (p1 * std::cos(phi) + p2 * std::sin(phi)) * std::sin(theta)) * radius;
+        if (opt.admissible(s, q, cand, c.min_lengths)) lowest = std::min(lowest, opt.costAt(s, q, cand));
+      }
+    if (c.cost - lowest > 1e-3 * (c.cost - tree_cost)) ++lower_along;
+  }
+  EXPECT_GT(on_sphere, 300);
+  EXPECT_LE(lower_along, on_sphere / 100) << lower_along << " of " << on_sphere << " could go lower along their sphere";
 }
 
 TEST(Growth, PathDerivativesMatchFiniteDifferences) {
