@@ -21,8 +21,9 @@ double supplyFactor(const std::vector<double>& c, double d) {
 
 namespace {
 
-// Calls supply(v, factor) for every voxel v in slices [k_first, k_last] within the cut-off of
-// terminal t (mm), with the factor its demand is multiplied by, in index order.
+// Calls supply(v, c, d) for every voxel v in slices [k_first, k_last] within the cut-off of the
+// terminal (mm), in index order: c the supply coefficients of the terminal's voxel, d the
+// distance in map voxels.
 template <class Supply>
 void forEachSuppliedVoxel(const DemandMap& map, const Vec3& terminal_mm, int k_first, int k_last, Supply&& supply) {
   const auto home = map.voxelAt(terminal_mm);

@@ -287,8 +287,8 @@ Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const 
   for (int it = 0; it < max_iterations; ++it) {
     Vec3 dir(-(H[0][0] * g.x + H[0][1] * g.y + H[0][2] * g.z), -(H[1][0] * g.x + H[1][1] * g.y + H[1][2] * g.z),
              -(H[2][0] * g.x + H[2][1] * g.y + H[2][2] * g.z));
-    // On a minimum-length sphere a step into it is only pushed back out, and the line search
-    // failed there, leaving the point to the compass polish: slide along the sphere instead.
+    // On a minimum-length sphere a step into it would only be pushed back out and the line search
+    // fail, leaving the point unpolished or to the compass polish: slide along the sphere instead.
     for (int j = 0; j < 3; ++j) {
       const Vec3 out = b - ends[j];
       const double len = norm(out);
