@@ -108,6 +108,10 @@ BifurcationOptimizer::MinLengths BifurcationOptimizer::minimumsFrom(std::int32_t
   return m;
 }
 
+void BifurcationOptimizer::lengthsFrom(const Vec3& b, const std::array<Vec3, 3>& ends, double (&l)[3]) const {
+  for (int j = 0; j < 3; ++j) l[j] = std::max(distance(b, ends[j]), min_length_);
+}
+
 Vec3 BifurcationOptimizer::keepLengths(Vec3 b, const std::array<Vec3, 3>& ends, const MinLengths& m) const {
   // Push b out to the minimum length from each end it comes too close to, so that the search
   // slides along the constraint (the optimum often wants b to merge into a node) instead of
@@ -132,9 +136,13 @@ BifurcationOptimizer::Level0 BifurcationOptimizer::level0(std::int32_t s, double
 
 BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, const double (&l)[3], bool with_radii) const {
   // β of the path's children, bottom-up: the radii multiply them top-down from the root, in the
-  // order radiiAt does, so that both give the same bits.
-  thread_local std::vector<double> betas;
-  betas.clear();
+  // order radiiAt does, so that both give the same bits. Kept only when the radii are asked for.
+  std::vector<double>* betas = nullptr;
+  if (with_radii) {
+    thread_local std::vector<double> buffer;
+    buffer.clear();
+    betas = &buffer;
+  }
   const auto& t = tree_;
   const auto& k = kernel_;
   const double lambda = params_.cost_radius_exponent;
@@ -156,7 +164,7 @@ BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, 
     const double inv = 1.0 / (4.0 * R * (1.0 + u));
     const double dV_dR = lambda * inv * (bc * V * u - bo * V_o);
     const double dR_dR = 1.0 / (R * D * (1.0 + u));
-    if (with_radii) betas.push_back(sp.beta_a);
+    if (betas) betas->push_back(sp.beta_a);
     bR = dV_dR * a + bc * bR;
     cV = bc * cV;
     a = dR_dR * a;
@@ -168,9 +176,9 @@ BifurcationOptimizer::Evaluation BifurcationOptimizer::evaluate(std::int32_t s, 
   const double rl = k.radiusCost(r_root);
   Evaluation e;
   e.cost = rl * V;
-  if (with_radii) {
+  if (betas) {
     double r = r_root;
-    for (auto beta = betas.rbegin(); beta != betas.rend(); ++beta) r *= *beta;
+    for (auto beta = betas->rbegin(); beta != betas->rend(); ++beta) r *= *beta;
     e.radii = {r, r * base.beta_a, r * base.beta_b};
   }
   const double gR = lambda / 4.0 * e.cost / R * a + rl * bR;  // ∂C/∂R0
@@ -208,7 +216,7 @@ Connection BifurcationOptimizer::optimise(std::int32_t s, const Vec3& term, int 
     // gives them also costs that point, which the search reuses when it starts there unmoved.
     const Vec3 at = start ? *start : (ends[0] + ends[1]) * 0.5;
     double l[3];
-    for (int j = 0; j < 3; ++j) l[j] = std::max(distance(at, ends[j]), min_length_);
+    lengthsFrom(at, ends, l);
     probe = Probe{at, evaluate(s, l, true)};
     m = minimumsFrom(s, probe->evaluation.radii);
   }
@@ -233,9 +241,6 @@ Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const 
   best.segment = s;
   best.terminal = term;
   best.min_lengths = m;
-  const auto lengths = [&](const Vec3& x, double(&l)[3]) {
-    for (int j = 0; j < 3; ++j) l[j] = std::max(distance(x, ends[j]), min_length_);
-  };
   // Start at VascuSynth's midpoint, moved a third of the way to the terminal; fall back to the
   // midpoint itself, whose only new segment is the one to the terminal.
   const Vec3 mid = (ends[0] + ends[1]) * 0.5;
@@ -248,7 +253,7 @@ Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const 
     if (length_ratio_ > 0) start = keepLengths(start, ends, m);
     if (!admissible(s, start, term, m)) continue;
     double ls[3];
-    lengths(start, ls);
+    lengthsFrom(start, ends, ls);
     const Evaluation es = probe && probe->point == start ? probe->evaluation : evaluate(s, ls, with_radii);
     if (have && es.cost >= e.cost) continue;
     have = true;
@@ -305,7 +310,7 @@ Connection BifurcationOptimizer::search(std::int32_t s, const Vec3& term, const 
     for (double t = 1.0; t > 1e-3 && !moved; t *= 0.5) {
       next = keepLengths(b + dir * t, ends, m);
       if (!admissible(s, next, term, m)) continue;
-      lengths(next, ln);
+      lengthsFrom(next, ends, ln);
       en = evaluate(s, ln, with_radii);
       moved = en.cost < e.cost + 1e-4 * t * slope || (t < 0.2 && en.cost < e.cost);
     }
@@ -349,7 +354,7 @@ void BifurcationOptimizer::polish(Connection& c) const {
   const std::array<Vec3, 3> ends{tree_.position[tree_.parent[s]], tree_.position[s], term};
   Vec3 b = c.bifurcation;
   double l[3];
-  for (int j = 0; j < 3; ++j) l[j] = std::max(distance(b, ends[j]), min_length_);
+  lengthsFrom(b, ends, l);
   double best_cost = c.cost;
   double step = 0.25 * std::min({l[0], l[1], l[2]});
   const double tol = 1e-6 * (distance(ends[0], ends[1]) + distance(ends[1], ends[2]) + 1e-12);
@@ -363,7 +368,7 @@ void BifurcationOptimizer::polish(Connection& c) const {
       if (!admissible(s, next, term, c.min_lengths)) continue;
       ++evals;
       double ln[3];
-      for (int j = 0; j < 3; ++j) ln[j] = std::max(distance(next, ends[j]), min_length_);
+      lengthsFrom(next, ends, ln);
       const double cn = cost(s, ln[0], ln[1], ln[2]);
       if (cn < best_cost) {
         b = next;

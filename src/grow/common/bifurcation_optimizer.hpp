@@ -137,6 +137,9 @@ class BifurcationOptimizer {
   MinLengths minimumsFrom(std::int32_t s, const std::array<double, 3>& radii) const;
   Connection search(std::int32_t s, const Vec3& t, const MinLengths& m, int max_iterations, const Vec3* start, const Probe* probe) const;
   Vec3 keepLengths(Vec3 b, const std::array<Vec3, 3>& ends, const MinLengths& m) const;
+  // The three lengths from b to the ends, each at least the absolute minimum (parent part, distal
+  // part, terminal).
+  void lengthsFrom(const Vec3& b, const std::array<Vec3, 3>& ends, double (&l)[3]) const;
   Level0 level0(std::int32_t s, double l_up, double l_down, double l_term) const;
 
   const VascularTree& tree_;
