@@ -363,6 +363,51 @@ TEST(DemandSampler, PerfusingAllTerminalsAtOnceLeavesTheSameBitsAsOneAtATime) {
   }
 }
 
+TEST(DemandSampler, ReperfusingAroundChangedTerminalsLeavesTheBitsOfPerfusingAllAgain) {
+  // A repair removes terminals, pulls some back and turns pruned bifurcations into terminals;
+  // recomputing only around those must leave the bits of perfusing the new set from scratch.
+  auto ex = test::vascusynthExample(300, 1);
+  const VascularTree t = test::grow(ex);
+  std::vector<Vec3> before, after, changed;
+  for (std::int32_t i = 1; i < t.nodeCount(); ++i) {
+    if (!t.isTerminal(i)) {
+      if (i % 37 == 0) {  // a pruned bifurcation, a terminal in its place in node order
+        after.push_back(t.position[i]);
+        changed.push_back(t.position[i]);
+      }
+      continue;
+    }
+    const Vec3 p = t.position[i];
+    before.push_back(p);
+    if (before.size() % 7 == 0) {  // removed
+      changed.push_back(p);
+    } else if (before.size() % 11 == 0) {  // retracted towards its bifurcation
+      const Vec3 q = p + (t.position[t.parent[i]] - p) * 0.3;
+      after.push_back(q);
+      changed.push_back(p);
+      changed.push_back(q);
+    } else {
+      after.push_back(p);
+    }
+  }
+  ASSERT_GT(changed.size(), 60u);
+  const DemandSampler fresh = perfusedDemand(ex.map, after);
+  for (int threads : {1, 2}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    DemandSampler s = perfusedDemand(ex.map, before);
+    reperfuse(ex.map, s, changed, after);
+    std::int64_t differing = 0, raised = 0;
+    const DemandSampler old = perfusedDemand(ex.map, before);
+    for (std::int64_t v = 0; v < ex.map.voxelCount(); ++v) {
+      differing += s.value(v) != fresh.value(v);
+      raised += s.value(v) > old.value(v);
+    }
+    EXPECT_GT(raised, 1000) << "the removed terminals must give back demand";
+    EXPECT_EQ(differing, 0) << threads << " threads";
+    EXPECT_EQ(s.total(), fresh.total());
+  }
+}
+
 TEST(DemandMap, SegmentClearDetectsRodsAndBoundary) {
   auto ex = test::vascusynthExample(10, 1);
   const double h = ex.map.voxel_mm;

@@ -13,7 +13,7 @@ DemandSampler::DemandSampler(const std::vector<float>& demand) : DemandSampler(d
 DemandSampler::DemandSampler(const std::vector<float>& demand, const std::function<void(std::span<double>)>& adjust) {
   while (leaves_ < static_cast<std::int64_t>(demand.size())) leaves_ <<= 1;
   tree_.assign(2 * leaves_, 0.0);
-  for (std::size_t i = 0; i < demand.size(); ++i) tree_[leaves_ + i] = demand[i] > 0 ? demand[i] : 0.0;
+  for (std::size_t i = 0; i < demand.size(); ++i) tree_[leaves_ + i] = weightOf(demand[i]);
   if (adjust) adjust(std::span<double>(tree_).subspan(std::size_t(leaves_), demand.size()));
   for (std::int64_t k = leaves_ - 1; k >= 1; --k) tree_[k] = tree_[2 * k] + tree_[2 * k + 1];
 }

@@ -17,6 +17,8 @@ class DemandSampler {
   // one O(V) pass instead of an update per changed voxel.
   DemandSampler(const std::vector<float>& demand, const std::function<void(std::span<double>)>& adjust);
   static std::uint64_t bytesFor(std::int64_t voxels);
+  // A voxel's weight for a map demand: a negative demand draws nothing.
+  static double weightOf(float demand) { return demand > 0 ? demand : 0.0; }
 
   double total() const { return tree_[1]; }
   double value(std::int64_t voxel) const { return tree_[leaves_ + voxel]; }

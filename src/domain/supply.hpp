@@ -23,4 +23,10 @@ void perfuse(const DemandMap& map, DemandSampler& sampler, const Vec3& terminal_
 // slabs of the map in parallel.
 DemandSampler perfusedDemand(const DemandMap& map, const std::vector<Vec3>& terminals_mm);
 
+// Brings a sampler perfused by one set of terminals to the bits perfusedDemand(map, terminals_mm)
+// gives, at the cost of the neighbourhoods of `changed_mm` only: the terminals of either set not
+// in the other (removed, moved, or new). The terminals both sets share must have perfused in the
+// same relative order.
+void reperfuse(const DemandMap& map, DemandSampler& sampler, const std::vector<Vec3>& changed_mm, const std::vector<Vec3>& terminals_mm);
+
 }  // namespace angiosynth

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <numbers>
 #include <tuple>
 
@@ -138,7 +139,7 @@ class Grower {
         rel_.assign(2, 1.0);
         root_history_[1] = rootRadius(params_, params_.terminalFlow(), tree_.reduced_resistance[t]);
         index_.refresh(tree_, true);
-        perfuse(map_, sampler_, cand, scratch_);
+        perfuseAt(cand);
         consecutive = 0;
         continue;
       }
@@ -213,7 +214,7 @@ class Grower {
       index_.insert(tree_, n - 1);
       index_.insert(tree_, tree_.child0[n - 2]);  // the split segment, now starting at b
       index_.refresh(tree_);
-      perfuse(map_, sampler_, cand, scratch_);
+      perfuseAt(cand);
       consecutive = 0;
     }
     if (progress) progress(tree_.terminalCount(), target);
@@ -434,13 +435,32 @@ class Grower {
     return {tree_.terminals[p] - 1, -1, p};
   }
 
-  // Demand as if only the current terminals had been perfused, in the order they were added.
+  // Records what the demand holds, so that the repair recomputes it only around what differs.
+  void perfuseAt(const Vec3& terminal) {
+    perfuse(map_, sampler_, terminal, scratch_);
+    perfused_.push_back(terminal);
+  }
+
+  // Demand as if only the current terminals had been perfused, in the order they were added
+  // (node order: a repair keeps the nodes' order). Only the neighbourhoods of the terminals
+  // removed, moved or made since the last perfusion are recomputed, unless they are so many that
+  // the parallel pass over the whole map is cheaper. Either way the same bits.
   void recomputeDemand() {
     std::vector<Vec3> terminals;
     terminals.reserve(std::size_t(tree_.terminalCount()));
     for (std::int32_t i = 1; i < tree_.nodeCount(); ++i)
       if (tree_.isTerminal(i)) terminals.push_back(tree_.position[i]);
-    sampler_ = perfusedDemand(map_, terminals);
+    const auto before = [](const Vec3& a, const Vec3& b) { return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z); };
+    auto now = terminals;
+    std::sort(perfused_.begin(), perfused_.end(), before);
+    std::sort(now.begin(), now.end(), before);
+    std::vector<Vec3> changed;
+    std::set_symmetric_difference(perfused_.begin(), perfused_.end(), now.begin(), now.end(), std::back_inserter(changed), before);
+    if (4 * changed.size() > terminals.size())
+      sampler_ = perfusedDemand(map_, terminals);
+    else
+      reperfuse(map_, sampler_, changed, terminals);
+    perfused_ = std::move(terminals);
   }
 
   // Each bifurcation was placed for the radii of its day; the vessels around it have thickened
@@ -597,6 +617,7 @@ class Grower {
   std::vector<double> rel_{1.0};      // radius / root radius, refreshed along every new path
   std::vector<double> root_history_;  // root radius when the tree had n terminals
   std::vector<std::pair<std::int64_t, double>> scratch_;
+  std::vector<Vec3> perfused_;  // the terminals the sampler's demand holds, in perfusion order
   double min_length_ = 0;
 };
 
