@@ -162,7 +162,7 @@ class Grower {
         // Near segments and their families: each costed at its starting point, and only the
         // closest_neighbours cheapest optimised (the cheapest start is almost always the
         // cheapest optimum; optimising all of them tripled the growth time).
-        for (std::size_t i = 0; i < near.size(); ++i) trials[i] = opt.optimise(near[i].second, cand, 0);
+        tbb::parallel_for(std::size_t(0), near.size(), [&](std::size_t i) { trials[i] = opt.optimise(near[i].second, cand, 0); });
         for (std::size_t i = 0; i < trials.size(); ++i)
           if (trials[i].valid) order.push_back(i);
         const auto kept = std::min(order.size(), std::size_t(opt_.closest_neighbours));
