@@ -101,8 +101,9 @@ std::vector<std::pair<std::int32_t, std::int32_t>> intersectingPairs(const Vascu
       const Vec3& a0 = t.position[t.parent[x]];
       const Vec3& a1 = t.position[x];
       index.forEachNearSegment(a0, a1, 2 * t.radius[x], m, [&](std::int32_t y) {
-        if (!thinner(y, x) || t.isLink(y) || withinTwoSegments(t, x, y)) return;
-        if (capsulesOverlap(a0, a1, t.radius[x], t.position[t.parent[y]], t.position[y], t.radius[y]))
+        if (!thinner(y, x) || t.isLink(y)) return;
+        // The distance first, as in overlapsOtherVessel: most pairs met are apart.
+        if (capsulesOverlap(a0, a1, t.radius[x], t.position[t.parent[y]], t.position[y], t.radius[y]) && !withinTwoSegments(t, x, y))
           found[std::size_t(b)].emplace_back(std::min(x, y), std::max(x, y));
       });
     }
