@@ -408,6 +408,32 @@ TEST(DemandSampler, ReperfusingAroundChangedTerminalsLeavesTheBitsOfPerfusingAll
   }
 }
 
+TEST(Intersections, CapsuleOverlapIsTheDistanceTestEvenWhereTheCapsulesJustTouch) {
+  // capsulesOverlap tells most pairs apart by their boxes; it must answer as the distance does,
+  // also for capsules a hair's breadth apart or overlapping, axis-aligned or not.
+  Rng rng(3, 0, Stage::Growth);
+  std::int64_t overlapping = 0, apart = 0, disagreeing = 0;
+  for (int i = 0; i < 20000; ++i) {
+    Vec3 a0 = uniformPoint(rng, 0, 1), a1 = uniformPoint(rng, 0, 1), b0 = uniformPoint(rng, 0, 1), b1 = uniformPoint(rng, 0, 1);
+    if (i % 2) {  // parallel to x, apart along x only: the box test decides alone
+      const double g = rng.uniform();
+      a0 = Vec3(0, 0.5, 0.5), a1 = Vec3(1, 0.5, 0.5), b0 = Vec3(1 + g, 0.5, 0.5), b1 = Vec3(2 + g, 0.5, 0.5);
+    }
+    const double d = segmentSegmentDistance(a0, a1, b0, b1);
+    const double ra = rng.uniform() * d;
+    for (double f : {1 - 1e-9, 1 - 1e-15, 1.0, 1 + 1e-15, 1 + 1e-9, 0.5, 2.0}) {
+      const double rb = f * d - ra;
+      if (rb < 0) continue;
+      const bool expected = d < ra + rb;
+      (expected ? overlapping : apart) += 1;
+      disagreeing += capsulesOverlap(a0, a1, ra, b0, b1, rb) != expected;
+    }
+  }
+  EXPECT_GT(overlapping, 20000);
+  EXPECT_GT(apart, 20000);
+  EXPECT_EQ(disagreeing, 0);
+}
+
 TEST(DemandMap, SegmentClearDetectsRodsAndBoundary) {
   auto ex = test::vascusynthExample(10, 1);
   const double h = ex.map.voxel_mm;
