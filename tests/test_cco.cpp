@@ -64,12 +64,9 @@ struct GrownDisc {
     v.cost_length_exponent = 1;
     return v;
   }();
-  BifurcationOptimizer opt{t, volume, d.frame(), 0.0};
+  BifurcationOptimizer opt{t, volume, nullptr, 0.0};
   SegmentIndex index{d.lo(), d.hi(), true};
-  GrownDisc() {
-    opt.checkObstacles(false);
-    index.refresh(t, true);
-  }
+  GrownDisc() { index.refresh(t, true); }
 };
 
 }  // namespace

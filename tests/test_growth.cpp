@@ -14,6 +14,7 @@
 #include "grow/common/bifurcation_optimizer.hpp"
 #include "grow/common/intersections.hpp"
 #include "core/segment_index.hpp"
+#include "domain/clear_paths.hpp"
 #include "physics/hemodynamics.hpp"
 #include "test_support.hpp"
 #include "tree_checks.hpp"
@@ -161,7 +162,8 @@ TEST(Growth, OptimiserBeatsVascuSynthAxisHillClimb) {
   auto ex = test::vascusynthExample(200, 3);
   const VascularTree t = test::grow(ex);
   PhysicsParameters p = ex.options.physics;
-  const BifurcationOptimizer opt(t, p, ex.map, ex.map.voxel_mm / 20);
+  const ClearPaths paths(ex.map);
+  const BifurcationOptimizer opt(t, p, &paths, ex.map.voxel_mm / 20);
   SegmentIndex index(Vec3(0, 0, 0), ex.map.extentMm());
   index.refresh(t, true);
   Rng rng(42, 0, Stage::Growth);
@@ -211,7 +213,8 @@ TEST(Growth, AConnectionOnAMinimumLengthSphereCannotGoLowerAlongIt) {
   // centre either way, no admissible point may lower the connection's added cost by 0.1 %.
   auto ex = test::vascusynthExample(300, 2);
   const VascularTree t = test::grow(ex);
-  const BifurcationOptimizer opt(t, ex.options.physics, ex.map, ex.map.voxel_mm / 20, 2.0);
+  const ClearPaths paths(ex.map);
+  const BifurcationOptimizer opt(t, ex.options.physics, &paths, ex.map.voxel_mm / 20, 2.0);
   const double tree_cost = treeCost(t, ex.options.physics);
   SegmentIndex index(Vec3(0, 0, 0), ex.map.extentMm());
   index.refresh(t, true);
@@ -253,7 +256,8 @@ TEST(Growth, AConnectionOnAMinimumLengthSphereCannotGoLowerAlongIt) {
 TEST(Growth, PathDerivativesMatchFiniteDifferences) {
   auto ex = test::vascusynthExample(300, 4);
   const VascularTree t = test::grow(ex);
-  const BifurcationOptimizer opt(t, ex.options.physics, ex.map, 1e-3);
+  const ClearPaths paths(ex.map);
+  const BifurcationOptimizer opt(t, ex.options.physics, &paths, 1e-3);
   for (std::int32_t s : {5, 50, 250, 400, 590}) {
     const double l[3] = {1.3, 0.7, 2.1};
     const auto e = opt.evaluate(s, l);
@@ -432,6 +436,34 @@ TEST(Intersections, CapsuleOverlapIsTheDistanceTestEvenWhereTheCapsulesJustTouch
   EXPECT_GT(overlapping, 20000);
   EXPECT_GT(apart, 20000);
   EXPECT_EQ(disagreeing, 0);
+}
+
+TEST(ClearPaths, AnswersAsTheMapsVoxelWalkForSegmentsOfEveryLengthNearAndFarFromTheRods) {
+  // ClearPaths passes segments within its clearance without walking them; it must answer as the
+  // map does, across the rods, beside them, on the map's faces and outside it.
+  auto ex = test::vascusynthExample(10, 1);
+  const ClearPaths paths(ex.map);
+  Rng rng(5, 0, Stage::Growth);
+  const double h = ex.map.voxel_mm;
+  std::int64_t clear = 0, blocked = 0, disagreeing = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const Vec3 a = uniformPoint(rng, -2, 102) * h;
+    const double length = std::pow(10.0, rng.uniform() * 2 - 0.5);  // 0.3 to 30 voxels
+    const Vec3 b = a + uniformPoint(rng, -1, 1) * (length * h);
+    const Vec3 on_face = Vec3(a.x, a.y, i % 3 ? a.z : 0.0);  // some start exactly on a face
+    const bool expected = ex.map.segmentClear(on_face, b);
+    (expected ? clear : blocked) += 1;
+    disagreeing += paths.segmentClear(on_face, b) != expected;
+  }
+  EXPECT_GT(clear, 50000);
+  EXPECT_GT(blocked, 50000);
+  EXPECT_EQ(disagreeing, 0);
+  // A map without obstacles keeps no distances; segments inside it are clear, outside not.
+  DemandMap open = ex.map;
+  std::fill(open.demand.begin(), open.demand.end(), 1.0f);
+  const ClearPaths open_paths(open);
+  EXPECT_TRUE(open_paths.segmentClear(Vec3(1, 1, 1) * h, Vec3(99, 99, 99) * h));
+  EXPECT_FALSE(open_paths.segmentClear(Vec3(1, 1, 1) * h, Vec3(101, 50, 50) * h));
 }
 
 TEST(DemandMap, SegmentClearDetectsRodsAndBoundary) {

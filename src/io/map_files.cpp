@@ -55,7 +55,8 @@ void forBox(const DemandMap& m, const Box& b, F&& f) {
 }  // namespace
 
 std::uint64_t growthBytesFor(std::int64_t voxels) {
-  return static_cast<std::uint64_t>(voxels) * (sizeof(float) + sizeof(std::uint16_t)) + DemandSampler::bytesFor(voxels);
+  // Demand, supply index and ClearPaths' clearance (its one-voxel padding left out) per voxel.
+  return static_cast<std::uint64_t>(voxels) * (sizeof(float) + sizeof(std::uint16_t) + sizeof(std::uint8_t)) + DemandSampler::bytesFor(voxels);
 }
 
 DemandMap loadDomain(const BoxMapSpec& sc, std::uint64_t memory_limit) {

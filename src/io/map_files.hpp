@@ -27,7 +27,7 @@ struct BoxMapSpec {
 // before allocating.
 DemandMap loadDomain(const BoxMapSpec& sc, std::uint64_t memory_limit_bytes);
 
-// Bytes the growth stage needs per map voxel (demand, supply index, sampler).
+// Bytes the growth stage needs per map voxel (demand, supply index, clearance, sampler).
 std::uint64_t growthBytesFor(std::int64_t voxels);
 
 }  // namespace angiosynth

@@ -544,8 +544,7 @@ class CcoGrower {
     std::vector<std::int64_t> n_new;
     for (int k : open) {
       auto& g = trees_[k];
-      opts.emplace_back(g.tree, g.params, dom_.frame(), 0.0);
-      opts.back().checkObstacles(false);  // `fits` tests the result's capsules against the domain
+      opts.emplace_back(g.tree, g.params, nullptr, 0.0);  // `fits` tests the result's capsules against the domain
       base.push_back(competing ? treeCostNow(g) : 0.0);
       rr_now.push_back(currentRootRadius(g));
       n_new.push_back(g.terminalCount() + 1);

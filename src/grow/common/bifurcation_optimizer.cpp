@@ -81,7 +81,7 @@ bool BifurcationOptimizer::admissible(std::int32_t s, const Vec3& b, const Vec3&
   const Vec3& p = tree_.position[tree_.parent[s]];
   const Vec3& o = tree_.position[s];
   if (distance(p, b) < m[0] || distance(b, o) < m[1] || distance(b, term) < m[2]) return false;
-  return !check_obstacles_ || (map_.segmentClear(p, b) && map_.segmentClear(b, o) && map_.segmentClear(b, term));
+  return !paths_ || (paths_->segmentClear(p, b) && paths_->segmentClear(b, o) && paths_->segmentClear(b, term));
 }
 
 std::array<double, 3> BifurcationOptimizer::radiiAt(std::int32_t s, const Vec3& b, const Vec3& term) const {

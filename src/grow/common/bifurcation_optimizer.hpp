@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "core/vascular_tree.hpp"
+#include "domain/clear_paths.hpp"
 #include "physics/hemodynamics.hpp"
 
 namespace angiosynth {
@@ -56,13 +57,14 @@ class BifurcationOptimizer {
  public:
   // length_ratio k: segments at least k × radius × radius_scale long (0: only the absolute
   // minimum); a new root segment k × radius × root_radius_scale. The scales stand for the growth
-  // a vessel's radius has still to come.
-  BifurcationOptimizer(const VascularTree& tree, const PhysicsParameters& p, const DemandMap& map, double min_segment_length_mm,
+  // a vessel's radius has still to come. `paths`: the obstacles trial points must not cross;
+  // null for a caller that checks the domain exactly on the result, as CCO's capsule test does.
+  BifurcationOptimizer(const VascularTree& tree, const PhysicsParameters& p, const ClearPaths* paths, double min_segment_length_mm,
                        double length_ratio = 0, double radius_scale = 1, double root_radius_scale = 1)
       : tree_(tree),
         params_(p),
         kernel_(p),
-        map_(map),
+        paths_(paths),
         min_length_(min_segment_length_mm),
         length_ratio_(length_ratio),
         radius_scale_(radius_scale),
@@ -72,9 +74,6 @@ class BifurcationOptimizer {
   // makes a segment cross a zero-demand voxel or shorter than the minimum length.
   // `start`: a known good point (Kamiya's) to start from instead of the midpoint rule.
   Connection optimise(std::int32_t s, const Vec3& t, int max_iterations = 20, const Vec3* start = nullptr) const;
-  // Off: trial points are not tested against zero-demand voxels (a caller that checks the
-  // domain exactly on the result, as CCO's capsule test does).
-  void checkObstacles(bool on) { check_obstacles_ = on; }
   // Exact whole-tree cost with the three new lengths (parent part, distal part, terminal).
   double cost(std::int32_t s, double l_up, double l_down, double l_term, std::vector<PathLevel>* record = nullptr) const;
   // The same walk without recording the path (which allocates, once per trial in parallel): the
@@ -145,12 +144,11 @@ class BifurcationOptimizer {
   const VascularTree& tree_;
   const PhysicsParameters& params_;
   PowerKernel kernel_;
-  const DemandMap& map_;
+  const ClearPaths* paths_;
   double min_length_;
   double length_ratio_;
   double radius_scale_;
   double root_radius_scale_;
-  bool check_obstacles_ = true;
 };
 
 }  // namespace angiosynth

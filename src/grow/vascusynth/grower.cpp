@@ -10,6 +10,7 @@
 
 #include "core/distributions.hpp"
 #include "core/rng.hpp"
+#include "domain/clear_paths.hpp"
 #include "domain/demand_sampler.hpp"
 #include "domain/supply.hpp"
 #include "grow/common/bifurcation_optimizer.hpp"
@@ -71,6 +72,7 @@ class Grower {
  public:
   Grower(const DemandMap& map, const GrowthOptions& o, GrowthReport& report)
       : map_(map),
+        paths_(map),
         opt_(o),
         report_(report),
         params_(o.physics),
@@ -129,7 +131,7 @@ class Grower {
       ++report_.candidates;
       const Vec3 cand = drawCandidate();
       if (tree_.segmentCount() == 0) {
-        if (distance(tree_.position[0], cand) < min_length_ || !map_.segmentClear(tree_.position[0], cand)) {
+        if (distance(tree_.position[0], cand) < min_length_ || !paths_.segmentClear(tree_.position[0], cand)) {
           ++report_.rejected_unreachable;
           continue;
         }
@@ -156,7 +158,7 @@ class Grower {
       // understate it). Measured over 20 seeds of examples/vascusynth_like.toml, this leaves the
       // fewest vessels for the final check to lengthen at the lowest cost (docs/methods/vascusynth.md).
       const double growth = rootGrowth();
-      const BifurcationOptimizer opt(tree_, params_, map_, min_length_, opt_.min_length_ratio, std::sqrt(finalScale()), 1.1 * growth);
+      const BifurcationOptimizer opt(tree_, params_, &paths_, min_length_, opt_.min_length_ratio, std::sqrt(finalScale()), 1.1 * growth);
       std::vector<std::size_t> order;
       if (near.size() > std::size_t(opt_.closest_neighbours)) {
         // Near segments and their families: each costed at its starting point, and only the
@@ -239,7 +241,7 @@ class Grower {
 
   // Applies a recorded connection: new bifurcation b (splitting s) and terminal t.
   ConnectionUndo commit(const Connection& c) {
-    const BifurcationOptimizer opt(tree_, params_, map_, min_length_);
+    const BifurcationOptimizer opt(tree_, params_, &paths_, min_length_);
     auto u = commitConnection(tree_, c, opt, PowerKernel(params_), rel_);
     root_history_[tree_.terminalCount()] = c.root_radius;
     return u;
@@ -287,7 +289,7 @@ class Grower {
   bool spliceClear(std::int32_t s) const {
     const auto p = tree_.parent[s];
     if (p == 0) return true;
-    return map_.segmentClear(tree_.position[tree_.parent[p]], tree_.position[tree_.sibling(s)]);
+    return paths_.segmentClear(tree_.position[tree_.parent[p]], tree_.position[tree_.sibling(s)]);
   }
 
   // The cheapest way to take segment s out of a collision: remove its subtree and splice its
@@ -336,7 +338,7 @@ class Grower {
       if (sg < 0 || !ok) continue;
       const Vec3& a = tree_.position[tree_.parent[sg]];
       const Vec3& e = tree_.position[sg];
-      ok = distance(a, e) >= minLength(sg) && map_.segmentClear(a, e) && capsuleClear(sg, a, e, index);
+      ok = distance(a, e) >= minLength(sg) && paths_.segmentClear(a, e) && capsuleClear(sg, a, e, index);
     }
     if (!ok) {
       tree_.position[v] = old;
@@ -587,7 +589,7 @@ class Grower {
       for (bool again = true; again && tree_.segmentCount() > 0;) {
         std::vector<std::int32_t> blocked;
         for (std::int32_t s = 1; s < tree_.nodeCount(); ++s)
-          if (!map_.segmentClear(tree_.position[tree_.parent[s]], tree_.position[s])) blocked.push_back(s);
+          if (!paths_.segmentClear(tree_.position[tree_.parent[s]], tree_.position[s])) blocked.push_back(s);
         again = !blocked.empty();
         if (again) tree_.removeSubtrees(blocked);
       }
@@ -607,6 +609,7 @@ class Grower {
   }
 
   const DemandMap& map_;
+  const ClearPaths paths_;
   const GrowthOptions& opt_;
   GrowthReport& report_;
   PhysicsParameters params_;
