@@ -57,10 +57,13 @@ class BifurcationOptimizer {
  public:
   // length_ratio k: segments at least k × radius × radius_scale long (0: only the absolute
   // minimum); a new root segment k × radius × root_radius_scale. The scales stand for the growth
-  // a vessel's radius has still to come. `paths`: the obstacles trial points must not cross;
+  // a vessel's radius has still to come; with `radius_share` (each segment's radius over the
+  // root's) the two parts of a split segment of share x take radius_scale ×
+  // (root_radius_scale / radius_scale)^(x²). `paths`: the obstacles trial points must not cross;
   // null for a caller that checks the domain exactly on the result, as CCO's capsule test does.
   BifurcationOptimizer(const VascularTree& tree, const PhysicsParameters& p, const ClearPaths* paths, double min_segment_length_mm,
-                       double length_ratio = 0, double radius_scale = 1, double root_radius_scale = 1)
+                       double length_ratio = 0, double radius_scale = 1, double root_radius_scale = 1,
+                       const std::vector<double>* radius_share = nullptr)
       : tree_(tree),
         params_(p),
         kernel_(p),
@@ -68,7 +71,8 @@ class BifurcationOptimizer {
         min_length_(min_segment_length_mm),
         length_ratio_(length_ratio),
         radius_scale_(radius_scale),
-        root_radius_scale_(root_radius_scale) {}
+        root_radius_scale_(root_radius_scale),
+        radius_share_(radius_share) {}
 
   // Best valid bifurcation on segment s for terminal t; valid = false when every trial point
   // makes a segment cross a zero-demand voxel or shorter than the minimum length.
@@ -149,6 +153,7 @@ class BifurcationOptimizer {
   double length_ratio_;
   double radius_scale_;
   double root_radius_scale_;
+  const std::vector<double>* radius_share_;
 };
 
 }  // namespace angiosynth

@@ -153,12 +153,16 @@ class Grower {
       if (opt_.min_length_ratio > 0) withFamilies(near);
       trials.assign(near.size(), Connection{});
       // Lengths are held to the ratio at radii grown towards the final tree: the root, whose
-      // fixed proximal end the final check cannot slide back, by 1.1 × its predicted growth; the
-      // others by its square root (the trunk's growth overstates theirs, the present radii
-      // understate it). Measured over 20 seeds of examples/vascusynth_like.toml, this leaves the
-      // fewest vessels for the final check to lengthen at the lowest cost (docs/methods/vascusynth.md).
+      // fixed proximal end the final check cannot slide back, by 1.1 × its predicted growth; thin
+      // vessels by its square root (the trunk's growth overstates theirs, the present radii
+      // understate it); the two parts of a split vessel by a growth between these, nearer the
+      // root's the thicker the vessel is against the root (its radius share, squared, as the
+      // exponent's weight), since a vessel carrying much of the root's flow thickens as the root
+      // does. Measured over 20 seeds of examples/vascusynth_like.toml and at 10⁴ terminals, this
+      // leaves the fewest vessels for the final check to lengthen or regrow at the lowest cost
+      // (docs/methods/vascusynth.md).
       const double growth = rootGrowth();
-      const BifurcationOptimizer opt(tree_, params_, &paths_, min_length_, opt_.min_length_ratio, std::sqrt(finalScale()), 1.1 * growth);
+      const BifurcationOptimizer opt(tree_, params_, &paths_, min_length_, opt_.min_length_ratio, std::sqrt(finalScale()), 1.1 * growth, &rel_);
       std::vector<std::size_t> order;
       if (near.size() > std::size_t(opt_.closest_neighbours)) {
         // Near segments and their families: each costed at its starting point, and only the
