@@ -42,12 +42,10 @@ ClearPaths::ClearPaths(const DemandMap& map) : map_(map) {
 
 bool ClearPaths::segmentClear(const Vec3& a_mm, const Vec3& b_mm) const {
   const Vec3 a = map_.toVoxel(a_mm), b = map_.toVoxel(b_mm);
-  bool inside = true;
-  for (int ax = 0; ax < 3; ++ax) inside = inside && a[ax] >= 0 && b[ax] >= 0 && a[ax] <= map_.dims[ax] && b[ax] <= map_.dims[ax];
-  if (inside) {
+  if (map_.holds(a, b)) {
+    if (clearance_.empty()) return true;
     // The voxels walked from a to b lie within ceil(|b − a|∞) of a's voxel along every axis.
     const double reach = std::max({std::abs(b.x - a.x), std::abs(b.y - a.y), std::abs(b.z - a.z)});
-    if (clearance_.empty()) return true;
     std::int64_t v = 0;
     for (int ax = 0; ax < 3; ++ax) v += (std::min(static_cast<std::int64_t>(std::floor(a[ax])), std::int64_t(map_.dims[ax] - 1)) + 1) * stride_[ax];
     if (double(clearance_[std::size_t(v)]) > reach + 1) return true;

@@ -15,8 +15,7 @@ std::int64_t DemandMap::voxelAt(const Vec3& p) const {
 
 bool DemandMap::segmentClear(const Vec3& a_mm, const Vec3& b_mm) const {
   const Vec3 a = toVoxel(a_mm), b = toVoxel(b_mm);
-  for (int ax = 0; ax < 3; ++ax)
-    if (a[ax] < 0 || b[ax] < 0 || a[ax] > dims[ax] || b[ax] > dims[ax]) return false;
+  if (!holds(a, b)) return false;
   return traverseVoxels(a, b, dims, [&](std::int32_t i, std::int32_t j, std::int32_t k) { return demand[flat(i, j, k)] > 0; });
 }
 

@@ -31,6 +31,13 @@ struct DemandMap {
     const auto v = voxelAt(p_mm);
     return v >= 0 && demand[v] > 0;
   }
+  // True if both ends, in map-voxel coordinates, lie in the map (its faces included); a NaN
+  // coordinate does not.
+  bool holds(const Vec3& a_voxel, const Vec3& b_voxel) const {
+    for (int ax = 0; ax < 3; ++ax)
+      if (!(a_voxel[ax] >= 0 && b_voxel[ax] >= 0 && a_voxel[ax] <= dims[ax] && b_voxel[ax] <= dims[ax])) return false;
+    return true;
+  }
   // True if the straight segment a–b (mm) stays inside the map and crosses no zero-demand voxel.
   bool segmentClear(const Vec3& a_mm, const Vec3& b_mm) const;
   const std::vector<double>& supplyAt(std::int64_t voxel) const { return supply_sets[supply_index[voxel]]; }

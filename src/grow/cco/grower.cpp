@@ -814,8 +814,7 @@ class CcoGrower {
     const auto candidates = [&](auto&& f) {
       g.index.forEachNearSegment(a, e, reach, [&](std::int32_t y) {
         if (!regrow || y >= T.nodeCount() || T.terminals[y] > small) return f(y);
-        if (y != x && !withinTwoSegments(T, x, y) && capsulesOverlap(a, e, rx, T.position[T.parent[y]], T.position[y], 1.02 * T.radius[y]))
-          regrow->push_back(y);
+        if (y != x && overlapsApart(T, x, a, e, rx, y, 1.02 * T.radius[y])) regrow->push_back(y);
       });
     };
     if (overlapsOtherVessel(T, x, a, e, rx, candidates, [&](std::int32_t y) { return 1.02 * T.radius[y]; })) return false;

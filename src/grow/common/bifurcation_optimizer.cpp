@@ -103,8 +103,8 @@ bool BifurcationOptimizer::keepsLengthRatio(const Connection& c) const {
 BifurcationOptimizer::MinLengths BifurcationOptimizer::minimumsFrom(std::int32_t s, const std::array<double, 3>& r) const {
   MinLengths m{min_length_, min_length_, min_length_};
   if (!(length_ratio_ > 0)) return m;
-  const double share = radius_share_ ? std::pow(std::clamp((*radius_share_)[std::size_t(s)], 0.0, 1.0), 2.0) : 0.0;
-  const double split_scale = radius_scale_ * std::pow(root_radius_scale_ / radius_scale_, share);
+  const double share = radius_share_ ? std::clamp((*radius_share_)[std::size_t(s)], 0.0, 1.0) : 0.0;
+  const double split_scale = radius_share_ ? radius_scale_ * std::pow(root_radius_scale_ / radius_scale_, share * share) : radius_scale_;
   for (int j = 0; j < 3; ++j) m[j] = std::max(m[j], length_ratio_ * (j < 2 ? split_scale : radius_scale_) * r[j]);
   if (tree_.parent[s] == 0) m[0] = std::max(m[0], length_ratio_ * root_radius_scale_ * r[0]);
   return m;

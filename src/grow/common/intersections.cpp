@@ -102,9 +102,7 @@ std::vector<std::pair<std::int32_t, std::int32_t>> intersectingPairs(const Vascu
       const Vec3& a1 = t.position[x];
       index.forEachNearSegment(a0, a1, 2 * t.radius[x], m, [&](std::int32_t y) {
         if (!thinner(y, x) || t.isLink(y)) return;
-        // The distance first, as in overlapsOtherVessel: most pairs met are apart.
-        if (capsulesOverlap(a0, a1, t.radius[x], t.position[t.parent[y]], t.position[y], t.radius[y]) && !withinTwoSegments(t, x, y))
-          found[std::size_t(b)].emplace_back(std::min(x, y), std::max(x, y));
+        if (overlapsApart(t, x, a0, a1, t.radius[x], y, t.radius[y])) found[std::size_t(b)].emplace_back(std::min(x, y), std::max(x, y));
       });
     }
   });

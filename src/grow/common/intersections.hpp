@@ -33,6 +33,14 @@ inline bool capsulesOverlap(const Vec3& a0, const Vec3& a1, double ra, const Vec
   return segmentSegmentDistance(a0, a1, b0, b1) < ra + rb;
 }
 
+// True if segment y, of radius ry, overlaps the capsule a–e of radius r that segment x occupies
+// (or is about to) and lies more than two segments from x. The distance first: most candidates a
+// query meets are apart, and the test of the tree's neighbourhood reads up to eight scattered
+// nodes where the distance reads two.
+inline bool overlapsApart(const VascularTree& t, std::int32_t x, const Vec3& a, const Vec3& e, double r, std::int32_t y, double ry) {
+  return capsulesOverlap(a, e, r, t.position[t.parent[y]], t.position[y], ry) && !withinTwoSegments(t, x, y);
+}
+
 // True if the capsule a–e of radius r, which segment x occupies (or is about to), overlaps a
 // vessel more than two segments from x. `for_each_candidate(f)` calls f(y) for the segments to
 // consider (e.g. SegmentIndex::forEachNearSegment); `radius_of(y)` gives y's radius.
@@ -42,9 +50,7 @@ bool overlapsOtherVessel(const VascularTree& t, std::int32_t x, const Vec3& a, c
   bool hit = false;
   for_each_candidate([&](std::int32_t y) {
     if (hit || y == x || y >= t.nodeCount()) return;
-    // Most candidates are apart, and the distance reads two nodes where the test of the tree's
-    // neighbourhood reads up to eight: the distance first.
-    hit = capsulesOverlap(a, e, r, t.position[t.parent[y]], t.position[y], radius_of(y)) && !withinTwoSegments(t, x, y);
+    hit = overlapsApart(t, x, a, e, r, y, radius_of(y));
   });
   return hit;
 }
